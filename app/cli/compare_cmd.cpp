@@ -1,0 +1,62 @@
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "mfr/error.hpp"
+#include "mfr/image.hpp"
+#include "mfr/io_util.hpp"
+#include "mfr/reference/metrics.hpp"
+
+namespace mfr::cli {
+
+void addCompare(CLI::App& app) {
+  struct Options {
+    std::string reference, test, metrics = "rmse,flip", heatmap, json;
+    double ppd = 67.0;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("compare", "Compare a test image against a reference (RMSE, FLIP)");
+  cmd->add_option("reference", opt->reference, "Reference PNG")->required();
+  cmd->add_option("test", opt->test, "Test PNG")->required();
+  cmd->add_option("--metric", opt->metrics, "Comma-separated: rmse, flip")->capture_default_str();
+  cmd->add_option("--ppd", opt->ppd, "FLIP pixels per degree")->capture_default_str();
+  cmd->add_option("--heatmap", opt->heatmap, "Write the error map (FLIP magma, else |difference|) as PNG");
+  cmd->add_option("--json", opt->json, "Write the metrics as JSON");
+  cmd->callback([opt] {
+    bool wantRmse = false, wantFlip = false;
+    for (const std::string& m : splitList(opt->metrics)) {
+      if (m == "rmse") wantRmse = true;
+      else if (m == "flip") wantFlip = true;
+      else throw Error("--metric " + m, "unknown metric (rmse, flip)");
+    }
+    if (!(opt->ppd > 0) || opt->ppd > 1e4) throw Error("--ppd", "must be in (0, 10000]");
+    const ImageRGBA8 ref = readPng(opt->reference);
+    const ImageRGBA8 test = readPng(opt->test);
+    if (ref.width != test.width || ref.height != test.height)
+      throw Error(opt->test, "size " + std::to_string(test.width) + "x" + std::to_string(test.height) +
+                                 " differs from reference " + std::to_string(ref.width) + "x" + std::to_string(ref.height));
+    nlohmann::ordered_json j;
+    std::cout << std::setprecision(6) << std::fixed;
+    ImageRGBA8 heat;
+    if (wantRmse) {
+      const double v = rmse(ref, test);
+      j["rmse"] = v;
+      std::cout << "rmse " << v << "\n";
+    }
+    if (wantFlip) {
+      const FlipResult f = flip(ref, test, opt->ppd);
+      j["flip"] = {{"mean", f.stats.mean}, {"p25", f.stats.p25}, {"median", f.stats.p50},
+                   {"p75", f.stats.p75},   {"min", f.stats.min}, {"max", f.stats.max}};
+      std::cout << "flip mean " << f.stats.mean << " median " << f.stats.p50 << " max " << f.stats.max << "\n";
+      if (!opt->heatmap.empty()) heat = magma(f.errorMap);
+    }
+    if (!opt->heatmap.empty() && heat.empty()) heat = heatmap(absoluteDifference(ref, test), 1.0f);
+    if (!opt->heatmap.empty()) writePng(opt->heatmap, heat);
+    if (!opt->json.empty()) writeFileAtomically(opt->json, j.dump(2) + "\n");
+  });
+}
+
+}  // namespace mfr::cli

@@ -1,0 +1,71 @@
+#include <iostream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
+#include "mfr/io_util.hpp"
+#include "mfr/reference/composite.hpp"
+#include "mfr/reference/oracle.hpp"
+#include "mfr/render.hpp"
+
+namespace mfr::cli {
+
+void addInfo(CLI::App& app) {
+  struct Options {
+    std::string scene, size = "256x256", view = "fit", json;
+    bool methods = false, noHistogram = false;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("info", "Describe a scene: parts, triangles, bounds, depth-complexity histogram");
+  cmd->add_option("scene", opt->scene, "Scene: model file, .mfrscene, or @sample");
+  cmd->add_flag("--methods", opt->methods, "List the available methods");
+  cmd->add_option("--size,-s", opt->size, "Image size for the depth-complexity histogram")->capture_default_str();
+  cmd->add_option("--view", opt->view, "View for the histogram")->capture_default_str();
+  cmd->add_flag("--no-histogram", opt->noHistogram, "Skip the oracle pass");
+  cmd->add_option("--json", opt->json, "Also write the information as JSON");
+  cmd->callback([opt] {
+    if (opt->methods) {
+      for (const std::string& m : availableMethods()) std::cout << m << "\n";
+      if (opt->scene.empty()) return;
+    }
+    if (opt->scene.empty()) throw Error("info", "needs a scene (or --methods)");
+    const auto [w, h] = parseSize("--size", opt->size);
+    const Scene scene = loadScene(opt->scene);
+    nlohmann::ordered_json j;
+    const Bounds b = scene.bounds();
+    j["scene"] = scene.name;
+    j["parts"] = scene.objects.size();
+    j["triangles"] = scene.triangleCount();
+    j["bounds"] = {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};
+    j["views"] = scene.viewNames();
+    std::cout << "scene      " << scene.name << "\nparts      " << scene.objects.size() << "\ntriangles  "
+              << scene.triangleCount() << "\nbounds     [" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – ["
+              << b.max.x << ", " << b.max.y << ", " << b.max.z << "]\nviews     ";
+    for (const std::string& v : scene.viewNames()) std::cout << " " << v;
+    std::cout << "\n";
+    const std::size_t shown = std::min<std::size_t>(scene.objects.size(), 20);
+    for (std::size_t i = 0; i < shown; ++i) {
+      const Object& o = scene.objects[i];
+      std::cout << "  part " << i << ": " << o.name << " (" << o.mesh->triangleCount() << " triangles, rgba "
+                << o.material.color.r << " " << o.material.color.g << " " << o.material.color.b << " "
+                << o.material.color.a << ")\n";
+    }
+    if (shown < scene.objects.size()) std::cout << "  … " << scene.objects.size() - shown << " more parts\n";
+    if (!opt->noHistogram) {
+      const FragmentLists lists = castFragments(scene, scene.view(opt->view), w, h);
+      const std::vector<std::uint64_t> hist = depthComplexityHistogram(lists);
+      j["depth_complexity"] = {{"size", opt->size}, {"view", opt->view}, {"max", lists.maxCount()},
+                               {"fragments", lists.fragments.size()}, {"histogram", hist}};
+      std::cout << "depth complexity (" << opt->size << ", view " << opt->view << "): max " << lists.maxCount()
+                << ", " << lists.fragments.size() << " fragments\n";
+      for (std::size_t n = 0; n < hist.size(); ++n)
+        if (hist[n] > 0) std::cout << "  n=" << n << ": " << hist[n] << " pixels\n";
+    }
+    if (!opt->json.empty()) writeFileAtomically(opt->json, j.dump(2) + "\n");
+  });
+}
+
+}  // namespace mfr::cli

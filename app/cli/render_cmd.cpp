@@ -1,0 +1,50 @@
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "mfr/error.hpp"
+#include "mfr/image.hpp"
+#include "mfr/io/load.hpp"
+#include "mfr/io_util.hpp"
+#include "mfr/render.hpp"
+
+namespace mfr::cli {
+
+void addRender(CLI::App& app) {
+  struct Options {
+    std::string scene, method = "oracle", op = "oit", size = "512x512", view = "fit", output, stats;
+    std::vector<std::string> params;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method and write a PNG (and stats JSON)");
+  cmd->add_option("scene", opt->scene, "Scene: model file, .mfrscene, or @sample")->required();
+  cmd->add_option("--method,-m", opt->method, "Construction method (see mfr info --methods)")->capture_default_str();
+  cmd->add_option("--op", opt->op, "Operation on the sorted lists")->capture_default_str();
+  cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
+  cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
+  cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
+  cmd->add_option("-o,--output", opt->output, "Output PNG")->required();
+  cmd->add_option("--stats", opt->stats, "Write Stats as JSON to this file");
+  cmd->callback([opt] {
+    const auto [w, h] = parseSize("--size", opt->size);
+    RenderRequest req;
+    req.method = opt->method;
+    req.operation = opt->op;
+    req.width = w;
+    req.height = h;
+    for (const std::string& p : opt->params) {
+      const auto eq = p.find('=');
+      if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");
+      req.params[p.substr(0, eq)] = p.substr(eq + 1);
+    }
+    const Scene scene = loadScene(opt->scene);
+    const Camera camera = scene.view(opt->view);
+    const RenderOutput out = render(scene, camera, req);
+    // Both outputs are produced before either is written, and each is written atomically.
+    writePng(opt->output, out.image);
+    if (!opt->stats.empty()) writeFileAtomically(opt->stats, toJson(out.stats) + "\n");
+    std::cout << opt->output << "\n";
+  });
+}
+
+}  // namespace mfr::cli

@@ -1,0 +1,37 @@
+#pragma once
+// Image-quality metrics against a reference: RMSE and FLIP (Andersson et al., "FLIP: A Difference
+// Evaluator for Alternating Images", Proc. ACM CGIT 3(2), 2020), plus error heat maps.
+#include "mfr/image.hpp"
+
+namespace mfr {
+
+// Root-mean-square error over the R, G, B channels of two same-size images, computed on the
+// stored 8-bit sRGB-encoded values scaled to [0,1] (not on linear values). Throws on size mismatch.
+double rmse(const ImageRGBA8& reference, const ImageRGBA8& test);
+
+struct FlipStats {
+  double mean = 0, p25 = 0, p50 = 0, p75 = 0, min = 0, max = 0;  // percentiles are weighted
+};
+
+struct FlipResult {
+  ImageF errorMap;  // 1 channel, per-pixel LDR-FLIP error in [0,1]
+  FlipStats stats;
+};
+
+// LDR-FLIP on sRGB 8-bit inputs (converted to linear RGB first), pixelsPerDegree as in the paper
+// (67 for a 0.7 m wide 4K monitor at 0.7 m). Throws mfr::Error on size mismatch.
+FlipResult flip(const ImageRGBA8& reference, const ImageRGBA8& test, double pixelsPerDegree = 67.0);
+
+// Weighted percentile as FLIP's tool reports it: sort ascending, return the first value at which
+// the running sum exceeds p × total.
+double weightedPercentile(std::vector<float> values, double p);
+
+// Colour maps for error images: magma (FLIP's) and a generic heat map of a scalar image scaled by
+// maxValue (values ≥ maxValue saturate).
+ImageRGBA8 magma(const ImageF& values);  // values in [0,1]
+ImageRGBA8 heatmap(const ImageF& values, float maxValue);
+
+// Per-pixel absolute RGB difference (max over channels, in [0,1]) — input to heatmap().
+ImageF absoluteDifference(const ImageRGBA8& reference, const ImageRGBA8& test);
+
+}  // namespace mfr

@@ -1,0 +1,62 @@
+#pragma once
+// The CPU oracle: exact per-pixel fragment lists by ray casting (CGAL AABB tree), independent of
+// any GPU code. One ray through each pixel centre — the sample point the rasteriser uses — and
+// every intersection with every visible triangle between the near and far planes, shaded with the
+// shared shading function (shaders/common/shading.h), sorted front to back.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "mfr/scene/scene.hpp"
+
+namespace mfr {
+
+// A fragment as the GPU methods store it, plus what operations beyond OIT need.
+struct Fragment {
+  float depth = 0.0f;        // window depth in [0,1] (gl_FragCoord.z)
+  std::uint32_t color = 0;   // shaded RGBA, packed like GLSL packUnorm4x8 (R in the low byte)
+  std::uint32_t objectId = 0;
+  bool frontFacing = false;  // counter-clockwise in window space, like gl_FrontFacing
+};
+
+struct OracleOptions {
+  // Screen-space distance (pixels) under which a pixel centre counts as lying on a triangle edge:
+  // there rasterisation tie rules and vertex snapping (1/256 px) decide, so tests exclude it.
+  double edgeEpsilon = 0.02;
+  // Relative depth difference under which two fragments of a pixel count as tied in depth.
+  double depthTieEpsilon = 1e-6;
+  int threads = 0;  // 0: hardware concurrency
+};
+
+// Exact fragment lists of one image. Pixel (x, y) uses image coordinates: y = 0 is the top row.
+struct FragmentLists {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint32_t> offsets;  // width*height+1 prefix offsets into fragments
+  std::vector<Fragment> fragments;     // per pixel, sorted by depth (near first)
+  // Per pixel bit flags: kEdge (centre within edgeEpsilon of a projected triangle edge, hit or
+  // missed), kDepthTie (two fragments closer than depthTieEpsilon: their order is undefined).
+  std::vector<std::uint8_t> flags;
+
+  static constexpr std::uint8_t kEdge = 1;
+  static constexpr std::uint8_t kDepthTie = 2;
+
+  [[nodiscard]] std::size_t index(int x, int y) const { return static_cast<std::size_t>(y) * width + x; }
+  [[nodiscard]] std::span<const Fragment> pixel(int x, int y) const {
+    const std::size_t i = index(x, y);
+    return {fragments.data() + offsets[i], fragments.data() + offsets[i + 1]};
+  }
+  [[nodiscard]] std::uint32_t count(int x, int y) const {
+    const std::size_t i = index(x, y);
+    return offsets[i + 1] - offsets[i];
+  }
+  [[nodiscard]] std::uint32_t maxCount() const;
+  [[nodiscard]] bool isEdge(int x, int y) const { return (flags[index(x, y)] & kEdge) != 0; }
+  [[nodiscard]] bool isAmbiguous(int x, int y) const { return flags[index(x, y)] != 0; }
+};
+
+// Throws mfr::Error for a zero-size image or an empty scene.
+FragmentLists castFragments(const Scene& scene, const Camera& camera, int width, int height,
+                            const OracleOptions& options = {});
+
+}  // namespace mfr

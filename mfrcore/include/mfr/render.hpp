@@ -1,0 +1,37 @@
+#pragma once
+// One entry point from a scene and settings to an image and Stats, shared by the CLI and the
+// viewer so that both produce the same pixels. "oracle" is the exact CPU reference; every other
+// name is a GPU method from the registry (methods/registry.hpp).
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mfr/image.hpp"
+#include "mfr/methods/stats.hpp"
+#include "mfr/scene/scene.hpp"
+
+namespace mfr {
+
+struct RenderRequest {
+  std::string method = "oracle";
+  std::string operation = "oit";
+  int width = 512;
+  int height = 512;
+  std::map<std::string, std::string> params;  // method parameters by name (k, budget_mib, …)
+};
+
+struct RenderOutput {
+  ImageRGBA8 image;
+  Stats stats;
+};
+
+// Throws mfr::Error for an unknown method or operation, a bad size or an empty scene.
+RenderOutput render(const Scene& scene, const Camera& camera, const RenderRequest& request);
+
+// Names accepted by render(): "oracle" first, then the registry's GPU methods.
+std::vector<std::string> availableMethods();
+
+// Checks an image size argument; throws mfr::Error(what, reason) when not 1..16384 each.
+void validateImageSize(const std::string& what, int width, int height);
+
+}  // namespace mfr

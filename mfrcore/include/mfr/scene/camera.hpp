@@ -1,0 +1,35 @@
+#pragma once
+// Cameras: look-at frame plus perspective or orthographic projection. Matrices follow OpenGL
+// conventions (right-handed eye space looking down -Z, NDC depth in [-1, 1], window depth in
+// [0, 1]). The oracle uses the same matrices, in double precision, to build its rays.
+#include <glm/glm.hpp>
+
+#include "mfr/scene/mesh.hpp"
+
+namespace mfr {
+
+enum class Projection { Perspective, Orthographic };
+
+struct Camera {
+  glm::dvec3 eye{0.0, 0.0, 5.0};
+  glm::dvec3 target{0.0};
+  glm::dvec3 up{0.0, 1.0, 0.0};
+  Projection projection = Projection::Perspective;
+  double fovyDegrees = 40.0;   // perspective
+  double orthoHeight = 2.0;    // orthographic: world height of the view
+  double nearPlane = 0.1;
+  double farPlane = 100.0;
+
+  [[nodiscard]] glm::dmat4 viewMatrix() const;
+  [[nodiscard]] glm::dmat4 projectionMatrix(double aspect) const;
+  // Unit vector from eye towards target: also the headlight direction.
+  [[nodiscard]] glm::dvec3 forward() const;
+
+  // Keeps the direction (eye → target) and up, moves the camera so the bounding sphere of b
+  // fills the view, and sets near/far to enclose it.
+  [[nodiscard]] Camera fittedTo(const Bounds& b) const;
+  // Recomputes only near/far so the sphere of b lies between them (camera position unchanged).
+  void fitDepthRange(const Bounds& b);
+};
+
+}  // namespace mfr

@@ -1,0 +1,47 @@
+#pragma once
+// Triangle meshes as every loader produces them and every renderer consumes them.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace mfr {
+
+struct Bounds {
+  glm::dvec3 min{1e300};
+  glm::dvec3 max{-1e300};
+  [[nodiscard]] bool valid() const { return min.x <= max.x && min.y <= max.y && min.z <= max.z; }
+  void extend(const glm::dvec3& p) {
+    min = glm::min(min, p);
+    max = glm::max(max, p);
+  }
+  void extend(const Bounds& b) {
+    if (b.valid()) {
+      extend(b.min);
+      extend(b.max);
+    }
+  }
+  [[nodiscard]] glm::dvec3 center() const { return 0.5 * (min + max); }
+  [[nodiscard]] double radius() const { return 0.5 * glm::length(max - min); }
+};
+
+// Indexed triangle mesh in object space. normals always has one entry per position (loaders
+// compute them when the file has none); colors is empty or one RGBA per position, multiplied
+// with the object's material colour.
+struct Mesh {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec4> colors;
+  std::vector<std::uint32_t> indices;  // 3 per triangle
+
+  [[nodiscard]] std::size_t triangleCount() const { return indices.size() / 3; }
+  [[nodiscard]] Bounds bounds() const;
+  // Throws mfr::Error(name, reason) when indices are out of range, sizes disagree, coordinates
+  // are not finite or there are no triangles.
+  void validate(const std::string& name) const;
+  // Area-weighted smooth normals from the triangles (replaces normals).
+  void computeSmoothNormals();
+};
+
+}  // namespace mfr

@@ -1,0 +1,50 @@
+#pragma once
+// A scene: objects (mesh + transform + material), named views and a background.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/scene/camera.hpp"
+#include "mfr/scene/mesh.hpp"
+
+namespace mfr {
+
+struct Material {
+  glm::vec4 color{0.8f, 0.8f, 0.8f, 0.5f};  // RGB display values in [0,1], A = opacity
+};
+
+struct Object {
+  std::string name;
+  std::shared_ptr<const Mesh> mesh;  // shared: CAD assemblies instance one mesh many times
+  glm::dmat4 transform{1.0};         // object → world
+  Material material;
+  bool visible = true;
+};
+
+struct NamedView {
+  std::string name;
+  Camera camera;
+};
+
+struct Scene {
+  std::string name;  // file name or sample name, for messages
+  std::vector<Object> objects;
+  std::vector<NamedView> views;  // the scene's own views; "fit" is always available besides
+  glm::vec3 background{1.0f, 1.0f, 1.0f};
+
+  [[nodiscard]] Bounds bounds() const;  // world bounds of visible objects
+  [[nodiscard]] std::size_t triangleCount() const;
+  // Object ids are indices into objects; GPU and oracle both report them.
+  // Throws mfr::Error when there is nothing visible to draw.
+  void validate() const;
+  // The named view, or the fit-all view for "fit" / empty name. Throws mfr::Error listing the
+  // available names for an unknown one.
+  [[nodiscard]] Camera view(const std::string& name) const;
+  [[nodiscard]] std::vector<std::string> viewNames() const;
+};
+
+}  // namespace mfr

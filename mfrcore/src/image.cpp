@@ -1,0 +1,137 @@
+#include "mfr/image.hpp"
+
+#include <png.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include "mfr/error.hpp"
+#include "mfr/io_util.hpp"
+
+namespace mfr {
+namespace {
+
+struct PngErrorState {
+  std::string message;
+};
+
+[[noreturn]] void pngError(png_structp png, png_const_charp msg) {
+  auto* state = static_cast<PngErrorState*>(png_get_error_ptr(png));
+  if (state) state->message = msg;
+  png_longjmp(png, 1);
+}
+void pngWarning(png_structp, png_const_charp) {}
+
+struct MemoryReader {
+  const std::string* data;
+  std::size_t offset = 0;
+};
+
+void readFromMemory(png_structp png, png_bytep out, png_size_t length) {
+  auto* r = static_cast<MemoryReader*>(png_get_io_ptr(png));
+  if (r->offset + length > r->data->size()) png_error(png, "file is truncated");
+  std::copy_n(r->data->data() + r->offset, length, out);
+  r->offset += length;
+}
+
+void writeToString(png_structp png, png_bytep data, png_size_t length) {
+  static_cast<std::string*>(png_get_io_ptr(png))->append(reinterpret_cast<const char*>(data), length);
+}
+void flushNothing(png_structp) {}
+
+}  // namespace
+
+// Decodes with libpng into *image (rows points into its pixels); only trivially destructible
+// locals live across setjmp. Returns false with state->message set on failure.
+static bool decodePng(const std::string* bytes, ImageRGBA8* image, std::vector<png_bytep>* rows, PngErrorState* state) {
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, state, pngError, pngWarning);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    state->message = "out of memory";
+    return false;
+  }
+  MemoryReader reader{bytes};
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_read_struct(&png, &info, nullptr);
+    return false;
+  }
+  png_set_read_fn(png, &reader, readFromMemory);
+  png_read_info(png, info);
+  const png_uint_32 w = png_get_image_width(png, info), h = png_get_image_height(png, info);
+  if (w == 0 || h == 0 || w > 65536 || h > 65536) png_error(png, "unsupported image size");
+  // Normalise every colour type to 8-bit RGBA.
+  png_set_expand(png);
+  png_set_strip_16(png);
+  png_set_gray_to_rgb(png);
+  png_set_add_alpha(png, 0xFF, PNG_FILLER_AFTER);
+  png_read_update_info(png, info);
+  image->width = static_cast<int>(w);
+  image->height = static_cast<int>(h);
+  image->pixels.resize(static_cast<std::size_t>(w) * h * 4);
+  rows->resize(h);
+  for (png_uint_32 y = 0; y < h; ++y) (*rows)[y] = image->pixels.data() + static_cast<std::size_t>(y) * w * 4;
+  png_read_image(png, rows->data());
+  png_read_end(png, nullptr);
+  png_destroy_read_struct(&png, &info, nullptr);
+  return true;
+}
+
+ImageRGBA8 readPng(const std::filesystem::path& path) {
+  const std::string bytes = readFile(path);
+  if (bytes.size() < 8 || png_sig_cmp(reinterpret_cast<png_const_bytep>(bytes.data()), 0, 8) != 0)
+    throw Error(path.string(), "not a PNG file");
+  ImageRGBA8 image;
+  std::vector<png_bytep> rows;
+  PngErrorState state;
+  if (!decodePng(&bytes, &image, &rows, &state)) throw Error(path.string(), "corrupt PNG (" + state.message + ")");
+  return image;
+}
+
+// Encodes with libpng; only trivially destructible locals live across setjmp (longjmp safety).
+// Returns false with state.message set on failure.
+static bool encodePng(const ImageRGBA8& image, const png_const_bytep* rows, std::string* encoded, PngErrorState* state) {
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, state, pngError, pngWarning);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info) {
+    png_destroy_write_struct(&png, &info);
+    state->message = "out of memory";
+    return false;
+  }
+  if (setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    return false;
+  }
+  png_set_write_fn(png, encoded, writeToString, flushNothing);
+  png_set_IHDR(png, info, static_cast<png_uint_32>(image.width), static_cast<png_uint_32>(image.height), 8,
+               PNG_COLOR_TYPE_RGBA, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  png_set_compression_level(png, 6);
+  png_write_info(png, info);
+  png_write_rows(png, const_cast<png_bytepp>(rows), static_cast<png_uint_32>(image.height));
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  return true;
+}
+
+void writePng(const std::filesystem::path& path, const ImageRGBA8& image) {
+  if (image.empty()) throw Error(path.string(), "cannot write an empty image");
+  std::vector<png_const_bytep> rows(static_cast<std::size_t>(image.height));
+  for (int y = 0; y < image.height; ++y) rows[static_cast<std::size_t>(y)] = image.at(0, y);
+  std::string encoded;
+  PngErrorState state;
+  if (!encodePng(image, rows.data(), &encoded, &state)) throw Error(path.string(), "PNG encoding failed (" + state.message + ")");
+  writeFileAtomically(path, encoded);
+}
+
+void flipVertically(ImageRGBA8& image) {
+  const std::size_t stride = static_cast<std::size_t>(image.width) * 4;
+  for (int y = 0; y < image.height / 2; ++y)
+    std::swap_ranges(image.pixels.begin() + static_cast<std::ptrdiff_t>(y * stride),
+                     image.pixels.begin() + static_cast<std::ptrdiff_t>((y + 1) * stride),
+                     image.pixels.begin() + static_cast<std::ptrdiff_t>((image.height - 1 - y) * stride));
+}
+
+}  // namespace mfr

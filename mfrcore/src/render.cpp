@@ -1,0 +1,43 @@
+#include "mfr/render.hpp"
+
+#include <algorithm>
+
+#include "mfr/error.hpp"
+#include "mfr/reference/composite.hpp"
+#include "mfr/reference/oracle.hpp"
+
+namespace mfr {
+
+void validateImageSize(const std::string& what, int width, int height) {
+  if (width <= 0 || height <= 0) throw Error(what, "image size must be positive (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
+  if (width > 16384 || height > 16384) throw Error(what, "image size above 16384 pixels per side");
+}
+
+std::vector<std::string> availableMethods() { return {"oracle"}; }
+
+RenderOutput render(const Scene& scene, const Camera& camera, const RenderRequest& request) {
+  validateImageSize("--size", request.width, request.height);
+  scene.validate();
+  const std::vector<std::string> methods = availableMethods();
+  if (std::find(methods.begin(), methods.end(), request.method) == methods.end()) {
+    std::string list;
+    for (const auto& m : methods) list += (list.empty() ? "" : ", ") + m;
+    throw Error("--method " + request.method, "unknown method (available: " + list + ")");
+  }
+  if (request.operation != "oit") throw Error("--op " + request.operation, "unknown operation (available: oit)");
+  RenderOutput out;
+  const FragmentLists lists = castFragments(scene, camera, request.width, request.height);
+  out.image = compositeOver(lists, scene.background);
+  out.stats.method = "oracle";
+  out.stats.operation = request.operation;
+  out.stats.sync = "none";
+  out.stats.fragmentsGenerated = lists.fragments.size();
+  out.stats.fragmentsStored = lists.fragments.size();
+  out.stats.bytesAllocated = lists.fragments.size() * sizeof(Fragment) + lists.offsets.size() * sizeof(std::uint32_t);
+  out.stats.bytesUsed = out.stats.bytesAllocated;
+  out.stats.kMax = lists.maxCount();
+  out.stats.notes.emplace_back("device", "CPU ray casting (CGAL AABB tree)");
+  return out;
+}
+
+}  // namespace mfr

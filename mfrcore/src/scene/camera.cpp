@@ -1,0 +1,53 @@
+#include "mfr/scene/camera.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+namespace mfr {
+
+glm::dmat4 Camera::viewMatrix() const { return glm::lookAt(eye, target, up); }
+
+glm::dmat4 Camera::projectionMatrix(double aspect) const {
+  if (projection == Projection::Orthographic) {
+    const double h = 0.5 * orthoHeight;
+    const double w = h * aspect;
+    return glm::ortho(-w, w, -h, h, nearPlane, farPlane);
+  }
+  return glm::perspective(glm::radians(fovyDegrees), aspect, nearPlane, farPlane);
+}
+
+glm::dvec3 Camera::forward() const {
+  const glm::dvec3 d = target - eye;
+  const double len = glm::length(d);
+  return len > 0.0 ? d / len : glm::dvec3(0.0, 0.0, -1.0);
+}
+
+Camera Camera::fittedTo(const Bounds& b) const {
+  Camera c = *this;
+  if (!b.valid()) return c;
+  const glm::dvec3 centre = b.center();
+  const double r = std::max(b.radius(), 1e-9);
+  const glm::dvec3 dir = forward();
+  // Distance at which a sphere of radius r fills the vertical field of view, with a small margin.
+  const double halfFov = glm::radians(std::clamp(fovyDegrees, 1.0, 170.0)) * 0.5;
+  const double dist = 1.05 * r / std::sin(halfFov);
+  c.target = centre;
+  c.eye = centre - dir * dist;
+  c.orthoHeight = 2.1 * r;
+  c.fitDepthRange(b);
+  return c;
+}
+
+void Camera::fitDepthRange(const Bounds& b) {
+  if (!b.valid()) return;
+  const double r = std::max(b.radius(), 1e-9);
+  const double d = glm::dot(b.center() - eye, forward());
+  // Near/far enclose the bounding sphere; near stays positive and not absurdly small, so depth
+  // precision stays usable (ratio far/near ≤ 1e4).
+  farPlane = std::max(d + 1.01 * r, 1e-6);
+  nearPlane = std::max(d - 1.01 * r, farPlane * 1e-4);
+}
+
+}  // namespace mfr

@@ -1,0 +1,271 @@
+// The .mfrscene format: see docs/scene-format.md. Every error names the file and the JSON path.
+#include "mfr/scene/scene_file.hpp"
+
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+#include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
+#include "mfr/io_util.hpp"
+#include "mfr/scene/primitives.hpp"
+#include "mfr/scene/sample.hpp"
+
+namespace mfr {
+namespace {
+
+using nlohmann::json;
+
+class Reader {
+ public:
+  explicit Reader(std::string file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const std::string& where, const std::string& reason) const {
+    throw Error(file_, where + ": " + reason);
+  }
+
+  double number(const json& j, const std::string& where) const {
+    if (!j.is_number()) fail(where, "expected a number");
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) fail(where, "not a finite number");
+    return v;
+  }
+  double number(const json& obj, const char* key, const std::string& where, double fallback) const {
+    return obj.contains(key) ? number(obj[key], where + "." + key) : fallback;
+  }
+  double positive(const json& obj, const char* key, const std::string& where, double fallback) const {
+    const double v = number(obj, key, where, fallback);
+    if (!(v > 0)) fail(where + "." + key, "must be > 0");
+    return v;
+  }
+  int integer(const json& obj, const char* key, const std::string& where, int fallback, int lo, int hi) const {
+    if (!obj.contains(key)) return fallback;
+    const json& j = obj[key];
+    if (!j.is_number_integer()) fail(where + "." + key, "expected an integer");
+    const long long v = j.get<long long>();
+    if (v < lo || v > hi) fail(where + "." + key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return static_cast<int>(v);
+  }
+  glm::dvec3 vec3(const json& j, const std::string& where) const {
+    if (!j.is_array() || j.size() != 3) fail(where, "expected an array of 3 numbers");
+    return {number(j[0], where + "[0]"), number(j[1], where + "[1]"), number(j[2], where + "[2]")};
+  }
+  std::string string(const json& obj, const char* key, const std::string& where, const std::string& fallback) const {
+    if (!obj.contains(key)) return fallback;
+    if (!obj[key].is_string()) fail(where + "." + key, "expected a string");
+    return obj[key].get<std::string>();
+  }
+  const json& object(const json& j, const std::string& where) const {
+    if (!j.is_object()) fail(where, "expected an object");
+    return j;
+  }
+
+ private:
+  std::string file_;
+};
+
+glm::dmat4 parseTransform(const Reader& r, const json& t, const std::string& where) {
+  r.object(t, where);
+  if (t.contains("matrix")) {
+    const json& m = t["matrix"];
+    if (!m.is_array() || m.size() != 16) r.fail(where + ".matrix", "expected 16 numbers (row-major)");
+    glm::dmat4 out(1.0);
+    for (int row = 0; row < 4; ++row)
+      for (int col = 0; col < 4; ++col)
+        out[col][row] = r.number(m[static_cast<std::size_t>(row * 4 + col)], where + ".matrix");
+    return out;
+  }
+  glm::dmat4 out(1.0);
+  if (t.contains("translate")) out = glm::translate(out, r.vec3(t["translate"], where + ".translate"));
+  if (t.contains("rotate")) {
+    const json& rot = t["rotate"];
+    if (rot.is_object()) {
+      const glm::dvec3 axis = r.vec3(rot.value("axis", json::array({0, 0, 1})), where + ".rotate.axis");
+      if (glm::length(axis) == 0.0) r.fail(where + ".rotate.axis", "zero axis");
+      out = glm::rotate(out, glm::radians(r.number(rot.value("degrees", json(0.0)), where + ".rotate.degrees")),
+                        glm::normalize(axis));
+    } else {
+      // Euler angles in degrees, applied X, then Y, then Z (world = Rz·Ry·Rx·p).
+      const glm::dvec3 e = glm::radians(r.vec3(rot, where + ".rotate"));
+      out = glm::rotate(out, e.z, glm::dvec3(0, 0, 1));
+      out = glm::rotate(out, e.y, glm::dvec3(0, 1, 0));
+      out = glm::rotate(out, e.x, glm::dvec3(1, 0, 0));
+    }
+  }
+  if (t.contains("scale")) {
+    const json& s = t["scale"];
+    const glm::dvec3 v = s.is_array() ? r.vec3(s, where + ".scale") : glm::dvec3(r.number(s, where + ".scale"));
+    if (v.x == 0 || v.y == 0 || v.z == 0) r.fail(where + ".scale", "zero scale");
+    out = glm::scale(out, v);
+  }
+  return out;
+}
+
+Mesh parsePrimitive(const Reader& r, const json& p, const std::string& where) {
+  r.object(p, where);
+  const std::string type = r.string(p, "type", where, "");
+  if (type == "sphere")
+    return makeSphere(r.positive(p, "radius", where, 1.0), r.integer(p, "slices", where, 48, 3, 4096),
+                      r.integer(p, "stacks", where, 24, 2, 4096));
+  if (type == "box") {
+    const glm::dvec3 size = p.contains("size") ? r.vec3(p["size"], where + ".size") : glm::dvec3(1.0);
+    if (size.x <= 0 || size.y <= 0 || size.z <= 0) r.fail(where + ".size", "must be > 0");
+    return makeBox(size);
+  }
+  if (type == "cylinder")
+    return makeCylinder(r.positive(p, "radius", where, 0.5), r.positive(p, "height", where, 1.0),
+                        r.integer(p, "slices", where, 48, 3, 4096));
+  if (type == "torus") {
+    const double major = r.positive(p, "major_radius", where, 1.0);
+    const double minor = r.positive(p, "minor_radius", where, 0.25);
+    if (minor >= major) r.fail(where + ".minor_radius", "must be smaller than major_radius");
+    return makeTorus(major, minor, r.integer(p, "major_segments", where, 64, 3, 4096),
+                     r.integer(p, "minor_segments", where, 24, 3, 4096));
+  }
+  if (type == "plane") return makePlane(r.positive(p, "width", where, 1.0), r.positive(p, "height", where, 1.0));
+  if (type == "tube") {
+    if (!p.contains("path") || !p["path"].is_array() || p["path"].size() < 2)
+      r.fail(where + ".path", "expected an array of at least 2 points");
+    std::vector<glm::dvec3> path;
+    for (std::size_t i = 0; i < p["path"].size(); ++i)
+      path.push_back(r.vec3(p["path"][i], where + ".path[" + std::to_string(i) + "]"));
+    for (std::size_t i = 1; i < path.size(); ++i)
+      if (path[i] == path[i - 1]) r.fail(where + ".path[" + std::to_string(i) + "]", "repeats the previous point");
+    return makeTube(path, r.positive(p, "radius", where, 0.05), r.integer(p, "sides", where, 12, 3, 1024));
+  }
+  if (type == "hairball") {
+    const double radius = r.positive(p, "radius", where, 1.0);
+    const double tube = r.positive(p, "tube_radius", where, 0.02);
+    if (tube >= radius) r.fail(where + ".tube_radius", "must be smaller than radius");
+    return makeHairball(r.integer(p, "count", where, 20, 1, 10000), radius, tube,
+                        static_cast<std::uint32_t>(r.integer(p, "seed", where, 1, 0, 1 << 30)),
+                        r.integer(p, "segments", where, 64, 2, 4096), r.integer(p, "sides", where, 10, 3, 256));
+  }
+  r.fail(where + ".type", "unknown primitive '" + type + "' (sphere, box, cylinder, torus, plane, tube, hairball)");
+}
+
+glm::vec4 parseColor(const Reader& r, const json& o, const std::string& where, glm::vec4 color) {
+  if (o.contains("color")) {
+    const json& c = o["color"];
+    if (!c.is_array() || (c.size() != 3 && c.size() != 4)) r.fail(where + ".color", "expected 3 or 4 numbers in [0,1]");
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const double v = r.number(c[i], where + ".color");
+      if (v < 0 || v > 1) r.fail(where + ".color", "components must be in [0,1]");
+      color[static_cast<int>(i)] = static_cast<float>(v);
+    }
+  }
+  if (o.contains("opacity")) {
+    const double a = r.number(o["opacity"], where + ".opacity");
+    if (a < 0 || a > 1) r.fail(where + ".opacity", "must be in [0,1]");
+    color.a = static_cast<float>(a);
+  }
+  return color;
+}
+
+Camera parseView(const Reader& r, const json& v, const std::string& where, const Bounds& bounds) {
+  r.object(v, where);
+  Camera c;
+  if (v.contains("eye")) c.eye = r.vec3(v["eye"], where + ".eye");
+  if (v.contains("target")) c.target = r.vec3(v["target"], where + ".target");
+  if (v.contains("up")) c.up = r.vec3(v["up"], where + ".up");
+  if (glm::length(c.eye - c.target) == 0.0) r.fail(where, "eye and target coincide");
+  if (glm::length(glm::cross(c.forward(), glm::normalize(c.up))) < 1e-9) r.fail(where + ".up", "parallel to the view direction");
+  const std::string proj = r.string(v, "projection", where, "perspective");
+  if (proj == "orthographic") c.projection = Projection::Orthographic;
+  else if (proj != "perspective") r.fail(where + ".projection", "must be 'perspective' or 'orthographic'");
+  c.fovyDegrees = r.number(v, "fovy", where, c.fovyDegrees);
+  if (c.fovyDegrees <= 0 || c.fovyDegrees >= 180) r.fail(where + ".fovy", "must be in (0, 180) degrees");
+  c.orthoHeight = r.positive(v, "height", where, c.orthoHeight);
+  if (v.value("fit", false)) c = c.fittedTo(bounds);
+  else c.fitDepthRange(bounds);
+  if (v.contains("near") || v.contains("far")) {
+    c.nearPlane = r.positive(v, "near", where, c.nearPlane);
+    c.farPlane = r.positive(v, "far", where, c.farPlane);
+    if (c.farPlane <= c.nearPlane) r.fail(where + ".far", "must be greater than near");
+  }
+  return c;
+}
+
+}  // namespace
+
+Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseDir, const std::string& name) {
+  json doc;
+  try {
+    doc = json::parse(text);
+  } catch (const json::parse_error& e) {
+    // Byte offset → line and column, which is what an editor shows.
+    std::size_t line = 1, col = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < text.size(); ++i) {
+      if (text[i] == '\n') {
+        ++line;
+        col = 1;
+      } else {
+        ++col;
+      }
+    }
+    throw Error(name, "JSON syntax error at line " + std::to_string(line) + ", column " + std::to_string(col));
+  }
+  const Reader r(name);
+  r.object(doc, "top level");
+  Scene scene;
+  scene.name = r.string(doc, "name", "top level", std::filesystem::path(name).stem().string());
+  if (doc.contains("background")) scene.background = glm::vec3(r.vec3(doc["background"], "background"));
+  if (doc.value("sample", false)) scene = makeSampleScene();
+
+  if (doc.contains("objects")) {
+    const json& objects = doc["objects"];
+    if (!objects.is_array()) r.fail("objects", "expected an array");
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      const std::string where = "objects[" + std::to_string(i) + "]";
+      const json& o = r.object(objects[i], where);
+      const std::string objName = r.string(o, "name", where, "object " + std::to_string(i));
+      const glm::dmat4 xf = o.contains("transform") ? parseTransform(r, o["transform"], where + ".transform") : glm::dmat4(1.0);
+      const bool visible = o.value("visible", true);
+      if (o.contains("file") == o.contains("primitive")) r.fail(where, "needs exactly one of 'file' or 'primitive'");
+      if (o.contains("primitive")) {
+        Object obj;
+        obj.name = objName;
+        try {
+          obj.mesh = std::make_shared<const Mesh>(parsePrimitive(r, o["primitive"], where + ".primitive"));
+        } catch (const Error& e) {
+          if (std::string(e.what()).rfind(name, 0) == 0) throw;
+          r.fail(where + ".primitive", e.what());
+        }
+        obj.transform = xf;
+        obj.material.color = parseColor(r, o, where, obj.material.color);
+        obj.visible = visible;
+        scene.objects.push_back(std::move(obj));
+      } else {
+        const std::filesystem::path file = baseDir / r.string(o, "file", where, "");
+        std::vector<Object> parts = loadModel(file);  // its errors name the model file
+        for (Object& part : parts) {
+          part.name = parts.size() == 1 ? objName : objName + "/" + part.name;
+          part.transform = xf * part.transform;
+          part.material.color = parseColor(r, o, where, part.material.color);
+          part.visible = visible;
+          scene.objects.push_back(std::move(part));
+        }
+      }
+    }
+  }
+  const Bounds bounds = scene.bounds();
+  if (doc.contains("views")) {
+    const json& views = doc["views"];
+    if (!views.is_array()) r.fail("views", "expected an array");
+    scene.views.clear();
+    for (std::size_t i = 0; i < views.size(); ++i) {
+      const std::string where = "views[" + std::to_string(i) + "]";
+      const std::string viewName = r.string(views[i], "name", where, "view " + std::to_string(i));
+      if (viewName == "fit") r.fail(where + ".name", "'fit' is reserved for the fit-all view");
+      scene.views.push_back({viewName, parseView(r, views[i], where, bounds)});
+    }
+  }
+  return scene;
+}
+
+Scene readSceneFile(const std::filesystem::path& path) {
+  return parseSceneFile(readFile(path), path.parent_path(), path.string());
+}
+
+}  // namespace mfr

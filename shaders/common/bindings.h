@@ -1,0 +1,41 @@
+// Binding points, image units and constants shared by C++ (mfrcore) and GLSL. Valid in both:
+// only #define lines. A method adds its own bindings here so that no two passes collide.
+#ifndef MFR_BINDINGS_H
+#define MFR_BINDINGS_H
+
+// Vertex attributes of scene meshes
+#define MFR_ATTR_POSITION 0
+#define MFR_ATTR_NORMAL 1
+#define MFR_ATTR_COLOR 2
+
+// Uniform block with the per-frame camera
+#define MFR_UBO_FRAME 0
+
+// Shader storage buffers
+#define MFR_SSBO_NODES 0      // fragment storage (linked-list nodes, arrays, …)
+#define MFR_SSBO_OFFSETS 1    // per-pixel offsets / heads
+#define MFR_SSBO_COUNTER 2    // global counters (allocation, overflow, statistics)
+#define MFR_SSBO_AUX 3        // method-specific extra storage
+#define MFR_SSBO_SCAN 4       // prefix-sum scratch
+#define MFR_SSBO_TAIL 5       // tail accumulation (hybrid transparency)
+
+// Image units
+#define MFR_IMAGE_HEADS 0
+#define MFR_IMAGE_COUNTS 1
+#define MFR_IMAGE_LOCKS 2
+#define MFR_IMAGE_AUX 3
+
+// Texture units
+#define MFR_TEX_DEPTH 0
+#define MFR_TEX_AUX0 1
+#define MFR_TEX_AUX1 2
+#define MFR_TEX_AUX2 3
+
+// Invalid index / end of a linked list
+#define MFR_NIL 0xFFFFFFFFu
+
+// Local array size used by the resolve pass to gather one pixel's fragments before sorting;
+// longer lists are sorted in l+-depth-sorting rounds (k+-buffer paper, §4.4).
+#define MFR_RESOLVE_LOCAL 64
+
+#endif
