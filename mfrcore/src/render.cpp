@@ -3,6 +3,9 @@
 #include <algorithm>
 
 #include "mfr/error.hpp"
+#include "mfr/gl/context.hpp"
+#include "mfr/gpu_renderer.hpp"
+#include "mfr/methods/registry.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/oracle.hpp"
 
@@ -13,7 +16,21 @@ void validateImageSize(const std::string& what, int width, int height) {
   if (width > 16384 || height > 16384) throw Error(what, "image size above 16384 pixels per side");
 }
 
-std::vector<std::string> availableMethods() { return {"oracle"}; }
+std::vector<std::string> availableMethods() {
+  std::vector<std::string> names{"oracle"};
+  for (const RegistryEntry& e : methodRegistry()) names.push_back(e.name);
+  return names;
+}
+
+namespace {
+// The CLI's GL state: one headless context and renderer for the process, created on first use.
+GpuRenderer& headlessRenderer() {
+  static gl::HeadlessContext context(true);
+  static GpuRenderer renderer;
+  context.makeCurrent();
+  return renderer;
+}
+}  // namespace
 
 RenderOutput render(const Scene& scene, const Camera& camera, const RenderRequest& request) {
   validateImageSize("--size", request.width, request.height);
@@ -25,6 +42,13 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     throw Error("--method " + request.method, "unknown method (available: " + list + ")");
   }
   if (request.operation != "oit") throw Error("--op " + request.operation, "unknown operation (available: oit)");
+  if (request.method != "oracle") {
+    GpuRenderer& gpu = headlessRenderer();
+    gpu.setScene(scene);
+    RenderOutput out = gpu.render(camera, request);
+    out.stats.notes.emplace_back("device", gl::queryContextInfo().renderer);
+    return out;
+  }
   RenderOutput out;
   const FragmentLists lists = castFragments(scene, camera, request.width, request.height);
   out.image = compositeOver(lists, scene.background);

@@ -18,6 +18,8 @@
 #define MFR_SSBO_AUX 3        // method-specific extra storage
 #define MFR_SSBO_SCAN 4       // prefix-sum scratch
 #define MFR_SSBO_TAIL 5       // tail accumulation (hybrid transparency)
+#define MFR_SSBO_DUMP 6       // debug operation: per-pixel sorted fragments (tests)
+#define MFR_SSBO_DUMP_COUNT 7 // debug operation: per-pixel fragment counts (tests)
 
 // Image units
 #define MFR_IMAGE_HEADS 0

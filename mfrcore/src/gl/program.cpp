@@ -32,14 +32,16 @@ std::string shaderSource(const std::string& path) {
 
 namespace {
 
-void expand(const std::string& path, std::vector<std::string>& files, std::set<std::string>& included,
-            std::string& out, int depth) {
+void expand(const std::string& path, const Defines& defines, std::vector<std::string>& files,
+            std::set<std::string>& included, std::string& out, int depth) {
   if (depth > 32) throw Error("shaders/" + path, "#include nested too deeply");
   if (!included.insert(path).second) return;  // each file once: includes need no guards
   const int index = static_cast<int>(files.size());
   files.push_back(path);
   std::istringstream in(shaderSource(path));
-  static const std::regex includeLine(R"(^\s*#\s*include\s+"([^"]+)\"\s*$)");
+  // #include "path", or #include NAME where NAME is an injected define holding "path" (this is how
+  // a resolve pass receives its operation).
+  static const std::regex includeLine(R"re(^\s*#\s*include\s+(?:"([^"]+)"|([A-Za-z_][A-Za-z0-9_]*))\s*$)re");
   static const std::regex versionLine(R"(^\s*#\s*version\b.*$)");
   out += "#line 1 " + std::to_string(index) + "\n";
   std::string line;
@@ -48,7 +50,14 @@ void expand(const std::string& path, std::vector<std::string>& files, std::set<s
     ++lineNo;
     std::smatch m;
     if (std::regex_match(line, m, includeLine)) {
-      expand(m[1].str(), files, included, out, depth + 1);
+      std::string target = m[1].str();
+      if (target.empty()) {
+        const auto d = defines.find(m[2].str());
+        if (d == defines.end()) throw Error("shaders/" + path + ":" + std::to_string(lineNo), "#include of undefined name " + m[2].str());
+        target = d->second;
+        if (target.size() >= 2 && target.front() == '"' && target.back() == '"') target = target.substr(1, target.size() - 2);
+      }
+      expand(target, defines, files, included, out, depth + 1);
       out += "#line " + std::to_string(lineNo + 1) + " " + std::to_string(index) + "\n";
     } else if (std::regex_match(line, versionLine)) {
       out += "\n";  // the preprocessor writes the one #version line
@@ -89,7 +98,7 @@ std::string preprocessShader(const std::string& path, const Defines& defines, st
     if (name.rfind("#extension", 0) != 0) out += "#define " + name + " " + value + "\n";
   std::vector<std::string> files;
   std::set<std::string> included;
-  expand(path, files, included, out, 0);
+  expand(path, defines, files, included, out, 0);
   if (fileNames) *fileNames = std::move(files);
   return out;
 }

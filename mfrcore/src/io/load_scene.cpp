@@ -20,10 +20,10 @@ Scene loadScene(const std::filesystem::path& path) {
     Camera front;
     front.eye = {0.0, 0.0, 1.0};
     front.target = {0.0, 0.0, 0.0};
-    scene.views.push_back({"front", front.fittedTo(scene.bounds())});
+    scene.views.push_back({"front", scene.fit(front)});
     Camera iso = front;
     iso.eye = {1.0, 0.8, 1.0};
-    scene.views.push_back({"iso", iso.fittedTo(scene.bounds())});
+    scene.views.push_back({"iso", scene.fit(iso)});
   }
   scene.validate();
   return scene;

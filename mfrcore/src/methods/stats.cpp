@@ -13,6 +13,7 @@ std::string toJson(const Stats& s, int indent) {
   j["bytes_used"] = s.bytesUsed;
   j["fragments_generated"] = s.fragmentsGenerated;
   j["fragments_stored"] = s.fragmentsStored;
+  j["fragments_dropped"] = s.fragmentsDropped;
   j["overflow"] = s.overflow;
   j["overflow_pixels"] = s.overflowPixels;
   j["lock_failures"] = s.lockFailures;

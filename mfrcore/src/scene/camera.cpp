@@ -24,11 +24,11 @@ glm::dvec3 Camera::forward() const {
   return len > 0.0 ? d / len : glm::dvec3(0.0, 0.0, -1.0);
 }
 
-Camera Camera::fittedTo(const Bounds& b) const {
+Camera Camera::fittedTo(const Bounds& b, double radius) const {
   Camera c = *this;
   if (!b.valid()) return c;
   const glm::dvec3 centre = b.center();
-  const double r = std::max(b.radius(), 1e-9);
+  const double r = std::max(radius > 0.0 ? radius : b.radius(), 1e-9);
   const glm::dvec3 dir = forward();
   // Distance at which a sphere of radius r fills the vertical field of view, with a small margin.
   const double halfFov = glm::radians(std::clamp(fovyDegrees, 1.0, 170.0)) * 0.5;
@@ -36,13 +36,13 @@ Camera Camera::fittedTo(const Bounds& b) const {
   c.target = centre;
   c.eye = centre - dir * dist;
   c.orthoHeight = 2.1 * r;
-  c.fitDepthRange(b);
+  c.fitDepthRange(b, r);
   return c;
 }
 
-void Camera::fitDepthRange(const Bounds& b) {
+void Camera::fitDepthRange(const Bounds& b, double radius) {
   if (!b.valid()) return;
-  const double r = std::max(b.radius(), 1e-9);
+  const double r = std::max(radius > 0.0 ? radius : b.radius(), 1e-9);
   const double d = glm::dot(b.center() - eye, forward());
   // Near/far enclose the bounding sphere; near stays positive and not absurdly small, so depth
   // precision stays usable (ratio far/near ≤ 1e4).

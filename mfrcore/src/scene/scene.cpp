@@ -1,5 +1,8 @@
 #include "mfr/scene/scene.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "mfr/error.hpp"
 
 namespace mfr {
@@ -19,6 +22,21 @@ Bounds Scene::bounds() const {
   }
   return b;
 }
+
+double Scene::boundingRadius() const {
+  const glm::dvec3 c = bounds().center();
+  double r2 = 0.0;
+  for (const Object& o : objects) {
+    if (!o.visible || !o.mesh) continue;
+    for (const glm::vec3& p : o.mesh->positions) {
+      const glm::dvec3 d = glm::dvec3(o.transform * glm::dvec4(glm::dvec3(p), 1.0)) - c;
+      r2 = std::max(r2, glm::dot(d, d));
+    }
+  }
+  return std::sqrt(r2);
+}
+
+Camera Scene::fit(const Camera& base) const { return base.fittedTo(bounds(), boundingRadius()); }
 
 std::size_t Scene::triangleCount() const {
   std::size_t n = 0;
@@ -43,7 +61,7 @@ Camera Scene::view(const std::string& viewName) const {
   if (viewName.empty() || viewName == "fit") {
     // Fit-all keeps the direction of the first named view, else looks down -Z from +Z.
     Camera base = views.empty() ? Camera{} : views.front().camera;
-    return base.fittedTo(bounds());
+    return fit(base);
   }
   std::string list;
   for (const std::string& n : viewNames()) list += (list.empty() ? "" : ", ") + n;

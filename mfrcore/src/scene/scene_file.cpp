@@ -163,7 +163,7 @@ glm::vec4 parseColor(const Reader& r, const json& o, const std::string& where, g
   return color;
 }
 
-Camera parseView(const Reader& r, const json& v, const std::string& where, const Bounds& bounds) {
+Camera parseView(const Reader& r, const json& v, const std::string& where, const Bounds& bounds, double radius) {
   r.object(v, where);
   Camera c;
   if (v.contains("eye")) c.eye = r.vec3(v["eye"], where + ".eye");
@@ -177,8 +177,8 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
   c.fovyDegrees = r.number(v, "fovy", where, c.fovyDegrees);
   if (c.fovyDegrees <= 0 || c.fovyDegrees >= 180) r.fail(where + ".fovy", "must be in (0, 180) degrees");
   c.orthoHeight = r.positive(v, "height", where, c.orthoHeight);
-  if (v.value("fit", false)) c = c.fittedTo(bounds);
-  else c.fitDepthRange(bounds);
+  if (v.value("fit", false)) c = c.fittedTo(bounds, radius);
+  else c.fitDepthRange(bounds, radius);
   if (v.contains("near") || v.contains("far")) {
     c.nearPlane = r.positive(v, "near", where, c.nearPlane);
     c.farPlane = r.positive(v, "far", where, c.farPlane);
@@ -250,6 +250,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     }
   }
   const Bounds bounds = scene.bounds();
+  const double radius = scene.boundingRadius();
   if (doc.contains("views")) {
     const json& views = doc["views"];
     if (!views.is_array()) r.fail("views", "expected an array");
@@ -258,7 +259,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
       const std::string where = "views[" + std::to_string(i) + "]";
       const std::string viewName = r.string(views[i], "name", where, "view " + std::to_string(i));
       if (viewName == "fit") r.fail(where + ".name", "'fit' is reserved for the fit-all view");
-      scene.views.push_back({viewName, parseView(r, views[i], where, bounds)});
+      scene.views.push_back({viewName, parseView(r, views[i], where, bounds, radius)});
     }
   }
   return scene;

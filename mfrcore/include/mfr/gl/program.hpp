@@ -5,6 +5,7 @@
 // Compile errors are reported as "shaders/<file>:<line>: <message>".
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -32,8 +33,14 @@ class Program {
  public:
   Program() = default;
   Program(const std::vector<ShaderStage>& stages, const Defines& defines = {});
-  Program(Program&&) noexcept = default;
-  Program& operator=(Program&&) noexcept = default;
+  Program(Program&& o) noexcept : id_(std::exchange(o.id_, 0)) {}
+  Program& operator=(Program&& o) noexcept {
+    if (this != &o) {
+      if (id_ != 0) glDeleteProgram(id_);
+      id_ = std::exchange(o.id_, 0);
+    }
+    return *this;
+  }
   ~Program();
   Program(const Program&) = delete;
   Program& operator=(const Program&) = delete;

@@ -1,5 +1,6 @@
 #pragma once
-// GPU time per named pass through GL_TIME_ELAPSED queries; results are read after the frame.
+// GPU time per named pass through timestamp queries; results are read after the frame.
+#include <chrono>
 #include <string>
 #include <utility>
 #include <vector>
@@ -8,8 +9,12 @@
 
 namespace mfr::gl {
 
+// Two modes: GPU timestamp queries (real GPUs), or glFinish + CPU clock around each pass
+// ("finish" mode). llvmpipe executes deferred, so its timestamps do not bracket the work: there
+// the renderer uses finish mode, which measures what a user waits for.
 class PassTimer {
  public:
+  explicit PassTimer(bool finishMode = false) : finishMode_(finishMode) {}
   void begin(const std::string& pass);
   void end();
   // Waits for the queries and returns (pass, milliseconds) in order; passes with the same name
@@ -19,8 +24,12 @@ class PassTimer {
  private:
   struct Entry {
     std::string pass;
-    Query query;
+    Query start;
+    Query stop;
+    double cpuMs = 0.0;
   };
+  bool finishMode_ = false;
+  std::chrono::steady_clock::time_point cpuStart_;
   std::vector<Entry> entries_;
   bool open_ = false;
 };

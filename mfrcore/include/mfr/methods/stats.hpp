@@ -15,6 +15,7 @@ struct Stats {
   std::uint64_t bytesUsed = 0;            // of which holding fragments or per-pixel state in use
   std::uint64_t fragmentsGenerated = 0;   // fragments rasterised (all passes' capture of unique ones)
   std::uint64_t fragmentsStored = 0;      // fragments kept in the structure
+  std::uint64_t fragmentsDropped = 0;     // fragments lost to a full structure (overflow)
   std::uint64_t overflowPixels = 0;       // pixels that lost fragments to a full structure
   std::uint64_t lockFailures = 0;         // spin-lock retries exhausted
   std::uint32_t passes = 0;               // geometry passes (peeling iterations, …)

@@ -27,7 +27,10 @@ FlipResult flip(const ImageRGBA8& reference, const ImageRGBA8& test, double pixe
 double weightedPercentile(std::vector<float> values, double p);
 
 // Colour maps for error images: magma (FLIP's) and a generic heat map of a scalar image scaled by
-// maxValue (values ≥ maxValue saturate).
+// maxValue (values ≥ maxValue saturate). magma uses matplotlib's 256-entry table, index
+// round(value·255) clamped to [0,255] as FLIP's tool does; heatmap is magma of value/maxValue
+// (perceptually uniform and readable in grey). Both take 1-channel images and throw mfr::Error
+// otherwise; heatmap also for maxValue ≤ 0.
 ImageRGBA8 magma(const ImageF& values);  // values in [0,1]
 ImageRGBA8 heatmap(const ImageF& values, float maxValue);
 

@@ -27,9 +27,11 @@ struct Camera {
 
   // Keeps the direction (eye → target) and up, moves the camera so the bounding sphere of b
   // fills the view, and sets near/far to enclose it.
-  [[nodiscard]] Camera fittedTo(const Bounds& b) const;
-  // Recomputes only near/far so the sphere of b lies between them (camera position unchanged).
-  void fitDepthRange(const Bounds& b);
+  // radius > 0 gives a tighter sphere around b's centre than b's half-diagonal (Scene computes
+  // it from the vertices).
+  [[nodiscard]] Camera fittedTo(const Bounds& b, double radius = 0.0) const;
+  // Recomputes only near/far so the sphere lies between them (camera position unchanged).
+  void fitDepthRange(const Bounds& b, double radius = 0.0);
 };
 
 }  // namespace mfr

@@ -37,6 +37,10 @@ struct Scene {
   glm::vec3 background{1.0f, 1.0f, 1.0f};
 
   [[nodiscard]] Bounds bounds() const;  // world bounds of visible objects
+  // Radius of the smallest sphere around bounds().center() holding every visible vertex.
+  [[nodiscard]] double boundingRadius() const;
+  // Camera with the direction and up of `base`, framing the visible objects.
+  [[nodiscard]] Camera fit(const Camera& base) const;
   [[nodiscard]] std::size_t triangleCount() const;
   // Object ids are indices into objects; GPU and oracle both report them.
   // Throws mfr::Error when there is nothing visible to draw.

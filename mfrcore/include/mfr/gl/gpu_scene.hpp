@@ -1,0 +1,50 @@
+#pragma once
+// A scene uploaded to the GPU: one vertex/index buffer pair per distinct mesh, drawn object by
+// object with the per-object uniforms every capture shader receives through
+// shaders/common/scene.vert (uModel, uNormalMatrix, uColor, uObjectId) plus the per-frame uViewProj
+// and uViewDir.
+#include <map>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/gl/objects.hpp"
+#include "mfr/gl/program.hpp"
+#include "mfr/scene/scene.hpp"
+
+namespace mfr::gl {
+
+struct FrameUniforms {
+  glm::mat4 viewProj{1.0f};
+  glm::vec3 viewDir{0.0f, 0.0f, -1.0f};  // headlight direction (camera forward), world space
+};
+
+class GpuScene {
+ public:
+  explicit GpuScene(const Scene& scene);
+  // Draws every visible object with program (already configured by the caller: state, buffers).
+  void draw(const Program& program, const FrameUniforms& frame) const;
+  [[nodiscard]] std::size_t triangleCount() const { return triangles_; }
+  [[nodiscard]] std::size_t bytes() const { return bytes_; }
+
+ private:
+  struct GpuMesh {
+    VertexArray vao;
+    Buffer vertices;
+    Buffer indices;
+    GLsizei indexCount = 0;
+  };
+  struct DrawItem {
+    std::size_t mesh;
+    glm::mat4 model;
+    glm::mat3 normalMatrix;
+    glm::vec4 color;
+    std::uint32_t objectId;
+  };
+  std::vector<GpuMesh> meshes_;
+  std::vector<DrawItem> items_;
+  std::size_t triangles_ = 0;
+  std::size_t bytes_ = 0;
+};
+
+}  // namespace mfr::gl

@@ -1,0 +1,68 @@
+#pragma once
+// Renders a scene with a registered GPU method into an offscreen RGBA8 framebuffer on the
+// current OpenGL 4.5 context (the CLI's headless EGL context or the viewer's Qt context), and
+// reads back images, Stats, or — for tests — every pixel's sorted fragment list.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mfr/gl/gpu_scene.hpp"
+#include "mfr/methods/method.hpp"
+#include "mfr/reference/oracle.hpp"
+#include "mfr/render.hpp"
+
+namespace mfr {
+
+// Per-pixel sorted lists as a GPU method captured them (image coordinates, y = 0 top row).
+struct CapturedLists {
+  int width = 0;
+  int height = 0;
+  int maxPerPixel = 0;                 // fragments kept per pixel in `fragments`
+  std::vector<std::uint32_t> counts;   // fragments the method holds per pixel
+  std::vector<Fragment> fragments;     // width*height*maxPerPixel, the first min(count, max) valid
+  [[nodiscard]] std::uint32_t count(int x, int y) const { return counts[static_cast<std::size_t>(y) * width + x]; }
+  [[nodiscard]] const Fragment* pixel(int x, int y) const {
+    return &fragments[(static_cast<std::size_t>(y) * width + x) * static_cast<std::size_t>(maxPerPixel)];
+  }
+};
+
+class GpuRenderer {
+ public:
+  // Needs a current 4.5 core context. finishTiming: time passes with glFinish + CPU clock (see
+  // gl::PassTimer); the default picks it on llvmpipe.
+  GpuRenderer() : GpuRenderer(defaultFinishTiming()) {}
+  explicit GpuRenderer(bool finishTiming);
+  static bool defaultFinishTiming();
+  ~GpuRenderer();
+  GpuRenderer(const GpuRenderer&) = delete;
+  GpuRenderer& operator=(const GpuRenderer&) = delete;
+
+  // Uploads the scene (validated: throws mfr::Error when empty).
+  void setScene(const Scene& scene);
+  // Renders into the internal framebuffer and reads it back. Throws mfr::Error for an unknown
+  // method/operation/parameter or a bad size.
+  RenderOutput render(const Camera& camera, const RenderRequest& request);
+  // Renders into framebuffer `target` (0 = default) at the request size, no read-back (viewer).
+  Stats renderTo(GLuint target, const Camera& camera, const RenderRequest& request);
+  // Captures with the method and resolves with the "dump" operation (tests, diagnostics).
+  CapturedLists capture(const Camera& camera, const RenderRequest& request, int maxPerPixel);
+
+ private:
+  Method& prepare(const RenderRequest& request);
+  FrameContext frameContext(const Camera& camera, int width, int height, gl::PassTimer& timer) const;
+
+  std::unique_ptr<gl::GpuScene> scene_;
+  glm::vec3 background_{1.0f};
+  std::string methodName_;
+  std::unique_ptr<Method> method_;
+  gl::Framebuffer fbo_;
+  gl::Texture color_;
+  int fboWidth_ = 0, fboHeight_ = 0;
+  bool finishTiming_ = false;
+};
+
+// The oracle-independent OIT operation ("over" with the background) and the test dump operation.
+Operation oitOperation();
+
+}  // namespace mfr

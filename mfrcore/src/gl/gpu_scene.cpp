@@ -1,0 +1,68 @@
+#include "mfr/gl/gpu_scene.hpp"
+
+#include "common/bindings.h"
+
+namespace mfr::gl {
+namespace {
+struct Vertex {
+  glm::vec3 position;
+  glm::vec3 normal;
+  glm::vec4 color;
+};
+}  // namespace
+
+GpuScene::GpuScene(const Scene& scene) {
+  std::map<const Mesh*, std::size_t> uploaded;
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    const Object& o = scene.objects[i];
+    if (!o.visible || !o.mesh || o.mesh->triangleCount() == 0) continue;
+    auto [it, isNew] = uploaded.try_emplace(o.mesh.get(), meshes_.size());
+    if (isNew) {
+      const Mesh& m = *o.mesh;
+      std::vector<Vertex> v(m.positions.size());
+      for (std::size_t k = 0; k < v.size(); ++k)
+        v[k] = {m.positions[k], m.normals.empty() ? glm::vec3(0, 0, 1) : m.normals[k],
+                m.colors.empty() ? glm::vec4(1.0f) : m.colors[k]};
+      GpuMesh g;
+      g.vertices = createBuffer(v.size() * sizeof(Vertex), v.data(), 0);
+      g.indices = createBuffer(m.indices.size() * sizeof(std::uint32_t), m.indices.data(), 0);
+      g.indexCount = static_cast<GLsizei>(m.indices.size());
+      g.vao = createVertexArray();
+      const GLuint vao = g.vao.id();
+      glVertexArrayVertexBuffer(vao, 0, g.vertices.id(), 0, sizeof(Vertex));
+      glVertexArrayElementBuffer(vao, g.indices.id());
+      const auto attrib = [&](GLuint loc, GLint n, std::size_t offset) {
+        glEnableVertexArrayAttrib(vao, loc);
+        glVertexArrayAttribFormat(vao, loc, n, GL_FLOAT, GL_FALSE, static_cast<GLuint>(offset));
+        glVertexArrayAttribBinding(vao, loc, 0);
+      };
+      attrib(MFR_ATTR_POSITION, 3, offsetof(Vertex, position));
+      attrib(MFR_ATTR_NORMAL, 3, offsetof(Vertex, normal));
+      attrib(MFR_ATTR_COLOR, 4, offsetof(Vertex, color));
+      bytes_ += v.size() * sizeof(Vertex) + m.indices.size() * sizeof(std::uint32_t);
+      meshes_.push_back(std::move(g));
+    }
+    const glm::mat4 model(o.transform);
+    items_.push_back({it->second, model, glm::mat3(glm::transpose(glm::inverse(o.transform))), o.material.color,
+                      static_cast<std::uint32_t>(i)});
+    triangles_ += o.mesh->triangleCount();
+  }
+}
+
+void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
+  program.use();
+  program.set("uViewProj", frame.viewProj);
+  program.set("uViewDir", frame.viewDir);
+  for (const DrawItem& item : items_) {
+    const GpuMesh& m = meshes_[item.mesh];
+    program.set("uModel", item.model);
+    program.set("uNormalMatrix", item.normalMatrix);
+    program.set("uColor", item.color);
+    program.set("uObjectId", item.objectId);
+    glBindVertexArray(m.vao.id());
+    glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
+  }
+  glBindVertexArray(0);
+}
+
+}  // namespace mfr::gl

@@ -1,0 +1,145 @@
+#include "mfr/gpu_renderer.hpp"
+
+#include <cstring>
+
+#include "common/bindings.h"
+#include "mfr/error.hpp"
+#include "mfr/gl/context.hpp"
+#include "mfr/methods/registry.hpp"
+
+namespace mfr {
+
+bool GpuRenderer::defaultFinishTiming() {
+  return gl::queryContextInfo().renderer.find("llvmpipe") != std::string::npos;
+}
+
+Operation oitOperation() { return {"oit", "ops/oit.glsl", nullptr}; }
+
+GpuRenderer::~GpuRenderer() = default;
+
+GpuRenderer::GpuRenderer(bool finishTiming) : finishTiming_(finishTiming) {}
+
+void GpuRenderer::setScene(const Scene& scene) {
+  scene.validate();
+  scene_ = std::make_unique<gl::GpuScene>(scene);
+  background_ = scene.background;
+  gl::checkErrors("scene upload");
+}
+
+Method& GpuRenderer::prepare(const RenderRequest& request) {
+  validateImageSize("--size", request.width, request.height);
+  if (!scene_) throw Error("render", "no scene loaded");
+  if (request.operation != "oit") throw Error("--op " + request.operation, "unknown operation (available: oit)");
+  if (!method_ || methodName_ != request.method) {
+    method_ = createMethod(request.method);
+    methodName_ = request.method;
+  }
+  const Params params(method_->info().params, request.params, request.method);
+  method_->configure(request.width, request.height, params);
+  gl::checkErrors(("configure " + request.method).c_str());
+  return *method_;
+}
+
+FrameContext GpuRenderer::frameContext(const Camera& camera, int width, int height, gl::PassTimer& timer) const {
+  gl::FrameUniforms frame;
+  const double aspect = static_cast<double>(width) / height;
+  frame.viewProj = glm::mat4(camera.projectionMatrix(aspect) * camera.viewMatrix());
+  frame.viewDir = glm::vec3(camera.forward());
+  return FrameContext{*scene_, frame, background_, width, height, timer};
+}
+
+Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderRequest& request) {
+  Method& method = prepare(request);
+  gl::PassTimer timer(finishTiming_);
+  const FrameContext ctx = frameContext(camera, request.width, request.height, timer);
+  glBindFramebuffer(GL_FRAMEBUFFER, target);
+  glViewport(0, 0, request.width, request.height);
+  method.capture(ctx);
+  gl::checkErrors(("capture " + request.method).c_str());
+  glBindFramebuffer(GL_FRAMEBUFFER, target);
+  glViewport(0, 0, request.width, request.height);
+  method.resolve(ctx, oitOperation());
+  gl::checkErrors(("resolve " + request.method).c_str());
+  Stats stats = method.stats();
+  stats.operation = request.operation;
+  stats.passTimesMs = timer.collect();
+  return stats;
+}
+
+RenderOutput GpuRenderer::render(const Camera& camera, const RenderRequest& request) {
+  validateImageSize("--size", request.width, request.height);
+  if (!fbo_ || fboWidth_ != request.width || fboHeight_ != request.height) {
+    color_ = gl::createTexture2D(GL_RGBA8, request.width, request.height);
+    fbo_ = gl::createFramebuffer();
+    glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, color_.id(), 0);
+    fboWidth_ = request.width;
+    fboHeight_ = request.height;
+  }
+  RenderOutput out;
+  out.stats = renderTo(fbo_.id(), camera, request);
+  out.image = ImageRGBA8(request.width, request.height);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(color_.id(), 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(out.image.pixels.size()),
+                    out.image.pixels.data());
+  flipVertically(out.image);
+  gl::checkErrors("read-back");
+  return out;
+}
+
+CapturedLists GpuRenderer::capture(const Camera& camera, const RenderRequest& request, int maxPerPixel) {
+  Method& method = prepare(request);
+  const int w = request.width, h = request.height;
+  const std::size_t pixels = static_cast<std::size_t>(w) * h;
+  gl::Buffer fragments = gl::createBuffer(pixels * static_cast<std::size_t>(maxPerPixel) * 8);
+  gl::Buffer counts = gl::createBuffer(pixels * 4);
+  const GLuint zero = 0;
+  glClearNamedBufferData(counts.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  glClearNamedBufferData(fragments.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  Operation dump{"dump", "ops/dump.glsl", [&](const gl::Program& p) {
+                   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_DUMP, fragments.id());
+                   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_DUMP_COUNT, counts.id());
+                   p.set("uDumpMax", static_cast<unsigned>(maxPerPixel));
+                   p.set("uDumpWidth", w);
+                 }};
+  gl::Texture color = gl::createTexture2D(GL_RGBA8, w, h);
+  gl::Framebuffer fbo = gl::createFramebuffer();
+  glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, color.id(), 0);
+  gl::PassTimer timer;
+  const FrameContext ctx = frameContext(camera, w, h, timer);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+  glViewport(0, 0, w, h);
+  method.capture(ctx);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+  glViewport(0, 0, w, h);
+  method.resolve(ctx, dump);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  gl::checkErrors(("capture (dump) " + request.method).c_str());
+  timer.collect();
+
+  CapturedLists out;
+  out.width = w;
+  out.height = h;
+  out.maxPerPixel = maxPerPixel;
+  std::vector<std::uint32_t> rawCounts(pixels);
+  std::vector<std::uint32_t> raw(pixels * static_cast<std::size_t>(maxPerPixel) * 2);
+  glGetNamedBufferSubData(counts.id(), 0, static_cast<GLsizeiptr>(rawCounts.size() * 4), rawCounts.data());
+  glGetNamedBufferSubData(fragments.id(), 0, static_cast<GLsizeiptr>(raw.size() * 4), raw.data());
+  out.counts.resize(pixels);
+  out.fragments.resize(pixels * static_cast<std::size_t>(maxPerPixel));
+  // GL rows are bottom-up; CapturedLists uses image rows (top-down) like the oracle.
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t src = static_cast<std::size_t>(h - 1 - y) * w + x;
+      const std::size_t dst = static_cast<std::size_t>(y) * w + x;
+      out.counts[dst] = rawCounts[src];
+      for (int i = 0; i < maxPerPixel; ++i) {
+        const std::size_t s = (src * static_cast<std::size_t>(maxPerPixel) + static_cast<std::size_t>(i)) * 2;
+        Fragment& f = out.fragments[dst * static_cast<std::size_t>(maxPerPixel) + static_cast<std::size_t>(i)];
+        f.color = raw[s];
+        std::memcpy(&f.depth, &raw[s + 1], sizeof(float));
+      }
+    }
+  return out;
+}
+
+}  // namespace mfr

@@ -1,0 +1,238 @@
+#include "assimp_loader.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <streambuf>
+#include <set>
+#include <utility>
+
+#include <assimp/Importer.hpp>
+#include <assimp/config.h>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "mfr/error.hpp"
+#include "vtk_loader.hpp"
+
+namespace mfr::io {
+namespace {
+
+bool finite(const aiVector3D& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// assimp matrices are row-major with the translation in the last column; glm is column-major.
+glm::dmat4 toGlm(const aiMatrix4x4& m) {
+  glm::dmat4 out(1.0);
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) out[c][r] = static_cast<double>(m[static_cast<unsigned>(r)][c]);
+  return out;
+}
+
+// One triangle mesh from an aiMesh; nullptr when it holds no triangles (points, lines).
+std::shared_ptr<const Mesh> convertMesh(const aiMesh& src, const std::string& name) {
+  if ((src.mPrimitiveTypes & aiPrimitiveType_TRIANGLE) == 0 || src.mNumVertices == 0 || src.mVertices == nullptr)
+    return nullptr;
+  auto mesh = std::make_shared<Mesh>();
+  mesh->positions.reserve(src.mNumVertices);
+  for (unsigned i = 0; i < src.mNumVertices; ++i) {
+    const aiVector3D& p = src.mVertices[i];
+    if (!finite(p)) throw Error(name, "non-finite coordinate in vertex " + std::to_string(i));
+    mesh->positions.emplace_back(p.x, p.y, p.z);
+  }
+  mesh->indices.reserve(3 * std::size_t{src.mNumFaces});
+  for (unsigned f = 0; f < src.mNumFaces; ++f) {
+    const aiFace& face = src.mFaces[f];
+    if (face.mNumIndices != 3) continue;  // points and lines left after triangulation
+    for (unsigned k = 0; k < 3; ++k) {
+      if (face.mIndices[k] >= src.mNumVertices)
+        throw Error(name, "face " + std::to_string(f) + " refers to vertex " + std::to_string(face.mIndices[k]) +
+                              " but there are " + std::to_string(src.mNumVertices) + " vertices");
+      mesh->indices.push_back(face.mIndices[k]);
+    }
+  }
+  if (mesh->indices.empty()) return nullptr;
+  if (src.HasVertexColors(0)) {
+    mesh->colors.reserve(src.mNumVertices);
+    for (unsigned i = 0; i < src.mNumVertices; ++i) {
+      const aiColor4D& c = src.mColors[0][i];
+      mesh->colors.push_back(glm::clamp(glm::vec4(c.r, c.g, c.b, c.a), 0.0f, 1.0f));
+    }
+  }
+  bool normalsOk = src.HasNormals();
+  for (unsigned i = 0; normalsOk && i < src.mNumVertices; ++i)
+    normalsOk = finite(src.mNormals[i]) && src.mNormals[i].SquareLength() > 0.0f;
+  if (normalsOk) {
+    mesh->normals.reserve(src.mNumVertices);
+    for (unsigned i = 0; i < src.mNumVertices; ++i) {
+      const aiVector3D n = src.mNormals[i].NormalizeSafe();
+      mesh->normals.emplace_back(n.x, n.y, n.z);
+    }
+  } else {
+    computeFeatureNormals(*mesh, name);  // same crease rule as the VTK formats
+  }
+  return mesh;
+}
+
+// Base colour (glTF PBR) or diffuse colour, and opacity; the default material when the file
+// says nothing.
+Material convertMaterial(const aiScene& scene, unsigned index) {
+  Material material;
+  if (index >= scene.mNumMaterials || scene.mMaterials[index] == nullptr) return material;
+  const aiMaterial& m = *scene.mMaterials[index];
+  aiColor4D c;
+  if (m.Get(AI_MATKEY_BASE_COLOR, c) == AI_SUCCESS || m.Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS)
+    material.color = glm::vec4(c.r, c.g, c.b, c.a);
+  float opacity = 1.0f;
+  if (m.Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS) material.color.a = opacity;
+  material.color = glm::clamp(material.color, 0.0f, 1.0f);
+  if (!std::isfinite(material.color.r + material.color.g + material.color.b + material.color.a))
+    material.color = Material{}.color;
+  return material;
+}
+
+// A few importers (OpenGEX's DDL parser, for one) write to std::cerr directly instead of to
+// assimp's logger. Their streams are muted while assimp runs; the mutex keeps concurrent loads
+// from restoring each other's buffers out of order.
+class MutedStandardStreams {
+ public:
+  MutedStandardStreams() : lock_(mutex()) {
+    cerr_ = std::cerr.rdbuf(&null_);
+    clog_ = std::clog.rdbuf(&null_);
+    cout_ = std::cout.rdbuf(&null_);
+  }
+  ~MutedStandardStreams() {
+    std::cerr.rdbuf(cerr_);
+    std::clog.rdbuf(clog_);
+    std::cout.rdbuf(cout_);
+  }
+  MutedStandardStreams(const MutedStandardStreams&) = delete;
+  MutedStandardStreams& operator=(const MutedStandardStreams&) = delete;
+
+ private:
+  struct NullBuffer final : std::streambuf {
+    int overflow(int c) override { return traits_type::not_eof(c); }
+  };
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  NullBuffer null_;
+  std::streambuf* cerr_ = nullptr;
+  std::streambuf* clog_ = nullptr;
+  std::streambuf* cout_ = nullptr;
+};
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  return s;
+}
+
+}  // namespace
+
+std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std::string* contents,
+                                   const std::string& extension, const std::string& name) {
+  Assimp::Importer importer;
+  // Points and lines are no surfaces; skeleton dummies are no geometry.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
+  // No PreTransformVertices: node transforms become Object::transform so instanced meshes are shared.
+  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
+                         aiProcess_ValidateDataStructure;
+  const aiScene* scene = nullptr;
+  const MutedStandardStreams muted;
+  if (contents != nullptr) {
+    const std::string hint = extension.empty() ? std::string() : extension.substr(1);
+    scene = importer.ReadFileFromMemory(contents->data(), contents->size(), flags, hint.c_str());
+  } else {
+    scene = importer.ReadFile(path.string(), flags);
+  }
+  if (scene == nullptr) {
+    std::string reason = importer.GetErrorString();
+    // What SortByPType says when it removed every mesh because all were points or lines.
+    if (reason.find("No meshes remaining") != std::string::npos) throw Error(name, "no triangles (only points or lines)");
+    throw Error(name, "cannot read " + (extension.empty() ? std::string("file") : extension.substr(1)) +
+                          (reason.empty() ? std::string() : ": " + reason));
+  }
+  if (scene->mRootNode == nullptr || scene->mNumMeshes == 0) throw Error(name, "no triangles (the file has no meshes)");
+
+  std::vector<std::shared_ptr<const Mesh>> meshes(scene->mNumMeshes);
+  std::vector<bool> converted(scene->mNumMeshes, false);
+  std::vector<Object> objects;
+  std::set<std::string> usedNames;
+
+  // Depth-first over the node tree, accumulating parent transforms.
+  std::vector<std::pair<const aiNode*, glm::dmat4>> stack{{scene->mRootNode, glm::dmat4(1.0)}};
+  std::size_t visited = 0;
+  while (!stack.empty()) {
+    auto [node, parent] = stack.back();
+    stack.pop_back();
+    if (++visited > 10'000'000) throw Error(name, "node hierarchy too large or cyclic");
+    const glm::dmat4 world = parent * toGlm(node->mTransformation);
+    for (unsigned k = 0; k < node->mNumMeshes; ++k) {
+      const unsigned mi = node->mMeshes[k];
+      if (mi >= scene->mNumMeshes || scene->mMeshes[mi] == nullptr) continue;
+      const aiMesh& src = *scene->mMeshes[mi];
+      if (!converted[mi]) {
+        meshes[mi] = convertMesh(src, name);
+        converted[mi] = true;
+      }
+      if (!meshes[mi]) continue;
+      for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r)
+          if (!std::isfinite(world[c][r])) throw Error(name, "non-finite node transform");
+
+      std::string partName = node->mName.length > 0 ? node->mName.C_Str() : "";
+      if (node->mNumMeshes > 1 || partName.empty()) {
+        const std::string meshName = src.mName.length > 0 ? src.mName.C_Str() : "mesh " + std::to_string(mi);
+        partName = partName.empty() ? meshName : partName + "/" + meshName;
+      }
+      // Names identify parts in the UI and scene files, so keep them unique.
+      if (usedNames.count(partName) != 0) {
+        int n = 2;
+        while (usedNames.count(partName + " #" + std::to_string(n)) != 0) ++n;
+        partName += " #" + std::to_string(n);
+      }
+      usedNames.insert(partName);
+
+      Object object;
+      object.name = std::move(partName);
+      object.mesh = meshes[mi];
+      object.transform = world;
+      object.material = convertMaterial(*scene, src.mMaterialIndex);
+      objects.push_back(std::move(object));
+    }
+    for (unsigned c = node->mNumChildren; c-- > 0;)  // reversed so parts come out in file order
+      if (node->mChildren[c] != nullptr) stack.emplace_back(node->mChildren[c], world);
+  }
+  if (objects.empty()) throw Error(name, "no triangles");
+  return objects;
+}
+
+std::vector<std::string> assimpExtensions() {
+  // Formats with loaders of their own, STEP (assimp reads only IFC-style STEP, not CAD B-rep),
+  // motion/camera-only formats, and the over-generic ".xml".
+  static const std::set<std::string> excluded = {".stl",       ".ply",        ".obj", ".off",  ".step", ".stp",
+                                                 ".md5anim",   ".md5camera",  ".bvh", ".xml"};
+  Assimp::Importer importer;
+  std::string list;
+  importer.GetExtensionList(list);  // "*.3d;*.3ds;…"
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (start < list.size()) {
+    std::size_t end = list.find(';', start);
+    if (end == std::string::npos) end = list.size();
+    std::string ext = lower(list.substr(start, end - start));
+    start = end + 1;
+    if (!ext.empty() && ext[0] == '*') ext.erase(0, 1);
+    if (ext.size() < 2 || ext[0] != '.' || excluded.count(ext) != 0) continue;
+    out.push_back(ext);
+  }
+  return out;
+}
+
+}  // namespace mfr::io

@@ -1,0 +1,234 @@
+// loadModel: picks the loader family by extension, reads compressed files into memory, and makes
+// sure that whatever goes wrong leaves as one mfr::Error("<path>", "<one-line reason>").
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <memory>
+#include <new>
+#include <optional>
+#include <set>
+#include <string>
+
+#include <unistd.h>
+#include <zlib.h>
+
+#include "assimp_loader.hpp"
+#include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
+#include "off_loader.hpp"
+#include "ply_loader.hpp"
+#include "vtk_loader.hpp"
+
+namespace mfr {
+namespace {
+
+namespace fs = std::filesystem;
+
+enum class Family { Vtk, Ply, Off, Assimp };
+
+struct Format {
+  Family family;
+  io::VtkFormat vtk = io::VtkFormat::Stl;
+};
+
+// Decompressed data beyond this is refused (a gzip bomb, or a file we could not hold anyway).
+constexpr std::uint64_t kMaxDecompressedBytes = std::uint64_t{4} << 30;
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+const std::map<std::string, Format>& formats() {
+  static const std::map<std::string, Format> table = [] {
+    std::map<std::string, Format> t;
+    for (const std::string& ext : io::assimpExtensions()) t[ext] = {Family::Assimp};
+    t[".stl"] = {Family::Vtk, io::VtkFormat::Stl};
+    t[".obj"] = {Family::Vtk, io::VtkFormat::Obj};
+    t[".vtp"] = {Family::Vtk, io::VtkFormat::Vtp};
+    t[".vtk"] = {Family::Vtk, io::VtkFormat::VtkLegacy};
+    t[".ply"] = {Family::Ply};
+    t[".off"] = {Family::Off};
+    return t;
+  }();
+  return table;
+}
+
+// The longest registered extension ending the (lower-case) file name, e.g. ".mesh.xml".
+std::optional<std::pair<std::string, Format>> match(const std::string& lowerName) {
+  std::optional<std::pair<std::string, Format>> best;
+  for (const auto& [ext, format] : formats())
+    if (lowerName.size() > ext.size() && endsWith(lowerName, ext) && (!best || ext.size() > best->first.size()))
+      best = {ext, format};
+  return best;
+}
+
+std::string oneLine(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  s.erase(std::unique(s.begin(), s.end(), [](char a, char b) { return a == ' ' && b == ' '; }), s.end());
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
+void checkReadable(const fs::path& path, const std::string& name) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (st.type() == fs::file_type::not_found) throw Error(name, "no such file");
+  if (ec) throw Error(name, "cannot access file: " + ec.message());
+  if (fs::is_directory(st)) throw Error(name, "is a directory, not a model file");
+  // FIFOs and devices would block or never end.
+  if (!fs::is_regular_file(st)) throw Error(name, "not a regular file");
+  if (::access(path.c_str(), R_OK) != 0) throw Error(name, std::string("cannot read file: ") + std::strerror(errno));
+  std::ifstream probe(path, std::ios::binary);
+  if (!probe) throw Error(name, "cannot open file for reading");
+  if (fs::file_size(path, ec) == 0 && !ec) throw Error(name, "empty file");
+}
+
+std::string readAll(const fs::path& path, const std::string& name) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(name, "cannot open file for reading");
+  std::string data;
+  data.resize(static_cast<std::size_t>(fs::file_size(path)));
+  in.read(data.data(), static_cast<std::streamsize>(data.size()));
+  if (in.gcount() != static_cast<std::streamsize>(data.size())) throw Error(name, "read error (file changed while reading?)");
+  return data;
+}
+
+// Whole .gz file into memory. gzread would pass non-gzip bytes through unchanged, so the magic is
+// checked first; truncated or corrupt streams are errors, not short data.
+std::string decompress(const fs::path& path, const std::string& name) {
+  {
+    std::ifstream in(path, std::ios::binary);
+    unsigned char magic[2] = {0, 0};
+    in.read(reinterpret_cast<char*>(magic), 2);
+    if (in.gcount() != 2 || magic[0] != 0x1f || magic[1] != 0x8b) throw Error(name, "not a gzip file (bad magic bytes)");
+  }
+  gzFile gz = gzopen(path.c_str(), "rb");
+  if (gz == nullptr) throw Error(name, "cannot open gzip file");
+  const std::unique_ptr<gzFile_s, int (*)(gzFile)> closer(gz, gzclose);
+  gzbuffer(gz, 1 << 17);
+  std::string out;
+  std::string chunk(1 << 20, '\0');
+  while (true) {
+    const int n = gzread(gz, chunk.data(), static_cast<unsigned>(chunk.size()));
+    if (n < 0) {
+      int code = 0;
+      const char* message = gzerror(gz, &code);
+      throw Error(name, std::string("corrupt gzip data: ") + (message ? message : "read error"));
+    }
+    if (n == 0) break;
+    out.append(chunk.data(), static_cast<std::size_t>(n));
+    if (out.size() > kMaxDecompressedBytes) throw Error(name, "decompressed data exceeds 4 GiB");
+  }
+  int code = Z_OK;
+  const char* message = gzerror(gz, &code);
+  if (code != Z_OK && code != Z_STREAM_END)
+    throw Error(name, std::string("corrupt or truncated gzip data: ") + (message ? message : "read error"));
+  if (out.empty()) throw Error(name, "empty file (after decompression)");
+  return out;
+}
+
+std::vector<Object> singleObject(Mesh mesh, const std::string& partName) {
+  Object object;
+  object.name = partName;
+  object.mesh = std::make_shared<const Mesh>(std::move(mesh));
+  return {std::move(object)};
+}
+
+std::vector<Object> load(const fs::path& path, const std::string& name) {
+  checkReadable(path, name);
+
+  std::string fileName = lower(path.filename().string());
+  const bool gz = endsWith(fileName, ".gz");
+  if (gz) fileName.resize(fileName.size() - 3);
+  const auto found = match(fileName);
+  if (!found) {
+    const std::string ext = path.extension().string();
+    if (gz)
+      throw Error(name, "unsupported compressed file type: name it after its contents, e.g. model.ply.gz");
+    throw Error(name, "unsupported file type '" + (ext.empty() ? path.filename().string() : lower(ext)) +
+                          "' (supported: .stl .ply .obj .off .vtp .vtk .glb .gltf and the other formats assimp "
+                          "reads, optionally gzip-compressed as .gz)");
+  }
+  const auto& [ext, format] = *found;
+  // The part name of single-object formats: the file name without its extension(s).
+  std::string stem = path.filename().string();
+  stem.resize(stem.size() - ext.size() - (gz ? 3 : 0));
+
+  std::string data;
+  const std::string* contents = nullptr;
+  if (gz) {
+    data = decompress(path, name);
+    contents = &data;
+  }
+
+  switch (format.family) {
+    case Family::Vtk: return singleObject(io::readWithVtk(format.vtk, path, contents, name), stem);
+    case Family::Ply:
+    case Family::Off: {
+      if (!gz) data = readAll(path, name);
+      const io::PolygonSoup soup = format.family == Family::Ply ? io::parsePly(data, name) : io::parseOff(data, name);
+      data.clear();
+      data.shrink_to_fit();
+      return singleObject(io::meshFromSoup(soup, name), stem);
+    }
+    case Family::Assimp: return io::readWithAssimp(path, contents, ext, name);
+  }
+  throw Error(name, "unsupported file type");
+}
+
+}  // namespace
+
+std::vector<Object> loadModel(const fs::path& path) {
+  const std::string name = path.string();
+  try {
+    std::vector<Object> objects = load(path, name);
+    if (objects.empty()) throw Error(name, "no triangles");
+    // Every mesh once (assemblies share meshes between parts): the invariants renderers rely on.
+    std::set<const Mesh*> checked;
+    for (Object& object : objects) {
+      if (!object.mesh) throw Error(name, "part '" + object.name + "' has no mesh");
+      if (!checked.insert(object.mesh.get()).second) continue;
+      const std::string label = objects.size() == 1 ? name : name + " (part '" + object.name + "')";
+      object.mesh->validate(label);
+      if (object.mesh->normals.size() != object.mesh->positions.size()) {
+        auto fixed = std::make_shared<Mesh>(*object.mesh);
+        fixed->computeSmoothNormals();
+        const Mesh* old = object.mesh.get();
+        for (Object& other : objects)
+          if (other.mesh.get() == old) other.mesh = fixed;
+        checked.insert(fixed.get());
+      }
+    }
+    return objects;
+  } catch (const Error& e) {
+    std::string message = oneLine(e.what());
+    if (message.rfind(name, 0) != 0) message = name + ": " + message;
+    throw Error(message);
+  } catch (const std::bad_alloc&) {
+    throw Error(name, "out of memory while loading");
+  } catch (const std::exception& e) {
+    throw Error(name, oneLine(e.what()));
+  } catch (...) {
+    throw Error(name, "unknown error while loading");
+  }
+}
+
+std::vector<std::string> supportedModelExtensions() {
+  std::set<std::string> out;
+  for (const auto& [ext, format] : formats()) out.insert(ext);
+  // Compressed variants that parse from memory without side files.
+  for (const char* ext : {".stl", ".ply", ".obj", ".off", ".vtp", ".vtk", ".glb"}) out.insert(std::string(ext) + ".gz");
+  return {out.begin(), out.end()};
+}
+
+}  // namespace mfr

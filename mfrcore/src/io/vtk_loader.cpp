@@ -1,0 +1,596 @@
+#include "vtk_loader.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <mutex>
+#include <string_view>
+#include <utility>
+
+#include <unistd.h>
+
+#include <vtkCellArray.h>
+#include <vtkDataArray.h>
+#include <vtkFloatArray.h>
+#include <vtkIdList.h>
+#include <vtkLogger.h>
+#include <vtkNew.h>
+#include <vtkOBJReader.h>
+#include <vtkOutputWindow.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataNormals.h>
+#include <vtkPolyDataReader.h>
+#include <vtkPolygon.h>
+#include <vtkSTLReader.h>
+#include <vtkSmartPointer.h>
+#include <vtkUnsignedCharArray.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include "mfr/error.hpp"
+
+namespace mfr::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kSoupColorArray = "mfr_colors";
+
+// ---------------------------------------------------------------------------------------------
+// VTK reports problems through a global output window (and vtkLogger), which prints to stderr.
+// We install a window that prints nothing and hands each message to the load running on the
+// same thread, so a failed read can name VTK's reason in its one-line mfr::Error.
+
+struct VtkMessage {
+  bool error = false;  // else a warning
+  std::string text;
+};
+
+thread_local std::vector<VtkMessage>* tlMessages = nullptr;
+
+class QuietOutputWindow final : public vtkOutputWindow {
+ public:
+  static QuietOutputWindow* New() {
+    auto* window = new QuietOutputWindow;
+    window->InitializeObjectBase();
+    return window;
+  }
+  void DisplayText(const char* text) override { record(false, text); }
+  void DisplayErrorText(const char* text) override { record(true, text); }
+  void DisplayWarningText(const char* text) override { record(false, text); }
+  void DisplayGenericWarningText(const char* text) override { record(false, text); }
+  void DisplayDebugText(const char*) override {}
+
+ private:
+  static void record(bool error, const char* text) {
+    if (tlMessages != nullptr && text != nullptr) tlMessages->push_back({error, text});
+  }
+};
+
+void silenceVtk() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
+    QuietOutputWindow* window = QuietOutputWindow::New();
+    vtkOutputWindow::SetInstance(window);
+    window->Delete();
+  });
+}
+
+// "ERROR: In /…/vtkSTLReader.cxx, line 657\nvtkSTLReader (0x55…): reason\n\n" → "reason".
+std::string cleanMessage(std::string_view text) {
+  std::string out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(start, end - start);
+    start = end + 1;
+    if (line.find(": In ") != std::string_view::npos && line.find(", line ") != std::string_view::npos)
+      continue;  // the source location line
+    if (const std::size_t p = line.find(" (0x"); p != std::string_view::npos) {
+      if (const std::size_t q = line.find("): ", p); q != std::string_view::npos) line = line.substr(q + 3);
+    }
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.front()))) line.remove_prefix(1);
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.remove_suffix(1);
+    if (line.empty()) continue;
+    if (!out.empty()) out += ' ';
+    out += line;
+  }
+  return out;
+}
+
+// Collects the VTK messages of one read (RAII: restores the previous collector).
+class VtkMessages {
+ public:
+  VtkMessages() : previous_(tlMessages) {
+    silenceVtk();
+    tlMessages = &messages_;
+  }
+  ~VtkMessages() { tlMessages = previous_; }
+  VtkMessages(const VtkMessages&) = delete;
+  VtkMessages& operator=(const VtkMessages&) = delete;
+
+  [[nodiscard]] bool hasError() const {
+    return std::any_of(messages_.begin(), messages_.end(), [](const VtkMessage& m) { return m.error; });
+  }
+  [[nodiscard]] bool hasWarning() const {
+    return std::any_of(messages_.begin(), messages_.end(), [](const VtkMessage& m) { return !m.error; });
+  }
+  // The most specific message: the first error (else warning) that is not the executive's
+  // generic "returned failure for request" dump.
+  [[nodiscard]] std::string reason() const {
+    for (const bool wantError : {true, false})
+      for (const VtkMessage& m : messages_)
+        if (m.error == wantError && m.text.find("returned failure for request") == std::string::npos) {
+          std::string r = cleanMessage(m.text);
+          if (!r.empty()) return r;
+        }
+    return {};
+  }
+  void clear() { messages_.clear(); }
+
+ private:
+  std::vector<VtkMessage> messages_;
+  std::vector<VtkMessage>* previous_;
+};
+
+// ---------------------------------------------------------------------------------------------
+// A temporary copy of decompressed bytes, for the VTK readers that only read named files.
+class TempFile {
+ public:
+  TempFile(const std::string& contents, const std::string& suffix, const std::string& name) {
+    std::string pattern = (fs::temp_directory_path() / ("mfr-load-XXXXXX" + suffix)).string();
+    const int fd = ::mkstemps(pattern.data(), static_cast<int>(suffix.size()));
+    if (fd < 0) throw Error(name, "cannot create a temporary file for the decompressed data");
+    path_ = pattern;
+    std::size_t written = 0;
+    while (written < contents.size()) {
+      const ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
+      if (n <= 0) break;
+      written += static_cast<std::size_t>(n);
+    }
+    ::close(fd);
+    if (written != contents.size()) {
+      std::error_code ec;
+      fs::remove(path_, ec);
+      throw Error(name, "cannot write the decompressed data to a temporary file");
+    }
+  }
+  ~TempFile() {
+    std::error_code ec;
+    fs::remove(path_, ec);
+  }
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  [[nodiscard]] const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+void replaceAll(std::string& s, const std::string& from, const std::string& to) {
+  if (from.empty()) return;
+  for (std::size_t p = s.find(from); p != std::string::npos; p = s.find(from, p + to.size()))
+    s.replace(p, from.size(), to);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Binary STL carries its triangle count in the header, and vtkSTLReader silently reads as many
+// triangles as are present, so the size is checked here first.
+void checkStl(std::string_view head, std::uintmax_t size, const std::string& name) {
+  std::size_t i = 0;
+  while (i < head.size() && std::isspace(static_cast<unsigned char>(head[i]))) ++i;
+  bool solid = head.size() >= i + 5;
+  for (std::size_t k = 0; solid && k < 5; ++k)
+    solid = std::tolower(static_cast<unsigned char>(head[i + k])) == "solid"[k];
+
+  if (size >= 84) {
+    const auto* b = reinterpret_cast<const unsigned char*>(head.data() + 80);
+    const std::uint64_t n = std::uint64_t{b[0]} | std::uint64_t{b[1]} << 8 | std::uint64_t{b[2]} << 16 |
+                            std::uint64_t{b[3]} << 24;
+    const std::uint64_t expected = 84 + 50 * n;
+    if (expected == size) {
+      if (n == 0) throw Error(name, "no triangles (binary STL with a triangle count of 0)");
+      return;  // binary, complete
+    }
+    if (solid) return;  // ASCII: vtkSTLReader parses it and reports syntax errors
+    if (size < expected)
+      throw Error(name, "truncated binary STL (" + std::to_string(size) + " of " + std::to_string(expected) +
+                            " bytes for " + std::to_string(n) + " triangles)");
+    return;  // binary with trailing bytes, which readers ignore
+  }
+  if (solid) return;
+  throw Error(name, "not an STL file (" + std::to_string(size) + " bytes: too short for a binary STL header and not ASCII 'solid')");
+}
+
+// vtkOBJReader reads "nan" or "1x" as 0 without a word, so vertex lines are checked here first.
+void checkObjVertices(std::string_view text, const std::string& name) {
+  std::size_t pos = 0;
+  std::size_t lineNo = 0;
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++lineNo;
+    std::size_t i = 0;
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    if (line.size() < i + 2 || line[i] != 'v' || (line[i + 1] != ' ' && line[i + 1] != '\t')) continue;
+    i += 2;
+    int count = 0;
+    while (true) {
+      while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+      if (i >= line.size() || line[i] == '#') break;
+      std::size_t j = i;
+      while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
+      const char* first = line.data() + i;
+      if (*first == '+') ++first;
+      double v = 0.0;
+      const auto [ptr, ec] = std::from_chars(first, line.data() + j, v);
+      if (ec != std::errc() || ptr != line.data() + j)
+        throw Error(name, "malformed vertex coordinate '" + std::string(line.substr(i, std::min<std::size_t>(j - i, 32))) +
+                              "' on line " + std::to_string(lineNo));
+      if (!std::isfinite(v)) throw Error(name, "non-finite coordinate on line " + std::to_string(lineNo));
+      ++count;
+      i = j;
+    }
+    if (count < 3) throw Error(name, "vertex with fewer than 3 coordinates on line " + std::to_string(lineNo));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+bool finite3(const double p[3]) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+
+// Readers do not check what they read: ids can be out of range (which would crash the filters)
+// and coordinates NaN.
+void checkPolyData(vtkPolyData* pd, const std::string& name) {
+  const vtkIdType np = pd->GetNumberOfPoints();
+  for (vtkIdType i = 0; i < np; ++i) {
+    double p[3];
+    pd->GetPoint(i, p);
+    if (!finite3(p)) throw Error(name, "non-finite coordinate in vertex " + std::to_string(i));
+  }
+  for (vtkCellArray* cells : {pd->GetVerts(), pd->GetLines(), pd->GetPolys(), pd->GetStrips()}) {
+    if (cells == nullptr) continue;
+    vtkIdType n = 0;
+    const vtkIdType* ids = nullptr;
+    vtkIdType cell = 0;
+    for (cells->InitTraversal(); cells->GetNextCell(n, ids) != 0; ++cell)
+      for (vtkIdType k = 0; k < n; ++k)
+        if (ids[k] < 0 || ids[k] >= np)
+          throw Error(name, "face " + std::to_string(cell) + " refers to vertex " + std::to_string(ids[k]) +
+                                " but there are " + std::to_string(np) + " vertices");
+  }
+  if (pd->GetNumberOfPolys() + pd->GetNumberOfStrips() == 0) {
+    if (pd->GetNumberOfLines() + pd->GetNumberOfVerts() > 0)
+      throw Error(name, "no triangles (only points or lines)");
+    throw Error(name, "no triangles");
+  }
+}
+
+// Normals the file brought along are kept only when usable.
+bool usableNormals(vtkPolyData* pd) {
+  vtkDataArray* n = pd->GetPointData()->GetNormals();
+  if (n == nullptr || n->GetNumberOfComponents() != 3 || n->GetNumberOfTuples() != pd->GetNumberOfPoints())
+    return false;
+  for (vtkIdType i = 0; i < n->GetNumberOfTuples(); ++i) {
+    double v[3];
+    n->GetTuple(i, v);
+    if (!finite3(v)) return false;
+  }
+  return true;
+}
+
+vtkDataArray* colorArray(vtkPolyData* pd) {
+  vtkPointData* data = pd->GetPointData();
+  if (vtkDataArray* soup = data->GetArray(kSoupColorArray)) return soup;
+  // Readers put per-vertex colours in unsigned char scalars with 3 or 4 components (PLY "RGB",
+  // VTP/legacy colour scalars); other scalars are data values, not colours.
+  vtkDataArray* s = data->GetScalars();
+  if (s != nullptr && s->GetDataType() == VTK_UNSIGNED_CHAR &&
+      (s->GetNumberOfComponents() == 3 || s->GetNumberOfComponents() == 4))
+    return s;
+  return nullptr;
+}
+
+// Polygons and strips to triangles. Ear cutting (vtkPolygon) handles concave polygons; where it
+// gives up (non-planar or partly degenerate polygons, where vtkTriangleFilter silently drops
+// triangles) a fan keeps the n−2 triangles the file implies. Points and point data are shared.
+vtkSmartPointer<vtkPolyData> triangulate(vtkPolyData* in) {
+  auto out = vtkSmartPointer<vtkPolyData>::New();
+  out->SetPoints(in->GetPoints());
+  out->GetPointData()->ShallowCopy(in->GetPointData());
+  vtkNew<vtkCellArray> triangles;
+  triangles->AllocateEstimate(in->GetNumberOfPolys() + in->GetNumberOfStrips(), 3);
+  vtkNew<vtkPolygon> polygon;
+  vtkNew<vtkIdList> local;
+  vtkIdType n = 0;
+  const vtkIdType* ids = nullptr;
+  vtkCellArray* polys = in->GetPolys();
+  for (polys->InitTraversal(); polys->GetNextCell(n, ids) != 0;) {
+    if (n < 3) continue;
+    if (n == 3) {
+      triangles->InsertNextCell(3, ids);
+      continue;
+    }
+    polygon->PointIds->SetNumberOfIds(n);
+    polygon->Points->SetNumberOfPoints(n);
+    for (vtkIdType k = 0; k < n; ++k) {
+      polygon->PointIds->SetId(k, ids[k]);
+      polygon->Points->SetPoint(k, in->GetPoint(ids[k]));
+    }
+    local->Reset();
+    if (polygon->Triangulate(local) != 0 && local->GetNumberOfIds() == 3 * (n - 2)) {
+      for (vtkIdType k = 0; k < local->GetNumberOfIds(); k += 3) {
+        const vtkIdType t[3] = {ids[local->GetId(k)], ids[local->GetId(k + 1)], ids[local->GetId(k + 2)]};
+        triangles->InsertNextCell(3, t);
+      }
+    } else {
+      for (vtkIdType k = 1; k + 1 < n; ++k) {
+        const vtkIdType t[3] = {ids[0], ids[k], ids[k + 1]};
+        triangles->InsertNextCell(3, t);
+      }
+    }
+  }
+  vtkCellArray* strips = in->GetStrips();
+  for (strips->InitTraversal(); strips->GetNextCell(n, ids) != 0;)
+    for (vtkIdType k = 0; k + 2 < n; ++k) {
+      // Every other strip triangle is wound the other way round.
+      const vtkIdType t[3] = {ids[k + (k & 1)], ids[k + 1 - (k & 1)], ids[k + 2]};
+      triangles->InsertNextCell(3, t);
+    }
+  out->SetPolys(triangles);
+  return out;
+}
+
+// Triangulates, adds feature-angle normals when missing, and converts to a Mesh.
+Mesh finish(vtkPolyData* input, const std::string& name) {
+  checkPolyData(input, name);
+  const bool keepNormals = usableNormals(input);
+  if (!keepNormals) input->GetPointData()->SetNormals(nullptr);
+
+  vtkSmartPointer<vtkPolyData> triangles = triangulate(input);
+  vtkNew<vtkPolyDataNormals> normals;
+  vtkPolyData* out = triangles;
+  if (!keepNormals) {
+    normals->SetInputData(triangles);
+    normals->SetFeatureAngle(kFeatureAngleDegrees);
+    normals->SplittingOn();
+    normals->ConsistencyOn();  // STL exports often mix windings; CSG needs them consistent
+    normals->AutoOrientNormalsOff();
+    normals->ComputePointNormalsOn();
+    normals->ComputeCellNormalsOff();
+    normals->Update();
+    out = normals->GetOutput();
+  }
+  if (out == nullptr || out->GetPoints() == nullptr || out->GetNumberOfPolys() == 0)
+    throw Error(name, "no triangles after triangulation");
+
+  Mesh mesh;
+  const vtkIdType np = out->GetNumberOfPoints();
+  mesh.positions.resize(static_cast<std::size_t>(np));
+  for (vtkIdType i = 0; i < np; ++i) {
+    double p[3];
+    out->GetPoint(i, p);
+    mesh.positions[static_cast<std::size_t>(i)] = glm::vec3(p[0], p[1], p[2]);
+  }
+  if (vtkDataArray* n = out->GetPointData()->GetNormals(); n != nullptr && n->GetNumberOfTuples() == np) {
+    mesh.normals.resize(static_cast<std::size_t>(np));
+    for (vtkIdType i = 0; i < np; ++i) {
+      double v[3];
+      n->GetTuple(i, v);
+      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      // Degenerate triangles get zero normals; shaders would normalise them into NaN.
+      mesh.normals[static_cast<std::size_t>(i)] =
+          len > 0.0 && std::isfinite(len) ? glm::vec3(v[0] / len, v[1] / len, v[2] / len) : glm::vec3(0, 0, 1);
+    }
+  }
+  if (vtkDataArray* c = colorArray(out); c != nullptr && c->GetNumberOfTuples() == np) {
+    const int comps = c->GetNumberOfComponents();
+    const double scale = c->GetDataType() == VTK_UNSIGNED_CHAR ? 1.0 / 255.0 : 1.0;
+    mesh.colors.resize(static_cast<std::size_t>(np));
+    for (vtkIdType i = 0; i < np; ++i) {
+      double v[4] = {0.0, 0.0, 0.0, 1.0 / scale};
+      for (int k = 0; k < comps && k < 4; ++k) v[k] = c->GetComponent(i, k);
+      glm::vec4 rgba(v[0] * scale, v[1] * scale, v[2] * scale, v[3] * scale);
+      mesh.colors[static_cast<std::size_t>(i)] = glm::clamp(rgba, 0.0f, 1.0f);
+    }
+  }
+  vtkCellArray* polys = out->GetPolys();
+  mesh.indices.reserve(static_cast<std::size_t>(polys->GetNumberOfConnectivityIds()));
+  vtkIdType n = 0;
+  const vtkIdType* ids = nullptr;
+  for (polys->InitTraversal(); polys->GetNextCell(n, ids) != 0;) {
+    if (n != 3) continue;  // the triangle filter leaves none, but never trust a size
+    for (vtkIdType k = 0; k < 3; ++k) mesh.indices.push_back(static_cast<std::uint32_t>(ids[k]));
+  }
+  if (mesh.normals.empty()) mesh.computeSmoothNormals();
+  return mesh;
+}
+
+vtkSmartPointer<vtkPolyData> polyDataFromSoup(const PolygonSoup& soup, const std::string& name) {
+  const std::size_t np = soup.points.size();
+  if (soup.offsets.empty() || soup.offsets.back() != soup.ids.size())
+    throw Error(name, "internal error: inconsistent polygon offsets");
+  for (std::size_t i = 0; i < np; ++i) {
+    const glm::vec3& p = soup.points[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw Error(name, "non-finite coordinate in vertex " + std::to_string(i));
+  }
+  for (std::size_t f = 0; f + 1 < soup.offsets.size(); ++f)
+    for (std::uint32_t k = soup.offsets[f]; k < soup.offsets[f + 1]; ++k)
+      if (soup.ids[k] >= np)
+        throw Error(name, "face " + std::to_string(f) + " refers to vertex " + std::to_string(soup.ids[k]) +
+                              " but there are " + std::to_string(np) + " vertices");
+
+  auto pd = vtkSmartPointer<vtkPolyData>::New();
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToFloat();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(np));
+  for (std::size_t i = 0; i < np; ++i) {
+    const glm::vec3& p = soup.points[i];
+    points->SetPoint(static_cast<vtkIdType>(i), p.x, p.y, p.z);
+  }
+  pd->SetPoints(points);
+
+  vtkNew<vtkCellArray> polys;
+  polys->AllocateExact(static_cast<vtkIdType>(soup.polygonCount()), static_cast<vtkIdType>(soup.ids.size()));
+  std::vector<vtkIdType> cell;
+  for (std::size_t f = 0; f + 1 < soup.offsets.size(); ++f) {
+    const std::uint32_t begin = soup.offsets[f], end = soup.offsets[f + 1];
+    if (end - begin < 3) continue;  // points and edges are not surfaces
+    cell.assign(soup.ids.begin() + begin, soup.ids.begin() + end);
+    polys->InsertNextCell(static_cast<vtkIdType>(cell.size()), cell.data());
+  }
+  pd->SetPolys(polys);
+
+  if (soup.normals.size() == np && np > 0) {
+    vtkNew<vtkFloatArray> normals;
+    normals->SetName("Normals");
+    normals->SetNumberOfComponents(3);
+    normals->SetNumberOfTuples(static_cast<vtkIdType>(np));
+    for (std::size_t i = 0; i < np; ++i) {
+      const glm::vec3& n = soup.normals[i];
+      normals->SetTypedTuple(static_cast<vtkIdType>(i), &n.x);
+    }
+    pd->GetPointData()->SetNormals(normals);
+  }
+  if (soup.colors.size() == np && np > 0) {
+    vtkNew<vtkFloatArray> colors;
+    colors->SetName(kSoupColorArray);
+    colors->SetNumberOfComponents(4);
+    colors->SetNumberOfTuples(static_cast<vtkIdType>(np));
+    for (std::size_t i = 0; i < np; ++i) {
+      const glm::vec4& c = soup.colors[i];
+      colors->SetTypedTuple(static_cast<vtkIdType>(i), &c.x);
+    }
+    pd->GetPointData()->AddArray(colors);
+  }
+  return pd;
+}
+
+std::string readHead(const fs::path& path, std::size_t count) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(count, '\0');
+  in.read(head.data(), static_cast<std::streamsize>(count));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return head;
+}
+
+// Runs a reader and throws with VTK's reason when it failed or produced nothing.
+template <typename Reader>
+vtkSmartPointer<vtkPolyData> runReader(Reader* reader, VtkMessages& messages, bool warningsFail,
+                                       const char* format, const std::string& name,
+                                       const std::string& tempPath = {}) {
+  reader->Update();
+  vtkPolyData* out = reader->GetOutput();
+  const bool failed = reader->GetErrorCode() != 0 || messages.hasError() ||
+                      (warningsFail && messages.hasWarning()) || out == nullptr;
+  if (failed) {
+    std::string reason = messages.reason();
+    replaceAll(reason, tempPath, name);
+    throw Error(name, std::string("cannot read ") + format + (reason.empty() ? "" : ": " + reason));
+  }
+  messages.clear();
+  vtkSmartPointer<vtkPolyData> pd = out;  // keep it alive past the reader
+  return pd;
+}
+
+}  // namespace
+
+Mesh meshFromSoup(const PolygonSoup& soup, const std::string& name) {
+  VtkMessages messages;
+  vtkSmartPointer<vtkPolyData> pd = polyDataFromSoup(soup, name);
+  return finish(pd, name);
+}
+
+void computeFeatureNormals(Mesh& mesh, const std::string& name) {
+  PolygonSoup soup;
+  soup.points = mesh.positions;
+  soup.colors = mesh.colors;
+  soup.ids = mesh.indices;
+  soup.offsets.resize(mesh.triangleCount() + 1);
+  for (std::size_t t = 0; t < soup.offsets.size(); ++t) soup.offsets[t] = static_cast<std::uint32_t>(3 * t);
+  mesh = meshFromSoup(soup, name);
+}
+
+Mesh readWithVtk(VtkFormat format, const fs::path& path, const std::string* contents, const std::string& name) {
+  VtkMessages messages;
+  vtkSmartPointer<vtkPolyData> pd;
+  switch (format) {
+    case VtkFormat::Stl:
+    case VtkFormat::Obj: {
+      if (format == VtkFormat::Obj) {
+        if (contents != nullptr) {
+          checkObjVertices(*contents, name);
+        } else {
+          std::ifstream in(path, std::ios::binary);
+          std::string text(static_cast<std::size_t>(fs::file_size(path)), '\0');
+          in.read(text.data(), static_cast<std::streamsize>(text.size()));
+          checkObjVertices(text, name);
+        }
+      }
+      if (format == VtkFormat::Stl) {
+        if (contents != nullptr)
+          checkStl(std::string_view(*contents).substr(0, 84), contents->size(), name);
+        else
+          checkStl(readHead(path, 84), fs::file_size(path), name);
+      }
+      // vtkSTLReader and vtkOBJReader only read named files.
+      std::unique_ptr<TempFile> temp;
+      if (contents != nullptr) temp = std::make_unique<TempFile>(*contents, format == VtkFormat::Stl ? ".stl" : ".obj", name);
+      const std::string file = temp ? temp->path().string() : path.string();
+      if (format == VtkFormat::Stl) {
+        vtkNew<vtkSTLReader> reader;
+        reader->SetFileName(file.c_str());
+        reader->MergingOn();  // STL repeats shared corners; merged, they get smooth normals
+        pd = runReader(reader.GetPointer(), messages, false, "STL", name, temp ? file : std::string{});
+      } else {
+        vtkNew<vtkOBJReader> reader;
+        reader->SetFileName(file.c_str());
+        pd = runReader(reader.GetPointer(), messages, false, "OBJ", name, temp ? file : std::string{});
+      }
+      break;
+    }
+    case VtkFormat::Vtp: {
+      vtkNew<vtkXMLPolyDataReader> reader;
+      if (contents != nullptr) {
+        reader->ReadFromInputStringOn();
+        reader->SetInputString(*contents);
+      } else {
+        reader->SetFileName(path.string().c_str());
+      }
+      pd = runReader(reader.GetPointer(), messages, true, "VTP (XML PolyData)", name);
+      break;
+    }
+    case VtkFormat::VtkLegacy: {
+      vtkNew<vtkPolyDataReader> reader;
+      if (contents != nullptr) {
+        if (contents->size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+          throw Error(name, "legacy VTK data over 2 GiB cannot be read from memory");
+        reader->ReadFromInputStringOn();
+        reader->SetBinaryInputString(contents->data(), static_cast<int>(contents->size()));
+      } else {
+        reader->SetFileName(path.string().c_str());
+      }
+      if (reader->IsFilePolyData() == 0) {
+        std::string reason = messages.reason();
+        throw Error(name, "not a legacy VTK POLYDATA file" + (reason.empty() ? "" : " (" + reason + ")"));
+      }
+      pd = runReader(reader.GetPointer(), messages, true, "legacy VTK", name);
+      break;
+    }
+  }
+  return finish(pd, name);
+}
+
+}  // namespace mfr::io

@@ -1,0 +1,49 @@
+#pragma once
+// VTK-backed loading (private to mfrcore/io): STL, OBJ, VTP and legacy .vtk readers, plus the
+// triangulation and feature-angle normals that every loader shares, so that all formats come out
+// with the same tessellation and shading rules.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/scene/mesh.hpp"
+
+namespace mfr::io {
+
+// Creases sharper than this get split normals (crisp CAD edges); smoother ones are averaged.
+inline constexpr double kFeatureAngleDegrees = 30.0;
+
+// Polygons of any size as the simple parsers (PLY, OFF) produce them.
+struct PolygonSoup {
+  std::vector<glm::vec3> points;
+  std::vector<glm::vec3> normals;          // empty or one per point
+  std::vector<glm::vec4> colors;           // empty or one RGBA in [0,1] per point
+  std::vector<std::uint32_t> offsets{0};   // polygon i is ids[offsets[i] .. offsets[i+1])
+  std::vector<std::uint32_t> ids;
+
+  void addPolygon(const std::uint32_t* first, std::size_t count) {
+    ids.insert(ids.end(), first, first + count);
+    offsets.push_back(static_cast<std::uint32_t>(ids.size()));
+  }
+  [[nodiscard]] std::size_t polygonCount() const { return offsets.size() - 1; }
+};
+
+// Checks ids and coordinates, triangulates (concave polygons too) and, when the soup carries no
+// normals, computes feature-angle normals. Throws mfr::Error(name, reason).
+Mesh meshFromSoup(const PolygonSoup& soup, const std::string& name);
+
+// Replaces mesh.normals by feature-angle normals; vertices on creases are split, so positions,
+// colors and indices change too.
+void computeFeatureNormals(Mesh& mesh, const std::string& name);
+
+enum class VtkFormat { Stl, Obj, Vtp, VtkLegacy };
+
+// Reads `path` with VTK, or `contents` (already decompressed bytes of that file) when not null.
+// Throws mfr::Error(name, reason); VTK's own messages never reach stderr.
+Mesh readWithVtk(VtkFormat format, const std::filesystem::path& path, const std::string* contents,
+                 const std::string& name);
+
+}  // namespace mfr::io

@@ -1,0 +1,33 @@
+#pragma once
+// Small pieces every method's C++ side uses: GL state for geometry passes, the resolve pass
+// draw, storage limits.
+#include <cstdint>
+
+#include "mfr/methods/method.hpp"
+
+namespace mfr {
+
+// Geometry pass state for capture passes with side effects only: depth test off, culling off,
+// colour writes off. Colour writes must be off: llvmpipe may drop earlier fragments of a tile
+// that a later primitive fully covers when the pass also writes colour (NOTES.md). Restores the
+// previous state on destruction.
+class GeometryPassState {
+ public:
+  explicit GeometryPassState(bool colorWrites = false, bool depthTest = false);
+  ~GeometryPassState();
+  GeometryPassState(const GeometryPassState&) = delete;
+  GeometryPassState& operator=(const GeometryPassState&) = delete;
+
+ private:
+  GLboolean depthTest_, cull_, blend_;
+  GLboolean colorMask_[4];
+  GLboolean depthMask_;
+};
+
+// Full-screen resolve: binds the operation, draws one triangle into the bound framebuffer.
+void runResolvePass(const FrameContext& ctx, const gl::Program& program, const Operation& op);
+
+// Largest element count of the given size one shader storage buffer may hold on this context.
+std::uint64_t maxStorageElements(std::uint64_t elementBytes);
+
+}  // namespace mfr

@@ -1,0 +1,379 @@
+// The CPU fragment oracle: exact per-pixel fragment lists by ray casting through a CGAL AABB tree
+// (double precision), independent of any GPU code.
+//
+// Rays: one per pixel centre. Pixel (x, y) of the image (y = 0 is the top row) is the GL window
+// point (x + 0.5, height − 1 − y + 0.5); its ray runs from the unprojected near-plane point to the
+// unprojected far-plane point through inverse(P·V), which gives eye rays for perspective and
+// parallel rays for orthographic cameras. Every hit with window depth in [0, 1] becomes a fragment
+// (depth = 0.5·clip.z/clip.w + 0.5 of the hit point), shaded with mfrShade from
+// shaders/common/shading.h; lists are sorted by depth, ties by object id, then triangle index.
+//
+// Edge rule (FragmentLists::kEdge): every visible triangle of non-zero world area is clipped in
+// clip space to the near and far planes (z ≥ −w, z ≤ w) and projected to window coordinates; a
+// pixel is an edge pixel when its centre lies within edgeEpsilon pixels (Euclidean distance in
+// window coordinates) of a side or vertex of that clipped polygon — whether its ray hits the
+// triangle or not. Sides created by the clipping count too (GL clips there). A triangle whose
+// clipped window area is below kMinScreenArea px² (edge-on) produces no fragments on the GPU, so
+// ray hits on it are dropped and their pixels marked kEdge (such pixels are also always within
+// epsilon of its sides). kDepthTie: two consecutive fragments of a pixel whose depths differ by
+// less than depthTieEpsilon·max(1e-30, |depth|).
+#include "mfr/reference/oracle.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Simple_cartesian.h>
+#include <glm/gtc/packing.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "mfr/error.hpp"
+
+namespace mfr::shading {
+using namespace glm;
+#include "common/shading.h"
+}  // namespace mfr::shading
+
+namespace mfr {
+namespace {
+
+using K = CGAL::Simple_cartesian<double>;
+using CgalTriangle = K::Triangle_3;
+using TriangleIterator = std::vector<CgalTriangle>::const_iterator;
+using Primitive = CGAL::AABB_triangle_primitive<K, TriangleIterator>;
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
+
+constexpr int kMaxImageSize = 16384;
+// Below this window-space area (px²) GL rasterises a triangle as nothing (edge-on).
+constexpr double kMinScreenArea = 1e-6;
+
+// A visible, non-degenerate triangle in world space plus what shading needs.
+struct WorldTriangle {
+  glm::dvec3 p[3];
+  std::uint32_t objectId = 0;
+  std::uint32_t vertex[3] = {0, 0, 0};  // indices into the object's mesh
+  bool screenDegenerate = false;
+};
+
+struct ObjectShading {
+  const Mesh* mesh = nullptr;
+  glm::dmat3 normalMatrix{1.0};  // inverse transpose of the object transform's linear part
+  glm::vec4 materialColor{1.0f};
+};
+
+struct Hit {
+  double depth;
+  std::uint32_t objectId;
+  std::uint32_t triangle;
+  Fragment fragment;
+};
+
+glm::dvec3 transformPoint(const glm::dmat4& m, const glm::dvec3& p) {
+  const glm::dvec4 h = m * glm::dvec4(p, 1.0);
+  // Affine transforms have w = 1; divide anyway so a projective one still means what it says.
+  return glm::dvec3(h) / h.w;
+}
+
+// Sutherland–Hodgman against one clip-space plane dot(plane, v) ≥ 0.
+std::vector<glm::dvec4> clipPolygon(const std::vector<glm::dvec4>& in, const glm::dvec4& plane) {
+  std::vector<glm::dvec4> out;
+  const std::size_t n = in.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const glm::dvec4& a = in[i];
+    const glm::dvec4& b = in[(i + 1) % n];
+    const double da = glm::dot(plane, a);
+    const double db = glm::dot(plane, b);
+    if (da >= 0.0) out.push_back(a);
+    if ((da >= 0.0) != (db >= 0.0)) out.push_back(a + (b - a) * (da / (da - db)));
+  }
+  return out;
+}
+
+// The triangle's footprint in window coordinates after clipping to the near and far planes.
+std::vector<glm::dvec2> windowPolygon(const WorldTriangle& t, const glm::dmat4& viewProj, int width, int height) {
+  std::vector<glm::dvec4> poly;
+  for (const glm::dvec3& p : t.p) poly.push_back(viewProj * glm::dvec4(p, 1.0));
+  poly = clipPolygon(poly, glm::dvec4(0.0, 0.0, 1.0, 1.0));  // near: z ≥ −w
+  if (!poly.empty()) poly = clipPolygon(poly, glm::dvec4(0.0, 0.0, -1.0, 1.0));  // far: z ≤ w
+  std::vector<glm::dvec2> window;
+  for (const glm::dvec4& c : poly) {
+    // After near clipping w ≥ near > 0 for our cameras; skip a point that still is not in front.
+    if (!(c.w > 0.0)) return {};
+    window.emplace_back((0.5 * c.x / c.w + 0.5) * width, (0.5 * c.y / c.w + 0.5) * height);
+  }
+  return window;
+}
+
+double polygonArea(const std::vector<glm::dvec2>& poly) {
+  double a = 0.0;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const glm::dvec2& p = poly[i];
+    const glm::dvec2& q = poly[(i + 1) % poly.size()];
+    a += p.x * q.y - q.x * p.y;
+  }
+  return 0.5 * std::abs(a);
+}
+
+double distanceToSegment(const glm::dvec2& p, const glm::dvec2& a, const glm::dvec2& b) {
+  const glm::dvec2 ab = b - a;
+  const double len2 = glm::dot(ab, ab);
+  const double t = len2 > 0.0 ? std::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+  return glm::length(p - (a + t * ab));
+}
+
+// Marks every pixel whose centre lies within eps of segment ab. Rows are walked over the
+// segment's extent; in each row only the x range of segment points within eps vertically
+// (widened by eps) can qualify, so long edges cost O(length), not O(bounding box).
+void markSegment(const glm::dvec2& a, const glm::dvec2& b, double eps, int width, int height,
+                 std::vector<std::uint8_t>& flags) {
+  const double ymin = std::min(a.y, b.y) - eps;
+  const double ymax = std::max(a.y, b.y) + eps;
+  // Window row r has its centre at r + 0.5.
+  const double rowLo = std::max(0.0, std::ceil(ymin - 0.5));
+  const double rowHi = std::min(static_cast<double>(height - 1), std::floor(ymax - 0.5));
+  if (!(rowLo <= rowHi)) return;
+  const glm::dvec2 d = b - a;
+  for (int row = static_cast<int>(rowLo); row <= static_cast<int>(rowHi); ++row) {
+    const double yc = row + 0.5;
+    double t0 = 0.0;
+    double t1 = 1.0;
+    if (d.y != 0.0) {
+      t0 = (yc - eps - a.y) / d.y;
+      t1 = (yc + eps - a.y) / d.y;
+      if (t0 > t1) std::swap(t0, t1);
+      t0 = std::max(t0, 0.0);
+      t1 = std::min(t1, 1.0);
+      if (t0 > t1) continue;
+    } else if (std::abs(a.y - yc) > eps) {
+      continue;
+    }
+    const double x0 = a.x + t0 * d.x;
+    const double x1 = a.x + t1 * d.x;
+    const double xLo = std::max(0.0, std::ceil(std::min(x0, x1) - eps - 0.5));
+    const double xHi = std::min(static_cast<double>(width - 1), std::floor(std::max(x0, x1) + eps - 0.5));
+    if (!(xLo <= xHi)) continue;
+    const std::size_t rowBase = static_cast<std::size_t>(height - 1 - row) * width;  // image rows top-down
+    for (int col = static_cast<int>(xLo); col <= static_cast<int>(xHi); ++col)
+      if (distanceToSegment(glm::dvec2(col + 0.5, yc), a, b) <= eps) flags[rowBase + col] |= FragmentLists::kEdge;
+  }
+}
+
+// Ray/triangle intersection (Möller–Trumbore) in double: ray parameter t and barycentrics (u, v)
+// of p[1] and p[2]. Rays in the triangle's plane count as misses (GL draws edge-on triangles as
+// nothing).
+bool intersect(const glm::dvec3& origin, const glm::dvec3& dir, const WorldTriangle& tri, double& u, double& v) {
+  const glm::dvec3 e1 = tri.p[1] - tri.p[0];
+  const glm::dvec3 e2 = tri.p[2] - tri.p[0];
+  const glm::dvec3 pv = glm::cross(dir, e2);
+  const double det = glm::dot(e1, pv);
+  if (det == 0.0 || !std::isfinite(det)) return false;
+  const double inv = 1.0 / det;
+  const glm::dvec3 tv = origin - tri.p[0];
+  u = glm::dot(tv, pv) * inv;
+  if (u < 0.0 || u > 1.0) return false;
+  const glm::dvec3 qv = glm::cross(tv, e1);
+  v = glm::dot(dir, qv) * inv;
+  return v >= 0.0 && u + v <= 1.0;
+}
+
+std::uint32_t shade(const WorldTriangle& tri, const ObjectShading& obj, double u, double v,
+                    const glm::vec3& viewDir) {
+  const double w[3] = {1.0 - u - v, u, v};
+  const Mesh& mesh = *obj.mesh;
+  // A mesh without normals gets object-space +Z, as the GPU upload (gl/gpu_scene.cpp) does.
+  glm::dvec3 n(0.0, 0.0, 1.0);
+  if (mesh.normals.size() == mesh.positions.size()) {
+    n = glm::dvec3(0.0);
+    for (int k = 0; k < 3; ++k) n += w[k] * glm::dvec3(mesh.normals[tri.vertex[k]]);
+  }
+  glm::dvec3 normal = obj.normalMatrix * n;
+  // Opposite vertex normals can cancel: fall back to the face normal rather than let normalize()
+  // produce NaN (the GPU's result is undefined there anyway).
+  if (!(glm::dot(normal, normal) > 1e-24))
+    normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
+  glm::vec4 base = obj.materialColor;
+  if (mesh.colors.size() == mesh.positions.size()) {
+    glm::dvec4 c(0.0);
+    for (int k = 0; k < 3; ++k) c += w[k] * glm::dvec4(mesh.colors[tri.vertex[k]]);
+    base *= glm::vec4(c);
+  }
+  return glm::packUnorm4x8(shading::mfrShade(base, glm::vec3(normal), viewDir));
+}
+
+}  // namespace
+
+FragmentLists castFragments(const Scene& scene, const Camera& camera, int width, int height,
+                            const OracleOptions& options) {
+  if (width <= 0 || height <= 0 || width > kMaxImageSize || height > kMaxImageSize)
+    throw Error("image size", std::to_string(width) + "x" + std::to_string(height) + " is not in 1.." +
+                                  std::to_string(kMaxImageSize) + " per side");
+
+  const glm::dmat4 viewProj =
+      camera.projectionMatrix(static_cast<double>(width) / height) * camera.viewMatrix();
+  const glm::dmat4 invViewProj = glm::inverse(viewProj);
+  {
+    const double* m = glm::value_ptr(invViewProj);
+    if (!std::all_of(m, m + 16, [](double x) { return std::isfinite(x); }))
+      throw Error("camera", "projection is singular (check near/far planes, field of view and up vector)");
+  }
+
+  // World-space triangles of all visible objects.
+  std::vector<ObjectShading> objects(scene.objects.size());
+  std::vector<WorldTriangle> triangles;
+  for (std::size_t o = 0; o < scene.objects.size(); ++o) {
+    const Object& object = scene.objects[o];
+    if (!object.visible || !object.mesh || object.mesh->triangleCount() == 0) continue;
+    const Mesh& mesh = *object.mesh;
+    mesh.validate(object.name);
+    objects[o] = {&mesh, glm::transpose(glm::inverse(glm::dmat3(object.transform))), object.material.color};
+    std::vector<glm::dvec3> world(mesh.positions.size());
+    for (std::size_t i = 0; i < world.size(); ++i)
+      world[i] = transformPoint(object.transform, glm::dvec3(mesh.positions[i]));
+    for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
+      WorldTriangle tri;
+      tri.objectId = static_cast<std::uint32_t>(o);
+      for (int k = 0; k < 3; ++k) {
+        tri.vertex[k] = mesh.indices[3 * t + k];
+        tri.p[k] = world[tri.vertex[k]];
+      }
+      // Zero world area (relative to the edge lengths): no plane, no fragments, no edges.
+      const double area2 = glm::length(glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]));
+      const double edge2 = std::max({glm::dot(tri.p[1] - tri.p[0], tri.p[1] - tri.p[0]),
+                                     glm::dot(tri.p[2] - tri.p[1], tri.p[2] - tri.p[1]),
+                                     glm::dot(tri.p[0] - tri.p[2], tri.p[0] - tri.p[2])});
+      if (!(area2 > 1e-14 * edge2)) continue;
+      triangles.push_back(tri);
+    }
+  }
+  if (triangles.empty())
+    throw Error("scene '" + scene.name + "'", "nothing to render (no visible triangles)");
+
+  FragmentLists lists;
+  lists.width = width;
+  lists.height = height;
+  const std::size_t pixelCount = static_cast<std::size_t>(width) * height;
+  lists.flags.assign(pixelCount, 0);
+
+  // Edge pass (2D, window space) — also decides which triangles GL would draw as nothing.
+  for (WorldTriangle& tri : triangles) {
+    const std::vector<glm::dvec2> poly = windowPolygon(tri, viewProj, width, height);
+    tri.screenDegenerate = polygonArea(poly) < kMinScreenArea;
+    for (std::size_t i = 0; i < poly.size(); ++i)
+      markSegment(poly[i], poly[(i + 1) % poly.size()], options.edgeEpsilon, width, height, lists.flags);
+  }
+
+  std::vector<CgalTriangle> cgalTriangles;
+  cgalTriangles.reserve(triangles.size());
+  for (const WorldTriangle& t : triangles)
+    cgalTriangles.emplace_back(K::Point_3(t.p[0].x, t.p[0].y, t.p[0].z), K::Point_3(t.p[1].x, t.p[1].y, t.p[1].z),
+                               K::Point_3(t.p[2].x, t.p[2].y, t.p[2].z));
+  Tree tree(cgalTriangles.cbegin(), cgalTriangles.cend());
+  tree.build();  // explicitly, before the threads query it (lazy construction is not thread-safe)
+
+  const glm::vec3 viewDir(camera.forward());
+  std::vector<std::vector<Fragment>> rowFragments(static_cast<std::size_t>(height));
+  std::vector<std::uint32_t> counts(pixelCount, 0);
+  std::vector<std::uint8_t> rayFlags(pixelCount, 0);
+
+  const auto castRow = [&](int y, std::vector<TriangleIterator>& candidates, std::vector<Hit>& hits) {
+    std::vector<Fragment>& out = rowFragments[static_cast<std::size_t>(y)];
+    const double wy = (height - 1 - y) + 0.5;
+    for (int x = 0; x < width; ++x) {
+      const std::size_t pixel = static_cast<std::size_t>(y) * width + x;
+      const double ndcX = 2.0 * (x + 0.5) / width - 1.0;
+      const double ndcY = 2.0 * wy / height - 1.0;
+      const glm::dvec4 n4 = invViewProj * glm::dvec4(ndcX, ndcY, -1.0, 1.0);
+      const glm::dvec4 f4 = invViewProj * glm::dvec4(ndcX, ndcY, 1.0, 1.0);
+      const glm::dvec3 origin = glm::dvec3(n4) / n4.w;
+      const glm::dvec3 dir = glm::dvec3(f4) / f4.w - origin;
+      // The broad phase queries a slightly longer segment; the exact depth test below decides.
+      const glm::dvec3 s0 = origin - 1e-6 * dir;
+      const glm::dvec3 s1 = origin + (1.0 + 1e-6) * dir;
+      candidates.clear();
+      tree.all_intersected_primitives(K::Segment_3(K::Point_3(s0.x, s0.y, s0.z), K::Point_3(s1.x, s1.y, s1.z)),
+                                      std::back_inserter(candidates));
+      hits.clear();
+      for (const TriangleIterator& it : candidates) {
+        const auto index = static_cast<std::uint32_t>(it - cgalTriangles.cbegin());
+        const WorldTriangle& tri = triangles[index];
+        double u = 0.0;
+        double v = 0.0;
+        if (!intersect(origin, dir, tri, u, v)) continue;
+        const glm::dvec3 p = tri.p[0] + u * (tri.p[1] - tri.p[0]) + v * (tri.p[2] - tri.p[0]);
+        const glm::dvec4 clip = viewProj * glm::dvec4(p, 1.0);
+        const double depth = 0.5 * clip.z / clip.w + 0.5;
+        if (!(depth >= 0.0 && depth <= 1.0)) continue;
+        if (tri.screenDegenerate) {
+          rayFlags[pixel] |= FragmentLists::kEdge;
+          continue;
+        }
+        const glm::dvec3 normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
+        Fragment frag;
+        frag.depth = static_cast<float>(depth);
+        frag.color = shade(tri, objects[tri.objectId], u, v, viewDir);
+        frag.objectId = tri.objectId;
+        frag.frontFacing = glm::dot(normal, dir) < 0.0;
+        hits.push_back({depth, tri.objectId, index, frag});
+      }
+      std::sort(hits.begin(), hits.end(), [](const Hit& a, const Hit& b) {
+        if (a.depth != b.depth) return a.depth < b.depth;
+        if (a.objectId != b.objectId) return a.objectId < b.objectId;
+        return a.triangle < b.triangle;
+      });
+      for (std::size_t i = 0; i < hits.size(); ++i) {
+        if (i > 0 && std::abs(hits[i].depth - hits[i - 1].depth) <
+                         options.depthTieEpsilon * std::max({1e-30, std::abs(hits[i].depth), std::abs(hits[i - 1].depth)}))
+          rayFlags[pixel] |= FragmentLists::kDepthTie;
+        out.push_back(hits[i].fragment);
+      }
+      counts[pixel] = static_cast<std::uint32_t>(hits.size());
+    }
+  };
+
+  unsigned threadCount = options.threads > 0 ? static_cast<unsigned>(options.threads) : std::thread::hardware_concurrency();
+  threadCount = std::clamp(threadCount, 1u, static_cast<unsigned>(height));
+  std::atomic<int> nextRow{0};
+  std::exception_ptr failure;
+  std::mutex failureMutex;
+  const auto worker = [&] {
+    try {
+      std::vector<TriangleIterator> candidates;
+      std::vector<Hit> hits;
+      for (int y = nextRow++; y < height; y = nextRow++) castRow(y, candidates, hits);
+    } catch (...) {
+      const std::lock_guard lock(failureMutex);
+      if (!failure) failure = std::current_exception();
+      nextRow = height;  // stop the others early
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned i = 1; i < threadCount; ++i) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+
+  lists.offsets.resize(pixelCount + 1);
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < pixelCount; ++i) {
+    lists.offsets[i] = static_cast<std::uint32_t>(total);
+    total += counts[i];
+    lists.flags[i] |= rayFlags[i];
+  }
+  if (total > UINT32_MAX) throw Error("oracle", "more than 2^32 fragments in one image");
+  lists.offsets[pixelCount] = static_cast<std::uint32_t>(total);
+  lists.fragments.reserve(total);
+  for (std::vector<Fragment>& row : rowFragments) {
+    lists.fragments.insert(lists.fragments.end(), row.begin(), row.end());
+    std::vector<Fragment>().swap(row);
+  }
+  return lists;
+}
+
+}  // namespace mfr

@@ -1,0 +1,21 @@
+// Scene vertex shader shared by every capture pass: world-space normal, material × vertex colour,
+// object id. Multifragment capture itself happens in each method's *.geom.frag.
+#include "common/bindings.h"
+
+layout(location = MFR_ATTR_POSITION) in vec3 aPosition;
+layout(location = MFR_ATTR_NORMAL) in vec3 aNormal;
+layout(location = MFR_ATTR_COLOR) in vec4 aColor;
+
+uniform mat4 uViewProj;
+uniform mat4 uModel;
+uniform mat3 uNormalMatrix;
+uniform vec4 uColor;
+
+out vec3 vNormal;
+out vec4 vColor;
+
+void main() {
+  vNormal = uNormalMatrix * aNormal;
+  vColor = uColor * aColor;
+  gl_Position = uViewProj * (uModel * vec4(aPosition, 1.0));
+}

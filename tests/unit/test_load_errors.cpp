@@ -1,0 +1,480 @@
+// loadModel on bad input: every failure must be one mfr::Error whose one-line message names the
+// file and the reason, with no crash, hang, abort or library exception. Plus small hand-written
+// files of every loader family with known triangle counts and bounds.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+class LoadModel : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "mfr-test-load-XXXXXX").string();
+    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add, ec);
+    fs::remove_all(dir_, ec);
+  }
+
+  fs::path write(const std::string& name, const std::string& bytes) {
+    const fs::path p = dir_ / name;
+    std::ofstream out(p, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    return p;
+  }
+
+  fs::path writeGz(const std::string& name, const std::string& bytes) {
+    const fs::path p = dir_ / name;
+    gzFile gz = gzopen(p.c_str(), "wb");
+    EXPECT_NE(gz, nullptr);
+    EXPECT_EQ(gzwrite(gz, bytes.data(), static_cast<unsigned>(bytes.size())), static_cast<int>(bytes.size()));
+    gzclose(gz);
+    return p;
+  }
+
+  // Expects mfr::Error with a one-line message that names the path and contains `reason`.
+  static void expectError(const fs::path& path, const std::string& reason) {
+    try {
+      const auto objects = mfr::loadModel(path);
+      ADD_FAILURE() << path << ": loaded " << objects.size() << " objects, expected an error about '" << reason << "'";
+    } catch (const mfr::Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.find('\n'), std::string::npos) << "not one line: " << what;
+      EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << "does not start with the path: " << what;
+      EXPECT_NE(what.find(reason), std::string::npos) << "expected '" << reason << "' in: " << what;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << path << ": non-mfr exception: " << e.what();
+    }
+  }
+
+  fs::path dir_;
+};
+
+std::string le32(std::uint32_t v) {
+  std::string s(4, '\0');
+  for (int i = 0; i < 4; ++i) s[static_cast<std::size_t>(i)] = static_cast<char>((v >> (8 * i)) & 0xff);
+  return s;
+}
+
+std::string f32(float f, bool bigEndian = false) {
+  std::string s = le32(std::bit_cast<std::uint32_t>(f));
+  if (bigEndian) std::reverse(s.begin(), s.end());
+  return s;
+}
+
+// Binary STL with `declared` triangles in the header and `present` triangles of data.
+std::string binaryStl(std::uint32_t declared, std::uint32_t present) {
+  std::string s(80, ' ');
+  s.replace(0, 12, "binary model");
+  s += le32(declared);
+  for (std::uint32_t t = 0; t < present; ++t) {
+    const float v[12] = {0, 0, 1, 0, 0, static_cast<float>(t), 1, 0, static_cast<float>(t), 0, 1, static_cast<float>(t)};
+    for (float x : v) s += f32(x);
+    s += std::string(2, '\0');
+  }
+  return s;
+}
+
+const char* kAsciiStl =
+    "solid four\n"
+    "facet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n endloop\nendfacet\n"
+    "facet normal 0 0 1\n outer loop\n  vertex 1 0 0\n  vertex 1 1 0\n  vertex 0 1 0\n endloop\nendfacet\n"
+    "facet normal 0 0 1\n outer loop\n  vertex 0 0 2\n  vertex 1 0 2\n  vertex 0 1 2\n endloop\nendfacet\n"
+    "facet normal 0 0 1\n outer loop\n  vertex -1 0 2\n  vertex 1 3 2\n  vertex 0 1 2\n endloop\nendfacet\n"
+    "endsolid four\n";
+
+const char* kPlyHeader3 =
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
+// Unit cube as six quads: sharp 90° edges.
+const char* kCubeObj =
+    "# cube\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+    "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+
+std::size_t triangles(const std::vector<mfr::Object>& objects) {
+  std::size_t n = 0;
+  for (const auto& o : objects) n += o.mesh->triangleCount();
+  return n;
+}
+
+void expectBounds(const mfr::Mesh& mesh, glm::dvec3 lo, glm::dvec3 hi) {
+  const mfr::Bounds b = mesh.bounds();
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(b.min[k], lo[k], 1e-6) << "axis " << k;
+    EXPECT_NEAR(b.max[k], hi[k], 1e-6) << "axis " << k;
+  }
+}
+
+// Normals the renderers can use: one per vertex, unit length.
+void expectUsableNormals(const mfr::Mesh& mesh) {
+  ASSERT_EQ(mesh.normals.size(), mesh.positions.size());
+  for (const glm::vec3& n : mesh.normals) ASSERT_NEAR(glm::length(n), 1.0f, 1e-4f);
+}
+
+// ---- failures ----------------------------------------------------------------------------------
+
+TEST_F(LoadModel, MissingFile) { expectError(dir_ / "nothing.stl", "no such file"); }
+
+TEST_F(LoadModel, DirectoryInsteadOfFile) {
+  fs::create_directory(dir_ / "folder.stl");
+  expectError(dir_ / "folder.stl", "is a directory");
+}
+
+TEST_F(LoadModel, UnreadableFile) {
+  if (::geteuid() == 0) GTEST_SKIP() << "running as root: permission bits do not stop root from reading";
+  const fs::path p = write("locked.stl", kAsciiStl);
+  fs::permissions(p, fs::perms::none);
+  expectError(p, "cannot read file");
+}
+
+TEST_F(LoadModel, FifoDoesNotBlock) {
+  const fs::path p = dir_ / "pipe.stl";
+  ASSERT_EQ(::mkfifo(p.c_str(), 0600), 0);
+  expectError(p, "not a regular file");
+}
+
+TEST_F(LoadModel, EmptyFiles) {
+  for (const char* name : {"empty.stl", "empty.ply", "empty.obj", "empty.off", "empty.glb", "empty.vtp"})
+    expectError(write(name, ""), "empty file");
+}
+
+TEST_F(LoadModel, TruncatedBinaryStl) {
+  expectError(write("truncated.stl", binaryStl(10, 3)), "truncated binary STL (234 of 584 bytes for 10 triangles)");
+}
+
+TEST_F(LoadModel, StlShorterThanHeader) { expectError(write("short.stl", std::string(40, '\x01')), "not an STL file"); }
+
+TEST_F(LoadModel, GarbageAsciiStl) {
+  expectError(write("garbage.stl", "solid junk\nthis is not\nan stl\n"), "cannot read STL");
+}
+
+TEST_F(LoadModel, GarbagePly) {
+  std::string junk;
+  for (int i = 0; i < 20; ++i) junk += std::string("no ply here \x01\x02\xff\n", 17);
+  expectError(write("garbage.ply", junk), "not a PLY file");
+}
+
+TEST_F(LoadModel, PlyBadHeaderLine) {
+  expectError(write("header.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty flaot x\nend_header\n"),
+              "bad PLY header line 4 'property flaot x': unknown property type");
+  expectError(write("element.ply", "ply\nformat ascii 1.0\nelement vertex many\nend_header\n"),
+              "bad PLY header line 3 'element vertex many': bad element count");
+  expectError(write("format.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n"), "unknown format");
+}
+
+TEST_F(LoadModel, PlyWithoutEndHeader) {
+  expectError(write("noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"), "no end_header");
+}
+
+TEST_F(LoadModel, PlyHeaderClaimsMoreVerticesThanPresent) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 100\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  expectError(write("short.ply", ply), "declares 100 'vertex' items");
+}
+
+TEST_F(LoadModel, PlyDataEndsEarly) {
+  // Counts small enough to pass the size estimate: the reader itself finds the end.
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  expectError(write("early.ply", ply), "unexpected end of data");
+}
+
+TEST_F(LoadModel, BinaryPlyTruncated) {
+  std::string ply =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  for (int i = 0; i < 9; ++i) ply += f32(0.5f);
+  ply += '\x03';
+  ply += le32(0) + le32(1);  // the third index is missing
+  expectError(write("truncated_bin.ply", ply), "unexpected end of data");
+}
+
+TEST_F(LoadModel, PlyHugeVertexCountDoesNotAllocate) {
+  const std::string ply =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n" +
+      std::string(64, '\0');
+  expectError(write("huge.ply", ply), "declares 4000000000 'vertex' items");
+}
+
+TEST_F(LoadModel, PlyFaceIndexOutOfRange) {
+  expectError(write("badindex.ply", std::string(kPlyHeader3) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"),
+              "face 0 refers to vertex 7 but there are 3 vertices");
+}
+
+TEST_F(LoadModel, PlyNegativeIndex) {
+  expectError(write("negative.ply", std::string(kPlyHeader3) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n"), "bad vertex index");
+}
+
+TEST_F(LoadModel, ObjIndexOutOfRange) {
+  expectError(write("badindex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "refers to vertex");
+}
+
+TEST_F(LoadModel, ObjNegativeIndexOutOfRange) {
+  expectError(write("badrelative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9\n"), "refers to vertex");
+}
+
+TEST_F(LoadModel, UnsupportedExtension) {
+  expectError(write("model.xyz", "1 2 3\n"), "unsupported file type '.xyz'");
+  expectError(write("README", "text\n"), "unsupported file type 'README'");
+}
+
+TEST_F(LoadModel, GzThatIsNotGzip) { expectError(write("fake.ply.gz", kPlyHeader3), "not a gzip file"); }
+
+TEST_F(LoadModel, TruncatedGzip) {
+  std::string ply = std::string(kPlyHeader3) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  for (int i = 0; i < 200; ++i) ply += "comment padding to make the stream longer than a header\n";
+  const fs::path full = writeGz("full.ply.gz", ply);
+  std::ifstream in(full, std::ios::binary);
+  std::string bytes(static_cast<std::size_t>(fs::file_size(full)), '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  ASSERT_GT(bytes.size(), 40u);
+  expectError(write("cut.ply.gz", bytes.substr(0, bytes.size() / 2)), "gzip");
+}
+
+TEST_F(LoadModel, GzWithoutInnerExtension) { expectError(writeGz("model.gz", kAsciiStl), "unsupported compressed file type"); }
+
+TEST_F(LoadModel, NanCoordinates) {
+  expectError(write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), "non-finite coordinate");
+  expectError(write("nan.ply", std::string(kPlyHeader3) + "0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n"), "non-finite coordinate");
+  expectError(write("nan.stl",
+                    "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\nvertex 0 1 0\n"
+                    "endloop\nendfacet\nendsolid x\n"),
+              "non-finite coordinate");
+  // CGAL's OFF scanner does not parse "nan" at all.
+  expectError(write("nan.off", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n"), "malformed or truncated OFF");
+  expectError(write("malformed.obj", "v 0 0 0\nv 1x 0 0\nv 0 1 0\nf 1 2 3\n"), "malformed vertex coordinate '1x' on line 2");
+}
+
+TEST_F(LoadModel, ZeroTriangles) {
+  expectError(write("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n"), "no triangles");
+  expectError(write("points.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                    "end_header\n0 0 0\n1 0 0\n0 1 0\n"),
+              "no triangles");
+  expectError(write("nofacets.stl", "solid x\nendsolid x\n"), "no triangles");
+  expectError(write("zero.stl", binaryStl(0, 0)), "no triangles");
+  expectError(write("nofaces.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n"), "no triangles");
+  expectError(write("edge.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n"), "no triangles");
+  expectError(write("vertsonly.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"), "no triangles");
+}
+
+TEST_F(LoadModel, GarbageOff) {
+  expectError(write("garbage.off", "this is not an off file\n"), "not an OFF file");
+  expectError(write("counts.off", "OFF\n300 100 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "declares 300 vertices");
+  expectError(write("badface.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 9\n"), "malformed or truncated OFF");
+}
+
+TEST_F(LoadModel, GarbageVtp) { expectError(write("garbage.vtp", "<VTKFile type=\"PolyData\"> bogus"), "cannot read VTP"); }
+
+TEST_F(LoadModel, GarbageLegacyVtk) {
+  expectError(write("garbage.vtk", "not a vtk file at all\n"), "not a legacy VTK POLYDATA file");
+  expectError(write("short.vtk",
+                    "# vtk DataFile Version 3.0\nshort\nASCII\nDATASET POLYDATA\nPOINTS 10 float\n0 0 0\n1 0 0\n"),
+              "cannot read legacy VTK");
+}
+
+TEST_F(LoadModel, GarbageGlb) { expectError(write("garbage.glb", "glTF but not really, just text\n"), "cannot read glb"); }
+
+// ---- small valid files ------------------------------------------------------------------------
+
+TEST_F(LoadModel, AsciiStl) {
+  const auto objects = mfr::loadModel(write("four.stl", kAsciiStl));
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].name, "four");
+  EXPECT_EQ(objects[0].mesh->triangleCount(), 4u);
+  expectBounds(*objects[0].mesh, {-1, 0, 0}, {1, 3, 2});
+  expectUsableNormals(*objects[0].mesh);
+}
+
+TEST_F(LoadModel, BinaryStl) {
+  const auto objects = mfr::loadModel(write("three.stl", binaryStl(3, 3)));
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].mesh->triangleCount(), 3u);
+  expectBounds(*objects[0].mesh, {0, 0, 0}, {1, 1, 2});
+}
+
+TEST_F(LoadModel, ObjQuadsAreTriangulatedAndCreasesSplit) {
+  const auto objects = mfr::loadModel(write("cube.obj", kCubeObj));
+  ASSERT_EQ(objects.size(), 1u);
+  const mfr::Mesh& mesh = *objects[0].mesh;
+  EXPECT_EQ(mesh.triangleCount(), 12u);
+  expectBounds(mesh, {0, 0, 0}, {1, 1, 1});
+  expectUsableNormals(mesh);
+  // 90° edges exceed the feature angle: each face gets its own four corners with its normal.
+  EXPECT_EQ(mesh.positions.size(), 24u);
+  for (std::size_t t = 0; t < mesh.triangleCount(); ++t) {
+    const glm::vec3 a = mesh.positions[mesh.indices[3 * t]], b = mesh.positions[mesh.indices[3 * t + 1]],
+                    c = mesh.positions[mesh.indices[3 * t + 2]];
+    const glm::vec3 faceNormal = glm::normalize(glm::cross(b - a, c - a));
+    for (int k = 0; k < 3; ++k)
+      EXPECT_GT(std::abs(glm::dot(faceNormal, mesh.normals[mesh.indices[3 * t + static_cast<std::size_t>(k)]])), 0.999f);
+  }
+}
+
+TEST_F(LoadModel, AsciiPlyWithColors) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\ncomment colours\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0 255 0 0 255\n2 0 0 0 255 0 255\n2 1 0 0 0 255 255\n0 1 0 255 255 255 51\n4 0 1 2 3\n";
+  const auto objects = mfr::loadModel(write("quad.ply", ply));
+  ASSERT_EQ(objects.size(), 1u);
+  const mfr::Mesh& mesh = *objects[0].mesh;
+  EXPECT_EQ(mesh.triangleCount(), 2u);
+  expectBounds(mesh, {0, 0, 0}, {2, 1, 0});
+  ASSERT_EQ(mesh.colors.size(), mesh.positions.size());
+  std::set<std::vector<int>> seen;
+  for (const glm::vec4& c : mesh.colors)
+    seen.insert({static_cast<int>(std::lround(c.r * 255)), static_cast<int>(std::lround(c.g * 255)),
+                 static_cast<int>(std::lround(c.b * 255)), static_cast<int>(std::lround(c.a * 255))});
+  EXPECT_EQ(seen, (std::set<std::vector<int>>{{255, 0, 0, 255}, {0, 255, 0, 255}, {0, 0, 255, 255}, {255, 255, 255, 51}}));
+}
+
+TEST_F(LoadModel, BinaryBigEndianPly) {
+  std::string ply =
+      "ply\nformat binary_big_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  for (float v : {0.0f, 0.0f, 0.0f, 4.0f, 0.0f, 0.0f, 0.0f, 0.0f, -2.0f}) ply += f32(v, true);
+  ply += '\x03';
+  for (std::uint32_t i : {0u, 1u, 2u}) {
+    std::string s = le32(i);
+    std::reverse(s.begin(), s.end());
+    ply += s;
+  }
+  const auto objects = mfr::loadModel(write("be.ply", ply));
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].mesh->triangleCount(), 1u);
+  expectBounds(*objects[0].mesh, {0, 0, -2}, {4, 0, 0});
+}
+
+TEST_F(LoadModel, GzippedPlyAndStl) {
+  const std::string ply = std::string(kPlyHeader3) + "0 0 0\n1 0 0\n0 5 0\n3 0 1 2\n";
+  const auto plyObjects = mfr::loadModel(writeGz("tri.PLY.GZ", ply));
+  ASSERT_EQ(plyObjects.size(), 1u);
+  EXPECT_EQ(plyObjects[0].name, "tri");
+  EXPECT_EQ(plyObjects[0].mesh->triangleCount(), 1u);
+  expectBounds(*plyObjects[0].mesh, {0, 0, 0}, {1, 5, 0});
+
+  const auto stlObjects = mfr::loadModel(writeGz("four.stl.gz", kAsciiStl));
+  EXPECT_EQ(triangles(stlObjects), 4u);
+  EXPECT_EQ(mfr::loadModel(writeGz("cube.obj.gz", kCubeObj))[0].mesh->triangleCount(), 12u);
+  EXPECT_EQ(mfr::loadModel(writeGz("three.stl.gz", binaryStl(3, 3)))[0].mesh->triangleCount(), 3u);
+  expectError(writeGz("truncated.stl.gz", binaryStl(10, 3)), "truncated binary STL");
+}
+
+TEST_F(LoadModel, OffWithPolygonsCommentsAndColors) {
+  const std::string off =
+      "COFF\n# a quad and a triangle\n5 2 0\n0 0 0 255 0 0 255\n1 0 0 255 0 0 255\n1 1 0 255 0 0 255\n"
+      "0 1 0 255 0 0 255\n0.5 0.5 3 0 0 255 255\n4 0 1 2 3\n3 0 1 4\n";
+  const auto objects = mfr::loadModel(write("shape.off", off));
+  ASSERT_EQ(objects.size(), 1u);
+  const mfr::Mesh& mesh = *objects[0].mesh;
+  EXPECT_EQ(mesh.triangleCount(), 3u);
+  expectBounds(mesh, {0, 0, 0}, {1, 1, 3});
+  ASSERT_EQ(mesh.colors.size(), mesh.positions.size());
+  expectUsableNormals(mesh);
+}
+
+TEST_F(LoadModel, GzippedOff) {
+  const auto objects = mfr::loadModel(writeGz("tri.off.gz", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
+  EXPECT_EQ(triangles(objects), 1u);
+}
+
+TEST_F(LoadModel, Vtp) {
+  const std::string vtp =
+      "<?xml version=\"1.0\"?>\n"
+      "<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      " <PolyData>\n  <Piece NumberOfPoints=\"4\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
+      "NumberOfPolys=\"1\">\n"
+      "   <Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">"
+      "0 0 0 3 0 0 3 2 0 0 2 0</DataArray></Points>\n"
+      "   <Polys><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1 2 3</DataArray>\n"
+      "   <DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">4</DataArray></Polys>\n"
+      "  </Piece>\n </PolyData>\n</VTKFile>\n";
+  const auto objects = mfr::loadModel(write("quad.vtp", vtp));
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].mesh->triangleCount(), 2u);
+  expectBounds(*objects[0].mesh, {0, 0, 0}, {3, 2, 0});
+  EXPECT_EQ(mfr::loadModel(writeGz("quad.vtp.gz", vtp))[0].mesh->triangleCount(), 2u);
+}
+
+TEST_F(LoadModel, LegacyVtk) {
+  const std::string vtk =
+      "# vtk DataFile Version 3.0\nquad\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n0 0 0\n1 0 0\n1 1 1\n0 1 1\n"
+      "POLYGONS 1 5\n4 0 1 2 3\n";
+  const auto objects = mfr::loadModel(write("quad.vtk", vtk));
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_EQ(objects[0].mesh->triangleCount(), 2u);
+  expectBounds(*objects[0].mesh, {0, 0, 0}, {1, 1, 1});
+  EXPECT_EQ(mfr::loadModel(writeGz("quad.vtk.gz", vtk))[0].mesh->triangleCount(), 2u);
+}
+
+TEST_F(LoadModel, AssimpFormatWithNodes) {
+  // A minimal glTF 2.0 with an embedded buffer: one triangle mesh instanced by two nodes.
+  const std::string gltf = R"({
+  "asset": {"version": "2.0"},
+  "scene": 0,
+  "scenes": [{"nodes": [0, 1]}],
+  "nodes": [{"name": "left", "mesh": 0, "translation": [-5, 0, 0]},
+            {"name": "right", "mesh": 0, "translation": [5, 0, 0]}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 0.25]}, "alphaMode": "BLEND"}],
+  "meshes": [{"name": "tri", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+  "buffers": [{"byteLength": 42, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIA"}],
+  "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}]
+})";
+  const auto objects = mfr::loadModel(write("two.gltf", gltf));
+  ASSERT_EQ(objects.size(), 2u);
+  EXPECT_EQ(objects[0].name, "left");
+  EXPECT_EQ(objects[1].name, "right");
+  EXPECT_EQ(objects[0].mesh, objects[1].mesh) << "an instanced mesh is shared";
+  EXPECT_EQ(objects[0].mesh->triangleCount(), 1u);
+  EXPECT_DOUBLE_EQ(objects[0].transform[3][0], -5.0);
+  EXPECT_DOUBLE_EQ(objects[1].transform[3][0], 5.0);
+  EXPECT_NEAR(objects[0].material.color.r, 1.0f, 1e-6f);
+  EXPECT_NEAR(objects[0].material.color.g, 0.0f, 1e-6f);
+  EXPECT_NEAR(objects[0].material.color.a, 0.25f, 1e-6f);
+  expectUsableNormals(*objects[0].mesh);
+}
+
+TEST(SupportedModelExtensions, ListsEveryFamilyInLowerCase) {
+  const std::vector<std::string> exts = mfr::supportedModelExtensions();
+  for (const char* e : {".stl", ".ply", ".ply.gz", ".obj", ".off", ".vtp", ".vtk", ".glb", ".gltf", ".3ds", ".fbx"})
+    EXPECT_NE(std::find(exts.begin(), exts.end(), e), exts.end()) << e;
+  for (const std::string& e : exts) {
+    EXPECT_EQ(e[0], '.');
+    EXPECT_TRUE(std::none_of(e.begin(), e.end(), [](unsigned char c) { return std::isupper(c); })) << e;
+  }
+  EXPECT_TRUE(std::is_sorted(exts.begin(), exts.end()));
+  EXPECT_EQ(std::find(exts.begin(), exts.end(), ".step"), exts.end()) << "STEP is not read through assimp";
+}
+
+}  // namespace
