@@ -65,7 +65,8 @@ void main() {
   uint n = 0u;
   uint cursor = mfrCursorBegin(p);
   MfrFragment f;
-  for (uint it = 0u; it < uMaxListLength && mfrNext(cursor, f); ++it) {
+  uint walk = min(uMaxListLength, MFR_MAX_LIST_WALK);
+  for (uint it = 0u; it < walk && mfrNext(cursor, f); ++it) {
     if (n < uint(MFR_RESOLVE_LOCAL)) {
       gLocal[n] = f;
       gIndex[n] = n;

@@ -102,7 +102,7 @@ void ABufferLinkedList::resolve(const FrameContext& ctx, const Operation& op) {
   const gl::Program& program = resolve_.get("abuffer-ll", op);
   glBindImageTexture(MFR_IMAGE_HEADS, heads_.id(), 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32UI);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_NODES, pool_.id());
-  program.set("uMaxListLength", static_cast<unsigned>(std::min<std::uint64_t>(poolNodes_, 0xFFFFFFFFu)));
+  program.set("uMaxListLength", static_cast<unsigned>(std::min<std::uint64_t>(poolNodes_, MFR_MAX_LIST_WALK)));
   runResolvePass(ctx, program, op);
 }
 

@@ -11,9 +11,8 @@ uint mfrCursorBegin(ivec2 pixel) { return imageLoad(uHeads, pixel).x; }
 
 bool mfrNext(inout uint cursor, out MfrFragment f) {
   if (cursor == MFR_NIL) return false;
-  Node n = nodes[cursor];
-  f = MfrFragment(n.color, n.depth);
-  cursor = n.next;
+  f = MfrFragment(nodeWords[3u * cursor], uintBitsToFloat(nodeWords[3u * cursor + 1u]));
+  cursor = nodeWords[3u * cursor + 2u];
   return true;
 }
 

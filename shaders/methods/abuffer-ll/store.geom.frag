@@ -15,5 +15,7 @@ void main() {
   }
   MfrFragment f = mfrCurrentFragment();
   uint previous = imageAtomicExchange(uHeads, ivec2(gl_FragCoord.xy), index);
-  nodes[index] = Node(f.color, f.depth, previous);
+  nodeWords[3u * index] = f.color;
+  nodeWords[3u * index + 1u] = floatBitsToUint(f.depth);
+  nodeWords[3u * index + 2u] = previous;
 }

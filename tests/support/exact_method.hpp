@@ -1,0 +1,27 @@
+#pragma once
+// Parameterised test of an exact method against the oracle (tests/gl/test_exact_methods.cpp
+// defines the tests; each method's test file instantiates them with its parameter sets).
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <map>
+#include <string>
+
+namespace mfr::test {
+
+struct ExactCase {
+  std::string method;
+  std::map<std::string, std::string> params;
+  std::string label;  // test name suffix, e.g. "pool_previous"
+};
+
+class ExactMethod : public ::testing::TestWithParam<ExactCase> {};
+
+inline std::string exactCaseName(const ::testing::TestParamInfo<ExactCase>& p) {
+  std::string n = p.param.method + (p.param.label.empty() ? "" : "_" + p.param.label);
+  for (char& c : n)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return n;
+}
+
+}  // namespace mfr::test
