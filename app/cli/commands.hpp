@@ -11,6 +11,7 @@ namespace mfr::cli {
 void addRender(CLI::App& app);
 void addCompare(CLI::App& app);
 void addInfo(CLI::App& app);
+void addBench(CLI::App& app);
 
 // "WxH" → (w, h); throws mfr::Error naming the option.
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);

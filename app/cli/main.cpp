@@ -12,10 +12,11 @@
 int main(int argc, char** argv) {
   CLI::App app{"mfr: multifragment rendering — capture, sort and operate on many fragments per pixel", "mfr"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", std::string("mfr ") + MFR_VERSION);
+  app.set_version_flag("--version", "mfr " MFR_VERSION);
   mfr::cli::addRender(app);
   mfr::cli::addCompare(app);
   mfr::cli::addInfo(app);
+  mfr::cli::addBench(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -25,9 +26,9 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::string msg = e.what();
-    std::replace(msg.begin(), msg.end(), '\n', ' ');
-    std::cerr << "mfr: " << msg << " (see mfr --help)\n";
+    std::cerr << "mfr: ";
+    for (const char* c = e.what(); *c; ++c) std::cerr << (*c == '\n' ? ' ' : *c);  // one line
+    std::cerr << " (see mfr --help)\n";
     return 2;
   } catch (const mfr::Error& e) {
     std::cerr << "mfr: " << e.what() << "\n";

@@ -22,15 +22,13 @@ std::vector<std::string> availableMethods() {
   return names;
 }
 
-namespace {
-// The CLI's GL state: one headless context and renderer for the process, created on first use.
+// One headless context and renderer for the process, created on first use.
 GpuRenderer& headlessRenderer() {
   static gl::HeadlessContext context(true);
   static GpuRenderer renderer;
   context.makeCurrent();
   return renderer;
 }
-}  // namespace
 
 RenderOutput render(const Scene& scene, const Camera& camera, const RenderRequest& request) {
   validateImageSize("--size", request.width, request.height);

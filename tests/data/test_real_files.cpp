@@ -194,6 +194,9 @@ const std::map<std::string, DragonExpectation>& dragons() {
 // test binary and each folder above it (the build folder is its parent).
 fs::path findDragon() {
   if (const char* env = std::getenv("MFR_DRAGON_PLY_GZ"); env != nullptr && *env != '\0') return env;
+  // Where scripts/setup puts it.
+  if (const fs::path fetched = fs::path(MFR_FETCHED_DATA_DIR) / "dragon" / "dragon_vrip_res3.ply.gz"; fs::exists(fetched))
+    return fetched;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (ec) return {};

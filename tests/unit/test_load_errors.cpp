@@ -2,6 +2,8 @@
 // file and the reason, with no crash, hang, abort or library exception. Plus small hand-written
 // files of every loader family with known triangle counts and bounds.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <sys/stat.h>
 #include <unistd.h>
@@ -9,6 +11,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -145,10 +148,32 @@ TEST_F(LoadModel, DirectoryInsteadOfFile) {
 }
 
 TEST_F(LoadModel, UnreadableFile) {
-  if (::geteuid() == 0) GTEST_SKIP() << "running as root: permission bits do not stop root from reading";
   const fs::path p = write("locked.stl", kAsciiStl);
   fs::permissions(p, fs::perms::none);
-  expectError(p, "cannot read file");
+  if (::geteuid() != 0) {
+    expectError(p, "cannot read file");
+    return;
+  }
+  // Permission bits do not stop root: check as user "nobody" in a child process.
+  fs::permissions(dir_, fs::perms::owner_all | fs::perms::others_read | fs::perms::others_exec);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    if (::setgid(65534) != 0 || ::setuid(65534) != 0) ::_exit(2);
+    try {
+      mfr::loadModel(p);
+    } catch (const mfr::Error& e) {
+      const std::string what = e.what();
+      ::_exit(what.rfind(p.string() + ": ", 0) == 0 && what.find("cannot read file") != std::string::npos ? 0 : 3);
+    } catch (...) {
+      ::_exit(4);
+    }
+    ::_exit(5);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "2: could not become nobody, 3: wrong message, 4: other exception, 5: loaded";
 }
 
 TEST_F(LoadModel, FifoDoesNotBlock) {
@@ -236,6 +261,17 @@ TEST_F(LoadModel, ObjIndexOutOfRange) {
   expectError(write("badindex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "refers to vertex");
 }
 
+TEST_F(LoadModel, ObjBadNormalIndexDoesNotCrash) {
+  // vtkOBJReader crashed on this (normal index 1 and texture index 1 that do not exist).
+  expectError(write("crash.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nvn 0 0 1\nf 1 2 3 4\n"
+                                 "f 1//1 2//1 55/1\nf 2 3 3\n"),
+              "line 8: face refers to vertex 55 but there are 5 vertices");
+  const auto objects = mfr::loadModel(write("fine.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/7/9 2/7/9 3/7/9\n"));
+  EXPECT_EQ(objects.at(0).mesh->triangleCount(), 1u);
+}
+
+TEST_F(LoadModel, ObjMalformedFace) { expectError(write("face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n"), "line 4: malformed face corner 'x'"); }
+
 TEST_F(LoadModel, ObjNegativeIndexOutOfRange) {
   expectError(write("badrelative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9\n"), "refers to vertex");
 }
@@ -269,7 +305,7 @@ TEST_F(LoadModel, NanCoordinates) {
               "non-finite coordinate");
   // CGAL's OFF scanner does not parse "nan" at all.
   expectError(write("nan.off", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n"), "malformed or truncated OFF");
-  expectError(write("malformed.obj", "v 0 0 0\nv 1x 0 0\nv 0 1 0\nf 1 2 3\n"), "malformed vertex coordinate '1x' on line 2");
+  expectError(write("malformed.obj", "v 0 0 0\nv 1x 0 0\nv 0 1 0\nf 1 2 3\n"), "line 2: malformed number '1x'");
 }
 
 TEST_F(LoadModel, ZeroTriangles) {
@@ -294,10 +330,24 @@ TEST_F(LoadModel, GarbageOff) {
 TEST_F(LoadModel, GarbageVtp) { expectError(write("garbage.vtp", "<VTKFile type=\"PolyData\"> bogus"), "cannot read VTP"); }
 
 TEST_F(LoadModel, GarbageLegacyVtk) {
-  expectError(write("garbage.vtk", "not a vtk file at all\n"), "not a legacy VTK POLYDATA file");
+  expectError(write("garbage.vtk", "not a vtk file at all\n"), "not a legacy VTK file");
   expectError(write("short.vtk",
                     "# vtk DataFile Version 3.0\nshort\nASCII\nDATASET POLYDATA\nPOINTS 10 float\n0 0 0\n1 0 0\n"),
-              "cannot read legacy VTK");
+              "header declares 10 points but only 13 bytes follow");
+  expectError(write("early.vtk",
+                    "# vtk DataFile Version 3.0\nshort\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0\n1 0 0\n1 1"),
+              "unexpected end of data");
+  // A mangled keyword line made vtkPolyDataReader read from a closed stream and crash.
+  expectError(write("mangled.vtk",
+                    "# vtk DataFile Version 3.0\nq\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n0 0 0E1 0 0\n1 1 1\n"
+                    "0 1 1\nPOLYGONS 1 5\xee" "4 0 1 2 3\n"),
+              "bad number 'POLYGONS'");
+  expectError(write("grid.vtk", "# vtk DataFile Version 3.0\ng\nASCII\nDATASET STRUCTURED_POINTS\n"),
+              "dataset type 'STRUCTURED_POINTS' is not supported");
+  expectError(write("badid.vtk",
+                    "# vtk DataFile Version 3.0\nq\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+                    "POLYGONS 1 4\n3 0 1 3\n"),
+              "face 0 refers to vertex 3 but there are 3 vertices");
 }
 
 TEST_F(LoadModel, GarbageGlb) { expectError(write("garbage.glb", "glTF but not really, just text\n"), "cannot read glb"); }
@@ -336,6 +386,32 @@ TEST_F(LoadModel, ObjQuadsAreTriangulatedAndCreasesSplit) {
     for (int k = 0; k < 3; ++k)
       EXPECT_GT(std::abs(glm::dot(faceNormal, mesh.normals[mesh.indices[3 * t + static_cast<std::size_t>(k)]])), 0.999f);
   }
+}
+
+TEST_F(LoadModel, ObjMaterialsBecomeColouredParts) {
+  write("parts.mtl", "newmtl red\nKd 1 0 0\nd 0.5\nnewmtl blue\nKd 0 0 1\nTr 0.75\n");
+  const std::string obj =
+      "mtllib parts.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 4\n"
+      "usemtl red\nf 1 2 3\nf 1 3 4\nusemtl blue\nf -5 -4 -1\n";
+  const auto objects = mfr::loadModel(write("parts.obj", obj));
+  ASSERT_EQ(objects.size(), 2u);
+  EXPECT_EQ(objects[0].name, "red");
+  EXPECT_EQ(objects[0].mesh->triangleCount(), 2u);
+  EXPECT_EQ(objects[0].material.color, glm::vec4(1, 0, 0, 0.5f));
+  expectBounds(*objects[0].mesh, {0, 0, 0}, {1, 1, 0});
+  EXPECT_EQ(objects[1].name, "blue");
+  EXPECT_EQ(objects[1].mesh->triangleCount(), 1u);
+  EXPECT_EQ(objects[1].material.color, glm::vec4(0, 0, 1, 0.25f));
+  expectBounds(*objects[1].mesh, {0, 0, 0}, {1, 0, 4});
+}
+
+TEST_F(LoadModel, ObjNormalsFromTheFileAreKept) {
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0.6 0 0.8\nf 1//1 2//1 3//1\n";
+  const auto objects = mfr::loadModel(write("normals.obj", obj));
+  ASSERT_EQ(objects.size(), 1u);
+  const mfr::Mesh& mesh = *objects[0].mesh;
+  ASSERT_EQ(mesh.normals.size(), 3u);
+  for (const glm::vec3& n : mesh.normals) EXPECT_LT(glm::length(n - glm::vec3(0.6f, 0, 0.8f)), 1e-6f);
 }
 
 TEST_F(LoadModel, AsciiPlyWithColors) {
@@ -434,6 +510,36 @@ TEST_F(LoadModel, LegacyVtk) {
   EXPECT_EQ(objects[0].mesh->triangleCount(), 2u);
   expectBounds(*objects[0].mesh, {0, 0, 0}, {1, 1, 1});
   EXPECT_EQ(mfr::loadModel(writeGz("quad.vtk.gz", vtk))[0].mesh->triangleCount(), 2u);
+}
+
+TEST_F(LoadModel, LegacyVtkBinaryAndNewCellLayout) {
+  // BINARY: big-endian values after the line that announces them.
+  std::string bin = "# vtk DataFile Version 3.0\nbin\nBINARY\nDATASET POLYDATA\nPOINTS 4 float\n";
+  for (float v : {0.0f, 0.0f, 0.0f, 2.0f, 0.0f, 0.0f, 2.0f, 2.0f, 0.0f, 0.0f, 2.0f, -1.0f}) bin += f32(v, true);
+  bin += "\nPOLYGONS 1 5\n";
+  for (std::uint32_t v : {4u, 0u, 1u, 2u, 3u}) {
+    std::string s = le32(v);
+    std::reverse(s.begin(), s.end());
+    bin += s;
+  }
+  bin += "\nPOINT_DATA 4\n";
+  const auto binary = mfr::loadModel(write("binary.vtk", bin));
+  ASSERT_EQ(binary.size(), 1u);
+  EXPECT_EQ(binary[0].mesh->triangleCount(), 2u);
+  expectBounds(*binary[0].mesh, {0, 0, -1}, {2, 2, 0});
+
+  // VTK 5.1 files: OFFSETS / CONNECTIVITY arrays, plus a triangle strip and skipped lines.
+  const std::string v51 =
+      "# vtk DataFile Version 5.1\nnew\nASCII\nDATASET POLYDATA\nFIELD FieldData 1\nTIME 1 1 double\n0.5\n"
+      "POINTS 5 float\n0 0 0 1 0 0 0 1 0 1 1 0 2 1 3\nMETADATA\nINFORMATION 0\n\n"
+      "LINES 2 2\nOFFSETS vtktypeint64\n0 2\nCONNECTIVITY vtktypeint64\n0 4\n"
+      "POLYGONS 2 3\nOFFSETS vtktypeint64\n0 3\nCONNECTIVITY vtktypeint64\n0 1 2\n"
+      "TRIANGLE_STRIPS 2 4\nOFFSETS vtktypeint64\n0 4\nCONNECTIVITY vtktypeint64\n1 3 2 4\n"
+      "CELL_DATA 3\n";
+  const auto modern = mfr::loadModel(write("modern.vtk", v51));
+  ASSERT_EQ(modern.size(), 1u);
+  EXPECT_EQ(modern[0].mesh->triangleCount(), 3u);
+  expectBounds(*modern[0].mesh, {0, 0, 0}, {2, 1, 3});
 }
 
 TEST_F(LoadModel, AssimpFormatWithNodes) {

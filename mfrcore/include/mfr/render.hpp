@@ -31,6 +31,10 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
 // Names accepted by render(): "oracle" first, then the registry's GPU methods.
 std::vector<std::string> availableMethods();
 
+class GpuRenderer;
+// The process's headless GL renderer (EGL context created on first use); the CLI uses it.
+GpuRenderer& headlessRenderer();
+
 // Checks an image size argument; throws mfr::Error(what, reason) when not 1..16384 each.
 void validateImageSize(const std::string& what, int width, int height);
 

@@ -95,19 +95,18 @@ Material convertMaterial(const aiScene& scene, unsigned index) {
 }
 
 // A few importers (OpenGEX's DDL parser, for one) write to std::cerr directly instead of to
-// assimp's logger. Their streams are muted while assimp runs; the mutex keeps concurrent loads
-// from restoring each other's buffers out of order.
+// assimp's logger. std::cerr and std::clog are muted while assimp runs (std::cout is left alone:
+// it carries the CLI's output); the mutex keeps concurrent loads from restoring each other's
+// buffers out of order.
 class MutedStandardStreams {
  public:
   MutedStandardStreams() : lock_(mutex()) {
     cerr_ = std::cerr.rdbuf(&null_);
     clog_ = std::clog.rdbuf(&null_);
-    cout_ = std::cout.rdbuf(&null_);
   }
   ~MutedStandardStreams() {
     std::cerr.rdbuf(cerr_);
     std::clog.rdbuf(clog_);
-    std::cout.rdbuf(cout_);
   }
   MutedStandardStreams(const MutedStandardStreams&) = delete;
   MutedStandardStreams& operator=(const MutedStandardStreams&) = delete;
@@ -124,7 +123,6 @@ class MutedStandardStreams {
   NullBuffer null_;
   std::streambuf* cerr_ = nullptr;
   std::streambuf* clog_ = nullptr;
-  std::streambuf* cout_ = nullptr;
 };
 
 std::string lower(std::string s) {

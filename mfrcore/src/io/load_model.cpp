@@ -19,8 +19,10 @@
 #include "assimp_loader.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "obj_loader.hpp"
 #include "off_loader.hpp"
 #include "ply_loader.hpp"
+#include "vtk_legacy_loader.hpp"
 #include "vtk_loader.hpp"
 
 namespace mfr {
@@ -28,7 +30,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-enum class Family { Vtk, Ply, Off, Assimp };
+enum class Family { Vtk, Ply, Off, Obj, VtkLegacy, Assimp };
 
 struct Format {
   Family family;
@@ -52,9 +54,9 @@ const std::map<std::string, Format>& formats() {
     std::map<std::string, Format> t;
     for (const std::string& ext : io::assimpExtensions()) t[ext] = {Family::Assimp};
     t[".stl"] = {Family::Vtk, io::VtkFormat::Stl};
-    t[".obj"] = {Family::Vtk, io::VtkFormat::Obj};
+    t[".obj"] = {Family::Obj};
     t[".vtp"] = {Family::Vtk, io::VtkFormat::Vtp};
-    t[".vtk"] = {Family::Vtk, io::VtkFormat::VtkLegacy};
+    t[".vtk"] = {Family::VtkLegacy};
     t[".ply"] = {Family::Ply};
     t[".off"] = {Family::Off};
     return t;
@@ -174,12 +176,33 @@ std::vector<Object> load(const fs::path& path, const std::string& name) {
   switch (format.family) {
     case Family::Vtk: return singleObject(io::readWithVtk(format.vtk, path, contents, name), stem);
     case Family::Ply:
-    case Family::Off: {
+    case Family::Off:
+    case Family::VtkLegacy: {
       if (!gz) data = readAll(path, name);
-      const io::PolygonSoup soup = format.family == Family::Ply ? io::parsePly(data, name) : io::parseOff(data, name);
+      const io::PolygonSoup soup = format.family == Family::Ply   ? io::parsePly(data, name)
+                                   : format.family == Family::Off ? io::parseOff(data, name)
+                                                                  : io::parseLegacyVtk(data, name);
       data.clear();
       data.shrink_to_fit();
       return singleObject(io::meshFromSoup(soup, name), stem);
+    }
+    case Family::Obj: {
+      if (!gz) data = readAll(path, name);
+      std::vector<io::ObjPart> parts = io::parseObj(data, path.parent_path(), name);
+      data.clear();
+      data.shrink_to_fit();
+      std::vector<Object> objects;
+      for (io::ObjPart& part : parts) {
+        Object object;
+        // Parts are named by material; a file without materials is one part named by the file.
+        object.name = parts.size() == 1 && part.material.empty() ? stem
+                      : part.material.empty()                    ? stem + " (no material)"
+                                                                 : part.material;
+        object.mesh = std::make_shared<const Mesh>(io::meshFromSoup(part.soup, name));
+        if (part.color) object.material.color = *part.color;
+        objects.push_back(std::move(object));
+      }
+      return objects;
     }
     case Family::Assimp: return io::readWithAssimp(path, contents, ext, name);
   }

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cstdio>
 
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
@@ -8,7 +9,19 @@
 namespace mfr {
 
 Scene loadScene(const std::filesystem::path& path) {
-  if (path == "@sample") return makeSampleScene();
+  const std::string text = path.string();
+  if (text == "@sample") return makeSampleScene();
+  if (text.rfind("@quads:", 0) == 0) {
+    // @quads:N[:density[:seed]]
+    int layers = 0;
+    double density = 1.0;
+    unsigned seed = 1;
+    char extra = 0;
+    const int got = std::sscanf(text.c_str(), "@quads:%d:%lf:%u%c", &layers, &density, &seed, &extra);
+    if (got < 1 || got > 3) throw Error(text, "expected @quads:N[:density[:seed]]");
+    return makeQuadsScene(layers, density, seed);
+  }
+  if (!text.empty() && text[0] == '@') throw Error(text, "unknown built-in scene (@sample, @quads:N[:density[:seed]])");
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   Scene scene;

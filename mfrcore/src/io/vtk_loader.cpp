@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -22,13 +21,11 @@
 #include <vtkIdList.h>
 #include <vtkLogger.h>
 #include <vtkNew.h>
-#include <vtkOBJReader.h>
 #include <vtkOutputWindow.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataNormals.h>
-#include <vtkPolyDataReader.h>
 #include <vtkPolygon.h>
 #include <vtkSTLReader.h>
 #include <vtkSmartPointer.h>
@@ -210,41 +207,6 @@ void checkStl(std::string_view head, std::uintmax_t size, const std::string& nam
   }
   if (solid) return;
   throw Error(name, "not an STL file (" + std::to_string(size) + " bytes: too short for a binary STL header and not ASCII 'solid')");
-}
-
-// vtkOBJReader reads "nan" or "1x" as 0 without a word, so vertex lines are checked here first.
-void checkObjVertices(std::string_view text, const std::string& name) {
-  std::size_t pos = 0;
-  std::size_t lineNo = 0;
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    std::string_view line = text.substr(pos, end - pos);
-    pos = end + 1;
-    ++lineNo;
-    std::size_t i = 0;
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
-    if (line.size() < i + 2 || line[i] != 'v' || (line[i + 1] != ' ' && line[i + 1] != '\t')) continue;
-    i += 2;
-    int count = 0;
-    while (true) {
-      while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
-      if (i >= line.size() || line[i] == '#') break;
-      std::size_t j = i;
-      while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
-      const char* first = line.data() + i;
-      if (*first == '+') ++first;
-      double v = 0.0;
-      const auto [ptr, ec] = std::from_chars(first, line.data() + j, v);
-      if (ec != std::errc() || ptr != line.data() + j)
-        throw Error(name, "malformed vertex coordinate '" + std::string(line.substr(i, std::min<std::size_t>(j - i, 32))) +
-                              "' on line " + std::to_string(lineNo));
-      if (!std::isfinite(v)) throw Error(name, "non-finite coordinate on line " + std::to_string(lineNo));
-      ++count;
-      i = j;
-    }
-    if (count < 3) throw Error(name, "vertex with fewer than 3 coordinates on line " + std::to_string(lineNo));
-  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -527,38 +489,19 @@ Mesh readWithVtk(VtkFormat format, const fs::path& path, const std::string* cont
   VtkMessages messages;
   vtkSmartPointer<vtkPolyData> pd;
   switch (format) {
-    case VtkFormat::Stl:
-    case VtkFormat::Obj: {
-      if (format == VtkFormat::Obj) {
-        if (contents != nullptr) {
-          checkObjVertices(*contents, name);
-        } else {
-          std::ifstream in(path, std::ios::binary);
-          std::string text(static_cast<std::size_t>(fs::file_size(path)), '\0');
-          in.read(text.data(), static_cast<std::streamsize>(text.size()));
-          checkObjVertices(text, name);
-        }
-      }
-      if (format == VtkFormat::Stl) {
-        if (contents != nullptr)
-          checkStl(std::string_view(*contents).substr(0, 84), contents->size(), name);
-        else
-          checkStl(readHead(path, 84), fs::file_size(path), name);
-      }
-      // vtkSTLReader and vtkOBJReader only read named files.
+    case VtkFormat::Stl: {
+      if (contents != nullptr)
+        checkStl(std::string_view(*contents).substr(0, 84), contents->size(), name);
+      else
+        checkStl(readHead(path, 84), fs::file_size(path), name);
+      // vtkSTLReader only reads named files.
       std::unique_ptr<TempFile> temp;
-      if (contents != nullptr) temp = std::make_unique<TempFile>(*contents, format == VtkFormat::Stl ? ".stl" : ".obj", name);
+      if (contents != nullptr) temp = std::make_unique<TempFile>(*contents, ".stl", name);
       const std::string file = temp ? temp->path().string() : path.string();
-      if (format == VtkFormat::Stl) {
-        vtkNew<vtkSTLReader> reader;
-        reader->SetFileName(file.c_str());
-        reader->MergingOn();  // STL repeats shared corners; merged, they get smooth normals
-        pd = runReader(reader.GetPointer(), messages, false, "STL", name, temp ? file : std::string{});
-      } else {
-        vtkNew<vtkOBJReader> reader;
-        reader->SetFileName(file.c_str());
-        pd = runReader(reader.GetPointer(), messages, false, "OBJ", name, temp ? file : std::string{});
-      }
+      vtkNew<vtkSTLReader> reader;
+      reader->SetFileName(file.c_str());
+      reader->MergingOn();  // STL repeats shared corners; merged, they get smooth normals
+      pd = runReader(reader.GetPointer(), messages, false, "STL", name, temp ? file : std::string{});
       break;
     }
     case VtkFormat::Vtp: {
@@ -570,23 +513,6 @@ Mesh readWithVtk(VtkFormat format, const fs::path& path, const std::string* cont
         reader->SetFileName(path.string().c_str());
       }
       pd = runReader(reader.GetPointer(), messages, true, "VTP (XML PolyData)", name);
-      break;
-    }
-    case VtkFormat::VtkLegacy: {
-      vtkNew<vtkPolyDataReader> reader;
-      if (contents != nullptr) {
-        if (contents->size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
-          throw Error(name, "legacy VTK data over 2 GiB cannot be read from memory");
-        reader->ReadFromInputStringOn();
-        reader->SetBinaryInputString(contents->data(), static_cast<int>(contents->size()));
-      } else {
-        reader->SetFileName(path.string().c_str());
-      }
-      if (reader->IsFilePolyData() == 0) {
-        std::string reason = messages.reason();
-        throw Error(name, "not a legacy VTK POLYDATA file" + (reason.empty() ? "" : " (" + reason + ")"));
-      }
-      pd = runReader(reader.GetPointer(), messages, true, "legacy VTK", name);
       break;
     }
   }

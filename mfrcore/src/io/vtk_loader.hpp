@@ -1,5 +1,5 @@
 #pragma once
-// VTK-backed loading (private to mfrcore/io): STL, OBJ, VTP and legacy .vtk readers, plus the
+// VTK-backed loading (private to mfrcore/io): the STL and VTP readers, plus the
 // triangulation and feature-angle normals that every loader shares, so that all formats come out
 // with the same tessellation and shading rules.
 #include <cstdint>
@@ -39,7 +39,9 @@ Mesh meshFromSoup(const PolygonSoup& soup, const std::string& name);
 // colors and indices change too.
 void computeFeatureNormals(Mesh& mesh, const std::string& name);
 
-enum class VtkFormat { Stl, Obj, Vtp, VtkLegacy };
+// STL and VTP; OBJ and legacy .vtk have parsers of their own (obj_loader, vtk_legacy_loader)
+// because VTK's readers crash on malformed input.
+enum class VtkFormat { Stl, Vtp };
 
 // Reads `path` with VTK, or `contents` (already decompressed bytes of that file) when not null.
 // Throws mfr::Error(name, reason); VTK's own messages never reach stderr.

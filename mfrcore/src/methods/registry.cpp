@@ -1,7 +1,19 @@
 #include "mfr/methods/registry.hpp"
 
+#include "abuffer_fixed_array.hpp"
 #include "abuffer_linked_list.hpp"
+#include "abuffer_sbuffer.hpp"
+#include "depth_peeling_front_to_back.hpp"
+#include "dual_depth_peeling.hpp"
+#include "k_peeling.hpp"
+#include "kbuffer.hpp"
+#include "kplus_array.hpp"
+#include "kplus_dynamic.hpp"
+#include "kplus_heap.hpp"
+#include "kplus_sbuffer.hpp"
 #include "mfr/error.hpp"
+#include "moment_based_oit.hpp"
+#include "weighted_blended_oit.hpp"
 
 namespace mfr {
 
@@ -14,6 +26,18 @@ static std::unique_ptr<Method> make() {
 const std::vector<RegistryEntry>& methodRegistry() {
   static const std::vector<RegistryEntry> entries{
       {"abuffer-ll", make<ABufferLinkedList>},
+      {"peel-f2b", make<DepthPeelingFrontToBack>},
+      {"peel-dual", make<DualDepthPeeling>},
+      {"abuffer-array", make<ABufferFixedArray>},
+      {"abuffer-sbuffer", make<ABufferSBuffer>},
+      {"wboit", make<WeightedBlendedOit>},
+      {"mboit", make<MomentBasedOit>},
+      {"kbuffer", make<KBufferSorted>},
+      {"kplus-array", make<KPlusBufferMaxArray>},
+      {"kplus-heap", make<KPlusBufferMaxHeap>},
+      {"kpeel", make<KPeeling>},
+      {"kplus-sbuffer", make<KPlusBufferSBuffer>},
+      {"kplus-dynamic", make<KPlusBufferDynamic>},
   };
   return entries;
 }

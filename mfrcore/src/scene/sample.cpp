@@ -2,6 +2,9 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include <cmath>
+
+#include "mfr/error.hpp"
 #include "mfr/scene/primitives.hpp"
 
 namespace mfr {
@@ -40,6 +43,58 @@ Scene makeSampleScene() {
   Camera iso = front;
   iso.eye = {2.5, 2.0, 2.5};
   s.views.push_back({"iso", s.fit(iso)});
+  return s;
+}
+
+Scene makeQuadsScene(int layers, double density, std::uint32_t seed) {
+  if (layers < 1 || layers > 4096) throw Error("@quads", "layer count must be in [1, 4096]");
+  if (!(density > 0.0) || density > 1.0) throw Error("@quads", "pixel density must be in (0, 1]");
+  Scene s;
+  s.name = "quads-" + std::to_string(layers);
+  s.background = glm::vec3(1.0f);
+  // Same deterministic generator as the primitives (splitmix-style), so runs are comparable.
+  std::uint32_t state = seed * 2654435761u + 0x9E3779B9u;
+  const auto uniform = [&state] {
+    std::uint32_t z = (state += 0x9E3779B9u);
+    z = (z ^ (z >> 16)) * 0x85EBCA6Bu;
+    z = (z ^ (z >> 13)) * 0xC2B2AE35u;
+    z ^= z >> 16;
+    return z / 4294967296.0;
+  };
+  const double side = 2.0 * std::sqrt(density);  // the view is 2 × 2 world units
+  // Four triangles fanned from an off-centre interior point: the two diagonals of a two-triangle
+  // quad would run exactly through pixel centres of a square image and be double-counted by
+  // the oracle's edge rule.
+  auto quad = std::make_shared<const Mesh>([side] {
+    Mesh m;
+    const float h = static_cast<float>(side / 2);
+    m.positions = {{-h, -h, 0}, {h, -h, 0}, {h, h, 0}, {-h, h, 0}, {0.1234567f * h, 0.0456789f * h, 0}};
+    m.normals.assign(5, glm::vec3(0, 0, 1));
+    m.indices = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4};
+    return m;
+  }());
+  for (int i = 0; i < layers; ++i) {
+    Object o;
+    o.name = "quad " + std::to_string(i);
+    o.mesh = quad;
+    // Depths spread over (−0.95, 0.95) in strata with jitter: random order, no exact ties.
+    const double z = -0.95 + 1.9 * (i + 0.1 + 0.8 * uniform()) / layers;
+    o.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 0.0, z));
+    o.material.color = glm::vec4(0.2f + 0.8f * static_cast<float>(uniform()), 0.2f + 0.8f * static_cast<float>(uniform()),
+                                 0.2f + 0.8f * static_cast<float>(uniform()), 0.15f + 0.35f * static_cast<float>(uniform()));
+    s.objects.push_back(std::move(o));
+  }
+  // Draw order must not follow depth order: shuffle (Fisher–Yates with the same generator).
+  for (std::size_t i = s.objects.size(); i > 1; --i)
+    std::swap(s.objects[i - 1], s.objects[static_cast<std::size_t>(uniform() * static_cast<double>(i))]);
+  Camera c;
+  c.projection = Projection::Orthographic;
+  c.eye = {0.0, 0.0, 2.0};
+  c.target = {0.0, 0.0, 0.0};
+  c.orthoHeight = 2.0;
+  c.nearPlane = 0.5;
+  c.farPlane = 3.5;
+  s.views.push_back({"front", c});
   return s;
 }
 

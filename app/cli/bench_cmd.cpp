@@ -1,0 +1,175 @@
+#include <algorithm>
+#include <chrono>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "mfr/error.hpp"
+#include "mfr/gl/context.hpp"
+#include "mfr/gpu_renderer.hpp"
+#include "mfr/io/load.hpp"
+#include "mfr/io_util.hpp"
+#include "mfr/reference/composite.hpp"
+#include "mfr/reference/metrics.hpp"
+#include "mfr/reference/oracle.hpp"
+#include "mfr/render.hpp"
+
+namespace mfr::cli {
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string mib(std::uint64_t bytes) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(2) << static_cast<double>(bytes) / (1024.0 * 1024.0);
+  return s.str();
+}
+
+// "name" or "name:key=value:key=value" → request (a method may be benchmarked with several settings).
+RenderRequest parseMethodSpec(const std::string& spec, int w, int h) {
+  RenderRequest r;
+  r.width = w;
+  r.height = h;
+  std::istringstream in(spec);
+  std::string part;
+  bool first = true;
+  while (std::getline(in, part, ':')) {
+    if (first) {
+      r.method = part;
+      first = false;
+      continue;
+    }
+    const auto eq = part.find('=');
+    if (eq == std::string::npos || eq == 0) throw Error("--methods " + spec, "expected name:key=value:…");
+    r.params[part.substr(0, eq)] = part.substr(eq + 1);
+  }
+  return r;
+}
+
+}  // namespace
+
+void addBench(CLI::App& app) {
+  struct Options {
+    std::string scene, methods, size = "512x512", view = "fit", json, label;
+    int repeat = 5, warmup = 1;
+    bool noQuality = false;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Benchmark methods side by side: per-pass median time, memory, fragments, RMSE and FLIP vs the oracle");
+  cmd->add_option("scene", opt->scene, "Scene: model file, .mfrscene, @sample or @quads:N[:density[:seed]]")->required();
+  cmd->add_option("--methods,-m", opt->methods, "Comma-separated methods, each name[:key=value…]")->required();
+  cmd->add_option("--repeat,-r", opt->repeat, "Timed frames per method")->capture_default_str()->check(CLI::Range(1, 1000));
+  cmd->add_option("--warmup", opt->warmup, "Untimed frames first")->capture_default_str()->check(CLI::Range(0, 100));
+  cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
+  cmd->add_option("--view", opt->view, "Named view")->capture_default_str();
+  cmd->add_flag("--no-quality", opt->noQuality, "Skip the oracle and the RMSE/FLIP columns");
+  cmd->add_option("--json", opt->json, "Write all results as JSON");
+  cmd->callback([opt] {
+    const auto [w, h] = parseSize("--size", opt->size);
+    std::vector<RenderRequest> requests;
+    for (const std::string& spec : splitList(opt->methods)) requests.push_back(parseMethodSpec(spec, w, h));
+    if (requests.empty()) throw Error("--methods", "no method given");
+    const Scene scene = loadScene(opt->scene);
+    const Camera camera = scene.view(opt->view);
+
+    ImageRGBA8 reference;
+    double oracleMs = 0.0;
+    std::uint64_t totalFragments = 0;
+    if (!opt->noQuality) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const FragmentLists lists = castFragments(scene, camera, w, h);
+      reference = compositeOver(lists, scene.background);
+      oracleMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      totalFragments = lists.fragments.size();
+    }
+    GpuRenderer& gpu = headlessRenderer();
+    gpu.setScene(scene);
+    const gl::ContextInfo info = gl::queryContextInfo();
+
+    nlohmann::ordered_json out;
+    out["scene"] = scene.name;
+    out["size"] = opt->size;
+    out["view"] = opt->view;
+    out["repeat"] = opt->repeat;
+    out["renderer"] = info.renderer;
+    out["gl_version"] = info.version;
+    out["timing"] = GpuRenderer::defaultFinishTiming() ? "glFinish + CPU clock per pass (llvmpipe)" : "GPU timestamp queries";
+    out["oracle_fragments"] = totalFragments;
+    out["oracle_ms"] = oracleMs;
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+
+    std::cout << "scene " << scene.name << ", " << opt->size << ", view " << opt->view << ", " << opt->repeat
+              << " frames, renderer: " << info.renderer << "\n";
+    std::cout << std::left << std::setw(34) << "method" << std::right << std::setw(11) << "total ms" << std::setw(11)
+              << "MiB alloc" << std::setw(10) << "MiB used" << std::setw(11) << "frags" << std::setw(11) << "stored"
+              << std::setw(9) << "RMSE" << std::setw(9) << "FLIP" << "  passes (median ms)\n";
+    for (const RenderRequest& req : requests) {
+      for (int i = 0; i < opt->warmup; ++i) gpu.render(camera, req);
+      std::vector<std::pair<std::string, std::vector<double>>> perPass;
+      std::vector<double> totals;
+      RenderOutput last;
+      for (int i = 0; i < opt->repeat; ++i) {
+        last = gpu.render(camera, req);
+        totals.push_back(last.stats.totalTimeMs());
+        for (const auto& [pass, ms] : last.stats.passTimesMs) {
+          auto it = std::find_if(perPass.begin(), perPass.end(), [&](const auto& p) { return p.first == pass; });
+          if (it == perPass.end()) perPass.push_back({pass, {ms}});
+          else it->second.push_back(ms);
+        }
+      }
+      std::string label = req.method;
+      for (const auto& [k, v] : req.params) label += ":" + k + "=" + v;
+      nlohmann::ordered_json row;
+      row["method"] = label;
+      row["median_total_ms"] = median(totals);
+      nlohmann::ordered_json passes = nlohmann::ordered_json::object();
+      std::ostringstream passText;
+      for (const auto& [pass, v] : perPass) {
+        passes[pass] = median(v);
+        passText << " " << pass << "=" << std::fixed << std::setprecision(1) << median(v);
+      }
+      row["median_pass_ms"] = passes;
+      row["bytes_allocated"] = last.stats.bytesAllocated;
+      row["bytes_used"] = last.stats.bytesUsed;
+      row["fragments_generated"] = last.stats.fragmentsGenerated;
+      row["fragments_stored"] = last.stats.fragmentsStored;
+      row["overflow"] = last.stats.overflow;
+      row["passes"] = last.stats.passes;
+      std::string rmseText = "-", flipText = "-";
+      if (!opt->noQuality) {
+        const double e = rmse(reference, last.image);
+        const FlipResult f = flip(reference, last.image);
+        row["rmse"] = e;
+        row["flip_mean"] = f.stats.mean;
+        std::ostringstream a, b;
+        a << std::fixed << std::setprecision(4) << e;
+        b << std::fixed << std::setprecision(4) << f.stats.mean;
+        rmseText = a.str();
+        flipText = b.str();
+      }
+      nlohmann::ordered_json notes = nlohmann::ordered_json::object();
+      for (const auto& [k, v] : last.stats.notes) notes[k] = v;
+      row["notes"] = notes;
+      rows.push_back(row);
+      std::cout << std::left << std::setw(34) << label << std::right << std::fixed << std::setprecision(1)
+                << std::setw(11) << median(totals) << std::setw(11) << mib(last.stats.bytesAllocated) << std::setw(10)
+                << mib(last.stats.bytesUsed) << std::setw(11) << last.stats.fragmentsGenerated << std::setw(11)
+                << last.stats.fragmentsStored << std::setw(9) << rmseText << std::setw(9) << flipText << " "
+                << passText.str() << (last.stats.overflow ? "  OVERFLOW" : "") << "\n";
+    }
+    out["results"] = rows;
+    if (!opt->json.empty()) writeFileAtomically(opt->json, out.dump(2) + "\n");
+  });
+}
+
+}  // namespace mfr::cli

@@ -1,0 +1,213 @@
+#include "obj_loader.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <map>
+#include <unordered_map>
+#include <utility>
+
+#include "mfr/error.hpp"
+
+namespace mfr::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// .mtl files bigger than this are not material libraries.
+constexpr std::uintmax_t kMaxMtlBytes = 64u << 20;
+
+std::vector<std::string_view> words(std::string_view line) {
+  std::vector<std::string_view> out;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    while (i < line.size() && std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+    if (i < line.size() && line[i] == '#') break;
+    const std::size_t start = i;
+    while (i < line.size() && !std::isspace(static_cast<unsigned char>(line[i]))) ++i;
+    if (i > start) out.push_back(line.substr(start, i - start));
+  }
+  return out;
+}
+
+bool parseDouble(std::string_view t, double& v) {
+  if (!t.empty() && t.front() == '+') t.remove_prefix(1);
+  const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  return ec == std::errc() && ptr == t.data() + t.size() && !t.empty();
+}
+
+bool parseInt(std::string_view t, std::int64_t& v) {
+  if (!t.empty() && t.front() == '+') t.remove_prefix(1);
+  const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+  return ec == std::errc() && ptr == t.data() + t.size() && !t.empty();
+}
+
+// Material colours from .mtl files: Kd, and opacity from d (or 1 − Tr).
+std::map<std::string, glm::vec4> readMaterials(const fs::path& file) {
+  std::map<std::string, glm::vec4> out;
+  std::error_code ec;
+  const std::uintmax_t size = fs::file_size(file, ec);
+  if (ec || size > kMaxMtlBytes || !fs::is_regular_file(file, ec)) return out;
+  std::ifstream in(file, std::ios::binary);
+  std::string line;
+  std::string current;
+  while (std::getline(in, line)) {
+    const std::vector<std::string_view> w = words(line);
+    if (w.empty()) continue;
+    if (w[0] == "newmtl" && w.size() >= 2) {
+      current = std::string(w[1]);
+      out.emplace(current, glm::vec4(0.8f, 0.8f, 0.8f, 1.0f));
+      continue;
+    }
+    if (current.empty()) continue;
+    glm::vec4& c = out[current];
+    double v[3];
+    if (w[0] == "Kd" && w.size() >= 4 && parseDouble(w[1], v[0]) && parseDouble(w[2], v[1]) && parseDouble(w[3], v[2]))
+      c = glm::vec4(glm::clamp(glm::vec3(v[0], v[1], v[2]), 0.0f, 1.0f), c.a);
+    else if (w[0] == "d" && w.size() >= 2 && parseDouble(w.back(), v[0]))
+      c.a = static_cast<float>(std::clamp(v[0], 0.0, 1.0));
+    else if (w[0] == "Tr" && w.size() >= 2 && parseDouble(w.back(), v[0]))
+      c.a = static_cast<float>(1.0 - std::clamp(v[0], 0.0, 1.0));
+  }
+  for (auto& [key, c] : out)
+    if (!std::isfinite(c.r + c.g + c.b + c.a)) c = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+  return out;
+}
+
+struct Corner {
+  std::uint32_t v;
+  std::int64_t vn;  // −1 when the corner has none
+};
+
+struct RawPart {
+  std::string material;
+  std::vector<Corner> corners;
+  std::vector<std::uint32_t> offsets{0};
+};
+
+}  // namespace
+
+std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory, const std::string& name) {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> vertexColors;
+  bool allColored = true;
+  std::vector<glm::vec3> normals;
+  std::vector<RawPart> parts(1);
+  std::map<std::string, std::size_t> partOf{{"", 0}};
+  std::size_t current = 0;
+  std::map<std::string, glm::vec4> materials;
+  std::vector<Corner> face;
+
+  std::size_t pos = 0;
+  std::size_t lineNo = 0;
+  while (pos < bytes.size()) {
+    std::size_t end = bytes.find('\n', pos);
+    if (end == std::string_view::npos) end = bytes.size();
+    const std::string_view line = bytes.substr(pos, end - pos);
+    pos = end + 1;
+    ++lineNo;
+    const std::vector<std::string_view> w = words(line);
+    if (w.empty()) continue;
+    const auto fail = [&](const std::string& why) -> void {
+      throw Error(name, "line " + std::to_string(lineNo) + ": " + why);
+    };
+    const auto number = [&](std::string_view t) {
+      double v = 0.0;
+      if (!parseDouble(t, v)) fail("malformed number '" + std::string(t.substr(0, 32)) + "'");
+      if (!std::isfinite(v)) fail("non-finite coordinate");
+      return v;
+    };
+
+    if (w[0] == "v") {
+      if (w.size() < 4) fail("vertex with fewer than 3 coordinates");
+      positions.emplace_back(number(w[1]), number(w[2]), number(w[3]));
+      // "v x y z r g b" is the common vertex-colour extension; "v x y z w" is not colour.
+      if (w.size() == 7)
+        vertexColors.emplace_back(number(w[4]), number(w[5]), number(w[6]));
+      else
+        allColored = false;
+      for (std::size_t k = 4; k < w.size() && w.size() != 7; ++k) number(w[k]);
+    } else if (w[0] == "vn") {
+      if (w.size() < 4) fail("normal with fewer than 3 components");
+      normals.emplace_back(number(w[1]), number(w[2]), number(w[3]));
+    } else if (w[0] == "f") {
+      face.clear();
+      for (std::size_t k = 1; k < w.size(); ++k) {
+        const std::string_view t = w[k];
+        const std::size_t s1 = t.find('/');
+        std::int64_t v = 0;
+        if (!parseInt(t.substr(0, s1), v) || v == 0) fail("malformed face corner '" + std::string(t.substr(0, 32)) + "'");
+        // Negative indices count back from the last vertex defined so far.
+        const std::int64_t vi = v < 0 ? static_cast<std::int64_t>(positions.size()) + v : v - 1;
+        if (vi < 0 || vi >= static_cast<std::int64_t>(positions.size()))
+          fail("face refers to vertex " + std::to_string(v) + " but there are " + std::to_string(positions.size()) +
+               " vertices");
+        std::int64_t ni = -1;
+        if (s1 != std::string_view::npos) {
+          const std::size_t s2 = t.find('/', s1 + 1);
+          if (s2 != std::string_view::npos && s2 + 1 < t.size()) {
+            std::int64_t n = 0;
+            if (!parseInt(t.substr(s2 + 1), n) || n == 0) fail("malformed face corner '" + std::string(t.substr(0, 32)) + "'");
+            ni = n < 0 ? static_cast<std::int64_t>(normals.size()) + n : n - 1;
+            // Normals are optional: an index that leads nowhere loses the normal, not the face.
+            if (ni < 0) ni = -1;
+          }
+        }
+        face.push_back({static_cast<std::uint32_t>(vi), ni});
+      }
+      if (face.size() < 3) continue;  // points and edges are no surface
+      RawPart& part = parts[current];
+      part.corners.insert(part.corners.end(), face.begin(), face.end());
+      part.offsets.push_back(static_cast<std::uint32_t>(part.corners.size()));
+    } else if (w[0] == "usemtl") {
+      const std::string material = w.size() >= 2 ? std::string(w[1]) : std::string();
+      auto [it, added] = partOf.emplace(material, parts.size());
+      if (added) {
+        parts.emplace_back();
+        parts.back().material = material;
+      }
+      current = it->second;
+    } else if (w[0] == "mtllib") {
+      for (std::size_t k = 1; k < w.size(); ++k)
+        for (auto& [key, c] : readMaterials(directory / std::string(w[k]))) materials.emplace(key, c);
+    }
+    // vt, vp, g, o, s, l, p and the free-form statements carry nothing we draw.
+  }
+
+  std::vector<ObjPart> out;
+  for (RawPart& raw : parts) {
+    if (raw.corners.empty()) continue;
+    const bool withNormals = std::all_of(raw.corners.begin(), raw.corners.end(), [&](const Corner& c) {
+      return c.vn >= 0 && static_cast<std::size_t>(c.vn) < normals.size();
+    });
+    const bool withColors = allColored && vertexColors.size() == positions.size();
+    ObjPart part;
+    part.material = raw.material;
+    if (auto m = materials.find(raw.material); m != materials.end()) part.color = m->second;
+    // Each part gets the vertices it uses; with normals, a vertex is a (position, normal) pair.
+    std::unordered_map<std::uint64_t, std::uint32_t> index;
+    part.soup.ids.reserve(raw.corners.size());
+    for (const Corner& c : raw.corners) {
+      const std::uint64_t key = withNormals ? (std::uint64_t{c.v} << 32 | static_cast<std::uint64_t>(c.vn)) : c.v;
+      auto [it, added] = index.emplace(key, static_cast<std::uint32_t>(part.soup.points.size()));
+      if (added) {
+        part.soup.points.push_back(positions[c.v]);
+        if (withNormals) part.soup.normals.push_back(normals[static_cast<std::size_t>(c.vn)]);
+        if (withColors) part.soup.colors.emplace_back(glm::clamp(vertexColors[c.v], 0.0f, 1.0f), 1.0f);
+      }
+      part.soup.ids.push_back(it->second);
+    }
+    part.soup.offsets = std::move(raw.offsets);
+    out.push_back(std::move(part));
+  }
+  if (out.empty()) {
+    if (positions.empty()) throw Error(name, "no triangles (no vertices or faces: is this an OBJ file?)");
+    throw Error(name, "no triangles (the OBJ file has no faces)");
+  }
+  return out;
+}
+
+}  // namespace mfr::io

@@ -1,0 +1,162 @@
+// The mfr command line end to end: bad input gives one line naming the file or argument and the
+// reason, a non-zero exit, no crash and no output file; good input gives the files.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "mfr/image.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int exitCode = -1;
+  std::string out;  // stdout + stderr
+};
+
+Result run(const std::string& args) {
+  Result r;
+  const std::string cmd = std::string(MFR_CLI) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
+  const int status = pclose(pipe);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+  return r;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("mfr-cli-" + std::to_string(::getpid()) + "-" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path file(const std::string& name, const std::string& content) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << content;
+    return p;
+  }
+  // Bad input: exit code non-zero (1 or 2), no crash (< 128), one line mentioning `mention`,
+  // and the output file was not created.
+  void expectCleanFailure(const std::string& args, const std::string& mention) {
+    const fs::path out = dir_ / "out.png";
+    const Result r = run(args + " -o " + out.string());
+    EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << "exit " << r.exitCode << ": " << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    EXPECT_NE(r.out.find(mention), std::string::npos) << "message does not name '" << mention << "': " << r.out;
+    EXPECT_EQ(r.out.rfind("mfr: ", 0), 0u) << r.out;
+    EXPECT_FALSE(fs::exists(out)) << "partial output left behind";
+    for (const auto& e : fs::directory_iterator(dir_))
+      EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << "temporary left: " << e.path();
+  }
+  fs::path dir_;
+};
+
+TEST_F(Cli, MissingFile) { expectCleanFailure("render " + (dir_ / "nope.stl").string(), "nope.stl: no such file"); }
+
+TEST_F(Cli, DirectoryInsteadOfFile) { expectCleanFailure("render " + dir_.string(), dir_.string()); }
+
+TEST_F(Cli, TruncatedBinaryStl) {
+  // 80-byte header, then a count of 10 triangles but only one present.
+  std::string stl(80, ' ');
+  const std::uint32_t n = 10;
+  stl.append(reinterpret_cast<const char*>(&n), 4);
+  stl.append(50, '\0');
+  const fs::path p = file("cut.stl", stl);
+  expectCleanFailure("render " + p.string(), "cut.stl");
+}
+
+TEST_F(Cli, GarbagePly) {
+  const fs::path p = file("junk.ply", "ply\nformat ascii 1.0\nelement vertex banana\nend_header\n\x01\x02\x03");
+  expectCleanFailure("render " + p.string(), "junk.ply");
+}
+
+TEST_F(Cli, JsonSyntaxError) {
+  const fs::path p = file("broken.mfrscene", "{\n  \"objects\": [\n    {\"primitive\": {\"type\": \"sphere\"}\n  ]\n}\n");
+  expectCleanFailure("render " + p.string(), "broken.mfrscene: JSON syntax error at line 4");
+}
+
+TEST_F(Cli, EmptyScene) {
+  const fs::path p = file("empty.mfrscene", R"({"objects": []})");
+  expectCleanFailure("render " + p.string(), "nothing to render");
+}
+
+TEST_F(Cli, UnknownPrimitiveNamesTheJsonPath) {
+  const fs::path p = file("prim.mfrscene", R"({"objects": [{"primitive": {"type": "teapot"}}]})");
+  expectCleanFailure("render " + p.string(), "objects[0].primitive.type");
+}
+
+TEST_F(Cli, UnknownMethod) { expectCleanFailure("render @sample --method magic", "--method magic: unknown method"); }
+
+TEST_F(Cli, ZeroSizeImage) { expectCleanFailure("render @sample --size 0x0", "--size 0x0"); }
+
+TEST_F(Cli, MalformedSize) { expectCleanFailure("render @sample --size big", "--size big"); }
+
+TEST_F(Cli, UnknownView) { expectCleanFailure("render @sample --view nowhere", "view 'nowhere'"); }
+
+TEST_F(Cli, BadMethodParameter) {
+  expectCleanFailure("render @sample --method abuffer-ll -p pool=sometimes", "--param pool=sometimes");
+  expectCleanFailure("render @sample --method abuffer-ll -p colour=red", "--param colour");
+}
+
+TEST_F(Cli, MissingOutputFolder) {
+  const Result r = run("render @sample --size 16x16 -o " + (dir_ / "no" / "such" / "dir.png").string());
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find("folder does not exist"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, CompareSizeMismatchAndCorruptPng) {
+  mfr::writePng(dir_ / "a.png", mfr::ImageRGBA8(4, 4));
+  mfr::writePng(dir_ / "b.png", mfr::ImageRGBA8(5, 4));
+  Result r = run("compare " + (dir_ / "a.png").string() + " " + (dir_ / "b.png").string());
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.out.find("differs from reference"), std::string::npos) << r.out;
+  const fs::path bad = file("bad.png", "\x89PNG\r\n\x1a\n garbage");
+  r = run("compare " + (dir_ / "a.png").string() + " " + bad.string());
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.out.find("bad.png"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, RenderWritesImageAndStats) {
+  const fs::path png = dir_ / "s.png", json = dir_ / "s.json";
+  const Result r = run("render @sample --size 48x40 --view front -o " + png.string() + " --stats " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const mfr::ImageRGBA8 img = mfr::readPng(png);
+  EXPECT_EQ(img.width, 48);
+  EXPECT_EQ(img.height, 40);
+  // The sample is visible: the centre pixel is not the white background.
+  const std::uint8_t* c = img.at(24, 20);
+  EXPECT_LT(int(c[0]) + c[1] + c[2], 3 * 250);
+  std::ifstream in(json);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"fragments_generated\""), std::string::npos);
+}
+
+TEST_F(Cli, GpuAndOracleImagesAgree) {
+  const fs::path a = dir_ / "oracle.png", b = dir_ / "gpu.png";
+  ASSERT_EQ(run("render @sample --size 64x48 --view iso -o " + a.string()).exitCode, 0);
+  ASSERT_EQ(run("render @sample --size 64x48 --view iso --method abuffer-ll -o " + b.string()).exitCode, 0);
+  const Result r = run("compare " + a.string() + " " + b.string() + " --metric rmse");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const double e = std::stod(r.out.substr(r.out.find("rmse ") + 5));
+  EXPECT_LT(e, 0.02) << r.out;  // edge pixels may differ; everything else is exact
+}
+
+TEST_F(Cli, InfoReportsTrianglesAndHistogram) {
+  const Result r = run("info @quads:7 --size 32x32 --view front");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("parts      7"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("triangles  28"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("n=7: 1024 pixels"), std::string::npos) << r.out;  // every pixel has 7 layers
+}
+
+}  // namespace

@@ -1,0 +1,121 @@
+// Dynamic k+-buffer (Vasilakis et al., TVCG 2015) on the GPU: the histogram built by the
+// compute pass gives the k that selectDynamicK picks from the oracle's histogram; the budget is
+// never exceeded and nearly used up; the captured set is the k nearest for the chosen k; a budget
+// below k = 1 is refused with a one-line reason.
+#include <gtest/gtest.h>
+
+#include "gl_fixture.hpp"
+#include "mfr/budget/dynamic_k.hpp"
+#include "mfr/error.hpp"
+#include "mfr/scene/sample.hpp"
+
+namespace mfr::test {
+namespace {
+
+constexpr int kW = 96, kH = 72;
+constexpr std::uint64_t kPixels = static_cast<std::uint64_t>(kW) * kH;
+
+struct Reference {
+  Scene scene = makeSampleScene();
+  Camera camera = scene.view("front");
+  FragmentLists oracle = castFragments(scene, camera, kW, kH);
+  ImageRGBA8 image = compositeOver(oracle, scene.background);
+};
+const Reference& reference() {
+  static const Reference r;
+  return r;
+}
+
+RenderRequest request(std::map<std::string, std::string> params) {
+  RenderRequest req;
+  req.method = "kplus-dynamic";
+  req.params = std::move(params);
+  req.width = kW;
+  req.height = kH;
+  return req;
+}
+
+// The model kplus-dynamic checks the budget against (spin lock, tail off): per pixel 8k + 4 (n(p)) +
+// 4 (semaphore), fixed 32 (counters) + 258·4 (histogram).
+KBufferMemoryModel model() { return {kPixels, 8, 8, 32 + 258 * 4}; }
+
+std::string note(const Stats& s, const std::string& key) {
+  for (const auto& [k, v] : s.notes)
+    if (k == key) return v;
+  return {};
+}
+
+TEST(KPlusDynamic, RobustnessPicksTheKOfTheHistogram) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  const std::vector<std::uint64_t> histogram = depthComplexityHistogram(ref.oracle);
+  for (double r : {0.3, 0.6, 0.9}) {
+    SCOPED_TRACE("R_h=" + std::to_string(r));
+    const DynamicKChoice expected = selectDynamicK(histogram, 0, 1ull << 30, r, model());
+    const RenderOutput out = gpu.render(ref.camera, request({{"robustness", std::to_string(r)}, {"budget_mib", "1024"}}));
+    // The rasteriser and the oracle may differ at a few edge pixels: allow one step of k.
+    EXPECT_NEAR(static_cast<double>(out.stats.kMax), static_cast<double>(expected.k), 1.0);
+    EXPECT_NE(note(out.stats, "k chosen").find("robustness"), std::string::npos) << note(out.stats, "k chosen");
+    EXPECT_EQ(out.stats.bytesAllocated, model().bytes(out.stats.kMax));
+    EXPECT_EQ(out.stats.lockFailures, 0u);
+    const double captured = static_cast<double>(out.stats.fragmentsStored) / static_cast<double>(out.stats.fragmentsGenerated);
+    EXPECT_GE(captured, r - 1e-9);
+  }
+}
+
+TEST(KPlusDynamic, FullRobustnessIsTheABuffer) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  const RenderOutput out = gpu.render(ref.camera, request({{"robustness", "1"}, {"budget_mib", "1024"}}));
+  EXPECT_EQ(out.stats.fragmentsDropped, 0u);
+  EXPECT_NEAR(static_cast<double>(out.stats.kMax), static_cast<double>(ref.oracle.maxCount()), 1.0);
+  const ImageComparison ic = compareImages(ref.oracle, ref.image, out.image, 2);
+  EXPECT_GE(ic.fraction(), 0.999) << (ic.compared - ic.within) << " pixels off; max " << ic.maxDifference;
+}
+
+TEST(KPlusDynamic, BudgetIsNeverExceededAndNearlyUsed) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  for (double mib : {0.2, 0.5, 0.8}) {
+    SCOPED_TRACE("budget " + std::to_string(mib) + " MiB");
+    const std::uint64_t budget = static_cast<std::uint64_t>(mib * 1024 * 1024);
+    for (const char* structure : {"array", "heap"}) {
+      const RenderRequest req = request({{"robustness", "1"}, {"budget_mib", std::to_string(mib)}, {"structure", structure}});
+      const RenderOutput out = gpu.render(ref.camera, req);
+      EXPECT_LE(out.stats.bytesAllocated, budget);
+      EXPECT_GT(out.stats.bytesAllocated + kPixels * 8, budget) << "one more slot per pixel would still fit";
+      EXPECT_NE(note(out.stats, "k chosen").find("memory budget"), std::string::npos) << note(out.stats, "k chosen");
+      // The capture is a k-buffer with the chosen k.
+      const auto k = out.stats.kMax;
+      const CapturedLists lists = gpu.capture(ref.camera, req, static_cast<int>(k));
+      const ListComparison lc = compareLists(ref.oracle, lists, k);
+      EXPECT_EQ(lc.countMismatches, 0u) << lc.firstMismatch;
+      EXPECT_EQ(lc.depthMismatches, 0u) << lc.firstMismatch;
+      EXPECT_EQ(lc.colorMismatches, 0u) << lc.firstMismatch;
+    }
+  }
+}
+
+TEST(KPlusDynamic, BudgetBelowOneSlotIsRefused) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  try {
+    gpu.render(ref.camera, request({{"budget_mib", "0.05"}}));
+    ADD_FAILURE() << "a 0.05 MiB budget cannot hold k = 1 at 96x72";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("--param budget_mib=0.05: memory budget", 0), 0u) << what;
+    EXPECT_NE(what.find("k = 1 needs " + std::to_string(model().bytes(1)) + " B"), std::string::npos) << what;
+  }
+}
+
+}  // namespace
+}  // namespace mfr::test
