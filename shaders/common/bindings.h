@@ -36,11 +36,13 @@
 // Invalid index / end of a linked list
 #define MFR_NIL 0xFFFFFFFFu
 
-// Longest per-pixel list any resolve walks. A hard bound keeps every GPU loop finite; it is also
-// kept below 65535 because llvmpipe (Mesa 22.3) miscomputed list walks whose loop bound
-// (a uniform) was ≥ 65535 — measured: wrong fragments along a screen diagonal at 65535, none at
-// 60000. A pixel with more fragments than this is reported as overflow.
-#define MFR_MAX_LIST_WALK 60000u
+// Longest per-pixel list any resolve walks. A hard bound keeps every GPU loop finite. It is kept
+// well below 65535 because llvmpipe (Mesa 22.3.6) miscomputed list walks whose loop bound (a
+// uniform) was large — measured: wrong fragments along a screen diagonal with a bound of 65535,
+// and fragments missing from l+-depth-sorting rounds (pixels with > MFR_RESOLVE_LOCAL fragments)
+// with 60000 and with 16384; correct with 4096 and below (tests: DeepPixelsUseLPlusDepthSorting).
+// A pixel with more fragments than this is cut off at resolve.
+#define MFR_MAX_LIST_WALK 4096u
 
 // Local array size used by the resolve pass to gather one pixel's fragments before sorting;
 // longer lists are sorted in l+-depth-sorting rounds (k+-buffer paper, §4.4).

@@ -59,7 +59,7 @@ void kbLockFailed();
 
 #ifndef MFR_SYNC_INTERLOCK
 layout(r32ui, binding = MFR_IMAGE_LOCKS) uniform coherent uimage2D uKbLocks;
-uniform uint uSpinLimit;  // attempts per fragment (< 65535: llvmpipe loop-bound trap)
+uniform uint uSpinLimit;  // attempts per fragment (≤ 4096: llvmpipe loop-bound trap, see bindings.h)
 #endif
 
 void main() {

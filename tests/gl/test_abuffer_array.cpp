@@ -15,7 +15,7 @@
 namespace mfr::test {
 
 INSTANTIATE_TEST_SUITE_P(ABufferFixedArray, ExactMethod,
-                         ::testing::Values(ExactCase{"abuffer-array", {{"slots", "64"}}, "slots64"},
+                         ::testing::Values(ExactCase{"abuffer-array", {{"slots", "64"}}, "slots64", {{"slots", "128"}}},
                                            ExactCase{"abuffer-array", {{"slots", "0"}}, "auto"}),
                          exactCaseName);
 

@@ -17,8 +17,8 @@ namespace mfr::test {
 
 // The sample reaches about 40 layers; the defaults (64 passes, 32 dual passes) cover it.
 INSTANTIATE_TEST_SUITE_P(DepthPeeling, ExactMethod,
-                         ::testing::Values(ExactCase{"peel-f2b", {}, "default"},
-                                           ExactCase{"peel-dual", {}, "default"}),
+                         ::testing::Values(ExactCase{"peel-f2b", {}, "default", {{"max_passes", "128"}}},
+                                           ExactCase{"peel-dual", {}, "default", {{"max_passes", "64"}}}),
                          exactCaseName);
 
 namespace {

@@ -53,6 +53,14 @@ TEST_P(ExactMethod, SampleIsoViewMatchesOracle) {
   checkAgainstOracle(scene, scene.view("iso"), 96, 96, GetParam());
 }
 
+// More fragments per pixel than the resolve's local array (64): the l+-depth-sorting rounds.
+TEST_P(ExactMethod, DeepPixelsUseLPlusDepthSorting) {
+  const Scene scene = makeQuadsScene(100, 0.5, 3);
+  ExactCase c = GetParam();
+  for (const auto& [k, v] : c.deepParams) c.params[k] = v;
+  checkAgainstOracle(scene, scene.view("front"), 40, 32, c);
+}
+
 // Real CAD files (Debian packages occt-misc and assimp-testmodels, see shared/DATA.md).
 TEST_P(ExactMethod, RealModelsMatchOracle) {
   for (const char* path : {"/usr/share/opencascade/data/stl/bearing.stl",

@@ -13,6 +13,9 @@ struct ExactCase {
   std::string method;
   std::map<std::string, std::string> params;
   std::string label;  // test name suffix, e.g. "pool_previous"
+  // Parameters added for the 100-layers-per-pixel test, for cases whose capacity (slots, passes)
+  // is deliberately smaller than that.
+  std::map<std::string, std::string> deepParams = {};
 };
 
 class ExactMethod : public ::testing::TestWithParam<ExactCase> {};
