@@ -61,6 +61,7 @@ void addBench(CLI::App& app) {
   struct Options {
     std::string scene, methods, size = "512x512", view = "fit", json, label;
     int repeat = 5, warmup = 1;
+    double opacity = -1.0;
     bool noQuality = false;
   };
   auto opt = std::make_shared<Options>();
@@ -72,6 +73,7 @@ void addBench(CLI::App& app) {
   cmd->add_option("--warmup", opt->warmup, "Untimed frames first")->capture_default_str()->check(CLI::Range(0, 100));
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view")->capture_default_str();
+  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--no-quality", opt->noQuality, "Skip the oracle and the RMSE/FLIP columns");
   cmd->add_option("--json", opt->json, "Write all results as JSON");
   cmd->callback([opt] {
@@ -79,7 +81,9 @@ void addBench(CLI::App& app) {
     std::vector<RenderRequest> requests;
     for (const std::string& spec : splitList(opt->methods)) requests.push_back(parseMethodSpec(spec, w, h));
     if (requests.empty()) throw Error("--methods", "no method given");
-    const Scene scene = loadScene(opt->scene);
+    Scene scene = loadScene(opt->scene);
+    if (opt->opacity >= 0.0)
+      for (Object& o : scene.objects) o.material.color.a = static_cast<float>(opt->opacity);
     const Camera camera = scene.view(opt->view);
 
     ImageRGBA8 reference;

@@ -14,6 +14,7 @@ void addRender(CLI::App& app) {
   struct Options {
     std::string scene, method = "oracle", op = "oit", size = "512x512", view = "fit", output, stats;
     std::vector<std::string> params;
+    double opacity = -1.0;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method and write a PNG (and stats JSON)");
@@ -25,6 +26,8 @@ void addRender(CLI::App& app) {
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
   cmd->add_option("-o,--output", opt->output, "Output PNG")->required();
   cmd->add_option("--stats", opt->stats, "Write Stats as JSON to this file");
+  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1): see through opaque CAD parts")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->callback([opt] {
     const auto [w, h] = parseSize("--size", opt->size);
     RenderRequest req;
@@ -37,7 +40,9 @@ void addRender(CLI::App& app) {
       if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");
       req.params[p.substr(0, eq)] = p.substr(eq + 1);
     }
-    const Scene scene = loadScene(opt->scene);
+    Scene scene = loadScene(opt->scene);
+    if (opt->opacity >= 0.0)
+      for (Object& o : scene.objects) o.material.color.a = static_cast<float>(opt->opacity);
     const Camera camera = scene.view(opt->view);
     const RenderOutput out = render(scene, camera, req);
     // Both outputs are produced before either is written, and each is written atomically.

@@ -1,4 +1,5 @@
-// Binding points, image units and constants shared by C++ (mfrcore) and GLSL. Valid in both:
+// [Multifragment rendering infrastructure — Vasilakis, Vardis, Papaioannou, "A Survey of Multifragment
+// Rendering", Computer Graphics Forum 39(2), 2020.] Binding points, image units and constants shared by C++ (mfrcore) and GLSL. Valid in both:
 // only #define lines. A method adds its own bindings here so that no two passes collide.
 #ifndef MFR_BINDINGS_H
 #define MFR_BINDINGS_H

@@ -1,4 +1,5 @@
-// Inputs of every capture fragment shader (*.geom.frag) and the shaded payload of the current
+// [Multifragment rendering infrastructure — Vasilakis, Vardis, Papaioannou, "A Survey of Multifragment
+// Rendering", Computer Graphics Forum 39(2), 2020.] Inputs of every capture fragment shader (*.geom.frag) and the shaded payload of the current
 // fragment. The colour comes from common/shading.h, the definition the CPU oracle uses too.
 #include "common/bindings.h"
 #include "common/shading.h"

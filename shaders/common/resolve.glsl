@@ -1,4 +1,5 @@
-// Resolve driver shared by every method that stores per-pixel lists: gather, sort, operate.
+// Resolve driver (k+-buffer paper: Vasilakis, Papaioannou, Fudos, IEEE TVCG 21(6) 2015, §4.4) shared by
+// every method that stores per-pixel lists: gather, sort, operate.
 // Sorting: insertion sort for short lists, Shell sort for longer ones, and l+-depth-sorting
 // (Vasilakis & Fudos, "k+-buffer: fragment synchronized k-buffer", I3D 2014, §4.4 of the TVCG 2015
 // k+-buffer paper) when a pixel holds more than MFR_RESOLVE_LOCAL fragments: rounds that each

@@ -1,4 +1,5 @@
-// Scene vertex shader shared by every capture pass: world-space normal, material × vertex colour,
+// [Multifragment rendering infrastructure — Vasilakis, Vardis, Papaioannou, "A Survey of Multifragment
+// Rendering", Computer Graphics Forum 39(2), 2020.] Scene vertex shader shared by every capture pass: world-space normal, material × vertex colour,
 // object id. Multifragment capture itself happens in each method's *.geom.frag.
 #include "common/bindings.h"
 

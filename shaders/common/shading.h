@@ -1,4 +1,5 @@
-// Headlight shading shared verbatim by GLSL shaders and the C++ oracle (one definition; see
+// [Multifragment rendering infrastructure — Vasilakis, Vardis, Papaioannou, "A Survey of Multifragment
+// Rendering", Computer Graphics Forum 39(2), 2020.] Headlight shading shared verbatim by GLSL shaders and the C++ oracle (one definition; see
 // docs/architecture.md, "The shading function"). It must stay valid GLSL 4.50 and valid C++ with
 // GLM: no swizzles, float literals with an f suffix, only functions both languages have.
 // Model: a directional light along the view direction, two-sided Lambert plus ambient, straight

@@ -1,0 +1,118 @@
+// The GL layer itself: context, debug output turned into errors, shader #include with errors
+// reported by file and line, injected defines, pass timers.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "gl_fixture.hpp"
+#include "mfr/error.hpp"
+#include "mfr/gl/program.hpp"
+#include "mfr/gl/timer.hpp"
+
+namespace fs = std::filesystem;
+
+namespace mfr::test {
+namespace {
+
+// Points MFR_SHADER_DIR at a temporary folder for the test's lifetime.
+class ShaderDir {
+ public:
+  ShaderDir() : dir_(fs::temp_directory_path() / ("mfr-shaders-" + std::to_string(::getpid()))) {
+    fs::create_directories(dir_ / "lib");
+    ::setenv("MFR_SHADER_DIR", dir_.c_str(), 1);
+  }
+  ~ShaderDir() {
+    ::unsetenv("MFR_SHADER_DIR");
+    fs::remove_all(dir_);
+  }
+  void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name) << text; }
+
+ private:
+  fs::path dir_;
+};
+
+TEST(GlInfrastructure, ContextIsOpenGL45Core) {
+  const gl::ContextInfo& info = context().info();
+  EXPECT_FALSE(info.renderer.empty());
+  EXPECT_TRUE(info.platform == "surfaceless" || info.platform == "device") << info.platform;
+  GLint major = 0, minor = 0, profile = 0;
+  glGetIntegerv(GL_MAJOR_VERSION, &major);
+  glGetIntegerv(GL_MINOR_VERSION, &minor);
+  glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &profile);
+  EXPECT_GE(major * 10 + minor, 45);
+  EXPECT_TRUE(profile & GL_CONTEXT_CORE_PROFILE_BIT);
+}
+
+TEST(GlInfrastructure, DebugOutputBecomesAnError) {
+  context();
+  gl::checkErrors("before");  // clean slate
+  glBindBuffer(GL_ARRAY_BUFFER, 987654);  // not a buffer name: GL_INVALID_OPERATION
+  try {
+    gl::checkErrors("bad bind");
+    FAIL() << "no error reported";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("bad bind"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(gl::checkErrors("after"));  // reported once
+}
+
+TEST(GlInfrastructure, CompileErrorNamesIncludedFileAndLine) {
+  context();
+  const ShaderDir dir;
+  dir.write("lib/helper.glsl", "// helper\nfloat helper() {\n  return undefinedThing;\n}\n");
+  dir.write("main.frag", "// main\n#include \"lib/helper.glsl\"\nout vec4 c;\nvoid main() { c = vec4(helper()); }\n");
+  try {
+    gl::Program p({{GL_FRAGMENT_SHADER, "main.frag"}});
+    FAIL() << "compiled";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("shaders/lib/helper.glsl:3:"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+}
+
+TEST(GlInfrastructure, ErrorAfterIncludeIsAttributedToTheIncludingFile) {
+  context();
+  const ShaderDir dir;
+  dir.write("lib/ok.glsl", "float ok() { return 1.0; }\n");
+  dir.write("main.frag", "#include \"lib/ok.glsl\"\nout vec4 c;\n\nvoid main() { c = vec4(ok()) + nope; }\n");
+  try {
+    gl::Program p({{GL_FRAGMENT_SHADER, "main.frag"}});
+    FAIL() << "compiled";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("shaders/main.frag:4:"), std::string::npos) << e.what();
+  }
+}
+
+TEST(GlInfrastructure, DefinesAndDefineNamedIncludes) {
+  context();
+  const ShaderDir dir;
+  dir.write("lib/a.glsl", "float pick() { return VALUE; }\n");
+  dir.write("main.frag", "#include CHOSEN\nout vec4 c;\nvoid main() { c = vec4(pick()); }\n");
+  EXPECT_NO_THROW(gl::Program({{GL_FRAGMENT_SHADER, "main.frag"}}, {{"CHOSEN", "\"lib/a.glsl\""}, {"VALUE", "0.5"}}));
+  EXPECT_THROW(gl::Program({{GL_FRAGMENT_SHADER, "main.frag"}}), Error);  // CHOSEN undefined
+  EXPECT_THROW(gl::shaderSource("missing.frag"), Error);
+}
+
+TEST(GlInfrastructure, PassTimerReportsEveryPassInOrder) {
+  context();
+  for (bool finish : {false, true}) {
+    gl::PassTimer timer(finish);
+    timer.begin("a");
+    glFinish();
+    timer.begin("b");  // begin closes the open pass
+    timer.end();
+    timer.begin("a");  // same name again: summed
+    timer.end();
+    const auto passes = timer.collect();
+    ASSERT_EQ(passes.size(), 2u);
+    EXPECT_EQ(passes[0].first, "a");
+    EXPECT_EQ(passes[1].first, "b");
+    for (const auto& [name, ms] : passes) EXPECT_TRUE(ms >= 0.0 && ms < 10000.0) << name << " " << ms;
+  }
+}
+
+}  // namespace
+}  // namespace mfr::test
