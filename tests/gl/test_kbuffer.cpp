@@ -16,6 +16,7 @@
 #include "exact_method.hpp"
 #include "gl_fixture.hpp"
 #include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
 #include "mfr/methods/registry.hpp"
 #include "mfr/scene/primitives.hpp"
 #include "mfr/scene/sample.hpp"
@@ -94,6 +95,32 @@ TEST_P(KBufferVariant, CapturesTheKNearest) {
     EXPECT_EQ(out.stats.sync, "spinlock");
     EXPECT_EQ(out.stats.fragmentsGenerated, out.stats.fragmentsStored + out.stats.fragmentsDropped);
     EXPECT_LE(out.stats.fragmentsStored, pixels() * static_cast<std::uint64_t>(k));
+  }
+}
+
+// The same on real CAD files (occt-misc bearing STL, the assimp 2CylinderEngine assembly), made
+// transparent so every layer is a candidate.
+TEST_P(KBufferVariant, CapturesTheKNearestOnRealModels) {
+  context();
+  for (const char* path : {"/usr/share/opencascade/data/stl/bearing.stl",
+                           "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb"}) {
+    SCOPED_TRACE(path);
+    Scene scene = loadScene(path);
+    for (Object& o : scene.objects) o.material.color.a = 0.4f;
+    const Camera camera = scene.view("iso");
+    const FragmentLists oracle = castFragments(scene, camera, kW, kH);
+    GpuRenderer gpu;
+    gpu.setScene(scene);
+    for (int k : {1, 2, 4, 8, 16, 32}) {
+      SCOPED_TRACE("k=" + std::to_string(k));
+      const RenderRequest req = request(GetParam().method, GetParam().params, k);
+      const CapturedLists lists = gpu.capture(camera, req, k);
+      const ListComparison lc = compareLists(oracle, lists, static_cast<std::uint32_t>(k));
+      EXPECT_GT(lc.compared, lc.pixels * 7 / 10);
+      EXPECT_EQ(lc.countMismatches, 0u) << lc.firstMismatch;
+      EXPECT_EQ(lc.depthMismatches, 0u) << lc.firstMismatch;
+      EXPECT_EQ(lc.colorMismatches, 0u) << lc.firstMismatch;
+    }
   }
 }
 
