@@ -6,6 +6,7 @@
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
 #include "mfr/methods/registry.hpp"
+#include "methods/kbuffer_common.hpp"
 
 namespace mfr {
 
@@ -14,6 +15,10 @@ bool GpuRenderer::defaultFinishTiming() {
 }
 
 Operation oitOperation() { return {"oit", "ops/oit.glsl", nullptr}; }
+
+// Hybrid transparency (deep hybrid OIT, The Visual Computer 2022, §3.3): core from the resolve's
+// sorted fragments, tail from the k-buffer family's tail SSBO, which the method binds itself.
+static Operation hybridOperation() { return {"hybrid", "ops/hybrid.glsl", nullptr}; }
 
 GpuRenderer::~GpuRenderer() = default;
 
@@ -29,13 +34,20 @@ void GpuRenderer::setScene(const Scene& scene) {
 Method& GpuRenderer::prepare(const RenderRequest& request) {
   validateImageSize("--size", request.width, request.height);
   if (!scene_) throw Error("render", "no scene loaded");
-  if (request.operation != "oit") throw Error("--op " + request.operation, "unknown operation (available: oit)");
+  if (request.operation != "oit" && request.operation != "hybrid")
+    throw Error("--op " + request.operation, "unknown operation (available: oit, hybrid)");
   if (!method_ || methodName_ != request.method) {
     method_ = createMethod(request.method);
     methodName_ = request.method;
   }
   const Params params(method_->info().params, request.params, request.method);
   method_->configure(request.width, request.height, params);
+  if (request.operation == "hybrid") {
+    // The tail sums exist only in the k-buffer family's tail hook.
+    const auto* kb = dynamic_cast<const KBufferFamily*>(method_.get());
+    if (!kb) throw Error("--op hybrid", "method " + request.method + " keeps no tail (use a k-buffer method with --param tail=true)");
+    if (!kb->tailEnabled()) throw Error("--op hybrid", "needs --param tail=true with method " + request.method);
+  }
   gl::checkErrors(("configure " + request.method).c_str());
   return *method_;
 }
@@ -58,7 +70,7 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   gl::checkErrors(("capture " + request.method).c_str());
   glBindFramebuffer(GL_FRAMEBUFFER, target);
   glViewport(0, 0, request.width, request.height);
-  method.resolve(ctx, oitOperation());
+  method.resolve(ctx, request.operation == "hybrid" ? hybridOperation() : oitOperation());
   gl::checkErrors(("resolve " + request.method).c_str());
   Stats stats = method.stats();
   stats.operation = request.operation;

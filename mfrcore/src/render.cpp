@@ -1,12 +1,14 @@
 #include "mfr/render.hpp"
 
 #include <algorithm>
+#include <exception>
 
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
 #include "mfr/gpu_renderer.hpp"
 #include "mfr/methods/registry.hpp"
 #include "mfr/reference/composite.hpp"
+#include "mfr/reference/hybrid.hpp"
 #include "mfr/reference/oracle.hpp"
 
 namespace mfr {
@@ -39,7 +41,8 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     for (const auto& m : methods) list += (list.empty() ? "" : ", ") + m;
     throw Error("--method " + request.method, "unknown method (available: " + list + ")");
   }
-  if (request.operation != "oit") throw Error("--op " + request.operation, "unknown operation (available: oit)");
+  if (request.operation != "oit" && request.operation != "hybrid")
+    throw Error("--op " + request.operation, "unknown operation (available: oit, hybrid)");
   if (request.method != "oracle") {
     GpuRenderer& gpu = headlessRenderer();
     gpu.setScene(scene);
@@ -49,7 +52,20 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
   }
   RenderOutput out;
   const FragmentLists lists = castFragments(scene, camera, request.width, request.height);
-  out.image = compositeOver(lists, scene.background);
+  if (request.operation == "hybrid") {
+    // The exact hybrid image for a uniform core size: --method oracle --op hybrid -p k=N.
+    const auto k = request.params.find("k");
+    if (k == request.params.end()) throw Error("--op hybrid", "the oracle needs --param k=N (core size)");
+    unsigned long value = 0;
+    try {
+      value = std::stoul(k->second);
+    } catch (const std::exception&) {
+      throw Error("--param k=" + k->second, "not a non-negative integer");
+    }
+    out.image = compositeHybrid(lists, static_cast<std::uint32_t>(value), scene.background);
+  } else {
+    out.image = compositeOver(lists, scene.background);
+  }
   out.stats.method = "oracle";
   out.stats.operation = request.operation;
   out.stats.sync = "none";

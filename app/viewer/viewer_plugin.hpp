@@ -1,0 +1,76 @@
+#pragma once
+// The mfrview plugin interface: what a plugin sees of the viewer (ViewerContext) and what it
+// provides (MfrViewerPlugin). Plugins are Qt plugins loaded with QPluginLoader from the folder
+// `plugins` beside the executable, or from the folders in $MFR_PLUGIN_PATH (colon-separated).
+//
+// ViewerContext is abstract and its virtual functions are the whole API, so a plugin needs only
+// mfrcore's headers, not its library; its signals' meta-object comes from the executable, which
+// is linked with exported symbols (CMake ENABLE_EXPORTS).
+#include <QJsonObject>
+#include <QObject>
+#include <QSize>
+#include <QString>
+#include <QStringList>
+#include <QVector>
+#include <QtPlugin>
+
+#include <map>
+#include <string>
+
+#include "mfr/methods/method.hpp"
+#include "mfr/methods/stats.hpp"
+
+class QWidget;
+
+class ViewerContext : public QObject {
+  Q_OBJECT
+
+ public:
+  using QObject::QObject;
+  ~ViewerContext() override = default;
+
+  // Render methods: "oracle" (exact, CPU) first, then every registered GPU method.
+  [[nodiscard]] virtual QStringList methodNames() const = 0;
+  // The method's description and parameters; nullptr for "oracle" or an unknown name.
+  [[nodiscard]] virtual const mfr::MethodInfo* methodInfo(const QString& method) const = 0;
+  [[nodiscard]] virtual QString method() const = 0;
+  virtual void setMethod(const QString& method) = 0;
+  // Parameter values of the current method (only those set explicitly; the rest take defaults).
+  [[nodiscard]] virtual std::map<std::string, std::string> params() const = 0;
+  // Merges `changes` into the current method's parameters and re-renders.
+  virtual void setParams(const std::map<std::string, std::string>& changes) = 0;
+
+  [[nodiscard]] virtual bool hasScene() const = 0;
+  // Stats of the last frame drawn in the view (empty before the first).
+  [[nodiscard]] virtual const mfr::Stats& stats() const = 0;
+  // Pixels of the live image.
+  [[nodiscard]] virtual QSize renderSize() const = 0;
+  // Starts (or queues) the exact per-pixel fragment counts of the current view, computed off the
+  // GUI thread by the oracle; depthComplexityReady delivers the histogram.
+  virtual void requestDepthComplexity() = 0;
+
+ signals:
+  void sceneChanged();                 // a new scene, or an object edited
+  void viewChanged();                  // camera or image size
+  void methodChanged(const QString& method);
+  void paramsChanged();
+  void frameRendered();                // stats() describes the new frame
+  // histogram[n] = pixels with exactly n fragments; the image size it was computed at.
+  void depthComplexityReady(const QVector<quint64>& histogram, QSize size);
+};
+
+class MfrViewerPlugin {
+ public:
+  virtual ~MfrViewerPlugin() = default;
+  [[nodiscard]] virtual QString id() const = 0;    // stable key in sessions and settings
+  [[nodiscard]] virtual QString name() const = 0;  // for menus and docks
+  [[nodiscard]] virtual QString description() const = 0;
+  // The plugin's panel; the viewer puts it into a dock widget and owns it.
+  virtual QWidget* createPanel(ViewerContext& context, QWidget* parent) = 0;
+  // State stored in session files (under "plugins"/id()).
+  [[nodiscard]] virtual QJsonObject saveSettings() const = 0;
+  virtual void loadSettings(const QJsonObject& settings) = 0;
+};
+
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.0"
+Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -1,0 +1,48 @@
+#pragma once
+// The offline optimal per-pixel k(p) under a total slot budget F (Σ_p k(p) ≤ F, 1 ≤ k(p) ≤ n(p)
+// where n(p) > 0, k(p) = 0 where n(p) = 0) minimising the total hybrid-transparency error
+// Σ_p e_p(k(p)), e_p(k) = ‖hybrid_p(k) − over_p(all)‖² (Tsopouridis, Fudos, Vasilakis, "Deep
+// hybrid order-independent transparency", The Visual Computer 2022, eq. 2 and Alg. 1).
+// Three solvers on the same per-pixel error table:
+//   greedy      the paper's backward greedy (Alg. 1): start at k(p) = n(p), repeatedly take one
+//               slot from the pixel whose error grows least (a min-heap of marginal errors).
+//               O(Σn log P). Optimal when every e_p is convex in k (its Lemma 1's premise);
+//               tests/unit/test_optimal_k.cpp shows it is not in general.
+//   dynamic     exact: a knapsack over pixels, dp[i][b] = least error of pixels < i with b slots.
+//               O(P · F · max n) time, O(P · F) memory: small cases only.
+//   exhaustive  every k vector; tiny cases (tests).
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/reference/oracle.hpp"
+
+namespace mfr {
+
+// errors[p][k] = e_p(k) for k = 0..n(p) (errors[p].size() = n(p) + 1; e_p(n(p)) = 0).
+using HybridErrorTable = std::vector<std::vector<double>>;
+
+// The table of the oracle's lists (pixel index = lists.index(x, y)), with hybridError().
+HybridErrorTable hybridErrorTable(const FragmentLists& lists, glm::vec3 background);
+
+struct KAllocation {
+  std::vector<std::uint32_t> k;  // per pixel
+  double error = 0.0;            // Σ_p e_p(k(p))
+  std::uint64_t slots = 0;       // Σ_p k(p)
+};
+
+// The least budget any solver accepts: one slot per non-empty pixel.
+std::uint64_t minimumSlots(const HybridErrorTable& errors);
+// Total error of an allocation (k.size() must equal errors.size()).
+double allocationError(const HybridErrorTable& errors, const std::vector<std::uint32_t>& k);
+
+// Each throws mfr::Error("budget F", …) when budget < minimumSlots(errors); a budget ≥ Σ n(p)
+// gives k = n everywhere (error 0).
+KAllocation optimalKGreedy(const HybridErrorTable& errors, std::uint64_t budget);
+KAllocation optimalKDynamic(const HybridErrorTable& errors, std::uint64_t budget);
+// Also throws when the number of candidate vectors (Π n(p)) exceeds maxCandidates.
+KAllocation optimalKExhaustive(const HybridErrorTable& errors, std::uint64_t budget,
+                               std::uint64_t maxCandidates = 10'000'000);
+
+}  // namespace mfr

@@ -1,0 +1,157 @@
+// Optimal per-pixel k under a slot budget: the deep hybrid OIT paper's backward greedy (Alg. 1;
+// Tsopouridis, Fudos, Vasilakis, The Visual Computer 2022), an exact knapsack DP and an
+// exhaustive search (see mfr/budget/optimal_k.hpp).
+#include "mfr/budget/optimal_k.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <numeric>
+#include <queue>
+#include <string>
+#include <tuple>
+
+#include "mfr/error.hpp"
+#include "mfr/reference/hybrid.hpp"
+
+namespace mfr {
+
+namespace {
+
+std::uint32_t listLength(const std::vector<double>& e) { return static_cast<std::uint32_t>(e.size() - 1); }
+
+void checkBudget(const HybridErrorTable& errors, std::uint64_t budget) {
+  for (const auto& e : errors)
+    if (e.empty()) throw Error("hybrid error table", "a pixel has no e(0) entry");
+  const std::uint64_t need = minimumSlots(errors);
+  if (budget < need)
+    throw Error("budget F=" + std::to_string(budget),
+                "below one slot per non-empty pixel (" + std::to_string(need) + " slots)");
+}
+
+KAllocation finish(const HybridErrorTable& errors, std::vector<std::uint32_t> k) {
+  KAllocation a;
+  a.error = allocationError(errors, k);
+  a.slots = std::accumulate(k.begin(), k.end(), std::uint64_t{0});
+  a.k = std::move(k);
+  return a;
+}
+
+}  // namespace
+
+HybridErrorTable hybridErrorTable(const FragmentLists& lists, glm::vec3 background) {
+  HybridErrorTable table(static_cast<std::size_t>(lists.width) * lists.height);
+  for (int y = 0; y < lists.height; ++y)
+    for (int x = 0; x < lists.width; ++x) {
+      const auto list = lists.pixel(x, y);
+      auto& e = table[lists.index(x, y)];
+      e.resize(list.size() + 1);
+      for (std::uint32_t k = 0; k <= list.size(); ++k) e[k] = hybridError(list, k, background);
+    }
+  return table;
+}
+
+std::uint64_t minimumSlots(const HybridErrorTable& errors) {
+  return static_cast<std::uint64_t>(
+      std::count_if(errors.begin(), errors.end(), [](const std::vector<double>& e) { return e.size() > 1; }));
+}
+
+double allocationError(const HybridErrorTable& errors, const std::vector<std::uint32_t>& k) {
+  double sum = 0.0;
+  for (std::size_t p = 0; p < errors.size(); ++p) sum += errors[p][k[p]];
+  return sum;
+}
+
+KAllocation optimalKGreedy(const HybridErrorTable& errors, std::uint64_t budget) {
+  checkBudget(errors, budget);
+  std::vector<std::uint32_t> k(errors.size());
+  std::uint64_t slots = 0;
+  // Min-heap of (error increase of taking one slot from pixel p, p); ties go to the lower index.
+  using Entry = std::tuple<double, std::size_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> heap;
+  for (std::size_t p = 0; p < errors.size(); ++p) {
+    k[p] = listLength(errors[p]);
+    slots += k[p];
+    if (k[p] > 1) heap.emplace(errors[p][k[p] - 1] - errors[p][k[p]], p);
+  }
+  while (slots > budget && !heap.empty()) {  // checkBudget guarantees the heap outlasts the excess
+    const std::size_t p = std::get<1>(heap.top());
+    heap.pop();
+    --k[p];
+    --slots;
+    if (k[p] > 1) heap.emplace(errors[p][k[p] - 1] - errors[p][k[p]], p);
+  }
+  return finish(errors, std::move(k));
+}
+
+KAllocation optimalKDynamic(const HybridErrorTable& errors, std::uint64_t budget) {
+  checkBudget(errors, budget);
+  std::uint64_t total = 0;
+  for (const auto& e : errors) total += listLength(e);
+  const std::size_t cap = static_cast<std::size_t>(std::min(budget, total));
+  const std::size_t pixels = errors.size();
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  // dp[b] = least error of the pixels so far using exactly b slots; choice[i][b] = k of pixel i.
+  std::vector<double> dp(cap + 1, kInf), next(cap + 1);
+  dp[0] = 0.0;
+  std::vector<std::vector<std::uint32_t>> choice(pixels, std::vector<std::uint32_t>(cap + 1, 0));
+  for (std::size_t i = 0; i < pixels; ++i) {
+    const std::uint32_t n = listLength(errors[i]);
+    const std::uint32_t kMin = n > 0 ? 1 : 0;
+    std::fill(next.begin(), next.end(), kInf);
+    for (std::size_t b = 0; b <= cap; ++b) {
+      if (dp[b] == kInf) continue;
+      for (std::uint32_t k = kMin; k <= n && b + k <= cap; ++k) {
+        const double v = dp[b] + errors[i][k];
+        if (v < next[b + k]) {
+          next[b + k] = v;
+          choice[i][b + k] = k;
+        }
+      }
+    }
+    dp.swap(next);
+  }
+  std::size_t best = 0;
+  for (std::size_t b = 0; b <= cap; ++b)
+    if (dp[b] < dp[best]) best = b;
+  std::vector<std::uint32_t> k(pixels);
+  for (std::size_t i = pixels; i-- > 0;) {
+    k[i] = choice[i][best];
+    best -= k[i];
+  }
+  return finish(errors, std::move(k));
+}
+
+KAllocation optimalKExhaustive(const HybridErrorTable& errors, std::uint64_t budget, std::uint64_t maxCandidates) {
+  checkBudget(errors, budget);
+  std::uint64_t candidates = 1;
+  for (const auto& e : errors) {
+    candidates *= std::max<std::uint64_t>(listLength(e), 1);
+    if (candidates > maxCandidates)
+      throw Error("exhaustive optimal k", "more than " + std::to_string(maxCandidates) + " candidate allocations");
+  }
+  const std::size_t pixels = errors.size();
+  std::vector<std::uint32_t> k(pixels), best;
+  for (std::size_t p = 0; p < pixels; ++p) k[p] = listLength(errors[p]) > 0 ? 1 : 0;
+  double bestError = std::numeric_limits<double>::infinity();
+  for (std::uint64_t c = 0; c < candidates; ++c) {
+    const std::uint64_t slots = std::accumulate(k.begin(), k.end(), std::uint64_t{0});
+    if (slots <= budget) {
+      const double e = allocationError(errors, k);
+      if (e < bestError) {
+        bestError = e;
+        best = k;
+      }
+    }
+    // Next vector, odometer order.
+    for (std::size_t p = 0; p < pixels; ++p) {
+      if (k[p] < listLength(errors[p])) {
+        ++k[p];
+        break;
+      }
+      k[p] = listLength(errors[p]) > 0 ? 1 : 0;
+    }
+  }
+  return finish(errors, std::move(best));
+}
+
+}  // namespace mfr

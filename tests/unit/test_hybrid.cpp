@@ -1,0 +1,126 @@
+// Hybrid transparency on exact lists (Tsopouridis, Fudos, Vasilakis, The Visual Computer 2022,
+// §3.3; Maule et al., I3D 2013) against hand-computed values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <span>
+#include <vector>
+
+#include "mfr/error.hpp"
+#include "mfr/reference/composite.hpp"
+#include "mfr/reference/hybrid.hpp"
+
+namespace {
+
+mfr::Fragment frag(float depth, std::uint32_t r, std::uint32_t g, std::uint32_t b, std::uint32_t a) {
+  mfr::Fragment f;
+  f.depth = depth;
+  f.color = r | (g << 8) | (b << 16) | (a << 24);
+  return f;
+}
+
+// Red α=0.4, green α=0.2, blue α=0.6 (α of 102, 51, 153 out of 255), white background.
+std::vector<mfr::Fragment> threeFragments() {
+  return {frag(0.1f, 255, 0, 0, 102), frag(0.2f, 0, 255, 0, 51), frag(0.3f, 0, 0, 255, 153)};
+}
+
+void expectNear(glm::vec3 got, glm::vec3 want) {
+  EXPECT_NEAR(got.r, want.r, 1e-5f);
+  EXPECT_NEAR(got.g, want.g, 1e-5f);
+  EXPECT_NEAR(got.b, want.b, 1e-5f);
+}
+
+std::vector<mfr::Fragment> randomList(std::mt19937& rng, int n) {
+  std::uniform_int_distribution<std::uint32_t> byte(0, 255);
+  std::vector<mfr::Fragment> list;
+  for (int i = 0; i < n; ++i) list.push_back(frag(0.01f * static_cast<float>(i + 1), byte(rng), byte(rng), byte(rng), byte(rng)));
+  return list;
+}
+
+TEST(Hybrid, ThreeFragmentsByHand) {
+  const auto list = threeFragments();
+  const glm::vec3 white(1.0f);
+  // k = 1: core red: C=(0.4,0,0), τ_core=0.6. Tail {green .2, blue .6}: α_avg=.4, τ_tail=.6²=.36,
+  // C_tail = (0·.2+…)/.8 → (0,.25,.75)·.64 = (0,.16,.48). C = core + .6·(C_tail + .36).
+  expectNear(mfr::compositeHybrid(list, 1, white), {0.616f, 0.312f, 0.504f});
+  // k = 0: tail of all three: α_avg=.4, τ=.6³=.216; average (.4,.2,.6)/1.2 · .784.
+  expectNear(mfr::compositeHybrid(list, 0, white),
+             {0.784f / 3.0f + 0.216f, 0.784f / 6.0f + 0.216f, 0.784f / 2.0f + 0.216f});
+  // k = 2: a tail of one fragment is exact: equals "over".
+  expectNear(mfr::compositeHybrid(list, 2, white), {0.592f, 0.312f, 0.48f});
+  expectNear(mfr::compositeHybrid(list, 2, white), mfr::compositeOver(list, white));
+}
+
+TEST(Hybrid, CoreAtLeastListIsOver) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 200; ++trial) {
+    const auto list = randomList(rng, 1 + trial % 9);
+    const glm::vec3 bg(0.2f, 0.5f, 0.9f);
+    const glm::vec3 over = mfr::compositeOver(list, bg);
+    for (std::uint32_t k = static_cast<std::uint32_t>(list.size()); k < list.size() + 3; ++k) {
+      EXPECT_EQ(mfr::compositeHybrid(list, k, bg), over);  // bit-identical: same arithmetic
+      EXPECT_EQ(mfr::hybridError(list, k, bg), 0.0);
+    }
+  }
+}
+
+TEST(Hybrid, ZeroCoreIsWeightedAverage) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 100; ++trial) {
+    const auto list = randomList(rng, 1 + trial % 7);
+    const glm::vec3 bg(0.3f, 0.6f, 0.1f);
+    glm::dvec3 sumCA(0.0);
+    double sumA = 0.0;
+    for (const auto& f : list) {
+      const double a = static_cast<double>(f.color >> 24) / 255.0;
+      for (int c = 0; c < 3; ++c) sumCA[c] += static_cast<double>((f.color >> (8 * c)) & 0xFFu) / 255.0 * a;
+      sumA += a;
+    }
+    const double n = static_cast<double>(list.size());
+    glm::dvec3 want = glm::dvec3(bg);
+    if (sumA > 0) {
+      const double tau = std::pow(1.0 - sumA / n, n);
+      want = sumCA / sumA * (1.0 - tau) + tau * glm::dvec3(bg);
+    }
+    const glm::vec3 got = mfr::compositeHybrid(list, 0, bg);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-5);
+  }
+}
+
+TEST(Hybrid, EmptyAndTransparentTails) {
+  const glm::vec3 bg(0.25f, 0.5f, 0.75f);
+  expectNear(mfr::compositeHybrid(std::span<const mfr::Fragment>{}, 0, bg), bg);
+  // A fully transparent tail (Σα = 0) shows the background through the core.
+  const std::vector<mfr::Fragment> list{frag(0.1f, 255, 255, 255, 51), frag(0.2f, 255, 0, 0, 0), frag(0.3f, 0, 255, 0, 0)};
+  expectNear(mfr::compositeHybrid(list, 1, bg), glm::vec3(0.2f) + 0.8f * bg);
+  const mfr::HybridTailSums s = mfr::hybridTailSums(threeFragments(), 1);
+  EXPECT_EQ(s.count, 2u);
+  EXPECT_EQ(s.alpha, 51u + 153u);
+  EXPECT_EQ(s.colorAlpha[0], 0u);
+  EXPECT_EQ(s.colorAlpha[1], 255u * 51u);
+  EXPECT_EQ(s.colorAlpha[2], 255u * 153u);
+}
+
+TEST(Hybrid, ImageWithPerPixelK) {
+  // 2x1 image: pixel 0 holds the three fragments, pixel 1 none.
+  mfr::FragmentLists lists;
+  lists.width = 2;
+  lists.height = 1;
+  lists.fragments = threeFragments();
+  lists.offsets = {0, 3, 3};
+  lists.flags = {0, 0};
+  const glm::vec3 white(1.0f);
+  const std::vector<std::uint32_t> kMap{1, 4};
+  const mfr::ImageRGBA8 image = mfr::compositeHybrid(lists, kMap, white);
+  EXPECT_EQ(image.at(0, 0)[0], 157);  // round(.616·255) = round(157.08)
+  EXPECT_EQ(image.at(0, 0)[1], 80);   // .312·255 = 79.56
+  EXPECT_EQ(image.at(0, 0)[2], 129);  // .504·255 = 128.52
+  EXPECT_EQ(image.at(1, 0)[0], 255);
+  const mfr::ImageRGBA8 uniform = mfr::compositeHybrid(lists, 8u, white);
+  EXPECT_EQ(uniform.pixels, mfr::compositeOver(lists, white).pixels);
+  EXPECT_THROW(mfr::compositeHybrid(lists, std::vector<std::uint32_t>{1}, white), mfr::Error);
+}
+
+}  // namespace
