@@ -188,6 +188,14 @@ void ViewerModel::setObjectOpacity(int index, double opacity) {
   sceneEdited();
 }
 
+void ViewerModel::setObjectMaterial(int index, const glm::vec4& rgba) {
+  if (index < 0 || index >= static_cast<int>(scene_.objects.size())) return;
+  glm::vec4& c = scene_.objects[static_cast<std::size_t>(index)].material.color;
+  if (c == rgba) return;
+  c = rgba;
+  sceneEdited();
+}
+
 // ---- camera ------------------------------------------------------------------------------
 
 void ViewerModel::setCamera(const mfr::Camera& camera) {

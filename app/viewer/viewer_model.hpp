@@ -46,6 +46,7 @@ class ViewerModel final : public ViewerContext {
   void setObjectVisible(int index, bool visible);
   void setObjectColor(int index, const QColor& rgb);
   void setObjectOpacity(int index, double opacity);
+  void setObjectMaterial(int index, const glm::vec4& rgba);
 
   // Camera: setCamera refits near/far around the visible objects, so navigation never clips.
   [[nodiscard]] const mfr::Camera& camera() const { return camera_; }

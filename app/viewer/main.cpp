@@ -1,0 +1,176 @@
+// mfrview: the Qt 6 viewer. Besides the interactive window, command-line options make it
+// scriptable: --screenshot renders the view at --size through mfrcore (the `mfr render` path),
+// writes a PNG and quits; --window-screenshot grabs the whole window once everything is drawn.
+#include <QApplication>
+#include <QCommandLineParser>
+#include <QElapsedTimer>
+#include <QJsonDocument>
+#include <QJsonObject>
+#include <QStatusBar>
+#include <QSurfaceFormat>
+#include <QTimer>
+
+#include <cstdio>
+#include <exception>
+#include <map>
+
+#include "main_window.hpp"
+#include "mfr/scene/scene.hpp"
+#include "render_view.hpp"
+#include "viewer_model.hpp"
+
+namespace {
+
+struct CommandLine {
+  QString scene = QStringLiteral("@sample");
+  QString session, screenshot, windowScreenshot, view, method, op;
+  std::map<QString, QJsonObject> pluginSettings;  // by plugin id
+  QSize size{800, 600}, windowSize;
+  std::map<std::string, std::string> params;
+};
+
+[[noreturn]] void fail(const QString& message, int code) {
+  std::fprintf(stderr, "mfrview: %s\n", qPrintable(message));
+  std::exit(code);
+}
+
+QSize parseSize(const QString& option, const QString& text) {
+  const QStringList parts = text.split(QLatin1Char('x'));
+  bool okW = false, okH = false;
+  const QSize size = parts.size() == 2 ? QSize(parts[0].toInt(&okW), parts[1].toInt(&okH)) : QSize();
+  if (!okW || !okH || size.width() <= 0 || size.height() <= 0 || size.width() > 16384 || size.height() > 16384)
+    fail(QStringLiteral("%1 %2: expected WIDTHxHEIGHT, e.g. 800x600").arg(option, text), 2);
+  return size;
+}
+
+CommandLine parseCommandLine(const QApplication& app) {
+  QCommandLineParser parser;
+  parser.setApplicationDescription(QStringLiteral("Multifragment rendering viewer"));
+  parser.addHelpOption();
+  parser.addVersionOption();
+  parser.addPositionalArgument(QStringLiteral("scene"), QStringLiteral("Model file, .mfrscene, .mfrsession or @sample (default)"));
+  const QCommandLineOption method({QStringLiteral("m"), QStringLiteral("method")}, QStringLiteral("Render method."), QStringLiteral("name"));
+  const QCommandLineOption op(QStringLiteral("op"), QStringLiteral("Operation: oit or hybrid."), QStringLiteral("name"));
+  const QCommandLineOption param({QStringLiteral("p"), QStringLiteral("param")}, QStringLiteral("Method parameter (repeatable)."), QStringLiteral("name=value"));
+  const QCommandLineOption view(QStringLiteral("view"), QStringLiteral("Named view of the scene, or 'fit'."), QStringLiteral("name"));
+  const QCommandLineOption size({QStringLiteral("s"), QStringLiteral("size")}, QStringLiteral("Image size for --screenshot (default 800x600)."), QStringLiteral("WxH"));
+  const QCommandLineOption screenshot(QStringLiteral("screenshot"), QStringLiteral("Render the view at --size, write this PNG and quit."), QStringLiteral("file.png"));
+  const QCommandLineOption windowScreenshot(QStringLiteral("window-screenshot"), QStringLiteral("Grab the whole window once drawn, write this PNG and quit."), QStringLiteral("file.png"));
+  const QCommandLineOption windowSize(QStringLiteral("window-size"), QStringLiteral("Window size."), QStringLiteral("WxH"));
+  const QCommandLineOption pluginSettings(QStringLiteral("plugin-settings"),
+                                         QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
+                                         QStringLiteral("id={json}"));
+  parser.addOptions({method, op, param, view, size, screenshot, windowScreenshot, windowSize, pluginSettings});
+  parser.process(app);
+
+  CommandLine cl;
+  if (parser.positionalArguments().size() > 1) fail(QStringLiteral("expected one scene, got %1").arg(parser.positionalArguments().size()), 2);
+  if (!parser.positionalArguments().isEmpty()) cl.scene = parser.positionalArguments().first();
+  if (cl.scene.endsWith(QStringLiteral(".mfrsession"), Qt::CaseInsensitive)) cl.session = cl.scene;
+  cl.method = parser.value(method);
+  cl.op = parser.value(op);
+  cl.view = parser.value(view);
+  cl.screenshot = parser.value(screenshot);
+  cl.windowScreenshot = parser.value(windowScreenshot);
+  if (parser.isSet(size)) cl.size = parseSize(QStringLiteral("--size"), parser.value(size));
+  if (parser.isSet(windowSize)) cl.windowSize = parseSize(QStringLiteral("--window-size"), parser.value(windowSize));
+  for (const QString& p : parser.values(param)) {
+    const qsizetype eq = p.indexOf(QLatin1Char('='));
+    if (eq <= 0) fail(QStringLiteral("--param %1: expected name=value").arg(p), 2);
+    cl.params[p.left(eq).toStdString()] = p.mid(eq + 1).toStdString();
+  }
+  for (const QString& p : parser.values(pluginSettings)) {
+    const qsizetype eq = p.indexOf(QLatin1Char('='));
+    const QJsonDocument json = eq > 0 ? QJsonDocument::fromJson(p.mid(eq + 1).toUtf8()) : QJsonDocument();
+    if (!json.isObject()) fail(QStringLiteral("--plugin-settings %1: expected id={json object}").arg(p), 2);
+    cl.pluginSettings[p.left(eq)] = json.object();
+  }
+  return cl;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // Every GL context mfrview creates is 4.5 core, like mfrcore's headless one.
+  QSurfaceFormat format;
+  format.setVersion(4, 5);
+  format.setProfile(QSurfaceFormat::CoreProfile);
+  format.setDepthBufferSize(24);
+  QSurfaceFormat::setDefaultFormat(format);
+
+  QApplication app(argc, argv);
+  QApplication::setApplicationName(QStringLiteral("mfrview"));
+  QApplication::setOrganizationName(QStringLiteral("mfr"));
+  QApplication::setApplicationVersion(QStringLiteral(MFR_VERSION));
+  const CommandLine cl = parseCommandLine(app);
+  const bool scripted = !cl.screenshot.isEmpty() || !cl.windowScreenshot.isEmpty();
+
+  // Scripted runs must not depend on (or change) what the last interactive session left behind.
+  MainWindow window(MainWindow::Options{.restoreSettings = !scripted, .loadPlugins = true});
+  ViewerModel& model = window.model();
+  if (!cl.windowSize.isEmpty()) window.resize(cl.windowSize);
+  if (!cl.method.isEmpty()) {
+    if (!model.methodNames().contains(cl.method))
+      fail(QStringLiteral("--method %1: unknown method (available: %2)").arg(cl.method, model.methodNames().join(", ")), 2);
+    model.setMethod(cl.method);
+  }
+  if (!cl.op.isEmpty()) model.setOperation(cl.op);
+  if (!cl.params.empty()) model.setParams(cl.params);
+
+  // Applied once the scene has loaded: the view and, for scripted runs, the pictures.
+  bool applied = false;
+  QObject::connect(&model, &ViewerModel::sceneLoaded, &window, [&] {
+    if (applied) return;
+    applied = true;
+    if (!cl.view.isEmpty()) {
+      try {
+        model.setCamera(model.scene().view(cl.view.toStdString()));
+      } catch (const std::exception& e) {
+        if (scripted) fail(QString::fromUtf8(e.what()), 1);
+        window.statusBar()->showMessage(QString::fromUtf8(e.what()));
+      }
+    }
+    for (const PluginRecord& r : window.plugins().records())
+      if (r.plugin && cl.pluginSettings.contains(r.id)) r.plugin->loadSettings(cl.pluginSettings.at(r.id));
+  });
+  if (scripted) {
+    QObject::connect(&model, &ViewerModel::loadFailed, &app, [](const QString&, const QString& message) { fail(message, 1); });
+    // Poll until the scene is loaded, a frame is drawn and background work (oracle image,
+    // depth-complexity histogram) is done, then take the pictures and quit.
+    auto* poll = new QTimer(&app);
+    auto* clock = new QElapsedTimer;
+    clock->start();
+    auto* settled = new QElapsedTimer;  // since everything was first drawn and idle
+    QObject::connect(poll, &QTimer::timeout, &app, [&, poll, clock, settled] {
+      if (clock->elapsed() > 120000) fail(QStringLiteral("timed out waiting for the first frame"), 1);
+      // The live view may fail where the screenshot does not (a budget too small for the window's
+      // size): a live error ends the wait too, and --screenshot reports its own render's errors.
+      const bool drawn = model.framesRendered() > 0 || !model.renderError().isEmpty();
+      if (!model.hasScene() || !window.view().glReady() || !drawn || model.busy()) return;
+      // A whole-window picture also waits for the panels' delayed work (the budget plugin asks
+      // for the depth-complexity histogram once the view has been still for a moment).
+      if (!cl.windowScreenshot.isEmpty()) {
+        if (!settled->isValid()) settled->start();
+        if (settled->elapsed() < 1500) return;
+      }
+      poll->stop();
+      try {
+        if (!cl.screenshot.isEmpty()) window.exportImage(cl.screenshot, cl.size);
+        if (!cl.windowScreenshot.isEmpty()) {
+          // Plugins' panels update from the frame's signals; let them paint first.
+          QApplication::processEvents();
+          if (!window.grab().save(cl.windowScreenshot)) fail(QStringLiteral("%1: cannot write").arg(cl.windowScreenshot), 1);
+        }
+      } catch (const std::exception& e) {
+        fail(QString::fromUtf8(e.what()), 1);
+      }
+      QApplication::exit(0);
+    });
+    poll->start(200);
+  }
+
+  window.show();
+  if (!cl.session.isEmpty()) window.openSession(cl.session);
+  else window.openScene(cl.scene);
+  return QApplication::exec();
+}

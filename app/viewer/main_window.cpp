@@ -1,0 +1,403 @@
+#include "main_window.hpp"
+
+#include <QAction>
+#include <QActionGroup>
+#include <QApplication>
+#include <QCloseEvent>
+#include <QDockWidget>
+#include <QDragEnterEvent>
+#include <QDropEvent>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QHeaderView>
+#include <QInputDialog>
+#include <QLabel>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QMimeData>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSettings>
+#include <QStatusBar>
+#include <QTableWidget>
+#include <QTimer>
+#include <QVBoxLayout>
+
+#include <exception>
+
+#include "camera_navigator.hpp"
+#include "mfr/error.hpp"
+#include "mfr/image.hpp"
+#include "mfr/io/load.hpp"
+#include "method_panel.hpp"
+#include "render_view.hpp"
+#include "scene_tree_panel.hpp"
+#include "stats_panel.hpp"
+#include "viewer_model.hpp"
+
+namespace {
+
+constexpr int kMaxRecentFiles = 10;
+const QString kSessionSuffix = QStringLiteral(".mfrsession");
+
+QString sceneFileFilter() {
+  QStringList patterns{QStringLiteral("*.mfrscene")};
+  for (const std::string& ext : mfr::supportedModelExtensions()) patterns << QStringLiteral("*") + QString::fromStdString(ext);
+  return QObject::tr("Scenes and models (%1);;mfrview sessions (*.mfrsession);;All files (*)").arg(patterns.join(' '));
+}
+
+}  // namespace
+
+MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), options_(options) {
+  setObjectName(QStringLiteral("mfrviewMainWindow"));
+  model_ = new ViewerModel(this);
+  view_ = new RenderView(*model_, this);
+  view_->setObjectName(QStringLiteral("renderView"));
+  setCentralWidget(view_);
+  setAcceptDrops(true);
+  setDockOptions(QMainWindow::AnimatedDocks | QMainWindow::AllowTabbedDocks);
+  setCorner(Qt::BottomLeftCorner, Qt::LeftDockWidgetArea);
+  setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
+
+  buildMenus();
+  buildDocks();
+  if (options_.loadPlugins) {
+    plugins_.loadAll();
+    buildPluginDocks();
+  }
+  buildStatusBar();
+
+  connect(model_, &ViewerModel::loadStarted, this, [this](const QString& path) {
+    loadProgress_->show();
+    cancelLoad_->show();
+    statusBar()->showMessage(tr("Loading %1…").arg(path));
+  });
+  const auto loadEnded = [this] {
+    loadProgress_->hide();
+    cancelLoad_->hide();
+  };
+  connect(model_, &ViewerModel::sceneLoaded, this, [this, loadEnded] {
+    loadEnded();
+    lastError_.clear();
+    statusBar()->showMessage(tr("Loaded %1 — %2 objects, %3 triangles")
+                                 .arg(model_->scenePath())
+                                 .arg(model_->scene().objects.size())
+                                 .arg(model_->scene().triangleCount()),
+                             8000);
+    addRecentFile(model_->scenePath());
+    rebuildNamedViews();
+    updateTitle();
+    if (pendingSession_) {
+      applySession(*pendingSession_, *model_);
+      for (const PluginRecord& r : plugins_.records())
+        if (r.plugin && pendingSession_->plugins.contains(r.id)) r.plugin->loadSettings(pendingSession_->plugins.value(r.id).toObject());
+      addRecentFile(pendingSessionFile_);
+      pendingSession_.reset();
+    }
+  });
+  connect(model_, &ViewerModel::loadFailed, this, [this, loadEnded](const QString& path, const QString& message) {
+    loadEnded();
+    pendingSession_.reset();
+    showError(tr("Cannot open %1").arg(QFileInfo(path).fileName()), message);
+  });
+  connect(model_, &ViewerModel::loadCancelled, this, [this, loadEnded] {
+    loadEnded();
+    pendingSession_.reset();
+    statusBar()->showMessage(tr("Loading cancelled; the current scene stays."), 5000);
+  });
+  connect(model_, &ViewerModel::frameRendered, this, &MainWindow::updateFrameInfo);
+  connect(model_, &ViewerModel::renderErrorChanged, this, [this](const QString& message) {
+    if (!message.isEmpty()) statusBar()->showMessage(tr("Cannot render: %1").arg(message));
+  });
+
+  resize(1400, 900);
+  if (options_.restoreSettings) {
+    QSettings settings;
+    restoreGeometry(settings.value(QStringLiteral("window/geometry")).toByteArray());
+    restoredLayout_ = restoreState(settings.value(QStringLiteral("window/state")).toByteArray());
+    const QString method = settings.value(QStringLiteral("method")).toString();
+    if (model_->methodNames().contains(method)) model_->setMethod(method);
+  }
+  rebuildRecentFiles();
+  updateTitle();
+}
+
+MainWindow::~MainWindow() = default;
+
+// ---- menus ---------------------------------------------------------------------------------
+
+void MainWindow::buildMenus() {
+  QMenu* file = menuBar()->addMenu(tr("&File"));
+  file->addAction(tr("&Open…"), QKeySequence::Open, this, &MainWindow::chooseFileToOpen);
+  recentMenu_ = file->addMenu(tr("Open &Recent"));
+  file->addAction(tr("Open &Sample"), this, [this] { openScene(QStringLiteral("@sample")); });
+  file->addSeparator();
+  file->addAction(tr("Save Session &As…"), QKeySequence::SaveAs, this, &MainWindow::chooseSessionToSave);
+  file->addAction(tr("&Export Image…"), QKeySequence(Qt::CTRL | Qt::Key_E), this, &MainWindow::chooseImageToExport);
+  file->addSeparator();
+  file->addAction(tr("&Quit"), QKeySequence::Quit, this, &QWidget::close);
+
+  viewMenu_ = menuBar()->addMenu(tr("&View"));
+  viewMenu_->addAction(tr("&Fit All"), QKeySequence(Qt::Key_F), this, [this] {
+    if (model_->hasScene()) model_->setCamera(model_->scene().fit(model_->camera()));
+  });
+  QMenu* standard = viewMenu_->addMenu(tr("&Standard Views"));
+  using navigation::StandardView;
+  int key = Qt::Key_1;
+  for (StandardView v : {StandardView::Front, StandardView::Back, StandardView::Left, StandardView::Right,
+                         StandardView::Top, StandardView::Bottom, StandardView::Iso}) {
+    QAction* a = standard->addAction(navigation::standardViewName(v), this, [this, v] {
+      if (model_->hasScene()) model_->setCamera(navigation::standardView(v, model_->scene(), model_->camera()));
+    });
+    a->setShortcut(QKeySequence(key++));
+  }
+  namedViewsMenu_ = viewMenu_->addMenu(tr("Scene &Views"));
+  QAction* ortho = viewMenu_->addAction(tr("&Orthographic Projection"));
+  ortho->setCheckable(true);
+  ortho->setShortcut(QKeySequence(Qt::Key_O));
+  connect(ortho, &QAction::triggered, this, [this] { model_->setCamera(navigation::toggledProjection(model_->camera())); });
+  connect(model_, &ViewerModel::viewChanged, ortho,
+          [this, ortho] { ortho->setChecked(model_->camera().projection == mfr::Projection::Orthographic); });
+  viewMenu_->addSeparator();
+  panelsMenu_ = viewMenu_->addMenu(tr("&Panels"));
+
+  QMenu* help = menuBar()->addMenu(tr("&Help"));
+  help->addAction(tr("&Plugins…"), this, &MainWindow::showPluginsDialog);
+  help->addAction(tr("&Navigation"), this, [this] {
+    QMessageBox::information(this, tr("Navigation"),
+                             tr("<table>"
+                                "<tr><td>Left drag</td><td>orbit (trackball)</td></tr>"
+                                "<tr><td>Middle or Shift + left drag</td><td>pan</td></tr>"
+                                "<tr><td>Wheel</td><td>zoom to the cursor</td></tr>"
+                                "<tr><td>F</td><td>fit all</td></tr>"
+                                "<tr><td>1 … 7</td><td>front, back, left, right, top, bottom, isometric</td></tr>"
+                                "<tr><td>O</td><td>perspective / orthographic</td></tr></table>"));
+  });
+  help->addAction(tr("&About mfrview"), this, [this] {
+    QMessageBox::about(this, tr("About mfrview"),
+                       tr("<b>mfrview</b> — multifragment rendering viewer.<br>%1").arg(view_->glInfo()));
+  });
+}
+
+void MainWindow::buildDocks() {
+  const auto dock = [this](const QString& title, const QString& name, QWidget* panel, Qt::DockWidgetArea area) {
+    auto* d = new QDockWidget(title, this);
+    d->setObjectName(name);
+    d->setWidget(panel);
+    addDockWidget(area, d);
+    panelsMenu_->addAction(d->toggleViewAction());
+    return d;
+  };
+  QDockWidget* scene = dock(tr("Scene"), QStringLiteral("sceneDock"), new SceneTreePanel(*model_), Qt::LeftDockWidgetArea);
+  dock(tr("Method"), QStringLiteral("methodDock"), new MethodPanel(*model_), Qt::LeftDockWidgetArea);
+  QDockWidget* stats = dock(tr("Statistics"), QStringLiteral("statsDock"), new StatsPanel(*model_), Qt::RightDockWidgetArea);
+  // The image gets most of the window; panels start narrow (users widen them as they like).
+  // Deferred until the window has its size, or the layout overrides it.
+  QTimer::singleShot(0, this, [this, scene, stats] {
+    if (!restoredLayout_) resizeDocks({scene, stats}, {330, 360}, Qt::Horizontal);
+  });
+}
+
+void MainWindow::buildPluginDocks() {
+  for (const PluginRecord& r : plugins_.records()) {
+    if (!r.plugin) continue;
+    auto* d = new QDockWidget(r.name, this);
+    d->setObjectName(QStringLiteral("plugin-") + r.id);
+    d->setWidget(r.plugin->createPanel(*model_, d));
+    addDockWidget(Qt::RightDockWidgetArea, d);
+    panelsMenu_->addAction(d->toggleViewAction());
+  }
+}
+
+void MainWindow::buildStatusBar() {
+  loadProgress_ = new QProgressBar;
+  loadProgress_->setRange(0, 0);  // the loaders report no progress: a busy indicator
+  loadProgress_->setMaximumWidth(160);
+  loadProgress_->hide();
+  cancelLoad_ = new QPushButton(tr("Cancel"));
+  cancelLoad_->setObjectName(QStringLiteral("cancelLoad"));
+  cancelLoad_->hide();
+  connect(cancelLoad_, &QPushButton::clicked, model_, &ViewerModel::cancelLoad);
+  frameInfo_ = new QLabel;
+  statusBar()->addPermanentWidget(loadProgress_);
+  statusBar()->addPermanentWidget(cancelLoad_);
+  statusBar()->addPermanentWidget(frameInfo_);
+}
+
+void MainWindow::rebuildNamedViews() {
+  namedViewsMenu_->clear();
+  for (const mfr::NamedView& v : model_->scene().views) {
+    const mfr::Camera camera = v.camera;
+    namedViewsMenu_->addAction(QString::fromStdString(v.name), this, [this, camera] { model_->setCamera(camera); });
+  }
+  namedViewsMenu_->setEnabled(!model_->scene().views.empty());
+}
+
+void MainWindow::rebuildRecentFiles() {
+  recentMenu_->clear();
+  const QStringList recent = QSettings().value(QStringLiteral("recentFiles")).toStringList();
+  for (const QString& path : recent) recentMenu_->addAction(path, this, [this, path] { open(path); });
+  recentMenu_->setEnabled(!recent.isEmpty());
+}
+
+void MainWindow::addRecentFile(const QString& path) {
+  if (path.isEmpty()) return;
+  QSettings settings;
+  QStringList recent = settings.value(QStringLiteral("recentFiles")).toStringList();
+  recent.removeAll(path);
+  recent.prepend(path);
+  while (recent.size() > kMaxRecentFiles) recent.removeLast();
+  settings.setValue(QStringLiteral("recentFiles"), recent);
+  rebuildRecentFiles();
+}
+
+// ---- files -------------------------------------------------------------------------------
+
+void MainWindow::open(const QString& path) {
+  if (path.endsWith(kSessionSuffix, Qt::CaseInsensitive)) openSession(path);
+  else openScene(path);
+}
+
+void MainWindow::openScene(const QString& path) {
+  pendingSession_.reset();
+  // Built-ins stay as typed; files are remembered by absolute path.
+  model_->loadSceneAsync(path.startsWith('@') ? path : QFileInfo(path).absoluteFilePath());
+}
+
+void MainWindow::openSession(const QString& path) {
+  try {
+    Session session = readSessionFile(path);
+    const QString scene = session.scenePath;
+    model_->loadSceneAsync(scene);
+    pendingSession_ = std::move(session);  // after loadSceneAsync, which cannot finish before we return
+    pendingSessionFile_ = QFileInfo(path).absoluteFilePath();
+  } catch (const std::exception& e) {
+    showError(tr("Cannot open session %1").arg(QFileInfo(path).fileName()), QString::fromUtf8(e.what()));
+  }
+}
+
+void MainWindow::saveSession(const QString& path) {
+  Session session = captureSession(*model_);
+  for (const PluginRecord& r : plugins_.records())
+    if (r.plugin) session.plugins.insert(r.id, r.plugin->saveSettings());
+  writeSessionFile(path, session);
+  addRecentFile(QFileInfo(path).absoluteFilePath());
+}
+
+void MainWindow::exportImage(const QString& path, QSize size) {
+  mfr::writePng(path.toStdString(), view_->renderImage(size));
+}
+
+void MainWindow::chooseFileToOpen() {
+  const QString path = QFileDialog::getOpenFileName(this, tr("Open"), QString(), sceneFileFilter());
+  if (!path.isEmpty()) open(path);
+}
+
+void MainWindow::chooseSessionToSave() {
+  QString path = QFileDialog::getSaveFileName(this, tr("Save Session"), QString(), tr("mfrview sessions (*.mfrsession)"));
+  if (path.isEmpty()) return;
+  if (!path.endsWith(kSessionSuffix)) path += kSessionSuffix;
+  try {
+    saveSession(path);
+    statusBar()->showMessage(tr("Saved %1").arg(path), 5000);
+  } catch (const std::exception& e) {
+    showError(tr("Cannot save the session"), QString::fromUtf8(e.what()));
+  }
+}
+
+void MainWindow::chooseImageToExport() {
+  bool ok = false;
+  const QSize current = model_->renderSize();
+  const QString sizeText = QInputDialog::getText(this, tr("Export Image"), tr("Size (width × height, pixels):"), QLineEdit::Normal,
+                                                 QStringLiteral("%1x%2").arg(current.width()).arg(current.height()), &ok);
+  if (!ok) return;
+  const QStringList parts = sizeText.split(QLatin1Char('x'));
+  const QSize size = parts.size() == 2 ? QSize(parts[0].trimmed().toInt(), parts[1].trimmed().toInt()) : QSize();
+  if (size.width() <= 0 || size.height() <= 0 || size.width() > 16384 || size.height() > 16384) {
+    showError(tr("Cannot export"), tr("size %1: expected WIDTHxHEIGHT, e.g. 1920x1080").arg(sizeText));
+    return;
+  }
+  QString path = QFileDialog::getSaveFileName(this, tr("Export Image"), QStringLiteral("mfrview.png"), tr("PNG images (*.png)"));
+  if (path.isEmpty()) return;
+  if (!path.endsWith(QStringLiteral(".png"), Qt::CaseInsensitive)) path += QStringLiteral(".png");
+  try {
+    exportImage(path, size);
+    statusBar()->showMessage(tr("Wrote %1").arg(path), 5000);
+  } catch (const std::exception& e) {
+    showError(tr("Cannot export the image"), QString::fromUtf8(e.what()));
+  }
+}
+
+void MainWindow::showError(const QString& title, const QString& message) {
+  lastError_ = message;
+  statusBar()->showMessage(message);
+  // Window-modal and non-blocking: loading finishes from the event loop, and tests can read it.
+  auto* box = new QMessageBox(QMessageBox::Warning, title, message, QMessageBox::Ok, this);
+  box->setObjectName(QStringLiteral("errorBox"));
+  box->setInformativeText(model_->hasScene() ? tr("The current scene (%1) stays open.").arg(QString::fromStdString(model_->scene().name))
+                                             : QString());
+  box->setAttribute(Qt::WA_DeleteOnClose);
+  box->open();
+}
+
+void MainWindow::showPluginsDialog() {
+  QDialog dialog(this);
+  dialog.setWindowTitle(tr("Plugins"));
+  auto* layout = new QVBoxLayout(&dialog);
+  layout->addWidget(new QLabel(tr("Searched: %1").arg(PluginManager::searchPaths().join(QStringLiteral(", ")))));
+  auto* table = new QTableWidget(static_cast<int>(plugins_.records().size()), 4);
+  table->setHorizontalHeaderLabels({tr("Plugin"), tr("Id"), tr("Status"), tr("File")});
+  int row = 0;
+  for (const PluginRecord& r : plugins_.records()) {
+    table->setItem(row, 0, new QTableWidgetItem(r.plugin ? r.name : QFileInfo(r.file).fileName()));
+    table->setItem(row, 1, new QTableWidgetItem(r.id));
+    table->setItem(row, 2, new QTableWidgetItem(r.plugin ? tr("loaded — %1").arg(r.description) : tr("failed: %1").arg(r.error)));
+    table->setItem(row, 3, new QTableWidgetItem(r.file));
+    ++row;
+  }
+  table->horizontalHeader()->setStretchLastSection(true);
+  table->resizeColumnsToContents();
+  table->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  layout->addWidget(table);
+  dialog.resize(820, 260);
+  dialog.exec();
+}
+
+void MainWindow::updateTitle() {
+  setWindowTitle(model_->hasScene() ? tr("%1 — mfrview").arg(QString::fromStdString(model_->scene().name)) : tr("mfrview"));
+}
+
+void MainWindow::updateFrameInfo() {
+  const mfr::Stats& s = model_->stats();
+  const QSize size = model_->renderSize();
+  frameInfo_->setText(tr("%1  ·  %2×%3  ·  %4 ms  ·  %5")
+                          .arg(QString::fromStdString(s.method))
+                          .arg(size.width())
+                          .arg(size.height())
+                          .arg(s.totalTimeMs(), 0, 'f', 1)
+                          .arg(formatBytes(s.bytesAllocated)));
+}
+
+// ---- window events -------------------------------------------------------------------------
+
+void MainWindow::closeEvent(QCloseEvent* event) {
+  if (options_.restoreSettings) {
+    QSettings settings;
+    settings.setValue(QStringLiteral("window/geometry"), saveGeometry());
+    settings.setValue(QStringLiteral("window/state"), saveState());
+    settings.setValue(QStringLiteral("method"), model_->method());
+  }
+  event->accept();
+}
+
+void MainWindow::dragEnterEvent(QDragEnterEvent* event) {
+  if (event->mimeData()->hasUrls() && !event->mimeData()->urls().isEmpty() && event->mimeData()->urls().first().isLocalFile())
+    event->acceptProposedAction();
+}
+
+void MainWindow::dropEvent(QDropEvent* event) {
+  const QList<QUrl> urls = event->mimeData()->urls();
+  if (urls.isEmpty() || !urls.first().isLocalFile()) return;
+  open(urls.first().toLocalFile());
+  event->acceptProposedAction();
+}

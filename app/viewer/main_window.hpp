@@ -1,0 +1,81 @@
+#pragma once
+// mfrview's main window: the render view in the centre, docks for the scene, the method, the
+// statistics and each plugin; menus for files, sessions, views and plugins.
+#include <QMainWindow>
+
+#include <optional>
+
+#include "plugin_manager.hpp"
+#include "session.hpp"
+
+class QLabel;
+class QMenu;
+class QProgressBar;
+class QPushButton;
+class RenderView;
+class ViewerModel;
+
+class MainWindow final : public QMainWindow {
+  Q_OBJECT
+
+ public:
+  struct Options {
+    bool restoreSettings = true;  // window layout, recent files and last method from QSettings
+    bool loadPlugins = true;
+  };
+  explicit MainWindow(Options options, QWidget* parent = nullptr);
+  MainWindow() : MainWindow(Options{}) {}
+  ~MainWindow() override;
+
+  // Starts loading a model, .mfrscene, built-in (@sample) or .mfrsession file.
+  void open(const QString& path);
+  void openScene(const QString& path);
+  void openSession(const QString& path);
+  // Throws mfr::Error naming the file.
+  void saveSession(const QString& path);
+  // Renders the current view at `size` (see RenderView::renderImage) and writes a PNG.
+  void exportImage(const QString& path, QSize size);
+
+  [[nodiscard]] ViewerModel& model() { return *model_; }
+  [[nodiscard]] RenderView& view() { return *view_; }
+  [[nodiscard]] const PluginManager& plugins() const { return plugins_; }
+  // The last load error shown to the user (empty when the last load succeeded).
+  [[nodiscard]] const QString& lastError() const { return lastError_; }
+
+ protected:
+  void closeEvent(QCloseEvent* event) override;
+  void dragEnterEvent(QDragEnterEvent* event) override;
+  void dropEvent(QDropEvent* event) override;
+
+ private:
+  void buildMenus();
+  void buildDocks();
+  void buildPluginDocks();
+  void buildStatusBar();
+  void rebuildNamedViews();
+  void rebuildRecentFiles();
+  void addRecentFile(const QString& path);
+  void showError(const QString& title, const QString& message);
+  void showPluginsDialog();
+  void chooseFileToOpen();
+  void chooseSessionToSave();
+  void chooseImageToExport();
+  void updateTitle();
+  void updateFrameInfo();
+
+  Options options_;
+  ViewerModel* model_ = nullptr;
+  RenderView* view_ = nullptr;
+  PluginManager plugins_;
+  QMenu* viewMenu_ = nullptr;
+  QMenu* namedViewsMenu_ = nullptr;
+  QMenu* recentMenu_ = nullptr;
+  QMenu* panelsMenu_ = nullptr;
+  QLabel* frameInfo_ = nullptr;
+  QProgressBar* loadProgress_ = nullptr;
+  QPushButton* cancelLoad_ = nullptr;
+  QString lastError_;
+  bool restoredLayout_ = false;
+  std::optional<Session> pendingSession_;  // applied once its scene has loaded
+  QString pendingSessionFile_;
+};

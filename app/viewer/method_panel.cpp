@@ -1,0 +1,160 @@
+#include "method_panel.hpp"
+
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QFormLayout>
+#include <QLabel>
+#include <QPushButton>
+#include <QSignalBlocker>
+#include <QSpinBox>
+#include <QVBoxLayout>
+
+#include <cmath>
+
+#include "viewer_model.hpp"
+
+namespace {
+
+// Float parameters as text: round-trips the spin box value without trailing noise.
+std::string floatText(double value) { return QString::number(value, 'g', 10).toStdString(); }
+
+}  // namespace
+
+MethodPanel::MethodPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), model_(model) {
+  auto* layout = new QVBoxLayout(this);
+  auto* top = new QFormLayout;
+  methodCombo_ = new QComboBox;
+  methodCombo_->setObjectName(QStringLiteral("methodCombo"));
+  for (const QString& name : model_.methodNames()) {
+    const mfr::MethodInfo* info = model_.methodInfo(name);
+    methodCombo_->addItem(info ? QStringLiteral("%1 — %2").arg(name, QString::fromStdString(info->title))
+                               : QStringLiteral("%1 — exact CPU reference").arg(name),
+                          name);
+  }
+  // Long method titles must not dictate the dock's width.
+  methodCombo_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
+  methodCombo_->setMinimumContentsLength(16);
+  operationCombo_ = new QComboBox;
+  operationCombo_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
+  operationCombo_->setMinimumContentsLength(16);
+  operationCombo_->setObjectName(QStringLiteral("operationCombo"));
+  operationCombo_->addItem(tr("oit — composite \"over\""), QStringLiteral("oit"));
+  operationCombo_->addItem(tr("hybrid — exact core + averaged tail"), QStringLiteral("hybrid"));
+  top->addRow(tr("Method"), methodCombo_);
+  top->addRow(tr("Operation"), operationCombo_);
+  layout->addLayout(top);
+
+  description_ = new QLabel;
+  description_->setWordWrap(true);
+  description_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  description_->setStyleSheet(QStringLiteral("color: palette(mid);"));
+  layout->addWidget(description_);
+
+  paramsBox_ = new QWidget;
+  paramsLayout_ = new QFormLayout(paramsBox_);
+  paramsLayout_->setContentsMargins(0, 0, 0, 0);
+  layout->addWidget(paramsBox_);
+
+  auto* reset = new QPushButton(tr("Reset to defaults"));
+  connect(reset, &QPushButton::clicked, this, [this] {
+    auto all = model_.allParams();
+    all.erase(model_.method().toStdString());
+    model_.setAllParams(std::move(all));
+  });
+  layout->addWidget(reset, 0, Qt::AlignRight);
+  layout->addStretch(1);
+
+  connect(methodCombo_, &QComboBox::currentIndexChanged, this,
+          [this](int index) { model_.setMethod(methodCombo_->itemData(index).toString()); });
+  connect(operationCombo_, &QComboBox::currentIndexChanged, this,
+          [this](int index) { model_.setOperation(operationCombo_->itemData(index).toString()); });
+  connect(&model_, &ViewerModel::methodChanged, this, [this] {
+    syncMethodCombo();
+    rebuildParameters();
+  });
+  connect(&model_, &ViewerModel::operationChanged, this, [this](const QString& op) {
+    const QSignalBlocker block(operationCombo_);
+    operationCombo_->setCurrentIndex(operationCombo_->findData(op));
+  });
+  connect(&model_, &ViewerModel::paramsChanged, this, &MethodPanel::showParameterValues);
+  syncMethodCombo();
+  rebuildParameters();
+}
+
+void MethodPanel::syncMethodCombo() {
+  const QSignalBlocker block(methodCombo_);
+  methodCombo_->setCurrentIndex(methodCombo_->findData(model_.method()));
+}
+
+void MethodPanel::rebuildParameters() {
+  while (paramsLayout_->rowCount() > 0) paramsLayout_->removeRow(0);
+  editors_.clear();
+  const mfr::MethodInfo* info = model_.methodInfo(model_.method());
+  if (!info) {
+    description_->setText(tr("Exact per-pixel fragment lists by CPU ray casting; the reference for every method."));
+    return;
+  }
+  description_->setText(QString::fromStdString(info->paper));
+  for (const mfr::ParamSpec& spec : info->params) {
+    QWidget* editor = nullptr;
+    const std::string name = spec.name;
+    const auto set = [this, name](const std::string& value) { model_.setParams({{name, value}}); };
+    switch (spec.type) {
+      case mfr::ParamSpec::Type::Int: {
+        auto* box = new QSpinBox;
+        box->setRange(static_cast<int>(spec.min), static_cast<int>(std::min(spec.max, 2.0e9)));
+        box->setKeyboardTracking(false);  // re-render when typing is done, not per digit
+        connect(box, &QSpinBox::valueChanged, this, [set](int v) { set(std::to_string(v)); });
+        editor = box;
+        break;
+      }
+      case mfr::ParamSpec::Type::Float: {
+        auto* box = new QDoubleSpinBox;
+        box->setDecimals(3);
+        box->setRange(spec.min, spec.max);
+        box->setSingleStep(spec.max - spec.min > 10.0 ? 1.0 : 0.05);
+        box->setKeyboardTracking(false);
+        connect(box, &QDoubleSpinBox::valueChanged, this, [set](double v) { set(floatText(v)); });
+        editor = box;
+        break;
+      }
+      case mfr::ParamSpec::Type::Bool: {
+        auto* box = new QCheckBox;
+        connect(box, &QCheckBox::toggled, this, [set](bool v) { set(v ? "true" : "false"); });
+        editor = box;
+        break;
+      }
+      case mfr::ParamSpec::Type::Choice: {
+        auto* box = new QComboBox;
+        for (const std::string& c : spec.choices) box->addItem(QString::fromStdString(c));
+        connect(box, &QComboBox::currentTextChanged, this, [set](const QString& v) { set(v.toStdString()); });
+        editor = box;
+        break;
+      }
+    }
+    editor->setObjectName(QStringLiteral("param-") + QString::fromStdString(name));
+    editor->setToolTip(QString::fromStdString(spec.help));
+    auto* label = new QLabel(QString::fromStdString(spec.label));
+    label->setToolTip(QString::fromStdString(spec.help));
+    paramsLayout_->addRow(label, editor);
+    editors_[name] = editor;
+  }
+  showParameterValues();
+}
+
+void MethodPanel::showParameterValues() {
+  const mfr::MethodInfo* info = model_.methodInfo(model_.method());
+  if (!info) return;
+  const auto values = model_.params();
+  for (const mfr::ParamSpec& spec : info->params) {
+    const auto it = values.find(spec.name);
+    const QString value = QString::fromStdString(it != values.end() ? it->second : spec.defaultValue);
+    QWidget* editor = editors_[spec.name];
+    const QSignalBlocker block(editor);
+    if (auto* i = qobject_cast<QSpinBox*>(editor)) i->setValue(value.toInt());
+    else if (auto* d = qobject_cast<QDoubleSpinBox*>(editor)) d->setValue(value.toDouble());
+    else if (auto* b = qobject_cast<QCheckBox*>(editor)) b->setChecked(value == QLatin1String("true") || value == QLatin1String("1"));
+    else if (auto* c = qobject_cast<QComboBox*>(editor)) c->setCurrentText(value);
+  }
+}

@@ -1,0 +1,113 @@
+#include "scene_tree_panel.hpp"
+
+#include <QColorDialog>
+#include <QHeaderView>
+#include <QPixmap>
+#include <QTreeWidget>
+#include <QVBoxLayout>
+
+#include <QSignalBlocker>
+
+#include <algorithm>
+#include <cmath>
+
+#include "viewer_model.hpp"
+
+namespace {
+
+enum Column { kName = 0, kColour = 1, kOpacity = 2, kTriangles = 3 };
+
+QColor colourOf(const mfr::Object& o) {
+  return QColor::fromRgbF(o.material.color.r, o.material.color.g, o.material.color.b);
+}
+
+QIcon swatch(const QColor& colour) {
+  QPixmap pixmap(16, 16);
+  pixmap.fill(colour);
+  return QIcon(pixmap);
+}
+
+}  // namespace
+
+SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(parent), model_(model) {
+  auto* layout = new QVBoxLayout(this);
+  layout->setContentsMargins(0, 0, 0, 0);
+  tree_ = new QTreeWidget;
+  tree_->setObjectName(QStringLiteral("sceneTree"));
+  tree_->setColumnCount(4);
+  tree_->setHeaderLabels({tr("Object"), tr("Colour"), tr("Opacity"), tr("Triangles")});
+  tree_->setRootIsDecorated(false);
+  tree_->setUniformRowHeights(true);  // CAD assemblies have thousands of parts
+  tree_->header()->setStretchLastSection(false);
+  tree_->header()->setSectionResizeMode(kName, QHeaderView::Stretch);
+  for (int c : {kColour, kOpacity, kTriangles}) tree_->header()->setSectionResizeMode(c, QHeaderView::ResizeToContents);
+  tree_->setEditTriggers(QAbstractItemView::DoubleClicked | QAbstractItemView::EditKeyPressed);
+  layout->addWidget(tree_);
+  connect(tree_, &QTreeWidget::itemChanged, this, &SceneTreePanel::itemChanged);
+  connect(tree_, &QTreeWidget::itemClicked, this, &SceneTreePanel::itemClicked);
+  connect(&model_, &ViewerModel::sceneLoaded, this, &SceneTreePanel::rebuild);
+  // Edits from elsewhere (a session's overrides, plugins) show up in the rows.
+  connect(&model_, &ViewerModel::sceneChanged, this, &SceneTreePanel::showValues);
+}
+
+void SceneTreePanel::showValues() {
+  const auto& objects = model_.scene().objects;
+  if (tree_->topLevelItemCount() != static_cast<int>(objects.size())) return;
+  const QSignalBlocker block(tree_);
+  for (int i = 0; i < tree_->topLevelItemCount(); ++i) {
+    QTreeWidgetItem* item = tree_->topLevelItem(i);
+    const mfr::Object& o = objects[static_cast<std::size_t>(i)];
+    item->setCheckState(kName, o.visible ? Qt::Checked : Qt::Unchecked);
+    if (item->text(kColour) != colourOf(o).name()) {
+      item->setIcon(kColour, swatch(colourOf(o)));
+      item->setText(kColour, colourOf(o).name());
+    }
+    item->setData(kOpacity, Qt::EditRole, std::round(o.material.color.a * 1000.0) / 1000.0);
+  }
+}
+
+void SceneTreePanel::rebuild() {
+  rebuilding_ = true;
+  tree_->clear();
+  const auto& objects = model_.scene().objects;
+  QList<QTreeWidgetItem*> items;
+  items.reserve(static_cast<qsizetype>(objects.size()));
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    const mfr::Object& o = objects[i];
+    auto* item = new QTreeWidgetItem;
+    item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsUserCheckable | Qt::ItemIsEditable);
+    item->setText(kName, QString::fromStdString(o.name.empty() ? "object " + std::to_string(i) : o.name));
+    item->setData(kName, Qt::UserRole, static_cast<int>(i));
+    item->setCheckState(kName, o.visible ? Qt::Checked : Qt::Unchecked);
+    item->setIcon(kColour, swatch(colourOf(o)));
+    item->setText(kColour, colourOf(o).name());
+    item->setToolTip(kColour, tr("Click to change the colour"));
+    item->setData(kOpacity, Qt::EditRole, std::round(o.material.color.a * 1000.0) / 1000.0);
+    item->setToolTip(kOpacity, tr("Double-click to edit (0 = invisible, 1 = opaque)"));
+    item->setText(kTriangles, QString::number(o.mesh ? o.mesh->triangleCount() : 0));
+    item->setTextAlignment(kTriangles, Qt::AlignRight | Qt::AlignVCenter);
+    items.push_back(item);
+  }
+  tree_->addTopLevelItems(items);
+  rebuilding_ = false;
+}
+
+void SceneTreePanel::itemChanged(QTreeWidgetItem* item, int column) {
+  if (rebuilding_) return;
+  const int index = item->data(kName, Qt::UserRole).toInt();
+  if (column == kName) {
+    model_.setObjectVisible(index, item->checkState(kName) == Qt::Checked);
+  } else if (column == kOpacity) {
+    const double opacity = std::clamp(item->data(kOpacity, Qt::EditRole).toDouble(), 0.0, 1.0);
+    model_.setObjectOpacity(index, opacity);  // sceneChanged shows the clamped value
+  }
+}
+
+void SceneTreePanel::itemClicked(QTreeWidgetItem* item, int column) {
+  if (column != kColour) return;
+  const int index = item->data(kName, Qt::UserRole).toInt();
+  const QColor initial = colourOf(model_.scene().objects[static_cast<std::size_t>(index)]);
+  const QColor chosen = QColorDialog::getColor(initial, this, tr("Colour of %1").arg(item->text(kName)));
+  if (!chosen.isValid()) return;
+  model_.setObjectColor(index, chosen);
+}

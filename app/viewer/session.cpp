@@ -1,0 +1,157 @@
+#include "session.hpp"
+
+#include <QDir>
+#include <QFile>
+#include <QFileInfo>
+#include <QJsonArray>
+#include <QJsonDocument>
+#include <QSaveFile>
+
+#include "mfr/error.hpp"
+#include "viewer_model.hpp"
+
+namespace {
+
+QJsonArray vec3(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+
+class Reader {
+ public:
+  explicit Reader(QString file) : file_(std::move(file)) {}
+  [[noreturn]] void fail(const QString& where, const QString& reason) const {
+    throw mfr::Error((file_ + ": " + where).toStdString(), reason.toStdString());
+  }
+  glm::dvec3 vec3(const QJsonObject& o, const QString& key, const QString& where) const {
+    const QJsonArray a = o.value(key).toArray();
+    if (a.size() != 3 || !a[0].isDouble() || !a[1].isDouble() || !a[2].isDouble())
+      fail(where + "." + key, QStringLiteral("expected [x, y, z]"));
+    return {a[0].toDouble(), a[1].toDouble(), a[2].toDouble()};
+  }
+  double number(const QJsonObject& o, const QString& key, const QString& where, double fallback) const {
+    if (!o.contains(key)) return fallback;
+    if (!o.value(key).isDouble()) fail(where + "." + key, QStringLiteral("expected a number"));
+    return o.value(key).toDouble();
+  }
+
+ private:
+  QString file_;
+};
+
+}  // namespace
+
+Session captureSession(const ViewerModel& model) {
+  Session s;
+  s.scenePath = model.scenePath();
+  s.camera = model.camera();
+  s.method = model.method();
+  s.operation = model.operation();
+  s.params = model.allParams();
+  for (const mfr::Object& o : model.scene().objects) {
+    s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color});
+  }
+  return s;
+}
+
+void applySession(const Session& session, ViewerModel& model) {
+  if (session.objects.size() == model.scene().objects.size()) {
+    for (std::size_t i = 0; i < session.objects.size(); ++i) {
+      const Session::ObjectState& o = session.objects[i];
+      const int index = static_cast<int>(i);
+      model.setObjectVisible(index, o.visible);
+      model.setObjectMaterial(index, o.color);
+    }
+  }
+  model.setAllParams(session.params);
+  if (!session.operation.isEmpty()) model.setOperation(session.operation);
+  if (!session.method.isEmpty()) model.setMethod(session.method);
+  model.setCamera(session.camera);
+}
+
+QJsonObject sessionToJson(const Session& s) {
+  QJsonObject camera{{"eye", vec3(s.camera.eye)},
+                     {"target", vec3(s.camera.target)},
+                     {"up", vec3(s.camera.up)},
+                     {"projection", s.camera.projection == mfr::Projection::Orthographic ? "orthographic" : "perspective"},
+                     {"fovy_degrees", s.camera.fovyDegrees},
+                     {"ortho_height", s.camera.orthoHeight},
+                     {"near", s.camera.nearPlane},
+                     {"far", s.camera.farPlane}};
+  QJsonObject params;
+  for (const auto& [method, values] : s.params) {
+    QJsonObject p;
+    for (const auto& [name, value] : values) p.insert(QString::fromStdString(name), QString::fromStdString(value));
+    params.insert(QString::fromStdString(method), p);
+  }
+  QJsonArray objects;
+  for (const Session::ObjectState& o : s.objects)
+    objects.append(QJsonObject{{"name", o.name},
+                               {"visible", o.visible},
+                               {"color", QJsonArray{o.color.r, o.color.g, o.color.b}},
+                               {"opacity", o.color.a}});
+  return {{"format", "mfrview-session"}, {"version", 1},           {"scene", s.scenePath},
+          {"camera", camera},            {"method", s.method},     {"operation", s.operation},
+          {"params", params},            {"objects", objects},     {"plugins", s.plugins}};
+}
+
+Session sessionFromJson(const QJsonObject& json, const QString& file) {
+  const Reader r(file);
+  if (json.value("format").toString() != QLatin1String("mfrview-session"))
+    r.fail(QStringLiteral("format"), QStringLiteral("not an mfrview session (expected \"format\": \"mfrview-session\")"));
+  Session s;
+  s.scenePath = json.value("scene").toString();
+  if (s.scenePath.isEmpty()) r.fail(QStringLiteral("scene"), QStringLiteral("missing scene path"));
+  const QJsonObject cam = json.value("camera").toObject();
+  s.camera.eye = r.vec3(cam, "eye", "camera");
+  s.camera.target = r.vec3(cam, "target", "camera");
+  s.camera.up = r.vec3(cam, "up", "camera");
+  const QString projection = cam.value("projection").toString("perspective");
+  if (projection != QLatin1String("perspective") && projection != QLatin1String("orthographic"))
+    r.fail(QStringLiteral("camera.projection"), QStringLiteral("expected perspective or orthographic"));
+  s.camera.projection = projection == QLatin1String("orthographic") ? mfr::Projection::Orthographic : mfr::Projection::Perspective;
+  s.camera.fovyDegrees = r.number(cam, "fovy_degrees", "camera", s.camera.fovyDegrees);
+  s.camera.orthoHeight = r.number(cam, "ortho_height", "camera", s.camera.orthoHeight);
+  s.camera.nearPlane = r.number(cam, "near", "camera", s.camera.nearPlane);
+  s.camera.farPlane = r.number(cam, "far", "camera", s.camera.farPlane);
+  s.method = json.value("method").toString();
+  s.operation = json.value("operation").toString();
+  const QJsonObject params = json.value("params").toObject();
+  for (auto m = params.begin(); m != params.end(); ++m) {
+    auto& values = s.params[m.key().toStdString()];
+    const QJsonObject p = m.value().toObject();
+    for (auto v = p.begin(); v != p.end(); ++v) {
+      if (!v.value().isString()) r.fail("params." + m.key() + "." + v.key(), QStringLiteral("expected a string value"));
+      values[v.key().toStdString()] = v.value().toString().toStdString();
+    }
+  }
+  const QJsonArray objects = json.value("objects").toArray();
+  for (qsizetype i = 0; i < objects.size(); ++i) {
+    const QJsonObject o = objects[i].toObject();
+    const QJsonArray c = o.value("color").toArray();
+    if (c.size() != 3) r.fail(QStringLiteral("objects[%1].color").arg(i), QStringLiteral("expected [r, g, b]"));
+    const glm::dvec4 rgba(c[0].toDouble(), c[1].toDouble(), c[2].toDouble(),
+                          r.number(o, "opacity", QStringLiteral("objects[%1]").arg(i), 1.0));
+    s.objects.push_back({o.value("name").toString(), o.value("visible").toBool(true), glm::vec4(rgba)});
+  }
+  s.plugins = json.value("plugins").toObject();
+  return s;
+}
+
+Session readSessionFile(const QString& path) {
+  QFile f(path);
+  if (!f.open(QIODevice::ReadOnly)) throw mfr::Error(path.toStdString(), f.errorString().toStdString());
+  QJsonParseError error{};
+  const QJsonDocument doc = QJsonDocument::fromJson(f.readAll(), &error);
+  if (error.error != QJsonParseError::NoError)
+    throw mfr::Error(path.toStdString(), QStringLiteral("JSON error at byte %1: %2").arg(error.offset).arg(error.errorString()).toStdString());
+  Session s = sessionFromJson(doc.object(), path);
+  // Built-ins (@sample) and absolute paths stay; relative ones are relative to the session file.
+  if (!s.scenePath.startsWith('@') && QFileInfo(s.scenePath).isRelative())
+    s.scenePath = QFileInfo(path).dir().absoluteFilePath(s.scenePath);
+  return s;
+}
+
+void writeSessionFile(const QString& path, const Session& session) {
+  QSaveFile f(path);  // temporary + rename: never a half-written session
+  if (!f.open(QIODevice::WriteOnly)) throw mfr::Error(path.toStdString(), f.errorString().toStdString());
+  f.write(QJsonDocument(sessionToJson(session)).toJson(QJsonDocument::Indented));
+  if (!f.commit()) throw mfr::Error(path.toStdString(), f.errorString().toStdString());
+}

@@ -1,0 +1,44 @@
+#pragma once
+// Session files (.mfrsession, JSON): the scene's path, camera, method and operation, the
+// parameters of every method the user set, per-object overrides and each plugin's settings.
+// Doubles are written shortest-round-trip, so a reloaded session renders the same image.
+#include <QJsonObject>
+#include <QString>
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mfr/scene/camera.hpp"
+
+class ViewerModel;
+
+struct Session {
+  struct ObjectState {
+    QString name;
+    bool visible = true;
+    glm::vec4 color{1.0f};  // RGB + opacity, the material's floats exactly
+  };
+  QString scenePath;
+  mfr::Camera camera;
+  QString method;
+  QString operation;
+  std::map<std::string, std::map<std::string, std::string>> params;  // per method
+  std::vector<ObjectState> objects;                                  // by object index
+  QJsonObject plugins;                                               // by plugin id
+};
+
+// The model's current state (plugins filled in by the caller).
+Session captureSession(const ViewerModel& model);
+// Camera, method, parameters and object overrides onto the loaded scene. Objects are matched by
+// index; a session written for a different scene (other object count) keeps the file's objects.
+void applySession(const Session& session, ViewerModel& model);
+
+QJsonObject sessionToJson(const Session& session);
+// Throws mfr::Error("<file>: <json path>", reason) for malformed content.
+Session sessionFromJson(const QJsonObject& json, const QString& file);
+
+// Read/write with paths: relative scene paths resolve against the session file's folder.
+// Throw mfr::Error naming the file.
+Session readSessionFile(const QString& path);
+void writeSessionFile(const QString& path, const Session& session);

@@ -1,0 +1,263 @@
+#include "budget_panel.hpp"
+
+#include <QComboBox>
+#include <QFormLayout>
+#include <QGroupBox>
+#include <QLabel>
+#include <QLocale>
+#include <QProgressBar>
+#include <QSignalBlocker>
+#include <QSlider>
+#include <QSpinBox>
+#include <QTimer>
+#include <QVBoxLayout>
+
+#include <algorithm>
+#include <cmath>
+
+#include "histogram_widget.hpp"
+#include "viewer_plugin.hpp"
+
+namespace {
+
+constexpr double kMiB = 1024.0 * 1024.0;
+constexpr int kMaxCorrections = 3;
+constexpr int kDefaultBudgetMiB = 16;
+constexpr double kPoolMarginBytes = 1024;
+
+QString mib(double bytes) { return QString::number(bytes / kMiB, 'f', bytes < 10 * kMiB ? 2 : 1); }
+
+std::string parameterValue(const ViewerContext& ctx, const std::string& name) {
+  const auto values = ctx.params();
+  if (const auto it = values.find(name); it != values.end()) return it->second;
+  if (const mfr::MethodInfo* info = ctx.methodInfo(ctx.method()))
+    for (const mfr::ParamSpec& spec : info->params)
+      if (spec.name == name) return spec.defaultValue;
+  return {};
+}
+
+}  // namespace
+
+BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(parent), ctx_(context) {
+  setObjectName(QStringLiteral("budgetPanel"));
+  auto* layout = new QVBoxLayout(this);
+  auto* form = new QFormLayout;
+  methodCombo_ = new QComboBox;
+  methodCombo_->setObjectName(QStringLiteral("budgetMethodCombo"));
+  methodCombo_->setPlaceholderText(tr("(current method has no memory parameter)"));
+  for (const QString& name : ctx_.methodNames())
+    if (driverFor(name).knob != Knob::None) methodCombo_->addItem(name, name);
+  form->addRow(tr("Method"), methodCombo_);
+
+  auto* budgetRow = new QHBoxLayout;
+  slider_ = new QSlider(Qt::Horizontal);
+  slider_->setObjectName(QStringLiteral("budgetSlider"));
+  slider_->setRange(1, 256);
+  slider_->setValue(kDefaultBudgetMiB);
+  slider_->setTickPosition(QSlider::TicksBelow);
+  slider_->setTickInterval(32);
+  spin_ = new QSpinBox;
+  spin_->setObjectName(QStringLiteral("budgetSpin"));
+  spin_->setRange(1, 4096);
+  spin_->setSuffix(QStringLiteral(" MiB"));
+  spin_->setValue(kDefaultBudgetMiB);
+  spin_->setKeyboardTracking(false);
+  budgetRow->addWidget(slider_, 1);
+  budgetRow->addWidget(spin_);
+  form->addRow(tr("Budget"), budgetRow);
+  knobLabel_ = new QLabel;
+  knobLabel_->setWordWrap(true);
+  form->addRow(tr("Drives"), knobLabel_);
+  layout->addLayout(form);
+
+  auto* frameBox = new QGroupBox(tr("Last frame"));
+  auto* frameForm = new QFormLayout(frameBox);
+  memoryBar_ = new QProgressBar;
+  memoryBar_->setObjectName(QStringLiteral("memoryBar"));
+  memoryBar_->setRange(0, 1000);
+  memoryBar_->setTextVisible(true);
+  memoryLabel_ = new QLabel;
+  capturedLabel_ = new QLabel;
+  capturedLabel_->setObjectName(QStringLiteral("capturedLabel"));
+  kLabel_ = new QLabel;
+  frameForm->addRow(tr("Memory"), memoryBar_);
+  frameForm->addRow(tr("Holding data"), memoryLabel_);
+  frameForm->addRow(tr("Captured"), capturedLabel_);
+  frameForm->addRow(tr("k"), kLabel_);
+  layout->addWidget(frameBox);
+
+  histogram_ = new HistogramWidget;
+  histogram_->setObjectName(QStringLiteral("depthHistogram"));
+  layout->addWidget(histogram_, 1);
+
+  histogramTimer_ = new QTimer(this);
+  histogramTimer_->setSingleShot(true);
+  histogramTimer_->setInterval(400);  // after the camera has come to rest
+  connect(histogramTimer_, &QTimer::timeout, this, [this] { ctx_.requestDepthComplexity(); });
+  connect(&ctx_, &ViewerContext::sceneChanged, histogramTimer_, qOverload<>(&QTimer::start));
+  connect(&ctx_, &ViewerContext::viewChanged, histogramTimer_, qOverload<>(&QTimer::start));
+  connect(&ctx_, &ViewerContext::depthComplexityReady, histogram_, &HistogramWidget::setHistogram);
+
+  connect(slider_, &QSlider::valueChanged, this, [this](int v) { setBudget(v); });
+  connect(spin_, &QSpinBox::valueChanged, this, [this](int v) { setBudget(v); });
+  connect(methodCombo_, &QComboBox::activated, this, [this](int index) {
+    ctx_.setMethod(methodCombo_->itemData(index).toString());
+  });
+  connect(&ctx_, &ViewerContext::methodChanged, this, &BudgetPanel::methodChanged);
+  connect(&ctx_, &ViewerContext::frameRendered, this, &BudgetPanel::frameRendered);
+  methodChanged();
+}
+
+int BudgetPanel::budgetMiB() const { return spin_->value(); }
+
+BudgetPanel::Driver BudgetPanel::driverFor(const QString& method) const {
+  Driver d;
+  const mfr::MethodInfo* info = ctx_.methodInfo(method);
+  if (!info) return d;
+  const auto find = [&](const std::string& name) -> const mfr::ParamSpec* {
+    for (const mfr::ParamSpec& s : info->params)
+      if (s.name == name) return &s;
+    return nullptr;
+  };
+  if (find("budget_mib")) {
+    d.knob = Knob::Budget;
+    d.param = "budget_mib";
+  } else if (find("pool_mib") && find("pool")) {
+    d.knob = Knob::Pool;
+    d.param = "pool_mib";
+  } else {
+    for (const char* name : {"k", "slots"})
+      if (const mfr::ParamSpec* s = find(name); s && s->type == mfr::ParamSpec::Type::Int) {
+        d.knob = Knob::Slots;
+        d.param = name;
+        d.minValue = std::max<long long>(1, static_cast<long long>(s->min));
+        d.maxValue = static_cast<long long>(s->max);
+        break;
+      }
+  }
+  return d;
+}
+
+void BudgetPanel::setBudget(int mib) {
+  {
+    const QSignalBlocker a(slider_), b(spin_);
+    slider_->setValue(mib);
+    spin_->setValue(mib);
+  }
+  driving_ = true;
+  corrections_ = 0;
+  applyBudget();
+}
+
+void BudgetPanel::methodChanged() {
+  const Driver d = driverFor(ctx_.method());
+  {
+    const QSignalBlocker block(methodCombo_);
+    methodCombo_->setCurrentIndex(methodCombo_->findData(ctx_.method()));
+  }
+  switch (d.knob) {
+    case Knob::None: knobLabel_->setText(tr("nothing: %1 has no memory parameter").arg(ctx_.method())); break;
+    case Knob::Budget: knobLabel_->setText(tr("budget_mib — the method picks k per frame within the budget")); break;
+    case Knob::Pool: knobLabel_->setText(tr("pool = fixed, pool_mib = budget − per-pixel heads")); break;
+    case Knob::Slots:
+      knobLabel_->setText(tr("%1 — the largest that fits (%2 … %3)").arg(QString::fromStdString(d.param)).arg(d.minValue).arg(d.maxValue));
+      break;
+  }
+  corrections_ = 0;
+  if (driving_) applyBudget();
+}
+
+void BudgetPanel::applyBudget() {
+  const Driver d = driverFor(ctx_.method());
+  const double budget = budgetMiB() * kMiB;
+  const double pixels = static_cast<double>(ctx_.renderSize().width()) * ctx_.renderSize().height();
+  switch (d.knob) {
+    case Knob::None: return;
+    case Knob::Budget: ctx_.setParams({{"budget_mib", std::to_string(budgetMiB())}}); return;
+    case Knob::Pool: {
+      // Before the first measurement assume 8 bytes per pixel besides the pool (head pointer,
+      // counter); the first frame measures the real overhead.
+      // The method rounds the pool to whole nodes, so keep a small margin below the budget, and
+      // round the MiB text down, never up.
+      const double overhead = fit_.poolOverhead >= 0 ? fit_.poolOverhead : 8.0 * pixels;
+      const double pool = std::max(budget - overhead - kPoolMarginBytes, kMiB / 64);
+      const double poolMiB = std::floor(pool / kMiB * 1e6) / 1e6;
+      ctx_.setParams({{"pool", "fixed"}, {"pool_mib", QString::number(poolMiB, 'f', 6).toStdString()}});
+      return;
+    }
+    case Knob::Slots: {
+      double perSlot = 8.0 * pixels, fixed = 0.0;  // RGBA8 + depth per slot until measured
+      if (fit_.bytes.size() >= 2) {
+        const auto lo = fit_.bytes.begin();
+        const auto hi = std::prev(fit_.bytes.end());
+        perSlot = static_cast<double>(hi->second - lo->second) / static_cast<double>(hi->first - lo->first);
+        fixed = static_cast<double>(lo->second) - perSlot * static_cast<double>(lo->first);
+      } else if (fit_.bytes.size() == 1) {
+        fixed = static_cast<double>(fit_.bytes.begin()->second) - perSlot * static_cast<double>(fit_.bytes.begin()->first);
+      }
+      const auto k = static_cast<long long>(std::floor((budget - fixed) / std::max(perSlot, 1.0)));
+      ctx_.setParams({{d.param, std::to_string(std::clamp(k, d.minValue, d.maxValue))}});
+      return;
+    }
+  }
+}
+
+void BudgetPanel::frameRendered() {
+  const mfr::Stats& s = ctx_.stats();
+  if (QString::fromStdString(s.method) != ctx_.method()) return;
+  const QSize size = ctx_.renderSize();
+  const std::string key = s.method + "@" + std::to_string(size.width()) + "x" + std::to_string(size.height());
+  if (key != fit_.key) fit_ = Fit{key, {}, -1};
+  const Driver d = driverFor(ctx_.method());
+  bool refit = false;
+  if (d.knob == Knob::Slots) {
+    const long long value = std::stoll(parameterValue(ctx_, d.param));
+    refit = !fit_.bytes.contains(value);
+    fit_.bytes[value] = s.bytesAllocated;
+  } else if (d.knob == Knob::Pool && parameterValue(ctx_, "pool") == "fixed") {
+    const double overhead = static_cast<double>(s.bytesAllocated) - std::stod(parameterValue(ctx_, "pool_mib")) * kMiB;
+    refit = std::abs(overhead - fit_.poolOverhead) > 1.0;
+    fit_.poolOverhead = overhead;
+  }
+  showFrame();
+  // A better model (or an over-budget frame) changes the parameter: re-render, a few times at
+  // most per budget change. Deferred: this runs inside the view's paint.
+  if (driving_ && refit && corrections_ < kMaxCorrections) {
+    ++corrections_;
+    QTimer::singleShot(0, this, &BudgetPanel::applyBudget);
+  }
+}
+
+void BudgetPanel::showFrame() {
+  const mfr::Stats& s = ctx_.stats();
+  const QLocale locale;
+  const double budget = budgetMiB() * kMiB;
+  const double allocated = static_cast<double>(s.bytesAllocated);
+  memoryBar_->setValue(static_cast<int>(std::min(1000.0, 1000.0 * allocated / budget)));
+  memoryBar_->setFormat(tr("%1 of %2 MiB (%3 %)").arg(mib(allocated)).arg(budgetMiB()).arg(100.0 * allocated / budget, 0, 'f', 0));
+  // Red only when the budget is in force: before the slider is used it is a reference line.
+  memoryBar_->setStyleSheet(driving_ && allocated > budget ? QStringLiteral("QProgressBar::chunk { background: #d04030; }") : QString());
+  if (!driving_) memoryBar_->setFormat(memoryBar_->format() + tr(" — budget not applied"));
+  memoryLabel_->setText(tr("%1 MiB of %2 MiB allocated").arg(mib(static_cast<double>(s.bytesUsed)), mib(allocated)));
+  capturedLabel_->setText(s.fragmentsGenerated
+                              ? tr("%1 % (%2 of %3 fragments)")
+                                    .arg(100.0 * static_cast<double>(s.fragmentsStored) / static_cast<double>(s.fragmentsGenerated), 0, 'f', 1)
+                                    .arg(locale.toString(s.fragmentsStored), locale.toString(s.fragmentsGenerated))
+                              : tr("—"));
+  kLabel_->setText(s.kMax == 0 ? tr("— (no per-pixel capacity)")
+                   : s.kMin == s.kMax ? QString::number(s.kMax)
+                                      : QStringLiteral("%1 … %2").arg(s.kMin).arg(s.kMax));
+  histogram_->setMarker(driverFor(ctx_.method()).knob == Knob::Pool ? 0 : static_cast<int>(s.kMax));
+}
+
+QJsonObject BudgetPanel::saveSettings() const { return {{"budget_mib", budgetMiB()}, {"driving", driving_}}; }
+
+void BudgetPanel::loadSettings(const QJsonObject& settings) {
+  const int mib = settings.value("budget_mib").toInt(kDefaultBudgetMiB);
+  const QSignalBlocker a(slider_), b(spin_);
+  slider_->setValue(mib);
+  spin_->setValue(mib);
+  driving_ = settings.value("driving").toBool(false);
+  corrections_ = 0;
+  if (driving_) applyBudget();  // same parameters as saved for the same image size
+}

@@ -1,0 +1,73 @@
+#pragma once
+// The budget panel. The slider sets a memory budget M (MiB) and the panel turns it into the
+// current method's memory parameter:
+//   budget_mib (kplus-dynamic)            M itself — the method chooses k per frame within it;
+//   pool + pool_mib (A-buffers)           a fixed node pool of M minus the per-pixel heads;
+//   k / slots (k-buffers, fixed arrays)   the largest k whose buffers fit, from a linear model
+//                                         bytes(k) = a·k + b fitted to the frames' Stats
+//                                         (a starts at 8 bytes per slot per pixel).
+// A frame that still exceeds M refits the model and tries again (a few times at most), so the
+// settled frame stays within budget whenever the method's smallest setting fits.
+#include <QJsonObject>
+#include <QWidget>
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+class QComboBox;
+class QLabel;
+class QProgressBar;
+class QSlider;
+class QSpinBox;
+class QTimer;
+class HistogramWidget;
+class ViewerContext;
+namespace mfr {
+struct MethodInfo;
+}
+
+class BudgetPanel final : public QWidget {
+  Q_OBJECT
+
+ public:
+  BudgetPanel(ViewerContext& context, QWidget* parent = nullptr);
+  [[nodiscard]] QJsonObject saveSettings() const;
+  void loadSettings(const QJsonObject& settings);
+  [[nodiscard]] int budgetMiB() const;
+
+ private:
+  enum class Knob { None, Budget, Pool, Slots };
+  struct Driver {
+    Knob knob = Knob::None;
+    std::string param;        // budget_mib, pool_mib, k or slots
+    long long minValue = 1, maxValue = 1;
+  };
+  [[nodiscard]] Driver driverFor(const QString& method) const;
+  void setBudget(int mib);
+  void applyBudget();
+  void frameRendered();
+  void showFrame();
+  void methodChanged();
+
+  ViewerContext& ctx_;
+  QComboBox* methodCombo_ = nullptr;
+  QSlider* slider_ = nullptr;
+  QSpinBox* spin_ = nullptr;
+  QLabel* knobLabel_ = nullptr;
+  QProgressBar* memoryBar_ = nullptr;
+  QLabel* memoryLabel_ = nullptr;
+  QLabel* capturedLabel_ = nullptr;
+  QLabel* kLabel_ = nullptr;
+  HistogramWidget* histogram_ = nullptr;
+  QTimer* histogramTimer_ = nullptr;
+
+  bool driving_ = false;   // the slider has been used: the budget owns the method's parameter
+  int corrections_ = 0;    // refits after an over-budget frame, per budget change
+  // Memory model of the current method and image size, from measured frames.
+  struct Fit {
+    std::string key;                          // method@WxH
+    std::map<long long, std::uint64_t> bytes; // parameter value → bytes allocated
+    double poolOverhead = -1;                 // bytes besides the pool (A-buffers)
+  } fit_;
+};

@@ -1,0 +1,24 @@
+#pragma once
+// Depth-complexity histogram drawn with QPainter: pixels per fragment count n (log scale), the
+// chosen k marked, the counts beyond k (fragments a k-buffer cannot keep) tinted.
+#include <QSize>
+#include <QVector>
+#include <QWidget>
+
+class HistogramWidget final : public QWidget {
+  Q_OBJECT
+
+ public:
+  explicit HistogramWidget(QWidget* parent = nullptr);
+  void setHistogram(const QVector<quint64>& histogram, QSize imageSize);
+  void setMarker(int k);  // 0: none
+  [[nodiscard]] const QVector<quint64>& histogram() const { return histogram_; }
+
+ protected:
+  void paintEvent(QPaintEvent* event) override;
+
+ private:
+  QVector<quint64> histogram_;
+  QSize imageSize_;
+  int marker_ = 0;
+};
