@@ -67,14 +67,7 @@ void DepthPeelingFrontToBack::resolve(const FrameContext& ctx, const Operation& 
     throw Error("--op " + op.name, "peel-f2b composites while it peels: it supports the operations oit and dump only");
   const gl::Program* dumpProgram = nullptr;
   if (dump) {
-    auto it = dump_.find(op.glslFile);
-    if (it == dump_.end())
-      it = dump_
-               .emplace(op.glslFile, gl::Program({{GL_VERTEX_SHADER, "common/fullscreen.vert"},
-                                                  {GL_FRAGMENT_SHADER, "methods/peel-f2b/dump.screen.frag"}},
-                                                 {{"MFR_OP_FILE", "\"" + op.glslFile + "\""}}))
-               .first;
-    dumpProgram = &it->second;
+    dumpProgram = &dumpPrograms_.get("peel-f2b", op, {}, "dump.screen.frag");
     if (op.bind) op.bind(*dumpProgram);
   }
   stats_ = Stats{};

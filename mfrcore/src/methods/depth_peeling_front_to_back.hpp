@@ -35,7 +35,7 @@ class DepthPeelingFrontToBack final : public Method {
   gl::Framebuffer accumFbo_;
   gl::VertexArray emptyVao_;  // full-screen passes draw a generated triangle
   gl::Program peel_, blend_, final_;
-  std::map<std::string, gl::Program> dump_;  // per operation file
+  ResolveProgramCache dumpPrograms_;  // the dump pass, per operation file
   Stats stats_;
 };
 

@@ -83,14 +83,7 @@ void DualDepthPeeling::resolve(const FrameContext& ctx, const Operation& op) {
     throw Error("--op " + op.name, "peel-dual composites while it peels: it supports the operations oit and dump only");
   const gl::Program* dumpProgram = nullptr;
   if (dump) {
-    auto it = dump_.find(op.glslFile);
-    if (it == dump_.end())
-      it = dump_
-               .emplace(op.glslFile, gl::Program({{GL_VERTEX_SHADER, "common/fullscreen.vert"},
-                                                  {GL_FRAGMENT_SHADER, "methods/peel-dual/dump.screen.frag"}},
-                                                 {{"MFR_OP_FILE", "\"" + op.glslFile + "\""}}))
-               .first;
-    dumpProgram = &it->second;
+    dumpProgram = &dumpPrograms_.get("peel-dual", op, {}, "dump.screen.frag");
     if (op.bind) op.bind(*dumpProgram);
     dumpProgram->set("uMaxLayers", static_cast<unsigned>(2 * maxPasses_));
   }

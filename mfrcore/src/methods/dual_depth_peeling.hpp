@@ -38,7 +38,7 @@ class DualDepthPeeling final : public Method {
   gl::Framebuffer noAttachFbo_; // side-effect and query-only passes
   gl::VertexArray emptyVao_;
   gl::Program peel_, blend_, remaining_, final_;
-  std::map<std::string, gl::Program> dump_;  // per operation file
+  ResolveProgramCache dumpPrograms_;  // the dump pass, per operation file
   Stats stats_;
 };
 

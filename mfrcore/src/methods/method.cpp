@@ -66,8 +66,9 @@ const std::string& Params::text(const std::string& name) const {
   return it->second;
 }
 
-const gl::Program& ResolveProgramCache::get(const std::string& methodFolder, const Operation& op, const gl::Defines& extra) {
-  std::string key = op.name;
+const gl::Program& ResolveProgramCache::get(const std::string& methodFolder, const Operation& op, const gl::Defines& extra,
+                                            const std::string& passFile) {
+  std::string key = passFile + ";" + op.glslFile;
   for (const auto& [k, v] : extra) key += ";" + k + "=" + v;
   auto it = programs_.find(key);
   if (it == programs_.end()) {
@@ -75,7 +76,7 @@ const gl::Program& ResolveProgramCache::get(const std::string& methodFolder, con
     defines["MFR_OP_FILE"] = "\"" + op.glslFile + "\"";
     it = programs_
              .emplace(key, gl::Program({{GL_VERTEX_SHADER, "common/fullscreen.vert"},
-                                        {GL_FRAGMENT_SHADER, "methods/" + methodFolder + "/resolve.screen.frag"}},
+                                        {GL_FRAGMENT_SHADER, "methods/" + methodFolder + "/" + passFile}},
                                        defines))
              .first;
   }

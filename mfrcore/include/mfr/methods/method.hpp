@@ -83,11 +83,12 @@ class Method {
   [[nodiscard]] virtual Stats stats() const = 0;
 };
 
-// Builds (and caches per operation) the resolve program of a list-storing method:
-// common/fullscreen.vert + methods/<folder>/resolve.screen.frag with the operation included.
+// Builds (and caches per operation) the screen pass of a method that runs an operation:
+// common/fullscreen.vert + methods/<folder>/<passFile> with the operation included (MFR_OP_FILE).
 class ResolveProgramCache {
  public:
-  const gl::Program& get(const std::string& methodFolder, const Operation& op, const gl::Defines& extra = {});
+  const gl::Program& get(const std::string& methodFolder, const Operation& op, const gl::Defines& extra = {},
+                         const std::string& passFile = "resolve.screen.frag");
 
  private:
   std::map<std::string, gl::Program> programs_;
