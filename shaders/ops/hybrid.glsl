@@ -13,23 +13,8 @@
 
 layout(std430, binding = MFR_SSBO_TAIL) readonly buffer HybridTailSums { uint hybridTail[]; };
 
-uniform vec3 uBackground;
-
-struct OpState {
-  vec3 color;
-  float transmittance;
-};
-
-void opBegin(inout OpState s, ivec2 pixel) {
-  s.color = vec3(0.0);
-  s.transmittance = 1.0;
-}
-
-void opFragment(inout OpState s, MfrFragment f, uint position) {
-  vec4 c = unpackUnorm4x8(f.color);
-  s.color += s.transmittance * c.a * vec3(c);
-  s.transmittance *= 1.0 - c.a;
-}
+// The core: "over", shared with the oit operation.
+#include "ops/over_core.glsl"
 
 vec4 opEnd(inout OpState s, ivec2 pixel, uint count) {
   uint base = 5u * kbPixel(pixel);

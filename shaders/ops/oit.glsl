@@ -1,22 +1,5 @@
 // Operation "oit": front-to-back "over" compositing with the background (Porter & Duff 1984;
-// as in every OIT paper, e.g. Yang et al. 2010). Same arithmetic, in the same order, as the
-// oracle's compositeOver (mfrcore/src/reference/composite.cpp).
-uniform vec3 uBackground;
-
-struct OpState {
-  vec3 color;
-  float transmittance;
-};
-
-void opBegin(inout OpState s, ivec2 pixel) {
-  s.color = vec3(0.0);
-  s.transmittance = 1.0;
-}
-
-void opFragment(inout OpState s, MfrFragment f, uint position) {
-  vec4 c = unpackUnorm4x8(f.color);
-  s.color += s.transmittance * c.a * vec3(c);
-  s.transmittance *= 1.0 - c.a;
-}
+// as in every OIT paper, e.g. Yang et al. 2010).
+#include "ops/over_core.glsl"
 
 vec4 opEnd(inout OpState s, ivec2 pixel, uint count) { return vec4(s.color + s.transmittance * uBackground, 1.0); }
