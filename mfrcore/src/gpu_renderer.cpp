@@ -1,5 +1,6 @@
 #include "mfr/gpu_renderer.hpp"
 
+#include <algorithm>
 #include <cstring>
 
 #include "common/bindings.h"
@@ -7,6 +8,7 @@
 #include "mfr/gl/context.hpp"
 #include "mfr/methods/registry.hpp"
 #include "methods/kbuffer_common.hpp"
+#include "methods/method_util.hpp"
 
 namespace mfr {
 
@@ -73,6 +75,8 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   method.resolve(ctx, request.operation == "hybrid" ? hybridOperation() : oitOperation());
   gl::checkErrors(("resolve " + request.method).c_str());
   Stats stats = method.stats();
+  lastWidth_ = request.width;
+  lastHeight_ = request.height;
   stats.operation = request.operation;
   stats.passTimesMs = timer.collect();
   return stats;
@@ -96,6 +100,56 @@ RenderOutput GpuRenderer::render(const Camera& camera, const RenderRequest& requ
   flipVertically(out.image);
   gl::checkErrors("read-back");
   return out;
+}
+
+// GL rows (bottom-up) → image rows (top-down).
+static std::vector<std::uint32_t> flipRows(const std::vector<std::uint32_t>& gl, int width, int height) {
+  std::vector<std::uint32_t> out(gl.size());
+  for (int y = 0; y < height; ++y)
+    std::copy_n(gl.begin() + static_cast<std::ptrdiff_t>(height - 1 - y) * width, width,
+                out.begin() + static_cast<std::ptrdiff_t>(y) * width);
+  return out;
+}
+
+std::vector<std::uint32_t> GpuRenderer::kMap() const {
+  if (!method_ || lastWidth_ == 0) return {};
+  const std::vector<std::uint32_t> map = method_->capacityMap();
+  if (map.size() != static_cast<std::size_t>(lastWidth_) * lastHeight_) return {};
+  return flipRows(map, lastWidth_, lastHeight_);
+}
+
+std::vector<std::uint32_t> GpuRenderer::depthComplexity(const Camera& camera, int width, int height) {
+  validateImageSize("--size", width, height);
+  if (!scene_) throw Error("depth complexity", "no scene loaded");
+  if (!countProgram_.id())
+    countProgram_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"},
+                                 {GL_FRAGMENT_SHADER, "common/depth_complexity.geom.frag"}});
+  const std::size_t pixels = static_cast<std::size_t>(width) * height;
+  gl::Buffer counts = gl::createBuffer(pixels * 4);
+  const GLuint zero = 0;
+  glClearNamedBufferData(counts.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  // A framebuffer of the right size without colour attachments' writes: no side effects lost.
+  gl::Texture color = gl::createTexture2D(GL_RGBA8, width, height);
+  gl::Framebuffer fbo = gl::createFramebuffer();
+  glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, color.id(), 0);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+  glViewport(0, 0, width, height);
+  gl::PassTimer timer;
+  const FrameContext ctx = frameContext(camera, width, height, timer);
+  {
+    GeometryPassState state;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_AUX, counts.id());
+    countProgram_.use();
+    countProgram_.set("uDcWidth", width);
+    scene_->draw(countProgram_, ctx.frame);
+  }
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  std::vector<std::uint32_t> raw(pixels);
+  glGetNamedBufferSubData(counts.id(), 0, static_cast<GLsizeiptr>(pixels * 4), raw.data());
+  gl::checkErrors("depth complexity");
+  timer.collect();
+  return flipRows(raw, width, height);
 }
 
 CapturedLists GpuRenderer::capture(const Camera& camera, const RenderRequest& request, int maxPerPixel) {

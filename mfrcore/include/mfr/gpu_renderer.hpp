@@ -45,6 +45,12 @@ class GpuRenderer {
   RenderOutput render(const Camera& camera, const RenderRequest& request);
   // Renders into framebuffer `target` (0 = default) at the request size, no read-back (viewer).
   Stats renderTo(GLuint target, const Camera& camera, const RenderRequest& request);
+  // Per-pixel capacity k(p) of the last frame's method (image rows top-down, width·height of that
+  // frame); empty when the method has none (A-buffers, peeling, WBOIT, MBOIT) or before a frame.
+  [[nodiscard]] std::vector<std::uint32_t> kMap() const;
+  // Exact fragment count n(p) per pixel of the scene from this camera (image rows top-down), by
+  // one rasterisation pass with colour writes off: the GPU's depth complexity.
+  std::vector<std::uint32_t> depthComplexity(const Camera& camera, int width, int height);
   // Captures with the method and resolves with the "dump" operation (tests, diagnostics).
   CapturedLists capture(const Camera& camera, const RenderRequest& request, int maxPerPixel);
 
@@ -56,6 +62,8 @@ class GpuRenderer {
   glm::vec3 background_{1.0f};
   std::string methodName_;
   std::unique_ptr<Method> method_;
+  int lastWidth_ = 0, lastHeight_ = 0;
+  gl::Program countProgram_;
   gl::Framebuffer fbo_;
   gl::Texture color_;
   int fboWidth_ = 0, fboHeight_ = 0;

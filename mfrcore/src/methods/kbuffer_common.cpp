@@ -177,6 +177,10 @@ Stats KBufferFamily::stats() const {
   return s;
 }
 
+std::vector<std::uint32_t> KBufferFamily::capacityMap() const {
+  return std::vector<std::uint32_t>(static_cast<std::size_t>(pixels()), k_);
+}
+
 std::vector<KBufferTail> KBufferFamily::readTail() const {
   std::vector<KBufferTail> out;
   if (!tailBuffer_) return out;

@@ -42,6 +42,8 @@ class KBufferFamily : public Method {
 
   void resolve(const FrameContext& ctx, const Operation& op) override;
   [[nodiscard]] Stats stats() const override;
+  // Uniform k; variable-capacity members override it.
+  [[nodiscard]] std::vector<std::uint32_t> capacityMap() const override;
 
   // Tail hook: with --param tail=true the store pass accumulates the fragments that leave (or
   // never enter) the k nearest into a per-pixel SSBO (5 uints, see KBufferTail), bound at

@@ -74,3 +74,11 @@ void KPlusBufferSBuffer::resolve(const FrameContext& ctx, const Operation& op) {
 }
 
 }  // namespace mfr
+
+namespace mfr {
+
+std::vector<std::uint32_t> KPlusBufferSBuffer::capacityMap() const {
+  return readCapacities(offsets_, pixels());
+}
+
+}  // namespace mfr

@@ -16,6 +16,8 @@ class KPlusBufferSBuffer final : public KBufferFamily {
   void configure(int width, int height, const Params& params) override;
   void capture(const FrameContext& ctx) override;
   void resolve(const FrameContext& ctx, const Operation& op) override;
+  // min(n(p), k): differences of the prefix-sum offsets.
+  [[nodiscard]] std::vector<std::uint32_t> capacityMap() const override;
 
  private:
   bool culling_ = true;

@@ -45,6 +45,16 @@ void runResolvePass(const FrameContext& ctx, const gl::Program& program, const O
   glBindVertexArray(0);
 }
 
+std::vector<std::uint32_t> readCapacities(const gl::Buffer& offsets, std::uint64_t pixels) {
+  std::vector<std::uint32_t> raw(static_cast<std::size_t>(pixels) + 1, 0);
+  if (!offsets) return {};
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  glGetNamedBufferSubData(offsets.id(), 0, static_cast<GLsizeiptr>(raw.size() * 4), raw.data());
+  std::vector<std::uint32_t> k(static_cast<std::size_t>(pixels));
+  for (std::size_t p = 0; p < k.size(); ++p) k[p] = raw[p + 1] - raw[p];
+  return k;
+}
+
 std::uint64_t maxStorageElements(std::uint64_t elementBytes) {
   GLint64 maxBytes = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBytes);

@@ -2,7 +2,9 @@
 // Small pieces every method's C++ side uses: GL state for geometry passes, the resolve pass
 // draw, storage limits.
 #include <cstdint>
+#include <vector>
 
+#include "mfr/gl/objects.hpp"
 #include "mfr/methods/method.hpp"
 
 namespace mfr {
@@ -26,6 +28,10 @@ class GeometryPassState {
 
 // Full-screen resolve: binds the operation, draws one triangle into the bound framebuffer.
 void runResolvePass(const FrameContext& ctx, const gl::Program& program, const Operation& op);
+
+// Per-pixel capacities from an exclusive prefix sum of pixels + 1 uints: offsets[p+1] − offsets[p]
+// (variable-capacity k-buffers). Waits for the GPU.
+std::vector<std::uint32_t> readCapacities(const gl::Buffer& offsets, std::uint64_t pixels);
 
 // Largest element count of the given size one shader storage buffer may hold on this context.
 std::uint64_t maxStorageElements(std::uint64_t elementBytes);

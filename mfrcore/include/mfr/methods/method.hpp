@@ -3,6 +3,7 @@
 // k-buffers, …): configure → capture → resolve with an operation → Stats. A method and an
 // operation meet only in the resolve pass (shaders/common/resolve.glsl + ops/*.glsl), so any
 // method can drive any operation its payload supports.
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -81,6 +82,9 @@ class Method {
   virtual void resolve(const FrameContext& ctx, const Operation& op) = 0;
   // Stats of the last capture + resolve (pass times are filled in by the caller from ctx.timer).
   [[nodiscard]] virtual Stats stats() const = 0;
+  // Per-pixel capacity k(p) of the last capture, in GL row order (bottom row first), width·height
+  // entries; empty for methods without a per-pixel capacity (A-buffers, peeling, WBOIT, MBOIT).
+  [[nodiscard]] virtual std::vector<std::uint32_t> capacityMap() const { return {}; }
 };
 
 // Builds (and caches per operation) the screen pass of a method that runs an operation:
