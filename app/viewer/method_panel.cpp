@@ -5,6 +5,7 @@
 #include <QDoubleSpinBox>
 #include <QFormLayout>
 #include <QLabel>
+#include <QLineEdit>
 #include <QPushButton>
 #include <QSignalBlocker>
 #include <QSpinBox>
@@ -125,6 +126,13 @@ void MethodPanel::rebuildParameters() {
         editor = box;
         break;
       }
+      case mfr::ParamSpec::Type::Text: {  // a file path (dkb's weights): applied when editing ends
+        auto* line = new QLineEdit;
+        line->setPlaceholderText(tr("(built-in)"));
+        connect(line, &QLineEdit::editingFinished, this, [set, line] { set(line->text().toStdString()); });
+        editor = line;
+        break;
+      }
       case mfr::ParamSpec::Type::Choice: {
         auto* box = new QComboBox;
         for (const std::string& c : spec.choices) box->addItem(QString::fromStdString(c));
@@ -156,5 +164,6 @@ void MethodPanel::showParameterValues() {
     else if (auto* d = qobject_cast<QDoubleSpinBox*>(editor)) d->setValue(value.toDouble());
     else if (auto* b = qobject_cast<QCheckBox*>(editor)) b->setChecked(value == QLatin1String("true") || value == QLatin1String("1"));
     else if (auto* c = qobject_cast<QComboBox*>(editor)) c->setCurrentText(value);
+    else if (auto* t = qobject_cast<QLineEdit*>(editor)) t->setText(value);
   }
 }

@@ -21,6 +21,10 @@
 #define MFR_SSBO_TAIL 5       // tail accumulation (hybrid transparency)
 #define MFR_SSBO_DUMP 6       // debug operation: per-pixel sorted fragments (tests)
 #define MFR_SSBO_DUMP_COUNT 7 // debug operation: per-pixel fragment counts (tests)
+#define MFR_SSBO_LOCKS 8      // per-pixel spin-lock words kept in a buffer (variable-k buffers)
+#define MFR_SSBO_ARENA 9      // per-pixel arena of the variable-k buffers (features, k(p), …)
+#define MFR_SSBO_BUDGET 10    // per-frame budget state: image sums, allocation search, F(M)
+#define MFR_SSBO_WEIGHTS 11   // neural importance: MLP weights
 
 // Image units
 #define MFR_IMAGE_HEADS 0

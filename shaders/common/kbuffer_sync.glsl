@@ -58,8 +58,20 @@ void kbRejected();
 void kbLockFailed();
 
 #ifndef MFR_SYNC_INTERLOCK
-layout(r32ui, binding = MFR_IMAGE_LOCKS) uniform coherent uimage2D uKbLocks;
 uniform uint uSpinLimit;  // attempts per fragment (≤ 4096: llvmpipe loop-bound trap, see bindings.h)
+#ifdef MFR_KB_LOCKS_IN_BUFFER
+// The same semaphore as one uint per pixel of an SSBO (atomicExchange): the variable-k buffers keep
+// it in their per-pixel arena, whose words held other per-pixel data before the store pass.
+layout(std430, binding = MFR_SSBO_LOCKS) coherent buffer KBufferLockWords { uint kbLockWords[]; };
+uniform int uKbLockWidth;
+uint kbLockWord(ivec2 p) { return uint(p.y) * uint(uKbLockWidth) + uint(p.x); }
+bool kbTryLock(ivec2 p) { return atomicExchange(kbLockWords[kbLockWord(p)], 1u) == 0u; }
+void kbUnlock(ivec2 p) { atomicExchange(kbLockWords[kbLockWord(p)], 0u); }
+#else
+layout(r32ui, binding = MFR_IMAGE_LOCKS) uniform coherent uimage2D uKbLocks;
+bool kbTryLock(ivec2 p) { return imageAtomicExchange(uKbLocks, p, 1u) == 0u; }
+void kbUnlock(ivec2 p) { imageAtomicExchange(uKbLocks, p, 0u); }
+#endif
 #endif
 
 void main() {
@@ -79,10 +91,10 @@ void main() {
     ivec2 p = ivec2(gl_FragCoord.xy);
     bool done = false;
     for (uint attempt = 0u; attempt < uSpinLimit && !done; ++attempt) {
-      if (kbReady() && imageAtomicExchange(uKbLocks, p, 1u) == 0u) {
+      if (kbReady() && kbTryLock(p)) {
         kbInsert();
         memoryBarrier();  // the slots' new contents before the release
-        imageAtomicExchange(uKbLocks, p, 0u);
+        kbUnlock(p);
         done = true;
       }
     }

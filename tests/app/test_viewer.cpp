@@ -4,6 +4,7 @@
 #include <QComboBox>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
+#include <QLineEdit>
 #include <QMessageBox>
 #include <QProcess>
 #include <QSlider>
@@ -143,6 +144,7 @@ class ViewerTest : public QObject {
             case mfr::ParamSpec::Type::Float: QVERIFY(qobject_cast<QDoubleSpinBox*>(editor)); break;
             case mfr::ParamSpec::Type::Bool: QVERIFY(qobject_cast<QCheckBox*>(editor)); break;
             case mfr::ParamSpec::Type::Choice: QVERIFY(qobject_cast<QComboBox*>(editor)); break;
+            case mfr::ParamSpec::Type::Text: QVERIFY(qobject_cast<QLineEdit*>(editor)); break;
           }
         }
       }

@@ -5,6 +5,7 @@
 #include <algorithm>
 
 #include "methods/kbuffer_common.hpp"
+#include "methods/prefix_sum.hpp"
 
 namespace mfr {
 
@@ -28,6 +29,20 @@ std::uint32_t largestUniformK(const KBufferMemoryModel& model, std::uint64_t bud
   if (model.pixels == 0) return kMax;
   const std::uint64_t k = slotBudget(model, budgetBytes) / model.pixels;
   return static_cast<std::uint32_t>(std::min<std::uint64_t>(k, kMax));
+}
+
+VariableKLayout variableKLayout(std::uint64_t pixels, std::uint64_t extraFixedBytes) {
+  const auto align = [](std::uint64_t words) { return (words + 63) / 64 * 64; };  // 256 bytes
+  VariableKLayout l;
+  l.pixels = pixels;
+  l.lockBase = 0;
+  l.tailBase = align(pixels);
+  l.stride = align(pixels + 1);  // a T region also holds the scans' W·H + 1 elements
+  l.kBase = l.tailBase + 5 * l.stride;
+  l.arenaWords = l.kBase + align(pixels + 1);
+  l.scanScratchBytes = 4 * PrefixSum::scratchElements(pixels + 1);
+  l.fixedBytes = KBufferFamily::kCounterBytes + kVariableKStateBytes + extraFixedBytes;
+  return l;
 }
 
 }  // namespace mfr

@@ -53,7 +53,7 @@ void KBufferFamily::configureCommon(int width, int height, const Params& params,
                                     const std::string& resolveFolder, const gl::Defines& storeDefines) {
   sync_ = kbufferSync(params.text("sync"));
   spinLimit_ = static_cast<std::uint32_t>(params.integer("spin_limit"));
-  tail_ = params.flag("tail");
+  tail_ = externalPixelState_ || params.flag("tail");  // the variable-k buffers always keep the tail
   folder_ = resolveFolder;
   if (width != width_ || height != height_) {
     width_ = width;
@@ -65,15 +65,19 @@ void KBufferFamily::configureCommon(int width, int height, const Params& params,
     slots_ = 0;
     auxBytes_ = 0;
   }
-  // The semaphore image exists only when the spin lock runs (interlock needs none).
-  if (sync_.name == "spinlock" && !locks_) locks_ = gl::createTexture2D(GL_R32UI, width_, height_);
-  if (sync_.name != "spinlock") locks_.reset();
-  if (tail_ && !tailBuffer_) tailBuffer_ = gl::createBuffer(pixels() * kTailBytesPerPixel);
-  if (!tail_) tailBuffer_.reset();
+  // The semaphore image exists only when the spin lock runs (interlock needs none). Members that
+  // keep locks and tail in their own per-pixel arena (externalPixelState_) allocate neither.
+  const bool ownLocks = sync_.name == "spinlock" && !externalPixelState_;
+  if (ownLocks && !locks_) locks_ = gl::createTexture2D(GL_R32UI, width_, height_);
+  if (!ownLocks) locks_.reset();
+  const bool ownTail = tail_ && !externalPixelState_;
+  if (ownTail && !tailBuffer_) tailBuffer_ = gl::createBuffer(pixels() * kTailBytesPerPixel);
+  if (!ownTail) tailBuffer_.reset();
   if (!counters_) counters_ = gl::createBuffer(kCounterBytes);
 
   gl::Defines defines = storeDefines;
   defines.insert(sync_.defines.begin(), sync_.defines.end());
+  if (externalPixelState_ && sync_.name == "spinlock") defines.emplace("MFR_KB_LOCKS_IN_BUFFER", "1");
   if (tail_) defines.emplace("MFR_KB_TAIL", "1");
   std::string key = storeFolder;
   for (const auto& [k, v] : defines) key += ";" + k + "=" + v;
@@ -112,6 +116,7 @@ void KBufferFamily::setCommonUniforms(const gl::Program& program) const {
   program.set("uKbPixels", static_cast<unsigned>(pixels()));
   program.set("uKbK", k_);
   program.set("uSpinLimit", spinLimit_);
+  if (externalPixelState_) program.set("uKbLockWidth", width_);
 }
 
 void KBufferFamily::beginStore() {

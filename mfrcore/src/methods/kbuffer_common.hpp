@@ -73,6 +73,10 @@ class KBufferFamily : public Method {
   void setCommonUniforms(const gl::Program& program) const;
   [[nodiscard]] std::uint64_t pixels() const { return static_cast<std::uint64_t>(width_) * height_; }
 
+  // Set by members that keep the spin-lock words and the tail sums in their own per-pixel buffer
+  // (the variable-k buffers' arena): configureCommon then allocates neither, the store pass takes
+  // its locks from MFR_SSBO_LOCKS (MFR_KB_LOCKS_IN_BUFFER), and the member clears and binds them.
+  bool externalPixelState_ = false;
   int width_ = 0, height_ = 0;
   std::uint32_t k_ = 1;
   std::uint32_t spinLimit_ = 1024;

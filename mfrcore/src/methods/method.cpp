@@ -39,6 +39,9 @@ Params::Params(const std::vector<ParamSpec>& specs, const std::map<std::string, 
         if (value != "true" && value != "false" && value != "1" && value != "0" && value != "on" && value != "off")
           throw Error(where, "expected true or false");
         break;
+      case ParamSpec::Type::Text:
+        if (value.find('\n') != std::string::npos) throw Error(where, "expected one line");
+        break;
       case ParamSpec::Type::Choice: {
         bool ok = false;
         std::string list;

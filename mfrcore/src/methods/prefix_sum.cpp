@@ -38,7 +38,9 @@ void PrefixSum::dispatch(const gl::Program& program, std::uint32_t count, std::u
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
-void PrefixSum::scan(GLuint input, GLuint output, std::uint32_t n) {
+void PrefixSum::scan(GLuint input, GLuint output, std::uint32_t n) { scan(input, 0, output, 0, n); }
+
+void PrefixSum::scan(GLuint input, std::uint32_t inBase, GLuint output, std::uint32_t outBase, std::uint32_t n) {
   if (!blockScan_.id()) {
     blockScan_ = gl::Program({{GL_COMPUTE_SHADER, "common/prefix_sum.comp"}});
     addOffsets_ = gl::Program({{GL_COMPUTE_SHADER, "common/prefix_sum.comp"}}, {{"MFR_SCAN_ADD", "1"}});
@@ -76,7 +78,7 @@ void PrefixSum::scan(GLuint input, GLuint output, std::uint32_t n) {
     if (l == 0) {
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_AUX, input);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_OFFSETS, output);
-      dispatch(blockScan_, L.count, L.blocks, 0, 0, L.sumsBase);
+      dispatch(blockScan_, L.count, L.blocks, inBase, outBase, L.sumsBase);
     } else {
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_AUX, scratch_.id());
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_OFFSETS, scratch_.id());
@@ -89,7 +91,7 @@ void PrefixSum::scan(GLuint input, GLuint output, std::uint32_t n) {
     const Level& L = levels[l];
     if (l == 0) {
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_OFFSETS, output);
-      dispatch(addOffsets_, L.count, L.blocks, 0, 0, L.sumsBase);
+      dispatch(addOffsets_, L.count, L.blocks, outBase, outBase, L.sumsBase);
     } else {
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_OFFSETS, scratch_.id());
       const std::uint32_t base = levels[l - 1].sumsBase;

@@ -29,6 +29,9 @@ class PrefixSum {
   // buffer copies or glGetBufferSubData. Needs a current GL 4.5 context. Clobbers the SSBO bindings
   // MFR_SSBO_AUX, MFR_SSBO_OFFSETS and MFR_SSBO_SCAN and the current program.
   void scan(GLuint input, GLuint output, std::uint32_t n);
+  // The same over elements [inBase, inBase + n) of input into [outBase, outBase + n) of output
+  // (word offsets: scans of regions inside one larger buffer).
+  void scan(GLuint input, std::uint32_t inBase, GLuint output, std::uint32_t outBase, std::uint32_t n);
 
   [[nodiscard]] GLuint totalBuffer() const { return scratch_.id(); }
   [[nodiscard]] GLintptr totalOffset() const { return static_cast<GLintptr>(4 * (scratchSize_ - 1)); }

@@ -4,7 +4,9 @@
 #include "abuffer_linked_list.hpp"
 #include "abuffer_sbuffer.hpp"
 #include "depth_peeling_front_to_back.hpp"
+#include "deep_variable_k_buffer.hpp"
 #include "dual_depth_peeling.hpp"
+#include "fixed_k_buffer.hpp"
 #include "k_peeling.hpp"
 #include "kbuffer.hpp"
 #include "kplus_array.hpp"
@@ -13,6 +15,7 @@
 #include "kplus_sbuffer.hpp"
 #include "mfr/error.hpp"
 #include "moment_based_oit.hpp"
+#include "variable_k_importance.hpp"
 #include "weighted_blended_oit.hpp"
 
 namespace mfr {
@@ -38,6 +41,9 @@ const std::vector<RegistryEntry>& methodRegistry() {
       {"kpeel", make<KPeeling>},
       {"kplus-sbuffer", make<KPlusBufferSBuffer>},
       {"kplus-dynamic", make<KPlusBufferDynamic>},
+      {"fkb", make<FixedKBuffer>},
+      {"vkb", make<VariableKBufferImportance>},
+      {"dkb", make<DeepVariableKBuffer>},
   };
   return entries;
 }

@@ -30,4 +30,28 @@ std::uint64_t slotBudget(const KBufferMemoryModel& model, std::uint64_t budgetBy
 // fkb: the largest uniform k (≤ kMax) with model.bytes(k) ≤ budgetBytes; 0 when k = 1 does not fit.
 std::uint32_t largestUniformK(const KBufferMemoryModel& model, std::uint64_t budgetBytes, std::uint32_t kMax = 256);
 
+// The variable-k buffers (vkb, dkb; mfrcore/src/methods/variable_k_buffer.hpp) keep every
+// per-pixel value in one arena of 32-bit words reused from pass to pass, so a budget pays for the
+// largest phase only: per pixel 1 word (n(p), then the spin lock), 5 words (features and
+// importance, then the tail sums) and 1 word (k(p), then the store's offsets), each region
+// starting on a 256-byte boundary so the store pass can bind it as its own buffer range. Besides:
+// the prefix-sum scratch for W·H + 1 elements, 32 bytes of statistics counters, 128 bytes of
+// budget state and the method's fixed extras (dkb: the network's weights). Then
+//   M(F) = 8·F + arena + scratch + fixed,   F(M) = floor((M − arena − scratch − fixed) / 8).
+struct VariableKLayout {
+  std::uint64_t pixels = 0;
+  std::uint64_t lockBase = 0, tailBase = 0, stride = 0, kBase = 0, arenaWords = 0;  // words
+  std::uint64_t scanScratchBytes = 0;
+  std::uint64_t fixedBytes = 0;
+  [[nodiscard]] std::uint64_t arenaBytes() const { return 4 * arenaWords; }
+  [[nodiscard]] std::uint64_t bytesBeforeSlots() const { return arenaBytes() + scanScratchBytes + fixedBytes; }
+  [[nodiscard]] std::uint64_t bytes(std::uint64_t slots) const { return 8 * slots + bytesBeforeSlots(); }
+  // F(M): 0 when not even the per-pixel and fixed parts fit.
+  [[nodiscard]] std::uint64_t slotBudget(std::uint64_t budgetBytes) const {
+    return budgetBytes > bytesBeforeSlots() ? (budgetBytes - bytesBeforeSlots()) / 8 : 0;
+  }
+};
+inline constexpr std::uint64_t kVariableKStateBytes = 128;
+VariableKLayout variableKLayout(std::uint64_t pixels, std::uint64_t extraFixedBytes = 0);
+
 }  // namespace mfr

@@ -21,7 +21,7 @@ namespace mfr {
 
 // A method parameter, described once: the CLI parses it and the viewer builds its widget from it.
 struct ParamSpec {
-  enum class Type { Int, Float, Bool, Choice };
+  enum class Type { Int, Float, Bool, Choice, Text };  // Text: free text (a file path)
   std::string name;          // CLI: --param name=value
   std::string label;         // viewer label
   Type type = Type::Int;
@@ -41,6 +41,7 @@ class Params {
   [[nodiscard]] double real(const std::string& name) const;
   [[nodiscard]] bool flag(const std::string& name) const;
   [[nodiscard]] const std::string& text(const std::string& name) const;
+  [[nodiscard]] bool has(const std::string& name) const { return values_.count(name) != 0; }
 
  private:
   std::map<std::string, std::string> values_;

@@ -1,0 +1,197 @@
+// The dkb network's weights, CPU forward pass and features (mfr/budget/neural_importance.hpp).
+// The forward pass and the features are the shaders' own definitions (shaders/budget/mlp.h,
+// features.h) compiled as C++.
+#include "mfr/budget/neural_importance.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "budget/glsl_shared.hpp"
+#include "mfr/error.hpp"
+#include "mfr/io_util.hpp"
+
+namespace mfr {
+
+namespace detail {
+const std::map<std::string, std::string_view, std::less<>>& embeddedResources();  // generated
+}  // namespace detail
+
+namespace glsl {
+namespace {
+thread_local const float* tMlpWeights = nullptr;
+}  // namespace
+#define MFR_MLP_WEIGHT(i) tMlpWeights[i]
+#include "budget/mlp.h"
+#undef MFR_MLP_WEIGHT
+}  // namespace glsl
+
+namespace {
+
+constexpr int kLayerShape[3][2] = {{MFR_MLP_HIDDEN1, MFR_MLP_INPUTS},
+                                   {MFR_MLP_HIDDEN2, MFR_MLP_HIDDEN1},
+                                   {1, MFR_MLP_HIDDEN2}};
+constexpr int kLayerWeights[3] = {MFR_MLP_W1, MFR_MLP_W2, MFR_MLP_W3};
+constexpr int kLayerBias[3] = {MFR_MLP_B1, MFR_MLP_B2, MFR_MLP_B3};
+
+std::vector<float> floats(const nlohmann::json& j, std::size_t count, const std::string& where,
+                          const std::string& source) {
+  if (!j.is_array() || j.size() != count)
+    throw Error(source, where + " must be an array of " + std::to_string(count) + " numbers");
+  std::vector<float> out;
+  out.reserve(count);
+  for (const auto& v : j) {
+    if (!v.is_number()) throw Error(source, where + " holds a non-number");
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) throw Error(source, where + " holds a non-finite number");
+    out.push_back(static_cast<float>(d));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::size_t NeuralImportanceModel::floatCount() { return MFR_MLP_FLOATS; }
+
+NeuralImportanceModel parseNeuralImportance(const std::string& text, const std::string& source) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw Error(source, std::string("not valid JSON (") + e.what() + ")");
+  }
+  if (!j.is_object() || j.value("format", "") != "mfr-dkb-weights")
+    throw Error(source, "not an mfr dkb weights file (\"format\": \"mfr-dkb-weights\" missing)");
+  if (j.value("version", 0) != 1) throw Error(source, "unsupported weights file version (expected 1)");
+  const nlohmann::json arch = j.value("architecture", nlohmann::json());
+  if (arch != nlohmann::json::array({MFR_MLP_INPUTS, MFR_MLP_HIDDEN1, MFR_MLP_HIDDEN2, 1}))
+    throw Error(source, "architecture must be [12, 128, 64, 1]");
+  NeuralImportanceModel m;
+  m.source = source;
+  m.target = j.value("target", "");
+  if (m.target != "k_over_n" && m.target != "k_over_budget")
+    throw Error(source, "target must be \"k_over_n\" or \"k_over_budget\"");
+  m.weights.assign(MFR_MLP_FLOATS, 0.0f);
+  const std::vector<float> mean = floats(j.value("input_mean", nlohmann::json()), MFR_MLP_INPUTS, "input_mean", source);
+  const std::vector<float> stddev = floats(j.value("input_std", nlohmann::json()), MFR_MLP_INPUTS, "input_std", source);
+  for (int i = 0; i < MFR_MLP_INPUTS; ++i) {
+    if (!(stddev[static_cast<std::size_t>(i)] > 0.0f)) throw Error(source, "input_std must be positive");
+    m.weights[MFR_MLP_MEAN + i] = mean[static_cast<std::size_t>(i)];
+    m.weights[MFR_MLP_STD + i] = stddev[static_cast<std::size_t>(i)];
+  }
+  const nlohmann::json layers = j.value("layers", nlohmann::json());
+  if (!layers.is_array() || layers.size() != 3) throw Error(source, "layers must hold 3 layers");
+  for (int l = 0; l < 3; ++l) {
+    const auto& layer = layers[static_cast<std::size_t>(l)];
+    const std::string where = "layers[" + std::to_string(l) + "]";
+    const int outputs = kLayerShape[l][0], inputs = kLayerShape[l][1];
+    const nlohmann::json rows = layer.is_object() ? layer.value("weights", nlohmann::json()) : nlohmann::json();
+    if (!rows.is_array() || rows.size() != static_cast<std::size_t>(outputs))
+      throw Error(source, where + ".weights must hold " + std::to_string(outputs) + " rows");
+    for (int o = 0; o < outputs; ++o) {
+      const std::vector<float> row = floats(rows[static_cast<std::size_t>(o)], static_cast<std::size_t>(inputs),
+                                            where + ".weights[" + std::to_string(o) + "]", source);
+      std::copy(row.begin(), row.end(), m.weights.begin() + kLayerWeights[l] + o * inputs);
+    }
+    const std::vector<float> bias = floats(layer.value("bias", nlohmann::json()), static_cast<std::size_t>(outputs),
+                                           where + ".bias", source);
+    std::copy(bias.begin(), bias.end(), m.weights.begin() + kLayerBias[l]);
+  }
+  m.trainingJson = j.contains("training") ? j["training"].dump() : "{}";
+  return m;
+}
+
+std::string neuralImportanceJson(const NeuralImportanceModel& m) {
+  if (m.weights.size() != MFR_MLP_FLOATS) throw Error("dkb weights", "model has the wrong number of weights");
+  nlohmann::ordered_json j;
+  j["format"] = "mfr-dkb-weights";
+  j["version"] = 1;
+  j["architecture"] = {MFR_MLP_INPUTS, MFR_MLP_HIDDEN1, MFR_MLP_HIDDEN2, 1};
+  j["target"] = m.target;
+  j["input_mean"] = std::vector<float>(m.weights.begin() + MFR_MLP_MEAN, m.weights.begin() + MFR_MLP_MEAN + MFR_MLP_INPUTS);
+  j["input_std"] = std::vector<float>(m.weights.begin() + MFR_MLP_STD, m.weights.begin() + MFR_MLP_STD + MFR_MLP_INPUTS);
+  nlohmann::ordered_json layers = nlohmann::ordered_json::array();
+  for (int l = 0; l < 3; ++l) {
+    const int outputs = kLayerShape[l][0], inputs = kLayerShape[l][1];
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+    for (int o = 0; o < outputs; ++o) {
+      const auto begin = m.weights.begin() + kLayerWeights[l] + o * inputs;
+      rows.push_back(std::vector<float>(begin, begin + inputs));
+    }
+    layers.push_back({{"weights", rows},
+                      {"bias", std::vector<float>(m.weights.begin() + kLayerBias[l],
+                                                  m.weights.begin() + kLayerBias[l] + outputs)}});
+  }
+  j["layers"] = layers;
+  j["training"] = nlohmann::ordered_json::parse(m.trainingJson.empty() ? "{}" : m.trainingJson);
+  return j.dump(1) + "\n";
+}
+
+NeuralImportanceModel loadNeuralImportance(const std::string& path) {
+  if (!path.empty()) return parseNeuralImportance(readFile(path), path);
+  const auto& files = detail::embeddedResources();
+  const auto it = files.find("dkb/weights.json");
+  if (it == files.end()) throw Error("dkb", "no built-in weights (resources/dkb/weights.json); give --param weights=FILE");
+  NeuralImportanceModel m = parseNeuralImportance(std::string(it->second), "resources/dkb/weights.json");
+  m.source = "built-in";
+  return m;
+}
+
+float predictNeuralImportance(const NeuralImportanceModel& model, const DkbFeatureVector& f) {
+  if (model.weights.size() != MFR_MLP_FLOATS) throw Error("dkb weights", "model has the wrong number of weights");
+  glsl::tMlpWeights = model.weights.data();
+  const float y = glsl::mfrMlpForward(glm::vec4(f[0], f[1], f[2], f[3]), glm::vec4(f[4], f[5], f[6], f[7]),
+                                      glm::vec4(f[8], f[9], f[10], f[11]));
+  glsl::tMlpWeights = nullptr;
+  return y;
+}
+
+float neuralImportance(const NeuralImportanceModel& model, const DkbFeatureVector& features, std::uint32_t n) {
+  const float y = predictNeuralImportance(model, features);
+  return model.predictsFractionOfList() ? y * static_cast<float>(n) : y;
+}
+
+DkbImageStats dkbImageStats(const FragmentLists& lists) {
+  DkbImageStats s;
+  s.imageNear = std::numeric_limits<float>::infinity();
+  s.imageFar = 0.0f;
+  for (int y = 0; y < lists.height; ++y)
+    for (int x = 0; x < lists.width; ++x) {
+      const auto l = lists.pixel(x, y);
+      if (l.empty()) continue;
+      s.totalFragments += l.size();
+      ++s.nonEmptyPixels;
+      s.imageNear = std::min(s.imageNear, l.front().depth);
+      s.imageFar = std::max(s.imageFar, l.back().depth);
+    }
+  if (s.nonEmptyPixels == 0) s.imageNear = 0.0f;
+  return s;
+}
+
+DkbFeatureVector dkbFeatures(std::span<const Fragment> sorted, const DkbImageStats& image, std::uint64_t budgetSlots) {
+  // The GPU's integer sums and tie rule: colour sums of the 8-bit values; among fragments at the
+  // nearest depth the largest packed colour.
+  std::uint32_t sum[3] = {0, 0, 0};
+  float nearDepth = std::numeric_limits<float>::infinity(), farDepth = 0.0f;
+  for (const Fragment& f : sorted) {
+    for (int c = 0; c < 3; ++c) sum[c] += (f.color >> (8 * c)) & 0xFFu;
+    nearDepth = std::min(nearDepth, f.depth);
+    farDepth = std::max(farDepth, f.depth);
+  }
+  std::uint32_t nearest = 0;
+  for (const Fragment& f : sorted)
+    if (f.depth == nearDepth) nearest = std::max(nearest, f.color);
+  glm::vec4 a, b, c;
+  glsl::mfrDkbFeatures(static_cast<std::uint32_t>(sorted.size()),
+                       static_cast<float>(static_cast<std::uint32_t>(image.totalFragments)),
+                       static_cast<float>(static_cast<std::uint32_t>(budgetSlots)), nearDepth, farDepth, image.imageNear,
+                       image.imageFar, nearest,
+                       glm::vec3(static_cast<float>(sum[0]), static_cast<float>(sum[1]), static_cast<float>(sum[2])), a,
+                       b, c);
+  return {a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, c.y, c.z, c.w};
+}
+
+}  // namespace mfr

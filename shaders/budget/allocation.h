@@ -1,0 +1,42 @@
+// [Variable k-buffer allocation — after Vasilakis, Vardis, Papaioannou, Moustakas, "Variable
+// k-buffer using Importance Maps", Eurographics 2017 Short Papers, and Tsopouridis, Fudos,
+// Vasilakis, "Deep hybrid order-independent transparency", The Visual Computer 2022.]
+// The allocation rule from per-pixel importance I(p) to k(p), shared verbatim by the GPU passes
+// (shaders/budget/alloc_*.comp) and the C++ reference (mfrcore/src/budget/k_allocation.cpp):
+//   k_λ(p) = clamp(floor(λ·I(p)), k_floor, n(p))   (0 where n(p) = 0)
+// Σ_p k_λ(p) never decreases with λ. λ is searched over the bit patterns of non-negative floats
+// (they order like the floats): MFR_ALLOC_SECTIONS − 1 candidates per round narrow [lo, hi] to
+// adjacent floats in MFR_ALLOC_ROUNDS rounds, keeping S(lo) ≤ F < S(hi); the F − S(lo) slots
+// left are then given, one pixel after another in pixel order, to the pixels whose k grows
+// between lo and hi. So Σk = F exactly whenever Σn ≥ F, where the papers' floor(F·I/ΣI)
+// leaves slots unused. k_floor is 1 when F holds one slot per non-empty pixel, else 0.
+// Valid GLSL 4.50 and C++ (included inside a namespace with uint, floor, min, clamp in scope).
+#ifndef MFR_ALLOCATION_H
+#define MFR_ALLOCATION_H
+
+#define MFR_ALLOC_SECTIONS 16u
+#define MFR_ALLOC_ROUNDS 8u
+#define MFR_ALLOC_INFINITY_BITS 0x7F800000u
+
+const float MFR_IMPORTANCE_FLOOR = 1.0e-6f;  // every non-empty pixel keeps a positive importance
+const float MFR_ALLOC_MAX_SCALED = 4294967040.0f;  // largest float below 2^32
+
+// NaN, negative and tiny importances become the floor (so λ = +inf reaches k = n everywhere).
+float mfrSanitizeImportance(float importance) {
+  return importance >= MFR_IMPORTANCE_FLOOR ? importance : MFR_IMPORTANCE_FLOOR;
+}
+
+uint mfrAllocK(float lambda, float importance, uint n, uint kFloor) {
+  if (n == 0u) return 0u;
+  float scaled = min(floor(lambda * importance), MFR_ALLOC_MAX_SCALED);
+  return clamp(uint(scaled), kFloor, n);
+}
+
+// Candidate j (0..MFR_ALLOC_SECTIONS) between the bit patterns lo ≤ hi: lo + floor((hi − lo)·j / S)
+// without 64-bit arithmetic.
+uint mfrAllocCandidate(uint lo, uint hi, uint j) {
+  uint d = hi - lo;
+  return lo + (d / MFR_ALLOC_SECTIONS) * j + ((d % MFR_ALLOC_SECTIONS) * j) / MFR_ALLOC_SECTIONS;
+}
+
+#endif

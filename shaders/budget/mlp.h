@@ -1,0 +1,48 @@
+// [Tsopouridis, Fudos, Vasilakis, "Deep hybrid order-independent transparency", The Visual
+// Computer 2022, §4: the per-pixel network 12 → 128 → 64 → 1, ReLU, ReLU, sigmoid.] Forward pass
+// shared verbatim by the GPU inference pass (shaders/methods/dkb/mlp.comp) and the C++ reference
+// (mfrcore/src/budget/neural_importance.cpp), same accumulation order. The including code defines
+// MFR_MLP_WEIGHT(i), the i-th float of the weights layout below (an SSBO in GLSL, a vector in
+// C++). The features are standardised first, (x − mean) / std, with the training set's statistics
+// stored in the weights file (an input normalisation layer of the model).
+// Valid GLSL 4.50 and C++ with GLM.
+#ifndef MFR_MLP_H
+#define MFR_MLP_H
+
+#define MFR_MLP_INPUTS 12
+#define MFR_MLP_HIDDEN1 128
+#define MFR_MLP_HIDDEN2 64
+// Float offsets of the weights layout: weights of layer l are row-major [output][input].
+#define MFR_MLP_MEAN 0
+#define MFR_MLP_STD (MFR_MLP_MEAN + MFR_MLP_INPUTS)
+#define MFR_MLP_W1 (MFR_MLP_STD + MFR_MLP_INPUTS)
+#define MFR_MLP_B1 (MFR_MLP_W1 + MFR_MLP_HIDDEN1 * MFR_MLP_INPUTS)
+#define MFR_MLP_W2 (MFR_MLP_B1 + MFR_MLP_HIDDEN1)
+#define MFR_MLP_B2 (MFR_MLP_W2 + MFR_MLP_HIDDEN2 * MFR_MLP_HIDDEN1)
+#define MFR_MLP_W3 (MFR_MLP_B2 + MFR_MLP_HIDDEN2)
+#define MFR_MLP_B3 (MFR_MLP_W3 + MFR_MLP_HIDDEN2)
+#define MFR_MLP_FLOATS (MFR_MLP_B3 + 1)
+
+float mfrMlpForward(vec4 a, vec4 b, vec4 c) {
+  float x[MFR_MLP_INPUTS];
+  x[0] = a.x; x[1] = a.y; x[2] = a.z; x[3] = a.w;
+  x[4] = b.x; x[5] = b.y; x[6] = b.z; x[7] = b.w;
+  x[8] = c.x; x[9] = c.y; x[10] = c.z; x[11] = c.w;
+  for (int i = 0; i < MFR_MLP_INPUTS; ++i)
+    x[i] = (x[i] - MFR_MLP_WEIGHT(MFR_MLP_MEAN + i)) / MFR_MLP_WEIGHT(MFR_MLP_STD + i);
+  float h1[MFR_MLP_HIDDEN1];
+  for (int j = 0; j < MFR_MLP_HIDDEN1; ++j) {
+    float s = MFR_MLP_WEIGHT(MFR_MLP_B1 + j);
+    for (int i = 0; i < MFR_MLP_INPUTS; ++i) s += MFR_MLP_WEIGHT(MFR_MLP_W1 + j * MFR_MLP_INPUTS + i) * x[i];
+    h1[j] = max(s, 0.0f);
+  }
+  float out_ = MFR_MLP_WEIGHT(MFR_MLP_B3);
+  for (int j = 0; j < MFR_MLP_HIDDEN2; ++j) {
+    float s = MFR_MLP_WEIGHT(MFR_MLP_B2 + j);
+    for (int i = 0; i < MFR_MLP_HIDDEN1; ++i) s += MFR_MLP_WEIGHT(MFR_MLP_W2 + j * MFR_MLP_HIDDEN1 + i) * h1[i];
+    out_ += MFR_MLP_WEIGHT(MFR_MLP_W3 + j) * max(s, 0.0f);
+  }
+  return 1.0f / (1.0f + exp(-out_));
+}
+
+#endif
