@@ -12,6 +12,9 @@ void addRender(CLI::App& app);
 void addCompare(CLI::App& app);
 void addInfo(CLI::App& app);
 void addBench(CLI::App& app);
+void addDataset(CLI::App& app);
+void addTrain(CLI::App& app);
+void addEvaluate(CLI::App& app);
 
 // "WxH" → (w, h); throws mfr::Error naming the option.
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);

@@ -17,6 +17,9 @@ int main(int argc, char** argv) {
   mfr::cli::addCompare(app);
   mfr::cli::addInfo(app);
   mfr::cli::addBench(app);
+  mfr::cli::addDataset(app);
+  mfr::cli::addTrain(app);
+  mfr::cli::addEvaluate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -36,15 +36,16 @@ void GpuRenderer::setScene(const Scene& scene) {
 Method& GpuRenderer::prepare(const RenderRequest& request) {
   validateImageSize("--size", request.width, request.height);
   if (!scene_) throw Error("render", "no scene loaded");
-  if (request.operation != "oit" && request.operation != "hybrid")
-    throw Error("--op " + request.operation, "unknown operation (available: oit, hybrid)");
+  if (request.operation != "oit" && request.operation != "hybrid" && request.operation != "auto")
+    throw Error("--op " + request.operation, "unknown operation (available: auto, oit, hybrid)");
   if (!method_ || methodName_ != request.method) {
     method_ = createMethod(request.method);
     methodName_ = request.method;
   }
+  operation_ = request.operation == "auto" ? method_->info().preferredOperation : request.operation;
   const Params params(method_->info().params, request.params, request.method);
   method_->configure(request.width, request.height, params);
-  if (request.operation == "hybrid") {
+  if (operation_ == "hybrid") {
     // The tail sums exist only in the k-buffer family's tail hook.
     const auto* kb = dynamic_cast<const KBufferFamily*>(method_.get());
     if (!kb) throw Error("--op hybrid", "method " + request.method + " keeps no tail (use a k-buffer method with --param tail=true)");
@@ -72,12 +73,12 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   gl::checkErrors(("capture " + request.method).c_str());
   glBindFramebuffer(GL_FRAMEBUFFER, target);
   glViewport(0, 0, request.width, request.height);
-  method.resolve(ctx, request.operation == "hybrid" ? hybridOperation() : oitOperation());
+  method.resolve(ctx, operation_ == "hybrid" ? hybridOperation() : oitOperation());
   gl::checkErrors(("resolve " + request.method).c_str());
   Stats stats = method.stats();
   lastWidth_ = request.width;
   lastHeight_ = request.height;
-  stats.operation = request.operation;
+  stats.operation = operation_;
   stats.passTimesMs = timer.collect();
   return stats;
 }

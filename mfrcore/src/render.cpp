@@ -1,12 +1,15 @@
 #include "mfr/render.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <exception>
 
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
 #include "mfr/gpu_renderer.hpp"
 #include "mfr/methods/registry.hpp"
+#include "mfr/budget/memory_model.hpp"
+#include "mfr/budget/optimal_k.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/hybrid.hpp"
 #include "mfr/reference/oracle.hpp"
@@ -21,8 +24,75 @@ void validateImageSize(const std::string& what, int width, int height) {
 std::vector<std::string> availableMethods() {
   std::vector<std::string> names{"oracle"};
   for (const RegistryEntry& e : methodRegistry()) names.push_back(e.name);
+  names.push_back("optimal-k");
   return names;
 }
+
+const MethodInfo& optimalKInfo() {
+  static const MethodInfo i{
+      "optimal-k",
+      "Hybrid transparency with the offline optimal k(p) under a memory budget (CPU reference)",
+      "Tsopouridis, Fudos, Vasilakis: Deep hybrid order-independent transparency. The Visual Computer 2022 (Alg. 1, "
+      "eq. 2); the better of its backward greedy and an exact-on-the-convex-hull Lagrangian allocation",
+      false,
+      {{"budget_mib", "Memory budget M (MiB)", ParamSpec::Type::Float, "16", 0, 65536, {},
+        "the budget of the variable-k buffers' layout (vkb without a network): F(M) slots to allocate"}},
+      "hybrid"};
+  return i;
+}
+
+namespace {
+
+// optimal-k: the oracle's exact lists, the F(M) of the variable-k layout at this size, the best
+// allocation of optimalKBest, composited by the CPU hybrid operation.
+RenderOutput renderOptimalK(const Scene& scene, const Camera& camera, const RenderRequest& request) {
+  if (request.operation == "oit")
+    throw Error("--op oit", "optimal-k is a hybrid-transparency reference: use --op hybrid (or auto)");
+  const Params params(optimalKInfo().params, request.params, "optimal-k");
+  const auto budgetBytes = static_cast<std::uint64_t>(std::floor(params.real("budget_mib") * 1024.0 * 1024.0));
+  const std::uint64_t pixels = static_cast<std::uint64_t>(request.width) * static_cast<std::uint64_t>(request.height);
+  const VariableKLayout layout = variableKLayout(pixels);
+  if (budgetBytes < layout.bytes(1))
+    throw Error("--param budget_mib=" + params.text("budget_mib"),
+                "below what optimal-k's variable-k layout needs at " + std::to_string(request.width) + "x" +
+                    std::to_string(request.height) + " (" + std::to_string(layout.bytes(1)) + " bytes)");
+  const FragmentLists lists = castFragments(scene, camera, request.width, request.height);
+  const HybridErrorTable errors = hybridErrorTable(lists, scene.background);
+  const std::uint64_t slots = std::min<std::uint64_t>(layout.slotBudget(budgetBytes), lists.fragments.size());
+  const std::uint64_t nonEmpty = minimumSlots(errors);
+  if (slots < nonEmpty)
+    throw Error("--param budget_mib=" + params.text("budget_mib"),
+                "holds " + std::to_string(slots) + " slots, fewer than the " + std::to_string(nonEmpty) +
+                    " non-empty pixels: optimal-k needs one per non-empty pixel");
+  std::string solver;
+  const KAllocation best = optimalKBest(errors, slots, &solver);
+  RenderOutput out;
+  out.image = compositeHybrid(lists, best.k, scene.background);
+  Stats& s = out.stats;
+  s.method = "optimal-k";
+  s.operation = "hybrid";
+  s.sync = "none";
+  s.fragmentsGenerated = lists.fragments.size();
+  s.fragmentsStored = best.slots;
+  s.fragmentsDropped = lists.fragments.size() - best.slots;
+  s.bytesAllocated = layout.bytes(slots);
+  s.bytesUsed = layout.bytes(best.slots);
+  std::uint32_t kMin = 0xFFFFFFFFu, kMax = 0;
+  for (std::size_t p = 0; p < best.k.size(); ++p)
+    if (lists.offsets[p + 1] > lists.offsets[p]) {
+      kMin = std::min(kMin, best.k[p]);
+      kMax = std::max(kMax, best.k[p]);
+    }
+  s.kMin = nonEmpty > 0 ? kMin : 0;
+  s.kMax = kMax;
+  s.notes.emplace_back("F(M)", std::to_string(layout.slotBudget(budgetBytes)) + " slots");
+  s.notes.emplace_back("solver", solver);
+  s.notes.emplace_back("error", std::to_string(best.error));
+  s.notes.emplace_back("device", "CPU ray casting (CGAL AABB tree)");
+  return out;
+}
+
+}  // namespace
 
 // One headless context and renderer for the process, created on first use.
 GpuRenderer& headlessRenderer() {
@@ -41,8 +111,9 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     for (const auto& m : methods) list += (list.empty() ? "" : ", ") + m;
     throw Error("--method " + request.method, "unknown method (available: " + list + ")");
   }
-  if (request.operation != "oit" && request.operation != "hybrid")
-    throw Error("--op " + request.operation, "unknown operation (available: oit, hybrid)");
+  if (request.operation != "oit" && request.operation != "hybrid" && request.operation != "auto")
+    throw Error("--op " + request.operation, "unknown operation (available: auto, oit, hybrid)");
+  if (request.method == "optimal-k") return renderOptimalK(scene, camera, request);
   if (request.method != "oracle") {
     GpuRenderer& gpu = headlessRenderer();
     gpu.setScene(scene);

@@ -9,19 +9,7 @@
 #ifndef MFR_MLP_H
 #define MFR_MLP_H
 
-#define MFR_MLP_INPUTS 12
-#define MFR_MLP_HIDDEN1 128
-#define MFR_MLP_HIDDEN2 64
-// Float offsets of the weights layout: weights of layer l are row-major [output][input].
-#define MFR_MLP_MEAN 0
-#define MFR_MLP_STD (MFR_MLP_MEAN + MFR_MLP_INPUTS)
-#define MFR_MLP_W1 (MFR_MLP_STD + MFR_MLP_INPUTS)
-#define MFR_MLP_B1 (MFR_MLP_W1 + MFR_MLP_HIDDEN1 * MFR_MLP_INPUTS)
-#define MFR_MLP_W2 (MFR_MLP_B1 + MFR_MLP_HIDDEN1)
-#define MFR_MLP_B2 (MFR_MLP_W2 + MFR_MLP_HIDDEN2 * MFR_MLP_HIDDEN1)
-#define MFR_MLP_W3 (MFR_MLP_B2 + MFR_MLP_HIDDEN2)
-#define MFR_MLP_B3 (MFR_MLP_W3 + MFR_MLP_HIDDEN2)
-#define MFR_MLP_FLOATS (MFR_MLP_B3 + 1)
+#include "budget/mlp_layout.h"
 
 float mfrMlpForward(vec4 a, vec4 b, vec4 c) {
   float x[MFR_MLP_INPUTS];

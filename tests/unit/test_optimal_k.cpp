@@ -212,6 +212,68 @@ TEST(OptimalK, GreedyVersusExactOnRandomCases) {
   EXPECT_GT(convexCases, kCases / 10);
 }
 
+// The O(n) error table (running core products, suffix tail sums) equals the definition,
+// hybridError() per entry, on random lists.
+TEST(OptimalK, FastErrorTableEqualsTheDefinition) {
+  std::mt19937 rng(7);
+  for (int i = 0; i < 300; ++i) {
+    const RandomCase c = randomCase(rng);
+    const mfr::FragmentLists lists = makeLists(c.lists);
+    const mfr::HybridErrorTable t = mfr::hybridErrorTable(lists, c.background);
+    for (std::size_t p = 0; p < c.lists.size(); ++p)
+      for (std::uint32_t k = 0; k <= c.lists[p].size(); ++k)
+        ASSERT_EQ(t[p][k], mfr::hybridError(lists.pixel(static_cast<int>(p), 0), k, c.background)) << "pixel " << p << " k " << k;
+  }
+}
+
+// The Lagrangian (convex-hull) solver: never below the exact optimum, within the budget, equal to
+// the optimum whenever every e_p is convex; on the pinned Lemma 1 counterexample it finds the
+// optimum the greedy misses. optimalKBest is never worse than either solver. Counts printed.
+TEST(OptimalK, LagrangianVersusExactOnRandomCases) {
+  std::mt19937 rng(20221);
+  constexpr int kCases = 3000;
+  int lagrangianExact = 0, greedyExact = 0, lagrangianBeatsGreedy = 0, greedyBeatsLagrangian = 0;
+  for (int i = 0; i < kCases; ++i) {
+    const RandomCase c = randomCase(rng);
+    const mfr::HybridErrorTable table = mfr::hybridErrorTable(makeLists(c.lists), c.background);
+    const mfr::KAllocation exact = mfr::optimalKDynamic(table, c.budget);
+    const mfr::KAllocation greedy = mfr::optimalKGreedy(table, c.budget);
+    const mfr::KAllocation hull = mfr::optimalKLagrangian(table, c.budget);
+    const mfr::KAllocation best = mfr::optimalKBest(table, c.budget);
+    const double tol = 1e-12 * (1.0 + exact.error);
+    ASSERT_LE(hull.slots, c.budget);
+    ASSERT_GE(hull.error, exact.error - tol);
+    ASSERT_LE(best.error, std::min(hull.error, greedy.error) + tol);
+    for (std::size_t p = 0; p < table.size(); ++p) {
+      ASSERT_LE(hull.k[p], table[p].size() - 1);
+      ASSERT_GE(hull.k[p], table[p].size() > 1 ? 1u : 0u);
+    }
+    bool allConvex = true;
+    for (const auto& e : table) allConvex = allConvex && convex(e);
+    if (allConvex) {
+      EXPECT_NEAR(hull.error, exact.error, tol);
+    }
+    lagrangianExact += hull.error <= exact.error + tol;
+    greedyExact += greedy.error <= exact.error + tol;
+    lagrangianBeatsGreedy += hull.error < greedy.error - tol;
+    greedyBeatsLagrangian += greedy.error < hull.error - tol;
+  }
+  std::cout << "[ lagrangian ] optimal on " << lagrangianExact << " of " << kCases << " random cases (greedy: "
+            << greedyExact << "); better than the greedy on " << lagrangianBeatsGreedy << ", worse on "
+            << greedyBeatsLagrangian << "\n";
+  EXPECT_GE(lagrangianExact, greedyExact);
+  EXPECT_GT(lagrangianBeatsGreedy, greedyBeatsLagrangian);
+
+  const auto lists = makeLists({{frag(0.1f, 147, 14, 77, 223), frag(0.2f, 179, 73, 196, 213), frag(0.3f, 85, 44, 60, 239)},
+                                {frag(0.1f, 159, 202, 32, 39), frag(0.2f, 217, 109, 174, 62), frag(0.3f, 184, 17, 58, 199),
+                                 frag(0.4f, 253, 147, 34, 191)}});
+  const mfr::HybridErrorTable t = mfr::hybridErrorTable(lists, glm::vec3(0.340950489f, 0.0643369555f, 0.0791269392f));
+  EXPECT_EQ(mfr::optimalKLagrangian(t, 3).k, (std::vector<std::uint32_t>{2, 1}));
+  std::string solver;
+  EXPECT_EQ(mfr::optimalKBest(t, 3, &solver).k, (std::vector<std::uint32_t>{2, 1}));
+  EXPECT_EQ(solver, "lagrangian");
+}
+
 // On the sample scene (40x30, front view): for several budgets the DP optimum ≤ the greedy ≤ the
 // best uniform k that fits the same budget; the ratios are printed (measured numbers).
 TEST(OptimalK, SampleSceneGreedyVersusOptimumAndUniform) {
@@ -223,6 +285,8 @@ TEST(OptimalK, SampleSceneGreedyVersusOptimumAndUniform) {
     const std::uint64_t budget = std::max(pixels * perPixel, nonEmpty);
     const mfr::KAllocation greedy = mfr::optimalKGreedy(table, budget);
     const mfr::KAllocation best = mfr::optimalKDynamic(table, budget);
+    const mfr::KAllocation hull = mfr::optimalKLagrangian(table, budget);
+    EXPECT_LE(best.error, hull.error + 1e-12);
     std::vector<std::uint32_t> uniform(pixels);
     for (std::size_t p = 0; p < pixels; ++p)
       uniform[p] = static_cast<std::uint32_t>(std::min<std::uint64_t>(perPixel, table[p].size() - 1));
@@ -232,7 +296,8 @@ TEST(OptimalK, SampleSceneGreedyVersusOptimumAndUniform) {
     EXPECT_LE(greedy.slots, budget);
     std::cout << "[ sample ] F = " << budget << " (" << perPixel << "/pixel, max n " << lists.maxCount()
               << "): optimum " << best.error << ", greedy " << greedy.error << " (x"
-              << (best.error > 0 ? greedy.error / best.error : 1.0) << "), uniform k=" << perPixel << " "
+              << (best.error > 0 ? greedy.error / best.error : 1.0) << "), lagrangian " << hull.error << " (x"
+              << (best.error > 0 ? hull.error / best.error : 1.0) << "), uniform k=" << perPixel << " "
               << uniformError << "\n";
   }
 }

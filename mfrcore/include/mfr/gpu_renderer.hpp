@@ -51,6 +51,9 @@ class GpuRenderer {
   // Exact fragment count n(p) per pixel of the scene from this camera (image rows top-down), by
   // one rasterisation pass with colour writes off: the GPU's depth complexity.
   std::vector<std::uint32_t> depthComplexity(const Camera& camera, int width, int height);
+  // The method object of the last request (nullptr before one): tests and diagnostics reach a
+  // method's own read-backs through it.
+  [[nodiscard]] Method* method() const { return method_.get(); }
   // Captures with the method and resolves with the "dump" operation (tests, diagnostics).
   CapturedLists capture(const Camera& camera, const RenderRequest& request, int maxPerPixel);
 
@@ -61,6 +64,7 @@ class GpuRenderer {
   std::unique_ptr<gl::GpuScene> scene_;
   glm::vec3 background_{1.0f};
   std::string methodName_;
+  std::string operation_ = "oit";  // of the prepared request, "auto" resolved
   std::unique_ptr<Method> method_;
   int lastWidth_ = 0, lastHeight_ = 0;
   gl::Program countProgram_;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "mfr/image.hpp"
+#include "mfr/methods/method.hpp"
 #include "mfr/methods/stats.hpp"
 #include "mfr/scene/scene.hpp"
 
@@ -14,7 +15,7 @@ namespace mfr {
 
 struct RenderRequest {
   std::string method = "oracle";
-  std::string operation = "oit";
+  std::string operation = "oit";  // "oit", "hybrid", or "auto": the method's preferred one
   int width = 512;
   int height = 512;
   std::map<std::string, std::string> params;  // method parameters by name (k, budget_mib, …)
@@ -28,8 +29,12 @@ struct RenderOutput {
 // Throws mfr::Error for an unknown method or operation, a bad size or an empty scene.
 RenderOutput render(const Scene& scene, const Camera& camera, const RenderRequest& request);
 
-// Names accepted by render(): "oracle" first, then the registry's GPU methods.
+// Names accepted by render(): "oracle" first, then the registry's GPU methods, then the CPU
+// reference "optimal-k" (hybrid transparency with the offline optimal k(p) under a budget).
 std::vector<std::string> availableMethods();
+
+// The description and parameters of the CPU method "optimal-k" (like a registry method's info).
+const MethodInfo& optimalKInfo();
 
 class GpuRenderer;
 // The process's headless GL renderer (EGL context created on first use); the CLI uses it.

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "budget/glsl_shared.hpp"
+#include "budget/mlp_layout.h"
 #include "mfr/error.hpp"
 #include "mfr/io_util.hpp"
 

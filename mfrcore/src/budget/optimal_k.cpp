@@ -4,13 +4,17 @@
 #include "mfr/budget/optimal_k.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <numeric>
 #include <queue>
 #include <string>
 #include <tuple>
 
+#include <glm/gtc/packing.hpp>
+
 #include "mfr/error.hpp"
+#include "mfr/reference/composite.hpp"
 #include "mfr/reference/hybrid.hpp"
 
 namespace mfr {
@@ -39,13 +43,40 @@ KAllocation finish(const HybridErrorTable& errors, std::vector<std::uint32_t> k)
 }  // namespace
 
 HybridErrorTable hybridErrorTable(const FragmentLists& lists, glm::vec3 background) {
+  // O(n) per pixel: the core's colour and transmittance as running products (the order
+  // compositeHybrid uses, so the values are the same floats) and the tail's integer sums as
+  // running suffix sums; e(k) = ‖hybrid(k) − over(all)‖² like hybridError().
   HybridErrorTable table(static_cast<std::size_t>(lists.width) * lists.height);
+  std::vector<HybridTailSums> suffix;
   for (int y = 0; y < lists.height; ++y)
     for (int x = 0; x < lists.width; ++x) {
       const auto list = lists.pixel(x, y);
+      const std::size_t n = list.size();
       auto& e = table[lists.index(x, y)];
-      e.resize(list.size() + 1);
-      for (std::uint32_t k = 0; k <= list.size(); ++k) e[k] = hybridError(list, k, background);
+      e.assign(n + 1, 0.0);
+      suffix.assign(n + 1, HybridTailSums{});
+      for (std::size_t i = n; i-- > 0;) {
+        suffix[i] = suffix[i + 1];
+        const std::uint32_t c = list[i].color;
+        const std::uint64_t a = (c >> 24) & 0xFFu;
+        for (int ch = 0; ch < 3; ++ch) suffix[i].colorAlpha[ch] += ((c >> (8 * ch)) & 0xFFu) * a;
+        suffix[i].alpha += a;
+        ++suffix[i].count;
+      }
+      const glm::dvec3 exact(compositeOver(list, background));
+      glm::vec3 colour(0.0f);
+      float transmittance = 1.0f;
+      for (std::size_t k = 0; k <= n; ++k) {
+        const HybridTail tail = hybridTail(suffix[k]);
+        const glm::vec3 h = colour + transmittance * (tail.color + (1.0f - tail.alpha) * background);
+        const glm::dvec3 d = glm::dvec3(h) - exact;
+        e[k] = glm::dot(d, d);
+        if (k < n) {
+          const glm::vec4 c = glm::unpackUnorm4x8(list[k].color);
+          colour += transmittance * c.a * glm::vec3(c);
+          transmittance *= 1.0f - c.a;
+        }
+      }
     }
   return table;
 }
@@ -119,6 +150,80 @@ KAllocation optimalKDynamic(const HybridErrorTable& errors, std::uint64_t budget
     best -= k[i];
   }
   return finish(errors, std::move(k));
+}
+
+KAllocation optimalKLagrangian(const HybridErrorTable& errors, std::uint64_t budget) {
+  checkBudget(errors, budget);
+  const std::size_t pixels = errors.size();
+  std::uint64_t total = 0;
+  double muHigh = 1.0;
+  for (const auto& e : errors) {
+    total += listLength(e);
+    if (e.size() > 1) muHigh = std::max(muHigh, 2.0 * e[1] + 1.0);
+  }
+  std::vector<std::uint32_t> k(pixels);
+  if (total <= budget) {
+    for (std::size_t p = 0; p < pixels; ++p) k[p] = listLength(errors[p]);
+    return finish(errors, std::move(k));
+  }
+  // k_p(μ) = argmin over 1 ≤ k ≤ n of e_p(k) + μ·k (the smallest on ties): a point of the lower
+  // convex hull of e_p. Σ k_p(μ) never increases with μ; at muHigh every pixel takes k = 1 (each
+  // further slot saves less than e_p(1) < μ).
+  const auto pick = [&](double mu, std::vector<std::uint32_t>& out) {
+    std::uint64_t sum = 0;
+    for (std::size_t p = 0; p < pixels; ++p) {
+      const auto& e = errors[p];
+      const std::uint32_t n = listLength(e);
+      std::uint32_t best = n > 0 ? 1 : 0;
+      double bestCost = e[best] + mu * best;
+      for (std::uint32_t c = best + 1; c <= n; ++c) {
+        const double cost = e[c] + mu * c;
+        if (cost < bestCost) {
+          bestCost = cost;
+          best = c;
+        }
+      }
+      out[p] = best;
+      sum += best;
+    }
+    return sum;
+  };
+  double lo = 0.0, hi = muHigh;  // S(lo) > budget ≥ S(hi)
+  std::vector<std::uint32_t> kHi(pixels);
+  pick(hi, kHi);
+  for (int it = 0; it < 100 && hi - lo > 1e-15 * hi; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (pick(mid, k) <= budget) {
+      hi = mid;
+      kHi = k;
+    } else {
+      lo = mid;
+    }
+  }
+  k = kHi;
+  // The slots the hull points leave: one at a time where they lower the error most.
+  std::uint64_t slots = std::accumulate(k.begin(), k.end(), std::uint64_t{0});
+  using Entry = std::tuple<double, std::size_t>;
+  std::priority_queue<Entry> gains;
+  for (std::size_t p = 0; p < pixels; ++p)
+    if (k[p] < listLength(errors[p])) gains.emplace(errors[p][k[p]] - errors[p][k[p] + 1], p);
+  while (slots < budget && !gains.empty()) {
+    const auto [gain, p] = gains.top();
+    gains.pop();
+    if (gain <= 0.0) break;
+    ++k[p];
+    ++slots;
+    if (k[p] < listLength(errors[p])) gains.emplace(errors[p][k[p]] - errors[p][k[p] + 1], p);
+  }
+  return finish(errors, std::move(k));
+}
+
+KAllocation optimalKBest(const HybridErrorTable& errors, std::uint64_t budget, std::string* solver) {
+  KAllocation greedy = optimalKGreedy(errors, budget);
+  KAllocation hull = optimalKLagrangian(errors, budget);
+  const bool hullWins = hull.error < greedy.error;
+  if (solver) *solver = hullWins ? "lagrangian" : "greedy";
+  return hullWins ? hull : greedy;
 }
 
 KAllocation optimalKExhaustive(const HybridErrorTable& errors, std::uint64_t budget, std::uint64_t maxCandidates) {

@@ -13,7 +13,7 @@ const MethodInfo& DeepVariableKBuffer::info() const {
     return MethodInfo{"dkb", "Deep variable k-buffer: a neural network predicts k(p) under a memory budget",
                       "Tsopouridis, Fudos, Vasilakis: Deep hybrid order-independent transparency. The Visual "
                       "Computer 2022",
-                      false, p};
+                      false, p, "hybrid"};
   }();
   return i;
 }

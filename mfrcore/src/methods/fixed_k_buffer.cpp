@@ -22,7 +22,7 @@ const MethodInfo& FixedKBuffer::info() const {
                       "Tsopouridis, Fudos, Vasilakis: Deep hybrid order-independent transparency. The Visual "
                       "Computer 2022 (fixed-k baseline) over the k+-buffer max-array of Vasilakis, Papaioannou, Fudos, "
                       "IEEE TVCG 21(6), 2015",
-                      false, p};
+                      false, p, "hybrid"};
   }();
   return i;
 }

@@ -27,7 +27,7 @@ const MethodInfo& VariableKBufferImportance::info() const {
     return MethodInfo{"vkb", "Variable k-buffer with importance maps, under a memory budget",
                       "Vasilakis, Vardis, Papaioannou, Moustakas: Variable k-buffer using Importance Maps. "
                       "Eurographics 2017 Short Papers (with the tail of hybrid transparency)",
-                      false, p};
+                      false, p, "hybrid"};
   }();
   return i;
 }

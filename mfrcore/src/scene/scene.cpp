@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+
+#include <glm/trigonometric.hpp>
 
 #include "mfr/error.hpp"
 
@@ -58,6 +61,21 @@ std::vector<std::string> Scene::viewNames() const {
 Camera Scene::view(const std::string& viewName) const {
   for (const NamedView& v : views)
     if (v.name == viewName) return v.camera;
+  if (viewName.rfind("orbit:", 0) == 0) {
+    // orbit:AZIMUTH:ELEVATION (degrees): a fit-all view from that direction, +Y up; azimuth 0
+    // looks from +Z, 90 from +X.
+    double azimuth = 0, elevation = 0;
+    char extra = 0;
+    if (std::sscanf(viewName.c_str(), "orbit:%lf:%lf%c", &azimuth, &elevation, &extra) != 2 ||
+        !std::isfinite(azimuth) || !std::isfinite(elevation) || std::abs(elevation) > 89.0)
+      throw Error("view '" + viewName + "'", "expected orbit:AZIMUTH:ELEVATION in degrees, |elevation| <= 89");
+    const double az = glm::radians(azimuth), el = glm::radians(elevation);
+    Camera base;
+    base.target = glm::dvec3(0.0);
+    base.eye = glm::dvec3(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+    base.up = {0.0, 1.0, 0.0};
+    return fit(base);
+  }
   if (viewName.empty() || viewName == "fit") {
     // Fit-all keeps the direction of the first named view, else looks down -Z from +Z.
     Camera base = views.empty() ? Camera{} : views.front().camera;
@@ -65,7 +83,8 @@ Camera Scene::view(const std::string& viewName) const {
   }
   std::string list;
   for (const std::string& n : viewNames()) list += (list.empty() ? "" : ", ") + n;
-  throw Error("view '" + viewName + "'", "not in scene '" + name + "' (available: " + list + ")");
+  throw Error("view '" + viewName + "'",
+              "not in scene '" + name + "' (available: " + list + ", or orbit:AZIMUTH:ELEVATION)");
 }
 
 }  // namespace mfr

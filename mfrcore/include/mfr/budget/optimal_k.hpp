@@ -10,8 +10,16 @@
 //               tests/unit/test_optimal_k.cpp shows it is not in general.
 //   dynamic     exact: a knapsack over pixels, dp[i][b] = least error of pixels < i with b slots.
 //               O(P · F · max n) time, O(P · F) memory: small cases only.
+//   lagrangian  exact on the lower convex hulls: for a multiplier μ every pixel takes the k
+//               minimising e_p(k) + μ·k; μ is bisected to the smallest that fits F; the slots
+//               left are then given one by one where they lower the error most. O(Σn · 100).
+//               Exact whenever its hull points sum to F; it does not depend on convexity, so it
+//               beats the greedy where e_p has bumps (and the greedy wins elsewhere, rarely).
+//   best        the lower-error allocation of greedy and lagrangian: the optimal-k reference
+//               (mfr render --method optimal-k, the training labels of mfr dataset).
 //   exhaustive  every k vector; tiny cases (tests).
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -41,6 +49,9 @@ double allocationError(const HybridErrorTable& errors, const std::vector<std::ui
 // gives k = n everywhere (error 0).
 KAllocation optimalKGreedy(const HybridErrorTable& errors, std::uint64_t budget);
 KAllocation optimalKDynamic(const HybridErrorTable& errors, std::uint64_t budget);
+KAllocation optimalKLagrangian(const HybridErrorTable& errors, std::uint64_t budget);
+// solver (optional) receives "greedy" or "lagrangian".
+KAllocation optimalKBest(const HybridErrorTable& errors, std::uint64_t budget, std::string* solver = nullptr);
 // Also throws when the number of candidate vectors (Π n(p)) exceeds maxCandidates.
 KAllocation optimalKExhaustive(const HybridErrorTable& errors, std::uint64_t budget,
                                std::uint64_t maxCandidates = 10'000'000);

@@ -53,6 +53,7 @@ struct MethodInfo {
   std::string paper;  // citation of the implemented paper
   bool exact = true;  // captures every fragment (given enough memory/passes)
   std::vector<ParamSpec> params;
+  std::string preferredOperation = "oit";  // what --op auto runs ("hybrid" for the budget methods)
 };
 
 // What the resolve pass does with each pixel's sorted list.

@@ -1,0 +1,129 @@
+// mfr dataset: training data for dkb — per scene × view × budget, the oracle's exact lists, the
+// optimal k(p) under the budget and the 12 features of a random sample of the non-empty pixels
+// (format: mfr/budget/dataset.hpp, docs/methods.md).
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <random>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "mfr/budget/dataset.hpp"
+#include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
+#include "mfr/reference/oracle.hpp"
+
+namespace mfr::cli {
+
+namespace {
+
+// "1.5" → 1.5 slots per non-empty pixel; "all" → every fragment (encoded as −1).
+std::vector<double> parseBudgetLevels(const std::string& text) {
+  std::vector<double> out;
+  for (const std::string& item : splitList(text)) {
+    if (item == "all") {
+      out.push_back(-1.0);
+      continue;
+    }
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != item.size() || !std::isfinite(v) || v < 1.0)
+      throw Error("--budgets " + item, "expected slots per non-empty pixel (a number >= 1) or 'all'");
+    out.push_back(v);
+  }
+  if (out.empty()) throw Error("--budgets", "no budget given");
+  return out;
+}
+
+}  // namespace
+
+void addDataset(CLI::App& app) {
+  struct Options {
+    std::vector<std::string> scenes, sizes{"200x150"};
+    std::string views = "iso", budgets = "1,1.25,1.5,2,2.5,3,4,6,all", output;
+    double sample = 0.2, opacity = -1.0;
+    std::uint64_t seed = 1;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "dataset", "Write dkb training data: features and optimal-k labels of sampled pixels per scene, view and budget");
+  cmd->add_option("scenes", opt->scenes, "Training scenes (model files, .mfrscene, @sample)")->required();
+  cmd->add_option("-o,--output", opt->output, "Output dataset file")->required();
+  cmd->add_option("--views", opt->views, "Comma-separated views (names or orbit:AZ:EL)")->capture_default_str();
+  cmd->add_option("--size,-s", opt->sizes, "Image size WxH (repeatable)")->capture_default_str();
+  cmd->add_option("--budgets", opt->budgets,
+                  "Slot budgets per frame, in slots per non-empty pixel (>= 1) or 'all' (every fragment)")
+      ->capture_default_str();
+  cmd->add_option("--sample", opt->sample, "Fraction of the non-empty pixels written per frame")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--seed", opt->seed, "Random seed of the pixel sampling")->capture_default_str();
+  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
+  cmd->callback([opt] {
+    const std::vector<double> levels = parseBudgetLevels(opt->budgets);
+    const std::vector<std::string> views = splitList(opt->views);
+    if (views.empty()) throw Error("--views", "no view given");
+    std::vector<std::pair<int, int>> sizes;
+    for (const std::string& s : opt->sizes) sizes.push_back(parseSize("--size", s));
+    // Load every scene first: a bad file fails before any work.
+    std::vector<Scene> scenes;
+    for (const std::string& path : opt->scenes) {
+      scenes.push_back(loadScene(path));
+      if (opt->opacity >= 0.0)
+        for (Object& o : scenes.back().objects) o.material.color.a = static_cast<float>(opt->opacity);
+      for (const std::string& v : views) (void)scenes.back().view(v);
+    }
+    DkbDataset dataset;
+    std::mt19937_64 rng(opt->seed);
+    nlohmann::ordered_json meta;
+    meta["scenes"] = opt->scenes;
+    meta["views"] = views;
+    meta["sizes"] = opt->sizes;
+    meta["budgets"] = opt->budgets;
+    meta["sample"] = opt->sample;
+    meta["seed"] = opt->seed;
+    nlohmann::ordered_json frames = nlohmann::ordered_json::array();
+    std::cout << std::left << std::setw(28) << "scene" << std::setw(16) << "view" << std::setw(9) << "size"
+              << std::right << std::setw(10) << "F" << std::setw(10) << "Σn" << std::setw(9) << "rows" << std::setw(12)
+              << "error" << "  solver\n";
+    for (std::size_t s = 0; s < scenes.size(); ++s)
+      for (const std::string& v : views)
+        for (const auto& [w, h] : sizes) {
+          const FragmentLists lists = castFragments(scenes[s], scenes[s].view(v), w, h);
+          const HybridErrorTable errors = hybridErrorTable(lists, scenes[s].background);
+          const std::uint64_t nonEmpty = minimumSlots(errors);
+          if (nonEmpty == 0) throw Error(opt->scenes[s] + " view " + v, "nothing visible");
+          bool allDone = false;  // levels at or above Σn all mean "every fragment": one frame of those
+          for (double level : levels) {
+            const std::uint64_t F =
+                level < 0 ? lists.fragments.size()
+                          : std::min<std::uint64_t>(lists.fragments.size(),
+                                                    static_cast<std::uint64_t>(std::llround(level * static_cast<double>(nonEmpty))));
+            if (F >= lists.fragments.size()) {
+              if (allDone) continue;
+              allDone = true;
+            }
+            const DatasetFrame f = appendDatasetFrame(dataset, lists, errors, F, opt->sample, rng);
+            std::cout << std::left << std::setw(28) << scenes[s].name.substr(0, 27) << std::setw(16) << v.substr(0, 15)
+                      << std::setw(9) << (std::to_string(w) + "x" + std::to_string(h)) << std::right << std::setw(10) << F
+                      << std::setw(10) << f.totalFragments << std::setw(9) << f.sampled << std::setw(12)
+                      << std::setprecision(4) << f.optimalError << "  " << f.solver << "\n";
+            frames.push_back({{"scene", opt->scenes[s]}, {"view", v}, {"width", w}, {"height", h}, {"budget_slots", F},
+                              {"total_fragments", f.totalFragments}, {"rows", f.sampled}, {"solver", f.solver}});
+          }
+        }
+    meta["frames"] = frames;
+    dataset.metadata = meta.dump();
+    writeDataset(opt->output, dataset);
+    std::cout << opt->output << ": " << dataset.size() << " rows\n";
+  });
+}
+
+}  // namespace mfr::cli

@@ -1,0 +1,244 @@
+// mfr evaluate: the budget methods side by side against the exact image — for each scene, view
+// and memory budget: fkb, vkb, dkb (GPU) and optimal-k (CPU reference): k range, fragments
+// captured (count and % of all, the deep hybrid OIT paper's Table 2), RMSE and mean FLIP against
+// the oracle's exact "over" image, and per-pass time (median of --repeat frames).
+#include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "mfr/budget/memory_model.hpp"
+#include "mfr/error.hpp"
+#include "mfr/gl/context.hpp"
+#include "mfr/gpu_renderer.hpp"
+#include "mfr/io/load.hpp"
+#include "mfr/io_util.hpp"
+#include "mfr/reference/composite.hpp"
+#include "mfr/reference/metrics.hpp"
+#include "mfr/reference/oracle.hpp"
+#include "mfr/render.hpp"
+
+namespace mfr::cli {
+
+namespace {
+
+struct Budget {
+  std::string label;
+  double mib = 0.0;
+  double fragmentPercent = 0.0;  // fN budgets
+};
+
+// "3.5" MiB; "kN": the bytes of a uniform-k k+-buffer with the tail (fkb's layout) at k = N;
+// "fN": the bytes with which the variable-k layout holds N % of the frame's fragments (resolved
+// per frame, mib stays 0 here).
+Budget parseBudget(const std::string& item, std::uint64_t pixels) {
+  Budget b;
+  b.label = item;
+  if (!item.empty() && item[0] == 'f') {
+    std::size_t used = 0;
+    double percent = 0;
+    try {
+      percent = std::stod(item.substr(1), &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used + 1 != item.size() || !(percent > 0.0) || percent > 100.0)
+      throw Error("--budgets " + item, "expected fN with 0 < N <= 100 (% of the frame's fragments)");
+    b.fragmentPercent = percent;
+    return b;
+  }
+  if (!item.empty() && item[0] == 'k') {
+    std::size_t used = 0;
+    long k = 0;
+    try {
+      k = std::stol(item.substr(1), &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used + 1 != item.size() || k < 1 || k > 256) throw Error("--budgets " + item, "expected kN with 1 <= N <= 256");
+    b.mib = static_cast<double>(kplusArrayMemoryModel(pixels).bytes(static_cast<std::uint64_t>(k))) / (1024.0 * 1024.0);
+    return b;
+  }
+  std::size_t used = 0;
+  try {
+    b.mib = std::stod(item, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != item.size() || !std::isfinite(b.mib) || b.mib <= 0.0)
+    throw Error("--budgets " + item, "expected MiB (a positive number) or kN");
+  return b;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+}  // namespace
+
+void addEvaluate(CLI::App& app) {
+  struct Options {
+    std::vector<std::string> scenes;
+    std::string views = "iso", budgets = "f30,f50,f70", size = "200x150", methods = "fkb,vkb,dkb,optimal-k", weights,
+                json;
+    int repeat = 3;
+    double opacity = -1.0;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "evaluate", "Compare fkb, vkb, dkb and optimal-k under memory budgets: k range, fragments captured, RMSE, FLIP, time");
+  cmd->add_option("scenes", opt->scenes, "Scenes (model files, .mfrscene, @sample)")->required();
+  cmd->add_option("--budgets", opt->budgets,
+                  "Comma-separated budgets: MiB; kN = the memory of a uniform k = N k+-buffer with the tail; fN = the "
+                  "memory with which the variable-k layout holds N % of each frame's fragments")
+      ->capture_default_str();
+  cmd->add_option("--views", opt->views, "Comma-separated views")->capture_default_str();
+  cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
+  cmd->add_option("--methods,-m", opt->methods, "Methods to compare")->capture_default_str();
+  cmd->add_option("--weights", opt->weights, "dkb weights file (default: the built-in weights)");
+  cmd->add_option("--repeat,-r", opt->repeat, "Timed frames per GPU method")->capture_default_str()->check(CLI::Range(1, 100));
+  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--json", opt->json, "Write all results as JSON");
+  cmd->callback([opt] {
+    const auto [w, h] = parseSize("--size", opt->size);
+    const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+    std::vector<Budget> budgets;
+    for (const std::string& b : splitList(opt->budgets)) budgets.push_back(parseBudget(b, pixels));
+    if (budgets.empty()) throw Error("--budgets", "no budget given");
+    const std::vector<std::string> methods = splitList(opt->methods);
+    const std::vector<std::string> known = availableMethods();
+    for (const std::string& m : methods)
+      if (std::find(known.begin(), known.end(), m) == known.end() || m == "oracle")
+        throw Error("--methods " + m, "not a method (see mfr info --methods)");
+    const std::vector<std::string> views = splitList(opt->views);
+    std::vector<Scene> scenes;
+    for (const std::string& path : opt->scenes) {
+      scenes.push_back(loadScene(path));
+      if (opt->opacity >= 0.0)
+        for (Object& o : scenes.back().objects) o.material.color.a = static_cast<float>(opt->opacity);
+      for (const std::string& v : views) (void)scenes.back().view(v);
+    }
+    GpuRenderer& gpu = headlessRenderer();
+    const gl::ContextInfo info = gl::queryContextInfo();
+    nlohmann::ordered_json out;
+    out["renderer"] = info.renderer;
+    out["size"] = opt->size;
+    out["repeat"] = opt->repeat;
+    nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+    std::cout << "renderer: " << info.renderer << ", " << opt->size << ", median of " << opt->repeat << " frames\n";
+    std::cout << std::left << std::setw(22) << "scene" << std::setw(12) << "view" << std::setw(14) << "budget"
+              << std::setw(11) << "method" << std::right << std::setw(9) << "k range" << std::setw(10) << "captured"
+              << std::setw(8) << "%" << std::setw(9) << "RMSE" << std::setw(9) << "FLIP" << std::setw(10) << "ms\n";
+    // Wins per (scene, view, budget): the method with the lowest FLIP and the lowest RMSE.
+    std::map<std::string, int> flipWins, rmseWins;
+    for (std::size_t s = 0; s < scenes.size(); ++s) {
+      gpu.setScene(scenes[s]);
+      for (const std::string& v : views) {
+        const Camera camera = scenes[s].view(v);
+        const FragmentLists lists = castFragments(scenes[s], camera, w, h);
+        const ImageRGBA8 exact = compositeOver(lists, scenes[s].background);
+        const std::uint64_t total = lists.fragments.size();
+        for (Budget b : budgets) {
+          if (b.fragmentPercent > 0.0) {
+            const auto slots = static_cast<std::uint64_t>(std::ceil(b.fragmentPercent / 100.0 * static_cast<double>(total)));
+            b.mib = static_cast<double>(variableKLayout(pixels).bytes(slots)) / (1024.0 * 1024.0);
+          }
+          std::string bestFlip, bestRmse;
+          double minFlip = 1e30, minRmse = 1e30;
+          for (const std::string& m : methods) {
+            RenderRequest req;
+            req.method = m;
+            req.operation = "hybrid";
+            req.width = w;
+            req.height = h;
+            req.params["budget_mib"] = fixed(b.mib, 6);
+            if (m == "dkb" && !opt->weights.empty()) req.params["weights"] = opt->weights;
+            nlohmann::ordered_json row;
+            row["scene"] = opt->scenes[s];
+            row["view"] = v;
+            row["budget"] = b.label;
+            row["budget_mib"] = b.mib;
+            row["method"] = m;
+            RenderOutput r;
+            std::vector<double> times;
+            std::map<std::string, std::vector<double>> passes;
+            try {
+              if (m == "optimal-k") {
+                r = render(scenes[s], camera, req);
+              } else {
+                for (int i = 0; i < opt->repeat; ++i) {
+                  r = gpu.render(camera, req);
+                  times.push_back(r.stats.totalTimeMs());
+                  for (const auto& [pass, ms] : r.stats.passTimesMs) passes[pass].push_back(ms);
+                }
+              }
+            } catch (const Error& e) {
+              row["error"] = e.what();
+              rows.push_back(row);
+              std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12) << v.substr(0, 11)
+                        << std::setw(14) << b.label << std::setw(11) << m << "  " << e.what() << "\n";
+              continue;
+            }
+            const double e = rmse(exact, r.image);
+            const double f = flip(exact, r.image).stats.mean;
+            const double captured = total ? 100.0 * static_cast<double>(r.stats.fragmentsStored) / static_cast<double>(total) : 0.0;
+            row["k_min"] = r.stats.kMin;
+            row["k_max"] = r.stats.kMax;
+            row["fragments_captured"] = r.stats.fragmentsStored;
+            row["fragments_total"] = total;
+            row["captured_percent"] = captured;
+            row["bytes_allocated"] = r.stats.bytesAllocated;
+            row["rmse"] = e;
+            row["flip_mean"] = f;
+            row["median_total_ms"] = median(times);
+            nlohmann::ordered_json p = nlohmann::ordered_json::object();
+            for (const auto& [pass, ms] : passes) p[pass] = median(ms);
+            row["median_pass_ms"] = p;
+            rows.push_back(row);
+            std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12) << v.substr(0, 11)
+                      << std::setw(14) << (b.label + " " + fixed(b.mib, 2)) << std::setw(11) << m << std::right
+                      << std::setw(9) << (std::to_string(r.stats.kMin) + "-" + std::to_string(r.stats.kMax))
+                      << std::setw(10) << r.stats.fragmentsStored << std::setw(8) << fixed(captured, 1) << std::setw(9)
+                      << fixed(e, 5) << std::setw(9) << fixed(f, 5) << std::setw(10)
+                      << (times.empty() ? std::string("cpu") : fixed(median(times), 1)) << "\n";
+            if (m == "optimal-k") continue;  // the bound, not a competitor: wins count among the others
+            if (f < minFlip) {
+              minFlip = f;
+              bestFlip = m;
+            }
+            if (e < minRmse) {
+              minRmse = e;
+              bestRmse = m;
+            }
+          }
+          ++flipWins[bestFlip];
+          ++rmseWins[bestRmse];
+        }
+      }
+    }
+    std::cout << "lowest FLIP per scene, view and budget:";
+    for (const auto& [m, n] : flipWins) std::cout << " " << m << " " << n;
+    std::cout << "\nlowest RMSE per scene, view and budget:";
+    for (const auto& [m, n] : rmseWins) std::cout << " " << m << " " << n;
+    std::cout << "\n";
+    out["results"] = rows;
+    if (!opt->json.empty()) writeFileAtomically(opt->json, out.dump(2) + "\n");
+  });
+}
+
+}  // namespace mfr::cli

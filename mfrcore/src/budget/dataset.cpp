@@ -1,0 +1,84 @@
+// dkb training data: frames → rows of features and optimal-k labels; the binary file format
+// (mfr/budget/dataset.hpp).
+#include "mfr/budget/dataset.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <string_view>
+
+#include "mfr/error.hpp"
+#include "mfr/io_util.hpp"
+
+namespace mfr {
+
+namespace {
+constexpr char kMagic[8] = {'M', 'F', 'R', 'D', 'K', 'B', '1', '\n'};
+
+template <class T>
+void put(std::string& out, T v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+}  // namespace
+
+DatasetFrame appendDatasetFrame(DkbDataset& dataset, const FragmentLists& lists, const HybridErrorTable& errors,
+                                std::uint64_t budgetSlots, double sampleFraction, std::mt19937_64& rng) {
+  DatasetFrame frame;
+  const DkbImageStats image = dkbImageStats(lists);
+  frame.budgetSlots = budgetSlots;
+  frame.nonEmptyPixels = image.nonEmptyPixels;
+  frame.totalFragments = image.totalFragments;
+  const KAllocation best = optimalKBest(errors, budgetSlots, &frame.solver);
+  frame.optimalError = best.error;
+  std::bernoulli_distribution take(sampleFraction);
+  for (int y = 0; y < lists.height; ++y)
+    for (int x = 0; x < lists.width; ++x) {
+      const auto list = lists.pixel(x, y);
+      if (list.empty() || !take(rng)) continue;
+      const DkbFeatureVector f = dkbFeatures(list, image, budgetSlots);
+      const std::uint32_t k = best.k[lists.index(x, y)];
+      dataset.rows.insert(dataset.rows.end(), f.begin(), f.end());
+      dataset.rows.push_back(static_cast<float>(static_cast<double>(k) / static_cast<double>(budgetSlots)));
+      dataset.rows.push_back(static_cast<float>(k));
+      dataset.rows.push_back(static_cast<float>(list.size()));
+      ++frame.sampled;
+    }
+  return frame;
+}
+
+void writeDataset(const std::filesystem::path& path, const DkbDataset& dataset) {
+  std::string bytes(kMagic, sizeof kMagic);
+  put<std::uint32_t>(bytes, kDatasetColumns);
+  put<std::uint64_t>(bytes, dataset.size());
+  put<std::uint32_t>(bytes, static_cast<std::uint32_t>(dataset.metadata.size()));
+  bytes += dataset.metadata;
+  bytes.append(reinterpret_cast<const char*>(dataset.rows.data()), dataset.size() * kDatasetColumns * sizeof(float));
+  writeFileAtomically(path, bytes);
+}
+
+DkbDataset readDataset(const std::filesystem::path& path) {
+  const std::string bytes = readFile(path);
+  const std::string where = path.string();
+  constexpr std::size_t header = sizeof kMagic + 4 + 8 + 4;
+  if (bytes.size() < header || std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0)
+    throw Error(where, "not an mfr dkb dataset (no MFRDKB1 header)");
+  std::uint32_t columns = 0, metaLength = 0;
+  std::uint64_t rows = 0;
+  std::memcpy(&columns, bytes.data() + 8, 4);
+  std::memcpy(&rows, bytes.data() + 12, 8);
+  std::memcpy(&metaLength, bytes.data() + 20, 4);
+  if (columns != kDatasetColumns)
+    throw Error(where, "has " + std::to_string(columns) + " columns, expected " + std::to_string(kDatasetColumns));
+  const std::uint64_t payload = rows * kDatasetColumns * sizeof(float);
+  if (rows > (1ull << 40) || bytes.size() != header + metaLength + payload)
+    throw Error(where, "truncated or corrupt (" + std::to_string(bytes.size()) + " bytes for " + std::to_string(rows) +
+                           " rows)");
+  DkbDataset d;
+  d.metadata = bytes.substr(header, metaLength);
+  d.rows.resize(rows * kDatasetColumns);
+  std::memcpy(d.rows.data(), bytes.data() + header + metaLength, payload);
+  for (float v : d.rows)
+    if (!std::isfinite(v)) throw Error(where, "holds a non-finite value");
+  return d;
+}
+
+}  // namespace mfr

@@ -1,0 +1,265 @@
+// fkb, vkb and dkb — hybrid transparency under a memory budget M (Tsopouridis, Fudos, Vasilakis,
+// The Visual Computer 2022; Vasilakis et al., EG 2017) — against independent references:
+//   * the GPU allocation equals the CPU rule (mfr/budget/k_allocation.hpp) run on the GPU's own
+//     importance and counts, pixel for pixel;
+//   * Σk(p) = min(F(M), Σn), 1 ≤ k(p) ≤ n(p), and Stats.bytesAllocated ≤ M for budgets from
+//     absurd (zero: refused) through one slot per pixel to more than all fragments;
+//   * the hybrid image equals the oracle's hybrid composite for the same k(p) map (2/255 on
+//     ≥ 99.9 % of the non-ambiguous pixels);
+//   * dkb's GPU importance equals the CPU features + network on the oracle's exact lists.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "../../mfrcore/src/methods/deep_variable_k_buffer.hpp"
+#include "../../mfrcore/src/methods/variable_k_buffer.hpp"
+#include "gl_fixture.hpp"
+#include "mfr/budget/k_allocation.hpp"
+#include "mfr/budget/memory_model.hpp"
+#include "mfr/budget/neural_importance.hpp"
+#include "mfr/budget/optimal_k.hpp"
+#include "mfr/error.hpp"
+#include "mfr/reference/hybrid.hpp"
+#include "mfr/render.hpp"
+#include "mfr/scene/sample.hpp"
+
+namespace mfr::test {
+namespace {
+
+constexpr int kW = 96, kH = 72;
+constexpr double kMiB = 1024.0 * 1024.0;
+
+struct Reference {
+  Scene scene = makeSampleScene();
+  Camera camera = scene.view("front");
+  FragmentLists oracle = castFragments(scene, camera, kW, kH);
+};
+const Reference& reference() {
+  static const Reference r;
+  return r;
+}
+
+std::uint64_t pixels() { return static_cast<std::uint64_t>(kW) * kH; }
+
+RenderRequest budgetRequest(const std::string& method, std::uint64_t budgetBytes) {
+  RenderRequest req;
+  req.method = method;
+  req.operation = "hybrid";
+  req.width = kW;
+  req.height = kH;
+  // Half a byte above: the method floors MiB·2^20 back to exactly budgetBytes.
+  char text[64];
+  std::snprintf(text, sizeof text, "%.12f", (static_cast<double>(budgetBytes) + 0.5) / kMiB);
+  req.params = {{"budget_mib", text}};
+  return req;
+}
+
+// Bytes the method's MiB text really stands for (the method floors MiB·2^20).
+std::uint64_t budgetOf(const RenderRequest& req) {
+  return static_cast<std::uint64_t>(std::floor(std::stod(req.params.at("budget_mib")) * kMiB));
+}
+
+std::uint64_t memberFixed(const std::string& method) {
+  return method == "dkb" ? NeuralImportanceModel::floatCount() * sizeof(float) : 0;
+}
+
+class VariableK : public ::testing::TestWithParam<std::string> {};
+
+// GPU k(p) = the CPU rule on the GPU's importance and n(p), for several budgets.
+TEST_P(VariableK, AllocationEqualsTheCpuRule) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
+  const std::uint64_t total = ref.oracle.fragments.size();
+  for (double fraction : {0.15, 0.3, 0.55, 0.8, 1.2}) {
+    SCOPED_TRACE("fraction " + std::to_string(fraction));
+    const RenderRequest req =
+        budgetRequest(GetParam(), layout.bytes(static_cast<std::uint64_t>(fraction * static_cast<double>(total))));
+    gpu.render(ref.camera, req);
+    auto* method = dynamic_cast<VariableKBuffer*>(gpu.method());
+    ASSERT_NE(method, nullptr);
+    method->setKeepImportance(true);
+    const RenderOutput out = gpu.render(ref.camera, req);
+    const std::vector<float>& importance = method->lastImportance();
+    const std::vector<std::uint32_t>& n = method->lastCounts();
+    const std::uint64_t gpuTotal = std::accumulate(n.begin(), n.end(), std::uint64_t{0});
+    const std::uint64_t F = std::min(layout.slotBudget(budgetOf(req)), gpuTotal);
+    const ImportanceAllocation cpu = allocateKFromImportance(importance, n, F);
+    const std::vector<std::uint32_t> k = method->capacityMap();  // GL row order, like importance
+    ASSERT_EQ(k.size(), cpu.k.size());
+    std::size_t differ = 0;
+    for (std::size_t p = 0; p < k.size(); ++p) differ += k[p] != cpu.k[p];
+    EXPECT_EQ(differ, 0u);
+    EXPECT_EQ(std::accumulate(k.begin(), k.end(), std::uint64_t{0}), F);  // the budget is used up
+    EXPECT_EQ(out.stats.fragmentsStored, F);
+    EXPECT_EQ(out.stats.lockFailures, 0u);
+    EXPECT_LE(out.stats.bytesAllocated, budgetOf(req));
+    EXPECT_EQ(out.stats.bytesAllocated, layout.bytes(std::max<std::uint64_t>(F, 1)));
+    for (std::size_t p = 0; p < k.size(); ++p) {
+      ASSERT_LE(k[p], n[p]);
+      if (n[p] > 0) {
+        ASSERT_GE(k[p], cpu.kFloor);
+      }
+    }
+    method->setKeepImportance(false);
+  }
+}
+
+// The budget is never exceeded; absurd budgets are refused with one line or handled.
+TEST_P(VariableK, NeverExceedsTheBudget) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
+  // Zero, and one byte short of one slot: refused, naming the parameter.
+  for (std::uint64_t bytes : {std::uint64_t{0}, layout.bytes(1) - 1}) {
+    try {
+      gpu.render(ref.camera, budgetRequest(GetParam(), bytes));
+      ADD_FAILURE() << "accepted a budget of " << bytes << " bytes";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("budget_mib"), std::string::npos) << e.what();
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+    }
+  }
+  const std::uint64_t total = ref.oracle.fragments.size();
+  for (std::uint64_t bytes : {layout.bytes(1), layout.bytes(pixels() / 4), layout.bytes(pixels()), layout.bytes(total / 2),
+                              layout.bytes(total) + 12345, std::uint64_t{1} << 35}) {
+    const RenderRequest req = budgetRequest(GetParam(), bytes);
+    const RenderOutput out = gpu.render(ref.camera, req);
+    const std::uint64_t F = layout.slotBudget(budgetOf(req));
+    EXPECT_LE(out.stats.bytesAllocated, budgetOf(req));
+    // ≥ 99 % of F(M) assigned whenever enough fragments exist; all of them otherwise.
+    if (F <= out.stats.fragmentsGenerated) {
+      EXPECT_GE(static_cast<double>(out.stats.fragmentsStored), 0.99 * static_cast<double>(F));
+    } else {
+      EXPECT_EQ(out.stats.fragmentsStored, out.stats.fragmentsGenerated);
+    }
+    const std::vector<std::uint32_t> k = gpu.kMap();
+    EXPECT_EQ(std::accumulate(k.begin(), k.end(), std::uint64_t{0}), out.stats.fragmentsStored);
+  }
+}
+
+// The hybrid image equals the oracle's hybrid composite with the GPU's own k(p) map.
+TEST_P(VariableK, HybridEqualsTheOracleForTheSameKMap) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
+  for (double fraction : {0.2, 0.5}) {
+    const RenderOutput out = gpu.render(
+        ref.camera,
+        budgetRequest(GetParam(), layout.bytes(static_cast<std::uint64_t>(fraction * ref.oracle.fragments.size()))));
+    const std::vector<std::uint32_t> kMap = gpu.kMap();  // image rows, like the oracle
+    const ImageRGBA8 expected = compositeHybrid(ref.oracle, kMap, ref.scene.background);
+    const ImageComparison c = compareImages(ref.oracle, expected, out.image, 2);
+    EXPECT_GT(c.compared, pixels() * 6 / 10);
+    EXPECT_GE(c.fraction(), 0.999) << "max difference " << c.maxDifference;
+    // Not trivially equal: the hybrid with this k(p) differs from the exact image.
+    const ImageComparison vsExact = compareImages(ref.oracle, compositeOver(ref.oracle, ref.scene.background), out.image, 2);
+    EXPECT_LT(vsExact.within, vsExact.compared);
+    std::cout << "[ budget ] " << GetParam() << " at " << fraction << " of the fragments: " << c.within << " of "
+              << c.compared << " pixels within 2/255 of the oracle's hybrid, max " << c.maxDifference << "; k "
+              << out.stats.kMin << ".." << out.stats.kMax << "\n";
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Budget, VariableK, ::testing::Values("vkb", "dkb"));
+
+TEST(FixedKUnderBudget, LargestUniformKAndTheOracleHybrid) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  const KBufferMemoryModel model = kplusArrayMemoryModel(pixels());
+  EXPECT_THROW(gpu.render(ref.camera, budgetRequest("fkb", model.bytes(1) - 1)), Error);
+  EXPECT_THROW(gpu.render(ref.camera, budgetRequest("fkb", 0)), Error);
+  for (std::uint64_t bytes : {model.bytes(1), model.bytes(3) + 4000, model.bytes(7) - 1, std::uint64_t{1} << 35}) {
+    const RenderRequest req = budgetRequest("fkb", bytes);
+    const RenderOutput out = gpu.render(ref.camera, req);
+    const std::uint32_t k = largestUniformK(model, budgetOf(req));
+    EXPECT_EQ(out.stats.kMax, k);
+    EXPECT_EQ(out.stats.bytesAllocated, model.bytes(k));
+    EXPECT_LE(out.stats.bytesAllocated, budgetOf(req));
+    const ImageComparison c = compareImages(ref.oracle, compositeHybrid(ref.oracle, k, ref.scene.background), out.image, 2);
+    EXPECT_GE(c.fraction(), 0.999) << "k " << k << " max difference " << c.maxDifference;
+  }
+}
+
+// dkb's feature passes and network on the GPU equal the CPU features of the oracle's exact lists
+// run through the same network (the weights shipped in resources/dkb/weights.json).
+TEST(DeepVariableK, GpuImportanceEqualsTheCpuNetworkOnTheOracleLists) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  const VariableKLayout layout = variableKLayout(pixels(), memberFixed("dkb"));
+  const std::uint64_t total = ref.oracle.fragments.size();
+  const RenderRequest req = budgetRequest("dkb", layout.bytes(total / 3));
+  gpu.render(ref.camera, req);
+  auto* method = dynamic_cast<DeepVariableKBuffer*>(gpu.method());
+  ASSERT_NE(method, nullptr);
+  method->setKeepImportance(true);
+  gpu.render(ref.camera, req);
+  const std::vector<float>& gpuImportance = method->lastImportance();
+  // Image-wide sums as the GPU counted them (the oracle's differ on edge pixels).
+  const std::vector<std::uint32_t>& n = method->lastCounts();
+  DkbImageStats image = dkbImageStats(ref.oracle);
+  image.totalFragments = std::accumulate(n.begin(), n.end(), std::uint64_t{0});
+  const std::uint64_t F = std::min(layout.slotBudget(budgetOf(req)), image.totalFragments);
+  std::size_t compared = 0, close = 0;
+  double worst = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      if (ref.oracle.isAmbiguous(x, y) || ref.oracle.count(x, y) == 0) continue;
+      const auto list = ref.oracle.pixel(x, y);
+      const float cpu = neuralImportance(method->model(), dkbFeatures(list, image, F), static_cast<std::uint32_t>(list.size()));
+      const float gpuValue = gpuImportance[static_cast<std::size_t>(kH - 1 - y) * kW + x];  // GL rows
+      const double rel = std::abs(gpuValue - std::max(cpu, 1e-6f)) / std::max(std::abs(cpu), 1e-3f);
+      worst = std::max(worst, rel);
+      ++compared;
+      close += rel < 1e-3;
+    }
+  EXPECT_GT(compared, pixels() / 4);
+  EXPECT_GE(static_cast<double>(close), 0.999 * static_cast<double>(compared)) << "worst relative difference " << worst;
+  std::cout << "[ dkb ] " << close << " of " << compared << " pixels' importance within 0.1 % of the CPU network, worst "
+            << worst << "\n";
+}
+
+// optimal-k is the bound: its hybrid error (the paper's eq. 2 summed over pixels) is below the
+// error of vkb's and dkb's own k(p) maps, evaluated on the same exact lists.
+TEST(OptimalKReference, BelowTheVariableKMethods) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  const HybridErrorTable errors = hybridErrorTable(ref.oracle, ref.scene.background);
+  const VariableKLayout layout = variableKLayout(pixels());
+  const std::uint64_t total = ref.oracle.fragments.size();
+  for (double fraction : {0.25, 0.45}) {
+    const std::uint64_t bytes = layout.bytes(static_cast<std::uint64_t>(fraction * static_cast<double>(total)));
+    const RenderRequest req = budgetRequest("optimal-k", bytes);
+    const RenderOutput optimal = render(ref.scene, ref.camera, req);
+    const std::uint64_t F = std::min(layout.slotBudget(budgetOf(req)), total);
+    EXPECT_LE(optimal.stats.fragmentsStored, F);
+    const KAllocation best = optimalKBest(errors, F);
+    for (const std::string method : {"vkb", "dkb"}) {
+      gpu.render(ref.camera, budgetRequest(method, bytes));
+      const std::vector<std::uint32_t> k = gpu.kMap();
+      std::vector<std::uint32_t> capped(k.size());
+      for (std::size_t p = 0; p < k.size(); ++p) capped[p] = std::min<std::uint32_t>(k[p], static_cast<std::uint32_t>(errors[p].size() - 1));
+      const double e = allocationError(errors, capped);
+      EXPECT_LT(best.error, e) << method;
+      std::cout << "[ optimal-k ] " << fraction << " of the fragments: optimal error " << best.error << ", " << method
+                << " " << e << "\n";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mfr::test

@@ -1,0 +1,275 @@
+// The variable-k budget machinery on the CPU: the allocation rule shared by vkb and dkb (against
+// its stated properties, and against the papers' floor(F·I/ΣI)), the dkb features of a hand-made
+// list, the weights file, the dataset file, and the dlib training export (the exported weights,
+// run by the shaders' own forward pass, reproduce the loss dlib reported).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <numeric>
+#include <random>
+
+#include "mfr/budget/dataset.hpp"
+#include "mfr/budget/k_allocation.hpp"
+#include "mfr/budget/memory_model.hpp"
+#include "mfr/budget/neural_importance.hpp"
+#include "mfr/budget/neural_training.hpp"
+#include "mfr/error.hpp"
+#include "mfr/io_util.hpp"
+#include "mfr/scene/sample.hpp"
+
+namespace {
+
+std::uint64_t sum(const std::vector<std::uint32_t>& v) { return std::accumulate(v.begin(), v.end(), std::uint64_t{0}); }
+
+TEST(KAllocation, PropertiesOnRandomCases) {
+  std::mt19937 rng(5);
+  for (int c = 0; c < 400; ++c) {
+    const std::size_t pixels = std::uniform_int_distribution<std::size_t>(1, 300)(rng);
+    std::vector<std::uint32_t> n(pixels);
+    std::vector<float> importance(pixels);
+    std::uniform_int_distribution<std::uint32_t> depth(0, c % 3 == 0 ? 3 : 40);
+    std::lognormal_distribution<float> imp(0.0f, 1.5f);
+    for (std::size_t p = 0; p < pixels; ++p) {
+      n[p] = depth(rng);
+      importance[p] = c % 5 == 0 ? 1.0f : imp(rng);  // every fifth case: all importances equal
+    }
+    const std::uint64_t total = sum(n);
+    const std::uint64_t nonEmpty = static_cast<std::uint64_t>(std::count_if(n.begin(), n.end(), [](auto v) { return v > 0; }));
+    for (std::uint64_t F : {std::uint64_t{0}, nonEmpty / 2, nonEmpty, nonEmpty + 1, (nonEmpty + total) / 2,
+                            total > 0 ? total - 1 : 0, total, total + 17}) {
+      const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(importance, n, F);
+      ASSERT_EQ(a.k.size(), pixels);
+      EXPECT_EQ(a.assigned, sum(a.k));
+      EXPECT_EQ(a.assigned, std::min(F, total)) << "case " << c << " F " << F;  // the budget is used up
+      EXPECT_EQ(a.kFloor, F >= nonEmpty ? 1u : 0u);
+      for (std::size_t p = 0; p < pixels; ++p) {
+        ASSERT_LE(a.k[p], n[p]);
+        if (n[p] == 0) {
+          EXPECT_EQ(a.k[p], 0u);
+        }
+        if (n[p] > 0 && F >= nonEmpty) {
+          EXPECT_GE(a.k[p], 1u);
+        }
+      }
+      // Monotone in importance (up to the one slot of the remainder): a more important pixel that
+      // is not full never has fewer slots than a less important one, minus one.
+      for (std::size_t p = 0; p + 1 < pixels; ++p) {
+        const std::size_t q = p + 1;
+        if (importance[p] >= importance[q] && a.k[p] < n[p] && n[q] > 0 && a.k[q] > a.kFloor) {
+          EXPECT_GE(a.k[p] + 1, a.k[q]) << "case " << c << " pixels " << p << "," << q;
+        }
+      }
+    }
+  }
+}
+
+// The papers' rule floor(F·I(p)/ΣI) (capped at n) wastes slots; ours uses all of them.
+TEST(KAllocation, UsesTheSlotsTheFloorRuleWastes) {
+  std::vector<std::uint32_t> n(1000);
+  std::vector<float> importance(1000);
+  std::mt19937 rng(11);
+  for (std::size_t p = 0; p < n.size(); ++p) {
+    n[p] = 1 + static_cast<std::uint32_t>(p % 7) * 3;
+    importance[p] = std::uniform_real_distribution<float>(0.1f, 1.0f)(rng);
+  }
+  const std::uint64_t F = 4321;
+  const double sumI = std::accumulate(importance.begin(), importance.end(), 0.0);
+  std::uint64_t floorRule = 0;
+  for (std::size_t p = 0; p < n.size(); ++p)
+    floorRule += std::clamp<std::uint64_t>(static_cast<std::uint64_t>(std::floor(F * importance[p] / sumI)), 1, n[p]);
+  const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(importance, n, F);
+  EXPECT_EQ(a.assigned, F);
+  EXPECT_LT(floorRule, static_cast<std::uint64_t>(0.97 * F));  // the floor rule leaves > 3 % unused here
+  std::cout << "[ allocation ] F = " << F << ": ours assigns " << a.assigned << ", floor(F·I/ΣI) capped at n assigns "
+            << floorRule << "\n";
+}
+
+TEST(KAllocation, EqualImportanceGivesEqualK) {
+  const std::vector<std::uint32_t> n(100, 50);
+  const std::vector<float> importance(100, 0.5f);
+  const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(importance, n, 730);
+  EXPECT_EQ(a.assigned, 730u);
+  const auto [lo, hi] = std::minmax_element(a.k.begin(), a.k.end());
+  EXPECT_LE(*hi - *lo, 1u);
+  EXPECT_EQ(*lo, 7u);
+}
+
+TEST(KAllocation, BadImportancesCountAsTheFloor) {
+  const std::vector<std::uint32_t> n{5, 5, 5, 5};
+  const std::vector<float> importance{std::numeric_limits<float>::quiet_NaN(), -3.0f, 0.0f, 1.0f};
+  const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(importance, n, 12);
+  EXPECT_EQ(a.assigned, 12u);
+  EXPECT_EQ(a.k[3], 5u);  // the only important pixel fills up first
+  EXPECT_THROW(mfr::allocateKFromImportance(importance, std::vector<std::uint32_t>{1, 2}, 3), mfr::Error);
+}
+
+mfr::Fragment frag(float depth, std::uint32_t r, std::uint32_t g, std::uint32_t b, std::uint32_t a) {
+  mfr::Fragment f;
+  f.depth = depth;
+  f.color = r | (g << 8) | (b << 16) | (a << 24);
+  return f;
+}
+
+TEST(DkbFeatures, HandMadeList) {
+  const std::vector<mfr::Fragment> list{frag(0.25f, 255, 0, 51, 128), frag(0.5f, 0, 102, 51, 64), frag(0.75f, 0, 0, 51, 32)};
+  mfr::DkbImageStats image;
+  image.totalFragments = 60;
+  image.nonEmptyPixels = 20;
+  image.imageNear = 0.125f;
+  image.imageFar = 0.875f;
+  const mfr::DkbFeatureVector f = mfr::dkbFeatures(list, image, 30);
+  const float expected[12] = {3.0f / 60, 30.0f / 60, 0.25f, 0.75f, 0.125f, 0.875f, 1.0f, 0.0f, 0.2f,
+                              255.0f / 765, 102.0f / 765, 153.0f / 765};
+  for (int i = 0; i < 12; ++i) EXPECT_NEAR(f[static_cast<std::size_t>(i)], expected[i], 1e-6f) << "feature " << i;
+}
+
+mfr::NeuralImportanceModel randomModel(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> w(0.0f, 0.2f);
+  mfr::NeuralImportanceModel m;
+  m.weights.resize(mfr::NeuralImportanceModel::floatCount());
+  for (float& x : m.weights) x = w(rng);
+  for (int i = 0; i < 12; ++i) m.weights[static_cast<std::size_t>(12 + i)] = 0.5f + static_cast<float>(i) * 0.1f;  // std > 0
+  return m;
+}
+
+TEST(NeuralImportance, WeightsFileRoundTripAndErrors) {
+  const mfr::NeuralImportanceModel m = randomModel(3);
+  const mfr::NeuralImportanceModel back = mfr::parseNeuralImportance(mfr::neuralImportanceJson(m), "w.json");
+  ASSERT_EQ(back.weights.size(), m.weights.size());
+  for (std::size_t i = 0; i < m.weights.size(); ++i) ASSERT_EQ(back.weights[i], m.weights[i]) << i;
+  const mfr::DkbFeatureVector x{0.001f, 0.5f, 0.3f, 0.6f, 0.1f, 0.9f, 0.2f, 0.4f, 0.6f, 0.3f, 0.3f, 0.3f};
+  const float y = mfr::predictNeuralImportance(m, x);
+  EXPECT_GT(y, 0.0f);
+  EXPECT_LT(y, 1.0f);
+  EXPECT_EQ(mfr::predictNeuralImportance(back, x), y);
+  EXPECT_FLOAT_EQ(mfr::neuralImportance(m, x, 10), 10 * y);  // k_over_n: y·n
+
+  for (const std::string bad : {"", "{", "[]", R"({"format":"mfr-dkb-weights","version":2})",
+                                R"({"format":"mfr-dkb-weights","version":1,"architecture":[12,64,1]})"}) {
+    try {
+      mfr::parseNeuralImportance(bad, "bad.json");
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const mfr::Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("bad.json: ", 0), 0u) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos);
+    }
+  }
+  std::string text = mfr::neuralImportanceJson(m);
+  text.replace(text.find("\"input_std\": ["), 14, "\"input_std\": [-1,");  // a wrong-length, negative std
+  EXPECT_THROW(mfr::parseNeuralImportance(text, "bad.json"), mfr::Error);
+  EXPECT_THROW(mfr::loadNeuralImportance("/nonexistent/weights.json"), mfr::Error);
+}
+
+TEST(DkbDataset, FramesFileRoundTripAndCorruptFiles) {
+  const mfr::Scene scene = mfr::makeSampleScene();
+  const mfr::FragmentLists lists = mfr::castFragments(scene, scene.view("front"), 32, 24);
+  const mfr::HybridErrorTable errors = mfr::hybridErrorTable(lists, scene.background);
+  const std::uint64_t nonEmpty = mfr::minimumSlots(errors);
+  mfr::DkbDataset d;
+  std::mt19937_64 rng(1);
+  const mfr::DatasetFrame f = mfr::appendDatasetFrame(d, lists, errors, 2 * nonEmpty, 1.0, rng);
+  EXPECT_EQ(f.sampled, nonEmpty);  // sample = 1: every non-empty pixel
+  EXPECT_EQ(d.size(), nonEmpty);
+  // Labels: the optimal allocation's k, Σk within the budget, k/F consistent, 1 ≤ k ≤ n.
+  double sumK = 0;
+  for (std::size_t r = 0; r < d.size(); ++r) {
+    const float* row = d.row(r);
+    EXPECT_GE(row[mfr::kDatasetK], 1.0f);
+    EXPECT_LE(row[mfr::kDatasetK], row[mfr::kDatasetN]);
+    EXPECT_NEAR(row[mfr::kDatasetLabel], row[mfr::kDatasetK] / static_cast<float>(2 * nonEmpty), 1e-9);
+    sumK += row[mfr::kDatasetK];
+  }
+  EXPECT_LE(sumK, static_cast<double>(2 * nonEmpty));
+  d.metadata = R"({"test":true})";
+  const auto dir = std::filesystem::temp_directory_path() / "mfr-dataset-test";
+  std::filesystem::create_directories(dir);
+  const auto path = dir / "d.bin";
+  mfr::writeDataset(path, d);
+  const mfr::DkbDataset back = mfr::readDataset(path);
+  EXPECT_EQ(back.rows, d.rows);
+  EXPECT_EQ(back.metadata, d.metadata);
+  // Truncated and foreign files: one line naming the file.
+  const std::string bytes = mfr::readFile(path);
+  mfr::writeFileAtomically(dir / "cut.bin", bytes.substr(0, bytes.size() - 5));
+  mfr::writeFileAtomically(dir / "foreign.bin", "PNG\x89 not a dataset at all, really");
+  for (const char* name : {"cut.bin", "foreign.bin", "missing.bin"}) {
+    try {
+      mfr::readDataset(dir / name);
+      ADD_FAILURE() << name;
+    } catch (const mfr::Error& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+  std::filesystem::remove_all(dir);
+}
+
+// Trains on a small synthetic dataset whose target is a known function of the features, then runs
+// the exported weights through the shaders' forward pass (predictNeuralImportance): its MSE over
+// all rows must equal the mix of dlib's training and validation MSE — a wrong export of dlib's
+// fc layout (transposed weights, bias in the wrong row) would not reproduce it.
+TEST(NeuralTraining, ExportedWeightsReproduceDlibsLoss) {
+  mfr::DkbDataset d;
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int r = 0; r < 3000; ++r) {
+    float row[mfr::kDatasetColumns];
+    for (int f = 0; f < 12; ++f) row[f] = u(rng) * static_cast<float>(f + 1);
+    const float n = 1.0f + std::floor(u(rng) * 20.0f);
+    const float kOverN = 0.2f + 0.6f / (1.0f + std::exp(2.0f - row[0] - 0.3f * row[5]));
+    row[mfr::kDatasetN] = n;
+    row[mfr::kDatasetK] = kOverN * n;
+    row[mfr::kDatasetLabel] = kOverN * n / 1000.0f;
+    d.rows.insert(d.rows.end(), row, row + mfr::kDatasetColumns);
+  }
+  mfr::NeuralTrainingOptions o;
+  o.epochs = 4;
+  o.batchSize = 64;
+  o.learningRate = 0.01;
+  std::vector<double> losses;
+  o.progress = [&](std::size_t, double train, double) { losses.push_back(train); };
+  const mfr::NeuralTrainingResult r = mfr::trainNeuralImportance(d, o);
+  ASSERT_EQ(losses.size(), 4u);
+  EXPECT_LT(losses.back(), losses.front());  // it learns
+  EXPECT_EQ(r.trainingRows + r.validationRows, d.size());
+  double sq = 0;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const float* row = d.row(i);
+    mfr::DkbFeatureVector x;
+    std::copy(row, row + 12, x.begin());
+    const double diff = mfr::predictNeuralImportance(r.model, x) - row[mfr::kDatasetK] / row[mfr::kDatasetN];
+    sq += diff * diff;
+  }
+  const double mixed = (r.trainingLoss * static_cast<double>(r.trainingRows) +
+                        r.validationLoss * static_cast<double>(r.validationRows)) /
+                       static_cast<double>(d.size());
+  EXPECT_NEAR(sq / static_cast<double>(d.size()), mixed, 1e-4 * mixed + 1e-9);
+  // And through the weights file.
+  const mfr::NeuralImportanceModel back = mfr::parseNeuralImportance(mfr::neuralImportanceJson(r.model), "t.json");
+  mfr::DkbFeatureVector x;
+  std::copy(d.row(0), d.row(0) + 12, x.begin());
+  EXPECT_EQ(mfr::predictNeuralImportance(back, x), mfr::predictNeuralImportance(r.model, x));
+}
+
+TEST(VariableKLayout, BytesAndSlotBudget) {
+  const mfr::VariableKLayout l = mfr::variableKLayout(1000, 40);
+  // Regions: 1000 → 1024 words (lock), 5 × 1024 (stride for 1001), 1024 (k): 7168 words.
+  EXPECT_EQ(l.tailBase, 1024u);
+  EXPECT_EQ(l.stride, 1024u);
+  EXPECT_EQ(l.kBase, 1024u + 5 * 1024u);
+  EXPECT_EQ(l.arenaWords, 7168u);
+  EXPECT_EQ(l.fixedBytes, 32u + 128u + 40u);
+  EXPECT_EQ(l.bytes(10), 80 + 4 * 7168 + l.scanScratchBytes + 200);
+  EXPECT_EQ(l.slotBudget(l.bytes(10)), 10u);
+  EXPECT_EQ(l.slotBudget(l.bytes(10) + 7), 10u);
+  EXPECT_EQ(l.slotBudget(l.bytesBeforeSlots()), 0u);
+  EXPECT_EQ(l.slotBudget(0), 0u);
+  EXPECT_EQ(mfr::variableKLayout(1024).stride, 1088u);  // 1025 words round up to 17 × 64
+}
+
+}  // namespace
