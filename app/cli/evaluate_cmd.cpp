@@ -55,14 +55,19 @@ Budget parseBudget(const std::string& item, std::uint64_t pixels) {
   }
   if (!item.empty() && item[0] == 'k') {
     std::size_t used = 0;
-    long k = 0;
+    double k = 0;
     try {
-      k = std::stol(item.substr(1), &used);
+      k = std::stod(item.substr(1), &used);
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used + 1 != item.size() || k < 1 || k > 256) throw Error("--budgets " + item, "expected kN with 1 <= N <= 256");
-    b.mib = static_cast<double>(kplusArrayMemoryModel(pixels).bytes(static_cast<std::uint64_t>(k))) / (1024.0 * 1024.0);
+    if (used + 1 != item.size() || !(k >= 1.0) || k > 256.0)
+      throw Error("--budgets " + item, "expected kN with 1 <= N <= 256 (N may be fractional)");
+    // bytes(k) = P·(8k + y) + z of fkb's layout, also for fractional k (between two uniform k).
+    const KBufferMemoryModel m = kplusArrayMemoryModel(pixels);
+    b.mib = (static_cast<double>(m.pixels) * (8.0 * k + static_cast<double>(m.bytesPerPixel)) +
+             static_cast<double>(m.fixedBytes)) /
+            (1024.0 * 1024.0);
     return b;
   }
   std::size_t used = 0;
@@ -133,6 +138,7 @@ void addEvaluate(CLI::App& app) {
         for (Object& o : scenes.back().objects) o.material.color.a = static_cast<float>(opt->opacity);
       for (const std::string& v : views) (void)scenes.back().view(v);
     }
+    if (views.empty()) throw Error("--views", "no view given");
     GpuRenderer& gpu = headlessRenderer();
     const gl::ContextInfo info = gl::queryContextInfo();
     nlohmann::ordered_json out;

@@ -159,4 +159,46 @@ TEST_F(Cli, InfoReportsTrianglesAndHistogram) {
   EXPECT_NE(r.out.find("n=7: 1024 pixels"), std::string::npos) << r.out;  // every pixel has 7 layers
 }
 
+// The budget commands: dataset → train → render with the trained weights → evaluate, end to end
+// on a tiny image; then their bad input.
+TEST_F(Cli, DatasetTrainRenderEvaluate) {
+  const fs::path data = dir_ / "d.bin", weights = dir_ / "w.json", png = dir_ / "dkb.png", json = dir_ / "e.json";
+  Result r = run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,2,all --sample 0.5 -o " + data.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find(" rows"), std::string::npos) << r.out;
+  r = run("train " + data.string() + " --epochs 2 --batch 64 -o " + weights.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("epoch    2"), std::string::npos) << r.out;
+  r = run("render @sample -s 40x30 -m dkb -p budget_mib=0.1 -p weights=" + weights.string() + " -o " + png.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_EQ(mfr::readPng(png).width, 40);
+  r = run("evaluate @sample -s 40x30 --views front --budgets k1,f50 -r 1 --weights " + weights.string() + " --json " +
+          json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  for (const char* m : {"fkb", "vkb", "dkb", "optimal-k", "lowest FLIP"}) EXPECT_NE(r.out.find(m), std::string::npos) << m;
+  std::ifstream in(json);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"flip_mean\""), std::string::npos);
+}
+
+TEST_F(Cli, BudgetCommandsBadInput) {
+  // A corrupt dataset, a missing dataset, bad budgets, a bad weights file.
+  const fs::path junk = file("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");
+  expectCleanFailure("train " + junk.string(), "junk.bin");
+  expectCleanFailure("train " + (dir_ / "missing.bin").string(), "missing.bin");
+  expectCleanFailure("dataset @sample --budgets 0.5", "--budgets 0.5");
+  expectCleanFailure("dataset @sample --views nowhere", "view 'nowhere'");
+  const fs::path badWeights = file("w.json", R"({"format":"mfr-dkb-weights","version":1})");
+  expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + badWeights.string(), "w.json");
+  expectCleanFailure("render @sample -s 16x16 -m vkb -p budget_mib=0", "--param budget_mib=0");
+  expectCleanFailure("render @sample -s 16x16 -m fkb -p budget_mib=0.001", "--param budget_mib=0.001");
+  expectCleanFailure("render @sample -s 16x16 -m optimal-k --op oit", "--op oit");
+  // evaluate writes no PNG; its --json must not appear on failure.
+  const fs::path json = dir_ / "e.json";
+  const Result r = run("evaluate @sample -s 16x16 --budgets banana --json " + json.string());
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find("--budgets banana"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(json));
+}
+
 }  // namespace
