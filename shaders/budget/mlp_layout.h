@@ -16,5 +16,8 @@
 #define MFR_MLP_W3 (MFR_MLP_B2 + MFR_MLP_HIDDEN2)
 #define MFR_MLP_B3 (MFR_MLP_W3 + MFR_MLP_HIDDEN2)
 #define MFR_MLP_FLOATS (MFR_MLP_B3 + 1)
+// On the GPU (dkb): words 0..23 the input mean and deviation as 32-bit floats, then the weights
+// and biases from MFR_MLP_W1 on as 16-bit floats, two per word (packHalf2x16: even index low).
+#define MFR_MLP_PACKED_WORDS (MFR_MLP_W1 + (MFR_MLP_FLOATS - MFR_MLP_W1 + 1) / 2)
 
 #endif

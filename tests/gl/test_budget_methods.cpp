@@ -62,7 +62,7 @@ std::uint64_t budgetOf(const RenderRequest& req) {
 }
 
 std::uint64_t memberFixed(const std::string& method) {
-  return method == "dkb" ? NeuralImportanceModel::floatCount() * sizeof(float) : 0;
+  return method == "dkb" ? NeuralImportanceModel::packedBytes() : 0;
 }
 
 class VariableK : public ::testing::TestWithParam<std::string> {};

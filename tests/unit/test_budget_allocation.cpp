@@ -5,12 +5,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <numeric>
 #include <random>
+
+#include <glm/gtc/packing.hpp>
 
 #include "mfr/budget/dataset.hpp"
 #include "mfr/budget/k_allocation.hpp"
@@ -164,6 +167,30 @@ TEST(NeuralImportance, WeightsFileRoundTripAndErrors) {
   text.replace(text.find("\"input_std\": ["), 14, "\"input_std\": [-1,");  // a wrong-length, negative std
   EXPECT_THROW(mfr::parseNeuralImportance(text, "bad.json"), mfr::Error);
   EXPECT_THROW(mfr::loadNeuralImportance("/nonexistent/weights.json"), mfr::Error);
+}
+
+// dkb's GPU copy: input statistics exact, weights rounded to halves and packed two per word.
+TEST(NeuralImportance, HalfPrecisionPacking) {
+  const mfr::NeuralImportanceModel m = randomModel(9);
+  const mfr::NeuralImportanceModel h = m.halfPrecision();
+  const std::vector<std::uint32_t> words = h.packedWords();
+  ASSERT_EQ(words.size() * 4, mfr::NeuralImportanceModel::packedBytes());
+  EXPECT_LT(mfr::NeuralImportanceModel::packedBytes(), m.weights.size() * 4 * 51 / 100);  // about half
+  for (std::size_t i = 0; i < 24; ++i) {
+    EXPECT_EQ(h.weights[i], m.weights[i]);
+    float f = 0;
+    std::memcpy(&f, &words[i], 4);
+    EXPECT_EQ(f, m.weights[i]);
+  }
+  std::size_t changed = 0;
+  for (std::size_t i = 24; i < m.weights.size(); ++i) {
+    const std::size_t j = i - 24;
+    const float unpacked = glm::unpackHalf1x16(static_cast<glm::uint16>(words[24 + j / 2] >> (16 * (j % 2))));
+    ASSERT_EQ(unpacked, h.weights[i]) << i;
+    EXPECT_NEAR(h.weights[i], m.weights[i], 1e-3 * std::abs(m.weights[i]) + 1e-7);
+    changed += h.weights[i] != m.weights[i];
+  }
+  EXPECT_GT(changed, m.weights.size() / 2);  // really rounded
 }
 
 TEST(DkbDataset, FramesFileRoundTripAndCorruptFiles) {

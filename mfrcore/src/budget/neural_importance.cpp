@@ -4,10 +4,12 @@
 #include "mfr/budget/neural_importance.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 #include <map>
 #include <string_view>
 
+#include <glm/gtc/packing.hpp>
 #include <nlohmann/json.hpp>
 
 #include "budget/glsl_shared.hpp"
@@ -56,6 +58,26 @@ std::vector<float> floats(const nlohmann::json& j, std::size_t count, const std:
 }  // namespace
 
 std::size_t NeuralImportanceModel::floatCount() { return MFR_MLP_FLOATS; }
+
+std::size_t NeuralImportanceModel::packedBytes() { return 4 * MFR_MLP_PACKED_WORDS; }
+
+NeuralImportanceModel NeuralImportanceModel::halfPrecision() const {
+  NeuralImportanceModel m = *this;
+  for (std::size_t i = MFR_MLP_W1; i < m.weights.size(); ++i)
+    m.weights[i] = glm::unpackHalf1x16(glm::packHalf1x16(m.weights[i]));
+  return m;
+}
+
+std::vector<std::uint32_t> NeuralImportanceModel::packedWords() const {
+  if (weights.size() != MFR_MLP_FLOATS) throw Error("dkb weights", "model has the wrong number of weights");
+  std::vector<std::uint32_t> words(MFR_MLP_PACKED_WORDS, 0);
+  for (std::size_t i = 0; i < MFR_MLP_W1; ++i) std::memcpy(&words[i], &weights[i], 4);
+  for (std::size_t i = MFR_MLP_W1; i < weights.size(); ++i) {
+    const std::size_t j = i - MFR_MLP_W1;
+    words[MFR_MLP_W1 + j / 2] |= static_cast<std::uint32_t>(glm::packHalf1x16(weights[i])) << (16 * (j % 2));
+  }
+  return words;
+}
 
 NeuralImportanceModel parseNeuralImportance(const std::string& text, const std::string& source) {
   nlohmann::json j;

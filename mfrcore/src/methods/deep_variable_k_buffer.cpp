@@ -21,10 +21,12 @@ const MethodInfo& DeepVariableKBuffer::info() const {
 void DeepVariableKBuffer::configureMember(const Params& params) {
   const std::string& path = params.text("weights");
   if (path != weightsPath_ || !weights_) {
-    NeuralImportanceModel model = loadNeuralImportance(path);  // throws before anything changes
+    // Half-precision weights on the GPU; model_ holds exactly the values it runs (tests compare).
+    NeuralImportanceModel model = loadNeuralImportance(path).halfPrecision();  // throws before anything changes
     model_ = std::move(model);
     weightsPath_ = path;
-    weights_ = gl::createBuffer(model_.weights.size() * sizeof(float), model_.weights.data());
+    const std::vector<std::uint32_t> words = model_.packedWords();
+    weights_ = gl::createBuffer(words.size() * sizeof(std::uint32_t), words.data());
   }
   if (!count_.id()) {
     count_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/dkb/count.geom.frag"}});
@@ -34,7 +36,7 @@ void DeepVariableKBuffer::configureMember(const Params& params) {
 }
 
 std::uint64_t DeepVariableKBuffer::memberFixedBytes() const {
-  return NeuralImportanceModel::floatCount() * sizeof(float);
+  return NeuralImportanceModel::packedBytes();
 }
 
 void DeepVariableKBuffer::clearFeatures() {
@@ -62,7 +64,7 @@ void DeepVariableKBuffer::computeImportance(const FrameContext&) {
 }
 
 std::string DeepVariableKBuffer::describeImportance() const {
-  return "MLP 12-128-64-1 (" + model_.source + ", predicts " + model_.target + ")";
+  return "MLP 12-128-64-1, 16-bit weights (" + model_.source + ", predicts " + model_.target + ")";
 }
 
 }  // namespace mfr

@@ -1,6 +1,6 @@
 // Deep hybrid order-independent transparency (Tsopouridis, Fudos, Vasilakis, The Visual Computer
 // 2022, §4): the 12 features of each pixel (budget/features.h) and the network's prediction
-// (budget/mlp.h, weights at MFR_SSBO_WEIGHTS), turned into the importance I(p) in T(0) that the
+// (budget/mlp.h, weights at MFR_SSBO_WEIGHTS as 16-bit floats), turned into the importance I(p) in T(0) that the
 // shared allocation rule distributes the budget by. uTarget says what the network predicts:
 // 0 = k(p)/n(p) (I = y·n), 1 = k(p)/F(M) (I = y).
 #include "budget/arena.glsl"
@@ -8,8 +8,15 @@
 #define MFR_OUT(T) out T
 #include "budget/features.h"
 
-layout(std430, binding = MFR_SSBO_WEIGHTS) readonly buffer DkbWeights { float mlpWeights[]; };
-#define MFR_MLP_WEIGHT(i) mlpWeights[i]
+#include "budget/mlp_layout.h"
+layout(std430, binding = MFR_SSBO_WEIGHTS) readonly buffer DkbWeights { uint mlpWords[]; };
+// Input statistics as floats, weights as packed halves (MFR_MLP_PACKED_WORDS layout).
+float mlpWeight(int i) {
+  if (i < MFR_MLP_W1) return uintBitsToFloat(mlpWords[i]);
+  int j = i - MFR_MLP_W1;
+  return unpackHalf2x16(mlpWords[MFR_MLP_W1 + (j >> 1)])[j & 1];
+}
+#define MFR_MLP_WEIGHT(i) mlpWeight(i)
 #include "budget/mlp.h"
 
 layout(local_size_x = 64) in;

@@ -32,6 +32,14 @@ struct NeuralImportanceModel {
 
   [[nodiscard]] bool predictsFractionOfList() const { return target == "k_over_n"; }
   static std::size_t floatCount();
+  // The model as dkb runs it on the GPU: the input statistics in 32-bit floats, every layer's
+  // weights and biases rounded to 16-bit floats (half the GPU memory the budget pays for; the
+  // forward pass still computes in 32-bit floats).
+  [[nodiscard]] NeuralImportanceModel halfPrecision() const;
+  // The GPU buffer of a half-precision model (shaders/budget/mlp_layout.h): 24 float words, then
+  // the weights two halves per word (packHalf2x16 order).
+  [[nodiscard]] std::vector<std::uint32_t> packedWords() const;
+  static std::size_t packedBytes();
 };
 
 // Reads a weights file; "" means the built-in weights shipped in resources/dkb/weights.json.
