@@ -194,7 +194,10 @@ void RenderView::paintGL() {
   QMetaObject::invokeMethod(
       this,
       [this, reports = std::move(reports_)] {
-        for (auto& [side, stats] : reports->frames) model_.reportFrame(side, stats);
+        // A frame whose settings changed meanwhile is not reported: its Stats would be read
+        // against the new parameters (the budget panel fits memory models to them).
+        for (const Frame& f : reports->frames)
+          if (f.key == model_.frameKey(f.side)) model_.reportFrame(f.side, f.stats);
         for (auto& [side, image] : reports->images) model_.reportFrameImage(side, image.first, std::move(image.second));
         if (reports->reportError) model_.reportRenderError(reports->error);
         updateOverlays();
@@ -213,7 +216,7 @@ void RenderView::paintSingleImage(QStringList& errors) {
   try {
     const mfr::Stats stats =
         renderer(0).renderTo(defaultFramebufferObject(), model_.camera(), model_.renderRequest(0, size));
-    reports_->frames.emplace_back(0, stats);
+    reports_->frames.push_back({0, model_.frameKey(0), stats});
     if (model_.wantsFrameImage(0))
       reports_->images.emplace_back(0, std::pair{model_.frameKey(0), readDefaultFramebuffer(size)});
   } catch (const std::exception& e) {
@@ -224,6 +227,7 @@ void RenderView::paintSingleImage(QStringList& errors) {
 }
 
 void RenderView::paintPane(int side, QStringList& errors) {
+  const qsizetype errorsBefore = errors.size();
   const QSize size = model_.paneSize();
   const ImageKey key = model_.frameKey(side);
   const mfr::RenderRequest request = model_.renderRequest(side, size);
@@ -243,7 +247,7 @@ void RenderView::paintPane(int side, QStringList& errors) {
     } else if (cpu && cpu->image.width == size.width() && cpu->image.height == size.height()) {
       image = cpu->image;
       if (current) {
-        reports_->frames.emplace_back(side, cpu->stats);
+        reports_->frames.push_back({side, key, cpu->stats});
         if (model_.wantsFrameImage(side)) reports_->images.emplace_back(side, std::pair{key, cpu->image});
       }
     }
@@ -251,7 +255,7 @@ void RenderView::paintPane(int side, QStringList& errors) {
     try {
       const mfr::Stats stats = renderer(side).renderTo(target.fbo, model_.camera(), request);
       inTexture = true;
-      reports_->frames.emplace_back(side, stats);
+      reports_->frames.push_back({side, key, stats});
     } catch (const std::exception& e) {
       mfr::gl::discardErrors();
       errors << prefix + QString::fromUtf8(e.what());
@@ -282,6 +286,7 @@ void RenderView::paintPane(int side, QStringList& errors) {
   if (!shown && image && !inTexture) shown = &*image;
   if (shown) upload(target, *shown);
   if (shown || inTexture) blitPane(side, target);
+  paneFailed_[i] = errors.size() > errorsBefore;
 }
 
 RenderView::DataMap RenderView::computeDataMap(int side, QSize size, const ImageKey& key, bool haveFrame) {
@@ -412,13 +417,20 @@ void RenderView::updateOverlays() {
     PaneCaption* caption = captions_[side];
     if (compare && shown) {
       const PaneMetrics& m = model_.metrics(side);
-      QString quality = tr("RMSE, FLIP: computing…");
-      if (model_.metricsCurrent(side))
-        quality = m.valid ? tr("RMSE %1 · FLIP %2").arg(m.rmse, 0, 'f', 5).arg(m.flip.mean, 0, 'f', 4)
-                          : tr("no metrics: %1").arg(m.error);
-      caption->setText(
-          QStringLiteral("%1 · %2 (%3) · %4")
-              .arg(QLatin1String(sideName(side)), model_.methodOf(side), model_.operationOf(side), quality));
+      QStringList lines{QStringLiteral("%1 · %2 (%3)")
+                            .arg(QLatin1String(sideName(side)), model_.methodOf(side), model_.operationOf(side))};
+      if (paneFailed_[side])
+        lines << tr("cannot render (see the status bar)");
+      else if (!model_.metricsCurrent(side))
+        lines << tr("RMSE, FLIP: computing…");
+      else if (!m.valid)
+        lines << tr("no metrics: %1").arg(m.error);
+      else
+        lines << tr("RMSE %1").arg(m.rmse, 0, 'f', 5) << tr("FLIP %1").arg(m.flip.mean, 0, 'f', 4);
+      // Within its pane (half the view when split), so the two captions never overlap.
+      const int room = std::max(40, (split ? width() / 2 : area.width()) - 12 - 2 * caption->margin());
+      for (QString& line : lines) line = caption->fontMetrics().elidedText(line, Qt::ElideRight, room);
+      caption->setText(lines.join(QLatin1Char('\n')));
       caption->adjustSize();
       const int x = split && side == 1 ? area.right() - caption->width() - 6 : area.left() + 6;
       caption->move(std::max(0, x), area.top() + 6);

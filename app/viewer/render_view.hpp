@@ -100,6 +100,7 @@ class RenderView final : public QOpenGLWidget {
   std::array<QString, kSides> uploadError_;
   std::array<PaneTarget, kSides> targets_;
   std::array<DataMap, kSides> maps_;
+  std::array<bool, kSides> paneFailed_{false, false};  // the pane's last paint had an error
   // n(p) of the last view (both panes share it when their sizes agree).
   struct DepthCache {
     quint64 scene = 0, view = 0;
@@ -111,8 +112,13 @@ class RenderView final : public QOpenGLWidget {
   enum class Drag { None, Orbit, Pan } drag_ = Drag::None;
 
   // What the frame being painted tells the model, delivered after paintGL.
+  struct Frame {
+    int side = 0;
+    ImageKey key;
+    mfr::Stats stats;
+  };
   struct Reports {
-    std::vector<std::pair<int, mfr::Stats>> frames;
+    std::vector<Frame> frames;
     std::vector<std::pair<int, std::pair<ImageKey, mfr::ImageRGBA8>>> images;
     QString error;
     bool reportError = false;

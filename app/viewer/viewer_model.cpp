@@ -201,7 +201,10 @@ void ViewerModel::setDataView(DataView view, bool overImage) {
 // ---- scene -------------------------------------------------------------------------------
 
 void ViewerModel::loadSceneAsync(const QString& path) {
-  if (load_) load_->cancel = true;  // superseded: stop the previous worker early
+  if (load_) {
+    load_->cancel = true;  // superseded: stop the previous worker early
+    ++abandonedLoads_;
+  }
   auto state = std::make_shared<LoadState>();
   load_ = state;
   loading_ = true;
@@ -233,7 +236,8 @@ void ViewerModel::loadSceneAsync(const QString& path) {
       },
       [this, path, state](Loaded loaded) {
         if (state != load_) {  // cancelled, or superseded by a newer load
-          if (state->cancel) lastCancelStoppedLoader_ = loaded.stopped;
+          --abandonedLoads_;
+          lastCancelStoppedLoader_ = loaded.stopped;
           return;
         }
         pollLoadProgress();  // the loader's last report
@@ -266,6 +270,7 @@ void ViewerModel::cancelLoad() {
   if (!loading_ || !load_) return;
   load_->cancel = true;  // the loader throws LoadCancelled at its next report
   load_.reset();
+  ++abandonedLoads_;
   loadPoll_->stop();
   loading_ = false;
   emit loadCancelled();
@@ -540,7 +545,7 @@ void ViewerModel::startMetrics(int side, const mfr::ImageRGBA8& reference) {
 }
 
 bool ViewerModel::busy() const {
-  return loading_ || cpuRunning_ || depthRunning_ || metricsRunning_[0] || metricsRunning_[1];
+  return loading_ || abandonedLoads_ > 0 || cpuRunning_ || depthRunning_ || metricsRunning_[0] || metricsRunning_[1];
 }
 
 // ---- depth complexity ---------------------------------------------------------------------

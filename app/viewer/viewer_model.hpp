@@ -123,8 +123,8 @@ class ViewerModel final : public ViewerContext {
   void cancelLoad();
   [[nodiscard]] bool isLoading() const { return loading_; }
   [[nodiscard]] double loadProgress() const { return loadProgress_; }  // of the current or last load
-  // True when the last cancelled load's worker stopped inside the loader (LoadCancelled) rather
-  // than finishing first (its scene was then dropped).
+  // True when the last cancelled (or superseded) load's worker stopped inside the loader
+  // (LoadCancelled) rather than finishing first (its scene was then dropped).
   [[nodiscard]] bool lastCancelStoppedLoader() const { return lastCancelStoppedLoader_; }
   void setScene(mfr::Scene scene, const QString& path);
   [[nodiscard]] const mfr::Scene& scene() const { return scene_; }
@@ -186,7 +186,8 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] const CpuImage* lastCpuImage(CpuSlot slot) const;
   [[nodiscard]] static CpuSlot paneSlot(int side) { return side == 0 ? CpuSlot::Pane0 : CpuSlot::Pane1; }
 
-  // True while any background job runs (loading, CPU images, depth complexity, metrics).
+  // True while any background job runs (loading — also a cancelled load's worker until it stops —,
+  // CPU images, depth complexity, metrics).
   [[nodiscard]] bool busy() const;
 
  signals:
@@ -248,6 +249,7 @@ class ViewerModel final : public ViewerContext {
   bool loading_ = false;
   double loadProgress_ = 0.0;
   bool lastCancelStoppedLoader_ = false;
+  int abandonedLoads_ = 0;  // cancelled or superseded loads whose workers still run
   QTimer* loadPoll_ = nullptr;
 
   // CPU images.

@@ -26,8 +26,9 @@ constexpr double kMiB = 1024.0 * 1024.0;
 constexpr int kMaxCorrections = 3;
 constexpr int kDefaultBudgetMiB = 16;
 constexpr double kPoolMarginBytes = 1024;
-// Quality is measured once the view has been still this long (it costs an exact CPU image).
-constexpr int kQualityDelayMs = 700;
+// Quality is measured once the view has been still this long (it costs an exact CPU image), with
+// the depth-complexity histogram (same delay), so the two run side by side.
+constexpr int kQualityDelayMs = 400;
 constexpr int kRobustnessSteps = 1000;
 
 // A CPU method other than the oracle (e.g. optimal-k): no ParamSpecs to read; it takes the
@@ -178,7 +179,7 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
           [this](bool on) { ctx_.setDataView(on ? DataView::Capacity : DataView::Image, on); });
   connect(&ctx_, &ViewerContext::dataViewChanged, this, [this] {
     const QSignalBlocker block(kMapOverlay_);
-    kMapOverlay_->setChecked(ctx_.dataView() == DataView::Capacity);
+    kMapOverlay_->setChecked(ctx_.dataView() == DataView::Capacity && ctx_.dataViewOverImage());
   });
   methodChanged();
 }
