@@ -270,7 +270,8 @@ void MainWindow::buildDocks() {
     return d;
   };
   QDockWidget* scene = dock(tr("Scene"), QStringLiteral("sceneDock"), new SceneTreePanel(*model_), Qt::LeftDockWidgetArea);
-  QDockWidget* method = dock(tr("Method"), QStringLiteral("methodDock"), new MethodPanel(*model_), Qt::LeftDockWidgetArea);
+  QDockWidget* method =
+      dock(tr("Method"), QStringLiteral("methodDock"), new MethodPanel(*model_), Qt::LeftDockWidgetArea);
   compareDock_ = dock(tr("Compare"), QStringLiteral("compareDock"), new ComparePanel(*model_), Qt::LeftDockWidgetArea);
   tabifyDockWidget(method, compareDock_);
   method->raise();

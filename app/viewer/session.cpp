@@ -31,8 +31,9 @@ QJsonObject paramsToJson(const ParamsByMethod& params) {
 // Enum values by their names in session files.
 const std::map<QString, CompareLayout> kLayouts{{"side-by-side", CompareLayout::SideBySide},
                                                 {"split", CompareLayout::Split}};
-const std::map<QString, CompareDisplay> kDisplays{
-    {"images", CompareDisplay::Images}, {"flip", CompareDisplay::FlipError}, {"difference", CompareDisplay::Difference}};
+const std::map<QString, CompareDisplay> kDisplays{{"images", CompareDisplay::Images},
+                                                  {"flip", CompareDisplay::FlipError},
+                                                  {"difference", CompareDisplay::Difference}};
 const std::map<QString, DataView> kDataViews{
     {"image", DataView::Image}, {"depth-complexity", DataView::DepthComplexity}, {"capacity", DataView::Capacity}};
 
@@ -73,7 +74,8 @@ class Reader {
       auto& values = out[m.key().toStdString()];
       const QJsonObject p = m.value().toObject();
       for (auto v = p.begin(); v != p.end(); ++v) {
-        if (!v.value().isString()) fail(where + "." + m.key() + "." + v.key(), QStringLiteral("expected a string value"));
+        if (!v.value().isString())
+          fail(where + "." + m.key() + "." + v.key(), QStringLiteral("expected a string value"));
         values[v.key().toStdString()] = v.value().toString().toStdString();
       }
     }

@@ -167,7 +167,8 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   connect(&ctx_, &ViewerContext::frameQualityReady, this, &BudgetPanel::showQuality);
 
   connect(robustnessSlider_, &QSlider::valueChanged, this, [this](int v) {
-    robustness_->setValue(robustness_->minimum() + (robustness_->maximum() - robustness_->minimum()) * v / kRobustnessSteps);
+    const double span = robustness_->maximum() - robustness_->minimum();
+    robustness_->setValue(robustness_->minimum() + span * v / kRobustnessSteps);
   });
   connect(robustness_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
     if (!findParam(ctx_, ctx_.method(), "robustness")) return;

@@ -218,8 +218,9 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     const json& objects = doc["objects"];
     if (!objects.is_array()) r.fail("objects", "expected an array");
     for (std::size_t i = 0; i < objects.size(); ++i) {
-      const LoadProgress objectProgress = progress.part(static_cast<double>(i) / static_cast<double>(objects.size()),
-                                                        static_cast<double>(i + 1) / static_cast<double>(objects.size()));
+      const double count = static_cast<double>(objects.size());
+      const LoadProgress objectProgress =
+          progress.part(static_cast<double>(i) / count, static_cast<double>(i + 1) / count);
       objectProgress.step(0.0);
       const std::string where = "objects[" + std::to_string(i) + "]";
       const json& o = r.object(objects[i], where);
