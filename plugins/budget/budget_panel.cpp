@@ -26,9 +26,9 @@ constexpr double kMiB = 1024.0 * 1024.0;
 constexpr int kMaxCorrections = 3;
 constexpr int kDefaultBudgetMiB = 16;
 constexpr double kPoolMarginBytes = 1024;
-// Quality is measured once the view has been still this long (it costs an exact CPU image), with
-// the depth-complexity histogram (same delay), so the two run side by side.
-constexpr int kQualityDelayMs = 400;
+// Quality is measured once the view has been still this long: it costs an exact CPU image, which
+// a short pause between two camera moves should not start.
+constexpr int kQualityDelayMs = 1200;
 constexpr int kRobustnessSteps = 1000;
 
 // A CPU method other than the oracle (e.g. optimal-k): no ParamSpecs to read; it takes the
