@@ -94,7 +94,7 @@ class ViewerModel final : public ViewerContext {
 
   // Methods rendered on the CPU by mfr::render (listed by mfr::availableMethods() but not GPU
   // methods of the registry): "oracle", and e.g. "optimal-k" once mfrcore has it.
-  [[nodiscard]] bool isCpuMethod(const QString& method) const;
+  [[nodiscard]] bool isCpuMethod(const QString& method) const override;
 
   // Per side (0: main, 1: compare).
   [[nodiscard]] QString methodOf(int side) const { return methods_[index(side)]; }

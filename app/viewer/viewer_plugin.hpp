@@ -51,6 +51,8 @@ class ViewerContext : public QObject {
   // The method's description and parameters; nullptr for CPU methods ("oracle", …) or an unknown
   // name.
   [[nodiscard]] virtual const mfr::MethodInfo* methodInfo(const QString& method) const = 0;
+  // Rendered on the CPU off the GUI thread (the oracle, optimal-k …) rather than on the GPU.
+  [[nodiscard]] virtual bool isCpuMethod(const QString& method) const = 0;
   [[nodiscard]] virtual QString method() const = 0;
   virtual void setMethod(const QString& method) = 0;
   // Parameter values of the current method (only those set explicitly; the rest take defaults).

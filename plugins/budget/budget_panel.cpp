@@ -31,10 +31,10 @@ constexpr double kPoolMarginBytes = 1024;
 constexpr int kQualityDelayMs = 1200;
 constexpr int kRobustnessSteps = 1000;
 
-// A CPU method other than the oracle (e.g. optimal-k): no ParamSpecs to read; it takes the
-// budget as budget_mib like its GPU competitors.
+// A CPU method other than the oracle (e.g. optimal-k): computed when shown, off the GUI thread.
+// Without ParamSpecs to read, it is given the budget as budget_mib like its GPU competitors.
 bool isOnDemandCpuMethod(const ViewerContext& ctx, const QString& method) {
-  return method != QLatin1String("oracle") && ctx.methodInfo(method) == nullptr && ctx.methodNames().contains(method);
+  return method != QLatin1String("oracle") && ctx.isCpuMethod(method);
 }
 
 const mfr::ParamSpec* findParam(const ViewerContext& ctx, const QString& method, const std::string& name) {
@@ -191,7 +191,7 @@ BudgetPanel::Driver BudgetPanel::driverFor(const QString& method) const {
   Driver d;
   const mfr::MethodInfo* info = ctx_.methodInfo(method);
   if (!info) {
-    if (isOnDemandCpuMethod(ctx_, method)) {
+    if (isOnDemandCpuMethod(ctx_, method)) {  // (with a MethodInfo it is read like any other)
       d.knob = Knob::Budget;
       d.param = "budget_mib";
     }

@@ -707,6 +707,8 @@ class ViewerTest : public QObject {
     for (int i = 0; i < combo->count(); ++i) QVERIFY(m.methodNames().contains(combo->itemData(i).toString()));
     QVERIFY(combo->findData(QStringLiteral("oracle")) < 0);
     QCOMPARE(combo->findData(QStringLiteral("optimal-k")) >= 0, m.methodNames().contains(QStringLiteral("optimal-k")));
+    for (const QString& name : m.methodNames())
+      if (name != QLatin1String("oracle") && m.isCpuMethod(name)) QVERIFY2(combo->findData(name) >= 0, qPrintable(name));
 
     const int dynamic = combo->findData(QStringLiteral("kplus-dynamic"));
     QVERIFY(dynamic >= 0);
