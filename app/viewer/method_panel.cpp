@@ -139,6 +139,7 @@ void MethodPanel::rebuildParameters() {
         break;
       }
     }
+    if (!editor) continue;  // a parameter type this viewer has no widget for
     editor->setObjectName(objectName(QStringLiteral("param-") + QString::fromStdString(name) +
                                      (side_ == 0 ? QString() : QStringLiteral("-"))));
     editor->setToolTip(QString::fromStdString(spec.help));
@@ -157,7 +158,9 @@ void MethodPanel::showParameterValues() {
   for (const mfr::ParamSpec& spec : info->params) {
     const auto it = values.find(spec.name);
     const QString value = QString::fromStdString(it != values.end() ? it->second : spec.defaultValue);
-    QWidget* editor = editors_[spec.name];
+    const auto found = editors_.find(spec.name);
+    if (found == editors_.end()) continue;
+    QWidget* editor = found->second;
     const QSignalBlocker block(editor);
     if (auto* i = qobject_cast<QSpinBox*>(editor)) i->setValue(value.toInt());
     else if (auto* d = qobject_cast<QDoubleSpinBox*>(editor)) d->setValue(value.toDouble());
