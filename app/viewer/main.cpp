@@ -170,7 +170,12 @@ int main(int argc, char** argv) {
   }
 
   window.show();
-  if (!cl.session.isEmpty()) window.openSession(cl.session);
-  else window.openScene(cl.scene);
+  if (!cl.session.isEmpty()) {
+    window.openSession(cl.session);
+    // A scripted run has no one to read the message box: a bad session file ends it.
+    if (scripted && !window.lastError().isEmpty()) fail(window.lastError(), 1);
+  } else {
+    window.openScene(cl.scene);
+  }
   return QApplication::exec();
 }

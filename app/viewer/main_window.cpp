@@ -21,11 +21,14 @@
 #include <QStatusBar>
 #include <QTableWidget>
 #include <QTimer>
+#include <QToolBar>
 #include <QVBoxLayout>
 
+#include <cmath>
 #include <exception>
 
 #include "camera_navigator.hpp"
+#include "compare_panel.hpp"
 #include "mfr/error.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
@@ -68,10 +71,13 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
   buildStatusBar();
 
   connect(model_, &ViewerModel::loadStarted, this, [this](const QString& path) {
+    loadProgress_->setValue(0);
     loadProgress_->show();
     cancelLoad_->show();
     statusBar()->showMessage(tr("Loading %1…").arg(path));
   });
+  connect(model_, &ViewerModel::loadProgressChanged, this,
+          [this](double fraction) { loadProgress_->setValue(static_cast<int>(std::lround(fraction * 1000.0))); });
   const auto loadEnded = [this] {
     loadProgress_->hide();
     cancelLoad_->hide();
@@ -89,6 +95,7 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
     updateTitle();
     if (pendingSession_) {
       applySession(*pendingSession_, *model_);
+      if (model_->compareEnabled()) compareDock_->show();
       for (const PluginRecord& r : plugins_.records())
         if (r.plugin && pendingSession_->plugins.contains(r.id)) r.plugin->loadSettings(pendingSession_->plugins.value(r.id).toObject());
       addRecentFile(pendingSessionFile_);
@@ -159,6 +166,8 @@ void MainWindow::buildMenus() {
   connect(model_, &ViewerModel::viewChanged, ortho,
           [this, ortho] { ortho->setChecked(model_->camera().projection == mfr::Projection::Orthographic); });
   viewMenu_->addSeparator();
+  buildCompareAndDataViewActions();
+  viewMenu_->addSeparator();
   panelsMenu_ = viewMenu_->addMenu(tr("&Panels"));
 
   QMenu* help = menuBar()->addMenu(tr("&Help"));
@@ -171,12 +180,84 @@ void MainWindow::buildMenus() {
                                 "<tr><td>Wheel</td><td>zoom to the cursor</td></tr>"
                                 "<tr><td>F</td><td>fit all</td></tr>"
                                 "<tr><td>1 … 7</td><td>front, back, left, right, top, bottom, isometric</td></tr>"
-                                "<tr><td>O</td><td>perspective / orthographic</td></tr></table>"));
+                                "<tr><td>O</td><td>perspective / orthographic</td></tr>"
+                                "<tr><td>C</td><td>compare mode on / off</td></tr>"
+                                "<tr><td>S</td><td>compare layout: side by side / split</td></tr>"
+                                "<tr><td>D</td><td>compare heat map: images / FLIP / |difference|</td></tr>"
+                                "<tr><td>I, N, K</td><td>image, depth complexity n(p), capacity k(p)</td></tr>"
+                                "<tr><td>B</td><td>data map blended over the image</td></tr></table>"));
   });
   help->addAction(tr("&About mfrview"), this, [this] {
     QMessageBox::about(this, tr("About mfrview"),
                        tr("<b>mfrview</b> — multifragment rendering viewer.<br>%1").arg(view_->glInfo()));
   });
+}
+
+void MainWindow::buildCompareAndDataViewActions() {
+  QToolBar* toolbar = addToolBar(tr("View"));
+  toolbar->setObjectName(QStringLiteral("viewToolBar"));
+  toolbar->setToolButtonStyle(Qt::ToolButtonTextOnly);
+
+  QAction* compare = viewMenu_->addAction(tr("&Compare Two Methods"));
+  compare->setObjectName(QStringLiteral("actionCompare"));
+  compare->setCheckable(true);
+  compare->setShortcut(QKeySequence(Qt::Key_C));
+  compare->setToolTip(tr("Two methods with one camera, against the exact image (C)"));
+  connect(compare, &QAction::triggered, this, [this](bool on) {
+    model_->setCompareEnabled(on);
+    if (on) {
+      compareDock_->show();
+      compareDock_->raise();
+    }
+  });
+  QAction* layout = viewMenu_->addAction(tr("Compare &Layout: Side by Side / Split"));
+  layout->setObjectName(QStringLiteral("actionCompareLayout"));
+  layout->setShortcut(QKeySequence(Qt::Key_S));
+  connect(layout, &QAction::triggered, this, [this] {
+    model_->setCompareLayout(model_->compareLayout() == CompareLayout::SideBySide ? CompareLayout::Split
+                                                                                  : CompareLayout::SideBySide);
+  });
+  QAction* heat = viewMenu_->addAction(tr("Compare &Heat Map: Images / FLIP / |Difference|"));
+  heat->setObjectName(QStringLiteral("actionCompareDisplay"));
+  heat->setShortcut(QKeySequence(Qt::Key_D));
+  connect(heat, &QAction::triggered, this, [this] {
+    model_->setCompareDisplay(static_cast<CompareDisplay>((static_cast<int>(model_->compareDisplay()) + 1) % 3));
+  });
+  connect(model_, &ViewerModel::compareChanged, this, [this, compare, layout, heat] {
+    compare->setChecked(model_->compareEnabled());
+    layout->setEnabled(model_->compareEnabled());
+    heat->setEnabled(model_->compareEnabled());
+  });
+  layout->setEnabled(false);
+  heat->setEnabled(false);
+  toolbar->addAction(compare);
+
+  QMenu* dataMenu = viewMenu_->addMenu(tr("&Data View"));
+  auto* group = new QActionGroup(this);
+  const auto addView = [&](const QString& text, const QString& name, DataView view, Qt::Key key) {
+    QAction* a = dataMenu->addAction(text);
+    a->setObjectName(name);
+    a->setCheckable(true);
+    a->setShortcut(QKeySequence(key));
+    group->addAction(a);
+    connect(a, &QAction::triggered, this, [this, view] { model_->setDataView(view, model_->dataViewOverImage()); });
+    connect(model_, &ViewerModel::dataViewChanged, a, [this, a, view] { a->setChecked(model_->dataView() == view); });
+    a->setChecked(model_->dataView() == view);
+    toolbar->addAction(a);
+    return a;
+  };
+  addView(tr("&Image"), QStringLiteral("actionViewImage"), DataView::Image, Qt::Key_I);
+  addView(tr("Depth Complexity &n(p)"), QStringLiteral("actionViewDepthComplexity"), DataView::DepthComplexity,
+          Qt::Key_N);
+  addView(tr("Capacity &k(p)"), QStringLiteral("actionViewCapacity"), DataView::Capacity, Qt::Key_K);
+  dataMenu->addSeparator();
+  QAction* over = dataMenu->addAction(tr("&Blend Map Over Image"));
+  over->setObjectName(QStringLiteral("actionViewOverImage"));
+  over->setCheckable(true);
+  over->setShortcut(QKeySequence(Qt::Key_B));
+  connect(over, &QAction::triggered, this, [this](bool on) { model_->setDataView(model_->dataView(), on); });
+  connect(model_, &ViewerModel::dataViewChanged, over, [this, over] { over->setChecked(model_->dataViewOverImage()); });
+  toolbar->addAction(over);
 }
 
 void MainWindow::buildDocks() {
@@ -189,7 +270,11 @@ void MainWindow::buildDocks() {
     return d;
   };
   QDockWidget* scene = dock(tr("Scene"), QStringLiteral("sceneDock"), new SceneTreePanel(*model_), Qt::LeftDockWidgetArea);
-  dock(tr("Method"), QStringLiteral("methodDock"), new MethodPanel(*model_), Qt::LeftDockWidgetArea);
+  QDockWidget* method =
+      dock(tr("Method"), QStringLiteral("methodDock"), new MethodPanel(*model_), Qt::LeftDockWidgetArea);
+  compareDock_ = dock(tr("Compare"), QStringLiteral("compareDock"), new ComparePanel(*model_), Qt::LeftDockWidgetArea);
+  tabifyDockWidget(method, compareDock_);
+  method->raise();
   QDockWidget* stats = dock(tr("Statistics"), QStringLiteral("statsDock"), new StatsPanel(*model_), Qt::RightDockWidgetArea);
   // The image gets most of the window; panels start narrow (users widen them as they like).
   // Deferred until the window has its size, or the layout overrides it.
@@ -211,7 +296,9 @@ void MainWindow::buildPluginDocks() {
 
 void MainWindow::buildStatusBar() {
   loadProgress_ = new QProgressBar;
-  loadProgress_->setRange(0, 0);  // the loaders report no progress: a busy indicator
+  loadProgress_->setObjectName(QStringLiteral("loadProgress"));
+  loadProgress_->setRange(0, 1000);  // the loader's fraction done (mfr::LoadProgress)
+  loadProgress_->setFormat(QStringLiteral("%p %"));
   loadProgress_->setMaximumWidth(160);
   loadProgress_->hide();
   cancelLoad_ = new QPushButton(tr("Cancel"));

@@ -8,6 +8,8 @@
 #include "plugin_manager.hpp"
 #include "session.hpp"
 
+class QAction;
+class QDockWidget;
 class QLabel;
 class QMenu;
 class QProgressBar;
@@ -49,6 +51,7 @@ class MainWindow final : public QMainWindow {
 
  private:
   void buildMenus();
+  void buildCompareAndDataViewActions();
   void buildDocks();
   void buildPluginDocks();
   void buildStatusBar();
@@ -71,6 +74,7 @@ class MainWindow final : public QMainWindow {
   QMenu* namedViewsMenu_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* panelsMenu_ = nullptr;
+  QDockWidget* compareDock_ = nullptr;
   QLabel* frameInfo_ = nullptr;
   QProgressBar* loadProgress_ = nullptr;
   QPushButton* cancelLoad_ = nullptr;

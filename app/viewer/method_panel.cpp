@@ -22,15 +22,16 @@ std::string floatText(double value) { return QString::number(value, 'g', 10).toS
 
 }  // namespace
 
-MethodPanel::MethodPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), model_(model) {
+MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidget(parent), model_(model), side_(side) {
   auto* layout = new QVBoxLayout(this);
   auto* top = new QFormLayout;
   methodCombo_ = new QComboBox;
-  methodCombo_->setObjectName(QStringLiteral("methodCombo"));
+  methodCombo_->setObjectName(objectName(QStringLiteral("methodCombo")));
   for (const QString& name : model_.methodNames()) {
     const mfr::MethodInfo* info = model_.methodInfo(name);
+    const QString cpuTitle = name == QLatin1String("oracle") ? tr("exact CPU reference") : tr("CPU method");
     methodCombo_->addItem(info ? QStringLiteral("%1 — %2").arg(name, QString::fromStdString(info->title))
-                               : QStringLiteral("%1 — exact CPU reference").arg(name),
+                               : QStringLiteral("%1 — %2").arg(name, cpuTitle),
                           name);
   }
   // Long method titles must not dictate the dock's width.
@@ -39,7 +40,7 @@ MethodPanel::MethodPanel(ViewerModel& model, QWidget* parent) : QWidget(parent),
   operationCombo_ = new QComboBox;
   operationCombo_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
   operationCombo_->setMinimumContentsLength(16);
-  operationCombo_->setObjectName(QStringLiteral("operationCombo"));
+  operationCombo_->setObjectName(objectName(QStringLiteral("operationCombo")));
   operationCombo_->addItem(tr("oit — composite \"over\""), QStringLiteral("oit"));
   operationCombo_->addItem(tr("hybrid — exact core + averaged tail"), QStringLiteral("hybrid"));
   top->addRow(tr("Method"), methodCombo_);
@@ -59,48 +60,53 @@ MethodPanel::MethodPanel(ViewerModel& model, QWidget* parent) : QWidget(parent),
 
   auto* reset = new QPushButton(tr("Reset to defaults"));
   connect(reset, &QPushButton::clicked, this, [this] {
-    auto all = model_.allParams();
-    all.erase(model_.method().toStdString());
-    model_.setAllParams(std::move(all));
+    auto all = model_.allParamsOf(side_);
+    all.erase(model_.methodOf(side_).toStdString());
+    model_.setAllParamsOf(side_, std::move(all));
   });
   layout->addWidget(reset, 0, Qt::AlignRight);
   layout->addStretch(1);
 
   connect(methodCombo_, &QComboBox::currentIndexChanged, this,
-          [this](int index) { model_.setMethod(methodCombo_->itemData(index).toString()); });
+          [this](int index) { model_.setMethodOf(side_, methodCombo_->itemData(index).toString()); });
   connect(operationCombo_, &QComboBox::currentIndexChanged, this,
-          [this](int index) { model_.setOperation(operationCombo_->itemData(index).toString()); });
-  connect(&model_, &ViewerModel::methodChanged, this, [this] {
+          [this](int index) { model_.setOperationOf(side_, operationCombo_->itemData(index).toString()); });
+  connect(&model_, &ViewerModel::sideChanged, this, [this](int changed) {
+    if (changed != side_) return;
     syncMethodCombo();
-    rebuildParameters();
+    if (model_.methodOf(side_) != shownMethod_) rebuildParameters();
+    else showParameterValues();
   });
-  connect(&model_, &ViewerModel::operationChanged, this, [this](const QString& op) {
-    const QSignalBlocker block(operationCombo_);
-    operationCombo_->setCurrentIndex(operationCombo_->findData(op));
-  });
-  connect(&model_, &ViewerModel::paramsChanged, this, &MethodPanel::showParameterValues);
   syncMethodCombo();
   rebuildParameters();
 }
 
+QString MethodPanel::objectName(const QString& base) const {
+  return side_ == 0 ? base : base + QStringLiteral("B");
+}
+
 void MethodPanel::syncMethodCombo() {
-  const QSignalBlocker block(methodCombo_);
-  methodCombo_->setCurrentIndex(methodCombo_->findData(model_.method()));
+  const QSignalBlocker block(methodCombo_), blockOp(operationCombo_);
+  methodCombo_->setCurrentIndex(methodCombo_->findData(model_.methodOf(side_)));
+  operationCombo_->setCurrentIndex(operationCombo_->findData(model_.operationOf(side_)));
 }
 
 void MethodPanel::rebuildParameters() {
   while (paramsLayout_->rowCount() > 0) paramsLayout_->removeRow(0);
   editors_.clear();
-  const mfr::MethodInfo* info = model_.methodInfo(model_.method());
+  shownMethod_ = model_.methodOf(side_);
+  const mfr::MethodInfo* info = model_.methodInfo(shownMethod_);
   if (!info) {
-    description_->setText(tr("Exact per-pixel fragment lists by CPU ray casting; the reference for every method."));
+    description_->setText(shownMethod_ == QLatin1String("oracle")
+                              ? tr("Exact per-pixel fragment lists by CPU ray casting; the reference for every method.")
+                              : tr("Computed on the CPU off the GUI thread, like the oracle."));
     return;
   }
   description_->setText(QString::fromStdString(info->paper));
   for (const mfr::ParamSpec& spec : info->params) {
     QWidget* editor = nullptr;
     const std::string name = spec.name;
-    const auto set = [this, name](const std::string& value) { model_.setParams({{name, value}}); };
+    const auto set = [this, name](const std::string& value) { model_.setParamsOf(side_, {{name, value}}); };
     switch (spec.type) {
       case mfr::ParamSpec::Type::Int: {
         auto* box = new QSpinBox;
@@ -141,7 +147,9 @@ void MethodPanel::rebuildParameters() {
         break;
       }
     }
-    editor->setObjectName(QStringLiteral("param-") + QString::fromStdString(name));
+    if (!editor) continue;  // a parameter type this viewer has no widget for
+    editor->setObjectName(objectName(QStringLiteral("param-") + QString::fromStdString(name) +
+                                     (side_ == 0 ? QString() : QStringLiteral("-"))));
     editor->setToolTip(QString::fromStdString(spec.help));
     auto* label = new QLabel(QString::fromStdString(spec.label));
     label->setToolTip(QString::fromStdString(spec.help));
@@ -152,13 +160,15 @@ void MethodPanel::rebuildParameters() {
 }
 
 void MethodPanel::showParameterValues() {
-  const mfr::MethodInfo* info = model_.methodInfo(model_.method());
+  const mfr::MethodInfo* info = model_.methodInfo(shownMethod_);
   if (!info) return;
-  const auto values = model_.params();
+  const auto values = model_.paramsOf(side_);
   for (const mfr::ParamSpec& spec : info->params) {
     const auto it = values.find(spec.name);
     const QString value = QString::fromStdString(it != values.end() ? it->second : spec.defaultValue);
-    QWidget* editor = editors_[spec.name];
+    const auto found = editors_.find(spec.name);
+    if (found == editors_.end()) continue;
+    QWidget* editor = found->second;
     const QSignalBlocker block(editor);
     if (auto* i = qobject_cast<QSpinBox*>(editor)) i->setValue(value.toInt());
     else if (auto* d = qobject_cast<QDoubleSpinBox*>(editor)) d->setValue(value.toDouble());

@@ -1,7 +1,9 @@
 #pragma once
 // The method dock: every render method, the operation, and one widget per parameter generated
 // from the method's ParamSpec list (Int → spin box, Float → double spin box, Bool → check box,
-// Choice → combo box), so a new method needs no viewer code.
+// Choice → combo box), so a new method needs no viewer code. One panel per side: side 0 edits
+// the main method, side 1 the second method of compare mode (its widgets' object names carry a
+// "B" suffix: methodComboB, param-k-B, …).
 #include <QWidget>
 
 #include <map>
@@ -16,14 +18,18 @@ class MethodPanel final : public QWidget {
   Q_OBJECT
 
  public:
-  explicit MethodPanel(ViewerModel& model, QWidget* parent = nullptr);
+  explicit MethodPanel(ViewerModel& model, int side = 0, QWidget* parent = nullptr);
 
  private:
   void rebuildParameters();
   void showParameterValues();
   void syncMethodCombo();
 
+  [[nodiscard]] QString objectName(const QString& base) const;
+
   ViewerModel& model_;
+  int side_ = 0;
+  QString shownMethod_;  // whose editors are built
   QComboBox* methodCombo_ = nullptr;
   QComboBox* operationCombo_ = nullptr;
   QLabel* description_ = nullptr;

@@ -4,13 +4,41 @@
 #include <QOpenGLContext>
 #include <QWheelEvent>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
+#include <optional>
 
 #include "camera_navigator.hpp"
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
-#include "viewer_model.hpp"
+#include "mfr/reference/metrics.hpp"
+#include "view_overlays.hpp"
+
+namespace {
+
+const char* sideName(int side) {
+  return side == 0 ? "A" : "B";
+}
+
+// The heat map of a data map (magma over 0 … max); over `image` (same size) it is blended 1:1
+// where the value is non-zero and leaves the image alone where it is zero.
+mfr::ImageRGBA8 colourise(const RenderView::DataMap& map, const mfr::ImageRGBA8* image) {
+  mfr::ImageF values(map.width, map.height, 1);
+  for (std::size_t i = 0; i < map.values.size(); ++i) values.data[i] = static_cast<float>(map.values[i]);
+  mfr::ImageRGBA8 heat = mfr::heatmap(values, static_cast<float>(std::max<std::uint32_t>(1, map.maxValue)));
+  if (!image) return heat;
+  for (std::size_t i = 0; i < map.values.size(); ++i) {
+    std::uint8_t* out = &heat.pixels[i * 4];
+    const std::uint8_t* in = &image->pixels[i * 4];
+    for (int c = 0; c < 3; ++c)
+      out[c] = map.values[i] == 0 ? in[c] : static_cast<std::uint8_t>((in[c] + out[c] + 1) / 2);
+    out[3] = 255;
+  }
+  return heat;
+}
+
+}  // namespace
 
 RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(parent), model_(model) {
   setFocusPolicy(Qt::StrongFocus);
@@ -19,15 +47,39 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
   const auto repaint = [this] { update(); };
   connect(&model_, &ViewerModel::sceneChanged, this, repaint);
   connect(&model_, &ViewerModel::viewChanged, this, repaint);
-  connect(&model_, &ViewerModel::methodChanged, this, repaint);
-  connect(&model_, &ViewerModel::paramsChanged, this, repaint);
-  connect(&model_, &ViewerModel::operationChanged, this, repaint);
-  connect(&model_, &ViewerModel::oracleImageReady, this, repaint);
+  connect(&model_, &ViewerModel::sideChanged, this, repaint);
+  connect(&model_, &ViewerModel::compareChanged, this, repaint);
+  connect(&model_, &ViewerModel::dataViewChanged, this, repaint);
+  connect(&model_, &ViewerModel::cpuImageReady, this, repaint);
+  // A requested frame quality needs the frame on the CPU: draw it once more and read it back
+  // (the widget's framebuffer is not kept between paints).
+  connect(&model_, &ViewerModel::frameImageWanted, this, repaint);
+  connect(&model_, &ViewerModel::metricsReady, this, [this] {
+    // Heat maps are drawn into the image; the captions are widgets.
+    if (model_.compareEnabled() && model_.compareDisplay() != CompareDisplay::Images)
+      update();
+    else
+      updateOverlays();
+  });
+
+  for (int side = 0; side < kSides; ++side) {
+    captions_[side] = new PaneCaption(this);
+    captions_[side]->setObjectName(QStringLiteral("paneCaption%1").arg(sideName(side)));
+    captions_[side]->hide();
+    legends_[side] = new MapLegend(this);
+    legends_[side]->setObjectName(QStringLiteral("mapLegend%1").arg(sideName(side)));
+    legends_[side]->hide();
+  }
+  splitHandle_ = new SplitHandle(this);
+  splitHandle_->setObjectName(QStringLiteral("splitHandle"));
+  splitHandle_->hide();
+  connect(splitHandle_, &SplitHandle::dragged, this,
+          [this](int x) { model_.setCompareSplit(static_cast<double>(x) / std::max(1, width())); });
 }
 
 RenderView::~RenderView() {
   // GL objects must be deleted with their context current.
-  if (renderer_ && context()) {
+  if (renderers_[0] && context()) {
     makeCurrent();
     releaseGl();
     doneCurrent();
@@ -35,10 +87,13 @@ RenderView::~RenderView() {
 }
 
 void RenderView::releaseGl() {
-  renderer_.reset();
-  if (oracleFbo_) glDeleteFramebuffers(1, &oracleFbo_);
-  if (oracleTexture_) glDeleteTextures(1, &oracleTexture_);
-  oracleFbo_ = oracleTexture_ = 0;
+  for (auto& r : renderers_) r.reset();
+  for (PaneTarget& t : targets_) {
+    if (t.fbo) glDeleteFramebuffers(1, &t.fbo);
+    if (t.texture) glDeleteTextures(1, &t.texture);
+    t = {};
+  }
+  depthCache_ = {};
 }
 
 QSize RenderView::pixelSize() const {
@@ -49,18 +104,19 @@ QSize RenderView::pixelSize() const {
 
 void RenderView::initializeGL() {
   const QSurfaceFormat f = context()->format();
-  glInfo_ = QStringLiteral("OpenGL %1.%2 %3")
-                .arg(f.majorVersion())
-                .arg(f.minorVersion())
-                .arg(f.profile() == QSurfaceFormat::CoreProfile ? QStringLiteral("core") : QStringLiteral("compatibility"));
+  glInfo_ =
+      QStringLiteral("OpenGL %1.%2 %3")
+          .arg(f.majorVersion())
+          .arg(f.minorVersion())
+          .arg(f.profile() == QSurfaceFormat::CoreProfile ? QStringLiteral("core") : QStringLiteral("compatibility"));
   if (f.majorVersion() < 4 || (f.majorVersion() == 4 && f.minorVersion() < 5)) {
     model_.reportRenderError(tr("mfrview needs OpenGL 4.5; this display offers %1").arg(glInfo_));
     return;
   }
   glInfo_ += QStringLiteral(" — ") + QString::fromLatin1(reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
   mfr::gl::installDebugOutput();
-  renderer_ = std::make_unique<mfr::GpuRenderer>();
-  uploadedRevision_ = 0;
+  renderers_[0] = std::make_unique<mfr::GpuRenderer>();
+  uploadedRevision_ = {0, 0};
   // Qt destroys the context with the window (e.g. when a dock is floated): free our objects first.
   connect(context(), &QOpenGLContext::aboutToBeDestroyed, this, [this] {
     makeCurrent();
@@ -70,18 +126,40 @@ void RenderView::initializeGL() {
   emit glInitialized();
 }
 
-void RenderView::resizeGL(int, int) { model_.setRenderSize(pixelSize()); }
+void RenderView::resizeGL(int, int) {
+  model_.setRenderSize(pixelSize());
+}
 
-void RenderView::uploadSceneIfChanged() {
-  if (uploadedRevision_ == model_.sceneRevision()) return;
-  uploadedRevision_ = model_.sceneRevision();
-  uploadError_.clear();
-  try {
-    renderer_->setScene(model_.scene());
-  } catch (const std::exception& e) {
-    uploadError_ = QString::fromUtf8(e.what());  // e.g. every object hidden
-    mfr::gl::discardErrors();
+void RenderView::resizeEvent(QResizeEvent* event) {
+  QOpenGLWidget::resizeEvent(event);
+  updateOverlays();
+}
+
+mfr::GpuRenderer& RenderView::renderer(int side) {
+  auto& r = renderers_[side == 1 ? 1 : 0];
+  if (!r) {
+    r = std::make_unique<mfr::GpuRenderer>();  // the second pane's, on first use
+    uploadedRevision_[1] = 0;
   }
+  return *r;
+}
+
+bool RenderView::uploadSceneIfChanged(int side, QStringList& errors) {
+  const std::size_t i = side == 1 ? 1 : 0;
+  mfr::GpuRenderer& r = renderer(side);
+  if (uploadedRevision_[i] != model_.sceneRevision()) {
+    uploadedRevision_[i] = model_.sceneRevision();
+    uploadError_[i].clear();
+    try {
+      r.setScene(model_.scene());
+    } catch (const std::exception& e) {
+      uploadError_[i] = QString::fromUtf8(e.what());  // e.g. every object hidden
+      mfr::gl::discardErrors();
+    }
+  }
+  if (uploadError_[i].isEmpty()) return true;
+  errors << uploadError_[i];
+  return false;
 }
 
 void RenderView::clearToBackground() {
@@ -93,74 +171,336 @@ void RenderView::clearToBackground() {
 
 void RenderView::paintGL() {
   model_.setRenderSize(pixelSize());
-  if (!renderer_ || !model_.hasScene()) {
+  QStringList errors;
+  reports_ = std::make_shared<Reports>();
+  if (!renderers_[0] || !model_.hasScene()) {
+    clearToBackground();
+    maps_ = {};
+  } else if (!model_.compareEnabled() && model_.dataView() == DataView::Image && !model_.isCpuMethod(model_.method())) {
+    maps_ = {};
+    paintSingleImage(errors);
+  } else {
+    clearToBackground();
+    for (int side = 0; side < model_.paneCount(); ++side) paintPane(side, errors);
+    if (!model_.compareEnabled()) maps_[1] = {};
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, defaultFramebufferObject());
+  errors.removeDuplicates();
+  reports_->error = errors.join(QStringLiteral("; "));
+  reports_->reportError = renderers_[0] != nullptr;
+  // Observers of the model may repaint other widgets at once (QProgressBar does), which makes
+  // the window's compositing context current in the middle of our GL work: deliver the frame's
+  // news after paintGL.
+  QMetaObject::invokeMethod(
+      this,
+      [this, reports = std::move(reports_)] {
+        // A frame whose settings changed meanwhile is not reported: its Stats would be read
+        // against the new parameters (the budget panel fits memory models to them).
+        for (const Frame& f : reports->frames)
+          if (f.key == model_.frameKey(f.side)) model_.reportFrame(f.side, f.stats);
+        for (auto& [side, image] : reports->images) model_.reportFrameImage(side, image.first, std::move(image.second));
+        if (reports->reportError) model_.reportRenderError(reports->error);
+        updateOverlays();
+      },
+      Qt::QueuedConnection);
+}
+
+// The main method straight into the widget's framebuffer, as GpuRenderer::render does into its
+// own: the pixels `mfr render` writes.
+void RenderView::paintSingleImage(QStringList& errors) {
+  if (!uploadSceneIfChanged(0, errors)) {
     clearToBackground();
     return;
   }
-  uploadSceneIfChanged();
-  if (!uploadError_.isEmpty()) {
-    clearToBackground();
-    model_.reportRenderError(uploadError_);
-    return;
-  }
-  if (model_.method() == QLatin1String("oracle")) {
-    drawOracleImage();
-    return;
-  }
+  const QSize size = pixelSize();
   try {
-    const mfr::Stats stats = renderer_->renderTo(defaultFramebufferObject(), model_.camera(), model_.renderRequest(pixelSize()));
-    model_.reportFrame(stats);
+    const mfr::Stats stats =
+        renderer(0).renderTo(defaultFramebufferObject(), model_.camera(), model_.renderRequest(0, size));
+    reports_->frames.push_back({0, model_.frameKey(0), stats});
+    if (model_.wantsFrameImage(0))
+      reports_->images.emplace_back(0, std::pair{model_.frameKey(0), readDefaultFramebuffer(size)});
   } catch (const std::exception& e) {
     mfr::gl::discardErrors();
     clearToBackground();
-    model_.reportRenderError(QString::fromUtf8(e.what()));
+    errors << QString::fromUtf8(e.what());
   }
 }
 
-void RenderView::drawOracleImage() {
-  const QImage* image = model_.oracleImage();
-  const bool current = image != nullptr;
-  if (!image) image = &model_.lastOracleImage();  // the previous view until the new one is ready
-  if (image->isNull()) {
-    clearToBackground();
-    return;
+void RenderView::paintPane(int side, QStringList& errors) {
+  const qsizetype errorsBefore = errors.size();
+  const QSize size = model_.paneSize();
+  const ImageKey key = model_.frameKey(side);
+  const mfr::RenderRequest request = model_.renderRequest(side, size);
+  const QString prefix = model_.compareEnabled() ? QStringLiteral("%1: ").arg(sideName(side)) : QString();
+  const std::size_t i = side == 1 ? 1 : 0;
+  PaneTarget& target = paneTarget(side, size);
+
+  std::optional<mfr::ImageRGBA8> image;  // the pane's image on the CPU, when needed
+  bool inTexture = false;                // `target` holds this frame (GPU methods)
+  if (model_.isCpuMethod(model_.methodOf(side))) {
+    const ViewerModel::CpuSlot slot = ViewerModel::paneSlot(side);
+    const CpuImage* cpu = model_.cpuImage(slot, request);
+    const bool current = cpu != nullptr;
+    if (!cpu) cpu = model_.lastCpuImage(slot);  // the previous view until the new one is ready
+    if (cpu && !cpu->error.isEmpty()) {
+      errors << prefix + cpu->error;
+    } else if (cpu && cpu->image.width == size.width() && cpu->image.height == size.height()) {
+      image = cpu->image;
+      if (current) {
+        reports_->frames.push_back({side, key, cpu->stats});
+        if (model_.wantsFrameImage(side)) reports_->images.emplace_back(side, std::pair{key, cpu->image});
+      }
+    }
+  } else if (uploadSceneIfChanged(side, errors)) {
+    try {
+      const mfr::Stats stats = renderer(side).renderTo(target.fbo, model_.camera(), request);
+      inTexture = true;
+      reports_->frames.push_back({side, key, stats});
+    } catch (const std::exception& e) {
+      mfr::gl::discardErrors();
+      errors << prefix + QString::fromUtf8(e.what());
+    }
   }
-  if (!oracleTexture_ || oracleTextureSize_ != image->size()) {
-    if (oracleFbo_) glDeleteFramebuffers(1, &oracleFbo_);
-    if (oracleTexture_) glDeleteTextures(1, &oracleTexture_);
-    glCreateTextures(GL_TEXTURE_2D, 1, &oracleTexture_);
-    glTextureStorage2D(oracleTexture_, 1, GL_RGBA8, image->width(), image->height());
-    glCreateFramebuffers(1, &oracleFbo_);
-    glNamedFramebufferTexture(oracleFbo_, GL_COLOR_ATTACHMENT0, oracleTexture_, 0);
-    oracleTextureSize_ = image->size();
+
+  const bool heat = model_.compareEnabled() && model_.compareDisplay() != CompareDisplay::Images;
+  const bool mapView = !heat && model_.dataView() != DataView::Image;
+  if (inTexture && (model_.wantsFrameImage(side) || (mapView && model_.dataViewOverImage()))) {
+    image = readBack(target);
+    if (model_.wantsFrameImage(side)) reports_->images.emplace_back(side, std::pair{key, *image});
   }
-  // GL rows are bottom-up: upload the top-down image flipped so the blit shows it upright.
-  const QImage flipped = image->mirrored(false, true);
-  glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-  glTextureSubImage2D(oracleTexture_, 0, 0, 0, flipped.width(), flipped.height(), GL_RGBA, GL_UNSIGNED_BYTE, flipped.constBits());
-  clearToBackground();
-  const QSize target = pixelSize();
-  glBlitNamedFramebuffer(oracleFbo_, defaultFramebufferObject(), 0, 0, image->width(), image->height(), 0,
-                         target.height() - image->height(), image->width(), target.height(), GL_COLOR_BUFFER_BIT,
-                         GL_NEAREST);
-  if (current) model_.reportFrame(model_.oracleStats());
+
+  maps_[i] = {};
+  const mfr::ImageRGBA8* shown = nullptr;
+  mfr::ImageRGBA8 composed;
+  if (heat) {
+    const PaneMetrics& m = model_.metrics(side);
+    if (model_.metricsCurrent(side) && m.valid)
+      shown = model_.compareDisplay() == CompareDisplay::FlipError ? &m.flipMap : &m.differenceMap;
+  } else if (mapView) {
+    maps_[i] = computeDataMap(side, size, key, inTexture);
+    if (!maps_[i].values.empty()) {
+      composed = colourise(maps_[i], model_.dataViewOverImage() && image ? &*image : nullptr);
+      shown = &composed;
+    }
+  }
+  if (!shown && image && !inTexture) shown = &*image;
+  if (shown) upload(target, *shown);
+  if (shown || inTexture) blitPane(side, target);
+  paneFailed_[i] = errors.size() > errorsBefore;
 }
+
+RenderView::DataMap RenderView::computeDataMap(int side, QSize size, const ImageKey& key, bool haveFrame) {
+  DataMap map;
+  map.kind = model_.dataView();
+  map.key = key;
+  map.width = size.width();
+  map.height = size.height();
+  if (map.kind == DataView::DepthComplexity) {
+    const bool cached = depthCache_.scene == model_.sceneRevision() && depthCache_.view == model_.viewRevision() &&
+                        depthCache_.size == size && !depthCache_.values.empty();
+    if (cached) {
+      map.values = depthCache_.values;
+    } else {
+      QStringList errors;
+      if (!uploadSceneIfChanged(side, errors)) {
+        map.note = errors.join(QStringLiteral("; "));
+        return map;
+      }
+      try {
+        map.values = renderer(side).depthComplexity(model_.camera(), size.width(), size.height());
+        depthCache_ = {model_.sceneRevision(), model_.viewRevision(), size, map.values};
+      } catch (const std::exception& e) {
+        mfr::gl::discardErrors();
+        map.note = QString::fromUtf8(e.what());
+        return map;
+      }
+    }
+  } else {
+    // k(p) belongs to the frame just rendered by this pane's renderer.
+    if (haveFrame) map.values = renderer(side).kMap();
+    if (map.values.size() != static_cast<std::size_t>(size.width()) * size.height()) {
+      map.values.clear();
+      map.note = tr("no k(p) for this method");
+      return map;
+    }
+  }
+  const auto [lo, hi] = std::minmax_element(map.values.begin(), map.values.end());
+  map.minValue = *lo;
+  map.maxValue = *hi;
+  return map;
+}
+
+RenderView::PaneTarget& RenderView::paneTarget(int side, QSize size) {
+  PaneTarget& t = targets_[side == 1 ? 1 : 0];
+  if (t.texture && t.size == size) return t;
+  if (t.fbo) glDeleteFramebuffers(1, &t.fbo);
+  if (t.texture) glDeleteTextures(1, &t.texture);
+  glCreateTextures(GL_TEXTURE_2D, 1, &t.texture);
+  glTextureStorage2D(t.texture, 1, GL_RGBA8, size.width(), size.height());
+  glCreateFramebuffers(1, &t.fbo);
+  glNamedFramebufferTexture(t.fbo, GL_COLOR_ATTACHMENT0, t.texture, 0);
+  t.size = size;
+  return t;
+}
+
+// Like GpuRenderer::render's read-back: the texture's rows, flipped to top-down.
+mfr::ImageRGBA8 RenderView::readBack(const PaneTarget& target) const {
+  mfr::ImageRGBA8 image(target.size.width(), target.size.height());
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glGetTextureImage(target.texture, 0, GL_RGBA, GL_UNSIGNED_BYTE, static_cast<GLsizei>(image.pixels.size()),
+                    image.pixels.data());
+  mfr::flipVertically(image);
+  return image;
+}
+
+mfr::ImageRGBA8 RenderView::readDefaultFramebuffer(QSize size) const {
+  mfr::ImageRGBA8 image(size.width(), size.height());
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, defaultFramebufferObject());
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, size.width(), size.height(), GL_RGBA, GL_UNSIGNED_BYTE, image.pixels.data());
+  mfr::flipVertically(image);
+  return image;
+}
+
+void RenderView::upload(const PaneTarget& target, const mfr::ImageRGBA8& image) {
+  if (image.width != target.size.width() || image.height != target.size.height()) return;
+  // GL rows are bottom-up: upload the top-down image flipped so the blit shows it upright.
+  mfr::ImageRGBA8 flipped = image;
+  mfr::flipVertically(flipped);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+  glTextureSubImage2D(target.texture, 0, 0, 0, image.width, image.height, GL_RGBA, GL_UNSIGNED_BYTE,
+                      flipped.pixels.data());
+}
+
+QRect RenderView::paneRect(int side) const {
+  const QSize full = pixelSize();
+  if (!model_.compareEnabled() || model_.compareLayout() == CompareLayout::Split) return {QPoint(0, 0), full};
+  const QSize pane = model_.paneSize();
+  return {QPoint(side == 1 ? pane.width() : 0, 0), pane};
+}
+
+QRect RenderView::paneVisibleRect(int side) const {
+  const QRect pane = paneRect(side);
+  if (!model_.compareEnabled() || model_.compareLayout() != CompareLayout::Split) return pane;
+  const int splitX = static_cast<int>(std::lround(model_.compareSplit() * pane.width()));
+  return side == 0 ? QRect(0, 0, splitX, pane.height()) : QRect(splitX, 0, pane.width() - splitX, pane.height());
+}
+
+void RenderView::blitPane(int side, const PaneTarget& target) {
+  const QRect pane = paneRect(side), shown = paneVisibleRect(side);
+  if (shown.isEmpty()) return;
+  const int fullHeight = pixelSize().height();
+  // Source: pane-local columns; rows flip from top-down rectangles to GL's bottom-up ones.
+  const int sx0 = shown.left() - pane.left(), sx1 = sx0 + shown.width();
+  const int sy0 = pane.height() - (shown.top() - pane.top() + shown.height()), sy1 = sy0 + shown.height();
+  const int dy0 = fullHeight - (shown.top() + shown.height()), dy1 = dy0 + shown.height();
+  glBlitNamedFramebuffer(target.fbo, defaultFramebufferObject(), sx0, sy0, sx1, sy1, shown.left(), dy0,
+                         shown.left() + shown.width(), dy1, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+}
+
+// ---- overlays ------------------------------------------------------------------------------
+
+void RenderView::updateOverlays() {
+  const double ratio = devicePixelRatioF();
+  const auto logical = [ratio](const QRect& r) {
+    return QRect(static_cast<int>(r.x() / ratio), static_cast<int>(r.y() / ratio), static_cast<int>(r.width() / ratio),
+                 static_cast<int>(r.height() / ratio));
+  };
+  const bool compare = model_.compareEnabled() && model_.hasScene();
+  const bool split = compare && model_.compareLayout() == CompareLayout::Split;
+  const bool heat = compare && model_.compareDisplay() != CompareDisplay::Images;
+  for (int side = 0; side < kSides; ++side) {
+    const bool shown = side < model_.paneCount() && model_.hasScene();
+    const QRect area = logical(split ? paneRect(side) : paneVisibleRect(side));
+    // Captions: which method, and how far it is from the exact image.
+    PaneCaption* caption = captions_[side];
+    if (compare && shown) {
+      const PaneMetrics& m = model_.metrics(side);
+      QStringList lines{QStringLiteral("%1 · %2 (%3)")
+                            .arg(QLatin1String(sideName(side)), model_.methodOf(side), model_.operationOf(side))};
+      if (paneFailed_[side])
+        lines << tr("cannot render (see the status bar)");
+      else if (!model_.metricsCurrent(side))
+        lines << tr("RMSE, FLIP: computing…");
+      else if (!m.valid)
+        lines << tr("no metrics: %1").arg(m.error);
+      else
+        lines << tr("RMSE %1").arg(m.rmse, 0, 'f', 5) << tr("FLIP %1").arg(m.flip.mean, 0, 'f', 4);
+      // Within its pane (half the view when split), so the two captions never overlap.
+      const int room = std::max(40, (split ? width() / 2 : area.width()) - 12 - 2 * caption->margin());
+      for (QString& line : lines) line = caption->fontMetrics().elidedText(line, Qt::ElideRight, room);
+      caption->setText(lines.join(QLatin1Char('\n')));
+      caption->adjustSize();
+      const int x = split && side == 1 ? area.right() - caption->width() - 6 : area.left() + 6;
+      caption->move(std::max(0, x), area.top() + 6);
+      caption->show();
+    } else {
+      caption->hide();
+    }
+    // Legends: the scale of whatever heat map the pane shows.
+    MapLegend* legend = legends_[side];
+    bool legendShown = false;
+    if (shown && heat) {
+      const PaneMetrics& m = model_.metrics(side);
+      const bool flip = model_.compareDisplay() == CompareDisplay::FlipError;
+      const QString title = flip ? tr("%1: FLIP error vs exact").arg(QLatin1String(sideName(side)))
+                                 : tr("%1: |difference| vs exact").arg(QLatin1String(sideName(side)));
+      if (!model_.metricsCurrent(side) || !m.valid)
+        legend->setNote(title, tr("computing…"));
+      else if (flip)
+        legend->setMap(title, 1.0, tr("mean %1 · max %2").arg(m.flip.mean, 0, 'f', 4).arg(m.flip.max, 0, 'f', 3));
+      else
+        legend->setMap(
+            title, std::max(m.maxDifference, 1.0f / 255.0f),
+            tr("max %1 (%2 of 255)").arg(m.maxDifference, 0, 'f', 4).arg(std::lround(m.maxDifference * 255.0f)));
+      legendShown = true;
+    } else if (shown && maps_[side].kind != DataView::Image) {
+      const DataMap& map = maps_[side];
+      const QString title = map.kind == DataView::DepthComplexity
+                                ? tr("n(p): fragments per pixel (exact)")
+                                : tr("k(p): capacity of %1").arg(model_.methodOf(side));
+      if (map.values.empty())
+        legend->setNote(title, map.note);
+      else
+        legend->setMap(title, std::max<std::uint32_t>(1, map.maxValue),
+                       tr("min %1 · max %2").arg(map.minValue).arg(map.maxValue));
+      legendShown = true;
+    }
+    if (legendShown) {
+      const int x = split && side == 1 ? area.right() - legend->width() - 6 : area.left() + 6;
+      legend->move(std::max(0, x), std::max(0, area.bottom() - legend->height() - 6));
+      legend->show();
+    } else {
+      legend->hide();
+    }
+  }
+  if (split) {
+    const int x = static_cast<int>(paneVisibleRect(1).left() / ratio);
+    splitHandle_->setGeometry(x - SplitHandle::kWidth / 2, 0, SplitHandle::kWidth, height());
+    splitHandle_->show();
+    splitHandle_->raise();
+  } else {
+    splitHandle_->hide();
+  }
+}
+
+// ---- export --------------------------------------------------------------------------------
 
 mfr::ImageRGBA8 RenderView::renderImage(QSize size) {
   if (!model_.hasScene()) throw mfr::Error("export", "no scene loaded");
-  const mfr::RenderRequest request = model_.renderRequest(size);
-  if (request.method == "oracle") return mfr::render(model_.scene(), model_.camera(), request).image;
-  if (!renderer_) throw mfr::Error("OpenGL", "the view has no OpenGL 4.5 context yet");
+  const mfr::RenderRequest request = model_.renderRequest(0, size);
+  if (model_.isCpuMethod(model_.method())) return mfr::render(model_.scene(), model_.camera(), request).image;
+  if (!renderers_[0]) throw mfr::Error("OpenGL", "the view has no OpenGL 4.5 context yet");
   makeCurrent();
   struct DoneCurrent {
     RenderView* view;
     ~DoneCurrent() { view->doneCurrent(); }
   } done{this};
-  uploadSceneIfChanged();
-  if (!uploadError_.isEmpty()) throw mfr::Error(model_.scene().name, uploadError_.toStdString());
+  QStringList errors;
+  if (!uploadSceneIfChanged(0, errors)) throw mfr::Error(model_.scene().name, errors.join("; ").toStdString());
   try {
-    return renderer_->render(model_.camera(), request).image;
+    return renderer(0).render(model_.camera(), request).image;
   } catch (...) {
     mfr::gl::discardErrors();
     throw;
@@ -181,11 +521,15 @@ void RenderView::mouseMoveEvent(QMouseEvent* event) {
   const QPoint pos = event->position().toPoint();
   const QPointF delta = pos - lastMouse_;
   lastMouse_ = pos;
-  if (drag_ == Drag::Orbit) model_.setCamera(navigation::orbit(model_.camera(), delta, size()));
-  else model_.setCamera(navigation::pan(model_.camera(), delta, size()));
+  if (drag_ == Drag::Orbit)
+    model_.setCamera(navigation::orbit(model_.camera(), delta, size()));
+  else
+    model_.setCamera(navigation::pan(model_.camera(), delta, size()));
 }
 
-void RenderView::mouseReleaseEvent(QMouseEvent*) { drag_ = Drag::None; }
+void RenderView::mouseReleaseEvent(QMouseEvent*) {
+  drag_ = Drag::None;
+}
 
 void RenderView::wheelEvent(QWheelEvent* event) {
   if (!model_.hasScene()) return;

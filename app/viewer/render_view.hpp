@@ -1,8 +1,15 @@
 #pragma once
-// The central OpenGL 4.5 view. GPU methods render through mfrcore's GpuRenderer::renderTo into
-// the widget's framebuffer — the code path of `mfr render` — so the widget's pixels equal the
-// CLI's image for the same scene, view, size and settings. The oracle is drawn from the CPU
-// image ViewerModel computes off the GUI thread.
+// The central OpenGL 4.5 view. GPU methods render through mfrcore's GpuRenderer::renderTo — the
+// code path of `mfr render` — so the view's pixels equal the CLI's image for the same scene,
+// view, size and settings. CPU methods (the oracle, …) are drawn from the images ViewerModel
+// computes off the GUI thread.
+//
+// One pane shows the main method; compare mode adds a second pane (its own GpuRenderer, same
+// camera), side by side or split. A single GPU image goes straight into the widget's
+// framebuffer; everything else is drawn per pane into an offscreen RGBA8 framebuffer — the one
+// `mfr render` reads back — and blitted into place. Data views (n(p), k(p)) and compare heat
+// maps replace (or blend over) a pane's image; their legends and the panes' captions are child
+// widgets, so the framebuffer holds only images.
 //
 // epoxy must come before Qt's OpenGL headers (it replaces the system GL headers).
 #include <epoxy/gl.h>
@@ -10,12 +17,18 @@
 #include <QOpenGLWidget>
 #include <QPoint>
 
+#include <array>
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "mfr/gpu_renderer.hpp"
 #include "mfr/image.hpp"
+#include "viewer_model.hpp"
 
-class ViewerModel;
+class MapLegend;
+class PaneCaption;
+class SplitHandle;
 
 class RenderView final : public QOpenGLWidget {
   Q_OBJECT
@@ -24,14 +37,29 @@ class RenderView final : public QOpenGLWidget {
   explicit RenderView(ViewerModel& model, QWidget* parent = nullptr);
   ~RenderView() override;
 
-  // An image of the current scene and camera at any size, rendered offscreen on this view's
-  // context exactly as `mfr render` does (GpuRenderer::render, or the oracle on the CPU).
-  // Throws mfr::Error (no GL context yet, no scene, bad settings).
+  // An image of the current scene and camera at any size with the main method, rendered
+  // offscreen on this view's context exactly as `mfr render` does (GpuRenderer::render, or the
+  // oracle on the CPU). Throws mfr::Error (no GL context yet, no scene, bad settings).
   mfr::ImageRGBA8 renderImage(QSize size);
-  [[nodiscard]] bool glReady() const { return renderer_ != nullptr; }
+  [[nodiscard]] bool glReady() const { return renderers_[0] != nullptr; }
   [[nodiscard]] const QString& glInfo() const { return glInfo_; }
   // The image size in device pixels.
   [[nodiscard]] QSize pixelSize() const;
+
+  // The data map a pane showed in its last frame (image rows top-down).
+  struct DataMap {
+    DataView kind = DataView::Image;
+    ImageKey key;  // of the pane's frame
+    int width = 0, height = 0;
+    std::vector<std::uint32_t> values;  // empty when the pane has no such map (see note)
+    std::uint32_t minValue = 0, maxValue = 0;
+    QString note;  // why there is no map, e.g. "no k(p) for this method"
+  };
+  [[nodiscard]] const DataMap& dataMap(int side) const { return maps_[side == 1 ? 1 : 0]; }
+  // Where a pane's image lies in the framebuffer (device pixels, top-down rows) and the part of
+  // it that shows (the split layout shows each image only on its side of the line).
+  [[nodiscard]] QRect paneRect(int side) const;
+  [[nodiscard]] QRect paneVisibleRect(int side) const;
 
  signals:
   void glInitialized();
@@ -40,25 +68,64 @@ class RenderView final : public QOpenGLWidget {
   void initializeGL() override;
   void resizeGL(int width, int height) override;
   void paintGL() override;
+  void resizeEvent(QResizeEvent* event) override;
   void mousePressEvent(QMouseEvent* event) override;
   void mouseMoveEvent(QMouseEvent* event) override;
   void mouseReleaseEvent(QMouseEvent* event) override;
   void wheelEvent(QWheelEvent* event) override;
 
  private:
-  void uploadSceneIfChanged();
-  void drawOracleImage();
+  // An offscreen RGBA8 colour target of one pane.
+  struct PaneTarget {
+    GLuint texture = 0, fbo = 0;
+    QSize size;
+  };
+  mfr::GpuRenderer& renderer(int side);
+  bool uploadSceneIfChanged(int side, QStringList& errors);
+  void paintSingleImage(QStringList& errors);
+  void paintPane(int side, QStringList& errors);
+  PaneTarget& paneTarget(int side, QSize size);
+  mfr::ImageRGBA8 readBack(const PaneTarget& target) const;
+  mfr::ImageRGBA8 readDefaultFramebuffer(QSize size) const;
+  void upload(const PaneTarget& target, const mfr::ImageRGBA8& image);
+  void blitPane(int side, const PaneTarget& target);
+  DataMap computeDataMap(int side, QSize size, const ImageKey& key, bool haveFrame);
   void clearToBackground();
   void releaseGl();
+  void updateOverlays();
 
   ViewerModel& model_;
-  std::unique_ptr<mfr::GpuRenderer> renderer_;
-  quint64 uploadedRevision_ = 0;
-  QString uploadError_;
+  std::array<std::unique_ptr<mfr::GpuRenderer>, kSides> renderers_;
+  std::array<quint64, kSides> uploadedRevision_{0, 0};
+  std::array<QString, kSides> uploadError_;
+  std::array<PaneTarget, kSides> targets_;
+  std::array<DataMap, kSides> maps_;
+  std::array<bool, kSides> paneFailed_{false, false};  // the pane's last paint had an error
+  // n(p) of the last view (both panes share it when their sizes agree).
+  struct DepthCache {
+    quint64 scene = 0, view = 0;
+    QSize size;
+    std::vector<std::uint32_t> values;
+  } depthCache_;
   QString glInfo_;
   QPoint lastMouse_;
   enum class Drag { None, Orbit, Pan } drag_ = Drag::None;
-  // Texture + read framebuffer through which the oracle's CPU image is blitted.
-  GLuint oracleTexture_ = 0, oracleFbo_ = 0;
-  QSize oracleTextureSize_;
+
+  // What the frame being painted tells the model, delivered after paintGL.
+  struct Frame {
+    int side = 0;
+    ImageKey key;
+    mfr::Stats stats;
+  };
+  struct Reports {
+    std::vector<Frame> frames;
+    std::vector<std::pair<int, std::pair<ImageKey, mfr::ImageRGBA8>>> images;
+    QString error;
+    bool reportError = false;
+  };
+  std::shared_ptr<Reports> reports_;
+
+  std::array<PaneCaption*, kSides> captions_{};
+  std::array<MapLegend*, kSides> legends_{};
+  SplitHandle* splitHandle_ = nullptr;
 };

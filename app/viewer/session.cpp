@@ -7,12 +7,42 @@
 #include <QJsonDocument>
 #include <QSaveFile>
 
+#include <algorithm>
+
 #include "mfr/error.hpp"
 #include "viewer_model.hpp"
 
 namespace {
 
 QJsonArray vec3(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+
+using ParamsByMethod = std::map<std::string, std::map<std::string, std::string>>;
+
+QJsonObject paramsToJson(const ParamsByMethod& params) {
+  QJsonObject json;
+  for (const auto& [method, values] : params) {
+    QJsonObject p;
+    for (const auto& [name, value] : values) p.insert(QString::fromStdString(name), QString::fromStdString(value));
+    json.insert(QString::fromStdString(method), p);
+  }
+  return json;
+}
+
+// Enum values by their names in session files.
+const std::map<QString, CompareLayout> kLayouts{{"side-by-side", CompareLayout::SideBySide},
+                                                {"split", CompareLayout::Split}};
+const std::map<QString, CompareDisplay> kDisplays{{"images", CompareDisplay::Images},
+                                                  {"flip", CompareDisplay::FlipError},
+                                                  {"difference", CompareDisplay::Difference}};
+const std::map<QString, DataView> kDataViews{
+    {"image", DataView::Image}, {"depth-complexity", DataView::DepthComplexity}, {"capacity", DataView::Capacity}};
+
+template <class Enum>
+QString nameOf(const std::map<QString, Enum>& names, Enum value) {
+  for (const auto& [name, v] : names)
+    if (v == value) return name;
+  return {};
+}
 
 class Reader {
  public:
@@ -25,6 +55,31 @@ class Reader {
     if (a.size() != 3 || !a[0].isDouble() || !a[1].isDouble() || !a[2].isDouble())
       fail(where + "." + key, QStringLiteral("expected [x, y, z]"));
     return {a[0].toDouble(), a[1].toDouble(), a[2].toDouble()};
+  }
+  template <class Enum>
+  Enum choice(const QJsonObject& o, const QString& key, const QString& where, const std::map<QString, Enum>& names,
+              Enum fallback) const {
+    if (!o.contains(key)) return fallback;
+    const auto it = names.find(o.value(key).toString());
+    if (it == names.end()) {
+      QStringList known;
+      for (const auto& entry : names) known << entry.first;
+      fail(where + "." + key, QStringLiteral("expected one of %1").arg(known.join(QStringLiteral(", "))));
+    }
+    return it->second;
+  }
+  ParamsByMethod params(const QJsonObject& json, const QString& where) const {
+    ParamsByMethod out;
+    for (auto m = json.begin(); m != json.end(); ++m) {
+      auto& values = out[m.key().toStdString()];
+      const QJsonObject p = m.value().toObject();
+      for (auto v = p.begin(); v != p.end(); ++v) {
+        if (!v.value().isString())
+          fail(where + "." + m.key() + "." + v.key(), QStringLiteral("expected a string value"));
+        values[v.key().toStdString()] = v.value().toString().toStdString();
+      }
+    }
+    return out;
   }
   double number(const QJsonObject& o, const QString& key, const QString& where, double fallback) const {
     if (!o.contains(key)) return fallback;
@@ -48,6 +103,15 @@ Session captureSession(const ViewerModel& model) {
   for (const mfr::Object& o : model.scene().objects) {
     s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color});
   }
+  s.compare.enabled = model.compareEnabled();
+  s.compare.layout = model.compareLayout();
+  s.compare.split = model.compareSplit();
+  s.compare.display = model.compareDisplay();
+  s.compare.method = model.methodOf(1);
+  s.compare.operation = model.operationOf(1);
+  s.compare.params = model.allParamsOf(1);
+  s.dataView = model.dataView();
+  s.dataOverImage = model.dataViewOverImage();
   return s;
 }
 
@@ -63,6 +127,14 @@ void applySession(const Session& session, ViewerModel& model) {
   model.setAllParams(session.params);
   if (!session.operation.isEmpty()) model.setOperation(session.operation);
   if (!session.method.isEmpty()) model.setMethod(session.method);
+  model.setAllParamsOf(1, session.compare.params);
+  if (!session.compare.operation.isEmpty()) model.setOperationOf(1, session.compare.operation);
+  if (!session.compare.method.isEmpty()) model.setMethodOf(1, session.compare.method);
+  model.setCompareLayout(session.compare.layout);
+  model.setCompareSplit(session.compare.split);
+  model.setCompareDisplay(session.compare.display);
+  model.setCompareEnabled(session.compare.enabled);
+  model.setDataView(session.dataView, session.dataOverImage);
   model.setCamera(session.camera);
 }
 
@@ -75,12 +147,14 @@ QJsonObject sessionToJson(const Session& s) {
                      {"ortho_height", s.camera.orthoHeight},
                      {"near", s.camera.nearPlane},
                      {"far", s.camera.farPlane}};
-  QJsonObject params;
-  for (const auto& [method, values] : s.params) {
-    QJsonObject p;
-    for (const auto& [name, value] : values) p.insert(QString::fromStdString(name), QString::fromStdString(value));
-    params.insert(QString::fromStdString(method), p);
-  }
+  const QJsonObject compare{{"enabled", s.compare.enabled},
+                            {"layout", nameOf(kLayouts, s.compare.layout)},
+                            {"split", s.compare.split},
+                            {"display", nameOf(kDisplays, s.compare.display)},
+                            {"method", s.compare.method},
+                            {"operation", s.compare.operation},
+                            {"params", paramsToJson(s.compare.params)}};
+  const QJsonObject dataView{{"mode", nameOf(kDataViews, s.dataView)}, {"over_image", s.dataOverImage}};
   QJsonArray objects;
   for (const Session::ObjectState& o : s.objects)
     objects.append(QJsonObject{{"name", o.name},
@@ -89,7 +163,8 @@ QJsonObject sessionToJson(const Session& s) {
                                {"opacity", o.color.a}});
   return {{"format", "mfrview-session"}, {"version", 1},           {"scene", s.scenePath},
           {"camera", camera},            {"method", s.method},     {"operation", s.operation},
-          {"params", params},            {"objects", objects},     {"plugins", s.plugins}};
+          {"params", paramsToJson(s.params)}, {"objects", objects},  {"compare", compare},
+          {"data_view", dataView},       {"plugins", s.plugins}};
 }
 
 Session sessionFromJson(const QJsonObject& json, const QString& file) {
@@ -113,15 +188,19 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   s.camera.farPlane = r.number(cam, "far", "camera", s.camera.farPlane);
   s.method = json.value("method").toString();
   s.operation = json.value("operation").toString();
-  const QJsonObject params = json.value("params").toObject();
-  for (auto m = params.begin(); m != params.end(); ++m) {
-    auto& values = s.params[m.key().toStdString()];
-    const QJsonObject p = m.value().toObject();
-    for (auto v = p.begin(); v != p.end(); ++v) {
-      if (!v.value().isString()) r.fail("params." + m.key() + "." + v.key(), QStringLiteral("expected a string value"));
-      values[v.key().toStdString()] = v.value().toString().toStdString();
-    }
-  }
+  s.params = r.params(json.value("params").toObject(), QStringLiteral("params"));
+  // Optional (sessions written before compare mode have neither).
+  const QJsonObject compare = json.value("compare").toObject();
+  s.compare.enabled = compare.value("enabled").toBool(false);
+  s.compare.layout = r.choice(compare, "layout", "compare", kLayouts, CompareLayout::SideBySide);
+  s.compare.split = std::clamp(r.number(compare, "split", "compare", 0.5), 0.0, 1.0);
+  s.compare.display = r.choice(compare, "display", "compare", kDisplays, CompareDisplay::Images);
+  s.compare.method = compare.value("method").toString();
+  s.compare.operation = compare.value("operation").toString();
+  s.compare.params = r.params(compare.value("params").toObject(), QStringLiteral("compare.params"));
+  const QJsonObject dataView = json.value("data_view").toObject();
+  s.dataView = r.choice(dataView, "mode", "data_view", kDataViews, DataView::Image);
+  s.dataOverImage = dataView.value("over_image").toBool(false);
   const QJsonArray objects = json.value("objects").toArray();
   for (qsizetype i = 0; i < objects.size(); ++i) {
     const QJsonObject o = objects[i].toObject();

@@ -1,6 +1,7 @@
 #pragma once
 // Session files (.mfrsession, JSON): the scene's path, camera, method and operation, the
-// parameters of every method the user set, per-object overrides and each plugin's settings.
+// parameters of every method the user set, per-object overrides, compare mode (with the second
+// method's own parameters), the data view and each plugin's settings.
 // Doubles are written shortest-round-trip, so a reloaded session renders the same image.
 #include <QJsonObject>
 #include <QString>
@@ -10,8 +11,7 @@
 #include <vector>
 
 #include "mfr/scene/camera.hpp"
-
-class ViewerModel;
+#include "viewer_model.hpp"
 
 struct Session {
   struct ObjectState {
@@ -25,7 +25,17 @@ struct Session {
   QString operation;
   std::map<std::string, std::map<std::string, std::string>> params;  // per method
   std::vector<ObjectState> objects;                                  // by object index
-  QJsonObject plugins;                                               // by plugin id
+  struct CompareState {
+    bool enabled = false;
+    CompareLayout layout = CompareLayout::SideBySide;
+    double split = 0.5;
+    CompareDisplay display = CompareDisplay::Images;
+    QString method, operation;  // side 1; empty: unchanged
+    std::map<std::string, std::map<std::string, std::string>> params;
+  } compare;
+  DataView dataView = DataView::Image;
+  bool dataOverImage = false;
+  QJsonObject plugins;  // by plugin id
 };
 
 // The model's current state (plugins filled in by the caller).

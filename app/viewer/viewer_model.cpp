@@ -1,12 +1,13 @@
 #include "viewer_model.hpp"
 
 #include <QFutureWatcher>
+#include <QTimer>
 #include <QtConcurrent/QtConcurrentRun>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <exception>
-#include <variant>
 
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
@@ -30,12 +31,50 @@ void runInBackground(QObject* receiver, Work work, Done done) {
 // The depth-complexity histogram is about the shape of the data, not the resolution: above this
 // many pixels it is computed on a proportionally smaller image, so it stays interactive.
 constexpr int kMaxDepthComplexityPixels = 320 * 240;
+// CPU images kept (panes and references of the last few views).
+constexpr std::size_t kCpuCacheSize = 6;
+constexpr int kLoadPollMs = 40;
+
+bool isGpuMethod(const std::string& name) {
+  const auto& registry = mfr::methodRegistry();
+  return std::any_of(registry.begin(), registry.end(), [&](const mfr::RegistryEntry& e) { return e.name == name; });
+}
+
+// Error maps of one pane against the reference (both the same size).
+PaneMetrics computeMetrics(const mfr::ImageRGBA8& reference, const mfr::ImageRGBA8& image) {
+  PaneMetrics m;
+  m.rmse = mfr::rmse(reference, image);
+  const mfr::FlipResult flip = mfr::flip(reference, image);
+  m.flip = flip.stats;
+  m.flipMap = mfr::magma(flip.errorMap);
+  const mfr::ImageF difference = mfr::absoluteDifference(reference, image);
+  for (float d : difference.data) m.maxDifference = std::max(m.maxDifference, d);
+  // A zero scale would be no scale: identical images show as all-zero (black) at 1/255.
+  m.differenceMap = mfr::heatmap(difference, std::max(m.maxDifference, 1.0f / 255.0f));
+  m.valid = true;
+  return m;
+}
 
 }  // namespace
 
-ViewerModel::ViewerModel(QObject* parent) : ViewerContext(parent) {}
+QImage wrapImage(const mfr::ImageRGBA8& image) {
+  return QImage(image.pixels.data(), image.width, image.height, image.width * 4, QImage::Format_RGBA8888);
+}
 
-ViewerModel::~ViewerModel() = default;
+struct ViewerModel::LoadState {
+  std::atomic<double> fraction{0.0};
+  std::atomic<bool> cancel{false};
+};
+
+ViewerModel::ViewerModel(QObject* parent) : ViewerContext(parent) {
+  loadPoll_ = new QTimer(this);
+  loadPoll_->setInterval(kLoadPollMs);
+  connect(loadPoll_, &QTimer::timeout, this, &ViewerModel::pollLoadProgress);
+}
+
+ViewerModel::~ViewerModel() {
+  if (load_) load_->cancel = true;  // the worker stops at its next progress report
+}
 
 QStringList ViewerModel::methodNames() const {
   QStringList names;
@@ -57,19 +96,36 @@ const mfr::MethodInfo* ViewerModel::methodInfo(const QString& method) const {
   return &it->second->info();
 }
 
-void ViewerModel::setMethod(const QString& method) {
-  if (method == method_) return;
-  method_ = method;
-  emit methodChanged(method_);
+bool ViewerModel::isCpuMethod(const QString& method) const {
+  const std::string name = method.toStdString();
+  const std::vector<std::string> all = mfr::availableMethods();
+  return std::find(all.begin(), all.end(), name) != all.end() && !isGpuMethod(name);
 }
 
-std::map<std::string, std::string> ViewerModel::params() const {
-  const auto it = params_.find(method_.toStdString());
-  return it == params_.end() ? std::map<std::string, std::string>{} : it->second;
+void ViewerModel::setMethodOf(int side, const QString& method) {
+  QString& current = methods_[index(side)];
+  if (method == current) return;
+  current = method;
+  if (side == 0) emit methodChanged(current);
+  emit sideChanged(side);
 }
 
-void ViewerModel::setParams(const std::map<std::string, std::string>& changes) {
-  auto& current = params_[method_.toStdString()];
+void ViewerModel::setOperationOf(int side, const QString& operation) {
+  QString& current = operations_[index(side)];
+  if (operation == current) return;
+  current = operation;
+  if (side == 0) emit operationChanged(current);
+  emit sideChanged(side);
+}
+
+std::map<std::string, std::string> ViewerModel::paramsOf(int side) const {
+  const ParamsByMethod& all = params_[index(side)];
+  const auto it = all.find(methodOf(side).toStdString());
+  return it == all.end() ? std::map<std::string, std::string>{} : it->second;
+}
+
+void ViewerModel::setParamsOf(int side, const std::map<std::string, std::string>& changes) {
+  auto& current = params_[index(side)][methodOf(side).toStdString()];
   bool changed = false;
   for (const auto& [name, value] : changes) {
     auto [it, inserted] = current.try_emplace(name, value);
@@ -77,68 +133,145 @@ void ViewerModel::setParams(const std::map<std::string, std::string>& changes) {
     it->second = value;
     changed = true;
   }
-  if (changed) emit paramsChanged();
+  if (!changed) return;
+  if (side == 0) emit paramsChanged();
+  emit sideChanged(side);
 }
 
-void ViewerModel::setAllParams(std::map<std::string, std::map<std::string, std::string>> params) {
-  params_ = std::move(params);
-  emit paramsChanged();
+void ViewerModel::setAllParamsOf(int side, ParamsByMethod params) {
+  params_[index(side)] = std::move(params);
+  if (side == 0) emit paramsChanged();
+  emit sideChanged(side);
 }
 
-void ViewerModel::setOperation(const QString& operation) {
-  if (operation == operation_) return;
-  operation_ = operation;
-  emit operationChanged(operation_);
-}
-
-mfr::RenderRequest ViewerModel::renderRequest(QSize size) const {
+mfr::RenderRequest ViewerModel::renderRequest(int side, QSize size) const {
   mfr::RenderRequest request;
-  request.method = method_.toStdString();
-  request.operation = operation_.toStdString();
+  request.method = methodOf(side).toStdString();
+  request.operation = operationOf(side).toStdString();
   request.width = size.width();
   request.height = size.height();
-  request.params = params();
+  request.params = paramsOf(side);
   return request;
+}
+
+// ---- compare mode and data views ----------------------------------------------------------
+
+void ViewerModel::setCompareEnabled(bool enabled) {
+  if (enabled == compare_) return;
+  compare_ = enabled;
+  if (!compare_) {
+    cpuWanted_.erase(CpuSlot::Pane1);
+    frameImage_[1].reset();
+  }
+  emit compareChanged();
+}
+
+void ViewerModel::setCompareLayout(CompareLayout layout) {
+  if (layout == layout_) return;
+  layout_ = layout;
+  emit compareChanged();
+}
+
+void ViewerModel::setCompareSplit(double split) {
+  split = std::clamp(split, 0.0, 1.0);
+  if (split == split_) return;
+  split_ = split;
+  emit compareChanged();
+}
+
+void ViewerModel::setCompareDisplay(CompareDisplay display) {
+  if (display == display_) return;
+  display_ = display;
+  emit compareChanged();
+}
+
+QSize ViewerModel::paneSize() const {
+  if (compare_ && layout_ == CompareLayout::SideBySide)
+    return {std::max(1, renderSize_.width() / 2), renderSize_.height()};
+  return renderSize_;
+}
+
+void ViewerModel::setDataView(DataView view, bool overImage) {
+  if (view == dataView_ && overImage == dataOverImage_) return;
+  dataView_ = view;
+  dataOverImage_ = overImage;
+  emit dataViewChanged();
 }
 
 // ---- scene -------------------------------------------------------------------------------
 
 void ViewerModel::loadSceneAsync(const QString& path) {
-  const quint64 generation = ++loadGeneration_;
+  if (load_) {
+    load_->cancel = true;  // superseded: stop the previous worker early
+    ++abandonedLoads_;
+  }
+  auto state = std::make_shared<LoadState>();
+  load_ = state;
   loading_ = true;
+  loadProgress_ = 0.0;
   emit loadStarted(path);
-  using Loaded = std::variant<mfr::Scene, QString>;
+  emit loadProgressChanged(loadProgress_);
+  loadPoll_->start();
+  struct Loaded {
+    std::optional<mfr::Scene> scene;
+    QString error;
+    bool stopped = false;  // LoadCancelled
+  };
   runInBackground<Loaded>(
       this,
-      [path]() -> Loaded {
+      [path, state]() -> Loaded {
+        Loaded loaded;
+        const mfr::LoadProgress progress{[state](double fraction) {
+          state->fraction = fraction;
+          return !state->cancel;
+        }};
         try {
-          return mfr::loadScene(path.toStdString());
+          loaded.scene = mfr::loadScene(path.toStdString(), progress);
+        } catch (const mfr::LoadCancelled&) {
+          loaded.stopped = true;
         } catch (const std::exception& e) {
-          return QString::fromUtf8(e.what());
+          loaded.error = QString::fromUtf8(e.what());
         }
+        return loaded;
       },
-      [this, path, generation](Loaded loaded) {
-        if (generation != loadGeneration_) return;  // cancelled, or superseded by a newer load
-        loading_ = false;
-        if (auto* message = std::get_if<QString>(&loaded)) {
-          emit loadFailed(path, *message);
+      [this, path, state](Loaded loaded) {
+        if (state != load_) {  // cancelled, or superseded by a newer load
+          --abandonedLoads_;
+          lastCancelStoppedLoader_ = loaded.stopped;
           return;
         }
-        mfr::Scene& scene = std::get<mfr::Scene>(loaded);
+        pollLoadProgress();  // the loader's last report
+        loadPoll_->stop();
+        load_.reset();
+        loading_ = false;
+        if (!loaded.error.isEmpty() || !loaded.scene) {
+          emit loadFailed(path, loaded.error.isEmpty() ? tr("loading stopped") : loaded.error);
+          return;
+        }
         try {
-          scene.validate();
+          loaded.scene->validate();
         } catch (const std::exception& e) {
           emit loadFailed(path, QString::fromUtf8(e.what()));
           return;
         }
-        setScene(std::move(scene), path);
+        setScene(std::move(*loaded.scene), path);
       });
 }
 
+void ViewerModel::pollLoadProgress() {
+  if (!load_) return;
+  const double fraction = load_->fraction;
+  if (fraction == loadProgress_) return;
+  loadProgress_ = fraction;
+  emit loadProgressChanged(loadProgress_);
+}
+
 void ViewerModel::cancelLoad() {
-  if (!loading_) return;
-  // The loaders cannot be interrupted; the worker finishes and its result is dropped.
-  ++loadGeneration_;
+  if (!loading_ || !load_) return;
+  load_->cancel = true;  // the loader throws LoadCancelled at its next report
+  load_.reset();
+  ++abandonedLoads_;
+  loadPoll_->stop();
   loading_ = false;
   emit loadCancelled();
 }
@@ -215,14 +348,13 @@ void ViewerModel::setRenderSize(QSize size) {
 
 // ---- frames ------------------------------------------------------------------------------
 
-void ViewerModel::reportFrame(const mfr::Stats& stats) {
-  stats_ = stats;
+void ViewerModel::reportFrame(int side, const mfr::Stats& stats) {
+  stats_[index(side)] = stats;
   ++framesRendered_;
-  if (!renderError_.isEmpty()) {
-    renderError_.clear();
-    emit renderErrorChanged(renderError_);
-  }
-  emit frameRendered();
+  if (side == 0)
+    emit frameRendered();
+  else
+    emit secondaryFrameRendered();
 }
 
 void ViewerModel::reportRenderError(const QString& message) {
@@ -231,52 +363,189 @@ void ViewerModel::reportRenderError(const QString& message) {
   emit renderErrorChanged(renderError_);
 }
 
-// ---- oracle ------------------------------------------------------------------------------
-
-ViewerModel::OracleKey ViewerModel::currentOracleKey() const {
-  std::string request = operation_.toStdString();
-  for (const auto& [name, value] : params()) request += ";" + name + "=" + value;
-  return {sceneRevision_, viewRevision_, renderSize_, request};
+ImageKey ViewerModel::imageKey(const mfr::RenderRequest& request) const {
+  std::string text = request.method + ";" + request.operation;
+  for (const auto& [name, value] : request.params) text += ";" + name + "=" + value;
+  return {sceneRevision_, viewRevision_, QSize(request.width, request.height), text};
 }
 
-const QImage* ViewerModel::oracleImage() {
-  const OracleKey key = currentOracleKey();
-  if (oracleKey_ == key) return &oracleImage_;
-  if (oracleRunning_) {
-    oracleWanted_ = key;  // picked up when the running job finishes
-    return nullptr;
+ImageKey ViewerModel::frameKey(int side) const {
+  return imageKey(renderRequest(side, paneSize()));
+}
+
+mfr::RenderRequest ViewerModel::referenceRequest() const {
+  mfr::RenderRequest request;
+  request.method = "oracle";
+  request.operation = "oit";  // exact "over" of every fragment, whatever the panes' operation
+  request.width = paneSize().width();
+  request.height = paneSize().height();
+  return request;
+}
+
+// ---- CPU images --------------------------------------------------------------------------
+
+const CpuImage* ViewerModel::cpuImage(CpuSlot slot, const mfr::RenderRequest& request) {
+  const ImageKey key = imageKey(request);
+  for (const auto& cached : cpuCache_) {
+    if (cached->key == key) {
+      cpuLast_[slot] = cached;
+      return cached.get();
+    }
   }
-  oracleRunning_ = true;
-  oracleWanted_ = key;
-  struct Result {
-    OracleKey key;
-    mfr::RenderOutput output;
-    QString error;
-  };
-  runInBackground<Result>(
-      this,
-      [scene = scene_, camera = camera_, request = renderRequest(renderSize_), key]() -> Result {
-        Result r{key, {}, {}};
-        try {
-          r.output = mfr::render(scene, camera, request);
-        } catch (const std::exception& e) {
-          r.error = QString::fromUtf8(e.what());
-        }
-        return r;
-      },
-      [this](const Result& r) {
-        oracleRunning_ = false;
-        if (!r.error.isEmpty()) {
-          reportRenderError(r.error);
-        } else {
-          const mfr::ImageRGBA8& img = r.output.image;
-          oracleImage_ = QImage(img.pixels.data(), img.width, img.height, img.width * 4, QImage::Format_RGBA8888).copy();
-          oracleStats_ = r.output.stats;
-          oracleKey_ = r.key;
-        }
-        emit oracleImageReady();
-      });
+  cpuWanted_[slot] = {key, request};
+  startCpuJob();
   return nullptr;
+}
+
+const CpuImage* ViewerModel::lastCpuImage(CpuSlot slot) const {
+  const auto it = cpuLast_.find(slot);
+  return it == cpuLast_.end() ? nullptr : it->second.get();
+}
+
+void ViewerModel::startCpuJob() {
+  if (cpuRunning_) return;
+  // Panes first (what is on screen), then the reference; wishes for an older scene or view are
+  // dropped (whoever still needs them asks again).
+  std::optional<CpuWish> next;
+  while (!cpuWanted_.empty() && !next) {
+    const auto it = cpuWanted_.begin();
+    CpuWish wish = it->second;
+    cpuWanted_.erase(it);
+    const bool current = wish.key.scene == sceneRevision_ && wish.key.view == viewRevision_;
+    const bool cached =
+        std::any_of(cpuCache_.begin(), cpuCache_.end(), [&](const auto& c) { return c->key == wish.key; });
+    if (current && !cached) next = std::move(wish);
+  }
+  if (!next || !hasScene_) return;
+  cpuRunning_ = true;
+  runInBackground<std::shared_ptr<const CpuImage>>(
+      this,
+      [scene = scene_, camera = camera_, wish = *next]() -> std::shared_ptr<const CpuImage> {
+        auto result = std::make_shared<CpuImage>();
+        result->key = wish.key;
+        try {
+          mfr::RenderOutput output = mfr::render(scene, camera, wish.request);
+          result->image = std::move(output.image);
+          result->stats = std::move(output.stats);
+        } catch (const std::exception& e) {
+          result->error = QString::fromUtf8(e.what());
+        }
+        return result;
+      },
+      [this](const std::shared_ptr<const CpuImage>& result) {
+        cpuRunning_ = false;
+        cpuCache_.push_front(result);
+        while (cpuCache_.size() > kCpuCacheSize) cpuCache_.pop_back();
+        emit cpuImageReady();
+        updateMetrics();
+        startCpuJob();
+      });
+}
+
+// ---- metrics -----------------------------------------------------------------------------
+
+bool ViewerModel::metricsWanted(int side) const {
+  if (!hasScene_ || side >= paneCount()) return false;
+  return compare_ || (side == 0 && qualityWanted_);
+}
+
+bool ViewerModel::metricsCurrent(int side) const {
+  const PaneMetrics& m = metrics_[index(side)];
+  return hasScene_ && (m.valid || !m.error.isEmpty()) && m.key == frameKey(side);
+}
+
+bool ViewerModel::wantsFrameImage(int side) const {
+  if (!hasScene_ || side >= paneCount() || metricsCurrent(side)) return false;
+  const auto& frame = frameImage_[index(side)];
+  if (frame && frame->first == frameKey(side)) return false;
+  // Once frame qualities are asked for, every main frame is kept (a read-back is cheap; drawing
+  // the frame again when the request comes is not).
+  return metricsWanted(side) || (side == 0 && keepFrameImages_);
+}
+
+void ViewerModel::reportFrameImage(int side, const ImageKey& key, mfr::ImageRGBA8 image) {
+  if (key != frameKey(side)) return;  // a frame of an older view
+  frameImage_[index(side)] = std::pair{key, std::move(image)};
+  updateMetrics();
+}
+
+void ViewerModel::requestFrameQuality() {
+  if (!hasScene_) return;
+  if (metricsCurrent(0)) {
+    emit frameQualityReady();
+    return;
+  }
+  qualityWanted_ = true;
+  keepFrameImages_ = true;
+  const auto& frame = frameImage_[0];
+  if (frame && frame->first == frameKey(0))
+    updateMetrics();
+  else
+    emit frameImageWanted();
+}
+
+FrameQuality ViewerModel::frameQuality() const {
+  FrameQuality q;
+  const PaneMetrics& m = metrics_[0];
+  if (!metricsCurrent(0) || !m.valid) return q;
+  q.valid = true;
+  q.method = m.method;
+  q.rmse = m.rmse;
+  q.flipMean = m.flip.mean;
+  q.flipMax = m.flip.max;
+  return q;
+}
+
+void ViewerModel::updateMetrics() {
+  for (int side = 0; side < paneCount(); ++side) {
+    if (!metricsWanted(side) || metricsCurrent(side) || metricsRunning_[index(side)]) continue;
+    const auto& frame = frameImage_[index(side)];
+    if (!frame || frame->first != frameKey(side)) continue;  // the view reads it back when it draws
+    const CpuImage* reference = cpuImage(CpuSlot::Reference, referenceRequest());
+    if (!reference) return;  // cpuImageReady calls again
+    if (!reference->error.isEmpty()) {
+      PaneMetrics failed;
+      failed.key = frame->first;
+      failed.method = methodOf(side);
+      failed.error = reference->error;
+      metrics_[index(side)] = std::move(failed);
+      emit metricsReady(side);
+      continue;
+    }
+    startMetrics(side, reference->image);
+  }
+}
+
+void ViewerModel::startMetrics(int side, const mfr::ImageRGBA8& reference) {
+  metricsRunning_[index(side)] = true;
+  const auto& frame = *frameImage_[index(side)];
+  runInBackground<PaneMetrics>(
+      this,
+      [reference, image = frame.second, key = frame.first, method = methodOf(side)]() -> PaneMetrics {
+        PaneMetrics m;
+        try {
+          m = computeMetrics(reference, image);
+        } catch (const std::exception& e) {
+          m.error = QString::fromUtf8(e.what());
+        }
+        m.key = key;
+        m.method = method;
+        return m;
+      },
+      [this, side](PaneMetrics m) {
+        metricsRunning_[index(side)] = false;
+        metrics_[index(side)] = std::move(m);
+        emit metricsReady(side);
+        if (side == 0 && qualityWanted_ && metricsCurrent(0)) {
+          qualityWanted_ = false;
+          emit frameQualityReady();
+        }
+        updateMetrics();  // a newer frame may be waiting
+      });
+}
+
+bool ViewerModel::busy() const {
+  return loading_ || abandonedLoads_ > 0 || cpuRunning_ || depthRunning_ || metricsRunning_[0] || metricsRunning_[1];
 }
 
 // ---- depth complexity ---------------------------------------------------------------------

@@ -1,44 +1,131 @@
 #pragma once
-// The viewer's state — scene, camera, method, parameters, last frame's Stats — and the work it
-// runs off the GUI thread (loading, the oracle's exact image and depth complexity). Widgets and
-// plugins observe it through ViewerContext's signals; RenderView draws it.
+// The viewer's state — scene, camera, the method of each pane, parameters, last frames' Stats,
+// compare mode, the data view — and the work it runs off the GUI thread: loading (with progress
+// and cancel), CPU images (the oracle and any other CPU method), depth-complexity histograms
+// and image metrics. Widgets and plugins observe it through ViewerContext's signals (and the
+// model's own); RenderView draws it.
+//
+// Sides: side 0 is the main method (ViewerContext's method()); side 1 is the second method of
+// compare mode. Each side has its own method, operation and parameters per method.
 #include <QColor>
 #include <QImage>
 #include <QSize>
 #include <QString>
 
+#include <array>
+#include <deque>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 
+#include "mfr/image.hpp"
+#include "mfr/reference/metrics.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/scene.hpp"
 #include "viewer_plugin.hpp"
+
+class QTimer;
+
+constexpr int kSides = 2;
+
+enum class CompareLayout { SideBySide, Split };
+// What each pane shows in compare mode: its image, or its error against the exact image.
+enum class CompareDisplay { Images, FlipError, Difference };
+
+// What determines an image: scene and view revisions, size, and the request (method, operation,
+// parameters) as text.
+struct ImageKey {
+  quint64 scene = 0, view = 0;
+  QSize size;
+  std::string request;
+  bool operator==(const ImageKey&) const = default;
+};
+
+// An image computed on the CPU by mfr::render (the oracle, or another CPU method).
+struct CpuImage {
+  ImageKey key;
+  mfr::ImageRGBA8 image;
+  mfr::Stats stats;
+  QString error;  // why there is no image
+};
+
+// One pane's frame against the exact image of the same size.
+struct PaneMetrics {
+  ImageKey key;
+  bool valid = false;
+  QString method;
+  QString error;
+  double rmse = 0.0;
+  mfr::FlipStats flip;
+  float maxDifference = 0.0f;     // largest per-pixel |difference| (the difference map's scale)
+  mfr::ImageRGBA8 flipMap;        // magma of the FLIP error, 0 … 1
+  mfr::ImageRGBA8 differenceMap;  // magma of |difference| / maxDifference
+};
+
+// A QImage sharing the pixels of `image` (which must outlive it).
+QImage wrapImage(const mfr::ImageRGBA8& image);
 
 class ViewerModel final : public ViewerContext {
   Q_OBJECT
 
  public:
+  using ParamsByMethod = std::map<std::string, std::map<std::string, std::string>>;
+
   explicit ViewerModel(QObject* parent = nullptr);
   ~ViewerModel() override;
 
-  // ViewerContext
+  // ViewerContext (side 0)
   [[nodiscard]] QStringList methodNames() const override;
   [[nodiscard]] const mfr::MethodInfo* methodInfo(const QString& method) const override;
-  [[nodiscard]] QString method() const override { return method_; }
-  void setMethod(const QString& method) override;
-  [[nodiscard]] std::map<std::string, std::string> params() const override;
-  void setParams(const std::map<std::string, std::string>& changes) override;
+  [[nodiscard]] QString method() const override { return methodOf(0); }
+  void setMethod(const QString& method) override { setMethodOf(0, method); }
+  [[nodiscard]] std::map<std::string, std::string> params() const override { return paramsOf(0); }
+  void setParams(const std::map<std::string, std::string>& changes) override { setParamsOf(0, changes); }
   [[nodiscard]] bool hasScene() const override { return hasScene_; }
-  [[nodiscard]] const mfr::Stats& stats() const override { return stats_; }
+  [[nodiscard]] const mfr::Stats& stats() const override { return stats_[0]; }
   [[nodiscard]] QSize renderSize() const override { return renderSize_; }
   void requestDepthComplexity() override;
+  void requestFrameQuality() override;
+  [[nodiscard]] FrameQuality frameQuality() const override;
+  [[nodiscard]] DataView dataView() const override { return dataView_; }
+  [[nodiscard]] bool dataViewOverImage() const override { return dataOverImage_; }
+  void setDataView(DataView view, bool overImage) override;
 
-  // Scene. loadSceneAsync reads the file on a worker thread; the current scene stays until the
-  // new one has loaded (sceneLoaded) — a failure (loadFailed) or cancelLoad() leaves it intact.
+  // Methods rendered on the CPU by mfr::render (listed by mfr::availableMethods() but not GPU
+  // methods of the registry): "oracle", and e.g. "optimal-k" once mfrcore has it.
+  [[nodiscard]] bool isCpuMethod(const QString& method) const override;
+
+  // Per side (0: main, 1: compare).
+  [[nodiscard]] QString methodOf(int side) const { return methods_[index(side)]; }
+  void setMethodOf(int side, const QString& method);
+  [[nodiscard]] QString operationOf(int side) const { return operations_[index(side)]; }
+  void setOperationOf(int side, const QString& operation);
+  [[nodiscard]] std::map<std::string, std::string> paramsOf(int side) const;
+  void setParamsOf(int side, const std::map<std::string, std::string>& changes);
+  // Parameters set per method (sessions keep those of every method the user touched).
+  [[nodiscard]] const ParamsByMethod& allParamsOf(int side) const { return params_[index(side)]; }
+  void setAllParamsOf(int side, ParamsByMethod params);
+  [[nodiscard]] mfr::RenderRequest renderRequest(int side, QSize size) const;
+  [[nodiscard]] const mfr::Stats& statsOf(int side) const { return stats_[index(side)]; }
+
+  // Side-0 shorthands.
+  [[nodiscard]] QString operation() const { return operationOf(0); }
+  void setOperation(const QString& operation) { setOperationOf(0, operation); }
+  [[nodiscard]] const ParamsByMethod& allParams() const { return allParamsOf(0); }
+  void setAllParams(ParamsByMethod params) { setAllParamsOf(0, std::move(params)); }
+  [[nodiscard]] mfr::RenderRequest renderRequest(QSize size) const { return renderRequest(0, size); }
+
+  // Scene. loadSceneAsync reads the file on a worker thread, reporting loadProgressChanged; the
+  // current scene stays until the new one has loaded (sceneLoaded) — a failure (loadFailed) or
+  // cancelLoad() leaves it intact. cancelLoad also stops the loader at its next progress report.
   void loadSceneAsync(const QString& path);
   void cancelLoad();
   [[nodiscard]] bool isLoading() const { return loading_; }
+  [[nodiscard]] double loadProgress() const { return loadProgress_; }  // of the current or last load
+  // True when the last cancelled (or superseded) load's worker stopped inside the loader
+  // (LoadCancelled) rather than finishing first (its scene was then dropped).
+  [[nodiscard]] bool lastCancelStoppedLoader() const { return lastCancelStoppedLoader_; }
   void setScene(mfr::Scene scene, const QString& path);
   [[nodiscard]] const mfr::Scene& scene() const { return scene_; }
   [[nodiscard]] const QString& scenePath() const { return scenePath_; }
@@ -56,41 +143,79 @@ class ViewerModel final : public ViewerContext {
   void setRenderSize(QSize size);
   [[nodiscard]] quint64 viewRevision() const { return viewRevision_; }
 
-  [[nodiscard]] QString operation() const { return operation_; }
-  void setOperation(const QString& operation);
-  // Parameters set per method (sessions keep those of every method the user touched).
-  [[nodiscard]] const std::map<std::string, std::map<std::string, std::string>>& allParams() const { return params_; }
-  void setAllParams(std::map<std::string, std::map<std::string, std::string>> params);
-  [[nodiscard]] mfr::RenderRequest renderRequest(QSize size) const;
+  // Compare mode: two panes (side 0 and side 1) with one camera, side by side (each half the
+  // width) or split (both full size; side 0 left of the split line, side 1 right of it).
+  [[nodiscard]] bool compareEnabled() const { return compare_; }
+  void setCompareEnabled(bool enabled);
+  [[nodiscard]] CompareLayout compareLayout() const { return layout_; }
+  void setCompareLayout(CompareLayout layout);
+  [[nodiscard]] double compareSplit() const { return split_; }  // 0 … 1 of the width
+  void setCompareSplit(double split);
+  [[nodiscard]] CompareDisplay compareDisplay() const { return display_; }
+  void setCompareDisplay(CompareDisplay display);
+  [[nodiscard]] int paneCount() const { return compare_ ? 2 : 1; }
+  // Image size of each pane: half the view's width (rounded down) side by side, else all of it.
+  [[nodiscard]] QSize paneSize() const;
 
-  // RenderView reports each frame (or why it could not draw one).
-  void reportFrame(const mfr::Stats& stats);
+  // RenderView reports each pane's frame (or why it could not draw one).
+  void reportFrame(int side, const mfr::Stats& stats);
+  void reportFrame(const mfr::Stats& stats) { reportFrame(0, stats); }
   void reportRenderError(const QString& message);
   [[nodiscard]] const QString& renderError() const { return renderError_; }
   [[nodiscard]] quint64 framesRendered() const { return framesRendered_; }
 
-  // The oracle's image of the current scene, view, size and request, or nullptr while it is
-  // being computed (oracleImageReady follows). Computed off the GUI thread.
-  const QImage* oracleImage();
-  [[nodiscard]] const mfr::Stats& oracleStats() const { return oracleStats_; }
-  // The last oracle image computed, whatever view it shows (drawn while a new one is computed).
-  [[nodiscard]] const QImage& lastOracleImage() const { return oracleImage_; }
-  // True while any background job runs (loading, oracle image, depth complexity).
-  [[nodiscard]] bool busy() const { return loading_ || oracleRunning_ || depthRunning_; }
+  // What the pane of `side` shows now, and the exact reference image of the panes' size.
+  [[nodiscard]] ImageKey frameKey(int side) const;
+  [[nodiscard]] mfr::RenderRequest referenceRequest() const;
+  // Metrics are computed for both panes in compare mode, and for side 0 when a frame quality was
+  // requested. The view reads a frame back only when wantsFrameImage says so.
+  [[nodiscard]] bool wantsFrameImage(int side) const;
+  void reportFrameImage(int side, const ImageKey& key, mfr::ImageRGBA8 image);
+  [[nodiscard]] const PaneMetrics& metrics(int side) const { return metrics_[index(side)]; }
+  // metrics(side) describes the frame the pane shows now.
+  [[nodiscard]] bool metricsCurrent(int side) const;
+
+  // CPU images by purpose: each slot wants one image at a time (a newer request replaces an
+  // older one not yet started); one job runs at a time, newest wishes first.
+  enum class CpuSlot { Pane0, Pane1, Reference };
+  // The image for `request` at the current scene and view, or nullptr while it is computed
+  // (cpuImageReady follows).
+  const CpuImage* cpuImage(CpuSlot slot, const mfr::RenderRequest& request);
+  // The last image delivered for the slot, whatever view it shows (drawn while the next one is
+  // computed); nullptr before the first.
+  [[nodiscard]] const CpuImage* lastCpuImage(CpuSlot slot) const;
+  [[nodiscard]] static CpuSlot paneSlot(int side) { return side == 0 ? CpuSlot::Pane0 : CpuSlot::Pane1; }
+
+  // True while any background job runs (loading — also a cancelled load's worker until it stops —,
+  // CPU images, depth complexity, metrics).
+  [[nodiscard]] bool busy() const;
 
  signals:
   void loadStarted(const QString& path);
+  void loadProgressChanged(double fraction);
   void sceneLoaded();  // followed by sceneChanged
   void loadFailed(const QString& path, const QString& message);
   void loadCancelled();
-  void operationChanged(const QString& operation);
-  void oracleImageReady();
+  void operationChanged(const QString& operation);  // side 0
+  void sideChanged(int side);                       // method, operation or parameters of a side
+  void compareChanged();                            // enabled, layout, split or display
+  void secondaryFrameRendered();                    // statsOf(1) describes the new frame
+  void cpuImageReady();
+  void metricsReady(int side);
+  void frameImageWanted();  // a frame quality was requested: the view reads back what it shows
   void renderErrorChanged(const QString& message);
 
  private:
+  [[nodiscard]] static std::size_t index(int side) { return side == 1 ? 1 : 0; }
+  [[nodiscard]] ImageKey imageKey(const mfr::RenderRequest& request) const;
+  [[nodiscard]] bool metricsWanted(int side) const;
   void sceneEdited();
   void updateSceneGeometry();
   void startDepthComplexity();
+  void startCpuJob();
+  void updateMetrics();
+  void startMetrics(int side, const mfr::ImageRGBA8& reference);
+  void pollLoadProgress();
 
   mfr::Scene scene_;
   bool hasScene_ = false;
@@ -103,30 +228,46 @@ class ViewerModel final : public ViewerContext {
   QSize renderSize_{1, 1};
   quint64 viewRevision_ = 0;
 
-  QString method_ = QStringLiteral("abuffer-ll");
-  QString operation_ = QStringLiteral("oit");
-  std::map<std::string, std::map<std::string, std::string>> params_;
+  std::array<QString, kSides> methods_{QStringLiteral("abuffer-ll"), QStringLiteral("kplus-array")};
+  std::array<QString, kSides> operations_{QStringLiteral("oit"), QStringLiteral("oit")};
+  std::array<ParamsByMethod, kSides> params_;
 
-  mfr::Stats stats_;
+  bool compare_ = false;
+  CompareLayout layout_ = CompareLayout::SideBySide;
+  double split_ = 0.5;
+  CompareDisplay display_ = CompareDisplay::Images;
+  DataView dataView_ = DataView::Image;
+  bool dataOverImage_ = false;
+
+  std::array<mfr::Stats, kSides> stats_;
   QString renderError_;
   quint64 framesRendered_ = 0;
 
+  // Loading: the worker writes progress and reads the cancel flag of its own state.
+  struct LoadState;
+  std::shared_ptr<LoadState> load_;
   bool loading_ = false;
-  quint64 loadGeneration_ = 0;
+  double loadProgress_ = 0.0;
+  bool lastCancelStoppedLoader_ = false;
+  int abandonedLoads_ = 0;  // cancelled or superseded loads whose workers still run
+  QTimer* loadPoll_ = nullptr;
 
-  // Oracle image cache, keyed by what determines it.
-  struct OracleKey {
-    quint64 scene = 0, view = 0;
-    QSize size;
-    std::string request;
-    bool operator==(const OracleKey&) const = default;
+  // CPU images.
+  struct CpuWish {
+    ImageKey key;
+    mfr::RenderRequest request;
   };
-  [[nodiscard]] OracleKey currentOracleKey() const;
-  std::optional<OracleKey> oracleKey_;    // of oracleImage_
-  std::optional<OracleKey> oracleWanted_; // being computed
-  bool oracleRunning_ = false;
-  QImage oracleImage_;
-  mfr::Stats oracleStats_;
+  std::map<CpuSlot, CpuWish> cpuWanted_;
+  std::deque<std::shared_ptr<const CpuImage>> cpuCache_;  // newest first
+  std::map<CpuSlot, std::shared_ptr<const CpuImage>> cpuLast_;
+  bool cpuRunning_ = false;
+
+  // Metrics.
+  bool qualityWanted_ = false;
+  bool keepFrameImages_ = false;
+  std::array<std::optional<std::pair<ImageKey, mfr::ImageRGBA8>>, kSides> frameImage_;
+  std::array<PaneMetrics, kSides> metrics_;
+  std::array<bool, kSides> metricsRunning_{false, false};
 
   bool depthRunning_ = false;
   bool depthPending_ = false;

@@ -22,6 +22,22 @@
 
 class QWidget;
 
+// What the view shows per pixel: the rendered image, or a heat map of the data behind it.
+enum class DataView {
+  Image,
+  DepthComplexity,  // n(p): fragments per pixel, exact (GPU count pass)
+  Capacity,         // k(p): the method's per-pixel capacity in the last frame
+};
+
+// The current frame against the exact image (the oracle's "over" of every fragment), same size.
+struct FrameQuality {
+  bool valid = false;    // computed for the frame now shown
+  QString method;
+  double rmse = 0.0;     // mfr::rmse over RGB, 8-bit values scaled to [0,1]
+  double flipMean = 0.0; // mean LDR-FLIP error, 67 pixels per degree
+  double flipMax = 0.0;
+};
+
 class ViewerContext : public QObject {
   Q_OBJECT
 
@@ -29,10 +45,14 @@ class ViewerContext : public QObject {
   using QObject::QObject;
   ~ViewerContext() override = default;
 
-  // Render methods: "oracle" (exact, CPU) first, then every registered GPU method.
+  // Render methods: "oracle" (exact, CPU) first, then every registered GPU method, then any
+  // other CPU method mfrcore offers (computed off the GUI thread, like the oracle).
   [[nodiscard]] virtual QStringList methodNames() const = 0;
-  // The method's description and parameters; nullptr for "oracle" or an unknown name.
+  // The method's description and parameters; nullptr for CPU methods ("oracle", …) or an unknown
+  // name.
   [[nodiscard]] virtual const mfr::MethodInfo* methodInfo(const QString& method) const = 0;
+  // Rendered on the CPU off the GUI thread (the oracle, optimal-k …) rather than on the GPU.
+  [[nodiscard]] virtual bool isCpuMethod(const QString& method) const = 0;
   [[nodiscard]] virtual QString method() const = 0;
   virtual void setMethod(const QString& method) = 0;
   // Parameter values of the current method (only those set explicitly; the rest take defaults).
@@ -48,6 +68,15 @@ class ViewerContext : public QObject {
   // Starts (or queues) the exact per-pixel fragment counts of the current view, computed off the
   // GUI thread by the oracle; depthComplexityReady delivers the histogram.
   virtual void requestDepthComplexity() = 0;
+  // Starts (or queues) RMSE and FLIP of the current frame against the exact image, computed off
+  // the GUI thread; frameQualityReady follows. frameQuality() is valid while it describes the
+  // frame on screen.
+  virtual void requestFrameQuality() = 0;
+  [[nodiscard]] virtual FrameQuality frameQuality() const = 0;
+  // The view's data mode; overImage blends the heat map over the image (empty pixels clear).
+  [[nodiscard]] virtual DataView dataView() const = 0;
+  [[nodiscard]] virtual bool dataViewOverImage() const = 0;
+  virtual void setDataView(DataView view, bool overImage) = 0;
 
  signals:
   void sceneChanged();                 // a new scene, or an object edited
@@ -57,6 +86,8 @@ class ViewerContext : public QObject {
   void frameRendered();                // stats() describes the new frame
   // histogram[n] = pixels with exactly n fragments; the image size it was computed at.
   void depthComplexityReady(const QVector<quint64>& histogram, QSize size);
+  void frameQualityReady();
+  void dataViewChanged();
 };
 
 class MfrViewerPlugin {
@@ -72,5 +103,6 @@ class MfrViewerPlugin {
   virtual void loadSettings(const QJsonObject& settings) = 0;
 };
 
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.0"
+// 1.1: frame quality and data views in ViewerContext (plugins built for 1.0 are refused).
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.1"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -1,6 +1,8 @@
 #include "budget_panel.hpp"
 
+#include <QCheckBox>
 #include <QComboBox>
+#include <QDoubleSpinBox>
 #include <QFormLayout>
 #include <QGroupBox>
 #include <QLabel>
@@ -24,6 +26,23 @@ constexpr double kMiB = 1024.0 * 1024.0;
 constexpr int kMaxCorrections = 3;
 constexpr int kDefaultBudgetMiB = 16;
 constexpr double kPoolMarginBytes = 1024;
+// Quality is measured once the view has been still this long: it costs an exact CPU image, which
+// a short pause between two camera moves should not start.
+constexpr int kQualityDelayMs = 1200;
+constexpr int kRobustnessSteps = 1000;
+
+// A CPU method other than the oracle (e.g. optimal-k): computed when shown, off the GUI thread.
+// Without ParamSpecs to read, it is given the budget as budget_mib like its GPU competitors.
+bool isOnDemandCpuMethod(const ViewerContext& ctx, const QString& method) {
+  return method != QLatin1String("oracle") && ctx.isCpuMethod(method);
+}
+
+const mfr::ParamSpec* findParam(const ViewerContext& ctx, const QString& method, const std::string& name) {
+  if (const mfr::MethodInfo* info = ctx.methodInfo(method))
+    for (const mfr::ParamSpec& spec : info->params)
+      if (spec.name == name) return &spec;
+  return nullptr;
+}
 
 QString mib(double bytes) { return QString::number(bytes / kMiB, 'f', bytes < 10 * kMiB ? 2 : 1); }
 
@@ -45,8 +64,11 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   methodCombo_ = new QComboBox;
   methodCombo_->setObjectName(QStringLiteral("budgetMethodCombo"));
   methodCombo_->setPlaceholderText(tr("(current method has no memory parameter)"));
-  for (const QString& name : ctx_.methodNames())
-    if (driverFor(name).knob != Knob::None) methodCombo_->addItem(name, name);
+  // From the registry (and mfrcore's CPU methods), never a fixed list.
+  for (const QString& name : ctx_.methodNames()) {
+    if (driverFor(name).knob == Knob::None) continue;
+    methodCombo_->addItem(isOnDemandCpuMethod(ctx_, name) ? tr("%1 (CPU, on demand)").arg(name) : name, name);
+  }
   form->addRow(tr("Method"), methodCombo_);
 
   auto* budgetRow = new QHBoxLayout;
@@ -68,6 +90,25 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   knobLabel_ = new QLabel;
   knobLabel_->setWordWrap(true);
   form->addRow(tr("Drives"), knobLabel_);
+
+  // R_h of kplus-dynamic (and any method with a `robustness` parameter).
+  robustnessRow_ = new QWidget;
+  auto* robustnessLayout = new QHBoxLayout(robustnessRow_);
+  robustnessLayout->setContentsMargins(0, 0, 0, 0);
+  robustnessSlider_ = new QSlider(Qt::Horizontal);
+  robustnessSlider_->setObjectName(QStringLiteral("budgetRobustnessSlider"));
+  robustnessSlider_->setRange(0, kRobustnessSteps);
+  robustness_ = new QDoubleSpinBox;
+  robustness_->setObjectName(QStringLiteral("budgetRobustness"));
+  robustness_->setDecimals(3);
+  robustness_->setSingleStep(0.01);
+  robustness_->setKeyboardTracking(false);
+  robustnessLayout->addWidget(robustnessSlider_, 1);
+  robustnessLayout->addWidget(robustness_);
+  robustnessLabel_ = new QLabel(tr("Robustness R_h"));
+  robustnessLabel_->setToolTip(tr("Fraction of the frame's fragments the chosen k should capture (within the budget)"));
+  robustnessRow_->setToolTip(robustnessLabel_->toolTip());
+  form->addRow(robustnessLabel_, robustnessRow_);
   layout->addLayout(form);
 
   auto* frameBox = new QGroupBox(tr("Last frame"));
@@ -84,6 +125,17 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   frameForm->addRow(tr("Holding data"), memoryLabel_);
   frameForm->addRow(tr("Captured"), capturedLabel_);
   frameForm->addRow(tr("k"), kLabel_);
+  rmseLabel_ = new QLabel(tr("—"));
+  rmseLabel_->setObjectName(QStringLiteral("budgetRmse"));
+  flipLabel_ = new QLabel(tr("—"));
+  flipLabel_->setObjectName(QStringLiteral("budgetFlip"));
+  rmseLabel_->setToolTip(tr("Root-mean-square RGB error against the exact image (oracle), 0 … 1"));
+  flipLabel_->setToolTip(tr("Mean (max) LDR-FLIP error against the exact image: 0 identical … 1 most different"));
+  frameForm->addRow(tr("RMSE vs exact"), rmseLabel_);
+  frameForm->addRow(tr("FLIP vs exact"), flipLabel_);
+  kMapOverlay_ = new QCheckBox(tr("Show k(p) over the image"));
+  kMapOverlay_->setObjectName(QStringLiteral("budgetKMapOverlay"));
+  frameForm->addRow(kMapOverlay_);
   layout->addWidget(frameBox);
 
   histogram_ = new HistogramWidget;
@@ -105,6 +157,31 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   });
   connect(&ctx_, &ViewerContext::methodChanged, this, &BudgetPanel::methodChanged);
   connect(&ctx_, &ViewerContext::frameRendered, this, &BudgetPanel::frameRendered);
+
+  qualityTimer_ = new QTimer(this);
+  qualityTimer_->setSingleShot(true);
+  qualityTimer_->setInterval(kQualityDelayMs);
+  connect(qualityTimer_, &QTimer::timeout, this, [this] {
+    if (isVisible()) ctx_.requestFrameQuality();  // hidden panels cost nothing
+  });
+  connect(&ctx_, &ViewerContext::frameQualityReady, this, &BudgetPanel::showQuality);
+
+  connect(robustnessSlider_, &QSlider::valueChanged, this, [this](int v) {
+    const double span = robustness_->maximum() - robustness_->minimum();
+    robustness_->setValue(robustness_->minimum() + span * v / kRobustnessSteps);
+  });
+  connect(robustness_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+    if (!findParam(ctx_, ctx_.method(), "robustness")) return;
+    ctx_.setParams({{"robustness", QString::number(v, 'g', 6).toStdString()}});
+  });
+  connect(&ctx_, &ViewerContext::paramsChanged, this, &BudgetPanel::showRobustness);
+
+  connect(kMapOverlay_, &QCheckBox::toggled, this,
+          [this](bool on) { ctx_.setDataView(on ? DataView::Capacity : DataView::Image, on); });
+  connect(&ctx_, &ViewerContext::dataViewChanged, this, [this] {
+    const QSignalBlocker block(kMapOverlay_);
+    kMapOverlay_->setChecked(ctx_.dataView() == DataView::Capacity && ctx_.dataViewOverImage());
+  });
   methodChanged();
 }
 
@@ -113,7 +190,13 @@ int BudgetPanel::budgetMiB() const { return spin_->value(); }
 BudgetPanel::Driver BudgetPanel::driverFor(const QString& method) const {
   Driver d;
   const mfr::MethodInfo* info = ctx_.methodInfo(method);
-  if (!info) return d;
+  if (!info) {
+    if (isOnDemandCpuMethod(ctx_, method)) {  // (with a MethodInfo it is read like any other)
+      d.knob = Knob::Budget;
+      d.param = "budget_mib";
+    }
+    return d;
+  }
   const auto find = [&](const std::string& name) -> const mfr::ParamSpec* {
     for (const mfr::ParamSpec& s : info->params)
       if (s.name == name) return &s;
@@ -164,7 +247,32 @@ void BudgetPanel::methodChanged() {
       break;
   }
   corrections_ = 0;
+  showRobustness();
   if (driving_) applyBudget();
+}
+
+void BudgetPanel::showRobustness() {
+  const mfr::ParamSpec* spec = findParam(ctx_, ctx_.method(), "robustness");
+  robustnessRow_->setVisible(spec != nullptr);
+  robustnessLabel_->setVisible(spec != nullptr);
+  if (!spec) return;
+  const QSignalBlocker a(robustness_), b(robustnessSlider_);
+  robustness_->setRange(spec->min, spec->max);
+  const double value = QString::fromStdString(parameterValue(ctx_, "robustness")).toDouble();
+  robustness_->setValue(value);
+  const double span = std::max(spec->max - spec->min, 1e-9);
+  robustnessSlider_->setValue(static_cast<int>(std::lround((value - spec->min) / span * kRobustnessSteps)));
+}
+
+void BudgetPanel::showQuality() {
+  const FrameQuality q = ctx_.frameQuality();
+  if (!q.valid) {
+    rmseLabel_->setText(tr("computing…"));
+    flipLabel_->setText(tr("computing…"));
+    return;
+  }
+  rmseLabel_->setText(QString::number(q.rmse, 'f', 5));
+  flipLabel_->setText(tr("%1 (max %2)").arg(q.flipMean, 0, 'f', 4).arg(q.flipMax, 0, 'f', 3));
 }
 
 void BudgetPanel::applyBudget() {
@@ -220,6 +328,8 @@ void BudgetPanel::frameRendered() {
     fit_.poolOverhead = overhead;
   }
   showFrame();
+  showQuality();
+  qualityTimer_->start();
   // A better model (or an over-budget frame) changes the parameter: re-render, a few times at
   // most per budget change. Deferred: this runs inside the view's paint.
   if (driving_ && refit && corrections_ < kMaxCorrections) {

@@ -8,6 +8,13 @@
 //                                         (a starts at 8 bytes per slot per pixel).
 // A frame that still exceeds M refits the model and tries again (a few times at most), so the
 // settled frame stays within budget whenever the method's smallest setting fits.
+//
+// The methods offered are every registered GPU method with one of those parameters (fkb, vkb,
+// dkb … appear as soon as the registry has them), plus CPU methods besides the oracle (such as
+// optimal-k), computed on demand off the GUI thread and given budget_mib like kplus-dynamic.
+// The panel also shows the frame's RMSE and FLIP against the exact image once the view is at
+// rest, the robustness ratio R_h of methods that have one (kplus-dynamic) and a switch for the
+// k(p) map over the image.
 #include <QJsonObject>
 #include <QWidget>
 
@@ -15,7 +22,9 @@
 #include <map>
 #include <string>
 
+class QCheckBox;
 class QComboBox;
+class QDoubleSpinBox;
 class QLabel;
 class QProgressBar;
 class QSlider;
@@ -49,6 +58,8 @@ class BudgetPanel final : public QWidget {
   void frameRendered();
   void showFrame();
   void methodChanged();
+  void showRobustness();
+  void showQuality();
 
   ViewerContext& ctx_;
   QComboBox* methodCombo_ = nullptr;
@@ -61,6 +72,14 @@ class BudgetPanel final : public QWidget {
   QLabel* kLabel_ = nullptr;
   HistogramWidget* histogram_ = nullptr;
   QTimer* histogramTimer_ = nullptr;
+  QDoubleSpinBox* robustness_ = nullptr;
+  QSlider* robustnessSlider_ = nullptr;
+  QWidget* robustnessRow_ = nullptr;
+  QLabel* robustnessLabel_ = nullptr;
+  QLabel* rmseLabel_ = nullptr;
+  QLabel* flipLabel_ = nullptr;
+  QTimer* qualityTimer_ = nullptr;
+  QCheckBox* kMapOverlay_ = nullptr;
 
   bool driving_ = false;   // the slider has been used: the budget owns the method's parameter
   int corrections_ = 0;    // refits after an over-budget frame, per budget change

@@ -1,5 +1,6 @@
 // mfrview GUI tests (QtTest): the real MainWindow with its docks and the budget plugin, on an X
 // server with Mesa llvmpipe. Each test function is one ctest test (tests/app/CMakeLists.txt).
+#include <QAction>
 #include <QCheckBox>
 #include <QComboBox>
 #include <QDockWidget>
@@ -7,22 +8,34 @@
 #include <QLineEdit>
 #include <QMessageBox>
 #include <QProcess>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSignalSpy>
 #include <QSlider>
 #include <QSpinBox>
 #include <QStandardPaths>
 #include <QSurfaceFormat>
+#include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTreeWidget>
 #include <QtTest>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <vector>
 
 #include "camera_navigator.hpp"
 #include "main_window.hpp"
 #include "mfr/image.hpp"
+#include "mfr/io/load.hpp"
 #include "mfr/methods/registry.hpp"
+#include "mfr/reference/metrics.hpp"
+#include "mfr/reference/oracle.hpp"
+#include "mfr/render.hpp"
 #include "render_view.hpp"
+#include "view_overlays.hpp"
 #include "viewer_model.hpp"
 
 namespace {
@@ -63,6 +76,62 @@ mfr::ImageRGBA8 fromQImage(const QImage& image) {
     std::copy_n(rgba.constScanLine(y), rgba.width() * 4, out.at(0, y));
   return out;
 }
+
+mfr::ImageRGBA8 crop(const mfr::ImageRGBA8& image, const QRect& r) {
+  mfr::ImageRGBA8 out(r.width(), r.height());
+  for (int y = 0; y < r.height(); ++y) std::copy_n(image.at(r.x(), r.y() + y), r.width() * 4, out.at(0, y));
+  return out;
+}
+
+// The exact image (oracle, "over" of every fragment) of the model's scene and camera.
+mfr::ImageRGBA8 exactImage(const ViewerModel& m, QSize size) {
+  mfr::RenderRequest request;
+  request.width = size.width();
+  request.height = size.height();
+  return mfr::render(m.scene(), m.camera(), request).image;
+}
+
+// A binary STL of `triangles` small triangles in rows (a flat strip), for loading tests.
+void writeBinaryStl(const QString& path, int triangles) {
+  QByteArray data(80, '\0');
+  const auto append = [&data](const void* p, int n) { data.append(static_cast<const char*>(p), n); };
+  const auto count = static_cast<quint32>(triangles);
+  append(&count, 4);
+  for (int i = 0; i < triangles; ++i) {
+    const float x = static_cast<float>(i % 400) * 0.01f, y = static_cast<float>(i / 400) * 0.01f;
+    const float v[12] = {0, 0, 1, x, y, 0, x + 0.01f, y, 0, x, y + 0.01f, 0};
+    append(v, sizeof v);
+    const quint16 attributes = 0;
+    append(&attributes, 2);
+  }
+  QFile f(path);
+  if (f.open(QIODevice::WriteOnly)) f.write(data);
+}
+
+// A .mfrscene of `objects` copies of one model file (and one primitive, which loads no file).
+void writeSceneFile(const QString& path, const QString& model, int objects) {
+  QString json = QStringLiteral("{\"name\": \"%1\", \"objects\": [").arg(QFileInfo(path).baseName());
+  for (int i = 0; i < objects; ++i)
+    json += QStringLiteral("{\"name\": \"part %1\", \"file\": \"%2\", \"transform\": {\"translate\": [0, 0, %1]}},")
+                .arg(i)
+                .arg(QFileInfo(model).fileName());
+  json += QStringLiteral("{\"name\": \"ball\", \"primitive\": {\"type\": \"sphere\", \"radius\": 0.5}}]}");
+  QFile f(path);
+  if (f.open(QIODevice::WriteOnly)) f.write(json.toUtf8());
+}
+
+// Every fraction a loader reports; optionally cancels at report number `cancelAt` (1-based).
+struct ProgressRecorder {
+  std::vector<double> fractions;
+  std::size_t cancelAt = 0;
+  mfr::LoadProgress progress() {
+    return {[this](double f) {
+      fractions.push_back(f);
+      return cancelAt == 0 || fractions.size() < cancelAt;
+    }};
+  }
+  [[nodiscard]] bool monotonic() const { return std::is_sorted(fractions.begin(), fractions.end()); }
+};
 
 // Runs a program; returns its exit code (output kept for failure messages).
 int runProgram(const QString& program, const QStringList& args, QString* output) {
@@ -234,16 +303,33 @@ class ViewerTest : public QObject {
       m.setObjectMaterial(2, glm::vec4(0.2f, 0.6f, 0.9f, 0.45f));
       settle(m);
       before = w->view().renderImage(size);
+      // Compare mode with the second method's own parameters, and the data view.
+      m.setMethodOf(1, "kplus-array");
+      m.setParamsOf(1, {{"k", "3"}});
+      m.setCompareLayout(CompareLayout::Split);
+      m.setCompareSplit(0.25);
+      m.setCompareDisplay(CompareDisplay::Difference);
+      m.setCompareEnabled(true);
+      m.setDataView(DataView::Capacity, true);
       w->saveSession(sessionPath);
     }
     auto w = openWindow(QString());
     QVERIFY(w);
+    w->view().setFixedSize(size);  // compare mode comes back on: keep its exact images small
     w->openSession(sessionPath);
     ViewerModel& m = w->model();
     QTRY_VERIFY_WITH_TIMEOUT(m.hasScene() && m.method() == "kbuffer" && m.framesRendered() > 0, kTimeoutMs);
     settle(m);
     QCOMPARE(m.params().at("k"), std::string("5"));
     QVERIFY(!m.scene().objects[1].visible);
+    QVERIFY(m.compareEnabled());
+    QCOMPARE(m.methodOf(1), QStringLiteral("kplus-array"));
+    QCOMPARE(m.paramsOf(1).at("k"), std::string("3"));
+    QCOMPARE(m.compareLayout(), CompareLayout::Split);
+    QCOMPARE(m.compareSplit(), 0.25);
+    QCOMPARE(m.compareDisplay(), CompareDisplay::Difference);
+    QVERIFY(m.dataView() == DataView::Capacity && m.dataViewOverImage());
+    QVERIFY(w->findChild<QAction*>("actionCompare")->isChecked());
     const mfr::ImageRGBA8 after = w->view().renderImage(size);
     QCOMPARE(maxChannelDifference(before, after), 0);
   }
@@ -303,6 +389,362 @@ class ViewerTest : public QObject {
       worst = std::max(worst, diff);
     }
     qInfo("widget vs mfr render: max channel difference %d", worst);
+  }
+
+  // Compare mode: two methods, one camera; each pane is the CLI's image of its settings, and the
+  // metrics are those of the pixels on screen against the exact image.
+  void compareMode() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(320, 200);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(320, 200), kTimeoutMs);
+    m.setMethod("abuffer-ll");
+    m.setCamera(m.scene().view("iso"));
+    auto* compare = w->findChild<QAction*>("actionCompare");
+    QVERIFY(compare);
+    QCOMPARE(compare->shortcut(), QKeySequence(Qt::Key_C));
+    compare->trigger();
+    QVERIFY(m.compareEnabled());
+    // The second method through its own generated panel: its k is not the first method's.
+    auto* methodB = w->findChild<QComboBox*>("methodComboB");
+    QVERIFY(methodB);
+    methodB->setCurrentIndex(methodB->findData(QStringLiteral("kplus-array")));
+    QCOMPARE(m.methodOf(1), QStringLiteral("kplus-array"));
+    auto* kB = w->findChild<QSpinBox*>("param-k-B");
+    QVERIFY(kB);
+    kB->setValue(1);
+    QCOMPARE(m.paramsOf(1).at("k"), std::string("1"));
+    QVERIFY(!m.allParamsOf(0).contains("kplus-array"));
+    QCOMPARE(m.paneSize(), QSize(160, 200));
+    settle(m);
+    QTRY_VERIFY_WITH_TIMEOUT(m.metricsCurrent(0) && m.metricsCurrent(1), kTimeoutMs);
+    const PaneMetrics exactA = m.metrics(0), k1 = m.metrics(1);
+    QVERIFY2(exactA.valid && k1.valid, qPrintable(exactA.error + k1.error));
+    qInfo("side by side 160x200: abuffer-ll RMSE %.6f FLIP %.5f; kplus-array k=1 RMSE %.6f FLIP %.5f", exactA.rmse,
+          exactA.flip.mean, k1.rmse, k1.flip.mean);
+    QVERIFY(exactA.rmse <= 1.0 / 255.0);  // an exact method differs only by rounding
+    QVERIFY(exactA.flip.mean < 0.02);
+    QVERIFY(k1.rmse > 0.05 && k1.rmse > 10.0 * exactA.rmse);
+    QVERIFY(k1.flip.mean > 0.1 && k1.flip.mean > 5.0 * exactA.flip.mean);
+
+    // The halves on screen: the CLI's images, and the very pixels the metrics describe.
+    QTemporaryDir dir;
+    const auto cli = [&](const QStringList& settings, QSize size) {
+      const QString png = dir.filePath(QStringLiteral("cli-%1.png").arg(settings.join('_')));
+      QString out;
+      const QStringList args = QStringList{"render", "@sample", "--view", "iso", "--size",
+                                           QStringLiteral("%1x%2").arg(size.width()).arg(size.height()), "-o", png} +
+                               settings;
+      if (runProgram(MFR_CLI, args, &out) != 0) qWarning("%s", qPrintable(out));
+      return mfr::readPng(png.toStdString());
+    };
+    const QStringList settingsA{"--method", "abuffer-ll"}, settingsB1{"--method", "kplus-array", "-p", "k=1"};
+    mfr::ImageRGBA8 screen = fromQImage(w->view().grabFramebuffer());
+    const mfr::ImageRGBA8 left = crop(screen, QRect(0, 0, 160, 200)), right = crop(screen, QRect(160, 0, 160, 200));
+    const int diffA = maxChannelDifference(left, cli(settingsA, QSize(160, 200)));
+    const int diffB = maxChannelDifference(right, cli(settingsB1, QSize(160, 200)));
+    qInfo("side by side vs mfr render: max channel difference A %d, B %d", diffA, diffB);
+    QVERIFY(diffA >= 0 && diffA <= 1);
+    QVERIFY(diffB >= 0 && diffB <= 1);
+    const mfr::ImageRGBA8 exact = exactImage(m, QSize(160, 200));
+    QVERIFY(std::abs(mfr::rmse(exact, left) - exactA.rmse) < 1e-9);
+    QVERIFY(std::abs(mfr::rmse(exact, right) - k1.rmse) < 1e-9);
+    QVERIFY(std::abs(mfr::flip(exact, right).stats.mean - k1.flip.mean) < 1e-9);
+    // The panel and the captions show the same numbers.
+    auto* table = w->findChild<QTableWidget*>("compareMetrics");
+    QVERIFY(table);
+    QCOMPARE(table->item(1, 1)->text(), QString::number(k1.rmse, 'f', 5));
+    QVERIFY(w->findChild<PaneCaption*>("paneCaptionB")->text().contains(QString::number(k1.rmse, 'f', 5)));
+
+    // Live: a better k on side B, better numbers; side A untouched.
+    kB->setValue(2);
+    settle(m);
+    QTRY_VERIFY_WITH_TIMEOUT(m.metricsCurrent(0) && m.metricsCurrent(1), kTimeoutMs);
+    const PaneMetrics k2 = m.metrics(1);
+    qInfo("kplus-array k=2 RMSE %.6f FLIP %.5f", k2.rmse, k2.flip.mean);
+    QVERIFY(k2.valid && k2.rmse < k1.rmse && k2.rmse > exactA.rmse);
+    QCOMPARE(m.metrics(0).rmse, exactA.rmse);
+
+    // Split: both full size, side A left of the line and side B right of it.
+    m.setCompareLayout(CompareLayout::Split);
+    m.setCompareSplit(0.5);
+    QCOMPARE(m.paneSize(), QSize(320, 200));
+    settle(m);
+    QTRY_VERIFY_WITH_TIMEOUT(m.metricsCurrent(0) && m.metricsCurrent(1), kTimeoutMs);
+    screen = fromQImage(w->view().grabFramebuffer());
+    const QStringList settingsB2{"--method", "kplus-array", "-p", "k=2"};
+    const mfr::ImageRGBA8 fullA = cli(settingsA, QSize(320, 200)), fullB = cli(settingsB2, QSize(320, 200));
+    const QRect leftPart(0, 0, 160, 200), rightPart(160, 0, 160, 200);
+    const int splitA = maxChannelDifference(crop(screen, leftPart), crop(fullA, leftPart));
+    const int splitB = maxChannelDifference(crop(screen, rightPart), crop(fullB, rightPart));
+    qInfo("split vs mfr render: max channel difference A %d, B %d; RMSE A %.6f B %.6f", splitA, splitB,
+          m.metrics(0).rmse, m.metrics(1).rmse);
+    QVERIFY(splitA >= 0 && splitA <= 1);
+    QVERIFY(splitB >= 0 && splitB <= 1);
+    QVERIFY(m.metrics(0).rmse <= 1.0 / 255.0 && m.metrics(1).rmse > 10.0 * m.metrics(0).rmse);
+
+    // The FLIP heat map of each side (magma of the per-pixel error), computed here from the CLI's
+    // images: exactly what the view shows when those images are identical to its own.
+    m.setCompareDisplay(CompareDisplay::FlipError);
+    settle(m);
+    screen = fromQImage(w->view().grabFramebuffer());
+    const mfr::ImageRGBA8 exactFull = exactImage(m, QSize(320, 200));
+    const mfr::ImageRGBA8 heatA = mfr::magma(mfr::flip(exactFull, fullA).errorMap);
+    const mfr::ImageRGBA8 heatB = mfr::magma(mfr::flip(exactFull, fullB).errorMap);
+    const int heatDiffA = maxChannelDifference(crop(screen, leftPart), crop(heatA, leftPart));
+    const int heatDiffB = maxChannelDifference(crop(screen, rightPart), crop(heatB, rightPart));
+    qInfo("FLIP heat maps vs FLIP of the CLI images: max channel difference A %d, B %d", heatDiffA, heatDiffB);
+    if (splitA == 0 && splitB == 0) {
+      QCOMPARE(heatDiffA, 0);
+      QCOMPARE(heatDiffB, 0);
+    }
+    QVERIFY(w->findChild<MapLegend*>("mapLegendB")->isVisible());
+  }
+
+  // n(p) equals the oracle's exact counts; k(p) of the memory-aware S-buffer is min(n(p), k);
+  // methods without a per-pixel capacity say so.
+  void depthComplexityAndCapacityMaps() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(200, 150);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(200, 150), kTimeoutMs);
+    m.setMethod("kplus-sbuffer");
+    m.setParams({{"k", "3"}});
+    m.setCamera(m.scene().view("iso"));
+    w->findChild<QAction*>("actionViewDepthComplexity")->trigger();
+    QCOMPARE(m.dataView(), DataView::DepthComplexity);
+    settle(m);
+    const RenderView::DataMap n = w->view().dataMap(0);
+    QCOMPARE(n.kind, DataView::DepthComplexity);
+    QVERIFY(n.key == m.frameKey(0));
+    QCOMPARE(n.values.size(), std::size_t{200 * 150});
+    const mfr::FragmentLists oracle = mfr::castFragments(m.scene(), m.camera(), 200, 150);
+    std::size_t compared = 0, equal = 0;
+    std::uint32_t deepest = 0;
+    for (int y = 0; y < 150; ++y)
+      for (int x = 0; x < 200; ++x) {
+        if (oracle.isAmbiguous(x, y)) continue;
+        ++compared;
+        equal += n.values[oracle.index(x, y)] == oracle.count(x, y);
+        deepest = std::max(deepest, oracle.count(x, y));
+      }
+    qInfo("n(p): %zu of %zu unambiguous pixels equal the oracle's counts; max %u (oracle %u)", equal, compared,
+          n.maxValue, deepest);
+    QVERIFY(compared > std::size_t{200 * 150 / 2});
+    QCOMPARE(equal, compared);
+    QVERIFY(deepest > 8 && n.maxValue >= deepest);
+    auto* legend = w->findChild<MapLegend*>("mapLegendA");
+    QVERIFY(legend && legend->isVisible());
+    QVERIFY2(legend->text().contains(QStringLiteral("max %1").arg(n.maxValue)), qPrintable(legend->text()));
+    // On screen: the magma colour of each oracle count on the legend's scale.
+    mfr::ImageF counts(200, 150, 1);
+    for (int y = 0; y < 150; ++y)
+      for (int x = 0; x < 200; ++x) counts.at(x, y) = static_cast<float>(oracle.count(x, y));
+    const mfr::ImageRGBA8 expectedColours = mfr::heatmap(counts, static_cast<float>(n.maxValue));
+    const mfr::ImageRGBA8 screen = fromQImage(w->view().grabFramebuffer());
+    std::size_t colourMismatches = 0;
+    for (int y = 0; y < 150; ++y)
+      for (int x = 0; x < 200; ++x)
+        if (!oracle.isAmbiguous(x, y) && std::memcmp(screen.at(x, y), expectedColours.at(x, y), 3) != 0)
+          ++colourMismatches;
+    QCOMPARE(colourMismatches, std::size_t{0});
+
+    w->findChild<QAction*>("actionViewCapacity")->trigger();
+    settle(m);
+    const RenderView::DataMap k = w->view().dataMap(0);
+    QCOMPARE(k.kind, DataView::Capacity);
+    QCOMPARE(k.values.size(), n.values.size());
+    std::size_t wrong = 0;
+    for (std::size_t i = 0; i < k.values.size(); ++i) wrong += k.values[i] != std::min<std::uint32_t>(n.values[i], 3);
+    qInfo("k(p) of kplus-sbuffer k=3: %zu of %zu pixels differ from min(n(p), 3); range %u … %u", wrong,
+          k.values.size(), k.minValue, k.maxValue);
+    QCOMPARE(wrong, std::size_t{0});
+    QCOMPARE(k.minValue, 0u);
+    QCOMPARE(k.maxValue, 3u);
+
+    // The budget panel's switch: k(p) blended over the image (empty pixels show the image).
+    auto* overlay = w->findChild<QCheckBox*>("budgetKMapOverlay");
+    QVERIFY(overlay);
+    overlay->setChecked(true);
+    QVERIFY(m.dataView() == DataView::Capacity && m.dataViewOverImage());
+    settle(m);
+    const mfr::ImageRGBA8 blended = fromQImage(w->view().grabFramebuffer());
+    const mfr::ImageRGBA8 image = w->view().renderImage(QSize(200, 150));
+    std::size_t emptyShowImage = 0, empty = 0;
+    for (std::size_t i = 0; i < k.values.size(); ++i) {
+      if (k.values[i] != 0) continue;
+      ++empty;
+      emptyShowImage += std::memcmp(&blended.pixels[i * 4], &image.pixels[i * 4], 3) == 0;
+    }
+    QVERIFY(empty > 0);
+    QCOMPARE(emptyShowImage, empty);
+    QVERIFY(maxChannelDifference(blended, image) > 32);  // and elsewhere the map shows
+
+    m.setMethod("abuffer-ll");
+    settle(m);
+    QVERIFY(w->view().dataMap(0).values.empty());
+    QCOMPARE(w->view().dataMap(0).note, QStringLiteral("no k(p) for this method"));
+    QCOMPARE(legend->text(), QStringLiteral("no k(p) for this method"));
+    QVERIFY(m.renderError().isEmpty());
+  }
+
+  // Loading reports real progress (mfr::LoadProgress) and stops when cancelled; the viewer's
+  // status bar shows it and its Cancel button keeps the current scene.
+  void loadProgressAndCancel() {
+    QTemporaryDir dir;
+    const QString small = dir.filePath("small.stl"), big = dir.filePath("big.stl");
+    writeBinaryStl(small, 2000);
+    writeBinaryStl(big, 150000);
+    const QString smallScene = dir.filePath("small.mfrscene"), bigScene = dir.filePath("big.mfrscene");
+    writeSceneFile(smallScene, small, 4);
+    writeSceneFile(bigScene, big, 8);
+
+    // mfrcore: per object, non-decreasing, from 0 to 1; false stops the loader at that report.
+    ProgressRecorder all;
+    const mfr::Scene loaded = mfr::loadScene(smallScene.toStdString(), all.progress());
+    QCOMPARE(loaded.objects.size(), std::size_t{5});
+    QVERIFY(all.monotonic());
+    QVERIFY(all.fractions.size() >= 10);  // start and end of each object, at least
+    QCOMPARE(all.fractions.front(), 0.0);
+    QCOMPARE(all.fractions.back(), 1.0);
+    ProgressRecorder stop;
+    stop.cancelAt = 3;
+    QVERIFY_THROWS_EXCEPTION(mfr::LoadCancelled, mfr::loadScene(smallScene.toStdString(), stop.progress()));
+    QCOMPARE(stop.fractions.size(), std::size_t{3});
+    // assimp: its import progress, then each mesh; cancelling during the import stops it.
+    const QString gltf = dir.filePath("two.gltf");
+    {
+      QFile f(gltf);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(R"({"asset": {"version": "2.0"},
+        "buffers": [{"byteLength": 44, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA="}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36, "target": 34962},
+                        {"buffer": 0, "byteOffset": 36, "byteLength": 6, "target": 34963}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
+                      {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}],
+        "meshes": [{"name": "a", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]},
+                   {"name": "b", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "nodes": [{"mesh": 0, "name": "A"}, {"mesh": 1, "name": "B", "translation": [2, 0, 0]}],
+        "scenes": [{"nodes": [0, 1]}], "scene": 0})");
+    }
+    ProgressRecorder assimp;
+    QCOMPARE(mfr::loadModel(gltf.toStdString(), assimp.progress()).size(), std::size_t{2});
+    QVERIFY(assimp.monotonic());
+    QVERIFY(assimp.fractions.size() >= 5);  // start, import, two meshes, end
+    QCOMPARE(assimp.fractions.back(), 1.0);
+    ProgressRecorder assimpStop;
+    assimpStop.cancelAt = 2;  // the first report from inside assimp's import
+    QVERIFY_THROWS_EXCEPTION(mfr::LoadCancelled, mfr::loadModel(gltf.toStdString(), assimpStop.progress()));
+    QCOMPARE(assimpStop.fractions.size(), std::size_t{2});
+
+    // The viewer: the status bar's bar follows the loader to 1.
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    QSignalSpy progress(&m, &ViewerModel::loadProgressChanged);
+    w->openScene(smallScene);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.scenePath() == QFileInfo(smallScene).absoluteFilePath(), kTimeoutMs);
+    std::vector<double> seen;
+    for (const QList<QVariant>& args : progress) seen.push_back(args.at(0).toDouble());
+    QVERIFY(!seen.empty() && std::is_sorted(seen.begin(), seen.end()));
+    QCOMPARE(seen.back(), 1.0);
+    QCOMPARE(m.loadProgress(), 1.0);
+    QCOMPARE(m.scene().objects.size(), std::size_t{5});
+    settle(m);
+
+    // Cancel from the status bar as soon as the big scene reports progress.
+    auto* cancel = w->findChild<QPushButton*>("cancelLoad");
+    auto* bar = w->findChild<QProgressBar*>("loadProgress");
+    QVERIFY(cancel && bar);
+    QSignalSpy cancelled(&m, &ViewerModel::loadCancelled);
+    QSignalSpy loadedSpy(&m, &ViewerModel::sceneLoaded);
+    bool clicked = false;
+    double barAtCancel = -1.0;
+    const QMetaObject::Connection c = connect(&m, &ViewerModel::loadProgressChanged, this, [&](double fraction) {
+      if (clicked || fraction <= 0.0) return;
+      clicked = true;
+      barAtCancel = bar->value() / 1000.0;
+      QVERIFY(cancel->isVisible());
+      QTest::mouseClick(cancel, Qt::LeftButton);
+    });
+    w->openScene(bigScene);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.busy(), kTimeoutMs);  // the cancelled worker has stopped too
+    disconnect(c);
+    QVERIFY(clicked);
+    qInfo("cancelled at %.3f of the load; the loader stopped early: %s", barAtCancel,
+          m.lastCancelStoppedLoader() ? "yes" : "no");
+    QVERIFY(barAtCancel > 0.0 && barAtCancel < 1.0);
+    QCOMPARE(cancelled.count(), 1);
+    QCOMPARE(loadedSpy.count(), 0);
+    QVERIFY(!bar->isVisible());
+    QVERIFY(m.lastCancelStoppedLoader());  // LoadCancelled inside mfr::loadScene, not a dropped result
+    QCOMPARE(m.scenePath(), QFileInfo(smallScene).absoluteFilePath());
+    QCOMPARE(m.scene().objects.size(), std::size_t{5});
+    const quint64 frames = m.framesRendered();
+    m.setCamera(navigation::orbit(m.camera(), QPointF(15, 5), m.renderSize()));
+    QTRY_VERIFY_WITH_TIMEOUT(m.framesRendered() > frames, kTimeoutMs);
+    QVERIFY(m.renderError().isEmpty());
+  }
+
+  // The budget panel: methods from the registry, quality against the exact image, R_h.
+  void budgetPanelQualityAndRobustness() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(240, 180);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(240, 180), kTimeoutMs);
+    auto* combo = w->findChild<QComboBox*>("budgetMethodCombo");
+    QVERIFY(combo);
+    // Offered: every registered method with a memory parameter (budget_mib first of all: fkb,
+    // vkb and dkb join when the registry has them), CPU methods besides the oracle on demand.
+    for (const mfr::RegistryEntry& e : mfr::methodRegistry()) {
+      const mfr::MethodInfo* info = m.methodInfo(QString::fromStdString(e.name));
+      QVERIFY(info);
+      const bool hasBudget = std::any_of(info->params.begin(), info->params.end(),
+                                         [](const mfr::ParamSpec& p) { return p.name == "budget_mib"; });
+      if (hasBudget) QVERIFY2(combo->findData(QString::fromStdString(e.name)) >= 0, e.name.c_str());
+    }
+    for (int i = 0; i < combo->count(); ++i) QVERIFY(m.methodNames().contains(combo->itemData(i).toString()));
+    QVERIFY(combo->findData(QStringLiteral("oracle")) < 0);
+    QCOMPARE(combo->findData(QStringLiteral("optimal-k")) >= 0, m.methodNames().contains(QStringLiteral("optimal-k")));
+    for (const QString& name : m.methodNames())
+      if (name != QLatin1String("oracle") && m.isCpuMethod(name)) QVERIFY2(combo->findData(name) >= 0, qPrintable(name));
+
+    const int dynamic = combo->findData(QStringLiteral("kplus-dynamic"));
+    QVERIFY(dynamic >= 0);
+    combo->setCurrentIndex(dynamic);
+    emit combo->activated(dynamic);
+    QCOMPARE(m.method(), QStringLiteral("kplus-dynamic"));
+    settle(m);
+    // Measured once the view rests, against the exact image of the same size.
+    QTRY_VERIFY_WITH_TIMEOUT(m.frameQuality().valid, kTimeoutMs);
+    const FrameQuality q = m.frameQuality();
+    const mfr::ImageRGBA8 frame = w->view().renderImage(m.renderSize());
+    const mfr::ImageRGBA8 exact = exactImage(m, m.renderSize());
+    qInfo("kplus-dynamic R_h=0.95: RMSE %.6f FLIP %.5f (k %u)", q.rmse, q.flipMean, m.stats().kMax);
+    QVERIFY(std::abs(mfr::rmse(exact, frame) - q.rmse) < 1e-9);
+    QVERIFY(std::abs(mfr::flip(exact, frame).stats.mean - q.flipMean) < 1e-9);
+    QCOMPARE(w->findChild<QLabel*>("budgetRmse")->text(), QString::number(q.rmse, 'f', 5));
+    QVERIFY(w->findChild<QLabel*>("budgetFlip")->text().startsWith(QString::number(q.flipMean, 'f', 4)));
+
+    // R_h drives the method's robustness: a lower ratio picks a smaller k and costs quality.
+    auto* robustness = w->findChild<QDoubleSpinBox*>("budgetRobustness");
+    QVERIFY(robustness && robustness->isVisible());
+    QCOMPARE(robustness->value(), 0.95);
+    const std::uint32_t k95 = m.stats().kMax;
+    robustness->setValue(0.5);
+    QCOMPARE(m.params().at("robustness"), std::string("0.5"));
+    settle(m);
+    QTRY_VERIFY_WITH_TIMEOUT(m.frameQuality().valid, kTimeoutMs);
+    qInfo("kplus-dynamic R_h=0.5: RMSE %.6f FLIP %.5f (k %u)", m.frameQuality().rmse, m.frameQuality().flipMean,
+          m.stats().kMax);
+    QVERIFY(m.stats().kMax < k95);
+    QVERIFY(m.frameQuality().rmse > q.rmse);
+
+    m.setMethod("abuffer-ll");
+    QVERIFY(!robustness->isVisible());
   }
 
   void navigation() {

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include <assimp/Importer.hpp>
+#include <assimp/ProgressHandler.hpp>
 #include <assimp/config.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -130,11 +131,35 @@ std::string lower(std::string s) {
   return s;
 }
 
+// assimp's import progress (it reports percentages that may step back between its stages, so
+// the largest so far is passed on) into a LoadProgress. Cancelling makes Update return false,
+// which aborts the import; exceptions must not cross assimp's code.
+class ImportProgress final : public Assimp::ProgressHandler {
+ public:
+  explicit ImportProgress(LoadProgress progress) : progress_(std::move(progress)) {}
+  bool Update(float percentage) override {
+    if (cancelled_) return false;
+    if (percentage >= 0.0f) done_ = std::max(done_, std::clamp(static_cast<double>(percentage), 0.0, 1.0));
+    cancelled_ = !progress_.tryStep(done_);
+    return !cancelled_;
+  }
+  [[nodiscard]] bool cancelled() const { return cancelled_; }
+
+ private:
+  LoadProgress progress_;
+  double done_ = 0.0;
+  bool cancelled_ = false;
+};
+
 }  // namespace
 
 std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std::string* contents,
-                                   const std::string& extension, const std::string& name) {
+                                   const std::string& extension, const std::string& name,
+                                   const LoadProgress& progress) {
   Assimp::Importer importer;
+  // The importer owns (and deletes) its progress handler; the import takes the first 80 %.
+  auto* importProgress = new ImportProgress(progress.part(0.0, 0.8));
+  importer.SetProgressHandler(importProgress);
   // Points and lines are no surfaces; skeleton dummies are no geometry.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
@@ -149,6 +174,7 @@ std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std:
   } else {
     scene = importer.ReadFile(path.string(), flags);
   }
+  if (importProgress->cancelled()) throw LoadCancelled();
   if (scene == nullptr) {
     std::string reason = importer.GetErrorString();
     // What SortByPType says when it removed every mesh because all were points or lines.
@@ -160,6 +186,7 @@ std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std:
 
   std::vector<std::shared_ptr<const Mesh>> meshes(scene->mNumMeshes);
   std::vector<bool> converted(scene->mNumMeshes, false);
+  unsigned convertedCount = 0;
   std::vector<Object> objects;
   std::set<std::string> usedNames;
 
@@ -178,6 +205,8 @@ std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std:
       if (!converted[mi]) {
         meshes[mi] = convertMesh(src, name);
         converted[mi] = true;
+        ++convertedCount;
+        progress.step(0.8 + 0.2 * static_cast<double>(convertedCount) / scene->mNumMeshes);
       }
       if (!meshes[mi]) continue;
       for (int c = 0; c < 4; ++c)

@@ -5,14 +5,17 @@
 #include <string>
 #include <vector>
 
+#include "mfr/io/load.hpp"
 #include "mfr/scene/scene.hpp"
 
 namespace mfr::io {
 
 // Reads `path`, or `contents` (decompressed bytes; `extension` such as ".glb" tells assimp the
-// format) when not null. Throws mfr::Error(name, reason).
+// format) when not null. Reports assimp's import progress, then each mesh converted. Throws
+// mfr::Error(name, reason), or LoadCancelled.
 std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std::string* contents,
-                                   const std::string& extension, const std::string& name);
+                                   const std::string& extension, const std::string& name,
+                                   const LoadProgress& progress = {});
 
 // Lower-case extensions with dot that assimp imports, less those other loaders own or that hold
 // no meshes.

@@ -146,7 +146,7 @@ std::vector<Object> singleObject(Mesh mesh, const std::string& partName) {
   return {std::move(object)};
 }
 
-std::vector<Object> load(const fs::path& path, const std::string& name) {
+std::vector<Object> load(const fs::path& path, const std::string& name, const LoadProgress& progress) {
   checkReadable(path, name);
 
   std::string fileName = lower(path.filename().string());
@@ -171,6 +171,7 @@ std::vector<Object> load(const fs::path& path, const std::string& name) {
   if (gz) {
     data = decompress(path, name);
     contents = &data;
+    progress.step(0.3);
   }
 
   switch (format.family) {
@@ -204,17 +205,18 @@ std::vector<Object> load(const fs::path& path, const std::string& name) {
       }
       return objects;
     }
-    case Family::Assimp: return io::readWithAssimp(path, contents, ext, name);
+    case Family::Assimp: return io::readWithAssimp(path, contents, ext, name, progress.part(gz ? 0.3 : 0.0, 0.95));
   }
   throw Error(name, "unsupported file type");
 }
 
 }  // namespace
 
-std::vector<Object> loadModel(const fs::path& path) {
+std::vector<Object> loadModel(const fs::path& path, const LoadProgress& progress) {
   const std::string name = path.string();
   try {
-    std::vector<Object> objects = load(path, name);
+    progress.step(0.0);
+    std::vector<Object> objects = load(path, name, progress);
     if (objects.empty()) throw Error(name, "no triangles");
     // Every mesh once (assemblies share meshes between parts): the invariants renderers rely on.
     std::set<const Mesh*> checked;
@@ -232,7 +234,10 @@ std::vector<Object> loadModel(const fs::path& path) {
         checked.insert(fixed.get());
       }
     }
+    progress.step(1.0);
     return objects;
+  } catch (const LoadCancelled&) {
+    throw;
   } catch (const Error& e) {
     std::string message = oneLine(e.what());
     if (message.rfind(name, 0) != 0) message = name + ": " + message;

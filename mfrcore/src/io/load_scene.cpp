@@ -8,7 +8,21 @@
 
 namespace mfr {
 
-Scene loadScene(const std::filesystem::path& path) {
+void LoadProgress::step(double fraction) const {
+  if (!tryStep(fraction)) throw LoadCancelled();
+}
+
+bool LoadProgress::tryStep(double fraction) const {
+  return !report || report(begin + std::clamp(fraction, 0.0, 1.0) * (end - begin));
+}
+
+LoadProgress LoadProgress::part(double from, double to) const {
+  return {report, begin + from * (end - begin), begin + to * (end - begin)};
+}
+
+namespace {
+
+Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadProgress& progress) {
   const std::string text = path.string();
   if (text == "@sample") return makeSampleScene();
   if (text.rfind("@quads:", 0) == 0) {
@@ -26,10 +40,10 @@ Scene loadScene(const std::filesystem::path& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   Scene scene;
   if (ext == ".mfrscene" || ext == ".json") {
-    scene = readSceneFile(path);
+    scene = readSceneFile(path, progress);
   } else {
     scene.name = path.filename().string();
-    scene.objects = loadModel(path);
+    scene.objects = loadModel(path, progress);
     Camera front;
     front.eye = {0.0, 0.0, 1.0};
     front.target = {0.0, 0.0, 0.0};
@@ -39,6 +53,15 @@ Scene loadScene(const std::filesystem::path& path) {
     scene.views.push_back({"iso", scene.fit(iso)});
   }
   scene.validate();
+  return scene;
+}
+
+}  // namespace
+
+Scene loadScene(const std::filesystem::path& path, const LoadProgress& progress) {
+  progress.step(0.0);
+  Scene scene = loadSceneWithoutEndReport(path, progress);
+  progress.step(1.0);
   return scene;
 }
 

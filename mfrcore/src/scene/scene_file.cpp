@@ -189,7 +189,8 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
 
 }  // namespace
 
-Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseDir, const std::string& name) {
+Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseDir, const std::string& name,
+                     const LoadProgress& progress) {
   json doc;
   try {
     doc = json::parse(text);
@@ -217,6 +218,10 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     const json& objects = doc["objects"];
     if (!objects.is_array()) r.fail("objects", "expected an array");
     for (std::size_t i = 0; i < objects.size(); ++i) {
+      const double count = static_cast<double>(objects.size());
+      const LoadProgress objectProgress =
+          progress.part(static_cast<double>(i) / count, static_cast<double>(i + 1) / count);
+      objectProgress.step(0.0);
       const std::string where = "objects[" + std::to_string(i) + "]";
       const json& o = r.object(objects[i], where);
       const std::string objName = r.string(o, "name", where, "object " + std::to_string(i));
@@ -238,7 +243,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
         scene.objects.push_back(std::move(obj));
       } else {
         const std::filesystem::path file = baseDir / r.string(o, "file", where, "");
-        std::vector<Object> parts = loadModel(file);  // its errors name the model file
+        std::vector<Object> parts = loadModel(file, objectProgress);  // its errors name the model file
         for (Object& part : parts) {
           part.name = parts.size() == 1 ? objName : objName + "/" + part.name;
           part.transform = xf * part.transform;
@@ -247,6 +252,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
           scene.objects.push_back(std::move(part));
         }
       }
+      objectProgress.step(1.0);
     }
   }
   const Bounds bounds = scene.bounds();
@@ -265,8 +271,8 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
   return scene;
 }
 
-Scene readSceneFile(const std::filesystem::path& path) {
-  return parseSceneFile(readFile(path), path.parent_path(), path.string());
+Scene readSceneFile(const std::filesystem::path& path, const LoadProgress& progress) {
+  return parseSceneFile(readFile(path), path.parent_path(), path.string(), progress);
 }
 
 }  // namespace mfr

@@ -2,23 +2,47 @@
 // Loading files into scenes. Model files become one object per part (mesh + node transform +
 // material colour); .mfrscene files are parsed by scene/scene_file.
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
+#include "mfr/error.hpp"
 #include "mfr/scene/scene.hpp"
 
 namespace mfr {
 
+// Thrown by a loader whose LoadProgress::report returned false.
+class LoadCancelled : public Error {
+ public:
+  LoadCancelled() : Error("loading cancelled") {}
+};
+
+// Progress of one load, reported on the loading thread: report(fraction) with fraction in [0, 1],
+// non-decreasing, 1 when done. Returning false cancels: the loader stops at that report and
+// throws LoadCancelled. Loaders report at the start and end of every file, per object of a
+// .mfrscene and per mesh of an assimp scene (and assimp's own import progress).
+struct LoadProgress {
+  std::function<bool(double fraction)> report;  // empty: no reporting, never cancelled
+  double begin = 0.0, end = 1.0;                // the part of the whole load this one covers
+
+  // Reports `fraction` of this part; throws LoadCancelled when report returns false.
+  void step(double fraction) const;
+  // Like step, but returns false instead of throwing (for callbacks that must not throw).
+  [[nodiscard]] bool tryStep(double fraction) const;
+  // The part [from, to] (fractions of this one) as a progress of its own.
+  [[nodiscard]] LoadProgress part(double from, double to) const;
+};
+
 // Loads a model file — STL, PLY (also .ply.gz), OBJ, OFF, VTP, VTK legacy, glTF/GLB and the other
 // formats assimp reads — into parts. Throws mfr::Error(path, reason) for a missing, unreadable,
-// truncated, corrupt or unsupported file, or one with no triangles.
-std::vector<Object> loadModel(const std::filesystem::path& path);
+// truncated, corrupt or unsupported file, or one with no triangles; LoadCancelled when cancelled.
+std::vector<Object> loadModel(const std::filesystem::path& path, const LoadProgress& progress = {});
 
 // File extensions loadModel accepts (lower case, with dot; ".ply.gz" included).
 std::vector<std::string> supportedModelExtensions();
 
 // A scene from any supported file: .mfrscene → the scene it describes; a model → its parts with
-// a default view fitted to them. Throws mfr::Error naming the file.
-Scene loadScene(const std::filesystem::path& path);
+// a default view fitted to them. Throws mfr::Error naming the file, or LoadCancelled.
+Scene loadScene(const std::filesystem::path& path, const LoadProgress& progress = {});
 
 }  // namespace mfr

@@ -3,12 +3,15 @@
 #include <filesystem>
 #include <string>
 
+#include "mfr/io/load.hpp"
 #include "mfr/scene/scene.hpp"
 
 namespace mfr {
 
 // Parses .mfrscene text; file paths inside resolve relative to baseDir. name is used in messages.
-Scene parseSceneFile(const std::string& json, const std::filesystem::path& baseDir, const std::string& name);
-Scene readSceneFile(const std::filesystem::path& path);
+// progress: one equal part per object (a model file's own progress within its part).
+Scene parseSceneFile(const std::string& json, const std::filesystem::path& baseDir, const std::string& name,
+                     const LoadProgress& progress = {});
+Scene readSceneFile(const std::filesystem::path& path, const LoadProgress& progress = {});
 
 }  // namespace mfr

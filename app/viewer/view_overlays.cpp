@@ -1,0 +1,114 @@
+#include "view_overlays.hpp"
+
+#include <QLinearGradient>
+#include <QMouseEvent>
+#include <QPainter>
+
+#include "mfr/reference/metrics.hpp"
+
+namespace {
+
+// The magma colours mfr::heatmap uses, as gradient stops.
+QLinearGradient magmaGradient(QPointF from, QPointF to) {
+  static const mfr::ImageRGBA8 ramp = [] {
+    mfr::ImageF values(256, 1, 1);
+    for (int i = 0; i < 256; ++i) values.at(i, 0) = static_cast<float>(i) / 255.0f;
+    return mfr::magma(values);
+  }();
+  QLinearGradient gradient(from, to);
+  for (int i = 0; i < 256; i += 15) {
+    const std::uint8_t* c = ramp.at(i, 0);
+    gradient.setColorAt(i / 255.0, QColor(c[0], c[1], c[2]));
+  }
+  const std::uint8_t* last = ramp.at(255, 0);
+  gradient.setColorAt(1.0, QColor(last[0], last[1], last[2]));
+  return gradient;
+}
+
+// Overlays paint opaque backgrounds: a translucent child would make every change of its text
+// repaint the OpenGL view beneath it.
+void makeOpaque(QWidget* widget) {
+  widget->setAutoFillBackground(true);
+  QPalette p = widget->palette();
+  p.setColor(QPalette::Window, QColor(24, 24, 28));
+  p.setColor(QPalette::WindowText, QColor(235, 235, 235));
+  widget->setPalette(p);
+}
+
+}  // namespace
+
+MapLegend::MapLegend(QWidget* parent) : QWidget(parent) {
+  makeOpaque(this);
+  setAttribute(Qt::WA_TransparentForMouseEvents);
+}
+
+void MapLegend::setMap(const QString& title, double scaleMax, const QString& range) {
+  title_ = title;
+  text_ = range;
+  scaleMax_ = scaleMax;
+  bar_ = true;
+  resize(sizeHint());
+  update();
+}
+
+void MapLegend::setNote(const QString& title, const QString& note) {
+  title_ = title;
+  text_ = note;
+  bar_ = false;
+  resize(sizeHint());
+  update();
+}
+
+QSize MapLegend::sizeHint() const {
+  const QFontMetrics fm = fontMetrics();
+  const int width = std::max({fm.horizontalAdvance(title_), fm.horizontalAdvance(text_), 160}) + 16;
+  return {width, fm.height() * 2 + (bar_ ? 14 + fm.height() : 0) + 12};
+}
+
+void MapLegend::paintEvent(QPaintEvent*) {
+  QPainter p(this);
+  const QFontMetrics fm = fontMetrics();
+  p.setPen(palette().color(QPalette::WindowText));
+  int y = 4;
+  p.drawText(QRect(8, y, width() - 16, fm.height()), Qt::AlignLeft | Qt::AlignVCenter, title_);
+  y += fm.height() + 2;
+  if (bar_) {
+    const QRect bar(8, y, width() - 16, 12);
+    p.fillRect(bar, magmaGradient(bar.topLeft(), bar.topRight()));
+    p.drawRect(bar.adjusted(0, 0, -1, -1));
+    y += 14;
+    p.drawText(QRect(8, y, width() - 16, fm.height()), Qt::AlignLeft | Qt::AlignVCenter, QStringLiteral("0"));
+    p.drawText(QRect(8, y, width() - 16, fm.height()), Qt::AlignRight | Qt::AlignVCenter,
+               QString::number(scaleMax_, 'g', 4));
+    y += fm.height();
+  }
+  p.drawText(QRect(8, y, width() - 16, fm.height()), Qt::AlignLeft | Qt::AlignVCenter, text_);
+}
+
+PaneCaption::PaneCaption(QWidget* parent) : QLabel(parent) {
+  makeOpaque(this);
+  setMargin(4);
+  setTextFormat(Qt::PlainText);
+  setAttribute(Qt::WA_TransparentForMouseEvents);
+}
+
+SplitHandle::SplitHandle(QWidget* parent) : QWidget(parent) {
+  setCursor(Qt::SplitHCursor);
+  setToolTip(tr("Drag to move the split between the two methods"));
+  // Opaque too: it covers the line's columns of both images.
+  setAttribute(Qt::WA_OpaquePaintEvent);
+}
+
+void SplitHandle::paintEvent(QPaintEvent*) {
+  QPainter p(this);
+  p.fillRect(rect(), QColor(24, 24, 28));
+  p.fillRect(QRect(width() / 2 - 1, 0, 3, height()), QColor(240, 240, 240));
+}
+
+void SplitHandle::mousePressEvent(QMouseEvent* event) {
+  event->accept();
+}
+
+void SplitHandle::mouseMoveEvent(QMouseEvent* event) {
+  if (event->buttons() & Qt::LeftButton) emit dragged(mapToParent(event->position().toPoint()).x());
+}
