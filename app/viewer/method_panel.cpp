@@ -41,6 +41,7 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
   operationCombo_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
   operationCombo_->setMinimumContentsLength(16);
   operationCombo_->setObjectName(objectName(QStringLiteral("operationCombo")));
+  operationCombo_->addItem(tr("auto — the method's own (hybrid for the budget methods)"), QStringLiteral("auto"));
   operationCombo_->addItem(tr("oit — composite \"over\""), QStringLiteral("oit"));
   operationCombo_->addItem(tr("hybrid — exact core + averaged tail"), QStringLiteral("hybrid"));
   top->addRow(tr("Method"), methodCombo_);

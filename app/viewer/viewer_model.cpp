@@ -87,6 +87,7 @@ const mfr::MethodInfo* ViewerModel::methodInfo(const QString& method) const {
   // GL objects until configure().
   static std::map<std::string, std::unique_ptr<mfr::Method>> described;
   const std::string name = method.toStdString();
+  if (name == "optimal-k") return &mfr::optimalKInfo();  // a CPU method with parameters
   auto it = described.find(name);
   if (it == described.end()) {
     for (const mfr::RegistryEntry& e : mfr::methodRegistry())

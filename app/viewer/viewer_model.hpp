@@ -229,7 +229,7 @@ class ViewerModel final : public ViewerContext {
   quint64 viewRevision_ = 0;
 
   std::array<QString, kSides> methods_{QStringLiteral("abuffer-ll"), QStringLiteral("kplus-array")};
-  std::array<QString, kSides> operations_{QStringLiteral("oit"), QStringLiteral("oit")};
+  std::array<QString, kSides> operations_{QStringLiteral("auto"), QStringLiteral("auto")};
   std::array<ParamsByMethod, kSides> params_;
 
   bool compare_ = false;

@@ -195,7 +195,7 @@ class ViewerTest : public QObject {
     ViewerModel& m = w->model();
     auto* combo = w->findChild<QComboBox*>("methodCombo");
     QVERIFY(combo);
-    QCOMPARE(combo->count(), static_cast<int>(mfr::methodRegistry().size()) + 1);  // + oracle
+    QCOMPARE(combo->count(), static_cast<int>(mfr::availableMethods().size()));  // oracle, GPU methods, optimal-k
     for (int i = 0; i < combo->count(); ++i) {
       const QString name = combo->itemData(i).toString();
       combo->setCurrentIndex(i);
