@@ -233,11 +233,14 @@ class ViewerTest : public QObject {
     auto* slider = w->findChild<QSlider*>("budgetSlider");
     QVERIFY(slider);
     const double pixels = static_cast<double>(m.renderSize().width()) * m.renderSize().height();
-    for (const QString method : {"kplus-array", "abuffer-ll", "abuffer-array", "kplus-dynamic", "kbuffer"}) {
+    for (const QString method : {"kplus-array", "abuffer-ll", "abuffer-array", "kplus-dynamic", "kbuffer", "fkb", "vkb", "dkb"}) {
       m.setMethod(method);
       settle(m);
       quint64 previous = 0;
-      for (int budget : {8, 16, 32, 64}) {
+      // The budget methods, where the budget binds (every fragment fits from ~17 MiB on here).
+      const bool budgetMethod = method == "fkb" || method == "vkb" || method == "dkb";
+      const std::vector<int> budgets = budgetMethod ? std::vector<int>{8, 12, 16} : std::vector<int>{8, 16, 32, 64};
+      for (int budget : budgets) {
         slider->setValue(budget);
         settle(m);
         const mfr::Stats& s = m.stats();
@@ -252,6 +255,10 @@ class ViewerTest : public QObject {
         if (method == "kplus-array" || method == "abuffer-array" || method == "kbuffer")
           QVERIFY(allocated > budget * kMiB - 8.0 * pixels - 1.0 * kMiB);
         if (method == "abuffer-ll") QVERIFY(allocated > 0.9 * budget * kMiB);
+        // The variable-k buffers use the whole budget unless every fragment already fits.
+        if ((method == "vkb" || method == "dkb") && s.fragmentsStored < s.fragmentsGenerated)
+          QVERIFY(allocated > 0.99 * budget * kMiB);
+        if (budgetMethod) QCOMPARE(QString::fromStdString(s.operation), QStringLiteral("hybrid"));
         previous = s.bytesAllocated;
       }
     }
