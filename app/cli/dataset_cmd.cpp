@@ -92,7 +92,8 @@ void addDataset(CLI::App& app) {
     nlohmann::ordered_json frames = nlohmann::ordered_json::array();
     std::cout << std::left << std::setw(28) << "scene" << std::setw(16) << "view" << std::setw(9) << "size"
               << std::right << std::setw(10) << "F" << std::setw(10) << "Σn" << std::setw(9) << "rows" << std::setw(12)
-              << "error" << "  solver\n";
+              << "error"
+              << "  solver\n";
     for (std::size_t s = 0; s < scenes.size(); ++s)
       for (const std::string& v : views)
         for (const auto& [w, h] : sizes) {
@@ -104,19 +105,26 @@ void addDataset(CLI::App& app) {
           for (double level : levels) {
             const std::uint64_t F =
                 level < 0 ? lists.fragments.size()
-                          : std::min<std::uint64_t>(lists.fragments.size(),
-                                                    static_cast<std::uint64_t>(std::llround(level * static_cast<double>(nonEmpty))));
+                          : std::min<std::uint64_t>(
+                                lists.fragments.size(),
+                                static_cast<std::uint64_t>(std::llround(level * static_cast<double>(nonEmpty))));
             if (F >= lists.fragments.size()) {
               if (allDone) continue;
               allDone = true;
             }
             const DatasetFrame f = appendDatasetFrame(dataset, lists, errors, F, opt->sample, rng);
             std::cout << std::left << std::setw(28) << scenes[s].name.substr(0, 27) << std::setw(16) << v.substr(0, 15)
-                      << std::setw(9) << (std::to_string(w) + "x" + std::to_string(h)) << std::right << std::setw(10) << F
-                      << std::setw(10) << f.totalFragments << std::setw(9) << f.sampled << std::setw(12)
+                      << std::setw(9) << (std::to_string(w) + "x" + std::to_string(h)) << std::right << std::setw(10)
+                      << F << std::setw(10) << f.totalFragments << std::setw(9) << f.sampled << std::setw(12)
                       << std::setprecision(4) << f.optimalError << "  " << f.solver << "\n";
-            frames.push_back({{"scene", opt->scenes[s]}, {"view", v}, {"width", w}, {"height", h}, {"budget_slots", F},
-                              {"total_fragments", f.totalFragments}, {"rows", f.sampled}, {"solver", f.solver}});
+            frames.push_back({{"scene", opt->scenes[s]},
+                              {"view", v},
+                              {"width", w},
+                              {"height", h},
+                              {"budget_slots", F},
+                              {"total_fragments", f.totalFragments},
+                              {"rows", f.sampled},
+                              {"solver", f.solver}});
           }
         }
     meta["frames"] = frames;

@@ -107,7 +107,8 @@ void addEvaluate(CLI::App& app) {
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "evaluate", "Compare fkb, vkb, dkb and optimal-k under memory budgets: k range, fragments captured, RMSE, FLIP, time");
+      "evaluate",
+      "Compare fkb, vkb, dkb and optimal-k under memory budgets: k range, fragments captured, RMSE, FLIP, time");
   cmd->add_option("scenes", opt->scenes, "Scenes (model files, .mfrscene, @sample)")->required();
   cmd->add_option("--budgets", opt->budgets,
                   "Comma-separated budgets: MiB; kN = the memory of a uniform k = N k+-buffer with the tail; fN = the "
@@ -117,7 +118,9 @@ void addEvaluate(CLI::App& app) {
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--methods,-m", opt->methods, "Methods to compare")->capture_default_str();
   cmd->add_option("--weights", opt->weights, "dkb weights file (default: the built-in weights)");
-  cmd->add_option("--repeat,-r", opt->repeat, "Timed frames per GPU method")->capture_default_str()->check(CLI::Range(1, 100));
+  cmd->add_option("--repeat,-r", opt->repeat, "Timed frames per GPU method")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--json", opt->json, "Write all results as JSON");
   cmd->callback([opt] {
@@ -172,7 +175,8 @@ void addEvaluate(CLI::App& app) {
         const std::uint64_t total = lists.fragments.size();
         for (Budget b : budgets) {
           if (b.fragmentPercent > 0.0) {
-            const auto slots = static_cast<std::uint64_t>(std::ceil(b.fragmentPercent / 100.0 * static_cast<double>(total)));
+            const auto slots =
+                static_cast<std::uint64_t>(std::ceil(b.fragmentPercent / 100.0 * static_cast<double>(total)));
             b.mib = static_cast<double>(variableKLayout(pixels).bytes(slots)) / (1024.0 * 1024.0);
           }
           std::string bestFlip, bestRmse;
@@ -207,15 +211,17 @@ void addEvaluate(CLI::App& app) {
             } catch (const Error& e) {
               row["error"] = e.what();
               rows.push_back(row);
-              std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12) << v.substr(0, 11)
-                        << std::setw(14) << b.label << std::setw(11) << m << "  " << e.what() << "\n";
+              std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12)
+                        << v.substr(0, 11) << std::setw(14) << b.label << std::setw(11) << m << "  " << e.what()
+                        << "\n";
               continue;
             }
             const bool cpu = m == "optimal-k";
             const ImageRGBA8& reference = cpu ? exact : gpuExact;
             const double e = rmse(reference, r.image);
             const double f = flip(reference, r.image).stats.mean;
-            const double captured = total ? 100.0 * static_cast<double>(r.stats.fragmentsStored) / static_cast<double>(total) : 0.0;
+            const double captured =
+                total ? 100.0 * static_cast<double>(r.stats.fragmentsStored) / static_cast<double>(total) : 0.0;
             row["k_min"] = r.stats.kMin;
             row["k_max"] = r.stats.kMax;
             row["fragments_captured"] = r.stats.fragmentsStored;

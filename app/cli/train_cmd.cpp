@@ -27,7 +27,9 @@ void addTrain(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--epochs", opt->training.epochs, "Epochs")->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->add_option("--learning-rate", opt->training.learningRate, "SGD learning rate")->capture_default_str();
-  cmd->add_option("--batch", opt->training.batchSize, "Mini-batch size")->capture_default_str()->check(CLI::Range(1, 1 << 20));
+  cmd->add_option("--batch", opt->training.batchSize, "Mini-batch size")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--weight-decay", opt->training.weightDecay, "L2 weight decay")->capture_default_str();
   cmd->add_option("--momentum", opt->training.momentum, "SGD momentum")->capture_default_str();
   cmd->add_option("--validation", opt->training.validationFraction, "Fraction of rows held out")
@@ -45,8 +47,8 @@ void addTrain(CLI::App& app) {
     all.metadata = meta + "]";
     NeuralTrainingOptions training = opt->training;
     training.progress = [](std::size_t epoch, double train, double valid) {
-      std::cout << "epoch " << std::setw(4) << epoch << "  train MSE " << std::scientific << std::setprecision(4) << train
-                << "  validation MSE " << valid << std::defaultfloat << std::endl;
+      std::cout << "epoch " << std::setw(4) << epoch << "  train MSE " << std::scientific << std::setprecision(4)
+                << train << "  validation MSE " << valid << std::defaultfloat << std::endl;
     };
     const NeuralTrainingResult r = trainNeuralImportance(all, training);
     writeFileAtomically(opt->output, neuralImportanceJson(r.model));

@@ -41,7 +41,9 @@ const Reference& reference() {
   return r;
 }
 
-std::uint64_t pixels() { return static_cast<std::uint64_t>(kW) * kH; }
+std::uint64_t pixels() {
+  return static_cast<std::uint64_t>(kW) * kH;
+}
 
 RenderRequest budgetRequest(const std::string& method, std::uint64_t budgetBytes) {
   RenderRequest req;
@@ -127,8 +129,8 @@ TEST_P(VariableK, NeverExceedsTheBudget) {
     }
   }
   const std::uint64_t total = ref.oracle.fragments.size();
-  for (std::uint64_t bytes : {layout.bytes(1), layout.bytes(pixels() / 4), layout.bytes(pixels()), layout.bytes(total / 2),
-                              layout.bytes(total) + 12345, std::uint64_t{1} << 35}) {
+  for (std::uint64_t bytes : {layout.bytes(1), layout.bytes(pixels() / 4), layout.bytes(pixels()),
+                              layout.bytes(total / 2), layout.bytes(total) + 12345, std::uint64_t{1} << 35}) {
     const RenderRequest req = budgetRequest(GetParam(), bytes);
     const RenderOutput out = gpu.render(ref.camera, req);
     const std::uint64_t F = layout.slotBudget(budgetOf(req));
@@ -161,7 +163,8 @@ TEST_P(VariableK, HybridEqualsTheOracleForTheSameKMap) {
     EXPECT_GT(c.compared, pixels() * 6 / 10);
     EXPECT_GE(c.fraction(), 0.999) << "max difference " << c.maxDifference;
     // Not trivially equal: the hybrid with this k(p) differs from the exact image.
-    const ImageComparison vsExact = compareImages(ref.oracle, compositeOver(ref.oracle, ref.scene.background), out.image, 2);
+    const ImageComparison vsExact =
+        compareImages(ref.oracle, compositeOver(ref.oracle, ref.scene.background), out.image, 2);
     EXPECT_LT(vsExact.within, vsExact.compared);
     std::cout << "[ budget ] " << GetParam() << " at " << fraction << " of the fragments: " << c.within << " of "
               << c.compared << " pixels within 2/255 of the oracle's hybrid, max " << c.maxDifference << "; k "
@@ -186,7 +189,8 @@ TEST(FixedKUnderBudget, LargestUniformKAndTheOracleHybrid) {
     EXPECT_EQ(out.stats.kMax, k);
     EXPECT_EQ(out.stats.bytesAllocated, model.bytes(k));
     EXPECT_LE(out.stats.bytesAllocated, budgetOf(req));
-    const ImageComparison c = compareImages(ref.oracle, compositeHybrid(ref.oracle, k, ref.scene.background), out.image, 2);
+    const ImageComparison c =
+        compareImages(ref.oracle, compositeHybrid(ref.oracle, k, ref.scene.background), out.image, 2);
     EXPECT_GE(c.fraction(), 0.999) << "k " << k << " max difference " << c.maxDifference;
   }
 }
@@ -218,7 +222,8 @@ TEST(DeepVariableK, GpuImportanceEqualsTheCpuNetworkOnTheOracleLists) {
     for (int x = 0; x < kW; ++x) {
       if (ref.oracle.isAmbiguous(x, y) || ref.oracle.count(x, y) == 0) continue;
       const auto list = ref.oracle.pixel(x, y);
-      const float cpu = neuralImportance(method->model(), dkbFeatures(list, image, F), static_cast<std::uint32_t>(list.size()));
+      const float cpu =
+          neuralImportance(method->model(), dkbFeatures(list, image, F), static_cast<std::uint32_t>(list.size()));
       const float gpuValue = gpuImportance[static_cast<std::size_t>(kH - 1 - y) * kW + x];  // GL rows
       const double rel = std::abs(gpuValue - std::max(cpu, 1e-6f)) / std::max(std::abs(cpu), 1e-3f);
       worst = std::max(worst, rel);
@@ -227,8 +232,8 @@ TEST(DeepVariableK, GpuImportanceEqualsTheCpuNetworkOnTheOracleLists) {
     }
   EXPECT_GT(compared, pixels() / 4);
   EXPECT_GE(static_cast<double>(close), 0.999 * static_cast<double>(compared)) << "worst relative difference " << worst;
-  std::cout << "[ dkb ] " << close << " of " << compared << " pixels' importance within 0.1 % of the CPU network, worst "
-            << worst << "\n";
+  std::cout << "[ dkb ] " << close << " of " << compared
+            << " pixels' importance within 0.1 % of the CPU network, worst " << worst << "\n";
 }
 
 // optimal-k is the bound: its hybrid error (the paper's eq. 2 summed over pixels) is below the
@@ -252,7 +257,8 @@ TEST(OptimalKReference, BelowTheVariableKMethods) {
       gpu.render(ref.camera, budgetRequest(method, bytes));
       const std::vector<std::uint32_t> k = gpu.kMap();
       std::vector<std::uint32_t> capped(k.size());
-      for (std::size_t p = 0; p < k.size(); ++p) capped[p] = std::min<std::uint32_t>(k[p], static_cast<std::uint32_t>(errors[p].size() - 1));
+      for (std::size_t p = 0; p < k.size(); ++p)
+        capped[p] = std::min<std::uint32_t>(k[p], static_cast<std::uint32_t>(errors[p].size() - 1));
       const double e = allocationError(errors, capped);
       EXPECT_LT(best.error, e) << method;
       std::cout << "[ optimal-k ] " << fraction << " of the fragments: optimal error " << best.error << ", " << method

@@ -26,7 +26,9 @@
 
 namespace {
 
-std::uint64_t sum(const std::vector<std::uint32_t>& v) { return std::accumulate(v.begin(), v.end(), std::uint64_t{0}); }
+std::uint64_t sum(const std::vector<std::uint32_t>& v) {
+  return std::accumulate(v.begin(), v.end(), std::uint64_t{0});
+}
 
 TEST(KAllocation, PropertiesOnRandomCases) {
   std::mt19937 rng(5);
@@ -41,7 +43,8 @@ TEST(KAllocation, PropertiesOnRandomCases) {
       importance[p] = c % 5 == 0 ? 1.0f : imp(rng);  // every fifth case: all importances equal
     }
     const std::uint64_t total = sum(n);
-    const std::uint64_t nonEmpty = static_cast<std::uint64_t>(std::count_if(n.begin(), n.end(), [](auto v) { return v > 0; }));
+    const std::uint64_t nonEmpty =
+        static_cast<std::uint64_t>(std::count_if(n.begin(), n.end(), [](auto v) { return v > 0; }));
     for (std::uint64_t F : {std::uint64_t{0}, nonEmpty / 2, nonEmpty, nonEmpty + 1, (nonEmpty + total) / 2,
                             total > 0 ? total - 1 : 0, total, total + 17}) {
       const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(importance, n, F);
@@ -118,15 +121,16 @@ mfr::Fragment frag(float depth, std::uint32_t r, std::uint32_t g, std::uint32_t 
 }
 
 TEST(DkbFeatures, HandMadeList) {
-  const std::vector<mfr::Fragment> list{frag(0.25f, 255, 0, 51, 128), frag(0.5f, 0, 102, 51, 64), frag(0.75f, 0, 0, 51, 32)};
+  const std::vector<mfr::Fragment> list{frag(0.25f, 255, 0, 51, 128), frag(0.5f, 0, 102, 51, 64),
+                                        frag(0.75f, 0, 0, 51, 32)};
   mfr::DkbImageStats image;
   image.totalFragments = 60;
   image.nonEmptyPixels = 20;
   image.imageNear = 0.125f;
   image.imageFar = 0.875f;
   const mfr::DkbFeatureVector f = mfr::dkbFeatures(list, image, 30);
-  const float expected[12] = {3.0f / 60, 30.0f / 60, 0.25f, 0.75f, 0.125f, 0.875f, 1.0f, 0.0f, 0.2f,
-                              255.0f / 765, 102.0f / 765, 153.0f / 765};
+  const float expected[12] = {3.0f / 60, 30.0f / 60, 0.25f, 0.75f,        0.125f,       0.875f,
+                              1.0f,      0.0f,       0.2f,  255.0f / 765, 102.0f / 765, 153.0f / 765};
   for (int i = 0; i < 12; ++i) EXPECT_NEAR(f[static_cast<std::size_t>(i)], expected[i], 1e-6f) << "feature " << i;
 }
 
@@ -136,7 +140,8 @@ mfr::NeuralImportanceModel randomModel(unsigned seed) {
   mfr::NeuralImportanceModel m;
   m.weights.resize(mfr::NeuralImportanceModel::floatCount());
   for (float& x : m.weights) x = w(rng);
-  for (int i = 0; i < 12; ++i) m.weights[static_cast<std::size_t>(12 + i)] = 0.5f + static_cast<float>(i) * 0.1f;  // std > 0
+  for (int i = 0; i < 12; ++i)
+    m.weights[static_cast<std::size_t>(12 + i)] = 0.5f + static_cast<float>(i) * 0.1f;  // std > 0
   return m;
 }
 

@@ -25,7 +25,8 @@ struct Compiled {
 };
 
 Compiled glslang(const std::string& source, const std::string& name) {
-  const auto path = std::filesystem::temp_directory_path() / ("mfr-" + std::to_string(::getpid()) + "-" + name + ".frag");
+  const auto path =
+      std::filesystem::temp_directory_path() / ("mfr-" + std::to_string(::getpid()) + "-" + name + ".frag");
   std::ofstream(path) << source;
   Compiled c;
   FILE* pipe = popen((std::string(MFR_GLSLANG) + " " + path.string() + " 2>&1").c_str(), "r");
@@ -51,7 +52,8 @@ std::vector<Variant> storeVariants() {
       {"methods/kbuffer/store.geom.frag", {}},
       {"methods/kplus-array/store.geom.frag", {{"MFR_KB_CULLING", "1"}}},
       {"methods/kplus-array/store.geom.frag", {{"MFR_KB_REVISED", "1"}}},
-      {"methods/kplus-array/store.geom.frag", {{"MFR_KB_VARIABLE", "1"}, {"MFR_KB_CULLING", "1"}, {"MFR_KB_TAIL", "1"}}},
+      {"methods/kplus-array/store.geom.frag",
+       {{"MFR_KB_VARIABLE", "1"}, {"MFR_KB_CULLING", "1"}, {"MFR_KB_TAIL", "1"}}},
       {"methods/kplus-heap/store.geom.frag", {{"MFR_KB_CULLING", "1"}, {"MFR_KB_TAIL", "1"}}},
       {"methods/kplus-heap/store.geom.frag", {{"MFR_KB_VARIABLE", "1"}}},
       {"methods/kpeel/store.geom.frag", {}},

@@ -26,8 +26,8 @@ std::uint64_t sumAt(std::uint32_t lambdaBits, std::span<const float> importance,
 ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportance, std::span<const std::uint32_t> n,
                                              std::uint64_t budgetSlots) {
   if (rawImportance.size() != n.size())
-    throw Error("importance map", std::to_string(rawImportance.size()) + " entries for " + std::to_string(n.size()) +
-                                      " pixels");
+    throw Error("importance map",
+                std::to_string(rawImportance.size()) + " entries for " + std::to_string(n.size()) + " pixels");
   std::vector<float> importance(rawImportance.size());
   std::transform(rawImportance.begin(), rawImportance.end(), importance.begin(), glsl::mfrSanitizeImportance);
 

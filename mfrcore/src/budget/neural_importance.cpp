@@ -34,9 +34,8 @@ thread_local const float* tMlpWeights = nullptr;
 
 namespace {
 
-constexpr int kLayerShape[3][2] = {{MFR_MLP_HIDDEN1, MFR_MLP_INPUTS},
-                                   {MFR_MLP_HIDDEN2, MFR_MLP_HIDDEN1},
-                                   {1, MFR_MLP_HIDDEN2}};
+constexpr int kLayerShape[3][2] = {
+    {MFR_MLP_HIDDEN1, MFR_MLP_INPUTS}, {MFR_MLP_HIDDEN2, MFR_MLP_HIDDEN1}, {1, MFR_MLP_HIDDEN2}};
 constexpr int kLayerWeights[3] = {MFR_MLP_W1, MFR_MLP_W2, MFR_MLP_W3};
 constexpr int kLayerBias[3] = {MFR_MLP_B1, MFR_MLP_B2, MFR_MLP_B3};
 
@@ -57,9 +56,13 @@ std::vector<float> floats(const nlohmann::json& j, std::size_t count, const std:
 
 }  // namespace
 
-std::size_t NeuralImportanceModel::floatCount() { return MFR_MLP_FLOATS; }
+std::size_t NeuralImportanceModel::floatCount() {
+  return MFR_MLP_FLOATS;
+}
 
-std::size_t NeuralImportanceModel::packedBytes() { return 4 * MFR_MLP_PACKED_WORDS; }
+std::size_t NeuralImportanceModel::packedBytes() {
+  return 4 * MFR_MLP_PACKED_WORDS;
+}
 
 NeuralImportanceModel NeuralImportanceModel::halfPrecision() const {
   NeuralImportanceModel m = *this;
@@ -119,8 +122,8 @@ NeuralImportanceModel parseNeuralImportance(const std::string& text, const std::
                                             where + ".weights[" + std::to_string(o) + "]", source);
       std::copy(row.begin(), row.end(), m.weights.begin() + kLayerWeights[l] + o * inputs);
     }
-    const std::vector<float> bias = floats(layer.value("bias", nlohmann::json()), static_cast<std::size_t>(outputs),
-                                           where + ".bias", source);
+    const std::vector<float> bias =
+        floats(layer.value("bias", nlohmann::json()), static_cast<std::size_t>(outputs), where + ".bias", source);
     std::copy(bias.begin(), bias.end(), m.weights.begin() + kLayerBias[l]);
   }
   m.trainingJson = j.contains("training") ? j["training"].dump() : "{}";
@@ -134,8 +137,10 @@ std::string neuralImportanceJson(const NeuralImportanceModel& m) {
   j["version"] = 1;
   j["architecture"] = {MFR_MLP_INPUTS, MFR_MLP_HIDDEN1, MFR_MLP_HIDDEN2, 1};
   j["target"] = m.target;
-  j["input_mean"] = std::vector<float>(m.weights.begin() + MFR_MLP_MEAN, m.weights.begin() + MFR_MLP_MEAN + MFR_MLP_INPUTS);
-  j["input_std"] = std::vector<float>(m.weights.begin() + MFR_MLP_STD, m.weights.begin() + MFR_MLP_STD + MFR_MLP_INPUTS);
+  j["input_mean"] =
+      std::vector<float>(m.weights.begin() + MFR_MLP_MEAN, m.weights.begin() + MFR_MLP_MEAN + MFR_MLP_INPUTS);
+  j["input_std"] =
+      std::vector<float>(m.weights.begin() + MFR_MLP_STD, m.weights.begin() + MFR_MLP_STD + MFR_MLP_INPUTS);
   nlohmann::ordered_json layers = nlohmann::ordered_json::array();
   for (int l = 0; l < 3; ++l) {
     const int outputs = kLayerShape[l][0], inputs = kLayerShape[l][1];
@@ -144,9 +149,9 @@ std::string neuralImportanceJson(const NeuralImportanceModel& m) {
       const auto begin = m.weights.begin() + kLayerWeights[l] + o * inputs;
       rows.push_back(std::vector<float>(begin, begin + inputs));
     }
-    layers.push_back({{"weights", rows},
-                      {"bias", std::vector<float>(m.weights.begin() + kLayerBias[l],
-                                                  m.weights.begin() + kLayerBias[l] + outputs)}});
+    layers.push_back(
+        {{"weights", rows},
+         {"bias", std::vector<float>(m.weights.begin() + kLayerBias[l], m.weights.begin() + kLayerBias[l] + outputs)}});
   }
   j["layers"] = layers;
   j["training"] = nlohmann::ordered_json::parse(m.trainingJson.empty() ? "{}" : m.trainingJson);
@@ -157,7 +162,8 @@ NeuralImportanceModel loadNeuralImportance(const std::string& path) {
   if (!path.empty()) return parseNeuralImportance(readFile(path), path);
   const auto& files = detail::embeddedResources();
   const auto it = files.find("dkb/weights.json");
-  if (it == files.end()) throw Error("dkb", "no built-in weights (resources/dkb/weights.json); give --param weights=FILE");
+  if (it == files.end())
+    throw Error("dkb", "no built-in weights (resources/dkb/weights.json); give --param weights=FILE");
   NeuralImportanceModel m = parseNeuralImportance(std::string(it->second), "resources/dkb/weights.json");
   m.source = "built-in";
   return m;
@@ -208,12 +214,10 @@ DkbFeatureVector dkbFeatures(std::span<const Fragment> sorted, const DkbImageSta
   for (const Fragment& f : sorted)
     if (f.depth == nearDepth) nearest = std::max(nearest, f.color);
   glm::vec4 a, b, c;
-  glsl::mfrDkbFeatures(static_cast<std::uint32_t>(sorted.size()),
-                       static_cast<float>(static_cast<std::uint32_t>(image.totalFragments)),
-                       static_cast<float>(static_cast<std::uint32_t>(budgetSlots)), nearDepth, farDepth, image.imageNear,
-                       image.imageFar, nearest,
-                       glm::vec3(static_cast<float>(sum[0]), static_cast<float>(sum[1]), static_cast<float>(sum[2])), a,
-                       b, c);
+  glsl::mfrDkbFeatures(
+      static_cast<std::uint32_t>(sorted.size()), static_cast<float>(static_cast<std::uint32_t>(image.totalFragments)),
+      static_cast<float>(static_cast<std::uint32_t>(budgetSlots)), nearDepth, farDepth, image.imageNear, image.imageFar,
+      nearest, glm::vec3(static_cast<float>(sum[0]), static_cast<float>(sum[1]), static_cast<float>(sum[2])), a, b, c);
   return {a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, c.y, c.z, c.w};
 }
 

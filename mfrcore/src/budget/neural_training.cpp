@@ -51,7 +51,8 @@ double meanSquaredError(DkbNet& net, const std::vector<Sample>& x, const std::ve
   const std::size_t batch = 4096;
   for (std::size_t i = 0; i < x.size(); i += batch) {
     const std::size_t end = std::min(x.size(), i + batch);
-    const std::vector<Sample> part(x.begin() + static_cast<std::ptrdiff_t>(i), x.begin() + static_cast<std::ptrdiff_t>(end));
+    const std::vector<Sample> part(x.begin() + static_cast<std::ptrdiff_t>(i),
+                                   x.begin() + static_cast<std::ptrdiff_t>(end));
     const std::vector<float> pred = net(part);
     for (std::size_t j = 0; j < pred.size(); ++j) {
       const double d = static_cast<double>(pred[j]) - y[i + j];

@@ -7,13 +7,22 @@ namespace mfr {
 const MethodInfo& DeepVariableKBuffer::info() const {
   static const MethodInfo i = [] {
     std::vector<ParamSpec> p = budgetParams();
-    p.push_back({"weights", "Network weights file", ParamSpec::Type::Text, "", 0, 0, {},
+    p.push_back({"weights",
+                 "Network weights file",
+                 ParamSpec::Type::Text,
+                 "",
+                 0,
+                 0,
+                 {},
                  "JSON weights of the 12-128-64-1 network (mfr train); empty: the built-in "
                  "resources/dkb/weights.json"});
-    return MethodInfo{"dkb", "Deep variable k-buffer: a neural network predicts k(p) under a memory budget",
+    return MethodInfo{"dkb",
+                      "Deep variable k-buffer: a neural network predicts k(p) under a memory budget",
                       "Tsopouridis, Fudos, Vasilakis: Deep hybrid order-independent transparency. The Visual "
                       "Computer 2022",
-                      false, p, "hybrid"};
+                      false,
+                      p,
+                      "hybrid"};
   }();
   return i;
 }
@@ -29,8 +38,10 @@ void DeepVariableKBuffer::configureMember(const Params& params) {
     weights_ = gl::createBuffer(words.size() * sizeof(std::uint32_t), words.data());
   }
   if (!count_.id()) {
-    count_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/dkb/count.geom.frag"}});
-    nearest_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/dkb/nearest.geom.frag"}});
+    count_ =
+        gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/dkb/count.geom.frag"}});
+    nearest_ =
+        gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/dkb/nearest.geom.frag"}});
     mlp_ = gl::Program({{GL_COMPUTE_SHADER, "methods/dkb/mlp.comp"}});
   }
 }

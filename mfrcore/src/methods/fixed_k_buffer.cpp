@@ -11,18 +11,26 @@ namespace mfr {
 
 const MethodInfo& FixedKBuffer::info() const {
   static const MethodInfo i = [] {
-    std::vector<ParamSpec> p{
-        {"budget_mib", "Memory budget M (MiB)", ParamSpec::Type::Float, "16", 0, 65536, {},
-         "GPU memory for all of the method's buffers; k is the largest uniform k that fits"}};
+    std::vector<ParamSpec> p{{"budget_mib",
+                              "Memory budget M (MiB)",
+                              ParamSpec::Type::Float,
+                              "16",
+                              0,
+                              65536,
+                              {},
+                              "GPU memory for all of the method's buffers; k is the largest uniform k that fits"}};
     for (ParamSpec& s : kbufferParams(true, false))
       if (s.name != "k") p.push_back(s);
     for (ParamSpec& s : p)
       if (s.name == "tail") s.defaultValue = "true";  // hybrid transparency is what a budget is for
-    return MethodInfo{"fkb", "Fixed k-buffer: the largest uniform k that fits a memory budget",
+    return MethodInfo{"fkb",
+                      "Fixed k-buffer: the largest uniform k that fits a memory budget",
                       "Tsopouridis, Fudos, Vasilakis: Deep hybrid order-independent transparency. The Visual "
                       "Computer 2022 (fixed-k baseline) over the k+-buffer max-array of Vasilakis, Papaioannou, Fudos, "
                       "IEEE TVCG 21(6), 2015",
-                      false, p, "hybrid"};
+                      false,
+                      p,
+                      "hybrid"};
   }();
   return i;
 }

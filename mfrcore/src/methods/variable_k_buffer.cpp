@@ -42,14 +42,38 @@ std::string mibText(std::uint64_t bytes) {
 }  // namespace
 
 std::vector<ParamSpec> VariableKBuffer::budgetParams() {
-  return {{"budget_mib", "Memory budget M (MiB)", ParamSpec::Type::Float, "16", 0, 65536, {},
+  return {{"budget_mib",
+           "Memory budget M (MiB)",
+           ParamSpec::Type::Float,
+           "16",
+           0,
+           65536,
+           {},
            "GPU memory for all of the method's buffers; k(p) is allocated so that it is used up"},
-          {"sync", "Per-pixel synchronisation", ParamSpec::Type::Choice, "spinlock", 0, 0, {"spinlock", "interlock"},
+          {"sync",
+           "Per-pixel synchronisation",
+           ParamSpec::Type::Choice,
+           "spinlock",
+           0,
+           0,
+           {"spinlock", "interlock"},
            "spinlock: a semaphore word per pixel + atomicExchange, bounded retries; interlock: "
            "ARB_fragment_shader_interlock where the driver has it"},
-          {"spin_limit", "Spin-lock attempts", ParamSpec::Type::Int, "1024", 1, 4096, {},
+          {"spin_limit",
+           "Spin-lock attempts",
+           ParamSpec::Type::Int,
+           "1024",
+           1,
+           4096,
+           {},
            "lock attempts per fragment before it is dropped (counted in lockFailures)"},
-          {"culling", "Cull against the maximum", ParamSpec::Type::Bool, "true", 0, 0, {},
+          {"culling",
+           "Cull against the maximum",
+           ParamSpec::Type::Bool,
+           "true",
+           0,
+           0,
+           {},
            "reject fragments behind the pixel's current k(p)-th nearest before taking the lock"}};
 }
 
@@ -73,8 +97,8 @@ void VariableKBuffer::configure(int width, int height, const Params& params) {
   if (budgetBytes_ < layout.bytes(1))
     throw Error("--param budget_mib=" + budgetText_,
                 "below what " + info().name + " needs at " + std::to_string(width) + "x" + std::to_string(height) +
-                    " for its per-pixel buffers and one fragment slot (" + mibText(layout.bytes(1)) + " MiB = " +
-                    std::to_string(layout.bytes(1)) + " bytes)");
+                    " for its per-pixel buffers and one fragment slot (" + mibText(layout.bytes(1)) +
+                    " MiB = " + std::to_string(layout.bytes(1)) + " bytes)");
   if (resized || !arena_ || layout.arenaWords != layout_.arenaWords) arena_ = gl::createBuffer(layout.arenaBytes());
   layout_ = layout;
   if (!state_) state_ = gl::createBuffer(kVariableKStateBytes);
@@ -199,7 +223,8 @@ void VariableKBuffer::capture(const FrameContext& ctx) {
   stats_.notes.emplace_back("budget", budgetText_ + " MiB = " + std::to_string(budgetBytes_) + " bytes");
   stats_.notes.emplace_back("F(M)", std::to_string(budgetSlots) + " slots");
   stats_.notes.emplace_back("slots assigned", std::to_string(slotsF_) + " of " + std::to_string(totalFragments_) +
-                                                   " fragments" + (kFloor == 0 ? " (k = 0 allowed: F < non-empty pixels)" : ""));
+                                                  " fragments" +
+                                                  (kFloor == 0 ? " (k = 0 allowed: F < non-empty pixels)" : ""));
   stats_.notes.emplace_back("importance", describeImportance());
   stats_.notes.emplace_back("culling", culling_ ? "on" : "off");
 }
@@ -237,8 +262,8 @@ std::vector<std::uint32_t> VariableKBuffer::capacityMap() const {
   if (!arena_) return {};
   std::vector<std::uint32_t> raw(static_cast<std::size_t>(pixels()) + 1);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  glGetNamedBufferSubData(arena_.id(), static_cast<GLintptr>(4 * layout_.kBase), static_cast<GLsizeiptr>(4 * raw.size()),
-                          raw.data());
+  glGetNamedBufferSubData(arena_.id(), static_cast<GLintptr>(4 * layout_.kBase),
+                          static_cast<GLsizeiptr>(4 * raw.size()), raw.data());
   std::vector<std::uint32_t> k(raw.size() - 1);
   for (std::size_t p = 0; p < k.size(); ++p) k[p] = raw[p + 1] - raw[p];
   return k;

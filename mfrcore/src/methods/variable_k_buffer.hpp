@@ -74,7 +74,7 @@ class VariableKBuffer : public KBufferFamily {
   std::vector<std::uint32_t> counts_;
   gl::Program imageStats_, search_, narrow_, assign_, finish_;
   PrefixSum scan_;
-  std::uint64_t slotsF_ = 0;      // F of the last frame
+  std::uint64_t slotsF_ = 0;  // F of the last frame
   std::uint64_t totalFragments_ = 0, nonEmpty_ = 0;
 };
 

@@ -9,25 +9,65 @@ namespace mfr {
 const MethodInfo& VariableKBufferImportance::info() const {
   static const MethodInfo i = [] {
     std::vector<ParamSpec> p = budgetParams();
-    p.push_back({"poi_x", "Point of interest x", ParamSpec::Type::Float, "0.5", 0, 1, {},
+    p.push_back({"poi_x",
+                 "Point of interest x",
+                 ParamSpec::Type::Float,
+                 "0.5",
+                 0,
+                 1,
+                 {},
                  "periphery criterion: where the viewer looks, as a fraction of the image width"});
-    p.push_back({"poi_y", "Point of interest y", ParamSpec::Type::Float, "0.5", 0, 1, {},
+    p.push_back({"poi_y",
+                 "Point of interest y",
+                 ParamSpec::Type::Float,
+                 "0.5",
+                 0,
+                 1,
+                 {},
                  "… as a fraction of the image height, from the top"});
-    p.push_back({"falloff", "Periphery falloff d", ParamSpec::Type::Float, "0.35", 0.01, 10, {},
+    p.push_back({"falloff",
+                 "Periphery falloff d",
+                 ParamSpec::Type::Float,
+                 "0.35",
+                 0.01,
+                 10,
+                 {},
                  "importance exp(-(r/d)^2), r the distance from the point of interest in image diagonals"});
-    p.push_back({"n_limit", "Depth complexity limit N", ParamSpec::Type::Float, "32", 1, 4096, {},
+    p.push_back({"n_limit",
+                 "Depth complexity limit N",
+                 ParamSpec::Type::Float,
+                 "32",
+                 1,
+                 4096,
+                 {},
                  "depth criterion (min(n, N)/N)^alpha saturates at N fragments"});
-    p.push_back({"alpha", "Depth complexity exponent", ParamSpec::Type::Float, "1", 0, 8, {}, "alpha of the depth criterion"});
+    p.push_back(
+        {"alpha", "Depth complexity exponent", ParamSpec::Type::Float, "1", 0, 8, {}, "alpha of the depth criterion"});
     p.push_back({"w_periphery", "Weight: periphery", ParamSpec::Type::Float, "1", 0, 100, {}, ""});
     p.push_back({"w_depth", "Weight: depth complexity", ParamSpec::Type::Float, "1", 0, 100, {}, ""});
-    p.push_back({"w_fresnel", "Weight: Fresnel", ParamSpec::Type::Float, "1", 0, 100, {},
+    p.push_back({"w_fresnel",
+                 "Weight: Fresnel",
+                 ParamSpec::Type::Float,
+                 "1",
+                 0,
+                 100,
+                 {},
                  "Schlick's Fresnel term of the nearest fragment (silhouettes matter more)"});
-    p.push_back({"noise", "Noise lambda", ParamSpec::Type::Float, "0", 0, 1, {},
+    p.push_back({"noise",
+                 "Noise lambda",
+                 ParamSpec::Type::Float,
+                 "0",
+                 0,
+                 1,
+                 {},
                  "blend of a per-pixel hash into the importance"});
-    return MethodInfo{"vkb", "Variable k-buffer with importance maps, under a memory budget",
+    return MethodInfo{"vkb",
+                      "Variable k-buffer with importance maps, under a memory budget",
                       "Vasilakis, Vardis, Papaioannou, Moustakas: Variable k-buffer using Importance Maps. "
                       "Eurographics 2017 Short Papers (with the tail of hybrid transparency)",
-                      false, p, "hybrid"};
+                      false,
+                      p,
+                      "hybrid"};
   }();
   return i;
 }
@@ -41,8 +81,10 @@ void VariableKBufferImportance::configureMember(const Params& params) {
               static_cast<float>(params.real("w_fresnel"))};
   noise_ = static_cast<float>(params.real("noise"));
   if (!count_.id()) {
-    count_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/vkb/count.geom.frag"}});
-    nearest_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/vkb/nearest.geom.frag"}});
+    count_ =
+        gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/vkb/count.geom.frag"}});
+    nearest_ =
+        gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/vkb/nearest.geom.frag"}});
     importance_ = gl::Program({{GL_COMPUTE_SHADER, "methods/vkb/importance.comp"}});
   }
 }

@@ -25,13 +25,13 @@
 namespace mfr {
 
 inline constexpr int kDatasetColumns = kDkbFeatures + 3;
-inline constexpr int kDatasetLabel = kDkbFeatures;      // k(p) / F
-inline constexpr int kDatasetK = kDkbFeatures + 1;      // k(p)
-inline constexpr int kDatasetN = kDkbFeatures + 2;      // n(p)
+inline constexpr int kDatasetLabel = kDkbFeatures;  // k(p) / F
+inline constexpr int kDatasetK = kDkbFeatures + 1;  // k(p)
+inline constexpr int kDatasetN = kDkbFeatures + 2;  // n(p)
 
 struct DkbDataset {
-  std::vector<float> rows;        // kDatasetColumns floats per row
-  std::string metadata = "{}";    // JSON text
+  std::vector<float> rows;      // kDatasetColumns floats per row
+  std::string metadata = "{}";  // JSON text
   [[nodiscard]] std::size_t size() const { return rows.size() / kDatasetColumns; }
   [[nodiscard]] const float* row(std::size_t i) const { return rows.data() + i * kDatasetColumns; }
 };
@@ -40,9 +40,9 @@ struct DatasetFrame {
   std::uint64_t budgetSlots = 0;
   std::uint64_t nonEmptyPixels = 0;
   std::uint64_t totalFragments = 0;
-  std::uint64_t sampled = 0;      // rows appended
-  double optimalError = 0.0;      // Σ_p e_p(k(p)) of the labels' allocation
-  std::string solver;             // which optimalKBest solver won
+  std::uint64_t sampled = 0;  // rows appended
+  double optimalError = 0.0;  // Σ_p e_p(k(p)) of the labels' allocation
+  std::string solver;         // which optimalKBest solver won
 };
 
 // Appends every non-empty pixel of one frame with probability sampleFraction. errors is the

@@ -14,10 +14,10 @@
 namespace mfr {
 
 struct ImportanceAllocation {
-  std::vector<std::uint32_t> k;   // per pixel
-  std::uint64_t assigned = 0;     // Σk
-  std::uint32_t kFloor = 1;       // 1, or 0 when F < non-empty pixels
-  float lambdaLow = 0.0f;         // the search's final interval [λ_lo, λ_hi]
+  std::vector<std::uint32_t> k;  // per pixel
+  std::uint64_t assigned = 0;    // Σk
+  std::uint32_t kFloor = 1;      // 1, or 0 when F < non-empty pixels
+  float lambdaLow = 0.0f;        // the search's final interval [λ_lo, λ_hi]
   float lambdaHigh = 0.0f;
 };
 

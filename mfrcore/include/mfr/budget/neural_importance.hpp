@@ -25,10 +25,10 @@ inline constexpr int kDkbFeatures = 12;
 using DkbFeatureVector = std::array<float, kDkbFeatures>;
 
 struct NeuralImportanceModel {
-  std::vector<float> weights;        // the shaders/budget/mlp.h layout (MFR_MLP_FLOATS floats)
-  std::string target = "k_over_n";   // or "k_over_budget"
-  std::string trainingJson = "{}";   // the file's "training" object, verbatim (provenance)
-  std::string source;                // the path it was read from, or "built-in"
+  std::vector<float> weights;       // the shaders/budget/mlp.h layout (MFR_MLP_FLOATS floats)
+  std::string target = "k_over_n";  // or "k_over_budget"
+  std::string trainingJson = "{}";  // the file's "training" object, verbatim (provenance)
+  std::string source;               // the path it was read from, or "built-in"
 
   [[nodiscard]] bool predictsFractionOfList() const { return target == "k_over_n"; }
   static std::size_t floatCount();

@@ -15,20 +15,20 @@
 namespace mfr {
 
 struct NeuralTrainingOptions {
-  std::string target = "k_over_n";   // what the sigmoid predicts: k/n or k/F ("k_over_budget")
+  std::string target = "k_over_n";  // what the sigmoid predicts: k/n or k/F ("k_over_budget")
   std::size_t epochs = 40;
   double learningRate = 0.001;
   std::size_t batchSize = 512;
-  double weightDecay = 0.0005;       // L2
+  double weightDecay = 0.0005;  // L2
   double momentum = 0.9;
-  double validationFraction = 0.1;   // rows held out to pick the best epoch
+  double validationFraction = 0.1;  // rows held out to pick the best epoch
   std::uint64_t seed = 1;
   // Called after each epoch: (epoch, training MSE, validation MSE).
   std::function<void(std::size_t, double, double)> progress;
 };
 
 struct NeuralTrainingResult {
-  NeuralImportanceModel model;       // weights of the epoch with the least validation error
+  NeuralImportanceModel model;  // weights of the epoch with the least validation error
   std::size_t bestEpoch = 0;
   double trainingLoss = 0.0, validationLoss = 0.0;
   std::size_t trainingRows = 0, validationRows = 0;
