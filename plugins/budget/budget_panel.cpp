@@ -357,7 +357,7 @@ void BudgetPanel::showFrame() {
   kLabel_->setText(s.kMax == 0 ? tr("— (no per-pixel capacity)")
                    : s.kMin == s.kMax ? QString::number(s.kMax)
                                       : QStringLiteral("%1 … %2").arg(s.kMin).arg(s.kMax));
-  histogram_->setMarker(driverFor(ctx_.method()).knob == Knob::Pool ? 0 : static_cast<int>(s.kMax));
+  histogram_->setMarker(driverFor(ctx_.method()).knob == Knob::Pool ? 0 : static_cast<int>(s.kMax), s.kMin != s.kMax);
 }
 
 QJsonObject BudgetPanel::saveSettings() const { return {{"budget_mib", budgetMiB()}, {"driving", driving_}}; }

@@ -17,9 +17,10 @@ void HistogramWidget::setHistogram(const QVector<quint64>& histogram, QSize imag
   update();
 }
 
-void HistogramWidget::setMarker(int k) {
-  if (k == marker_) return;
+void HistogramWidget::setMarker(int k, bool variable) {
+  if (k == marker_ && variable == variable_) return;
   marker_ = k;
+  variable_ = variable;
   update();
 }
 
@@ -50,7 +51,7 @@ void HistogramWidget::paintEvent(QPaintEvent*) {
     if (histogram_[n] == 0) continue;
     const double h = plot.height() * std::log10(static_cast<double>(histogram_[n]) + 1.0) / logMax;
     const QRectF bar(plot.left() + (n - 1) * barWidth, plot.bottom() - h, std::max(1.0, barWidth - (barWidth > 4 ? 1 : 0)), h);
-    p.fillRect(bar, marker_ > 0 && n > marker_ ? lost : kept);
+    p.fillRect(bar, marker_ > 0 && !variable_ && n > marker_ ? lost : kept);
   }
   // Axes and labels.
   p.setPen(pal.color(QPalette::Mid));
@@ -71,6 +72,7 @@ void HistogramWidget::paintEvent(QPaintEvent*) {
     const int x = static_cast<int>(plot.left() + marker_ * barWidth);
     p.setPen(QPen(QColor(200, 30, 30), 2, Qt::DashLine));
     p.drawLine(x, plot.top(), x, plot.bottom());
-    p.drawText(QRect(x + 4, plot.top(), 80, fm.height()), Qt::AlignLeft | Qt::AlignTop, QStringLiteral("k = %1").arg(marker_));
+    const QString label = variable_ ? tr("max k(p) = %1").arg(marker_) : QStringLiteral("k = %1").arg(marker_);
+    p.drawText(QRect(x + 4, plot.top(), fm.horizontalAdvance(label) + 8, fm.height()), Qt::AlignLeft | Qt::AlignTop, label);
   }
 }

@@ -11,7 +11,9 @@ class HistogramWidget final : public QWidget {
  public:
   explicit HistogramWidget(QWidget* parent = nullptr);
   void setHistogram(const QVector<quint64>& histogram, QSize imageSize);
-  void setMarker(int k);  // 0: none
+  // 0: none. variable: k differs per pixel (vkb, dkb, kplus-sbuffer…) and k is its maximum, so
+  // pixels with n ≤ k may lose fragments too: the bars are not split into kept and lost.
+  void setMarker(int k, bool variable = false);
   [[nodiscard]] const QVector<quint64>& histogram() const { return histogram_; }
 
  protected:
@@ -21,4 +23,5 @@ class HistogramWidget final : public QWidget {
   QVector<quint64> histogram_;
   QSize imageSize_;
   int marker_ = 0;
+  bool variable_ = false;
 };
