@@ -36,6 +36,9 @@ void addTrain(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 0.9));
   cmd->add_option("--seed", opt->training.seed, "Random seed (split, batches)")->capture_default_str();
+  cmd->add_option("--weighting", opt->training.weighting,
+                  "none, or fragments: rows drawn with probability proportional to n(p), losses weighted by n(p)")
+      ->capture_default_str();
   cmd->callback([opt] {
     DkbDataset all;
     std::string meta = "[";

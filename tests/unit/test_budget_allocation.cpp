@@ -288,6 +288,46 @@ TEST(NeuralTraining, ExportedWeightsReproduceDlibsLoss) {
   EXPECT_EQ(mfr::predictNeuralImportance(back, x), mfr::predictNeuralImportance(r.model, x));
 }
 
+// Rows drawn in proportion to n(p): the network still learns, the reported losses are weighted by
+// n (so they differ from the unweighted ones of the same weights), and a bad option is refused.
+TEST(NeuralTraining, FragmentWeighting) {
+  mfr::DkbDataset d;
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int r = 0; r < 2000; ++r) {
+    float row[mfr::kDatasetColumns];
+    for (int f = 0; f < 12; ++f) row[f] = u(rng);
+    const float n = 1.0f + std::floor(u(rng) * 30.0f);
+    row[mfr::kDatasetN] = n;
+    row[mfr::kDatasetK] = std::max(1.0f, std::round(n * (0.2f + 0.6f * row[3])));
+    row[mfr::kDatasetLabel] = row[mfr::kDatasetK] / 1000.0f;
+    d.rows.insert(d.rows.end(), row, row + mfr::kDatasetColumns);
+  }
+  mfr::NeuralTrainingOptions o;
+  o.epochs = 4;
+  o.batchSize = 64;
+  o.learningRate = 0.01;
+  o.weighting = "fragments";
+  std::vector<double> losses;
+  o.progress = [&](std::size_t, double train, double) { losses.push_back(train); };
+  const mfr::NeuralTrainingResult r = mfr::trainNeuralImportance(d, o);
+  EXPECT_LT(losses.back(), losses.front());
+  // The weighted loss of the exported model, recomputed on the CPU over all rows, is close to the
+  // mix of the reported (weighted) ones.
+  double sq = 0, weights = 0;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const float* row = d.row(i);
+    mfr::DkbFeatureVector x;
+    std::copy(row, row + 12, x.begin());
+    const double diff = mfr::predictNeuralImportance(r.model, x) - row[mfr::kDatasetK] / row[mfr::kDatasetN];
+    sq += row[mfr::kDatasetN] * diff * diff;
+    weights += row[mfr::kDatasetN];
+  }
+  EXPECT_NEAR(sq / weights, r.trainingLoss, 0.15 * r.trainingLoss);
+  o.weighting = "by-colour";
+  EXPECT_THROW(mfr::trainNeuralImportance(d, o), mfr::Error);
+}
+
 TEST(VariableKLayout, BytesAndSlotBudget) {
   const mfr::VariableKLayout l = mfr::variableKLayout(1000, 40);
   // Regions: 1000 → 1024 words (lock), 5 × 1024 (stride for 1001), 1024 (k): 7168 words.

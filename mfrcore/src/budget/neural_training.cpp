@@ -45,9 +45,11 @@ void exportFc(const Layer& layer, int inputs, int outputs, int weightBase, int b
   }
 }
 
-double meanSquaredError(DkbNet& net, const std::vector<Sample>& x, const std::vector<float>& y) {
+// Mean squared error, weighted by w when w is not empty.
+double meanSquaredError(DkbNet& net, const std::vector<Sample>& x, const std::vector<float>& y,
+                        const std::vector<float>& w) {
   if (x.empty()) return 0.0;
-  double sum = 0.0;
+  double sum = 0.0, weights = 0.0;
   const std::size_t batch = 4096;
   for (std::size_t i = 0; i < x.size(); i += batch) {
     const std::size_t end = std::min(x.size(), i + batch);
@@ -56,10 +58,12 @@ double meanSquaredError(DkbNet& net, const std::vector<Sample>& x, const std::ve
     const std::vector<float> pred = net(part);
     for (std::size_t j = 0; j < pred.size(); ++j) {
       const double d = static_cast<double>(pred[j]) - y[i + j];
-      sum += d * d;
+      const double weight = w.empty() ? 1.0 : w[i + j];
+      sum += weight * d * d;
+      weights += weight;
     }
   }
-  return sum / static_cast<double>(x.size());
+  return weights > 0.0 ? sum / weights : 0.0;
 }
 
 }  // namespace
@@ -69,6 +73,9 @@ NeuralTrainingResult trainNeuralImportance(const DkbDataset& dataset, const Neur
   if (options.target != "k_over_n" && options.target != "k_over_budget")
     throw Error("--target " + options.target, "expected k_over_n or k_over_budget");
   if (options.batchSize == 0 || options.epochs == 0) throw Error("mfr train", "epochs and batch size must be positive");
+  if (options.weighting != "none" && options.weighting != "fragments")
+    throw Error("--weighting " + options.weighting, "expected none or fragments");
+  const bool weighted = options.weighting == "fragments";
 
   // Standardisation from all rows (the same for training and validation rows).
   std::vector<double> mean(kDkbFeatures, 0.0), var(kDkbFeatures, 0.0);
@@ -93,7 +100,7 @@ NeuralTrainingResult trainNeuralImportance(const DkbDataset& dataset, const Neur
   const std::size_t validation = std::min<std::size_t>(
       dataset.size() - 1, static_cast<std::size_t>(options.validationFraction * static_cast<double>(dataset.size())));
   std::vector<Sample> trainX, validX;
-  std::vector<float> trainY, validY;
+  std::vector<float> trainY, validY, trainW, validW;
   for (std::size_t i = 0; i < order.size(); ++i) {
     const float* row = dataset.row(order[i]);
     Sample s;
@@ -103,6 +110,7 @@ NeuralTrainingResult trainNeuralImportance(const DkbDataset& dataset, const Neur
     const float y = options.target == "k_over_n" ? row[kDatasetK] / n : row[kDatasetLabel];
     (i < validation ? validX : trainX).push_back(s);
     (i < validation ? validY : trainY).push_back(y);
+    if (weighted) (i < validation ? validW : trainW).push_back(n);
   }
 
   dlib::set_dnn_prefer_smallest_algorithms();
@@ -123,8 +131,13 @@ NeuralTrainingResult trainNeuralImportance(const DkbDataset& dataset, const Neur
   std::iota(batchOrder.begin(), batchOrder.end(), std::size_t{0});
   std::vector<Sample> bx;
   std::vector<float> by;
+  std::discrete_distribution<std::size_t> byFragments(trainW.begin(), trainW.end());
   for (std::size_t epoch = 1; epoch <= options.epochs; ++epoch) {
-    std::shuffle(batchOrder.begin(), batchOrder.end(), rng);
+    if (weighted) {
+      for (std::size_t& i : batchOrder) i = byFragments(rng);
+    } else {
+      std::shuffle(batchOrder.begin(), batchOrder.end(), rng);
+    }
     for (std::size_t i = 0; i < batchOrder.size(); i += options.batchSize) {
       const std::size_t end = std::min(batchOrder.size(), i + options.batchSize);
       bx.clear();
@@ -136,8 +149,8 @@ NeuralTrainingResult trainNeuralImportance(const DkbDataset& dataset, const Neur
       trainer.train_one_step(bx, by);
     }
     trainer.get_net(dlib::force_flush_to_disk::no);  // waits for the trainer's thread
-    const double trainLoss = meanSquaredError(net, trainX, trainY);
-    const double validLoss = validX.empty() ? trainLoss : meanSquaredError(net, validX, validY);
+    const double trainLoss = meanSquaredError(net, trainX, trainY, trainW);
+    const double validLoss = validX.empty() ? trainLoss : meanSquaredError(net, validX, validY, validW);
     if (options.progress) options.progress(epoch, trainLoss, validLoss);
     if (validLoss < result.validationLoss) {
       result.validationLoss = validLoss;
@@ -168,6 +181,7 @@ NeuralTrainingResult trainNeuralImportance(const DkbDataset& dataset, const Neur
   t["weight_decay_l2"] = options.weightDecay;
   t["l1"] = "not available in dlib's sgd solver";
   t["momentum"] = options.momentum;
+  t["weighting"] = options.weighting;
   t["epochs"] = options.epochs;
   t["best_epoch"] = result.bestEpoch;
   t["training_rows"] = result.trainingRows;

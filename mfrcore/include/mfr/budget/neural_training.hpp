@@ -22,6 +22,10 @@ struct NeuralTrainingOptions {
   double weightDecay = 0.0005;  // L2
   double momentum = 0.9;
   double validationFraction = 0.1;  // rows held out to pick the best epoch
+  // "none": every row as often as the next; "fragments": rows drawn (with replacement) with
+  // probability ∝ n(p) each epoch, and the losses weighted by n(p) — a pixel's k error costs slots
+  // in proportion to its depth, so deep pixels should be fitted better (still mean squared error).
+  std::string weighting = "none";
   std::uint64_t seed = 1;
   // Called after each epoch: (epoch, training MSE, validation MSE).
   std::function<void(std::size_t, double, double)> progress;
