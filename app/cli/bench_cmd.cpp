@@ -21,13 +21,6 @@
 namespace mfr::cli {
 namespace {
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 std::string mib(std::uint64_t bytes) {
   std::ostringstream s;
   s << std::fixed << std::setprecision(2) << static_cast<double>(bytes) / (1024.0 * 1024.0);
@@ -86,9 +79,7 @@ void addBench(CLI::App& app) {
     std::vector<RenderRequest> requests;
     for (const std::string& spec : splitList(opt->methods)) requests.push_back(parseMethodSpec(spec, w, h));
     if (requests.empty()) throw Error("--methods", "no method given");
-    Scene scene = loadScene(opt->scene);
-    if (opt->opacity >= 0.0)
-      for (Object& o : scene.objects) o.material.color.a = static_cast<float>(opt->opacity);
+    const Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
     const Camera camera = scene.view(opt->view);
 
     ImageRGBA8 reference;

@@ -1,7 +1,10 @@
+#include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "commands.hpp"
 #include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
 #include "mfr/render.hpp"
 
 namespace mfr::cli {
@@ -23,6 +26,43 @@ std::vector<std::string> splitList(const std::string& text) {
   while (std::getline(in, item, ','))
     if (!item.empty()) out.push_back(item);
   return out;
+}
+
+Scene loadSceneWithOpacity(const std::string& path, double opacity) {
+  Scene scene = loadScene(path);
+  if (opacity >= 0.0)
+    for (Object& o : scene.objects) o.material.color.a = static_cast<float>(opacity);
+  return scene;
+}
+
+std::vector<Scene> loadScenesWithViews(const std::vector<std::string>& paths, double opacity,
+                                       const std::vector<std::string>& views) {
+  if (views.empty()) throw Error("--views", "no view given");
+  std::vector<Scene> scenes;
+  for (const std::string& path : paths) {
+    scenes.push_back(loadSceneWithOpacity(path, opacity));
+    for (const std::string& v : views) (void)scenes.back().view(v);
+  }
+  return scenes;
+}
+
+std::optional<double> parseNumber(const std::string& text) {
+  std::size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  if (used != text.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
 }  // namespace mfr::cli

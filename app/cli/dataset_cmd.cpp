@@ -27,16 +27,9 @@ std::vector<double> parseBudgetLevels(const std::string& text) {
       out.push_back(-1.0);
       continue;
     }
-    std::size_t used = 0;
-    double v = 0;
-    try {
-      v = std::stod(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != item.size() || !std::isfinite(v) || v < 1.0)
-      throw Error("--budgets " + item, "expected slots per non-empty pixel (a number >= 1) or 'all'");
-    out.push_back(v);
+    const std::optional<double> v = parseNumber(item);
+    if (!v || *v < 1.0) throw Error("--budgets " + item, "expected slots per non-empty pixel (a number >= 1) or 'all'");
+    out.push_back(*v);
   }
   if (out.empty()) throw Error("--budgets", "no budget given");
   return out;
@@ -69,17 +62,9 @@ void addDataset(CLI::App& app) {
   cmd->callback([opt] {
     const std::vector<double> levels = parseBudgetLevels(opt->budgets);
     const std::vector<std::string> views = splitList(opt->views);
-    if (views.empty()) throw Error("--views", "no view given");
     std::vector<std::pair<int, int>> sizes;
     for (const std::string& s : opt->sizes) sizes.push_back(parseSize("--size", s));
-    // Load every scene first: a bad file fails before any work.
-    std::vector<Scene> scenes;
-    for (const std::string& path : opt->scenes) {
-      scenes.push_back(loadScene(path));
-      if (opt->opacity >= 0.0)
-        for (Object& o : scenes.back().objects) o.material.color.a = static_cast<float>(opt->opacity);
-      for (const std::string& v : views) (void)scenes.back().view(v);
-    }
+    const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     DkbDataset dataset;
     std::mt19937_64 rng(opt->seed);
     nlohmann::ordered_json meta;

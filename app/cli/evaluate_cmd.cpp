@@ -42,51 +42,27 @@ Budget parseBudget(const std::string& item, std::uint64_t pixels) {
   Budget b;
   b.label = item;
   if (!item.empty() && item[0] == 'f') {
-    std::size_t used = 0;
-    double percent = 0;
-    try {
-      percent = std::stod(item.substr(1), &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used + 1 != item.size() || !(percent > 0.0) || percent > 100.0)
+    const std::optional<double> percent = parseNumber(item.substr(1));
+    if (!percent || !(*percent > 0.0) || *percent > 100.0)
       throw Error("--budgets " + item, "expected fN with 0 < N <= 100 (% of the frame's fragments)");
-    b.fragmentPercent = percent;
+    b.fragmentPercent = *percent;
     return b;
   }
   if (!item.empty() && item[0] == 'k') {
-    std::size_t used = 0;
-    double k = 0;
-    try {
-      k = std::stod(item.substr(1), &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used + 1 != item.size() || !(k >= 1.0) || k > 256.0)
+    const std::optional<double> k = parseNumber(item.substr(1));
+    if (!k || !(*k >= 1.0) || *k > 256.0)
       throw Error("--budgets " + item, "expected kN with 1 <= N <= 256 (N may be fractional)");
     // bytes(k) = P·(8k + y) + z of fkb's layout, also for fractional k (between two uniform k).
     const KBufferMemoryModel m = kplusArrayMemoryModel(pixels);
-    b.mib = (static_cast<double>(m.pixels) * (8.0 * k + static_cast<double>(m.bytesPerPixel)) +
+    b.mib = (static_cast<double>(m.pixels) * (8.0 * *k + static_cast<double>(m.bytesPerPixel)) +
              static_cast<double>(m.fixedBytes)) /
             (1024.0 * 1024.0);
     return b;
   }
-  std::size_t used = 0;
-  try {
-    b.mib = std::stod(item, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != item.size() || !std::isfinite(b.mib) || b.mib <= 0.0)
-    throw Error("--budgets " + item, "expected MiB (a positive number) or kN");
+  const std::optional<double> mib = parseNumber(item);
+  if (!mib || *mib <= 0.0) throw Error("--budgets " + item, "expected MiB (a positive number) or kN");
+  b.mib = *mib;
   return b;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 std::string fixed(double v, int digits) {
@@ -135,14 +111,7 @@ void addEvaluate(CLI::App& app) {
       if (std::find(known.begin(), known.end(), m) == known.end() || m == "oracle")
         throw Error("--methods " + m, "not a method (see mfr info --methods)");
     const std::vector<std::string> views = splitList(opt->views);
-    std::vector<Scene> scenes;
-    for (const std::string& path : opt->scenes) {
-      scenes.push_back(loadScene(path));
-      if (opt->opacity >= 0.0)
-        for (Object& o : scenes.back().objects) o.material.color.a = static_cast<float>(opt->opacity);
-      for (const std::string& v : views) (void)scenes.back().view(v);
-    }
-    if (views.empty()) throw Error("--views", "no view given");
+    const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     GpuRenderer& gpu = headlessRenderer();
     const gl::ContextInfo info = gl::queryContextInfo();
     nlohmann::ordered_json out;

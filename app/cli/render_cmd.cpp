@@ -40,9 +40,7 @@ void addRender(CLI::App& app) {
       if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");
       req.params[p.substr(0, eq)] = p.substr(eq + 1);
     }
-    Scene scene = loadScene(opt->scene);
-    if (opt->opacity >= 0.0)
-      for (Object& o : scene.objects) o.material.color.a = static_cast<float>(opt->opacity);
+    const Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
     const Camera camera = scene.view(opt->view);
     const RenderOutput out = render(scene, camera, req);
     // Both outputs are produced before either is written, and each is written atomically.

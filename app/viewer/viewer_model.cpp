@@ -83,18 +83,7 @@ QStringList ViewerModel::methodNames() const {
 }
 
 const mfr::MethodInfo* ViewerModel::methodInfo(const QString& method) const {
-  // One instance per method, only for its (static) description; creating a method allocates no
-  // GL objects until configure().
-  static std::map<std::string, std::unique_ptr<mfr::Method>> described;
-  const std::string name = method.toStdString();
-  if (name == "optimal-k") return &mfr::optimalKInfo();  // a CPU method with parameters
-  auto it = described.find(name);
-  if (it == described.end()) {
-    for (const mfr::RegistryEntry& e : mfr::methodRegistry())
-      if (e.name == name) it = described.emplace(name, e.create()).first;
-    if (it == described.end()) return nullptr;
-  }
-  return &it->second->info();
+  return mfr::findMethodInfo(method.toStdString());
 }
 
 bool ViewerModel::isCpuMethod(const QString& method) const {

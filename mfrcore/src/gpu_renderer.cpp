@@ -83,15 +83,18 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   return stats;
 }
 
+void GpuRenderer::ensureFramebuffer(int width, int height) {
+  if (fbo_ && fboWidth_ == width && fboHeight_ == height) return;
+  color_ = gl::createTexture2D(GL_RGBA8, width, height);
+  fbo_ = gl::createFramebuffer();
+  glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, color_.id(), 0);
+  fboWidth_ = width;
+  fboHeight_ = height;
+}
+
 RenderOutput GpuRenderer::render(const Camera& camera, const RenderRequest& request) {
   validateImageSize("--size", request.width, request.height);
-  if (!fbo_ || fboWidth_ != request.width || fboHeight_ != request.height) {
-    color_ = gl::createTexture2D(GL_RGBA8, request.width, request.height);
-    fbo_ = gl::createFramebuffer();
-    glNamedFramebufferTexture(fbo_.id(), GL_COLOR_ATTACHMENT0, color_.id(), 0);
-    fboWidth_ = request.width;
-    fboHeight_ = request.height;
-  }
+  ensureFramebuffer(request.width, request.height);
   RenderOutput out;
   out.stats = renderTo(fbo_.id(), camera, request);
   out.image = ImageRGBA8(request.width, request.height);
@@ -126,28 +129,29 @@ std::vector<std::uint32_t> GpuRenderer::depthComplexity(const Camera& camera, in
     countProgram_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"},
                                  {GL_FRAGMENT_SHADER, "common/depth_complexity.geom.frag"}});
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
-  gl::Buffer counts = gl::createBuffer(pixels * 4);
+  if (countPixels_ != pixels) {  // kept between calls: the viewer asks again on every view change
+    counts_ = gl::createBuffer(pixels * 4);
+    countPixels_ = pixels;
+  }
   const GLuint zero = 0;
-  glClearNamedBufferData(counts.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  glClearNamedBufferData(counts_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-  // A framebuffer of the right size without colour attachments' writes: no side effects lost.
-  gl::Texture color = gl::createTexture2D(GL_RGBA8, width, height);
-  gl::Framebuffer fbo = gl::createFramebuffer();
-  glNamedFramebufferTexture(fbo.id(), GL_COLOR_ATTACHMENT0, color.id(), 0);
-  glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
+  // The render framebuffer gives the pass its size; colour writes stay off (GeometryPassState).
+  ensureFramebuffer(width, height);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_.id());
   glViewport(0, 0, width, height);
   gl::PassTimer timer;
   const FrameContext ctx = frameContext(camera, width, height, timer);
   {
     GeometryPassState state;
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_AUX, counts.id());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_AUX, counts_.id());
     countProgram_.use();
     countProgram_.set("uDcWidth", width);
     scene_->draw(countProgram_, ctx.frame);
   }
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   std::vector<std::uint32_t> raw(pixels);
-  glGetNamedBufferSubData(counts.id(), 0, static_cast<GLsizeiptr>(pixels * 4), raw.data());
+  glGetNamedBufferSubData(counts_.id(), 0, static_cast<GLsizeiptr>(pixels * 4), raw.data());
   gl::checkErrors("depth complexity");
   timer.collect();
   return flipRows(raw, width, height);

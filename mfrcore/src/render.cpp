@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <map>
+#include <memory>
+#include <mutex>
 
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
@@ -39,6 +42,22 @@ const MethodInfo& optimalKInfo() {
         "the budget of the variable-k buffers' layout (vkb without a network): F(M) slots to allocate"}},
       "hybrid"};
   return i;
+}
+
+const MethodInfo* findMethodInfo(const std::string& name) {
+  if (name == "optimal-k") return &optimalKInfo();
+  // One instance per registry method, kept only for its description (a method allocates no GL
+  // objects before configure()).
+  static std::mutex mutex;
+  static std::map<std::string, std::unique_ptr<Method>> described;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto it = described.find(name);
+  if (it == described.end()) {
+    for (const RegistryEntry& e : methodRegistry())
+      if (e.name == name) it = described.emplace(name, e.create()).first;
+    if (it == described.end()) return nullptr;
+  }
+  return &it->second->info();
 }
 
 namespace {

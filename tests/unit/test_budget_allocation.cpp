@@ -241,6 +241,22 @@ TEST(DkbDataset, FramesFileRoundTripAndCorruptFiles) {
   std::filesystem::remove_all(dir);
 }
 
+// Mean squared error of k/n over every row, run through the shaders' forward pass on the CPU;
+// weightByN: each row weighted by its n(p).
+double cpuLoss(const mfr::NeuralImportanceModel& model, const mfr::DkbDataset& d, bool weightByN) {
+  double sq = 0, weights = 0;
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const float* row = d.row(i);
+    mfr::DkbFeatureVector x;
+    std::copy(row, row + 12, x.begin());
+    const double diff = mfr::predictNeuralImportance(model, x) - row[mfr::kDatasetK] / row[mfr::kDatasetN];
+    const double w = weightByN ? row[mfr::kDatasetN] : 1.0;
+    sq += w * diff * diff;
+    weights += w;
+  }
+  return sq / weights;
+}
+
 // Trains on a small synthetic dataset whose target is a known function of the features, then runs
 // the exported weights through the shaders' forward pass (predictNeuralImportance): its MSE over
 // all rows must equal the mix of dlib's training and validation MSE — a wrong export of dlib's
@@ -269,18 +285,11 @@ TEST(NeuralTraining, ExportedWeightsReproduceDlibsLoss) {
   ASSERT_EQ(losses.size(), 4u);
   EXPECT_LT(losses.back(), losses.front());  // it learns
   EXPECT_EQ(r.trainingRows + r.validationRows, d.size());
-  double sq = 0;
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    const float* row = d.row(i);
-    mfr::DkbFeatureVector x;
-    std::copy(row, row + 12, x.begin());
-    const double diff = mfr::predictNeuralImportance(r.model, x) - row[mfr::kDatasetK] / row[mfr::kDatasetN];
-    sq += diff * diff;
-  }
+  const double cpu = cpuLoss(r.model, d, false);
   const double mixed = (r.trainingLoss * static_cast<double>(r.trainingRows) +
                         r.validationLoss * static_cast<double>(r.validationRows)) /
                        static_cast<double>(d.size());
-  EXPECT_NEAR(sq / static_cast<double>(d.size()), mixed, 1e-4 * mixed + 1e-9);
+  EXPECT_NEAR(cpu, mixed, 1e-4 * mixed + 1e-9);
   // And through the weights file.
   const mfr::NeuralImportanceModel back = mfr::parseNeuralImportance(mfr::neuralImportanceJson(r.model), "t.json");
   mfr::DkbFeatureVector x;
@@ -314,16 +323,7 @@ TEST(NeuralTraining, FragmentWeighting) {
   EXPECT_LT(losses.back(), losses.front());
   // The weighted loss of the exported model, recomputed on the CPU over all rows, is close to the
   // mix of the reported (weighted) ones.
-  double sq = 0, weights = 0;
-  for (std::size_t i = 0; i < d.size(); ++i) {
-    const float* row = d.row(i);
-    mfr::DkbFeatureVector x;
-    std::copy(row, row + 12, x.begin());
-    const double diff = mfr::predictNeuralImportance(r.model, x) - row[mfr::kDatasetK] / row[mfr::kDatasetN];
-    sq += row[mfr::kDatasetN] * diff * diff;
-    weights += row[mfr::kDatasetN];
-  }
-  EXPECT_NEAR(sq / weights, r.trainingLoss, 0.15 * r.trainingLoss);
+  EXPECT_NEAR(cpuLoss(r.model, d, true), r.trainingLoss, 0.15 * r.trainingLoss);
   o.weighting = "by-colour";
   EXPECT_THROW(mfr::trainNeuralImportance(d, o), mfr::Error);
 }

@@ -59,6 +59,8 @@ class GpuRenderer {
 
  private:
   Method& prepare(const RenderRequest& request);
+  // The internal RGBA8 framebuffer (render(), depthComplexity()) at this size.
+  void ensureFramebuffer(int width, int height);
   FrameContext frameContext(const Camera& camera, int width, int height, gl::PassTimer& timer) const;
 
   std::unique_ptr<gl::GpuScene> scene_;
@@ -71,6 +73,8 @@ class GpuRenderer {
   gl::Framebuffer fbo_;
   gl::Texture color_;
   int fboWidth_ = 0, fboHeight_ = 0;
+  gl::Buffer counts_;  // depthComplexity's per-pixel counters
+  std::size_t countPixels_ = 0;
   bool finishTiming_ = false;
 };
 

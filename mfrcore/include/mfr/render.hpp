@@ -35,6 +35,9 @@ std::vector<std::string> availableMethods();
 
 // The description and parameters of the CPU method "optimal-k" (like a registry method's info).
 const MethodInfo& optimalKInfo();
+// The description and parameters of any method render() accepts: a registry method's info(), or
+// optimal-k's; nullptr for "oracle" (no parameters) and unknown names. Thread-safe.
+const MethodInfo* findMethodInfo(const std::string& name);
 
 class GpuRenderer;
 // The process's headless GL renderer (EGL context created on first use); the CLI uses it.

@@ -26,7 +26,7 @@ class DeepVariableKBuffer final : public VariableKBuffer {
   [[nodiscard]] std::string describeImportance() const override;
 
  private:
-  std::string weightsPath_ = "\x01";  // of the loaded model ("" = built-in); none loaded yet
+  std::string weightsPath_;  // of the loaded model ("" = built-in; none loaded while !weights_)
   NeuralImportanceModel model_;
   gl::Buffer weights_;
   gl::Program count_, nearest_, mlp_;

@@ -45,11 +45,12 @@ void runResolvePass(const FrameContext& ctx, const gl::Program& program, const O
   glBindVertexArray(0);
 }
 
-std::vector<std::uint32_t> readCapacities(const gl::Buffer& offsets, std::uint64_t pixels) {
-  std::vector<std::uint32_t> raw(static_cast<std::size_t>(pixels) + 1, 0);
+std::vector<std::uint32_t> readCapacities(const gl::Buffer& offsets, std::uint64_t pixels, std::uint64_t baseWord) {
   if (!offsets) return {};
+  std::vector<std::uint32_t> raw(static_cast<std::size_t>(pixels) + 1, 0);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  glGetNamedBufferSubData(offsets.id(), 0, static_cast<GLsizeiptr>(raw.size() * 4), raw.data());
+  glGetNamedBufferSubData(offsets.id(), static_cast<GLintptr>(4 * baseWord), static_cast<GLsizeiptr>(raw.size() * 4),
+                          raw.data());
   std::vector<std::uint32_t> k(static_cast<std::size_t>(pixels));
   for (std::size_t p = 0; p < k.size(); ++p) k[p] = raw[p + 1] - raw[p];
   return k;

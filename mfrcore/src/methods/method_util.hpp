@@ -29,9 +29,10 @@ class GeometryPassState {
 // Full-screen resolve: binds the operation, draws one triangle into the bound framebuffer.
 void runResolvePass(const FrameContext& ctx, const gl::Program& program, const Operation& op);
 
-// Per-pixel capacities from an exclusive prefix sum of pixels + 1 uints: offsets[p+1] − offsets[p]
-// (variable-capacity k-buffers). Waits for the GPU.
-std::vector<std::uint32_t> readCapacities(const gl::Buffer& offsets, std::uint64_t pixels);
+// Per-pixel capacities from an exclusive prefix sum of pixels + 1 uints starting at word
+// baseWord of the buffer: offsets[p+1] − offsets[p] (variable-capacity k-buffers). Empty for no
+// buffer. Waits for the GPU.
+std::vector<std::uint32_t> readCapacities(const gl::Buffer& offsets, std::uint64_t pixels, std::uint64_t baseWord = 0);
 
 // Largest element count of the given size one shader storage buffer may hold on this context.
 std::uint64_t maxStorageElements(std::uint64_t elementBytes);

@@ -259,14 +259,7 @@ void VariableKBuffer::resolve(const FrameContext& ctx, const Operation& op) {
 }
 
 std::vector<std::uint32_t> VariableKBuffer::capacityMap() const {
-  if (!arena_) return {};
-  std::vector<std::uint32_t> raw(static_cast<std::size_t>(pixels()) + 1);
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  glGetNamedBufferSubData(arena_.id(), static_cast<GLintptr>(4 * layout_.kBase),
-                          static_cast<GLsizeiptr>(4 * raw.size()), raw.data());
-  std::vector<std::uint32_t> k(raw.size() - 1);
-  for (std::size_t p = 0; p < k.size(); ++p) k[p] = raw[p + 1] - raw[p];
-  return k;
+  return readCapacities(arena_, pixels(), layout_.kBase);
 }
 
 }  // namespace mfr

@@ -41,7 +41,6 @@ class Params {
   [[nodiscard]] double real(const std::string& name) const;
   [[nodiscard]] bool flag(const std::string& name) const;
   [[nodiscard]] const std::string& text(const std::string& name) const;
-  [[nodiscard]] bool has(const std::string& name) const { return values_.count(name) != 0; }
 
  private:
   std::map<std::string, std::string> values_;
