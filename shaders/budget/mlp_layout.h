@@ -16,8 +16,18 @@
 #define MFR_MLP_W3 (MFR_MLP_B2 + MFR_MLP_HIDDEN2)
 #define MFR_MLP_B3 (MFR_MLP_W3 + MFR_MLP_HIDDEN2)
 #define MFR_MLP_FLOATS (MFR_MLP_B3 + 1)
-// On the GPU (dkb): words 0..23 the input mean and deviation as 32-bit floats, then the weights
-// and biases from MFR_MLP_W1 on as 16-bit floats, two per word (packHalf2x16: even index low).
-#define MFR_MLP_PACKED_WORDS (MFR_MLP_W1 + (MFR_MLP_FLOATS - MFR_MLP_W1 + 1) / 2)
+// On the GPU (dkb), in 32-bit words: the input mean and deviation (24 floats), the biases of the
+// three layers (128 + 64 + 1 floats), one scale per output row (same count), then every weight as
+// a signed 8-bit integer, four per word (byte j % 4 of word j / 4), rows of W1, W2, W3 in turn:
+// weight = scale[row] · q, with q ∈ [−127, 127] (symmetric per-row quantisation).
+#define MFR_MLP_ROWS (MFR_MLP_HIDDEN1 + MFR_MLP_HIDDEN2 + 1)
+#define MFR_MLP_Q_W1 0
+#define MFR_MLP_Q_W2 (MFR_MLP_Q_W1 + MFR_MLP_HIDDEN1 * MFR_MLP_INPUTS)
+#define MFR_MLP_Q_W3 (MFR_MLP_Q_W2 + MFR_MLP_HIDDEN2 * MFR_MLP_HIDDEN1)
+#define MFR_MLP_Q_COUNT (MFR_MLP_Q_W3 + MFR_MLP_HIDDEN2)
+#define MFR_MLP_GPU_BIAS (2 * MFR_MLP_INPUTS)
+#define MFR_MLP_GPU_SCALE (MFR_MLP_GPU_BIAS + MFR_MLP_ROWS)
+#define MFR_MLP_GPU_QUANT (MFR_MLP_GPU_SCALE + MFR_MLP_ROWS)
+#define MFR_MLP_PACKED_WORDS (MFR_MLP_GPU_QUANT + (MFR_MLP_Q_COUNT + 3) / 4)
 
 #endif

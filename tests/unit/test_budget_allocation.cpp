@@ -7,13 +7,14 @@
 #include <algorithm>
 #include <cstring>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <limits>
 #include <numeric>
 #include <random>
 
-#include <glm/gtc/packing.hpp>
+#include "budget/mlp_layout.h"
 
 #include "mfr/budget/dataset.hpp"
 #include "mfr/budget/k_allocation.hpp"
@@ -174,28 +175,57 @@ TEST(NeuralImportance, WeightsFileRoundTripAndErrors) {
   EXPECT_THROW(mfr::loadNeuralImportance("/nonexistent/weights.json"), mfr::Error);
 }
 
-// dkb's GPU copy: input statistics exact, weights rounded to halves and packed two per word.
-TEST(NeuralImportance, HalfPrecisionPacking) {
+// dkb's GPU copy: input statistics and biases exact, each weight scale(row)·q with q a signed byte
+// and scale(row) = max|w| / 127 of its output row, packed four per word; the packing reads back.
+TEST(NeuralImportance, EightBitPacking) {
   const mfr::NeuralImportanceModel m = randomModel(9);
-  const mfr::NeuralImportanceModel h = m.halfPrecision();
+  const mfr::NeuralImportanceModel h = m.quantised();
   const std::vector<std::uint32_t> words = h.packedWords();
   ASSERT_EQ(words.size() * 4, mfr::NeuralImportanceModel::packedBytes());
-  EXPECT_LT(mfr::NeuralImportanceModel::packedBytes(), m.weights.size() * 4 * 51 / 100);  // about half
-  for (std::size_t i = 0; i < 24; ++i) {
-    EXPECT_EQ(h.weights[i], m.weights[i]);
+  EXPECT_LT(mfr::NeuralImportanceModel::packedBytes(), m.weights.size() * 4 * 30 / 100);  // under a third
+  EXPECT_THROW((void)m.packedWords(), mfr::Error);                                        // not quantised
+  const auto wordFloat = [&](std::size_t i) {
     float f = 0;
     std::memcpy(&f, &words[i], 4);
-    EXPECT_EQ(f, m.weights[i]);
+    return f;
+  };
+  for (std::size_t i = 0; i < MFR_MLP_W1; ++i) {
+    EXPECT_EQ(h.weights[i], m.weights[i]);
+    EXPECT_EQ(wordFloat(i), m.weights[i]);
   }
-  std::size_t changed = 0;
-  for (std::size_t i = 24; i < m.weights.size(); ++i) {
-    const std::size_t j = i - 24;
-    const float unpacked = glm::unpackHalf1x16(static_cast<glm::uint16>(words[24 + j / 2] >> (16 * (j % 2))));
-    ASSERT_EQ(unpacked, h.weights[i]) << i;
-    EXPECT_NEAR(h.weights[i], m.weights[i], 1e-3 * std::abs(m.weights[i]) + 1e-7);
-    changed += h.weights[i] != m.weights[i];
-  }
-  EXPECT_GT(changed, m.weights.size() / 2);  // really rounded
+  struct Layer {
+    int weights, bias, rows, cols, firstRow, quant;
+  };
+  const Layer layers[3] = {
+      {MFR_MLP_W1, MFR_MLP_B1, MFR_MLP_HIDDEN1, MFR_MLP_INPUTS, 0, MFR_MLP_Q_W1},
+      {MFR_MLP_W2, MFR_MLP_B2, MFR_MLP_HIDDEN2, MFR_MLP_HIDDEN1, MFR_MLP_HIDDEN1, MFR_MLP_Q_W2},
+      {MFR_MLP_W3, MFR_MLP_B3, 1, MFR_MLP_HIDDEN2, MFR_MLP_HIDDEN1 + MFR_MLP_HIDDEN2, MFR_MLP_Q_W3}};
+  std::size_t changed = 0, extremes = 0;
+  for (const Layer& l : layers)
+    for (int r = 0; r < l.rows; ++r) {
+      const auto row = static_cast<std::size_t>(l.firstRow + r);
+      const auto bias = static_cast<std::size_t>(l.bias + r);
+      EXPECT_EQ(h.weights[bias], m.weights[bias]);
+      EXPECT_EQ(wordFloat(MFR_MLP_GPU_BIAS + row), m.weights[bias]);
+      float maxAbs = 0;
+      for (int c = 0; c < l.cols; ++c)
+        maxAbs = std::max(maxAbs, std::abs(m.weights[static_cast<std::size_t>(l.weights + r * l.cols + c)]));
+      const float scale = wordFloat(MFR_MLP_GPU_SCALE + row);
+      ASSERT_EQ(scale, h.rowScales[row]);
+      EXPECT_FLOAT_EQ(scale, maxAbs / 127.0f);
+      for (int c = 0; c < l.cols; ++c) {
+        const auto i = static_cast<std::size_t>(l.weights + r * l.cols + c);
+        const int j = l.quant + r * l.cols + c;
+        const auto q =
+            static_cast<std::int8_t>(words[MFR_MLP_GPU_QUANT + static_cast<std::size_t>(j / 4)] >> (8 * (j % 4)));
+        ASSERT_EQ(scale * static_cast<float>(q), h.weights[i]) << i;
+        EXPECT_LE(std::abs(h.weights[i] - m.weights[i]), 0.5f * scale * 1.0001f) << i;
+        changed += h.weights[i] != m.weights[i];
+        extremes += q == 127 || q == -127;
+      }
+    }
+  EXPECT_GT(changed, m.weights.size() / 2);                     // really rounded
+  EXPECT_GE(extremes, static_cast<std::size_t>(MFR_MLP_ROWS));  // each row's largest weight is ±127
 }
 
 TEST(DkbDataset, FramesFileRoundTripAndCorruptFiles) {

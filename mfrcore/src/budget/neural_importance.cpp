@@ -4,12 +4,12 @@
 #include "mfr/budget/neural_importance.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <cmath>
 #include <map>
 #include <string_view>
 
-#include <glm/gtc/packing.hpp>
 #include <nlohmann/json.hpp>
 
 #include "budget/glsl_shared.hpp"
@@ -27,9 +27,13 @@ namespace glsl {
 namespace {
 thread_local const float* tMlpWeights = nullptr;
 }  // namespace
-#define MFR_MLP_WEIGHT(i) tMlpWeights[i]
+#define MFR_MLP_STAT(i) tMlpWeights[i]
+#define MFR_MLP_BIAS(f, b) tMlpWeights[f]
+#define MFR_MLP_ROW_WEIGHT(f, q, r) tMlpWeights[f]
 #include "budget/mlp.h"
-#undef MFR_MLP_WEIGHT
+#undef MFR_MLP_STAT
+#undef MFR_MLP_BIAS
+#undef MFR_MLP_ROW_WEIGHT
 }  // namespace glsl
 
 namespace {
@@ -38,6 +42,8 @@ constexpr int kLayerShape[3][2] = {
     {MFR_MLP_HIDDEN1, MFR_MLP_INPUTS}, {MFR_MLP_HIDDEN2, MFR_MLP_HIDDEN1}, {1, MFR_MLP_HIDDEN2}};
 constexpr int kLayerWeights[3] = {MFR_MLP_W1, MFR_MLP_W2, MFR_MLP_W3};
 constexpr int kLayerBias[3] = {MFR_MLP_B1, MFR_MLP_B2, MFR_MLP_B3};
+constexpr int kLayerRows[3] = {0, MFR_MLP_HIDDEN1, MFR_MLP_HIDDEN1 + MFR_MLP_HIDDEN2};  // first row of each layer
+constexpr int kLayerQuant[3] = {MFR_MLP_Q_W1, MFR_MLP_Q_W2, MFR_MLP_Q_W3};
 
 std::vector<float> floats(const nlohmann::json& j, std::size_t count, const std::string& where,
                           const std::string& source) {
@@ -64,20 +70,52 @@ std::size_t NeuralImportanceModel::packedBytes() {
   return 4 * MFR_MLP_PACKED_WORDS;
 }
 
-NeuralImportanceModel NeuralImportanceModel::halfPrecision() const {
+NeuralImportanceModel NeuralImportanceModel::quantised() const {
+  if (weights.size() != MFR_MLP_FLOATS) throw Error("dkb weights", "model has the wrong number of weights");
   NeuralImportanceModel m = *this;
-  for (std::size_t i = MFR_MLP_W1; i < m.weights.size(); ++i)
-    m.weights[i] = glm::unpackHalf1x16(glm::packHalf1x16(m.weights[i]));
+  m.rowScales.assign(MFR_MLP_ROWS, 0.0f);
+  for (int l = 0; l < 3; ++l) {
+    const int rows = kLayerShape[l][0], cols = kLayerShape[l][1];
+    for (int r = 0; r < rows; ++r) {
+      float* w = m.weights.data() + kLayerWeights[l] + r * cols;
+      float maxAbs = 0.0f;
+      for (int c = 0; c < cols; ++c) maxAbs = std::max(maxAbs, std::abs(w[c]));
+      const float scale = maxAbs / 127.0f;
+      m.rowScales[static_cast<std::size_t>(kLayerRows[l] + r)] = scale;
+      for (int c = 0; c < cols; ++c)
+        w[c] = scale > 0.0f ? scale * std::clamp(std::round(w[c] / scale), -127.0f, 127.0f) : 0.0f;
+    }
+  }
   return m;
 }
 
 std::vector<std::uint32_t> NeuralImportanceModel::packedWords() const {
   if (weights.size() != MFR_MLP_FLOATS) throw Error("dkb weights", "model has the wrong number of weights");
+  if (rowScales.size() != MFR_MLP_ROWS) throw Error("dkb weights", "model is not quantised");
   std::vector<std::uint32_t> words(MFR_MLP_PACKED_WORDS, 0);
-  for (std::size_t i = 0; i < MFR_MLP_W1; ++i) std::memcpy(&words[i], &weights[i], 4);
-  for (std::size_t i = MFR_MLP_W1; i < weights.size(); ++i) {
-    const std::size_t j = i - MFR_MLP_W1;
-    words[MFR_MLP_W1 + j / 2] |= static_cast<std::uint32_t>(glm::packHalf1x16(weights[i])) << (16 * (j % 2));
+  const auto bits = [](float f) {
+    std::uint32_t u = 0;
+    std::memcpy(&u, &f, 4);
+    return u;
+  };
+  for (std::size_t i = 0; i < MFR_MLP_W1; ++i) words[i] = bits(weights[i]);
+  for (int l = 0; l < 3; ++l) {
+    const int rows = kLayerShape[l][0], cols = kLayerShape[l][1];
+    for (int r = 0; r < rows; ++r) {
+      const int row = kLayerRows[l] + r;
+      const float scale = rowScales[static_cast<std::size_t>(row)];
+      words[static_cast<std::size_t>(MFR_MLP_GPU_BIAS + row)] =
+          bits(weights[static_cast<std::size_t>(kLayerBias[l] + r)]);
+      words[static_cast<std::size_t>(MFR_MLP_GPU_SCALE + row)] = bits(scale);
+      for (int c = 0; c < cols; ++c) {
+        const float w = weights[static_cast<std::size_t>(kLayerWeights[l] + r * cols + c)];
+        const int q = scale > 0.0f ? static_cast<int>(std::round(w / scale)) : 0;
+        if (q < -127 || q > 127) throw Error("dkb weights", "a weight is out of its row's 8-bit range");
+        const int j = kLayerQuant[l] + r * cols + c;
+        words[static_cast<std::size_t>(MFR_MLP_GPU_QUANT + j / 4)] |=
+            static_cast<std::uint32_t>(static_cast<std::uint8_t>(static_cast<std::int8_t>(q))) << (8 * (j % 4));
+      }
+    }
   }
   return words;
 }

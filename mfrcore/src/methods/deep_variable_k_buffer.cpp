@@ -30,8 +30,8 @@ const MethodInfo& DeepVariableKBuffer::info() const {
 void DeepVariableKBuffer::configureMember(const Params& params) {
   const std::string& path = params.text("weights");
   if (path != weightsPath_ || !weights_) {
-    // Half-precision weights on the GPU; model_ holds exactly the values it runs (tests compare).
-    NeuralImportanceModel model = loadNeuralImportance(path).halfPrecision();  // throws before anything changes
+    // 8-bit weights on the GPU; model_ holds exactly the values it runs (tests compare).
+    NeuralImportanceModel model = loadNeuralImportance(path).quantised();  // throws before anything changes
     model_ = std::move(model);
     weightsPath_ = path;
     const std::vector<std::uint32_t> words = model_.packedWords();
@@ -75,7 +75,7 @@ void DeepVariableKBuffer::computeImportance(const FrameContext&) {
 }
 
 std::string DeepVariableKBuffer::describeImportance() const {
-  return "MLP 12-128-64-1, 16-bit weights (" + model_.source + ", predicts " + model_.target + ")";
+  return "MLP 12-128-64-1, 8-bit weights (" + model_.source + ", predicts " + model_.target + ")";
 }
 
 }  // namespace mfr

@@ -1,7 +1,7 @@
 // Deep hybrid order-independent transparency (Tsopouridis, Fudos, Vasilakis, The Visual Computer
 // 2022, §4): the 12 features of each pixel (budget/features.h) and the network's prediction
-// (budget/mlp.h, weights at MFR_SSBO_WEIGHTS as 16-bit floats), turned into the importance I(p) in T(0) that the
-// shared allocation rule distributes the budget by. uTarget says what the network predicts:
+// (budget/mlp.h; weights at MFR_SSBO_WEIGHTS as 8-bit integers with per-row scales), turned into
+// the importance I(p) in T(0) that the shared allocation rule distributes the budget by. uTarget says what the network predicts:
 // 0 = k(p)/n(p) (I = y·n), 1 = k(p)/F(M) (I = y).
 #include "budget/arena.glsl"
 #include "budget/allocation.h"
@@ -10,13 +10,14 @@
 
 #include "budget/mlp_layout.h"
 layout(std430, binding = MFR_SSBO_WEIGHTS) readonly buffer DkbWeights { uint mlpWords[]; };
-// Input statistics as floats, weights as packed halves (MFR_MLP_PACKED_WORDS layout).
-float mlpWeight(int i) {
-  if (i < MFR_MLP_W1) return uintBitsToFloat(mlpWords[i]);
-  int j = i - MFR_MLP_W1;
-  return unpackHalf2x16(mlpWords[MFR_MLP_W1 + (j >> 1)])[j & 1];
+// Statistics, biases and row scales as floats; weights as signed bytes (MFR_MLP_PACKED_WORDS layout).
+#define MFR_MLP_STAT(i) uintBitsToFloat(mlpWords[i])
+#define MFR_MLP_BIAS(f, b) uintBitsToFloat(mlpWords[MFR_MLP_GPU_BIAS + (b)])
+float mlpRowWeight(int q, int row) {
+  int byte = bitfieldExtract(int(mlpWords[MFR_MLP_GPU_QUANT + (q >> 2)]), 8 * (q & 3), 8);  // sign-extends
+  return uintBitsToFloat(mlpWords[MFR_MLP_GPU_SCALE + row]) * float(byte);
 }
-#define MFR_MLP_WEIGHT(i) mlpWeight(i)
+#define MFR_MLP_ROW_WEIGHT(f, q, r) mlpRowWeight(q, r)
 #include "budget/mlp.h"
 
 layout(local_size_x = 64) in;

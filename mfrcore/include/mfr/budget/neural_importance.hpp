@@ -29,15 +29,17 @@ struct NeuralImportanceModel {
   std::string target = "k_over_n";  // or "k_over_budget"
   std::string trainingJson = "{}";  // the file's "training" object, verbatim (provenance)
   std::string source;               // the path it was read from, or "built-in"
+  std::vector<float> rowScales;     // per output row (MFR_MLP_ROWS) once quantised(), else empty
 
   [[nodiscard]] bool predictsFractionOfList() const { return target == "k_over_n"; }
   static std::size_t floatCount();
-  // The model as dkb runs it on the GPU: the input statistics in 32-bit floats, every layer's
-  // weights and biases rounded to 16-bit floats (half the GPU memory the budget pays for; the
-  // forward pass still computes in 32-bit floats).
-  [[nodiscard]] NeuralImportanceModel halfPrecision() const;
-  // The GPU buffer of a half-precision model (shaders/budget/mlp_layout.h): 24 float words, then
-  // the weights two halves per word (packHalf2x16 order).
+  // The model as dkb runs it on the GPU: input statistics and biases in 32-bit floats, every
+  // weight rounded to scale(row)·q with q a signed 8-bit integer and scale(row) = max|w| / 127 of
+  // its output row (under a third of the float weights' GPU memory, which the budget pays for; the
+  // forward pass still computes in 32-bit floats). `weights` then holds the dequantised values.
+  [[nodiscard]] NeuralImportanceModel quantised() const;
+  // The GPU buffer of a quantised() model (shaders/budget/mlp_layout.h): statistics, biases and
+  // row scales as float words, then the weights four signed bytes per word.
   [[nodiscard]] std::vector<std::uint32_t> packedWords() const;
   static std::size_t packedBytes();
 };
