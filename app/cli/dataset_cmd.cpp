@@ -40,7 +40,7 @@ std::vector<double> parseBudgetLevels(const std::string& text) {
 void addDataset(CLI::App& app) {
   struct Options {
     std::vector<std::string> scenes, sizes{"200x150"};
-    std::string views = "iso", budgets = "1,1.25,1.5,2,2.5,3,4,6,all", output;
+    std::string views = "iso", budgets = "1,1.25,1.5,2,2.5,3,4,6,all", output, sampleBy = "pixels";
     double sample = 0.2, opacity = -1.0;
     std::uint64_t seed = 1;
   };
@@ -57,6 +57,11 @@ void addDataset(CLI::App& app) {
   cmd->add_option("--sample", opt->sample, "Fraction of the non-empty pixels written per frame")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--sample-by", opt->sampleBy,
+                  "pixels: each non-empty pixel with probability --sample; deep: pixels deeper than the frame's "
+                  "mean n(p) more often, in proportion to n(p)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"pixels", "deep"}));
   cmd->add_option("--seed", opt->seed, "Random seed of the pixel sampling")->capture_default_str();
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
   cmd->callback([opt] {
@@ -73,6 +78,7 @@ void addDataset(CLI::App& app) {
     meta["sizes"] = opt->sizes;
     meta["budgets"] = opt->budgets;
     meta["sample"] = opt->sample;
+    meta["sample_by"] = opt->sampleBy;
     meta["seed"] = opt->seed;
     nlohmann::ordered_json frames = nlohmann::ordered_json::array();
     std::cout << std::left << std::setw(28) << "scene" << std::setw(16) << "view" << std::setw(9) << "size"
@@ -97,7 +103,9 @@ void addDataset(CLI::App& app) {
               if (allDone) continue;
               allDone = true;
             }
-            const DatasetFrame f = appendDatasetFrame(dataset, lists, errors, F, opt->sample, rng);
+            const DatasetFrame f =
+                appendDatasetFrame(dataset, lists, errors, F, opt->sample, rng,
+                                   opt->sampleBy == "deep" ? DatasetSampling::DeepPixels : DatasetSampling::Pixels);
             std::cout << std::left << std::setw(28) << scenes[s].name.substr(0, 27) << std::setw(16) << v.substr(0, 15)
                       << std::setw(9) << (std::to_string(w) + "x" + std::to_string(h)) << std::right << std::setw(10)
                       << F << std::setw(10) << f.totalFragments << std::setw(9) << f.sampled << std::setw(12)

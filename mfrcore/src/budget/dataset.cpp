@@ -21,7 +21,8 @@ void put(std::string& out, T v) {
 }  // namespace
 
 DatasetFrame appendDatasetFrame(DkbDataset& dataset, const FragmentLists& lists, const HybridErrorTable& errors,
-                                std::uint64_t budgetSlots, double sampleFraction, std::mt19937_64& rng) {
+                                std::uint64_t budgetSlots, double sampleFraction, std::mt19937_64& rng,
+                                DatasetSampling sampling) {
   DatasetFrame frame;
   const DkbImageStats image = dkbImageStats(lists);
   frame.budgetSlots = budgetSlots;
@@ -29,11 +30,16 @@ DatasetFrame appendDatasetFrame(DkbDataset& dataset, const FragmentLists& lists,
   frame.totalFragments = image.totalFragments;
   const KAllocation best = optimalKBest(errors, budgetSlots, &frame.solver);
   frame.optimalError = best.error;
-  std::bernoulli_distribution take(sampleFraction);
+  // Deep pixels are few but hold most of the slots; DeepPixels keeps more of them.
+  const double meanDepth =
+      static_cast<double>(image.totalFragments) / static_cast<double>(std::max<std::uint64_t>(image.nonEmptyPixels, 1));
   for (int y = 0; y < lists.height; ++y)
     for (int x = 0; x < lists.width; ++x) {
       const auto list = lists.pixel(x, y);
-      if (list.empty() || !take(rng)) continue;
+      if (list.empty()) continue;
+      const double boost =
+          sampling == DatasetSampling::DeepPixels ? std::max(1.0, static_cast<double>(list.size()) / meanDepth) : 1.0;
+      if (!std::bernoulli_distribution(std::min(1.0, sampleFraction * boost))(rng)) continue;  // one draw each
       const DkbFeatureVector f = dkbFeatures(list, image, budgetSlots);
       const std::uint32_t k = best.k[lists.index(x, y)];
       dataset.rows.insert(dataset.rows.end(), f.begin(), f.end());

@@ -45,11 +45,17 @@ struct DatasetFrame {
   std::string solver;         // which optimalKBest solver won
 };
 
-// Appends every non-empty pixel of one frame with probability sampleFraction. errors is the
+// How pixels are drawn: each non-empty pixel with probability s (Pixels), or with probability
+// min(1, s·max(1, n(p)/n̄)), n̄ the frame's mean depth complexity (DeepPixels: pixels deeper
+// than average in proportion to n(p), where one wrong k costs most slots).
+enum class DatasetSampling { Pixels, DeepPixels };
+
+// Appends the non-empty pixels of one frame drawn with sampleFraction = s. errors is the
 // frame's hybridErrorTable (reused across budgets). Throws mfr::Error when budgetSlots is below
 // one slot per non-empty pixel.
 DatasetFrame appendDatasetFrame(DkbDataset& dataset, const FragmentLists& lists, const HybridErrorTable& errors,
-                                std::uint64_t budgetSlots, double sampleFraction, std::mt19937_64& rng);
+                                std::uint64_t budgetSlots, double sampleFraction, std::mt19937_64& rng,
+                                DatasetSampling sampling = DatasetSampling::Pixels);
 
 // Both throw mfr::Error naming the path: unwritable; missing, truncated, corrupt or foreign file.
 void writeDataset(const std::filesystem::path& path, const DkbDataset& dataset);
