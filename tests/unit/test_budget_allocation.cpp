@@ -271,6 +271,42 @@ TEST(DkbDataset, FramesFileRoundTripAndCorruptFiles) {
   std::filesystem::remove_all(dir);
 }
 
+// --sample-by: Pixels draws every non-empty pixel with probability s; DeepPixels draws a pixel of
+// depth n with min(1, s·max(1, n/n̄)). Observed row counts, split at the mean depth n̄, must match the
+// expected counts of each rule within 4 standard deviations (and the two rules must differ).
+TEST(DkbDataset, DeepPixelSampling) {
+  const mfr::Scene scene = mfr::makeSampleScene();
+  const mfr::FragmentLists lists = mfr::castFragments(scene, scene.view("iso"), 160, 120);
+  const mfr::HybridErrorTable errors = mfr::hybridErrorTable(lists, scene.background);
+  const std::uint64_t nonEmpty = mfr::minimumSlots(errors);
+  const double meanDepth = static_cast<double>(lists.fragments.size()) / static_cast<double>(nonEmpty);
+  const double s = 0.1;
+  for (const auto sampling : {mfr::DatasetSampling::Pixels, mfr::DatasetSampling::DeepPixels}) {
+    const bool deep = sampling == mfr::DatasetSampling::DeepPixels;
+    double expected[2] = {0, 0}, variance[2] = {0, 0}, pixels[2] = {0, 0};  // [shallow, deep]
+    for (int y = 0; y < lists.height; ++y)
+      for (int x = 0; x < lists.width; ++x) {
+        const double n = static_cast<double>(lists.count(x, y));
+        if (n == 0) continue;
+        const double p = deep ? std::min(1.0, s * std::max(1.0, n / meanDepth)) : s;
+        expected[n > meanDepth] += p;
+        pixels[n > meanDepth] += 1;
+        variance[n > meanDepth] += p * (1 - p);
+      }
+    mfr::DkbDataset d;
+    std::mt19937_64 rng(7);
+    mfr::appendDatasetFrame(d, lists, errors, 2 * nonEmpty, s, rng, sampling);
+    double observed[2] = {0, 0};
+    for (std::size_t r = 0; r < d.size(); ++r) observed[d.row(r)[mfr::kDatasetN] > meanDepth] += 1;
+    for (int part = 0; part < 2; ++part)
+      EXPECT_NEAR(observed[part], expected[part], 4 * std::sqrt(variance[part]) + 1) << deep << " " << part;
+    if (deep) {
+      EXPECT_GT(observed[1], 1.3 * s * pixels[1]);  // deep pixels really drawn more often
+    }
+    EXPECT_GT(pixels[1], 200);
+  }
+}
+
 // Mean squared error of k/n over every row, run through the shaders' forward pass on the CPU;
 // weightByN: each row weighted by its n(p).
 double cpuLoss(const mfr::NeuralImportanceModel& model, const mfr::DkbDataset& d, bool weightByN) {
