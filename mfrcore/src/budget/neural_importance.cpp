@@ -218,7 +218,7 @@ float predictNeuralImportance(const NeuralImportanceModel& model, const DkbFeatu
 
 float neuralImportance(const NeuralImportanceModel& model, const DkbFeatureVector& features, std::uint32_t n) {
   const float y = predictNeuralImportance(model, features);
-  return model.predictsFractionOfList() ? y * static_cast<float>(n) : y;
+  return model.predictsFractionOfList() ? y * static_cast<float>(n) + 0.5f : y;
 }
 
 DkbImageStats dkbImageStats(const FragmentLists& lists) {

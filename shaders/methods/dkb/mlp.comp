@@ -38,6 +38,6 @@ void main() {
                  uintBitsToFloat(arena[vkT(1u, p)]), uintBitsToFloat(vkImageNearBits),
                  uintBitsToFloat(vkImageFarBits), arena[vkK(p)], colorSum, a, b, c);
   float y = mfrMlpForward(a, b, c);
-  float importance = uTarget == 0u ? y * float(n) : y;
+  float importance = uTarget == 0u ? y * float(n) + 0.5 : y;
   arena[vkT(0u, p)] = floatBitsToUint(mfrSanitizeImportance(importance));
 }
