@@ -156,7 +156,7 @@ TEST(NeuralImportance, WeightsFileRoundTripAndErrors) {
   EXPECT_GT(y, 0.0f);
   EXPECT_LT(y, 1.0f);
   EXPECT_EQ(mfr::predictNeuralImportance(back, x), y);
-  EXPECT_FLOAT_EQ(mfr::neuralImportance(m, x, 10), 10 * y);  // k_over_n: y·n
+  EXPECT_FLOAT_EQ(mfr::neuralImportance(m, x, 10), 10 * y + 0.5f);  // k_over_n: y·n + ½ (rounds k)
 
   for (const std::string bad : {"", "{", "[]", R"({"format":"mfr-dkb-weights","version":2})",
                                 R"({"format":"mfr-dkb-weights","version":1,"architecture":[12,64,1]})"}) {
