@@ -35,7 +35,8 @@ void expectNear(glm::vec3 got, glm::vec3 want) {
 std::vector<mfr::Fragment> randomList(std::mt19937& rng, int n) {
   std::uniform_int_distribution<std::uint32_t> byte(0, 255);
   std::vector<mfr::Fragment> list;
-  for (int i = 0; i < n; ++i) list.push_back(frag(0.01f * static_cast<float>(i + 1), byte(rng), byte(rng), byte(rng), byte(rng)));
+  for (int i = 0; i < n; ++i)
+    list.push_back(frag(0.01f * static_cast<float>(i + 1), byte(rng), byte(rng), byte(rng), byte(rng)));
   return list;
 }
 
@@ -62,6 +63,22 @@ TEST(Hybrid, CoreAtLeastListIsOver) {
     for (std::uint32_t k = static_cast<std::uint32_t>(list.size()); k < list.size() + 3; ++k) {
       EXPECT_EQ(mfr::compositeHybrid(list, k, bg), over);  // bit-identical: same arithmetic
       EXPECT_EQ(mfr::hybridError(list, k, bg), 0.0);
+    }
+  }
+}
+
+// k = n − 1 is exact too: a one-fragment tail is composited like "over" (why budgets above
+// Σ(n − 1) cost optimal-k nothing; docs/results.md).
+TEST(Hybrid, OneFragmentTailIsExact) {
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 200; ++trial) {
+    const auto list = randomList(rng, 2 + trial % 9);
+    const glm::vec3 bg(0.2f, 0.5f, 0.9f);
+    const auto k = static_cast<std::uint32_t>(list.size() - 1);
+    expectNear(mfr::compositeHybrid(list, k, bg), mfr::compositeOver(list, bg));
+    EXPECT_LT(mfr::hybridError(list, k, bg), 1e-10);
+    if (list.size() >= 3) {
+      EXPECT_GT(mfr::hybridError(list, k - 1, bg) + mfr::hybridError(list, 0, bg), 0.0);
     }
   }
 }
@@ -93,7 +110,8 @@ TEST(Hybrid, EmptyAndTransparentTails) {
   const glm::vec3 bg(0.25f, 0.5f, 0.75f);
   expectNear(mfr::compositeHybrid(std::span<const mfr::Fragment>{}, 0, bg), bg);
   // A fully transparent tail (Σα = 0) shows the background through the core.
-  const std::vector<mfr::Fragment> list{frag(0.1f, 255, 255, 255, 51), frag(0.2f, 255, 0, 0, 0), frag(0.3f, 0, 255, 0, 0)};
+  const std::vector<mfr::Fragment> list{frag(0.1f, 255, 255, 255, 51), frag(0.2f, 255, 0, 0, 0),
+                                        frag(0.3f, 0, 255, 0, 0)};
   expectNear(mfr::compositeHybrid(list, 1, bg), glm::vec3(0.2f) + 0.8f * bg);
   const mfr::HybridTailSums s = mfr::hybridTailSums(threeFragments(), 1);
   EXPECT_EQ(s.count, 2u);
