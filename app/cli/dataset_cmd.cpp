@@ -70,6 +70,7 @@ void addDataset(CLI::App& app) {
     std::vector<std::pair<int, int>> sizes;
     for (const std::string& s : opt->sizes) sizes.push_back(parseSize("--size", s));
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
+    const DatasetSampling sampling = opt->sampleBy == "deep" ? DatasetSampling::DeepPixels : DatasetSampling::Pixels;
     DkbDataset dataset;
     std::mt19937_64 rng(opt->seed);
     nlohmann::ordered_json meta;
@@ -103,9 +104,7 @@ void addDataset(CLI::App& app) {
               if (allDone) continue;
               allDone = true;
             }
-            const DatasetFrame f =
-                appendDatasetFrame(dataset, lists, errors, F, opt->sample, rng,
-                                   opt->sampleBy == "deep" ? DatasetSampling::DeepPixels : DatasetSampling::Pixels);
+            const DatasetFrame f = appendDatasetFrame(dataset, lists, errors, F, opt->sample, rng, sampling);
             std::cout << std::left << std::setw(28) << scenes[s].name.substr(0, 27) << std::setw(16) << v.substr(0, 15)
                       << std::setw(9) << (std::to_string(w) + "x" + std::to_string(h)) << std::right << std::setw(10)
                       << F << std::setw(10) << f.totalFragments << std::setw(9) << f.sampled << std::setw(12)

@@ -38,4 +38,11 @@ float mfrMlpForward(vec4 a, vec4 b, vec4 c) {
   return 1.0f / (1.0f + exp(-out_));
 }
 
+// The importance dkb allocates by, from the network's output y (before sanitising): y·n + ½ when
+// it predicts k/n, so that the allocation rule's floor rounds the predicted k instead of
+// truncating it; y when it predicts k/F.
+float mfrDkbImportance(float y, uint n, bool predictsFractionOfList) {
+  return predictsFractionOfList ? y * float(n) + 0.5f : y;
+}
+
 #endif

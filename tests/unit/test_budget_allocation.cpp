@@ -323,24 +323,33 @@ double cpuLoss(const mfr::NeuralImportanceModel& model, const mfr::DkbDataset& d
   return sq / weights;
 }
 
+// A training set whose label is a known function of the features: per row 12 uniform features
+// (feature f scaled by scale(f)), n uniform in 1..nRange, k = kOf(features, n), k/F with F = 1000.
+template <class Scale, class KOf>
+mfr::DkbDataset syntheticDataset(unsigned seed, int rows, float nRange, Scale scale, KOf kOf) {
+  mfr::DkbDataset d;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int r = 0; r < rows; ++r) {
+    float row[mfr::kDatasetColumns];
+    for (int f = 0; f < 12; ++f) row[f] = u(rng) * scale(f);
+    const float n = 1.0f + std::floor(u(rng) * nRange);
+    row[mfr::kDatasetN] = n;
+    row[mfr::kDatasetK] = kOf(row, n);
+    row[mfr::kDatasetLabel] = row[mfr::kDatasetK] / 1000.0f;
+    d.rows.insert(d.rows.end(), row, row + mfr::kDatasetColumns);
+  }
+  return d;
+}
+
 // Trains on a small synthetic dataset whose target is a known function of the features, then runs
 // the exported weights through the shaders' forward pass (predictNeuralImportance): its MSE over
 // all rows must equal the mix of dlib's training and validation MSE — a wrong export of dlib's
 // fc layout (transposed weights, bias in the wrong row) would not reproduce it.
 TEST(NeuralTraining, ExportedWeightsReproduceDlibsLoss) {
-  mfr::DkbDataset d;
-  std::mt19937 rng(2);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  for (int r = 0; r < 3000; ++r) {
-    float row[mfr::kDatasetColumns];
-    for (int f = 0; f < 12; ++f) row[f] = u(rng) * static_cast<float>(f + 1);
-    const float n = 1.0f + std::floor(u(rng) * 20.0f);
-    const float kOverN = 0.2f + 0.6f / (1.0f + std::exp(2.0f - row[0] - 0.3f * row[5]));
-    row[mfr::kDatasetN] = n;
-    row[mfr::kDatasetK] = kOverN * n;
-    row[mfr::kDatasetLabel] = kOverN * n / 1000.0f;
-    d.rows.insert(d.rows.end(), row, row + mfr::kDatasetColumns);
-  }
+  const mfr::DkbDataset d = syntheticDataset(
+      2, 3000, 20.0f, [](int f) { return static_cast<float>(f + 1); },
+      [](const float* row, float n) { return (0.2f + 0.6f / (1.0f + std::exp(2.0f - row[0] - 0.3f * row[5]))) * n; });
   mfr::NeuralTrainingOptions o;
   o.epochs = 4;
   o.batchSize = 64;
@@ -366,18 +375,9 @@ TEST(NeuralTraining, ExportedWeightsReproduceDlibsLoss) {
 // Rows drawn in proportion to n(p): the network still learns, the reported losses are weighted by
 // n (so they differ from the unweighted ones of the same weights), and a bad option is refused.
 TEST(NeuralTraining, FragmentWeighting) {
-  mfr::DkbDataset d;
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
-  for (int r = 0; r < 2000; ++r) {
-    float row[mfr::kDatasetColumns];
-    for (int f = 0; f < 12; ++f) row[f] = u(rng);
-    const float n = 1.0f + std::floor(u(rng) * 30.0f);
-    row[mfr::kDatasetN] = n;
-    row[mfr::kDatasetK] = std::max(1.0f, std::round(n * (0.2f + 0.6f * row[3])));
-    row[mfr::kDatasetLabel] = row[mfr::kDatasetK] / 1000.0f;
-    d.rows.insert(d.rows.end(), row, row + mfr::kDatasetColumns);
-  }
+  const mfr::DkbDataset d = syntheticDataset(
+      4, 2000, 30.0f, [](int) { return 1.0f; },
+      [](const float* row, float n) { return std::max(1.0f, std::round(n * (0.2f + 0.6f * row[3]))); });
   mfr::NeuralTrainingOptions o;
   o.epochs = 4;
   o.batchSize = 64;

@@ -217,8 +217,7 @@ float predictNeuralImportance(const NeuralImportanceModel& model, const DkbFeatu
 }
 
 float neuralImportance(const NeuralImportanceModel& model, const DkbFeatureVector& features, std::uint32_t n) {
-  const float y = predictNeuralImportance(model, features);
-  return model.predictsFractionOfList() ? y * static_cast<float>(n) + 0.5f : y;
+  return glsl::mfrDkbImportance(predictNeuralImportance(model, features), n, model.predictsFractionOfList());
 }
 
 DkbImageStats dkbImageStats(const FragmentLists& lists) {

@@ -2,7 +2,7 @@
 // 2022, §4): the 12 features of each pixel (budget/features.h) and the network's prediction
 // (budget/mlp.h; weights at MFR_SSBO_WEIGHTS as 8-bit integers with per-row scales), turned into
 // the importance I(p) in T(0) that the shared allocation rule distributes the budget by. uTarget says what the network predicts:
-// 0 = k(p)/n(p) (I = y·n + ½: the rule's floor rounds the predicted k), 1 = k(p)/F(M) (I = y).
+// 0 = k(p)/n(p), 1 = k(p)/F(M) (mfrDkbImportance).
 #include "budget/arena.glsl"
 #include "budget/allocation.h"
 #define MFR_OUT(T) out T
@@ -38,6 +38,5 @@ void main() {
                  uintBitsToFloat(arena[vkT(1u, p)]), uintBitsToFloat(vkImageNearBits),
                  uintBitsToFloat(vkImageFarBits), arena[vkK(p)], colorSum, a, b, c);
   float y = mfrMlpForward(a, b, c);
-  float importance = uTarget == 0u ? y * float(n) + 0.5 : y;
-  arena[vkT(0u, p)] = floatBitsToUint(mfrSanitizeImportance(importance));
+  arena[vkT(0u, p)] = floatBitsToUint(mfrSanitizeImportance(mfrDkbImportance(y, n, uTarget == 0u)));
 }

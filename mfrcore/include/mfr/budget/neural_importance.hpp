@@ -54,8 +54,8 @@ std::string neuralImportanceJson(const NeuralImportanceModel& model);
 
 // The network's output y ∈ (0, 1) for raw (not yet standardised) features.
 float predictNeuralImportance(const NeuralImportanceModel& model, const DkbFeatureVector& features);
-// The importance dkb allocates by: y·n + ½ (k_over_n; the rule's floor then rounds the predicted k)
-// or y (k_over_budget), before sanitising.
+// The importance dkb allocates by (mfrDkbImportance of shaders/budget/mlp.h): y·n + ½ (k_over_n;
+// the rule's floor then rounds the predicted k) or y (k_over_budget), before sanitising.
 float neuralImportance(const NeuralImportanceModel& model, const DkbFeatureVector& features, std::uint32_t n);
 
 // Image-wide inputs of the features: Σn(p), the nearest and farthest depth of the image.
