@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "mfr/render.hpp"
 #include "mfr/scene/scene.hpp"
 
 namespace mfr::cli {
@@ -29,6 +30,9 @@ std::vector<Scene> loadScenesWithViews(const std::vector<std::string>& paths, do
                                        const std::vector<std::string>& views);
 // The whole text as a finite number, or nothing ("1.5" yes; "1.5x", "", "nan", "inf" no).
 std::optional<double> parseNumber(const std::string& text);
+// "name" or "name:key=value:key=value" → request of w×h (a method run with several settings);
+// op=… sets the operation (default "auto"). Throws mfr::Error naming --methods.
+RenderRequest parseMethodSpec(const std::string& spec, int w, int h);
 // Median of the values (0 for none).
 double median(std::vector<double> values);
 

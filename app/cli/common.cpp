@@ -65,4 +65,30 @@ double median(std::vector<double> values) {
   return n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
+// "name" or "name:key=value:key=value" → request (a method may be benchmarked with several settings).
+RenderRequest parseMethodSpec(const std::string& spec, int w, int h) {
+  RenderRequest r;
+  r.width = w;
+  r.height = h;
+  r.operation = "auto";  // the method's own: hybrid for the budget methods (op=… overrides)
+  std::istringstream in(spec);
+  std::string part;
+  bool first = true;
+  while (std::getline(in, part, ':')) {
+    if (first) {
+      r.method = part;
+      first = false;
+      continue;
+    }
+    const auto eq = part.find('=');
+    if (eq == std::string::npos || eq == 0) throw Error("--methods " + spec, "expected name:key=value:…");
+    if (part.substr(0, eq) == "op") {
+      r.operation = part.substr(eq + 1);
+      continue;
+    }
+    r.params[part.substr(0, eq)] = part.substr(eq + 1);
+  }
+  return r;
+}
+
 }  // namespace mfr::cli

@@ -92,7 +92,9 @@ void addEvaluate(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--views", opt->views, "Comma-separated views")->capture_default_str();
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
-  cmd->add_option("--methods,-m", opt->methods, "Methods to compare")->capture_default_str();
+  cmd->add_option("--methods,-m", opt->methods,
+                  "Methods to compare, each name or name:key=value:… (e.g. vkb:exact_tail=false)")
+      ->capture_default_str();
   cmd->add_option("--weights", opt->weights, "dkb weights file (default: the built-in weights)");
   cmd->add_option("--repeat,-r", opt->repeat, "Timed frames per GPU method")
       ->capture_default_str()
@@ -107,9 +109,15 @@ void addEvaluate(CLI::App& app) {
     if (budgets.empty()) throw Error("--budgets", "no budget given");
     const std::vector<std::string> methods = splitList(opt->methods);
     const std::vector<std::string> known = availableMethods();
-    for (const std::string& m : methods)
-      if (std::find(known.begin(), known.end(), m) == known.end() || m == "oracle")
+    std::map<std::string, RenderRequest> specs;  // each method spec's request, without size and budget
+    std::size_t methodWidth = 11;
+    for (const std::string& m : methods) {
+      const RenderRequest spec = parseMethodSpec(m, w, h);
+      if (std::find(known.begin(), known.end(), spec.method) == known.end() || spec.method == "oracle")
         throw Error("--methods " + m, "not a method (see mfr info --methods)");
+      specs[m] = spec;
+      methodWidth = std::max(methodWidth, m.size() + 2);
+    }
     const std::vector<std::string> views = splitList(opt->views);
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     GpuRenderer& gpu = headlessRenderer();
@@ -121,10 +129,24 @@ void addEvaluate(CLI::App& app) {
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
     std::cout << "renderer: " << info.renderer << ", " << opt->size << ", median of " << opt->repeat << " frames\n";
     std::cout << std::left << std::setw(22) << "scene" << std::setw(12) << "view" << std::setw(14) << "budget"
-              << std::setw(11) << "method" << std::right << std::setw(9) << "k range" << std::setw(10) << "captured"
+              << std::setw(static_cast<int>(methodWidth)) << "method" << std::right << std::setw(9) << "k range" << std::setw(10) << "captured"
               << std::setw(8) << "%" << std::setw(9) << "RMSE" << std::setw(9) << "FLIP" << std::setw(10) << "ms\n";
-    // Wins per (scene, view, budget): the method with the lowest FLIP and the lowest RMSE.
+    // Wins per (scene, view, budget): the method with the lowest FLIP and the lowest RMSE, compared
+    // at the 5 decimals printed; equal lowest values count as a tie of those methods.
     std::map<std::string, int> flipWins, rmseWins;
+    auto countWin = [](std::map<std::string, int>& wins, const std::vector<std::pair<std::string, double>>& values) {
+      if (values.empty()) return;
+      auto printed = [](double v) { return std::llround(v * 1e5); };
+      long long best = printed(values.front().second);
+      for (const auto& [m, v] : values) best = std::min(best, printed(v));
+      std::string key;
+      int count = 0;
+      for (const auto& [m, v] : values)
+        if (printed(v) == best) {
+          key += (count++ ? "=" : "") + m;
+        }
+      ++wins[count > 1 ? "tie " + key : key];
+    };
     for (std::size_t s = 0; s < scenes.size(); ++s) {
       gpu.setScene(scenes[s]);
       for (const std::string& v : views) {
@@ -148,16 +170,13 @@ void addEvaluate(CLI::App& app) {
                 static_cast<std::uint64_t>(std::ceil(b.fragmentPercent / 100.0 * static_cast<double>(total)));
             b.mib = static_cast<double>(variableKLayout(pixels).bytes(slots)) / (1024.0 * 1024.0);
           }
-          std::string bestFlip, bestRmse;
-          double minFlip = 1e30, minRmse = 1e30;
+          std::vector<std::pair<std::string, double>> flips, rmses;
           for (const std::string& m : methods) {
-            RenderRequest req;
-            req.method = m;
-            req.operation = "hybrid";
-            req.width = w;
-            req.height = h;
+            RenderRequest req = specs.at(m);
+            if (req.operation == "auto") req.operation = "hybrid";
             req.params["budget_mib"] = fixed(b.mib, 6);
-            if (m == "dkb" && !opt->weights.empty()) req.params["weights"] = opt->weights;
+            if (req.method == "dkb" && !opt->weights.empty()) req.params["weights"] = opt->weights;
+            const bool cpu = req.method == "optimal-k";
             nlohmann::ordered_json row;
             row["scene"] = opt->scenes[s];
             row["view"] = v;
@@ -168,7 +187,7 @@ void addEvaluate(CLI::App& app) {
             std::vector<double> times;
             std::map<std::string, std::vector<double>> passes;
             try {
-              if (m == "optimal-k") {
+              if (cpu) {
                 r = render(scenes[s], camera, req);
               } else {
                 for (int i = 0; i < opt->repeat; ++i) {
@@ -181,11 +200,11 @@ void addEvaluate(CLI::App& app) {
               row["error"] = e.what();
               rows.push_back(row);
               std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12)
-                        << v.substr(0, 11) << std::setw(14) << b.label << std::setw(11) << m << "  " << e.what()
+                        << v.substr(0, 11) << std::setw(14) << b.label << std::setw(static_cast<int>(methodWidth)) << m
+                        << "  " << e.what()
                         << "\n";
               continue;
             }
-            const bool cpu = m == "optimal-k";
             const ImageRGBA8& reference = cpu ? exact : gpuExact;
             const double e = rmse(reference, r.image);
             const double f = flip(reference, r.image).stats.mean;
@@ -207,30 +226,25 @@ void addEvaluate(CLI::App& app) {
             row["median_pass_ms"] = p;
             rows.push_back(row);
             std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12) << v.substr(0, 11)
-                      << std::setw(14) << (b.label + " " + fixed(b.mib, 2)) << std::setw(11) << m << std::right
+                      << std::setw(14) << (b.label + " " + fixed(b.mib, 2)) << std::setw(static_cast<int>(methodWidth))
+                      << m << std::right
                       << std::setw(9) << (std::to_string(r.stats.kMin) + "-" + std::to_string(r.stats.kMax))
                       << std::setw(10) << r.stats.fragmentsStored << std::setw(8) << fixed(captured, 1) << std::setw(9)
                       << fixed(e, 5) << std::setw(9) << fixed(f, 5) << std::setw(10)
                       << (times.empty() ? std::string("cpu") : fixed(median(times), 1)) << "\n";
-            if (m == "optimal-k") continue;  // the bound, not a competitor: wins count among the others
-            if (f < minFlip) {
-              minFlip = f;
-              bestFlip = m;
-            }
-            if (e < minRmse) {
-              minRmse = e;
-              bestRmse = m;
-            }
+            if (cpu) continue;  // the bound, not a competitor: wins count among the others
+            flips.emplace_back(m, f);
+            rmses.emplace_back(m, e);
           }
-          ++flipWins[bestFlip];
-          ++rmseWins[bestRmse];
+          countWin(flipWins, flips);
+          countWin(rmseWins, rmses);
         }
       }
     }
     std::cout << "lowest FLIP per scene, view and budget:";
-    for (const auto& [m, n] : flipWins) std::cout << " " << m << " " << n;
+    for (const auto& [m, n] : flipWins) std::cout << (m == flipWins.begin()->first ? " " : ", ") << m << " " << n;
     std::cout << "\nlowest RMSE per scene, view and budget:";
-    for (const auto& [m, n] : rmseWins) std::cout << " " << m << " " << n;
+    for (const auto& [m, n] : rmseWins) std::cout << (m == rmseWins.begin()->first ? " " : ", ") << m << " " << n;
     std::cout << "\n";
     out["results"] = rows;
     if (!opt->json.empty()) writeFileAtomically(opt->json, out.dump(2) + "\n");

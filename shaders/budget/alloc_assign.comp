@@ -12,8 +12,8 @@ void main() {
   if (p >= uVkPixels) return;
   uint n = arena[vkN(p)];
   float importance = uintBitsToFloat(arena[vkT(0u, p)]);
-  uint kLo = mfrAllocK(uintBitsToFloat(vkLo), importance, n, vkKFloor);
-  uint kHi = mfrAllocK(uintBitsToFloat(vkHi), importance, n, vkKFloor);
+  uint kLo = mfrAllocK(uintBitsToFloat(vkLo), importance, n, vkAllocMode);
+  uint kHi = mfrAllocK(uintBitsToFloat(vkHi), importance, n, vkAllocMode);
   arena[vkK(p)] = kLo;
   arena[vkT(1u, p)] = kHi - kLo;
   if (p == 0u) {

@@ -19,9 +19,9 @@ void main() {
     uint n = arena[vkN(p)];
     if (n > 0u) {
       float importance = uintBitsToFloat(arena[vkT(0u, p)]);
-      uint lo = vkLo, hi = vkHi, kFloor = vkKFloor;
+      uint lo = vkLo, hi = vkHi, mode = vkAllocMode;
       for (uint j = 1u; j < MFR_ALLOC_SECTIONS; ++j) {
-        uint k = mfrAllocK(uintBitsToFloat(mfrAllocCandidate(lo, hi, j)), importance, n, kFloor);
+        uint k = mfrAllocK(uintBitsToFloat(mfrAllocCandidate(lo, hi, j)), importance, n, mode);
         if (k != 0u) atomicAdd(sSums[j - 1u], k);
       }
     }

@@ -3,13 +3,20 @@
 // Vasilakis, "Deep hybrid order-independent transparency", The Visual Computer 2022.]
 // The allocation rule from per-pixel importance I(p) to k(p), shared verbatim by the GPU passes
 // (shaders/budget/alloc_*.comp) and the C++ reference (mfrcore/src/budget/k_allocation.cpp):
-//   k_λ(p) = clamp(floor(λ·I(p)), k_floor, n(p))   (0 where n(p) = 0)
+//   k_λ(p) = clamp(floor(λ·I(p)), lower(p), upper(p))   (0 where n(p) = 0)
+// with the bounds set once per frame by a mode word (mfr::allocationMode in budget/k_allocation.hpp):
+//   lower = 1 (MFR_ALLOC_FLOOR_ONE: F holds one slot per non-empty pixel) or 0;
+//   upper = max(1, n − 1) (MFR_ALLOC_CAP_TAIL) or n. Hybrid transparency composites a tail of
+//     one fragment exactly (τ = 1 − α, colour = the fragment's), so the n-th slot buys nothing
+//     while any pixel still lacks its (n − 1)-th;
+//   when F exceeds Σ max(1, n − 1) (MFR_ALLOC_FILL): lower = max(1, n − 1), upper = n — every
+//     pixel is exact and the remaining slots only use the budget up.
 // Σ_p k_λ(p) never decreases with λ. λ is searched over the bit patterns of non-negative floats
 // (they order like the floats): MFR_ALLOC_SECTIONS − 1 candidates per round narrow [lo, hi] to
 // adjacent floats in MFR_ALLOC_ROUNDS rounds, keeping S(lo) ≤ F < S(hi); the F − S(lo) slots
 // left are then given, one pixel after another in pixel order, to the pixels whose k grows
 // between lo and hi. So Σk = F exactly whenever Σn ≥ F, where the papers' floor(F·I/ΣI)
-// leaves slots unused. k_floor is 1 when F holds one slot per non-empty pixel, else 0.
+// leaves slots unused.
 // Valid GLSL 4.50 and C++ (included inside a namespace with uint, floor, min, clamp in scope).
 #ifndef MFR_ALLOCATION_H
 #define MFR_ALLOCATION_H
@@ -17,6 +24,9 @@
 #define MFR_ALLOC_SECTIONS 16u
 #define MFR_ALLOC_ROUNDS 8u
 #define MFR_ALLOC_INFINITY_BITS 0x7F800000u
+#define MFR_ALLOC_FLOOR_ONE 1u
+#define MFR_ALLOC_CAP_TAIL 2u
+#define MFR_ALLOC_FILL 4u
 
 const float MFR_IMPORTANCE_FLOOR = 1.0e-6f;  // every non-empty pixel keeps a positive importance
 const float MFR_ALLOC_MAX_SCALED = 4294967040.0f;  // largest float below 2^32
@@ -26,10 +36,20 @@ float mfrSanitizeImportance(float importance) {
   return importance >= MFR_IMPORTANCE_FLOOR ? importance : MFR_IMPORTANCE_FLOOR;
 }
 
-uint mfrAllocK(float lambda, float importance, uint n, uint kFloor) {
+// max(1, n − 1): the slots after which a pixel's hybrid result is exact.
+uint mfrAllocExactK(uint n) { return n > 1u ? n - 1u : n; }
+
+uint mfrAllocLower(uint n, uint mode) {
+  if ((mode & MFR_ALLOC_FILL) != 0u) return mfrAllocExactK(n);
+  return (mode & MFR_ALLOC_FLOOR_ONE) != 0u ? 1u : 0u;
+}
+
+uint mfrAllocUpper(uint n, uint mode) { return (mode & MFR_ALLOC_CAP_TAIL) != 0u ? mfrAllocExactK(n) : n; }
+
+uint mfrAllocK(float lambda, float importance, uint n, uint mode) {
   if (n == 0u) return 0u;
   float scaled = min(floor(lambda * importance), MFR_ALLOC_MAX_SCALED);
-  return clamp(uint(scaled), kFloor, n);
+  return clamp(uint(scaled), mfrAllocLower(n, mode), mfrAllocUpper(n, mode));
 }
 
 // Candidate j (0..MFR_ALLOC_SECTIONS) between the bit patterns lo ≤ hi: lo + floor((hi − lo)·j / S)

@@ -20,11 +20,11 @@ layout(std430, binding = MFR_SSBO_BUDGET) coherent buffer VariableKBudget {
   uint vkImageNearBits;   // min over pixels of the nearest depth (float bits)
   uint vkImageFarBits;    // max over pixels of the farthest depth (float bits)
   uint vkBudgetSlots;     // F: slots to assign, min(F(M), Σn)
-  uint vkKFloor;          // 1 or 0 (F < non-empty pixels)
+  uint vkAllocMode;       // MFR_ALLOC_* bounds of k(p) (budget/allocation.h)
   uint vkLo;              // λ search interval, float bit patterns
   uint vkHi;
   uint vkSumLo;           // S(lo)
-  uint vkReserved0;
+  uint vkMultiFragment;   // pixels with n(p) > 1
   uint vkSums[15];        // S at the candidates j = 1..15 of the current round
   uint vkKMin;            // over non-empty pixels, after the allocation
   uint vkKMax;

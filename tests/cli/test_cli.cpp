@@ -172,13 +172,16 @@ TEST_F(Cli, DatasetTrainRenderEvaluate) {
   r = run("render @sample -s 40x30 -m dkb -p budget_mib=0.1 -p weights=" + weights.string() + " -o " + png.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_EQ(mfr::readPng(png).width, 40);
-  r = run("evaluate @sample -s 40x30 --views front --budgets k1,f50 -r 1 --weights " + weights.string() + " --json " +
-          json.string());
+  r = run("evaluate @sample -s 40x30 --views front --budgets k1,f50 -r 1 --weights " + weights.string() +
+          " -m fkb,vkb,vkb:exact_tail=false,dkb,optimal-k --json " + json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
-  for (const char* m : {"fkb", "vkb", "dkb", "optimal-k", "lowest FLIP"}) EXPECT_NE(r.out.find(m), std::string::npos) << m;
+  for (const char* m : {"fkb", "vkb", "vkb:exact_tail=false", "dkb", "optimal-k", "lowest FLIP"})
+    EXPECT_NE(r.out.find(m), std::string::npos) << m;
+  EXPECT_EQ(r.out.find("error"), std::string::npos) << r.out;
   std::ifstream in(json);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\"flip_mean\""), std::string::npos);
+  EXPECT_NE(text.find("\"vkb:exact_tail=false\""), std::string::npos);
 }
 
 TEST_F(Cli, BudgetCommandsBadInput) {
@@ -195,10 +198,16 @@ TEST_F(Cli, BudgetCommandsBadInput) {
   expectCleanFailure("render @sample -s 16x16 -m optimal-k --op oit", "--op oit");
   // evaluate writes no PNG; its --json must not appear on failure.
   const fs::path json = dir_ / "e.json";
-  const Result r = run("evaluate @sample -s 16x16 --budgets banana --json " + json.string());
-  EXPECT_EQ(r.exitCode, 1) << r.out;
-  EXPECT_NE(r.out.find("--budgets banana"), std::string::npos) << r.out;
-  EXPECT_FALSE(fs::exists(json));
+  for (const auto& [args, mention] : std::vector<std::pair<std::string, std::string>>{
+           {"--budgets banana", "--budgets banana"},
+           {"-m vkb:exact_tail", "--methods vkb:exact_tail"},
+           {"-m vkb,nosuch:k=1", "--methods nosuch:k=1"}}) {
+    const Result r = run("evaluate @sample -s 16x16 " + args + " --json " + json.string());
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    EXPECT_NE(r.out.find(mention), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(json));
+  }
 }
 
 }  // namespace

@@ -77,10 +77,12 @@ TEST_P(VariableK, AllocationEqualsTheCpuRule) {
   gpu.setScene(ref.scene);
   const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
   const std::uint64_t total = ref.oracle.fragments.size();
-  for (double fraction : {0.15, 0.3, 0.55, 0.8, 1.2}) {
-    SCOPED_TRACE("fraction " + std::to_string(fraction));
-    const RenderRequest req =
+  for (const bool exactTail : {true, false})
+  for (double fraction : {0.15, 0.3, 0.55, 0.8, 0.9, 1.2}) {
+    SCOPED_TRACE("fraction " + std::to_string(fraction) + (exactTail ? "" : ", exact_tail off"));
+    RenderRequest req =
         budgetRequest(GetParam(), layout.bytes(static_cast<std::uint64_t>(fraction * static_cast<double>(total))));
+    req.params["exact_tail"] = exactTail ? "true" : "false";
     gpu.render(ref.camera, req);
     auto* method = dynamic_cast<VariableKBuffer*>(gpu.method());
     ASSERT_NE(method, nullptr);
@@ -90,7 +92,7 @@ TEST_P(VariableK, AllocationEqualsTheCpuRule) {
     const std::vector<std::uint32_t>& n = method->lastCounts();
     const std::uint64_t gpuTotal = std::accumulate(n.begin(), n.end(), std::uint64_t{0});
     const std::uint64_t F = std::min(layout.slotBudget(budgetOf(req)), gpuTotal);
-    const ImportanceAllocation cpu = allocateKFromImportance(importance, n, F);
+    const ImportanceAllocation cpu = allocateKFromImportance(importance, n, F, exactTail);
     const std::vector<std::uint32_t> k = method->capacityMap();  // GL row order, like importance
     ASSERT_EQ(k.size(), cpu.k.size());
     std::size_t differ = 0;
@@ -169,6 +171,60 @@ TEST_P(VariableK, HybridEqualsTheOracleForTheSameKMap) {
     std::cout << "[ budget ] " << GetParam() << " at " << fraction << " of the fragments: " << c.within << " of "
               << c.compared << " pixels within 2/255 of the oracle's hybrid, max " << c.maxDifference << "; k "
               << out.stats.kMin << ".." << out.stats.kMax << "\n";
+  }
+}
+
+// With exact_tail, a budget of Σ max(1, n − 1) slots gives every pixel k = max(1, n − 1) and so
+// the exact image: a one-fragment tail composites exactly. The papers' bounds (1 ≤ k ≤ n) spend
+// slots on last fragments instead and leave other pixels with a longer tail at the same budget.
+TEST_P(VariableK, ExactTailMakesTheLastFragmentsFree) {
+  context();
+  const Reference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
+  // The GPU's own n(p) (it may differ from the oracle's on edge pixels).
+  RenderRequest probe = budgetRequest(GetParam(), layout.bytes(pixels()));
+  gpu.render(ref.camera, probe);
+  auto* method = dynamic_cast<VariableKBuffer*>(gpu.method());
+  ASSERT_NE(method, nullptr);
+  method->setKeepImportance(true);
+  gpu.render(ref.camera, probe);
+  const std::vector<std::uint32_t> n = method->lastCounts();
+  method->setKeepImportance(false);
+  std::uint64_t exactSlots = 0, total = 0;
+  for (std::uint32_t v : n) {
+    exactSlots += v > 1 ? v - 1 : v;
+    total += v;
+  }
+  ASSERT_LT(exactSlots, total * 95 / 100);  // the claim is not vacuous on this scene
+  const ImageRGBA8 exact = compositeOver(ref.oracle, ref.scene.background);
+  for (const bool exactTail : {true, false}) {
+    RenderRequest req = budgetRequest(GetParam(), layout.bytes(exactSlots));
+    req.params["exact_tail"] = exactTail ? "true" : "false";
+    const RenderOutput out = gpu.render(ref.camera, req);
+    EXPECT_EQ(out.stats.fragmentsStored, exactSlots);
+    EXPECT_LE(out.stats.bytesAllocated, budgetOf(req));
+    const std::vector<std::uint32_t> k = method->capacityMap();  // GL row order, like n
+    ASSERT_EQ(k.size(), n.size());
+    std::size_t shortOfExact = 0, full = 0;
+    for (std::size_t p = 0; p < n.size(); ++p) {
+      shortOfExact += n[p] > 1 && k[p] < n[p] - 1;
+      full += n[p] > 1 && k[p] == n[p];
+    }
+    const ImageComparison c = compareImages(ref.oracle, exact, out.image, 2);
+    std::cout << "[ budget ] " << GetParam() << " exact_tail " << exactTail << " at Σmax(1, n − 1) = " << exactSlots
+              << " of " << total << " slots: " << shortOfExact << " pixels below n − 1, " << full
+              << " at n (n > 1); " << c.within << " of " << c.compared << " pixels within 2/255 of the exact image, max "
+              << c.maxDifference << "\n";
+    if (exactTail) {
+      EXPECT_EQ(shortOfExact, 0u);
+      EXPECT_EQ(full, 0u);
+      EXPECT_GE(c.fraction(), 0.999) << "max difference " << c.maxDifference;
+    } else {
+      EXPECT_GT(shortOfExact, 0u);
+      EXPECT_GT(full, 0u);
+    }
   }
 }
 

@@ -46,28 +46,38 @@ TEST(KAllocation, PropertiesOnRandomCases) {
     const std::uint64_t total = sum(n);
     const std::uint64_t nonEmpty =
         static_cast<std::uint64_t>(std::count_if(n.begin(), n.end(), [](auto v) { return v > 0; }));
-    for (std::uint64_t F : {std::uint64_t{0}, nonEmpty / 2, nonEmpty, nonEmpty + 1, (nonEmpty + total) / 2,
-                            total > 0 ? total - 1 : 0, total, total + 17}) {
-      const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(importance, n, F);
-      ASSERT_EQ(a.k.size(), pixels);
-      EXPECT_EQ(a.assigned, sum(a.k));
-      EXPECT_EQ(a.assigned, std::min(F, total)) << "case " << c << " F " << F;  // the budget is used up
-      EXPECT_EQ(a.kFloor, F >= nonEmpty ? 1u : 0u);
-      for (std::size_t p = 0; p < pixels; ++p) {
-        ASSERT_LE(a.k[p], n[p]);
-        if (n[p] == 0) {
-          EXPECT_EQ(a.k[p], 0u);
+    // Σ max(1, n − 1): the slots after which every pixel's hybrid result is exact.
+    std::uint64_t exactSlots = 0;
+    for (std::uint32_t v : n) exactSlots += v > 1 ? v - 1 : v;
+    for (bool exactTail : {true, false}) {
+      for (std::uint64_t F : {std::uint64_t{0}, nonEmpty / 2, nonEmpty, nonEmpty + 1, (nonEmpty + exactSlots) / 2,
+                              exactSlots, exactSlots + 1, (nonEmpty + total) / 2, total > 0 ? total - 1 : 0, total,
+                              total + 17}) {
+        const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(importance, n, F, exactTail);
+        ASSERT_EQ(a.k.size(), pixels);
+        EXPECT_EQ(a.assigned, sum(a.k));
+        EXPECT_EQ(a.assigned, std::min(F, total)) << "case " << c << " F " << F;  // the budget is used up
+        EXPECT_EQ(a.kFloor, F >= nonEmpty ? 1u : 0u);
+        // The bounds of k(p), written out from the rule's statement.
+        auto lower = [&](std::size_t p) -> std::uint32_t {
+          if (n[p] == 0) return 0;
+          if (exactTail && F > exactSlots) return n[p] > 1 ? n[p] - 1 : 1;
+          return F >= nonEmpty ? 1 : 0;
+        };
+        auto upper = [&](std::size_t p) -> std::uint32_t {
+          return exactTail && F <= exactSlots && n[p] > 1 ? n[p] - 1 : n[p];
+        };
+        for (std::size_t p = 0; p < pixels; ++p) {
+          ASSERT_GE(a.k[p], lower(p)) << "case " << c << " F " << F << " n " << n[p];
+          ASSERT_LE(a.k[p], upper(p)) << "case " << c << " F " << F << " n " << n[p];
         }
-        if (n[p] > 0 && F >= nonEmpty) {
-          EXPECT_GE(a.k[p], 1u);
-        }
-      }
-      // Monotone in importance (up to the one slot of the remainder): a more important pixel that
-      // is not full never has fewer slots than a less important one, minus one.
-      for (std::size_t p = 0; p + 1 < pixels; ++p) {
-        const std::size_t q = p + 1;
-        if (importance[p] >= importance[q] && a.k[p] < n[p] && n[q] > 0 && a.k[q] > a.kFloor) {
-          EXPECT_GE(a.k[p] + 1, a.k[q]) << "case " << c << " pixels " << p << "," << q;
+        // Monotone in importance (up to the one slot of the remainder): a more important pixel that
+        // is not full never has fewer slots than a less important one, minus one.
+        for (std::size_t p = 0; p + 1 < pixels; ++p) {
+          const std::size_t q = p + 1;
+          if (importance[p] >= importance[q] && a.k[p] < upper(p) && n[q] > 0 && a.k[q] > lower(q)) {
+            EXPECT_GE(a.k[p] + 1, a.k[q]) << "case " << c << " pixels " << p << "," << q;
+          }
         }
       }
     }
@@ -110,7 +120,10 @@ TEST(KAllocation, BadImportancesCountAsTheFloor) {
   const std::vector<float> importance{std::numeric_limits<float>::quiet_NaN(), -3.0f, 0.0f, 1.0f};
   const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(importance, n, 12);
   EXPECT_EQ(a.assigned, 12u);
-  EXPECT_EQ(a.k[3], 5u);  // the only important pixel fills up first
+  EXPECT_EQ(a.k[3], 4u);  // the only important pixel fills up first, to n − 1 (its tail is exact)
+  const mfr::ImportanceAllocation paper = mfr::allocateKFromImportance(importance, n, 12, false);
+  EXPECT_EQ(paper.assigned, 12u);
+  EXPECT_EQ(paper.k[3], 5u);  // the papers' bounds: up to n
   EXPECT_THROW(mfr::allocateKFromImportance(importance, std::vector<std::uint32_t>{1, 2}, 3), mfr::Error);
 }
 

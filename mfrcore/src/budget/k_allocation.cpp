@@ -14,34 +14,44 @@ namespace mfr {
 namespace {
 
 std::uint64_t sumAt(std::uint32_t lambdaBits, std::span<const float> importance, std::span<const std::uint32_t> n,
-                    std::uint32_t kFloor) {
+                    std::uint32_t mode) {
   const float lambda = std::bit_cast<float>(lambdaBits);
   std::uint64_t s = 0;
-  for (std::size_t p = 0; p < n.size(); ++p) s += glsl::mfrAllocK(lambda, importance[p], n[p], kFloor);
+  for (std::size_t p = 0; p < n.size(); ++p) s += glsl::mfrAllocK(lambda, importance[p], n[p], mode);
   return s;
 }
 
 }  // namespace
 
+std::uint32_t allocationMode(std::uint64_t F, std::uint64_t total, std::uint64_t nonEmpty, std::uint64_t multi,
+                             bool exactTail) {
+  std::uint32_t mode = F >= nonEmpty ? MFR_ALLOC_FLOOR_ONE : 0u;
+  if (!exactTail) return mode;
+  return mode | (F <= total - multi ? MFR_ALLOC_CAP_TAIL : MFR_ALLOC_FILL);
+}
+
 ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportance, std::span<const std::uint32_t> n,
-                                             std::uint64_t budgetSlots) {
+                                             std::uint64_t budgetSlots, bool exactTail) {
   if (rawImportance.size() != n.size())
     throw Error("importance map",
                 std::to_string(rawImportance.size()) + " entries for " + std::to_string(n.size()) + " pixels");
   std::vector<float> importance(rawImportance.size());
   std::transform(rawImportance.begin(), rawImportance.end(), importance.begin(), glsl::mfrSanitizeImportance);
 
-  std::uint64_t total = 0, nonEmpty = 0;
+  std::uint64_t total = 0, nonEmpty = 0, multi = 0;
   for (std::uint32_t c : n) {
     total += c;
     nonEmpty += c > 0;
+    multi += c > 1;
   }
   ImportanceAllocation out;
   out.kFloor = budgetSlots >= nonEmpty ? 1u : 0u;
+  out.mode = allocationMode(budgetSlots, total, nonEmpty, multi, exactTail);
 
   // Invariant S(lo) ≤ F < S(hi), or lo = hi = +inf when every fragment fits.
   std::uint32_t lo = 0, hi = MFR_ALLOC_INFINITY_BITS;
-  std::uint64_t sLo = out.kFloor * nonEmpty;
+  std::uint64_t sLo = 0;  // S(0) = Σ lower(p)
+  for (std::uint32_t c : n) sLo += c > 0 ? glsl::mfrAllocLower(c, out.mode) : 0u;
   if (total <= budgetSlots) {
     lo = hi;
     sLo = total;
@@ -51,7 +61,7 @@ ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportanc
     std::uint64_t newSLo = sLo;
     for (std::uint32_t j = 1; j < MFR_ALLOC_SECTIONS; ++j) {
       const std::uint32_t c = glsl::mfrAllocCandidate(lo, hi, j);
-      const std::uint64_t s = sumAt(c, importance, n, out.kFloor);
+      const std::uint64_t s = sumAt(c, importance, n, out.mode);
       if (s <= budgetSlots) {
         newLo = c;
         newSLo = s;
@@ -69,8 +79,8 @@ ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportanc
   std::uint64_t remaining = budgetSlots > sLo ? budgetSlots - sLo : 0;
   out.k.resize(n.size());
   for (std::size_t p = 0; p < n.size(); ++p) {
-    const std::uint32_t kLo = glsl::mfrAllocK(lambdaLo, importance[p], n[p], out.kFloor);
-    const std::uint32_t kHi = glsl::mfrAllocK(lambdaHi, importance[p], n[p], out.kFloor);
+    const std::uint32_t kLo = glsl::mfrAllocK(lambdaLo, importance[p], n[p], out.mode);
+    const std::uint32_t kHi = glsl::mfrAllocK(lambdaHi, importance[p], n[p], out.mode);
     const std::uint64_t extra = std::min<std::uint64_t>(remaining, kHi - kLo);
     remaining -= extra;
     out.k[p] = kLo + static_cast<std::uint32_t>(extra);

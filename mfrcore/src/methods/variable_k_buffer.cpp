@@ -9,6 +9,7 @@
 
 #include "budget/glsl_shared.hpp"
 #include "common/bindings.h"
+#include "mfr/budget/k_allocation.hpp"
 #include "mfr/error.hpp"
 #include "method_util.hpp"
 
@@ -23,10 +24,11 @@ enum StateWord : std::uint32_t {
   kImageNear = 2,
   kImageFar = 3,
   kBudgetSlots = 4,
-  kKFloor = 5,
+  kAllocMode = 5,
   kLo = 6,
   kHi = 7,
   kSumLo = 8,
+  kMultiFragment = 9,
   kKMin = 25,
   kKMax = 26,
   kStateWords = 32,
@@ -74,12 +76,22 @@ std::vector<ParamSpec> VariableKBuffer::budgetParams() {
            0,
            0,
            {},
-           "reject fragments behind the pixel's current k(p)-th nearest before taking the lock"}};
+           "reject fragments behind the pixel's current k(p)-th nearest before taking the lock"},
+          {"exact_tail",
+           "No slot for a pixel's last fragment",
+           ParamSpec::Type::Bool,
+           "true",
+           0,
+           0,
+           {},
+           "k(p) <= n(p) - 1 until every pixel has n - 1 slots: hybrid transparency composites a "
+           "one-fragment tail exactly (off: the papers' bounds 1 <= k(p) <= n(p))"}};
 }
 
 void VariableKBuffer::configure(int width, int height, const Params& params) {
   externalPixelState_ = true;
   culling_ = params.flag("culling");
+  exactTail_ = params.flag("exact_tail");
   budgetText_ = params.text("budget_mib");
   budgetBytes_ = static_cast<std::uint64_t>(std::floor(params.real("budget_mib") * 1024.0 * 1024.0));
   configureMember(params);
@@ -165,16 +177,21 @@ void VariableKBuffer::capture(const FrameContext& ctx) {
   dispatchPixels(imageStats_, 256);
   ctx.timer.end();
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  glGetNamedBufferSubData(state_.id(), 0, 4 * 2, state);
+  glGetNamedBufferSubData(state_.id(), 0, 4 * (kMultiFragment + 1), state);
   totalFragments_ = state[kTotal];
   nonEmpty_ = state[kNonEmpty];
+  const std::uint64_t multiFragment = state[kMultiFragment];
   const std::uint64_t budgetSlots = layout_.slotBudget(budgetBytes_);
   slotsF_ = std::min<std::uint64_t>(budgetSlots, totalFragments_);
-  const std::uint32_t kFloor = slotsF_ >= nonEmpty_ ? 1u : 0u;
+  const std::uint32_t mode = allocationMode(slotsF_, totalFragments_, nonEmpty_, multiFragment, exactTail_);
   const bool allFit = totalFragments_ <= budgetSlots;
-  const std::uint32_t search[5] = {static_cast<std::uint32_t>(slotsF_), kFloor, allFit ? MFR_ALLOC_INFINITY_BITS : 0u,
+  // S(0) = Σ lower(p): 1 per non-empty pixel, 0, or Σ max(1, n − 1) (budget/allocation.h).
+  const std::uint64_t sumAtZero = (mode & MFR_ALLOC_FILL) != 0u           ? totalFragments_ - multiFragment
+                                  : (mode & MFR_ALLOC_FLOOR_ONE) != 0u ? nonEmpty_
+                                                                        : 0u;
+  const std::uint32_t search[5] = {static_cast<std::uint32_t>(slotsF_), mode, allFit ? MFR_ALLOC_INFINITY_BITS : 0u,
                                    MFR_ALLOC_INFINITY_BITS,
-                                   static_cast<std::uint32_t>(allFit ? totalFragments_ : kFloor * nonEmpty_)};
+                                   static_cast<std::uint32_t>(allFit ? totalFragments_ : sumAtZero)};
   glNamedBufferSubData(state_.id(), 4 * kBudgetSlots, sizeof search, search);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
 
@@ -224,9 +241,12 @@ void VariableKBuffer::capture(const FrameContext& ctx) {
   stats_.notes.emplace_back("F(M)", std::to_string(budgetSlots) + " slots");
   stats_.notes.emplace_back("slots assigned", std::to_string(slotsF_) + " of " + std::to_string(totalFragments_) +
                                                   " fragments" +
-                                                  (kFloor == 0 ? " (k = 0 allowed: F < non-empty pixels)" : ""));
+                                                  ((mode & MFR_ALLOC_FLOOR_ONE) == 0 ? " (k = 0 allowed: F < non-empty pixels)" : ""));
   stats_.notes.emplace_back("importance", describeImportance());
   stats_.notes.emplace_back("culling", culling_ ? "on" : "off");
+  stats_.notes.emplace_back("exact tail", !exactTail_                     ? "off (1 <= k <= n)"
+                                          : (mode & MFR_ALLOC_FILL) != 0u ? "every pixel exact (k >= n - 1)"
+                                                                          : "k <= n - 1");
 }
 
 void VariableKBuffer::allocate(const FrameContext& ctx) {

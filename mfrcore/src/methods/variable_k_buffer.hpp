@@ -28,7 +28,7 @@ class VariableKBuffer : public KBufferFamily {
   void resolve(const FrameContext& ctx, const Operation& op) final;
   [[nodiscard]] std::vector<std::uint32_t> capacityMap() const final;
 
-  // The budget parameters every variable-k method has (budget_mib, sync, spin_limit, culling).
+  // The budget parameters every variable-k method has (budget_mib, sync, spin_limit, culling, exact_tail).
   static std::vector<ParamSpec> budgetParams();
   [[nodiscard]] const VariableKLayout& layout() const { return layout_; }
   // Per-pixel importance of the last frame (GL row order), read back from the arena: valid only
@@ -69,6 +69,7 @@ class VariableKBuffer : public KBufferFamily {
   void allocate(const FrameContext& ctx);
 
   bool culling_ = true;
+  bool exactTail_ = true;
   bool keepImportance_ = false;
   std::vector<float> importance_;
   std::vector<std::uint32_t> counts_;
