@@ -33,19 +33,24 @@ struct Budget {
   std::string label;
   double mib = 0.0;
   double fragmentPercent = 0.0;  // fN budgets
+  bool ofExactSlots = false;     // eN budgets: the percentage is of Σ max(1, n − 1)
 };
 
 // "3.5" MiB; "kN": the bytes of a uniform-k k+-buffer with the tail (fkb's layout) at k = N;
-// "fN": the bytes with which the variable-k layout holds N % of the frame's fragments (resolved
+// "fN": the bytes with which the variable-k layout holds N % of the frame's fragments; "eN": N % of
+// Σ max(1, n − 1), the slots after which hybrid transparency is exact everywhere (both resolved
 // per frame, mib stays 0 here).
 Budget parseBudget(const std::string& item, std::uint64_t pixels) {
   Budget b;
   b.label = item;
-  if (!item.empty() && item[0] == 'f') {
+  if (!item.empty() && (item[0] == 'f' || item[0] == 'e')) {
     const std::optional<double> percent = parseNumber(item.substr(1));
     if (!percent || !(*percent > 0.0) || *percent > 100.0)
-      throw Error("--budgets " + item, "expected fN with 0 < N <= 100 (% of the frame's fragments)");
+      throw Error("--budgets " + item, item[0] == 'f'
+                                           ? "expected fN with 0 < N <= 100 (% of the frame's fragments)"
+                                           : "expected eN with 0 < N <= 100 (% of the frame's Σ max(1, n − 1))");
     b.fragmentPercent = *percent;
+    b.ofExactSlots = item[0] == 'e';
     return b;
   }
   if (!item.empty() && item[0] == 'k') {
@@ -88,7 +93,8 @@ void addEvaluate(CLI::App& app) {
   cmd->add_option("scenes", opt->scenes, "Scenes (model files, .mfrscene, @sample)")->required();
   cmd->add_option("--budgets", opt->budgets,
                   "Comma-separated budgets: MiB; kN = the memory of a uniform k = N k+-buffer with the tail; fN = the "
-                  "memory with which the variable-k layout holds N % of each frame's fragments")
+                  "memory with which the variable-k layout holds N % of each frame's fragments; eN = N % of its "
+                  "sum of max(1, n - 1), the slots with which hybrid is exact")
       ->capture_default_str();
   cmd->add_option("--views", opt->views, "Comma-separated views")->capture_default_str();
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
@@ -164,10 +170,15 @@ void addEvaluate(CLI::App& app) {
         exactRequest.height = h;
         const ImageRGBA8 gpuExact = gpu.render(camera, exactRequest).image;
         const std::uint64_t total = lists.fragments.size();
+        std::uint64_t exactSlots = 0;  // Σ max(1, n − 1) over the oracle's lists
+        for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p) {
+          const std::uint32_t n = lists.offsets[p + 1] - lists.offsets[p];
+          exactSlots += n > 1 ? n - 1 : n;
+        }
         for (Budget b : budgets) {
           if (b.fragmentPercent > 0.0) {
-            const auto slots =
-                static_cast<std::uint64_t>(std::ceil(b.fragmentPercent / 100.0 * static_cast<double>(total)));
+            const double of = static_cast<double>(b.ofExactSlots ? exactSlots : total);
+            const auto slots = static_cast<std::uint64_t>(std::ceil(b.fragmentPercent / 100.0 * of));
             b.mib = static_cast<double>(variableKLayout(pixels).bytes(slots)) / (1024.0 * 1024.0);
           }
           std::vector<std::pair<std::string, double>> flips, rmses;
@@ -182,6 +193,7 @@ void addEvaluate(CLI::App& app) {
             row["view"] = v;
             row["budget"] = b.label;
             row["budget_mib"] = b.mib;
+            row["exact_slots"] = exactSlots;
             row["method"] = m;
             RenderOutput r;
             std::vector<double> times;

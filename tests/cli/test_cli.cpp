@@ -172,7 +172,7 @@ TEST_F(Cli, DatasetTrainRenderEvaluate) {
   r = run("render @sample -s 40x30 -m dkb -p budget_mib=0.1 -p weights=" + weights.string() + " -o " + png.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_EQ(mfr::readPng(png).width, 40);
-  r = run("evaluate @sample -s 40x30 --views front --budgets k1,f50 -r 1 --weights " + weights.string() +
+  r = run("evaluate @sample -s 40x30 --views front --budgets k1,f50,e90 -r 1 --weights " + weights.string() +
           " -m fkb,vkb,vkb:exact_tail=false,dkb,optimal-k --json " + json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   for (const char* m : {"fkb", "vkb", "vkb:exact_tail=false", "dkb", "optimal-k", "lowest FLIP"})
@@ -182,6 +182,8 @@ TEST_F(Cli, DatasetTrainRenderEvaluate) {
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\"flip_mean\""), std::string::npos);
   EXPECT_NE(text.find("\"vkb:exact_tail=false\""), std::string::npos);
+  EXPECT_NE(text.find("\"e90\""), std::string::npos);
+  EXPECT_NE(text.find("\"exact_slots\""), std::string::npos);
 }
 
 TEST_F(Cli, BudgetCommandsBadInput) {
@@ -200,6 +202,7 @@ TEST_F(Cli, BudgetCommandsBadInput) {
   const fs::path json = dir_ / "e.json";
   for (const auto& [args, mention] : std::vector<std::pair<std::string, std::string>>{
            {"--budgets banana", "--budgets banana"},
+           {"--budgets e0", "--budgets e0"},
            {"-m vkb:exact_tail", "--methods vkb:exact_tail"},
            {"-m vkb,nosuch:k=1", "--methods nosuch:k=1"}}) {
     const Result r = run("evaluate @sample -s 16x16 " + args + " --json " + json.string());
