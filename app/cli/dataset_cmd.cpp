@@ -43,6 +43,7 @@ void addDataset(CLI::App& app) {
     std::string views = "iso", budgets = "1,1.25,1.5,2,2.5,3,4,6,all", output, sampleBy = "pixels";
     double sample = 0.2, opacity = -1.0;
     std::uint64_t seed = 1;
+    bool skipExact = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -63,6 +64,9 @@ void addDataset(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::IsMember({"pixels", "deep"}));
   cmd->add_option("--seed", opt->seed, "Random seed of the pixel sampling")->capture_default_str();
+  cmd->add_flag("--skip-exact-budgets", opt->skipExact,
+                "Leave out a frame's budgets of at least sum max(1, n - 1) slots: there the exact-tail bound makes "
+                "every allocation exact, so their labels teach the network nothing");
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
   cmd->callback([opt] {
     const std::vector<double> levels = parseBudgetLevels(opt->budgets);
@@ -81,6 +85,7 @@ void addDataset(CLI::App& app) {
     meta["sample"] = opt->sample;
     meta["sample_by"] = opt->sampleBy;
     meta["seed"] = opt->seed;
+    meta["skip_exact_budgets"] = opt->skipExact;
     nlohmann::ordered_json frames = nlohmann::ordered_json::array();
     std::cout << std::left << std::setw(28) << "scene" << std::setw(16) << "view" << std::setw(9) << "size"
               << std::right << std::setw(10) << "F" << std::setw(10) << "Σn" << std::setw(9) << "rows" << std::setw(12)
@@ -94,12 +99,18 @@ void addDataset(CLI::App& app) {
           const std::uint64_t nonEmpty = minimumSlots(errors);
           if (nonEmpty == 0) throw Error(opt->scenes[s] + " view " + v, "nothing visible");
           bool allDone = false;  // levels at or above Σn all mean "every fragment": one frame of those
+          std::uint64_t exactSlots = 0;  // Σ max(1, n − 1)
+          for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p) {
+            const std::uint32_t n = lists.offsets[p + 1] - lists.offsets[p];
+            exactSlots += n > 1 ? n - 1 : n;
+          }
           for (double level : levels) {
             const std::uint64_t F =
                 level < 0 ? lists.fragments.size()
                           : std::min<std::uint64_t>(
                                 lists.fragments.size(),
                                 static_cast<std::uint64_t>(std::llround(level * static_cast<double>(nonEmpty))));
+            if (opt->skipExact && F >= exactSlots) continue;
             if (F >= lists.fragments.size()) {
               if (allDone) continue;
               allDone = true;

@@ -166,6 +166,20 @@ TEST_F(Cli, DatasetTrainRenderEvaluate) {
   Result r = run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,2,all --sample 0.5 -o " + data.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_NE(r.out.find(" rows"), std::string::npos) << r.out;
+  // --skip-exact-budgets leaves out the frames whose budget makes every allocation exact ("all").
+  auto frames = [](const std::string& out) {
+    std::size_t count = 0;
+    for (std::size_t at = out.find("\nsample "); at != std::string::npos; at = out.find("\nsample ", at + 1)) ++count;
+    return count;
+  };
+  const fs::path cut = dir_ / "cut.bin";
+  Result all = run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,all --sample 0.5 -o " + cut.string());
+  ASSERT_EQ(all.exitCode, 0) << all.out;
+  EXPECT_EQ(frames(all.out), 4u) << all.out;
+  all = run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,all --sample 0.5 --skip-exact-budgets -o " +
+            cut.string());
+  ASSERT_EQ(all.exitCode, 0) << all.out;
+  EXPECT_EQ(frames(all.out), 2u) << all.out;
   r = run("train " + data.string() + " --epochs 2 --batch 64 -o " + weights.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_NE(r.out.find("epoch    2"), std::string::npos) << r.out;
