@@ -98,7 +98,7 @@ void addDataset(CLI::App& app) {
           const HybridErrorTable errors = hybridErrorTable(lists, scenes[s].background);
           const std::uint64_t nonEmpty = minimumSlots(errors);
           if (nonEmpty == 0) throw Error(opt->scenes[s] + " view " + v, "nothing visible");
-          bool allDone = false;  // levels at or above Σn all mean "every fragment": one frame of those
+          bool allDone = false;          // levels at or above Σn all mean "every fragment": one frame of those
           std::uint64_t exactSlots = 0;  // Σ max(1, n − 1)
           for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p) {
             const std::uint32_t n = lists.offsets[p + 1] - lists.offsets[p];

@@ -135,8 +135,9 @@ void addEvaluate(CLI::App& app) {
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
     std::cout << "renderer: " << info.renderer << ", " << opt->size << ", median of " << opt->repeat << " frames\n";
     std::cout << std::left << std::setw(22) << "scene" << std::setw(12) << "view" << std::setw(14) << "budget"
-              << std::setw(static_cast<int>(methodWidth)) << "method" << std::right << std::setw(9) << "k range" << std::setw(10) << "captured"
-              << std::setw(8) << "%" << std::setw(9) << "RMSE" << std::setw(9) << "FLIP" << std::setw(10) << "ms\n";
+              << std::setw(static_cast<int>(methodWidth)) << "method" << std::right << std::setw(9) << "k range"
+              << std::setw(10) << "captured" << std::setw(8) << "%" << std::setw(9) << "RMSE" << std::setw(9) << "FLIP"
+              << std::setw(10) << "ms\n";
     // Wins per (scene, view, budget): the method with the lowest FLIP and the lowest RMSE, compared
     // at the 5 decimals printed; equal lowest values count as a tie of those methods.
     std::map<std::string, int> flipWins, rmseWins;
@@ -213,8 +214,7 @@ void addEvaluate(CLI::App& app) {
               rows.push_back(row);
               std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12)
                         << v.substr(0, 11) << std::setw(14) << b.label << std::setw(static_cast<int>(methodWidth)) << m
-                        << "  " << e.what()
-                        << "\n";
+                        << "  " << e.what() << "\n";
               continue;
             }
             const ImageRGBA8& reference = cpu ? exact : gpuExact;
@@ -239,10 +239,10 @@ void addEvaluate(CLI::App& app) {
             rows.push_back(row);
             std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12) << v.substr(0, 11)
                       << std::setw(14) << (b.label + " " + fixed(b.mib, 2)) << std::setw(static_cast<int>(methodWidth))
-                      << m << std::right
-                      << std::setw(9) << (std::to_string(r.stats.kMin) + "-" + std::to_string(r.stats.kMax))
-                      << std::setw(10) << r.stats.fragmentsStored << std::setw(8) << fixed(captured, 1) << std::setw(9)
-                      << fixed(e, 5) << std::setw(9) << fixed(f, 5) << std::setw(10)
+                      << m << std::right << std::setw(9)
+                      << (std::to_string(r.stats.kMin) + "-" + std::to_string(r.stats.kMax)) << std::setw(10)
+                      << r.stats.fragmentsStored << std::setw(8) << fixed(captured, 1) << std::setw(9) << fixed(e, 5)
+                      << std::setw(9) << fixed(f, 5) << std::setw(10)
                       << (times.empty() ? std::string("cpu") : fixed(median(times), 1)) << "\n";
             if (cpu) continue;  // the bound, not a competitor: wins count among the others
             flips.emplace_back(m, f);

@@ -37,14 +37,18 @@ float mfrSanitizeImportance(float importance) {
 }
 
 // max(1, n − 1): the slots after which a pixel's hybrid result is exact.
-uint mfrAllocExactK(uint n) { return n > 1u ? n - 1u : n; }
+uint mfrAllocExactK(uint n) {
+  return n > 1u ? n - 1u : n;
+}
 
 uint mfrAllocLower(uint n, uint mode) {
   if ((mode & MFR_ALLOC_FILL) != 0u) return mfrAllocExactK(n);
   return (mode & MFR_ALLOC_FLOOR_ONE) != 0u ? 1u : 0u;
 }
 
-uint mfrAllocUpper(uint n, uint mode) { return (mode & MFR_ALLOC_CAP_TAIL) != 0u ? mfrAllocExactK(n) : n; }
+uint mfrAllocUpper(uint n, uint mode) {
+  return (mode & MFR_ALLOC_CAP_TAIL) != 0u ? mfrAllocExactK(n) : n;
+}
 
 uint mfrAllocK(float lambda, float importance, uint n, uint mode) {
   if (n == 0u) return 0u;

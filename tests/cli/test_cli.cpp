@@ -173,7 +173,8 @@ TEST_F(Cli, DatasetTrainRenderEvaluate) {
     return count;
   };
   const fs::path cut = dir_ / "cut.bin";
-  Result all = run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,all --sample 0.5 -o " + cut.string());
+  Result all =
+      run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,all --sample 0.5 -o " + cut.string());
   ASSERT_EQ(all.exitCode, 0) << all.out;
   EXPECT_EQ(frames(all.out), 4u) << all.out;
   all = run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,all --sample 0.5 --skip-exact-budgets -o " +
@@ -214,11 +215,11 @@ TEST_F(Cli, BudgetCommandsBadInput) {
   expectCleanFailure("render @sample -s 16x16 -m optimal-k --op oit", "--op oit");
   // evaluate writes no PNG; its --json must not appear on failure.
   const fs::path json = dir_ / "e.json";
-  for (const auto& [args, mention] : std::vector<std::pair<std::string, std::string>>{
-           {"--budgets banana", "--budgets banana"},
-           {"--budgets e0", "--budgets e0"},
-           {"-m vkb:exact_tail", "--methods vkb:exact_tail"},
-           {"-m vkb,nosuch:k=1", "--methods nosuch:k=1"}}) {
+  for (const auto& [args, mention] :
+       std::vector<std::pair<std::string, std::string>>{{"--budgets banana", "--budgets banana"},
+                                                        {"--budgets e0", "--budgets e0"},
+                                                        {"-m vkb:exact_tail", "--methods vkb:exact_tail"},
+                                                        {"-m vkb,nosuch:k=1", "--methods nosuch:k=1"}}) {
     const Result r = run("evaluate @sample -s 16x16 " + args + " --json " + json.string());
     EXPECT_EQ(r.exitCode, 1) << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;

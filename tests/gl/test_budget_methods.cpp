@@ -78,39 +78,39 @@ TEST_P(VariableK, AllocationEqualsTheCpuRule) {
   const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
   const std::uint64_t total = ref.oracle.fragments.size();
   for (const bool exactTail : {true, false})
-  for (double fraction : {0.15, 0.3, 0.55, 0.8, 0.9, 1.2}) {
-    SCOPED_TRACE("fraction " + std::to_string(fraction) + (exactTail ? "" : ", exact_tail off"));
-    RenderRequest req =
-        budgetRequest(GetParam(), layout.bytes(static_cast<std::uint64_t>(fraction * static_cast<double>(total))));
-    req.params["exact_tail"] = exactTail ? "true" : "false";
-    gpu.render(ref.camera, req);
-    auto* method = dynamic_cast<VariableKBuffer*>(gpu.method());
-    ASSERT_NE(method, nullptr);
-    method->setKeepImportance(true);
-    const RenderOutput out = gpu.render(ref.camera, req);
-    const std::vector<float>& importance = method->lastImportance();
-    const std::vector<std::uint32_t>& n = method->lastCounts();
-    const std::uint64_t gpuTotal = std::accumulate(n.begin(), n.end(), std::uint64_t{0});
-    const std::uint64_t F = std::min(layout.slotBudget(budgetOf(req)), gpuTotal);
-    const ImportanceAllocation cpu = allocateKFromImportance(importance, n, F, exactTail);
-    const std::vector<std::uint32_t> k = method->capacityMap();  // GL row order, like importance
-    ASSERT_EQ(k.size(), cpu.k.size());
-    std::size_t differ = 0;
-    for (std::size_t p = 0; p < k.size(); ++p) differ += k[p] != cpu.k[p];
-    EXPECT_EQ(differ, 0u);
-    EXPECT_EQ(std::accumulate(k.begin(), k.end(), std::uint64_t{0}), F);  // the budget is used up
-    EXPECT_EQ(out.stats.fragmentsStored, F);
-    EXPECT_EQ(out.stats.lockFailures, 0u);
-    EXPECT_LE(out.stats.bytesAllocated, budgetOf(req));
-    EXPECT_EQ(out.stats.bytesAllocated, layout.bytes(std::max<std::uint64_t>(F, 1)));
-    for (std::size_t p = 0; p < k.size(); ++p) {
-      ASSERT_LE(k[p], n[p]);
-      if (n[p] > 0) {
-        ASSERT_GE(k[p], cpu.kFloor);
+    for (double fraction : {0.15, 0.3, 0.55, 0.8, 0.9, 1.2}) {
+      SCOPED_TRACE("fraction " + std::to_string(fraction) + (exactTail ? "" : ", exact_tail off"));
+      RenderRequest req =
+          budgetRequest(GetParam(), layout.bytes(static_cast<std::uint64_t>(fraction * static_cast<double>(total))));
+      req.params["exact_tail"] = exactTail ? "true" : "false";
+      gpu.render(ref.camera, req);
+      auto* method = dynamic_cast<VariableKBuffer*>(gpu.method());
+      ASSERT_NE(method, nullptr);
+      method->setKeepImportance(true);
+      const RenderOutput out = gpu.render(ref.camera, req);
+      const std::vector<float>& importance = method->lastImportance();
+      const std::vector<std::uint32_t>& n = method->lastCounts();
+      const std::uint64_t gpuTotal = std::accumulate(n.begin(), n.end(), std::uint64_t{0});
+      const std::uint64_t F = std::min(layout.slotBudget(budgetOf(req)), gpuTotal);
+      const ImportanceAllocation cpu = allocateKFromImportance(importance, n, F, exactTail);
+      const std::vector<std::uint32_t> k = method->capacityMap();  // GL row order, like importance
+      ASSERT_EQ(k.size(), cpu.k.size());
+      std::size_t differ = 0;
+      for (std::size_t p = 0; p < k.size(); ++p) differ += k[p] != cpu.k[p];
+      EXPECT_EQ(differ, 0u);
+      EXPECT_EQ(std::accumulate(k.begin(), k.end(), std::uint64_t{0}), F);  // the budget is used up
+      EXPECT_EQ(out.stats.fragmentsStored, F);
+      EXPECT_EQ(out.stats.lockFailures, 0u);
+      EXPECT_LE(out.stats.bytesAllocated, budgetOf(req));
+      EXPECT_EQ(out.stats.bytesAllocated, layout.bytes(std::max<std::uint64_t>(F, 1)));
+      for (std::size_t p = 0; p < k.size(); ++p) {
+        ASSERT_LE(k[p], n[p]);
+        if (n[p] > 0) {
+          ASSERT_GE(k[p], cpu.kFloor);
+        }
       }
+      method->setKeepImportance(false);
     }
-    method->setKeepImportance(false);
-  }
 }
 
 // The budget is never exceeded; absurd budgets are refused with one line or handled.
@@ -214,9 +214,9 @@ TEST_P(VariableK, ExactTailMakesTheLastFragmentsFree) {
     }
     const ImageComparison c = compareImages(ref.oracle, exact, out.image, 2);
     std::cout << "[ budget ] " << GetParam() << " exact_tail " << exactTail << " at Σmax(1, n − 1) = " << exactSlots
-              << " of " << total << " slots: " << shortOfExact << " pixels below n − 1, " << full
-              << " at n (n > 1); " << c.within << " of " << c.compared << " pixels within 2/255 of the exact image, max "
-              << c.maxDifference << "\n";
+              << " of " << total << " slots: " << shortOfExact << " pixels below n − 1, " << full << " at n (n > 1); "
+              << c.within << " of " << c.compared << " pixels within 2/255 of the exact image, max " << c.maxDifference
+              << "\n";
     if (exactTail) {
       EXPECT_EQ(shortOfExact, 0u);
       EXPECT_EQ(full, 0u);

@@ -50,9 +50,9 @@ TEST(KAllocation, PropertiesOnRandomCases) {
     std::uint64_t exactSlots = 0;
     for (std::uint32_t v : n) exactSlots += v > 1 ? v - 1 : v;
     for (bool exactTail : {true, false}) {
-      for (std::uint64_t F : {std::uint64_t{0}, nonEmpty / 2, nonEmpty, nonEmpty + 1, (nonEmpty + exactSlots) / 2,
-                              exactSlots, exactSlots + 1, (nonEmpty + total) / 2, total > 0 ? total - 1 : 0, total,
-                              total + 17}) {
+      for (std::uint64_t F :
+           {std::uint64_t{0}, nonEmpty / 2, nonEmpty, nonEmpty + 1, (nonEmpty + exactSlots) / 2, exactSlots,
+            exactSlots + 1, (nonEmpty + total) / 2, total > 0 ? total - 1 : 0, total, total + 17}) {
         const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(importance, n, F, exactTail);
         ASSERT_EQ(a.k.size(), pixels);
         EXPECT_EQ(a.assigned, sum(a.k));

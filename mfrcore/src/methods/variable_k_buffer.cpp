@@ -186,9 +186,9 @@ void VariableKBuffer::capture(const FrameContext& ctx) {
   const std::uint32_t mode = allocationMode(slotsF_, totalFragments_, nonEmpty_, multiFragment, exactTail_);
   const bool allFit = totalFragments_ <= budgetSlots;
   // S(0) = Σ lower(p): 1 per non-empty pixel, 0, or Σ max(1, n − 1) (budget/allocation.h).
-  const std::uint64_t sumAtZero = (mode & MFR_ALLOC_FILL) != 0u           ? totalFragments_ - multiFragment
+  const std::uint64_t sumAtZero = (mode & MFR_ALLOC_FILL) != 0u        ? totalFragments_ - multiFragment
                                   : (mode & MFR_ALLOC_FLOOR_ONE) != 0u ? nonEmpty_
-                                                                        : 0u;
+                                                                       : 0u;
   const std::uint32_t search[5] = {static_cast<std::uint32_t>(slotsF_), mode, allFit ? MFR_ALLOC_INFINITY_BITS : 0u,
                                    MFR_ALLOC_INFINITY_BITS,
                                    static_cast<std::uint32_t>(allFit ? totalFragments_ : sumAtZero)};
@@ -239,9 +239,9 @@ void VariableKBuffer::capture(const FrameContext& ctx) {
   stats_.notes.clear();
   stats_.notes.emplace_back("budget", budgetText_ + " MiB = " + std::to_string(budgetBytes_) + " bytes");
   stats_.notes.emplace_back("F(M)", std::to_string(budgetSlots) + " slots");
-  stats_.notes.emplace_back("slots assigned", std::to_string(slotsF_) + " of " + std::to_string(totalFragments_) +
-                                                  " fragments" +
-                                                  ((mode & MFR_ALLOC_FLOOR_ONE) == 0 ? " (k = 0 allowed: F < non-empty pixels)" : ""));
+  stats_.notes.emplace_back("slots assigned",
+                            std::to_string(slotsF_) + " of " + std::to_string(totalFragments_) + " fragments" +
+                                ((mode & MFR_ALLOC_FLOOR_ONE) == 0 ? " (k = 0 allowed: F < non-empty pixels)" : ""));
   stats_.notes.emplace_back("importance", describeImportance());
   stats_.notes.emplace_back("culling", culling_ ? "on" : "off");
   stats_.notes.emplace_back("exact tail", !exactTail_                     ? "off (1 <= k <= n)"
