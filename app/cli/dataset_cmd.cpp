@@ -13,6 +13,7 @@
 #include "mfr/budget/dataset.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "mfr/reference/hybrid.hpp"
 #include "mfr/reference/oracle.hpp"
 
 namespace mfr::cli {
@@ -99,11 +100,7 @@ void addDataset(CLI::App& app) {
           const std::uint64_t nonEmpty = minimumSlots(errors);
           if (nonEmpty == 0) throw Error(opt->scenes[s] + " view " + v, "nothing visible");
           bool allDone = false;          // levels at or above Σn all mean "every fragment": one frame of those
-          std::uint64_t exactSlots = 0;  // Σ max(1, n − 1)
-          for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p) {
-            const std::uint32_t n = lists.offsets[p + 1] - lists.offsets[p];
-            exactSlots += n > 1 ? n - 1 : n;
-          }
+          const std::uint64_t exactSlots = exactHybridSlots(lists);
           for (double level : levels) {
             const std::uint64_t F =
                 level < 0 ? lists.fragments.size()

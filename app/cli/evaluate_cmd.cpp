@@ -21,6 +21,7 @@
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
 #include "mfr/reference/composite.hpp"
+#include "mfr/reference/hybrid.hpp"
 #include "mfr/reference/metrics.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "mfr/render.hpp"
@@ -171,11 +172,7 @@ void addEvaluate(CLI::App& app) {
         exactRequest.height = h;
         const ImageRGBA8 gpuExact = gpu.render(camera, exactRequest).image;
         const std::uint64_t total = lists.fragments.size();
-        std::uint64_t exactSlots = 0;  // Σ max(1, n − 1) over the oracle's lists
-        for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p) {
-          const std::uint32_t n = lists.offsets[p + 1] - lists.offsets[p];
-          exactSlots += n > 1 ? n - 1 : n;
-        }
+        const std::uint64_t exactSlots = exactHybridSlots(lists);
         for (Budget b : budgets) {
           if (b.fragmentPercent > 0.0) {
             const double of = static_cast<double>(b.ofExactSlots ? exactSlots : total);

@@ -83,6 +83,27 @@ TEST(Hybrid, OneFragmentTailIsExact) {
   }
 }
 
+// exactHybridSlots counts max(1, n − 1) per non-empty pixel, and that k map gives the exact image.
+TEST(Hybrid, ExactHybridSlots) {
+  std::mt19937 rng(9);
+  mfr::FragmentLists lists;
+  lists.width = 4;
+  lists.height = 1;
+  lists.offsets = {0};
+  for (int n : {0, 1, 2, 5}) {
+    const auto list = randomList(rng, n);
+    lists.fragments.insert(lists.fragments.end(), list.begin(), list.end());
+    lists.offsets.push_back(static_cast<std::uint32_t>(lists.fragments.size()));
+  }
+  lists.flags.assign(4, 0);
+  EXPECT_EQ(mfr::exactHybridSlots(lists), 0u + 1u + 1u + 4u);
+  const std::vector<std::uint32_t> k{0, 1, 1, 4};
+  const glm::vec3 bg(0.1f, 0.4f, 0.7f);
+  const mfr::ImageRGBA8 hybrid = mfr::compositeHybrid(lists, k, bg), exact = mfr::compositeOver(lists, bg);
+  for (std::size_t i = 0; i < exact.pixels.size(); ++i)
+    EXPECT_LE(std::abs(static_cast<int>(hybrid.pixels[i]) - static_cast<int>(exact.pixels[i])), 1) << "byte " << i;
+}
+
 TEST(Hybrid, ZeroCoreIsWeightedAverage) {
   std::mt19937 rng(11);
   for (int trial = 0; trial < 100; ++trial) {

@@ -77,6 +77,15 @@ ImageRGBA8 compositeHybrid(const FragmentLists& lists, std::uint32_t k, glm::vec
   return compositeHybrid(lists, kMap, background);
 }
 
+std::uint64_t exactHybridSlots(const FragmentLists& lists) {
+  std::uint64_t slots = 0;
+  for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p) {
+    const std::uint32_t n = lists.offsets[p + 1] - lists.offsets[p];
+    slots += n > 1 ? n - 1 : n;
+  }
+  return slots;
+}
+
 double hybridError(std::span<const Fragment> sorted, std::uint32_t k, glm::vec3 background) {
   const glm::dvec3 d = glm::dvec3(compositeHybrid(sorted, k, background)) - glm::dvec3(compositeOver(sorted, background));
   return glm::dot(d, d);

@@ -51,4 +51,8 @@ ImageRGBA8 compositeHybrid(const FragmentLists& lists, std::uint32_t k, glm::vec
 // ‖hybrid(k) − over(all)‖² of one pixel, in float.
 double hybridError(std::span<const Fragment> sorted, std::uint32_t k, glm::vec3 background);
 
+// Σ max(1, n(p) − 1) over the non-empty pixels: with that many core slots, k(p) = max(1, n − 1),
+// the hybrid image is exact everywhere (a one-fragment tail composites exactly).
+std::uint64_t exactHybridSlots(const FragmentLists& lists);
+
 }  // namespace mfr
