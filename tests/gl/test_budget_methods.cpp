@@ -205,6 +205,12 @@ TEST_P(VariableK, ExactTailMakesTheLastFragmentsFree) {
     const RenderOutput out = gpu.render(ref.camera, req);
     EXPECT_EQ(out.stats.fragmentsStored, exactSlots);
     EXPECT_LE(out.stats.bytesAllocated, budgetOf(req));
+    // The method says where exactness starts (the viewer's stats panel shows it).
+    const auto note = std::find_if(out.stats.notes.begin(), out.stats.notes.end(),
+                                   [](const auto& kv) { return kv.first == "exact at"; });
+    ASSERT_NE(note, out.stats.notes.end());
+    EXPECT_NE(note->second.find("(" + std::to_string(exactTail ? exactSlots : total) + " slots)"), std::string::npos)
+        << note->second;
     const std::vector<std::uint32_t> k = method->capacityMap();  // GL row order, like n
     ASSERT_EQ(k.size(), n.size());
     std::size_t shortOfExact = 0, full = 0;

@@ -247,6 +247,11 @@ void VariableKBuffer::capture(const FrameContext& ctx) {
   stats_.notes.emplace_back("exact tail", !exactTail_                     ? "off (1 <= k <= n)"
                                           : (mode & MFR_ALLOC_FILL) != 0u ? "every pixel exact (k >= n - 1)"
                                                                           : "k <= n - 1");
+  // The least budget at which this frame's hybrid image is exact: Σ max(1, n − 1) slots with the
+  // bound, every fragment without it.
+  const std::uint64_t exactSlots = exactTail_ ? totalFragments_ - multiFragment : totalFragments_;
+  stats_.notes.emplace_back("exact at", ">= " + mibText(layout_.bytes(std::max<std::uint64_t>(exactSlots, 1))) +
+                                            " MiB (" + std::to_string(exactSlots) + " slots)");
 }
 
 void VariableKBuffer::allocate(const FrameContext& ctx) {
