@@ -121,10 +121,16 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   capturedLabel_ = new QLabel;
   capturedLabel_->setObjectName(QStringLiteral("capturedLabel"));
   kLabel_ = new QLabel;
+  exactLabel_ = new QLabel(tr("—"));
+  exactLabel_->setObjectName(QStringLiteral("budgetExactAt"));
+  exactLabel_->setToolTip(
+      tr("The least budget at which this frame's image is exact (vkb, dkb: a one-fragment "
+         "tail is exact, so Σ max(1, n − 1) slots suffice)"));
   frameForm->addRow(tr("Memory"), memoryBar_);
   frameForm->addRow(tr("Holding data"), memoryLabel_);
   frameForm->addRow(tr("Captured"), capturedLabel_);
   frameForm->addRow(tr("k"), kLabel_);
+  frameForm->addRow(tr("Exact from"), exactLabel_);
   rmseLabel_ = new QLabel(tr("—"));
   rmseLabel_->setObjectName(QStringLiteral("budgetRmse"));
   flipLabel_ = new QLabel(tr("—"));
@@ -357,6 +363,9 @@ void BudgetPanel::showFrame() {
   kLabel_->setText(s.kMax == 0 ? tr("— (no per-pixel capacity)")
                    : s.kMin == s.kMax ? QString::number(s.kMax)
                                       : QStringLiteral("%1 … %2").arg(s.kMin).arg(s.kMax));
+  const auto exact =
+      std::find_if(s.notes.begin(), s.notes.end(), [](const auto& kv) { return kv.first == "exact at"; });
+  exactLabel_->setText(exact == s.notes.end() ? tr("—") : QString::fromStdString(exact->second));
   histogram_->setMarker(driverFor(ctx_.method()).knob == Knob::Pool ? 0 : static_cast<int>(s.kMax), s.kMin != s.kMax);
 }
 

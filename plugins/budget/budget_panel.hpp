@@ -70,6 +70,7 @@ class BudgetPanel final : public QWidget {
   QLabel* memoryLabel_ = nullptr;
   QLabel* capturedLabel_ = nullptr;
   QLabel* kLabel_ = nullptr;
+  QLabel* exactLabel_ = nullptr;  // the method's "exact at" note
   HistogramWidget* histogram_ = nullptr;
   QTimer* histogramTimer_ = nullptr;
   QDoubleSpinBox* robustness_ = nullptr;

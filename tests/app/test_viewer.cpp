@@ -259,6 +259,18 @@ class ViewerTest : public QObject {
         if ((method == "vkb" || method == "dkb") && s.fragmentsStored < s.fragmentsGenerated)
           QVERIFY(allocated > 0.99 * budget * kMiB);
         if (budgetMethod) QCOMPARE(QString::fromStdString(s.operation), QStringLiteral("hybrid"));
+        // The panel shows where the frame becomes exact: the variable-k methods' own note.
+        auto* exactAt = w->findChild<QLabel*>("budgetExactAt");
+        QVERIFY(exactAt);
+        if (method == "vkb" || method == "dkb") {
+          const auto note =
+              std::find_if(s.notes.begin(), s.notes.end(), [](const auto& kv) { return kv.first == "exact at"; });
+          QVERIFY(note != s.notes.end());
+          QTRY_COMPARE_WITH_TIMEOUT(exactAt->text(), QString::fromStdString(note->second), kTimeoutMs);
+          QVERIFY(exactAt->text().contains(QStringLiteral("MiB")));
+        } else {
+          QTRY_COMPARE_WITH_TIMEOUT(exactAt->text(), QStringLiteral("—"), kTimeoutMs);
+        }
         previous = s.bytesAllocated;
       }
     }
