@@ -250,11 +250,17 @@ void addEvaluate(CLI::App& app) {
         }
       }
     }
-    std::cout << "lowest FLIP per scene, view and budget:";
-    for (const auto& [m, n] : flipWins) std::cout << (m == flipWins.begin()->first ? " " : ", ") << m << " " << n;
-    std::cout << "\nlowest RMSE per scene, view and budget:";
-    for (const auto& [m, n] : rmseWins) std::cout << (m == rmseWins.begin()->first ? " " : ", ") << m << " " << n;
-    std::cout << "\n";
+    auto printWins = [](const char* metric, const std::map<std::string, int>& wins) {
+      std::cout << "lowest " << metric << " per scene, view and budget:";
+      const char* separator = " ";
+      for (const auto& [m, n] : wins) {
+        std::cout << separator << m << " " << n;
+        separator = ", ";
+      }
+      std::cout << "\n";
+    };
+    printWins("FLIP", flipWins);
+    printWins("RMSE", rmseWins);
     out["results"] = rows;
     if (!opt->json.empty()) writeFileAtomically(opt->json, out.dump(2) + "\n");
   });

@@ -363,9 +363,8 @@ void BudgetPanel::showFrame() {
   kLabel_->setText(s.kMax == 0 ? tr("— (no per-pixel capacity)")
                    : s.kMin == s.kMax ? QString::number(s.kMax)
                                       : QStringLiteral("%1 … %2").arg(s.kMin).arg(s.kMax));
-  const auto exact =
-      std::find_if(s.notes.begin(), s.notes.end(), [](const auto& kv) { return kv.first == "exact at"; });
-  exactLabel_->setText(exact == s.notes.end() ? tr("—") : QString::fromStdString(exact->second));
+  const std::string* exactAt = s.note("exact at");
+  exactLabel_->setText(exactAt ? QString::fromStdString(*exactAt) : tr("—"));
   histogram_->setMarker(driverFor(ctx_.method()).knob == Knob::Pool ? 0 : static_cast<int>(s.kMax), s.kMin != s.kMax);
 }
 

@@ -23,11 +23,18 @@ std::uint64_t sumAt(std::uint32_t lambdaBits, std::span<const float> importance,
 
 }  // namespace
 
-std::uint32_t allocationMode(std::uint64_t F, std::uint64_t total, std::uint64_t nonEmpty, std::uint64_t multi,
-                             bool exactTail) {
-  std::uint32_t mode = F >= nonEmpty ? MFR_ALLOC_FLOOR_ONE : 0u;
-  if (!exactTail) return mode;
-  return mode | (F <= total - multi ? MFR_ALLOC_CAP_TAIL : MFR_ALLOC_FILL);
+AllocationBounds allocationBounds(std::uint64_t F, std::uint64_t total, std::uint64_t nonEmpty, std::uint64_t multi,
+                                  bool exactTail) {
+  const bool floorOne = F >= nonEmpty;
+  AllocationBounds b{floorOne ? MFR_ALLOC_FLOOR_ONE : 0u, floorOne ? nonEmpty : 0u};
+  if (!exactTail) return b;
+  if (F <= total - multi) {
+    b.mode |= MFR_ALLOC_CAP_TAIL;
+  } else {
+    b.mode |= MFR_ALLOC_FILL;
+    b.sumAtZero = total - multi;  // lower = max(1, n − 1) everywhere
+  }
+  return b;
 }
 
 ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportance, std::span<const std::uint32_t> n,
@@ -45,13 +52,13 @@ ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportanc
     multi += c > 1;
   }
   ImportanceAllocation out;
-  out.kFloor = budgetSlots >= nonEmpty ? 1u : 0u;
-  out.mode = allocationMode(budgetSlots, total, nonEmpty, multi, exactTail);
+  const AllocationBounds bounds = allocationBounds(budgetSlots, total, nonEmpty, multi, exactTail);
+  const std::uint32_t mode = bounds.mode;
+  out.kFloor = (mode & MFR_ALLOC_FLOOR_ONE) != 0u ? 1u : 0u;
 
   // Invariant S(lo) ≤ F < S(hi), or lo = hi = +inf when every fragment fits.
   std::uint32_t lo = 0, hi = MFR_ALLOC_INFINITY_BITS;
-  std::uint64_t sLo = 0;  // S(0) = Σ lower(p)
-  for (std::uint32_t c : n) sLo += c > 0 ? glsl::mfrAllocLower(c, out.mode) : 0u;
+  std::uint64_t sLo = bounds.sumAtZero;
   if (total <= budgetSlots) {
     lo = hi;
     sLo = total;
@@ -61,7 +68,7 @@ ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportanc
     std::uint64_t newSLo = sLo;
     for (std::uint32_t j = 1; j < MFR_ALLOC_SECTIONS; ++j) {
       const std::uint32_t c = glsl::mfrAllocCandidate(lo, hi, j);
-      const std::uint64_t s = sumAt(c, importance, n, out.mode);
+      const std::uint64_t s = sumAt(c, importance, n, mode);
       if (s <= budgetSlots) {
         newLo = c;
         newSLo = s;
@@ -79,8 +86,8 @@ ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportanc
   std::uint64_t remaining = budgetSlots > sLo ? budgetSlots - sLo : 0;
   out.k.resize(n.size());
   for (std::size_t p = 0; p < n.size(); ++p) {
-    const std::uint32_t kLo = glsl::mfrAllocK(lambdaLo, importance[p], n[p], out.mode);
-    const std::uint32_t kHi = glsl::mfrAllocK(lambdaHi, importance[p], n[p], out.mode);
+    const std::uint32_t kLo = glsl::mfrAllocK(lambdaLo, importance[p], n[p], mode);
+    const std::uint32_t kHi = glsl::mfrAllocK(lambdaHi, importance[p], n[p], mode);
     const std::uint64_t extra = std::min<std::uint64_t>(remaining, kHi - kLo);
     remaining -= extra;
     out.k[p] = kLo + static_cast<std::uint32_t>(extra);

@@ -183,15 +183,12 @@ void VariableKBuffer::capture(const FrameContext& ctx) {
   const std::uint64_t multiFragment = state[kMultiFragment];
   const std::uint64_t budgetSlots = layout_.slotBudget(budgetBytes_);
   slotsF_ = std::min<std::uint64_t>(budgetSlots, totalFragments_);
-  const std::uint32_t mode = allocationMode(slotsF_, totalFragments_, nonEmpty_, multiFragment, exactTail_);
+  const AllocationBounds bounds = allocationBounds(slotsF_, totalFragments_, nonEmpty_, multiFragment, exactTail_);
+  const std::uint32_t mode = bounds.mode;
   const bool allFit = totalFragments_ <= budgetSlots;
-  // S(0) = Σ lower(p): 1 per non-empty pixel, 0, or Σ max(1, n − 1) (budget/allocation.h).
-  const std::uint64_t sumAtZero = (mode & MFR_ALLOC_FILL) != 0u        ? totalFragments_ - multiFragment
-                                  : (mode & MFR_ALLOC_FLOOR_ONE) != 0u ? nonEmpty_
-                                                                       : 0u;
   const std::uint32_t search[5] = {static_cast<std::uint32_t>(slotsF_), mode, allFit ? MFR_ALLOC_INFINITY_BITS : 0u,
                                    MFR_ALLOC_INFINITY_BITS,
-                                   static_cast<std::uint32_t>(allFit ? totalFragments_ : sumAtZero)};
+                                   static_cast<std::uint32_t>(allFit ? totalFragments_ : bounds.sumAtZero)};
   glNamedBufferSubData(state_.id(), 4 * kBudgetSlots, sizeof search, search);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
 

@@ -20,15 +20,19 @@ struct ImportanceAllocation {
   std::vector<std::uint32_t> k;  // per pixel
   std::uint64_t assigned = 0;    // Σk
   std::uint32_t kFloor = 1;      // 1, or 0 when F < non-empty pixels
-  std::uint32_t mode = 0;        // MFR_ALLOC_* bits of shaders/budget/allocation.h
   float lambdaLow = 0.0f;        // the search's final interval [λ_lo, λ_hi]
   float lambdaHigh = 0.0f;
 };
 
-// The bounds' mode word for F slots over an image with Σn = total, nonEmpty pixels with n > 0 and
-// multi pixels with n > 1 (so Σ max(1, n − 1) = total − multi).
-std::uint32_t allocationMode(std::uint64_t F, std::uint64_t total, std::uint64_t nonEmpty, std::uint64_t multi,
-                             bool exactTail);
+// The bounds of k(p) for F slots over an image with Σn = total, nonEmpty pixels with n > 0 and
+// multi pixels with n > 1 (so Σ max(1, n − 1) = total − multi): the mode word of
+// shaders/budget/allocation.h (MFR_ALLOC_* bits) and S(0) = Σ_p lower(p), where the λ search starts.
+struct AllocationBounds {
+  std::uint32_t mode = 0;
+  std::uint64_t sumAtZero = 0;
+};
+AllocationBounds allocationBounds(std::uint64_t F, std::uint64_t total, std::uint64_t nonEmpty, std::uint64_t multi,
+                                  bool exactTail);
 
 // importance and n have one entry per pixel (any order; the tie-break follows it). Importances
 // that are NaN, negative or below the floor count as the floor. Throws mfr::Error when the sizes

@@ -24,6 +24,12 @@ struct Stats {
   std::vector<std::pair<std::string, double>> passTimesMs;  // per-pass GPU time
   std::vector<std::pair<std::string, std::string>> notes;   // e.g. ("k chosen", "eq. 6 with R_h=0.9")
 
+  // The value of note `key`, or nullptr when the method wrote none.
+  [[nodiscard]] const std::string* note(const std::string& key) const {
+    for (const auto& [k, v] : notes)
+      if (k == key) return &v;
+    return nullptr;
+  }
   [[nodiscard]] double totalTimeMs() const {
     double t = 0;
     for (const auto& p : passTimesMs) t += p.second;
