@@ -2,6 +2,7 @@
 // Subcommands of mfr; each adds itself to the app and runs from its callback.
 #include <CLI/CLI.hpp>
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -17,6 +18,7 @@ void addBench(CLI::App& app);
 void addDataset(CLI::App& app);
 void addTrain(CLI::App& app);
 void addEvaluate(CLI::App& app);
+void addAllocations(CLI::App& app);
 
 // "WxH" → (w, h); throws mfr::Error naming the option.
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);
@@ -33,6 +35,25 @@ std::optional<double> parseNumber(const std::string& text);
 // "name" or "name:key=value:key=value" → request of w×h (a method run with several settings);
 // op=… sets the operation (default "auto"). Throws mfr::Error naming --methods.
 RenderRequest parseMethodSpec(const std::string& spec, int w, int h);
+// A memory budget of mfr evaluate / mfr allocations: "3.5" MiB; "kN" the bytes of a uniform-k
+// k+-buffer with the tail (fkb's layout) at k = N; "fN" the bytes with which the variable-k layout
+// holds N % of the frame's fragments; "eN" N % of Σ max(1, n − 1), the slots after which hybrid
+// transparency is exact everywhere (fN and eN resolved per frame by resolve()).
+struct BudgetSpec {
+  std::string label;
+  double mib = 0.0;
+  double fragmentPercent = 0.0;  // fN, eN
+  bool ofExactSlots = false;     // eN: the percentage is of Σ max(1, n − 1)
+  std::uint64_t bytes = 0;       // kN, fN, eN: the exact byte count (0: mib as the user gave it)
+  // fN, eN: the bytes for a frame with Σn = total and Σ max(1, n − 1) = exactSlots.
+  void resolve(std::uint64_t total, std::uint64_t exactSlots, std::uint64_t pixels);
+  // budget_mib for the methods: exact byte counts half a byte up, so that their floor(MiB · 2^20)
+  // gives back those bytes, not one less (a kN budget must hold k = N).
+  [[nodiscard]] std::string paramText() const;
+  [[nodiscard]] std::uint64_t byteCount() const;
+};
+// Throws mfr::Error naming --budgets.
+BudgetSpec parseBudgetSpec(const std::string& item, std::uint64_t pixels);
 // Median of the values (0 for none).
 double median(std::vector<double> values);
 

@@ -1,8 +1,10 @@
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include "commands.hpp"
+#include "mfr/budget/memory_model.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/render.hpp"
@@ -89,6 +91,59 @@ RenderRequest parseMethodSpec(const std::string& spec, int w, int h) {
     r.params[part.substr(0, eq)] = part.substr(eq + 1);
   }
   return r;
+}
+
+BudgetSpec parseBudgetSpec(const std::string& item, std::uint64_t pixels) {
+  BudgetSpec b;
+  b.label = item;
+  if (!item.empty() && (item[0] == 'f' || item[0] == 'e')) {
+    const std::optional<double> percent = parseNumber(item.substr(1));
+    if (!percent || !(*percent > 0.0) || *percent > 100.0)
+      throw Error("--budgets " + item, item[0] == 'f'
+                                           ? "expected fN with 0 < N <= 100 (% of the frame's fragments)"
+                                           : "expected eN with 0 < N <= 100 (% of the frame's Σ max(1, n − 1))");
+    b.fragmentPercent = *percent;
+    b.ofExactSlots = item[0] == 'e';
+    return b;
+  }
+  if (!item.empty() && item[0] == 'k') {
+    const std::optional<double> k = parseNumber(item.substr(1));
+    if (!k || !(*k >= 1.0) || *k > 256.0)
+      throw Error("--budgets " + item, "expected kN with 1 <= N <= 256 (N may be fractional)");
+    // bytes(k) = P·(8k + y) + z of fkb's layout, also for fractional k (between two uniform k).
+    const KBufferMemoryModel m = kplusArrayMemoryModel(pixels);
+    b.bytes = static_cast<std::uint64_t>(
+        std::ceil(static_cast<double>(m.pixels) * (8.0 * *k + static_cast<double>(m.bytesPerPixel)) +
+                  static_cast<double>(m.fixedBytes)));
+    b.mib = static_cast<double>(b.bytes) / (1024.0 * 1024.0);
+    return b;
+  }
+  const std::optional<double> mib = parseNumber(item);
+  if (!mib || *mib <= 0.0) throw Error("--budgets " + item, "expected MiB (a positive number), kN, fN or eN");
+  b.mib = *mib;
+  return b;
+}
+
+void BudgetSpec::resolve(std::uint64_t total, std::uint64_t exactSlots, std::uint64_t pixels) {
+  if (!(fragmentPercent > 0.0)) return;
+  const double of = static_cast<double>(ofExactSlots ? exactSlots : total);
+  const auto slots = static_cast<std::uint64_t>(std::ceil(fragmentPercent / 100.0 * of));
+  bytes = variableKLayout(pixels).bytes(slots);
+  mib = static_cast<double>(bytes) / (1024.0 * 1024.0);
+}
+
+std::string BudgetSpec::paramText() const {
+  std::ostringstream s;
+  s << std::fixed;
+  if (bytes)
+    s << std::setprecision(10) << (static_cast<double>(bytes) + 0.5) / (1024.0 * 1024.0);
+  else
+    s << std::setprecision(6) << mib;
+  return s.str();
+}
+
+std::uint64_t BudgetSpec::byteCount() const {
+  return bytes ? bytes : static_cast<std::uint64_t>(std::floor(mib * 1024.0 * 1024.0));
 }
 
 }  // namespace mfr::cli

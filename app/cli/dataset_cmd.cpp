@@ -41,7 +41,7 @@ std::vector<double> parseBudgetLevels(const std::string& text) {
 void addDataset(CLI::App& app) {
   struct Options {
     std::vector<std::string> scenes, sizes{"200x150"};
-    std::string views = "iso", budgets = "1,1.25,1.5,2,2.5,3,4,6,all", output, sampleBy = "pixels";
+    std::string views = "iso", budgets = "1,1.25,1.5,2,2.5,3,4,6,all", output, sampleBy = "pixels", labels = "optimal";
     double sample = 0.2, opacity = -1.0;
     std::uint64_t seed = 1;
     bool skipExact = false;
@@ -65,6 +65,11 @@ void addDataset(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::IsMember({"pixels", "deep"}));
   cmd->add_option("--seed", opt->seed, "Random seed of the pixel sampling")->capture_default_str();
+  cmd->add_option("--labels", opt->labels,
+                  "optimal: each pixel's k of optimal-k; class-optimal: optimal-k on the curves averaged over the "
+                  "pixels of equal n(p), the best a network that cannot see which lists have cheap tails can do")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"optimal", "class-optimal"}));
   cmd->add_flag("--skip-exact-budgets", opt->skipExact,
                 "Leave out a frame's budgets of at least sum max(1, n - 1) slots: there the exact-tail bound makes "
                 "every allocation exact, so their labels teach the network nothing");
@@ -87,6 +92,7 @@ void addDataset(CLI::App& app) {
     meta["sample_by"] = opt->sampleBy;
     meta["seed"] = opt->seed;
     meta["skip_exact_budgets"] = opt->skipExact;
+    meta["labels"] = opt->labels;
     nlohmann::ordered_json frames = nlohmann::ordered_json::array();
     std::cout << std::left << std::setw(28) << "scene" << std::setw(16) << "view" << std::setw(9) << "size"
               << std::right << std::setw(10) << "F" << std::setw(10) << "Σn" << std::setw(9) << "rows" << std::setw(12)
@@ -96,10 +102,11 @@ void addDataset(CLI::App& app) {
       for (const std::string& v : views)
         for (const auto& [w, h] : sizes) {
           const FragmentLists lists = castFragments(scenes[s], scenes[s].view(v), w, h);
-          const HybridErrorTable errors = hybridErrorTable(lists, scenes[s].background);
+          HybridErrorTable errors = hybridErrorTable(lists, scenes[s].background);
+          if (opt->labels == "class-optimal") errors = classMeanErrorTable(errors);
           const std::uint64_t nonEmpty = minimumSlots(errors);
           if (nonEmpty == 0) throw Error(opt->scenes[s] + " view " + v, "nothing visible");
-          bool allDone = false;          // levels at or above Σn all mean "every fragment": one frame of those
+          bool allDone = false;  // levels at or above Σn all mean "every fragment": one frame of those
           const std::uint64_t exactSlots = exactHybridSlots(lists);
           for (double level : levels) {
             const std::uint64_t F =

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <span>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -30,45 +31,28 @@ namespace mfr::cli {
 
 namespace {
 
-struct Budget {
-  std::string label;
-  double mib = 0.0;
-  double fragmentPercent = 0.0;  // fN budgets
-  bool ofExactSlots = false;     // eN budgets: the percentage is of Σ max(1, n − 1)
+// Mean k(p) of the pixels whose depth complexity n(p) lies in [lo, hi): where a method puts its
+// slots (--k-by-depth). Buckets grow by about ×1.5 so that deep pixels are not averaged away.
+struct DepthBucket {
+  std::uint32_t lo = 0, hi = 0;  // hi = 0: no upper end
+  std::uint64_t pixels = 0;
+  double sumN = 0.0, sumK = 0.0;
 };
 
-// "3.5" MiB; "kN": the bytes of a uniform-k k+-buffer with the tail (fkb's layout) at k = N;
-// "fN": the bytes with which the variable-k layout holds N % of the frame's fragments; "eN": N % of
-// Σ max(1, n − 1), the slots after which hybrid transparency is exact everywhere (both resolved
-// per frame, mib stays 0 here).
-Budget parseBudget(const std::string& item, std::uint64_t pixels) {
-  Budget b;
-  b.label = item;
-  if (!item.empty() && (item[0] == 'f' || item[0] == 'e')) {
-    const std::optional<double> percent = parseNumber(item.substr(1));
-    if (!percent || !(*percent > 0.0) || *percent > 100.0)
-      throw Error("--budgets " + item, item[0] == 'f'
-                                           ? "expected fN with 0 < N <= 100 (% of the frame's fragments)"
-                                           : "expected eN with 0 < N <= 100 (% of the frame's Σ max(1, n − 1))");
-    b.fragmentPercent = *percent;
-    b.ofExactSlots = item[0] == 'e';
-    return b;
+std::vector<DepthBucket> kByDepth(std::span<const std::uint32_t> n, std::span<const std::uint32_t> k) {
+  static constexpr std::uint32_t kEdges[] = {1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128, 192, 256};
+  std::vector<DepthBucket> buckets;
+  for (std::size_t i = 0; i < std::size(kEdges); ++i)
+    buckets.push_back({kEdges[i], i + 1 < std::size(kEdges) ? kEdges[i + 1] : 0u});
+  if (n.size() != k.size()) throw Error("--k-by-depth", "the k map and the depth complexity differ in size");
+  for (std::size_t p = 0; p < n.size(); ++p) {
+    if (n[p] == 0) continue;
+    auto b = std::upper_bound(std::begin(kEdges), std::end(kEdges), n[p]) - std::begin(kEdges) - 1;
+    buckets[static_cast<std::size_t>(b)].pixels += 1;
+    buckets[static_cast<std::size_t>(b)].sumN += n[p];
+    buckets[static_cast<std::size_t>(b)].sumK += k[p];
   }
-  if (!item.empty() && item[0] == 'k') {
-    const std::optional<double> k = parseNumber(item.substr(1));
-    if (!k || !(*k >= 1.0) || *k > 256.0)
-      throw Error("--budgets " + item, "expected kN with 1 <= N <= 256 (N may be fractional)");
-    // bytes(k) = P·(8k + y) + z of fkb's layout, also for fractional k (between two uniform k).
-    const KBufferMemoryModel m = kplusArrayMemoryModel(pixels);
-    b.mib = (static_cast<double>(m.pixels) * (8.0 * *k + static_cast<double>(m.bytesPerPixel)) +
-             static_cast<double>(m.fixedBytes)) /
-            (1024.0 * 1024.0);
-    return b;
-  }
-  const std::optional<double> mib = parseNumber(item);
-  if (!mib || *mib <= 0.0) throw Error("--budgets " + item, "expected MiB (a positive number) or kN");
-  b.mib = *mib;
-  return b;
+  return buckets;
 }
 
 std::string fixed(double v, int digits) {
@@ -86,6 +70,7 @@ void addEvaluate(CLI::App& app) {
                 json;
     int repeat = 3;
     double opacity = -1.0;
+    bool kByDepth = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -108,11 +93,13 @@ void addEvaluate(CLI::App& app) {
       ->check(CLI::Range(1, 100));
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--json", opt->json, "Write all results as JSON");
+  cmd->add_flag("--k-by-depth", opt->kByDepth,
+                "Also print (and write to the JSON) each method's mean k per depth-complexity class n(p)");
   cmd->callback([opt] {
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-    std::vector<Budget> budgets;
-    for (const std::string& b : splitList(opt->budgets)) budgets.push_back(parseBudget(b, pixels));
+    std::vector<BudgetSpec> budgets;
+    for (const std::string& b : splitList(opt->budgets)) budgets.push_back(parseBudgetSpec(b, pixels));
     if (budgets.empty()) throw Error("--budgets", "no budget given");
     const std::vector<std::string> methods = splitList(opt->methods);
     const std::vector<std::string> known = availableMethods();
@@ -173,17 +160,22 @@ void addEvaluate(CLI::App& app) {
         const ImageRGBA8 gpuExact = gpu.render(camera, exactRequest).image;
         const std::uint64_t total = lists.fragments.size();
         const std::uint64_t exactSlots = exactHybridSlots(lists);
-        for (Budget b : budgets) {
-          if (b.fragmentPercent > 0.0) {
-            const double of = static_cast<double>(b.ofExactSlots ? exactSlots : total);
-            const auto slots = static_cast<std::uint64_t>(std::ceil(b.fragmentPercent / 100.0 * of));
-            b.mib = static_cast<double>(variableKLayout(pixels).bytes(slots)) / (1024.0 * 1024.0);
-          }
+        // --k-by-depth: n(p) of each method's own lists (the GPU's rasterisation, the oracle's rays).
+        std::vector<std::uint32_t> gpuDepth, oracleDepth;
+        if (opt->kByDepth) {
+          gpuDepth = gpu.depthComplexity(camera, w, h);
+          oracleDepth.resize(lists.offsets.size() - 1);
+          for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p)
+            oracleDepth[p] = lists.offsets[p + 1] - lists.offsets[p];
+        }
+        for (BudgetSpec b : budgets) {
+          b.resolve(total, exactSlots, pixels);
           std::vector<std::pair<std::string, double>> flips, rmses;
+          std::vector<std::pair<std::string, std::vector<DepthBucket>>> depthTables;
           for (const std::string& m : methods) {
             RenderRequest req = specs.at(m);
             if (req.operation == "auto") req.operation = "hybrid";
-            req.params["budget_mib"] = fixed(b.mib, 6);
+            req.params["budget_mib"] = b.paramText();
             if (req.method == "dkb" && !opt->weights.empty()) req.params["weights"] = opt->weights;
             const bool cpu = req.method == "optimal-k";
             nlohmann::ordered_json row;
@@ -233,6 +225,24 @@ void addEvaluate(CLI::App& app) {
             nlohmann::ordered_json p = nlohmann::ordered_json::object();
             for (const auto& [pass, ms] : passes) p[pass] = median(ms);
             row["median_pass_ms"] = p;
+            if (opt->kByDepth) {
+              const std::vector<std::uint32_t> k = cpu ? r.kMap : gpu.kMap();
+              if (!k.empty()) {
+                depthTables.emplace_back(m, kByDepth(cpu ? oracleDepth : gpuDepth, k));
+                nlohmann::ordered_json t = nlohmann::ordered_json::array();
+                for (const DepthBucket& d : depthTables.back().second) {
+                  if (d.pixels == 0) continue;
+                  nlohmann::ordered_json entry;
+                  entry["n_min"] = d.lo;
+                  entry["n_below"] = d.hi ? nlohmann::ordered_json(d.hi) : nlohmann::ordered_json();
+                  entry["pixels"] = d.pixels;
+                  entry["mean_n"] = d.sumN / static_cast<double>(d.pixels);
+                  entry["mean_k"] = d.sumK / static_cast<double>(d.pixels);
+                  t.push_back(entry);
+                }
+                row["k_by_depth"] = t;
+              }
+            }
             rows.push_back(row);
             std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12) << v.substr(0, 11)
                       << std::setw(14) << (b.label + " " + fixed(b.mib, 2)) << std::setw(static_cast<int>(methodWidth))
@@ -247,6 +257,23 @@ void addEvaluate(CLI::App& app) {
           }
           countWin(flipWins, flips);
           countWin(rmseWins, rmses);
+          if (!depthTables.empty()) {
+            std::cout << "  mean k by depth complexity n (pixels with that n in each method's own lists):\n";
+            for (std::size_t i = 0; i < depthTables.front().second.size(); ++i) {
+              const DepthBucket& ref = depthTables.front().second[i];
+              bool any = false;
+              for (const auto& [m, t] : depthTables) any = any || t[i].pixels > 0;
+              if (!any) continue;
+              std::cout << "    n " << std::left << std::setw(10)
+                        << ("[" + std::to_string(ref.lo) + ", " + (ref.hi ? std::to_string(ref.hi) : "inf") + ")")
+                        << std::right;
+              for (const auto& [m, t] : depthTables)
+                std::cout << "  " << m << " "
+                          << (t[i].pixels ? fixed(t[i].sumK / static_cast<double>(t[i].pixels), 2) : "-") << " ("
+                          << t[i].pixels << ")";
+              std::cout << "\n";
+            }
+          }
         }
       }
     }

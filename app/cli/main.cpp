@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   mfr::cli::addDataset(app);
   mfr::cli::addTrain(app);
   mfr::cli::addEvaluate(app);
+  mfr::cli::addAllocations(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

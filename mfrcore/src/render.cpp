@@ -108,6 +108,7 @@ RenderOutput renderOptimalK(const Scene& scene, const Camera& camera, const Rend
   s.notes.emplace_back("solver", solver);
   s.notes.emplace_back("error", std::to_string(best.error));
   s.notes.emplace_back("device", "CPU ray casting (CGAL AABB tree)");
+  out.kMap = best.k;
   return out;
 }
 

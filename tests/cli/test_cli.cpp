@@ -9,6 +9,8 @@
 #include <fstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "mfr/image.hpp"
 
 namespace fs = std::filesystem;
@@ -61,9 +63,13 @@ class Cli : public ::testing::Test {
   fs::path dir_;
 };
 
-TEST_F(Cli, MissingFile) { expectCleanFailure("render " + (dir_ / "nope.stl").string(), "nope.stl: no such file"); }
+TEST_F(Cli, MissingFile) {
+  expectCleanFailure("render " + (dir_ / "nope.stl").string(), "nope.stl: no such file");
+}
 
-TEST_F(Cli, DirectoryInsteadOfFile) { expectCleanFailure("render " + dir_.string(), dir_.string()); }
+TEST_F(Cli, DirectoryInsteadOfFile) {
+  expectCleanFailure("render " + dir_.string(), dir_.string());
+}
 
 TEST_F(Cli, TruncatedBinaryStl) {
   // 80-byte header, then a count of 10 triangles but only one present.
@@ -81,7 +87,8 @@ TEST_F(Cli, GarbagePly) {
 }
 
 TEST_F(Cli, JsonSyntaxError) {
-  const fs::path p = file("broken.mfrscene", "{\n  \"objects\": [\n    {\"primitive\": {\"type\": \"sphere\"}\n  ]\n}\n");
+  const fs::path p =
+      file("broken.mfrscene", "{\n  \"objects\": [\n    {\"primitive\": {\"type\": \"sphere\"}\n  ]\n}\n");
   expectCleanFailure("render " + p.string(), "broken.mfrscene: JSON syntax error at line 4");
 }
 
@@ -95,13 +102,21 @@ TEST_F(Cli, UnknownPrimitiveNamesTheJsonPath) {
   expectCleanFailure("render " + p.string(), "objects[0].primitive.type");
 }
 
-TEST_F(Cli, UnknownMethod) { expectCleanFailure("render @sample --method magic", "--method magic: unknown method"); }
+TEST_F(Cli, UnknownMethod) {
+  expectCleanFailure("render @sample --method magic", "--method magic: unknown method");
+}
 
-TEST_F(Cli, ZeroSizeImage) { expectCleanFailure("render @sample --size 0x0", "--size 0x0"); }
+TEST_F(Cli, ZeroSizeImage) {
+  expectCleanFailure("render @sample --size 0x0", "--size 0x0");
+}
 
-TEST_F(Cli, MalformedSize) { expectCleanFailure("render @sample --size big", "--size big"); }
+TEST_F(Cli, MalformedSize) {
+  expectCleanFailure("render @sample --size big", "--size big");
+}
 
-TEST_F(Cli, UnknownView) { expectCleanFailure("render @sample --view nowhere", "view 'nowhere'"); }
+TEST_F(Cli, UnknownView) {
+  expectCleanFailure("render @sample --view nowhere", "view 'nowhere'");
+}
 
 TEST_F(Cli, BadMethodParameter) {
   expectCleanFailure("render @sample --method abuffer-ll -p pool=sometimes", "--param pool=sometimes");
@@ -163,7 +178,8 @@ TEST_F(Cli, InfoReportsTrianglesAndHistogram) {
 // on a tiny image; then their bad input.
 TEST_F(Cli, DatasetTrainRenderEvaluate) {
   const fs::path data = dir_ / "d.bin", weights = dir_ / "w.json", png = dir_ / "dkb.png", json = dir_ / "e.json";
-  Result r = run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,2,all --sample 0.5 -o " + data.string());
+  Result r =
+      run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,2,all --sample 0.5 -o " + data.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_NE(r.out.find(" rows"), std::string::npos) << r.out;
   // --skip-exact-budgets leaves out the frames whose budget makes every allocation exact ("all").
@@ -199,6 +215,90 @@ TEST_F(Cli, DatasetTrainRenderEvaluate) {
   EXPECT_NE(text.find("\"vkb:exact_tail=false\""), std::string::npos);
   EXPECT_NE(text.find("\"e90\""), std::string::npos);
   EXPECT_NE(text.find("\"exact_slots\""), std::string::npos);
+}
+
+// evaluate --k-by-depth: where each method puts its slots, per depth-complexity class. Checked
+// against what the methods' rules say independently of the code that counts: fkb at k2 has
+// capacity two in every pixel; vkb with room for every fragment (1 MiB at 48×36) gives every pixel
+// k = n, so each class's mean k is its mean n.
+TEST_F(Cli, EvaluateKByDepth) {
+  const fs::path json = dir_ / "k.json";
+  const Result r =
+      run("evaluate @sample -s 48x36 --views front --budgets k2,1 -r 1 -m fkb,vkb,optimal-k "
+          "--k-by-depth --json " +
+          json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("mean k by depth complexity"), std::string::npos) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json results = nlohmann::json::parse(in).at("results");
+  int checked = 0;
+  for (const nlohmann::json& row : results) {
+    ASSERT_TRUE(row.contains("k_by_depth")) << row.dump();
+    const std::string method = row.at("method"), budget = row.at("budget");
+    std::uint64_t pixels = 0;
+    for (const nlohmann::json& b : row.at("k_by_depth")) {
+      const double n = b.at("mean_n"), k = b.at("mean_k");
+      pixels += b.at("pixels").get<std::uint64_t>();
+      EXPECT_GE(n, b.at("n_min").get<double>());
+      EXPECT_GE(k, 1.0 - 1e-12) << method << " " << budget;
+      if (method != "fkb") {
+        EXPECT_LE(k, n + 1e-12) << method << " " << budget;
+      }
+      if (method == "fkb" && budget == "k2") {
+        EXPECT_DOUBLE_EQ(k, 2.0) << b.dump();
+      }
+      if (method == "vkb" && budget == "1") {
+        EXPECT_NEAR(k, n, 1e-9) << b.dump();
+      }
+      ++checked;
+    }
+    EXPECT_GT(pixels, 0u) << method;
+  }
+  EXPECT_EQ(results.size(), 6u);
+  EXPECT_GT(checked, 12);
+}
+
+// allocations: four allocations at one F on the oracle's lists. Each holds at most F slots (and
+// the rule-based ones exactly F, the budget used up); optimal-k's eq. 2 error is the least; the
+// cut counts are consistent with each other; RMSE 0 and error 0 when F holds every fragment.
+TEST_F(Cli, AllocationsCompareAtOneBudget) {
+  const fs::path json = dir_ / "a.json";
+  const Result r =
+      run("allocations @sample -s 48x36 --views front,orbit:30:20 --budgets k2,e80,1 --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json results = nlohmann::json::parse(in).at("results");
+  ASSERT_EQ(results.size(), 6u) << r.out;
+  for (const nlohmann::json& row : results) {
+    const std::uint64_t F = row.at("budget_slots"), total = row.at("fragments_total");
+    const double best = row.at("optimal-k").at("eq2_error");
+    for (const char* m : {"dkb", "flat", "class-optimal", "optimal-k"}) {
+      const nlohmann::json& a = row.at(m);
+      EXPECT_LE(a.at("slots").get<std::uint64_t>(), F) << m;
+      if (std::string(m) == "dkb" || std::string(m) == "flat") {
+        EXPECT_EQ(a.at("slots").get<std::uint64_t>(), std::min(F, total)) << m;
+      }
+      EXPECT_GE(a.at("eq2_error").get<double>(), best - 1e-12) << m << " " << row.dump();
+      if (F >= total) {
+        EXPECT_LT(a.at("eq2_error").get<double>(), 1e-9) << m;
+        EXPECT_LT(a.at("rmse").get<double>(), 1e-9) << m;
+      }
+    }
+    const nlohmann::json& c = row.at("cuts");
+    EXPECT_LE(c.at("dkb_and_optimal_k"),
+              std::min(c.at("dkb").get<std::uint64_t>(), c.at("optimal_k").get<std::uint64_t>()));
+    EXPECT_LE(c.at("optimal_k"), c.at("lists"));
+  }
+  for (const auto& [args, mention] : std::vector<std::pair<std::string, std::string>>{
+           {"@sample -s 16x16 --budgets k0", "--budgets k0"},
+           {(dir_ / "missing.ply").string(), "missing.ply"},
+           {"@sample -s 16x16 --weights " + (dir_ / "none.json").string(), "none.json"}}) {
+    const Result bad = run("allocations " + args + " --json " + (dir_ / "bad.json").string());
+    EXPECT_EQ(bad.exitCode, 1) << bad.out;
+    EXPECT_EQ(std::count(bad.out.begin(), bad.out.end(), '\n'), 1) << bad.out;
+    EXPECT_NE(bad.out.find(mention), std::string::npos) << bad.out;
+    EXPECT_FALSE(fs::exists(dir_ / "bad.json"));
+  }
 }
 
 TEST_F(Cli, BudgetCommandsBadInput) {

@@ -2,6 +2,7 @@
 // One entry point from a scene and settings to an image and Stats, shared by the CLI and the
 // viewer so that both produce the same pixels. "oracle" is the exact CPU reference; every other
 // name is a GPU method from the registry (methods/registry.hpp).
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -24,6 +25,9 @@ struct RenderRequest {
 struct RenderOutput {
   ImageRGBA8 image;
   Stats stats;
+  // optimal-k only: its k(p), indexed like the oracle's lists (FragmentLists::index). The GPU
+  // methods' k(p) comes from GpuRenderer::kMap().
+  std::vector<std::uint32_t> kMap;
 };
 
 // Throws mfr::Error for an unknown method or operation, a bad size or an empty scene.

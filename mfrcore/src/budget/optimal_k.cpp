@@ -4,6 +4,7 @@
 #include "mfr/budget/optimal_k.hpp"
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -21,7 +22,9 @@ namespace mfr {
 
 namespace {
 
-std::uint32_t listLength(const std::vector<double>& e) { return static_cast<std::uint32_t>(e.size() - 1); }
+std::uint32_t listLength(const std::vector<double>& e) {
+  return static_cast<std::uint32_t>(e.size() - 1);
+}
 
 void checkBudget(const HybridErrorTable& errors, std::uint64_t budget) {
   for (const auto& e : errors)
@@ -90,6 +93,22 @@ double allocationError(const HybridErrorTable& errors, const std::vector<std::ui
   double sum = 0.0;
   for (std::size_t p = 0; p < errors.size(); ++p) sum += errors[p][k[p]];
   return sum;
+}
+
+HybridErrorTable classMeanErrorTable(const HybridErrorTable& errors) {
+  std::map<std::size_t, std::pair<std::vector<double>, std::size_t>> classes;  // n + 1 → (Σ curves, pixels)
+  for (const std::vector<double>& e : errors) {
+    auto& [sum, count] = classes[e.size()];
+    if (sum.empty()) sum.assign(e.size(), 0.0);
+    for (std::size_t k = 0; k < e.size(); ++k) sum[k] += e[k];
+    ++count;
+  }
+  for (auto& [size, c] : classes)
+    for (double& v : c.first) v /= static_cast<double>(c.second);
+  HybridErrorTable out;
+  out.reserve(errors.size());
+  for (const std::vector<double>& e : errors) out.push_back(classes.at(e.size()).first);
+  return out;
 }
 
 KAllocation optimalKGreedy(const HybridErrorTable& errors, std::uint64_t budget) {

@@ -45,6 +45,12 @@ std::uint64_t minimumSlots(const HybridErrorTable& errors);
 // Total error of an allocation (k.size() must equal errors.size()).
 double allocationError(const HybridErrorTable& errors, const std::vector<std::uint32_t>& k);
 
+// The table with each pixel's curve replaced by the mean curve of all pixels of the same depth
+// complexity n(p): what an allocation can know of a pixel that sees only n(p), not its colours.
+// optimalKBest on it is the best allocation that treats pixels of equal n alike in expectation —
+// the training labels of `mfr dataset --labels class-optimal` (docs/methods.md, "dkb training data").
+HybridErrorTable classMeanErrorTable(const HybridErrorTable& errors);
+
 // Each throws mfr::Error("budget F", …) when budget < minimumSlots(errors); a budget ≥ Σ n(p)
 // gives k = n everywhere (error 0).
 KAllocation optimalKGreedy(const HybridErrorTable& errors, std::uint64_t budget);
