@@ -3,7 +3,9 @@
 // scene, view and budget: dkb's network (on the CPU, the same features, weights and rule as on
 // the GPU), a flat importance under the same rule (water-filling), the optimum for each
 // depth-complexity class's mean error curve (class-optimal: the best any allocation that tells
-// pixels apart only by n(p) can expect), and optimal-k. Printed: Σk, the deep hybrid OIT paper's
+// pixels apart only by n(p) can expect), the same with each class split by whether the two
+// farthest fragments share a colour (class-optimal+tail: what one more bit per pixel is worth),
+// and optimal-k. Printed: Σk, the deep hybrid OIT paper's
 // eq. 2 error Σ_p e_p(k(p)), RMSE and mean FLIP against the oracle's exact image; then how well
 // dkb picks the lists to cut: of the pixels it gives fewer than max(1, n − 1) slots, the share that
 // optimal-k cuts too, against optimal-k's share among all (equal shares = chance).
@@ -66,6 +68,14 @@ void addAllocations(CLI::App& app) {
         const ImageRGBA8 exact = compositeOver(lists, scenes[s].background);
         const HybridErrorTable errors = hybridErrorTable(lists, scenes[s].background);
         const HybridErrorTable classes = classMeanErrorTable(errors);
+        // The same, with each depth class split by whether the two farthest fragments have one
+        // colour: then a two-fragment tail is exact, the cheapest cut there is.
+        std::vector<std::uint32_t> lastTwoEqual(pixels, 0u);
+        for (std::size_t p = 0; p < pixels; ++p)
+          if (lists.offsets[p + 1] - lists.offsets[p] >= 2)
+            lastTwoEqual[p] =
+                lists.fragments[lists.offsets[p + 1] - 1].color == lists.fragments[lists.offsets[p + 1] - 2].color;
+        const HybridErrorTable classesByTail = classMeanErrorTable(errors, lastTwoEqual);
         const DkbImageStats stats = dkbImageStats(lists);
         std::vector<std::uint32_t> n(pixels);
         for (std::size_t p = 0; p < pixels; ++p) n[p] = lists.offsets[p + 1] - lists.offsets[p];
@@ -92,6 +102,7 @@ void addAllocations(CLI::App& app) {
               {"dkb", allocateKFromImportance(importance, n, F).k},
               {"flat", allocateKFromImportance(std::vector<float>(pixels, 1.0f), n, F).k},
               {"class-optimal", optimalKBest(classes, F).k},
+              {"class-optimal+tail", optimalKBest(classesByTail, F).k},
               {"optimal-k", optimalKBest(errors, F).k}};
           nlohmann::ordered_json row;
           row["scene"] = opt->scenes[s];
@@ -105,7 +116,7 @@ void addAllocations(CLI::App& app) {
             for (std::uint32_t x : k) sum += x;
             const ImageRGBA8 image = compositeHybrid(lists, k, scenes[s].background);
             const double e = allocationError(errors, k), r = rmse(exact, image), f = flip(exact, image).stats.mean;
-            std::cout << "  " << std::left << std::setw(15) << name << std::right << " slots " << std::setw(9) << sum
+            std::cout << "  " << std::left << std::setw(19) << name << std::right << " slots " << std::setw(9) << sum
                       << "  eq. 2 error " << std::scientific << std::setprecision(4) << e << std::fixed
                       << std::setprecision(5) << "  RMSE " << r << "  FLIP " << f << "\n";
             row[name] = {{"slots", sum}, {"eq2_error", e}, {"rmse", r}, {"flip_mean", f}};

@@ -322,6 +322,14 @@ TEST(OptimalK, ClassMeanErrorTable) {
       EXPECT_NEAR(mean[p][k], expected[p][k], 1e-12) << p << "," << k;
   }
 
+  // Groups split the classes: pixels 2 and 3 (both n = 2) in different groups keep their own curves.
+  const std::vector<std::uint32_t> group = {0, 0, 1, 2, 0, 0};
+  const mfr::HybridErrorTable split = mfr::classMeanErrorTable(table, group);
+  for (std::size_t p : {2u, 3u})
+    for (std::size_t k = 0; k < table[p].size(); ++k) EXPECT_DOUBLE_EQ(split[p][k], table[p][k]) << p;
+  EXPECT_NEAR(split[1][0], 0.3, 1e-12);
+  EXPECT_THROW((void)mfr::classMeanErrorTable(table, std::vector<std::uint32_t>{0, 1}), mfr::Error);
+
   const mfr::Scene scene = mfr::makeSampleScene();
   const mfr::FragmentLists lists = mfr::castFragments(scene, scene.view("front"), 40, 30);
   const mfr::HybridErrorTable errors = mfr::hybridErrorTable(lists, scene.background);

@@ -95,19 +95,24 @@ double allocationError(const HybridErrorTable& errors, const std::vector<std::ui
   return sum;
 }
 
-HybridErrorTable classMeanErrorTable(const HybridErrorTable& errors) {
-  std::map<std::size_t, std::pair<std::vector<double>, std::size_t>> classes;  // n + 1 → (Σ curves, pixels)
-  for (const std::vector<double>& e : errors) {
-    auto& [sum, count] = classes[e.size()];
-    if (sum.empty()) sum.assign(e.size(), 0.0);
-    for (std::size_t k = 0; k < e.size(); ++k) sum[k] += e[k];
+HybridErrorTable classMeanErrorTable(const HybridErrorTable& errors, std::span<const std::uint32_t> group) {
+  if (!group.empty() && group.size() != errors.size())
+    throw Error("class mean error table",
+                std::to_string(group.size()) + " groups for " + std::to_string(errors.size()) + " pixels");
+  // (n + 1, group) → (Σ curves, pixels)
+  std::map<std::pair<std::size_t, std::uint32_t>, std::pair<std::vector<double>, std::size_t>> classes;
+  auto key = [&](std::size_t p) { return std::make_pair(errors[p].size(), group.empty() ? 0u : group[p]); };
+  for (std::size_t p = 0; p < errors.size(); ++p) {
+    auto& [sum, count] = classes[key(p)];
+    if (sum.empty()) sum.assign(errors[p].size(), 0.0);
+    for (std::size_t k = 0; k < errors[p].size(); ++k) sum[k] += errors[p][k];
     ++count;
   }
   for (auto& [size, c] : classes)
     for (double& v : c.first) v /= static_cast<double>(c.second);
   HybridErrorTable out;
   out.reserve(errors.size());
-  for (const std::vector<double>& e : errors) out.push_back(classes.at(e.size()).first);
+  for (std::size_t p = 0; p < errors.size(); ++p) out.push_back(classes.at(key(p)).first);
   return out;
 }
 

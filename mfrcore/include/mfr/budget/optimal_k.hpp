@@ -19,6 +19,7 @@
 //               (mfr render --method optimal-k, the training labels of mfr dataset).
 //   exhaustive  every k vector; tiny cases (tests).
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -49,7 +50,10 @@ double allocationError(const HybridErrorTable& errors, const std::vector<std::ui
 // complexity n(p): what an allocation can know of a pixel that sees only n(p), not its colours.
 // optimalKBest on it is the best allocation that treats pixels of equal n alike in expectation —
 // the training labels of `mfr dataset --labels class-optimal` (docs/methods.md, "dkb training data").
-HybridErrorTable classMeanErrorTable(const HybridErrorTable& errors);
+// group (optional, one entry per pixel) splits the classes further: pixels are alike when both
+// n(p) and group[p] agree (mfr allocations groups by whether the two farthest fragments share a
+// colour). Throws mfr::Error when group has another size than errors.
+HybridErrorTable classMeanErrorTable(const HybridErrorTable& errors, std::span<const std::uint32_t> group = {});
 
 // Each throws mfr::Error("budget F", …) when budget < minimumSlots(errors); a budget ≥ Σ n(p)
 // gives k = n everywhere (error 0).
