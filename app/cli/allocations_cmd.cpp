@@ -5,7 +5,8 @@
 // depth-complexity class's mean error curve (class-optimal: the best any allocation that tells
 // pixels apart only by n(p) can expect), the same with each class split by whether the two
 // farthest fragments share a colour (class-optimal+tail: what one more bit per pixel is worth),
-// and optimal-k. Printed: Σk, the deep hybrid OIT paper's
+// a flat allocation under a tighter exact-tail bound, max(1, n − m) for a final run of m fragments
+// of one RGBA (flat+runs), and optimal-k. Printed: Σk, the deep hybrid OIT paper's
 // eq. 2 error Σ_p e_p(k(p)), RMSE and mean FLIP against the oracle's exact image; then how well
 // dkb picks the lists to cut: of the pixels it gives fewer than max(1, n − 1) slots, the share that
 // optimal-k cuts too, against optimal-k's share among all (equal shares = chance).
@@ -30,6 +31,38 @@
 #include "mfr/reference/oracle.hpp"
 
 namespace mfr::cli {
+
+namespace {
+
+// Water-filling under per-pixel caps: k(p) = min(cap(p), K) (at least 1) for the largest K that
+// fits F, the slots left one each to the first pixels in pixel order that can take one more.
+// Analysis only: how a flat allocation would do under a tighter exact-tail bound.
+std::vector<std::uint32_t> waterFill(std::span<const std::uint32_t> cap, std::uint64_t F) {
+  auto sumAt = [&](std::uint32_t K) {
+    std::uint64_t s = 0;
+    for (std::uint32_t c : cap) s += std::min(c, K);
+    return s;
+  };
+  std::uint32_t lo = 1, hi = 1;
+  for (std::uint32_t c : cap) hi = std::max(hi, c + 1);
+  if (sumAt(hi) <= F) return {cap.begin(), cap.end()};
+  while (hi - lo > 1) {  // sumAt(lo) <= F < sumAt(hi)
+    const std::uint32_t mid = lo + (hi - lo) / 2;
+    (sumAt(mid) <= F ? lo : hi) = mid;
+  }
+  std::uint64_t left = F - sumAt(lo);
+  std::vector<std::uint32_t> k(cap.size());
+  for (std::size_t p = 0; p < cap.size(); ++p) {
+    k[p] = std::min(cap[p], lo);
+    if (left > 0 && cap[p] > lo) {
+      ++k[p];
+      --left;
+    }
+  }
+  return k;
+}
+
+}  // namespace
 
 void addAllocations(CLI::App& app) {
   struct Options {
@@ -76,6 +109,17 @@ void addAllocations(CLI::App& app) {
             lastTwoEqual[p] =
                 lists.fragments[lists.offsets[p + 1] - 1].color == lists.fragments[lists.offsets[p + 1] - 2].color;
         const HybridErrorTable classesByTail = classMeanErrorTable(errors, lastTwoEqual);
+        // A tail of m fragments of one RGBA is composited exactly, so the exact-tail bound could be
+        // max(1, n − m) for the final run of m equal fragments (today m = 1): flat+runs.
+        std::vector<std::uint32_t> runCap(pixels, 0u);
+        for (std::size_t p = 0; p < pixels; ++p) {
+          const std::uint32_t count = lists.offsets[p + 1] - lists.offsets[p];
+          if (count == 0) continue;
+          const std::uint32_t last = lists.fragments[lists.offsets[p + 1] - 1].color;
+          std::uint32_t m = 1;
+          while (m < count && lists.fragments[lists.offsets[p + 1] - 1 - m].color == last) ++m;
+          runCap[p] = std::max(1u, count - m);
+        }
         const DkbImageStats stats = dkbImageStats(lists);
         std::vector<std::uint32_t> n(pixels);
         for (std::size_t p = 0; p < pixels; ++p) n[p] = lists.offsets[p + 1] - lists.offsets[p];
@@ -101,6 +145,7 @@ void addAllocations(CLI::App& app) {
           const std::vector<std::pair<std::string, std::vector<std::uint32_t>>> allocations = {
               {"dkb", allocateKFromImportance(importance, n, F).k},
               {"flat", allocateKFromImportance(std::vector<float>(pixels, 1.0f), n, F).k},
+              {"flat+runs", waterFill(runCap, F)},
               {"class-optimal", optimalKBest(classes, F).k},
               {"class-optimal+tail", optimalKBest(classesByTail, F).k},
               {"optimal-k", optimalKBest(errors, F).k}};
