@@ -86,9 +86,7 @@ void addAllocations(CLI::App& app) {
   cmd->callback([opt] {
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-    std::vector<BudgetSpec> budgets;
-    for (const std::string& b : splitList(opt->budgets)) budgets.push_back(parseBudgetSpec(b, pixels));
-    if (budgets.empty()) throw Error("--budgets", "no budget given");
+    const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
     const NeuralImportanceModel model = loadNeuralImportance(opt->weights).quantised();  // as on the GPU
     const std::vector<std::string> views = splitList(opt->views);
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
@@ -100,30 +98,25 @@ void addAllocations(CLI::App& app) {
         const FragmentLists lists = castFragments(scenes[s], scenes[s].view(v), w, h);
         const ImageRGBA8 exact = compositeOver(lists, scenes[s].background);
         const HybridErrorTable errors = hybridErrorTable(lists, scenes[s].background);
-        const HybridErrorTable classes = classMeanErrorTable(errors);
-        // The same, with each depth class split by whether the two farthest fragments have one
-        // colour: then a two-fragment tail is exact, the cheapest cut there is.
-        std::vector<std::uint32_t> lastTwoEqual(pixels, 0u);
-        for (std::size_t p = 0; p < pixels; ++p)
-          if (lists.offsets[p + 1] - lists.offsets[p] >= 2)
-            lastTwoEqual[p] =
-                lists.fragments[lists.offsets[p + 1] - 1].color == lists.fragments[lists.offsets[p + 1] - 2].color;
-        const HybridErrorTable classesByTail = classMeanErrorTable(errors, lastTwoEqual);
-        // A tail of m fragments of one RGBA is composited exactly, so the exact-tail bound could be
-        // max(1, n − m) for the final run of m equal fragments (today m = 1): flat+runs.
-        std::vector<std::uint32_t> runCap(pixels, 0u);
+        const std::vector<std::uint32_t> n = lists.counts();
+        // m(p): the final run of fragments of one RGBA, whose tail hybrid transparency composites
+        // exactly. The exact-tail bound could be max(1, n − m) (today m = 1): flat+runs. The
+        // depth classes split by m ≥ 2 (the two farthest fragments share a colour, so a two-fragment
+        // tail is exact, the cheapest cut there is): class-optimal+tail.
+        std::vector<std::uint32_t> runCap(pixels, 0u), lastTwoEqual(pixels, 0u);
         for (std::size_t p = 0; p < pixels; ++p) {
-          const std::uint32_t count = lists.offsets[p + 1] - lists.offsets[p];
-          if (count == 0) continue;
-          const std::uint32_t last = lists.fragments[lists.offsets[p + 1] - 1].color;
+          const std::span<const Fragment> list = lists.pixel(p);
+          if (list.empty()) continue;
           std::uint32_t m = 1;
-          while (m < count && lists.fragments[lists.offsets[p + 1] - 1 - m].color == last) ++m;
-          runCap[p] = std::max(1u, count - m);
+          while (m < n[p] && list[n[p] - 1 - m].color == list.back().color) ++m;
+          runCap[p] = std::max(1u, n[p] - m);
+          lastTwoEqual[p] = m >= 2 ? 1u : 0u;
         }
+        const HybridErrorTable classes = classMeanErrorTable(errors);
+        const HybridErrorTable classesByTail = classMeanErrorTable(errors, lastTwoEqual);
         const DkbImageStats stats = dkbImageStats(lists);
-        std::vector<std::uint32_t> n(pixels);
-        for (std::size_t p = 0; p < pixels; ++p) n[p] = lists.offsets[p + 1] - lists.offsets[p];
         const std::uint64_t total = lists.fragments.size(), exactSlots = exactHybridSlots(lists);
+        const std::uint64_t nonEmpty = minimumSlots(errors);
         for (BudgetSpec b : budgets) {
           b.resolve(total, exactSlots, pixels);
           const std::uint64_t F = std::min<std::uint64_t>(layout.slotBudget(b.byteCount()), total);
@@ -131,24 +124,22 @@ void addAllocations(CLI::App& app) {
                     << std::setprecision(1) << 100.0 * static_cast<double>(F) / static_cast<double>(total)
                     << " % of Σn, " << 100.0 * static_cast<double>(F) / static_cast<double>(exactSlots)
                     << " % of Σ max(1, n − 1))\n";
-          if (F < minimumSlots(errors)) {
-            std::cout << "  fewer slots than non-empty pixels (" << minimumSlots(errors) << "): skipped\n";
+          if (F < nonEmpty) {
+            std::cout << "  fewer slots than non-empty pixels (" << nonEmpty << "): skipped\n";
             continue;
           }
           std::vector<float> importance(pixels, 0.0f);
           for (std::size_t p = 0; p < pixels; ++p)
-            if (n[p] > 0)
-              importance[p] = neuralImportance(
-                  model,
-                  dkbFeatures(std::span<const Fragment>(lists.fragments.data() + lists.offsets[p], n[p]), stats, F),
-                  n[p]);
+            if (n[p] > 0) importance[p] = neuralImportance(model, dkbFeatures(lists.pixel(p), stats, F), n[p]);
+          const std::vector<std::uint32_t> kd = allocateKFromImportance(importance, n, F).k;
+          const std::vector<std::uint32_t> ko = optimalKBest(errors, F).k;
           const std::vector<std::pair<std::string, std::vector<std::uint32_t>>> allocations = {
-              {"dkb", allocateKFromImportance(importance, n, F).k},
+              {"dkb", kd},
               {"flat", allocateKFromImportance(std::vector<float>(pixels, 1.0f), n, F).k},
               {"flat+runs", waterFill(runCap, F)},
               {"class-optimal", optimalKBest(classes, F).k},
               {"class-optimal+tail", optimalKBest(classesByTail, F).k},
-              {"optimal-k", optimalKBest(errors, F).k}};
+              {"optimal-k", ko}};
           nlohmann::ordered_json row;
           row["scene"] = opt->scenes[s];
           row["view"] = v;
@@ -168,8 +159,6 @@ void addAllocations(CLI::App& app) {
           }
           // Which lists dkb cuts below max(1, n − 1), against optimal-k's (pixels with n ≥ 3: n = 2
           // cannot be cut once every pixel holds one slot).
-          const std::vector<std::uint32_t>& kd = allocations.front().second;
-          const std::vector<std::uint32_t>& ko = allocations.back().second;
           std::uint64_t lists3 = 0, dkbCuts = 0, optimalCuts = 0, both = 0;
           for (std::size_t p = 0; p < pixels; ++p) {
             if (n[p] < 3) continue;

@@ -54,6 +54,8 @@ struct BudgetSpec {
 };
 // Throws mfr::Error naming --budgets.
 BudgetSpec parseBudgetSpec(const std::string& item, std::uint64_t pixels);
+// The comma-separated list of --budgets; throws mfr::Error for a bad item or an empty list.
+std::vector<BudgetSpec> parseBudgetSpecs(const std::string& text, std::uint64_t pixels);
 // Median of the values (0 for none).
 double median(std::vector<double> values);
 

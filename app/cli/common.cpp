@@ -124,6 +124,13 @@ BudgetSpec parseBudgetSpec(const std::string& item, std::uint64_t pixels) {
   return b;
 }
 
+std::vector<BudgetSpec> parseBudgetSpecs(const std::string& text, std::uint64_t pixels) {
+  std::vector<BudgetSpec> budgets;
+  for (const std::string& b : splitList(text)) budgets.push_back(parseBudgetSpec(b, pixels));
+  if (budgets.empty()) throw Error("--budgets", "no budget given");
+  return budgets;
+}
+
 void BudgetSpec::resolve(std::uint64_t total, std::uint64_t exactSlots, std::uint64_t pixels) {
   if (!(fragmentPercent > 0.0)) return;
   const double of = static_cast<double>(ofExactSlots ? exactSlots : total);

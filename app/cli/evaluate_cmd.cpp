@@ -61,6 +61,38 @@ std::string fixed(double v, int digits) {
   return s.str();
 }
 
+// The non-empty classes of one method as JSON rows (k_by_depth).
+nlohmann::ordered_json depthTableJson(const std::vector<DepthBucket>& buckets) {
+  nlohmann::ordered_json t = nlohmann::ordered_json::array();
+  for (const DepthBucket& d : buckets) {
+    if (d.pixels == 0) continue;
+    nlohmann::ordered_json entry;
+    entry["n_min"] = d.lo;
+    entry["n_below"] = d.hi ? nlohmann::ordered_json(d.hi) : nlohmann::ordered_json();
+    entry["pixels"] = d.pixels;
+    entry["mean_n"] = d.sumN / static_cast<double>(d.pixels);
+    entry["mean_k"] = d.sumK / static_cast<double>(d.pixels);
+    t.push_back(entry);
+  }
+  return t;
+}
+
+// One line per class that any method has pixels in: each method's mean k and pixel count.
+void printDepthTables(const std::vector<std::pair<std::string, std::vector<DepthBucket>>>& tables) {
+  std::cout << "  mean k by depth complexity n (pixels with that n in each method's own lists):\n";
+  for (std::size_t i = 0; i < tables.front().second.size(); ++i) {
+    const bool any = std::any_of(tables.begin(), tables.end(), [i](const auto& t) { return t.second[i].pixels > 0; });
+    if (!any) continue;
+    const DepthBucket& ref = tables.front().second[i];
+    std::cout << "    n " << std::left << std::setw(10)
+              << ("[" + std::to_string(ref.lo) + ", " + (ref.hi ? std::to_string(ref.hi) : "inf") + ")") << std::right;
+    for (const auto& [m, t] : tables)
+      std::cout << "  " << m << " " << (t[i].pixels ? fixed(t[i].sumK / static_cast<double>(t[i].pixels), 2) : "-")
+                << " (" << t[i].pixels << ")";
+    std::cout << "\n";
+  }
+}
+
 }  // namespace
 
 void addEvaluate(CLI::App& app) {
@@ -98,9 +130,7 @@ void addEvaluate(CLI::App& app) {
   cmd->callback([opt] {
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-    std::vector<BudgetSpec> budgets;
-    for (const std::string& b : splitList(opt->budgets)) budgets.push_back(parseBudgetSpec(b, pixels));
-    if (budgets.empty()) throw Error("--budgets", "no budget given");
+    const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
     const std::vector<std::string> methods = splitList(opt->methods);
     const std::vector<std::string> known = availableMethods();
     std::map<std::string, RenderRequest> specs;  // each method spec's request, without size and budget
@@ -164,9 +194,7 @@ void addEvaluate(CLI::App& app) {
         std::vector<std::uint32_t> gpuDepth, oracleDepth;
         if (opt->kByDepth) {
           gpuDepth = gpu.depthComplexity(camera, w, h);
-          oracleDepth.resize(lists.offsets.size() - 1);
-          for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p)
-            oracleDepth[p] = lists.offsets[p + 1] - lists.offsets[p];
+          oracleDepth = lists.counts();
         }
         for (BudgetSpec b : budgets) {
           b.resolve(total, exactSlots, pixels);
@@ -229,18 +257,7 @@ void addEvaluate(CLI::App& app) {
               const std::vector<std::uint32_t> k = cpu ? r.kMap : gpu.kMap();
               if (!k.empty()) {
                 depthTables.emplace_back(m, kByDepth(cpu ? oracleDepth : gpuDepth, k));
-                nlohmann::ordered_json t = nlohmann::ordered_json::array();
-                for (const DepthBucket& d : depthTables.back().second) {
-                  if (d.pixels == 0) continue;
-                  nlohmann::ordered_json entry;
-                  entry["n_min"] = d.lo;
-                  entry["n_below"] = d.hi ? nlohmann::ordered_json(d.hi) : nlohmann::ordered_json();
-                  entry["pixels"] = d.pixels;
-                  entry["mean_n"] = d.sumN / static_cast<double>(d.pixels);
-                  entry["mean_k"] = d.sumK / static_cast<double>(d.pixels);
-                  t.push_back(entry);
-                }
-                row["k_by_depth"] = t;
+                row["k_by_depth"] = depthTableJson(depthTables.back().second);
               }
             }
             rows.push_back(row);
@@ -257,23 +274,7 @@ void addEvaluate(CLI::App& app) {
           }
           countWin(flipWins, flips);
           countWin(rmseWins, rmses);
-          if (!depthTables.empty()) {
-            std::cout << "  mean k by depth complexity n (pixels with that n in each method's own lists):\n";
-            for (std::size_t i = 0; i < depthTables.front().second.size(); ++i) {
-              const DepthBucket& ref = depthTables.front().second[i];
-              bool any = false;
-              for (const auto& [m, t] : depthTables) any = any || t[i].pixels > 0;
-              if (!any) continue;
-              std::cout << "    n " << std::left << std::setw(10)
-                        << ("[" + std::to_string(ref.lo) + ", " + (ref.hi ? std::to_string(ref.hi) : "inf") + ")")
-                        << std::right;
-              for (const auto& [m, t] : depthTables)
-                std::cout << "  " << m << " "
-                          << (t[i].pixels ? fixed(t[i].sumK / static_cast<double>(t[i].pixels), 2) : "-") << " ("
-                          << t[i].pixels << ")";
-              std::cout << "\n";
-            }
-          }
+          if (!depthTables.empty()) printDepthTables(depthTables);
         }
       }
     }

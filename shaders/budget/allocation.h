@@ -4,7 +4,7 @@
 // The allocation rule from per-pixel importance I(p) to k(p), shared verbatim by the GPU passes
 // (shaders/budget/alloc_*.comp) and the C++ reference (mfrcore/src/budget/k_allocation.cpp):
 //   k_λ(p) = clamp(floor(λ·I(p)), lower(p), upper(p))   (0 where n(p) = 0)
-// with the bounds set once per frame by a mode word (mfr::allocationMode in budget/k_allocation.hpp):
+// with the bounds set once per frame by a mode word (mfr::allocationBounds in mfr/budget/k_allocation.hpp):
 //   lower = 1 (MFR_ALLOC_FLOOR_ONE: F holds one slot per non-empty pixel) or 0;
 //   upper = max(1, n − 1) (MFR_ALLOC_CAP_TAIL) or n. Hybrid transparency composites a tail of
 //     one fragment exactly (τ = 1 − α, colour = the fragment's), so the n-th slot buys nothing

@@ -4,9 +4,9 @@
 #include "mfr/budget/optimal_k.hpp"
 
 #include <algorithm>
-#include <map>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 #include <queue>
 #include <string>

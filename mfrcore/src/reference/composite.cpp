@@ -9,6 +9,12 @@
 
 namespace mfr {
 
+std::vector<std::uint32_t> FragmentLists::counts() const {
+  std::vector<std::uint32_t> n(offsets.empty() ? 0 : offsets.size() - 1);
+  for (std::size_t i = 0; i < n.size(); ++i) n[i] = offsets[i + 1] - offsets[i];
+  return n;
+}
+
 std::uint32_t FragmentLists::maxCount() const {
   std::uint32_t m = 0;
   for (std::size_t i = 0; i + 1 < offsets.size(); ++i) m = std::max(m, offsets[i + 1] - offsets[i]);

@@ -13,8 +13,8 @@ namespace mfr {
 
 // A fragment as the GPU methods store it, plus what operations beyond OIT need.
 struct Fragment {
-  float depth = 0.0f;        // window depth in [0,1] (gl_FragCoord.z)
-  std::uint32_t color = 0;   // shaded RGBA, packed like GLSL packUnorm4x8 (R in the low byte)
+  float depth = 0.0f;       // window depth in [0,1] (gl_FragCoord.z)
+  std::uint32_t color = 0;  // shaded RGBA, packed like GLSL packUnorm4x8 (R in the low byte)
   std::uint32_t objectId = 0;
   bool frontFacing = false;  // counter-clockwise in window space, like gl_FrontFacing
 };
@@ -50,6 +50,12 @@ struct FragmentLists {
     const std::size_t i = index(x, y);
     return offsets[i + 1] - offsets[i];
   }
+  // The same by pixel index (index(x, y)).
+  [[nodiscard]] std::span<const Fragment> pixel(std::size_t i) const {
+    return {fragments.data() + offsets[i], fragments.data() + offsets[i + 1]};
+  }
+  // n(p) of every pixel, in index order.
+  [[nodiscard]] std::vector<std::uint32_t> counts() const;
   [[nodiscard]] std::uint32_t maxCount() const;
   [[nodiscard]] bool isEdge(int x, int y) const { return (flags[index(x, y)] & kEdge) != 0; }
   [[nodiscard]] bool isAmbiguous(int x, int y) const { return flags[index(x, y)] != 0; }
