@@ -5,9 +5,9 @@
 // depth-complexity class's mean error curve (class-optimal: the best any allocation that tells
 // pixels apart only by n(p) can expect), the same with each class split by whether the two
 // farthest fragments share a colour (class-optimal+tail: what one more bit per pixel is worth),
-// a flat allocation under a tighter exact-tail bound, max(1, n − m) for a final run of m fragments
-// of one RGBA (flat+runs), and optimal-k. Printed: Σk, the deep hybrid OIT paper's
-// eq. 2 error Σ_p e_p(k(p)), RMSE and mean FLIP against the oracle's exact image; then how well
+// dkb and flat under the tail-run bound max(1, n − m) for a final run of m fragments of one RGBA
+// (dkb+runs, flat+runs: what vkb and dkb do on the GPU with tail_runs, the default), and optimal-k. Printed: Σk, the
+// deep hybrid OIT paper's eq. 2 error Σ_p e_p(k(p)), RMSE and mean FLIP against the oracle's exact image; then how well
 // dkb picks the lists to cut: of the pixels it gives fewer than max(1, n − 1) slots, the share that
 // optimal-k cuts too, against optimal-k's share among all (equal shares = chance).
 #include <algorithm>
@@ -32,37 +32,7 @@
 
 namespace mfr::cli {
 
-namespace {
-
-// Water-filling under per-pixel caps: k(p) = min(cap(p), K) (at least 1) for the largest K that
-// fits F, the slots left one each to the first pixels in pixel order that can take one more.
-// Analysis only: how a flat allocation would do under a tighter exact-tail bound.
-std::vector<std::uint32_t> waterFill(std::span<const std::uint32_t> cap, std::uint64_t F) {
-  auto sumAt = [&](std::uint32_t K) {
-    std::uint64_t s = 0;
-    for (std::uint32_t c : cap) s += std::min(c, K);
-    return s;
-  };
-  std::uint32_t lo = 1, hi = 1;
-  for (std::uint32_t c : cap) hi = std::max(hi, c + 1);
-  if (sumAt(hi) <= F) return {cap.begin(), cap.end()};
-  while (hi - lo > 1) {  // sumAt(lo) <= F < sumAt(hi)
-    const std::uint32_t mid = lo + (hi - lo) / 2;
-    (sumAt(mid) <= F ? lo : hi) = mid;
-  }
-  std::uint64_t left = F - sumAt(lo);
-  std::vector<std::uint32_t> k(cap.size());
-  for (std::size_t p = 0; p < cap.size(); ++p) {
-    k[p] = std::min(cap[p], lo);
-    if (left > 0 && cap[p] > lo) {
-      ++k[p];
-      --left;
-    }
-  }
-  return k;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 void addAllocations(CLI::App& app) {
   struct Options {
@@ -100,18 +70,12 @@ void addAllocations(CLI::App& app) {
         const HybridErrorTable errors = hybridErrorTable(lists, scenes[s].background);
         const std::vector<std::uint32_t> n = lists.counts();
         // m(p): the final run of fragments of one RGBA, whose tail hybrid transparency composites
-        // exactly. The exact-tail bound could be max(1, n − m) (today m = 1): flat+runs. The
-        // depth classes split by m ≥ 2 (the two farthest fragments share a colour, so a two-fragment
-        // tail is exact, the cheapest cut there is): class-optimal+tail.
-        std::vector<std::uint32_t> runCap(pixels, 0u), lastTwoEqual(pixels, 0u);
-        for (std::size_t p = 0; p < pixels; ++p) {
-          const std::span<const Fragment> list = lists.pixel(p);
-          if (list.empty()) continue;
-          std::uint32_t m = 1;
-          while (m < n[p] && list[n[p] - 1 - m].color == list.back().color) ++m;
-          runCap[p] = std::max(1u, n[p] - m);
-          lastTwoEqual[p] = m >= 2 ? 1u : 0u;
-        }
+        // exactly — the shared rule's tail-run bound max(1, n − m) (vkb and dkb on the GPU, with
+        // tail_runs). The depth classes split by m ≥ 2 (the two farthest fragments share a colour,
+        // so a two-fragment tail is exact, the cheapest cut there is): class-optimal+tail.
+        const std::vector<std::uint32_t> runs = tailRunLengths(lists);
+        std::vector<std::uint32_t> lastTwoEqual(pixels, 0u);
+        for (std::size_t p = 0; p < pixels; ++p) lastTwoEqual[p] = runs[p] >= 2 ? 1u : 0u;
         const HybridErrorTable classes = classMeanErrorTable(errors);
         const HybridErrorTable classesByTail = classMeanErrorTable(errors, lastTwoEqual);
         const DkbImageStats stats = dkbImageStats(lists);
@@ -131,12 +95,13 @@ void addAllocations(CLI::App& app) {
           std::vector<float> importance(pixels, 0.0f);
           for (std::size_t p = 0; p < pixels; ++p)
             if (n[p] > 0) importance[p] = neuralImportance(model, dkbFeatures(lists.pixel(p), stats, F), n[p]);
-          const std::vector<std::uint32_t> kd = allocateKFromImportance(importance, n, F).k;
+          const std::vector<std::uint32_t> kd = allocateKFromImportance(importance, n, F, true, {}).k;
           const std::vector<std::uint32_t> ko = optimalKBest(errors, F).k;
           const std::vector<std::pair<std::string, std::vector<std::uint32_t>>> allocations = {
               {"dkb", kd},
-              {"flat", allocateKFromImportance(std::vector<float>(pixels, 1.0f), n, F).k},
-              {"flat+runs", waterFill(runCap, F)},
+              {"dkb+runs", allocateKFromImportance(importance, n, F, true, runs).k},
+              {"flat", allocateKFromImportance(std::vector<float>(pixels, 1.0f), n, F, true, {}).k},
+              {"flat+runs", allocateKFromImportance(std::vector<float>(pixels, 1.0f), n, F, true, runs).k},
               {"class-optimal", optimalKBest(classes, F).k},
               {"class-optimal+tail", optimalKBest(classesByTail, F).k},
               {"optimal-k", ko}};

@@ -6,7 +6,7 @@
 // variable_k_buffer.hpp has the layout):
 //   N(p)      fragment count n(p)                 → the spin-lock word in the store pass
 //   T(i, p)   i = 0..4: features / importance    → the tail sums (5 interleaved words per pixel)
-//   K(p)      nearest colour (dkb) → k(p)        → the prefix-sum offsets of the store pass
+//   K(p)      nearest colour (dkb) → tail run m(p) → k(p) → the prefix-sum offsets of the store pass
 #ifndef MFR_ARENA_GLSL
 #define MFR_ARENA_GLSL
 #include "common/bindings.h"
@@ -28,7 +28,8 @@ layout(std430, binding = MFR_SSBO_BUDGET) coherent buffer VariableKBudget {
   uint vkSums[15];        // S at the candidates j = 1..15 of the current round
   uint vkKMin;            // over non-empty pixels, after the allocation
   uint vkKMax;
-  uint vkReserved[5];
+  uint vkExactSlots;      // Σ max(1, n − m) after the tail-run passes
+  uint vkReserved[4];
 };
 
 uniform uint uVkPixels;  // W*H
@@ -42,6 +43,14 @@ uint vkPixel(ivec2 p) { return uint(p.y) * uint(uVkWidth) + uint(p.x); }
 uint vkN(uint p) { return uVkLockBase + p; }
 uint vkT(uint i, uint p) { return uVkTailBase + i * uVkStride + p; }
 uint vkK(uint p) { return uVkKBase + p; }
+
+#ifdef MFR_ALLOCATION_H
+// e(p) of the allocation rule (budget/allocation.h, included before this file): with
+// MFR_ALLOC_RUNS the tail-run passes left m(p) in K(p), which the assign pass then overwrites.
+uint vkExactK(uint p, uint n) {
+  return mfrAllocExactK(n, (vkAllocMode & MFR_ALLOC_RUNS) != 0u ? arena[vkK(p)] : 1u);
+}
+#endif
 
 // Compute passes over pixels: `size` per work group on a 2D grid (one dimension holds 65535 groups).
 // A macro, so that fragment shaders including this file never see compute built-ins.

@@ -13,6 +13,8 @@
 #include <cmath>
 #include <numeric>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "../../mfrcore/src/methods/deep_variable_k_buffer.hpp"
 #include "../../mfrcore/src/methods/variable_k_buffer.hpp"
 #include "gl_fixture.hpp"
@@ -77,12 +79,15 @@ TEST_P(VariableK, AllocationEqualsTheCpuRule) {
   gpu.setScene(ref.scene);
   const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
   const std::uint64_t total = ref.oracle.fragments.size();
-  for (const bool exactTail : {true, false})
+  // exact_tail with tail runs (the default), exact_tail alone, the papers' bounds.
+  for (const auto& [exactTail, tailRuns] : {std::pair{true, true}, std::pair{true, false}, std::pair{false, false}})
     for (double fraction : {0.15, 0.3, 0.55, 0.8, 0.9, 1.2}) {
-      SCOPED_TRACE("fraction " + std::to_string(fraction) + (exactTail ? "" : ", exact_tail off"));
+      SCOPED_TRACE("fraction " + std::to_string(fraction) + (exactTail ? "" : ", exact_tail off") +
+                   (tailRuns ? "" : ", tail_runs off"));
       RenderRequest req =
           budgetRequest(GetParam(), layout.bytes(static_cast<std::uint64_t>(fraction * static_cast<double>(total))));
       req.params["exact_tail"] = exactTail ? "true" : "false";
+      req.params["tail_runs"] = tailRuns ? "true" : "false";
       gpu.render(ref.camera, req);
       auto* method = dynamic_cast<VariableKBuffer*>(gpu.method());
       ASSERT_NE(method, nullptr);
@@ -92,7 +97,9 @@ TEST_P(VariableK, AllocationEqualsTheCpuRule) {
       const std::vector<std::uint32_t>& n = method->lastCounts();
       const std::uint64_t gpuTotal = std::accumulate(n.begin(), n.end(), std::uint64_t{0});
       const std::uint64_t F = std::min(layout.slotBudget(budgetOf(req)), gpuTotal);
-      const ImportanceAllocation cpu = allocateKFromImportance(importance, n, F, exactTail);
+      const std::vector<std::uint32_t>& runs = method->lastTailRuns();
+      ASSERT_EQ(runs.size(), exactTail && tailRuns ? n.size() : 0u);
+      const ImportanceAllocation cpu = allocateKFromImportance(importance, n, F, exactTail, runs);
       const std::vector<std::uint32_t> k = method->capacityMap();  // GL row order, like importance
       ASSERT_EQ(k.size(), cpu.k.size());
       std::size_t differ = 0;
@@ -174,7 +181,7 @@ TEST_P(VariableK, HybridEqualsTheOracleForTheSameKMap) {
   }
 }
 
-// With exact_tail, a budget of Σ max(1, n − 1) slots gives every pixel k = max(1, n − 1) and so
+// With exact_tail (and tail_runs off), a budget of Σ max(1, n − 1) slots gives every pixel k = max(1, n − 1) and so
 // the exact image: a one-fragment tail composites exactly. The papers' bounds (1 ≤ k ≤ n) spend
 // slots on last fragments instead and leave other pixels with a longer tail at the same budget.
 TEST_P(VariableK, ExactTailMakesTheLastFragmentsFree) {
@@ -202,6 +209,7 @@ TEST_P(VariableK, ExactTailMakesTheLastFragmentsFree) {
   for (const bool exactTail : {true, false}) {
     RenderRequest req = budgetRequest(GetParam(), layout.bytes(exactSlots));
     req.params["exact_tail"] = exactTail ? "true" : "false";
+    req.params["tail_runs"] = "false";  // the bound max(1, n − 1) alone (TailRunsMakeOneColourTailsFree has m)
     const RenderOutput out = gpu.render(ref.camera, req);
     EXPECT_EQ(out.stats.fragmentsStored, exactSlots);
     EXPECT_LE(out.stats.bytesAllocated, budgetOf(req));
@@ -230,6 +238,99 @@ TEST_P(VariableK, ExactTailMakesTheLastFragmentsFree) {
     } else {
       EXPECT_GT(shortOfExact, 0u);
       EXPECT_GT(full, 0u);
+    }
+  }
+}
+
+// Quads at 8 depths, shifted sideways so that lists differ from pixel to pixel; the four farthest
+// share one colour and opacity, so many pixels end in a run of m > 1 fragments of one RGBA.
+Scene tailRunScene() {
+  Scene s = makeQuadsScene(8, 0.45, 3);
+  std::sort(s.objects.begin(), s.objects.end(),
+            [](const Object& a, const Object& b) { return a.transform[3][2] < b.transform[3][2]; });  // far first
+  const double shift[8][2] = {{-0.3, 0.1}, {0.25, -0.2}, {0.1, 0.3}, {-0.2, -0.3},
+                              {0.3, 0.25}, {-0.1, 0.2},  {0.2, 0.0}, {0.0, -0.15}};
+  for (std::size_t i = 0; i < s.objects.size(); ++i) {
+    Object& o = s.objects[i];
+    o.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(shift[i][0], shift[i][1], o.transform[3][2]));
+    if (i < 4) o.material.color = glm::vec4(0.3f, 0.6f, 0.9f, 0.3f);
+  }
+  return s;
+}
+
+// Image rows (oracle) to GL rows (the methods' maps).
+std::vector<std::uint32_t> toGlRows(const std::vector<std::uint32_t>& image, int w, int h) {
+  std::vector<std::uint32_t> gl(image.size());
+  for (int y = 0; y < h; ++y)
+    std::copy_n(image.begin() + static_cast<std::ptrdiff_t>(y) * w, w,
+                gl.begin() + static_cast<std::ptrdiff_t>(h - 1 - y) * w);
+  return gl;
+}
+
+// With tail_runs, the GPU finds the oracle's final runs m(p), and a budget of Σ max(1, n − m)
+// slots gives every pixel k = max(1, n − m) and the exact image; the bound max(1, n − 1) alone
+// leaves that budget short of exact.
+TEST_P(VariableK, TailRunsMakeOneColourTailsFree) {
+  context();
+  const Scene scene = tailRunScene();
+  const Camera camera = scene.view("front");
+  const FragmentLists oracle = castFragments(scene, camera, kW, kH);
+  GpuRenderer gpu;
+  gpu.setScene(scene);
+  const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
+  RenderRequest probe = budgetRequest(GetParam(), layout.bytes(pixels()));
+  gpu.render(camera, probe);
+  auto* method = dynamic_cast<VariableKBuffer*>(gpu.method());
+  ASSERT_NE(method, nullptr);
+  method->setKeepImportance(true);
+  gpu.render(camera, probe);
+  const std::vector<std::uint32_t> n = method->lastCounts(), m = method->lastTailRuns();
+  method->setKeepImportance(false);
+  ASSERT_EQ(m.size(), n.size());
+  // m(p) on the GPU = the oracle's, wherever the two see the same list length.
+  const std::vector<std::uint32_t> oracleN = toGlRows(oracle.counts(), kW, kH);
+  const std::vector<std::uint32_t> oracleM = toGlRows(tailRunLengths(oracle), kW, kH);
+  std::size_t same = 0, compared = 0, longRuns = 0;
+  std::uint64_t exactSlots = 0, exactSlotsOneTail = 0;
+  for (std::size_t p = 0; p < n.size(); ++p) {
+    const std::uint32_t run = std::max(m[p], 1u);
+    exactSlots += n[p] > run ? n[p] - run : std::min(n[p], 1u);
+    exactSlotsOneTail += n[p] > 1 ? n[p] - 1 : n[p];
+    if (n[p] != oracleN[p] || n[p] == 0) continue;
+    ++compared;
+    same += m[p] == oracleM[p];
+    longRuns += m[p] >= 2 && m[p] < n[p];
+  }
+  EXPECT_GT(compared, pixels() / 2);
+  EXPECT_EQ(same, compared);
+  EXPECT_GT(longRuns, pixels() / 10);                   // not vacuous: runs of 2..n−1 are common
+  ASSERT_LT(exactSlots * 100, exactSlotsOneTail * 90);  // and they save slots
+  const ImageRGBA8 exact = compositeOver(oracle, scene.background);
+  for (const bool tailRuns : {true, false}) {
+    RenderRequest req = budgetRequest(GetParam(), layout.bytes(exactSlots));
+    req.params["tail_runs"] = tailRuns ? "true" : "false";
+    const RenderOutput out = gpu.render(camera, req);
+    EXPECT_EQ(out.stats.fragmentsStored, exactSlots);
+    EXPECT_LE(out.stats.bytesAllocated, budgetOf(req));
+    const ImageComparison c = compareImages(oracle, exact, out.image, 2);
+    std::cout << "[ budget ] " << GetParam() << " tail_runs " << tailRuns << " at Σmax(1, n − m) = " << exactSlots
+              << " (Σmax(1, n − 1) = " << exactSlotsOneTail << "): " << c.within << " of " << c.compared
+              << " pixels within 2/255 of the exact image, max " << c.maxDifference << "\n";
+    if (tailRuns) {
+      const std::vector<std::uint32_t> k = method->capacityMap();
+      std::size_t notAtBound = 0;
+      for (std::size_t p = 0; p < n.size(); ++p) {
+        const std::uint32_t run = std::max(m[p], 1u);
+        notAtBound += k[p] != (n[p] > run ? n[p] - run : std::min(n[p], 1u));
+      }
+      EXPECT_EQ(notAtBound, 0u);
+      const auto note = std::find_if(out.stats.notes.begin(), out.stats.notes.end(),
+                                     [](const auto& kv) { return kv.first == "exact at"; });
+      ASSERT_NE(note, out.stats.notes.end());
+      EXPECT_NE(note->second.find("(" + std::to_string(exactSlots) + " slots)"), std::string::npos) << note->second;
+      EXPECT_GE(c.fraction(), 0.999) << "max difference " << c.maxDifference;
+    } else {
+      EXPECT_LT(c.fraction(), 0.95);
     }
   }
 }

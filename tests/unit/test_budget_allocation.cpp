@@ -13,6 +13,7 @@
 #include <limits>
 #include <numeric>
 #include <random>
+#include <span>
 
 #include "budget/mlp_layout.h"
 
@@ -46,37 +47,48 @@ TEST(KAllocation, PropertiesOnRandomCases) {
     const std::uint64_t total = sum(n);
     const std::uint64_t nonEmpty =
         static_cast<std::uint64_t>(std::count_if(n.begin(), n.end(), [](auto v) { return v > 0; }));
-    // Σ max(1, n − 1): the slots after which every pixel's hybrid result is exact.
-    std::uint64_t exactSlots = 0;
-    for (std::uint32_t v : n) exactSlots += v > 1 ? v - 1 : v;
-    for (bool exactTail : {true, false}) {
-      for (std::uint64_t F :
-           {std::uint64_t{0}, nonEmpty / 2, nonEmpty, nonEmpty + 1, (nonEmpty + exactSlots) / 2, exactSlots,
-            exactSlots + 1, (nonEmpty + total) / 2, total > 0 ? total - 1 : 0, total, total + 17}) {
-        const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(importance, n, F, exactTail);
-        ASSERT_EQ(a.k.size(), pixels);
-        EXPECT_EQ(a.assigned, sum(a.k));
-        EXPECT_EQ(a.assigned, std::min(F, total)) << "case " << c << " F " << F;  // the budget is used up
-        EXPECT_EQ(a.kFloor, F >= nonEmpty ? 1u : 0u);
-        // The bounds of k(p), written out from the rule's statement.
-        auto lower = [&](std::size_t p) -> std::uint32_t {
-          if (n[p] == 0) return 0;
-          if (exactTail && F > exactSlots) return n[p] > 1 ? n[p] - 1 : 1;
-          return F >= nonEmpty ? 1 : 0;
-        };
-        auto upper = [&](std::size_t p) -> std::uint32_t {
-          return exactTail && F <= exactSlots && n[p] > 1 ? n[p] - 1 : n[p];
-        };
-        for (std::size_t p = 0; p < pixels; ++p) {
-          ASSERT_GE(a.k[p], lower(p)) << "case " << c << " F " << F << " n " << n[p];
-          ASSERT_LE(a.k[p], upper(p)) << "case " << c << " F " << F << " n " << n[p];
-        }
-        // Monotone in importance (up to the one slot of the remainder): a more important pixel that
-        // is not full never has fewer slots than a less important one, minus one.
-        for (std::size_t p = 0; p + 1 < pixels; ++p) {
-          const std::size_t q = p + 1;
-          if (importance[p] >= importance[q] && a.k[p] < upper(p) && n[q] > 0 && a.k[q] > lower(q)) {
-            EXPECT_GE(a.k[p] + 1, a.k[q]) << "case " << c << " pixels " << p << "," << q;
+    // Tail runs: none (m = 1), or a random final run m(p) ∈ [0, n(p)] of one colour.
+    std::vector<std::uint32_t> runs(pixels);
+    for (std::size_t p = 0; p < pixels; ++p) runs[p] = std::uniform_int_distribution<std::uint32_t>(0, n[p])(rng);
+    for (bool withRuns : {false, true}) {
+      // e(p): the core size from which the pixel's hybrid result is exact — max(1, n − 1), or
+      // max(1, n − m) with a run of m ≥ 1 (m = 0 counts as 1: one fragment is always exact).
+      auto exact = [&](std::size_t p) -> std::uint32_t {
+        const std::uint32_t m = withRuns ? std::max<std::uint32_t>(runs[p], 1) : 1;
+        if (n[p] == 0) return 0;
+        return n[p] > m ? n[p] - m : 1;
+      };
+      std::uint64_t exactSlots = 0;
+      for (std::size_t p = 0; p < pixels; ++p) exactSlots += exact(p);
+      for (bool exactTail : {true, false}) {
+        for (std::uint64_t F :
+             {std::uint64_t{0}, nonEmpty / 2, nonEmpty, nonEmpty + 1, (nonEmpty + exactSlots) / 2, exactSlots,
+              exactSlots + 1, (nonEmpty + total) / 2, total > 0 ? total - 1 : 0, total, total + 17}) {
+          const mfr::ImportanceAllocation a = mfr::allocateKFromImportance(
+              importance, n, F, exactTail,
+              withRuns ? std::span<const std::uint32_t>(runs) : std::span<const std::uint32_t>{});
+          ASSERT_EQ(a.k.size(), pixels);
+          EXPECT_EQ(a.assigned, sum(a.k));
+          EXPECT_EQ(a.assigned, std::min(F, total)) << "case " << c << " F " << F;  // the budget is used up
+          EXPECT_EQ(a.kFloor, F >= nonEmpty ? 1u : 0u);
+          // The bounds of k(p), written out from the rule's statement.
+          auto lower = [&](std::size_t p) -> std::uint32_t {
+            if (n[p] == 0) return 0;
+            if (exactTail && F > exactSlots) return exact(p);
+            return F >= nonEmpty ? 1 : 0;
+          };
+          auto upper = [&](std::size_t p) -> std::uint32_t { return exactTail && F <= exactSlots ? exact(p) : n[p]; };
+          for (std::size_t p = 0; p < pixels; ++p) {
+            ASSERT_GE(a.k[p], lower(p)) << "case " << c << " F " << F << " n " << n[p] << " m " << runs[p];
+            ASSERT_LE(a.k[p], upper(p)) << "case " << c << " F " << F << " n " << n[p] << " m " << runs[p];
+          }
+          // Monotone in importance (up to the one slot of the remainder): a more important pixel
+          // that is not full never has fewer slots than a less important one, minus one.
+          for (std::size_t p = 0; p + 1 < pixels; ++p) {
+            const std::size_t q = p + 1;
+            if (importance[p] >= importance[q] && a.k[p] < upper(p) && n[q] > 0 && a.k[q] > lower(q)) {
+              EXPECT_GE(a.k[p] + 1, a.k[q]) << "case " << c << " pixels " << p << "," << q;
+            }
           }
         }
       }

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <random>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "mfr/error.hpp"
@@ -102,6 +103,48 @@ TEST(Hybrid, ExactHybridSlots) {
   const mfr::ImageRGBA8 hybrid = mfr::compositeHybrid(lists, k, bg), exact = mfr::compositeOver(lists, bg);
   for (std::size_t i = 0; i < exact.pixels.size(); ++i)
     EXPECT_LE(std::abs(static_cast<int>(hybrid.pixels[i]) - static_cast<int>(exact.pixels[i])), 1) << "byte " << i;
+}
+
+// tailRunLengths: the farthest fragments of one RGBA strictly behind every other colour; a core of
+// max(1, n − m) slots then composites exactly, one slot fewer does not.
+TEST(Hybrid, TailRunLengthsAndTheirExactness) {
+  const mfr::Fragment a = frag(0, 200, 40, 40, 90), b = frag(0, 40, 200, 40, 120), c = frag(0, 40, 40, 200, 80);
+  auto at = [](mfr::Fragment f, float depth) {
+    f.depth = depth;
+    return f;
+  };
+  const std::vector<std::vector<mfr::Fragment>> pixels = {
+      {},                                                                 // m = 0
+      {at(a, 0.5f)},                                                      // 1
+      {at(a, 0.1f), at(b, 0.2f), at(c, 0.3f), at(c, 0.4f), at(c, 0.5f)},  // 3
+      {at(c, 0.1f), at(c, 0.2f), at(c, 0.3f)},                            // all one colour: 3
+      {at(a, 0.1f), at(c, 0.2f), at(b, 0.3f)},                            // 1
+      {at(a, 0.1f), at(c, 0.8f), at(b, 0.8f)},                            // a tie of two colours at the back: 0
+      {at(c, 0.1f), at(a, 0.2f), at(c, 0.3f), at(c, 0.4f)},               // 2
+  };
+  mfr::FragmentLists lists;
+  lists.width = static_cast<int>(pixels.size());
+  lists.height = 1;
+  lists.offsets = {0};
+  for (const auto& list : pixels) {
+    lists.fragments.insert(lists.fragments.end(), list.begin(), list.end());
+    lists.offsets.push_back(static_cast<std::uint32_t>(lists.fragments.size()));
+  }
+  lists.flags.assign(pixels.size(), 0);
+  const std::vector<std::uint32_t> m = mfr::tailRunLengths(lists);
+  EXPECT_EQ(m, (std::vector<std::uint32_t>{0, 1, 3, 3, 1, 0, 2}));
+  // max(1, n − max(m, 1)): 0, 1, 2, 1, 2, 2, 2.
+  EXPECT_EQ(mfr::exactHybridSlots(lists, true), 10u);
+  EXPECT_EQ(mfr::exactHybridSlots(lists), 0u + 1u + 4u + 2u + 2u + 2u + 3u);
+  const glm::vec3 bg(0.9f, 0.8f, 0.3f);
+  const std::vector<std::uint32_t> k{0, 1, 2, 1, 2, 2, 2};
+  for (std::size_t p = 0; p < pixels.size(); ++p) {
+    SCOPED_TRACE("pixel " + std::to_string(p));
+    EXPECT_LT(mfr::hybridError(pixels[p], k[p], bg), 1e-10);
+  }
+  // One slot fewer is not exact where a run of another colour is cut into the tail.
+  EXPECT_GT(mfr::hybridError(pixels[2], 1, bg), 1e-4);
+  EXPECT_GT(mfr::hybridError(pixels[6], 1, bg), 1e-4);
 }
 
 TEST(Hybrid, ZeroCoreIsWeightedAverage) {

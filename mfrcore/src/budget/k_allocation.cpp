@@ -14,45 +14,53 @@ namespace mfr {
 namespace {
 
 std::uint64_t sumAt(std::uint32_t lambdaBits, std::span<const float> importance, std::span<const std::uint32_t> n,
-                    std::uint32_t mode) {
+                    std::span<const std::uint32_t> e, std::uint32_t mode) {
   const float lambda = std::bit_cast<float>(lambdaBits);
   std::uint64_t s = 0;
-  for (std::size_t p = 0; p < n.size(); ++p) s += glsl::mfrAllocK(lambda, importance[p], n[p], mode);
+  for (std::size_t p = 0; p < n.size(); ++p) s += glsl::mfrAllocK(lambda, importance[p], n[p], e[p], mode);
   return s;
 }
 
 }  // namespace
 
-AllocationBounds allocationBounds(std::uint64_t F, std::uint64_t total, std::uint64_t nonEmpty, std::uint64_t multi,
-                                  bool exactTail) {
+AllocationBounds allocationBounds(std::uint64_t F, std::uint64_t nonEmpty, std::uint64_t exactSlots, bool exactTail,
+                                  bool tailRuns) {
   const bool floorOne = F >= nonEmpty;
   AllocationBounds b{floorOne ? MFR_ALLOC_FLOOR_ONE : 0u, floorOne ? nonEmpty : 0u};
   if (!exactTail) return b;
-  if (F <= total - multi) {
+  if (tailRuns) b.mode |= MFR_ALLOC_RUNS;
+  if (F <= exactSlots) {
     b.mode |= MFR_ALLOC_CAP_TAIL;
   } else {
     b.mode |= MFR_ALLOC_FILL;
-    b.sumAtZero = total - multi;  // lower = max(1, n − 1) everywhere
+    b.sumAtZero = exactSlots;  // lower = e(p) everywhere
   }
   return b;
 }
 
 ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportance, std::span<const std::uint32_t> n,
-                                             std::uint64_t budgetSlots, bool exactTail) {
+                                             std::uint64_t budgetSlots, bool exactTail,
+                                             std::span<const std::uint32_t> tailRuns) {
   if (rawImportance.size() != n.size())
     throw Error("importance map",
                 std::to_string(rawImportance.size()) + " entries for " + std::to_string(n.size()) + " pixels");
+  if (!tailRuns.empty() && tailRuns.size() != n.size())
+    throw Error("tail-run map",
+                std::to_string(tailRuns.size()) + " entries for " + std::to_string(n.size()) + " pixels");
   std::vector<float> importance(rawImportance.size());
   std::transform(rawImportance.begin(), rawImportance.end(), importance.begin(), glsl::mfrSanitizeImportance);
 
-  std::uint64_t total = 0, nonEmpty = 0, multi = 0;
-  for (std::uint32_t c : n) {
-    total += c;
-    nonEmpty += c > 0;
-    multi += c > 1;
+  const bool runs = exactTail && !tailRuns.empty();
+  std::vector<std::uint32_t> e(n.size());
+  std::uint64_t total = 0, nonEmpty = 0, exactSlots = 0;
+  for (std::size_t p = 0; p < n.size(); ++p) {
+    e[p] = glsl::mfrAllocExactK(n[p], runs ? tailRuns[p] : 1u);
+    total += n[p];
+    nonEmpty += n[p] > 0;
+    exactSlots += e[p];
   }
   ImportanceAllocation out;
-  const AllocationBounds bounds = allocationBounds(budgetSlots, total, nonEmpty, multi, exactTail);
+  const AllocationBounds bounds = allocationBounds(budgetSlots, nonEmpty, exactSlots, exactTail, runs);
   const std::uint32_t mode = bounds.mode;
   out.kFloor = (mode & MFR_ALLOC_FLOOR_ONE) != 0u ? 1u : 0u;
 
@@ -68,7 +76,7 @@ ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportanc
     std::uint64_t newSLo = sLo;
     for (std::uint32_t j = 1; j < MFR_ALLOC_SECTIONS; ++j) {
       const std::uint32_t c = glsl::mfrAllocCandidate(lo, hi, j);
-      const std::uint64_t s = sumAt(c, importance, n, mode);
+      const std::uint64_t s = sumAt(c, importance, n, e, mode);
       if (s <= budgetSlots) {
         newLo = c;
         newSLo = s;
@@ -86,8 +94,8 @@ ImportanceAllocation allocateKFromImportance(std::span<const float> rawImportanc
   std::uint64_t remaining = budgetSlots > sLo ? budgetSlots - sLo : 0;
   out.k.resize(n.size());
   for (std::size_t p = 0; p < n.size(); ++p) {
-    const std::uint32_t kLo = glsl::mfrAllocK(lambdaLo, importance[p], n[p], mode);
-    const std::uint32_t kHi = glsl::mfrAllocK(lambdaHi, importance[p], n[p], mode);
+    const std::uint32_t kLo = glsl::mfrAllocK(lambdaLo, importance[p], n[p], e[p], mode);
+    const std::uint32_t kHi = glsl::mfrAllocK(lambdaHi, importance[p], n[p], e[p], mode);
     const std::uint64_t extra = std::min<std::uint64_t>(remaining, kHi - kLo);
     remaining -= extra;
     out.k[p] = kLo + static_cast<std::uint32_t>(extra);

@@ -22,6 +22,7 @@ class DeepVariableKBuffer final : public VariableKBuffer {
   void clearFeatures() override;
   std::uint32_t drawFeatures(const FrameContext& ctx) override;
   [[nodiscard]] bool needsDepthRange() const override { return true; }
+  [[nodiscard]] std::uint32_t farthestDepthRegion() const override { return 1; }
   void computeImportance(const FrameContext& ctx) override;
   [[nodiscard]] std::string describeImportance() const override;
 

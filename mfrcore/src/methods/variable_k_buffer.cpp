@@ -31,6 +31,7 @@ enum StateWord : std::uint32_t {
   kMultiFragment = 9,
   kKMin = 25,
   kKMax = 26,
+  kExactSlots = 27,
   kStateWords = 32,
 };
 
@@ -85,13 +86,23 @@ std::vector<ParamSpec> VariableKBuffer::budgetParams() {
            0,
            {},
            "k(p) <= n(p) - 1 until every pixel has n - 1 slots: hybrid transparency composites a "
-           "one-fragment tail exactly (off: the papers' bounds 1 <= k(p) <= n(p))"}};
+           "one-fragment tail exactly (off: the papers' bounds 1 <= k(p) <= n(p))"},
+          {"tail_runs",
+           "No slots for a final run of one colour",
+           ParamSpec::Type::Bool,
+           "true",
+           0,
+           0,
+           {},
+           "with exact_tail: k(p) <= max(1, n - m) for the m farthest fragments of one RGBA, a tail hybrid "
+           "transparency composites exactly (three more geometry passes find m)"}};
 }
 
 void VariableKBuffer::configure(int width, int height, const Params& params) {
   externalPixelState_ = true;
   culling_ = params.flag("culling");
   exactTail_ = params.flag("exact_tail");
+  tailRuns_ = params.flag("tail_runs");
   budgetText_ = params.text("budget_mib");
   budgetBytes_ = static_cast<std::uint64_t>(std::floor(params.real("budget_mib") * 1024.0 * 1024.0));
   configureMember(params);
@@ -122,6 +133,13 @@ void VariableKBuffer::configure(int width, int height, const Params& params) {
     gl::Defines statsDefines;
     if (needsDepthRange()) statsDefines.emplace("MFR_VK_DEPTH_RANGE", "1");
     imageStats_ = gl::Program({{GL_COMPUTE_SHADER, "budget/image_stats.comp"}}, statsDefines);
+    runColor_ =
+        gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "budget/tail_run_color.geom.frag"}});
+    runBreak_ =
+        gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "budget/tail_run_break.geom.frag"}});
+    runLength_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "budget/tail_run_length.geom.frag"}});
+    runSum_ = gl::Program({{GL_COMPUTE_SHADER, "budget/tail_run_sum.comp"}});
   }
 }
 
@@ -183,13 +201,8 @@ void VariableKBuffer::capture(const FrameContext& ctx) {
   const std::uint64_t multiFragment = state[kMultiFragment];
   const std::uint64_t budgetSlots = layout_.slotBudget(budgetBytes_);
   slotsF_ = std::min<std::uint64_t>(budgetSlots, totalFragments_);
-  const AllocationBounds bounds = allocationBounds(slotsF_, totalFragments_, nonEmpty_, multiFragment, exactTail_);
-  const std::uint32_t mode = bounds.mode;
-  const bool allFit = totalFragments_ <= budgetSlots;
-  const std::uint32_t search[5] = {static_cast<std::uint32_t>(slotsF_), mode, allFit ? MFR_ALLOC_INFINITY_BITS : 0u,
-                                   MFR_ALLOC_INFINITY_BITS,
-                                   static_cast<std::uint32_t>(allFit ? totalFragments_ : bounds.sumAtZero)};
-  glNamedBufferSubData(state_.id(), 4 * kBudgetSlots, sizeof search, search);
+  const auto slotsWord = static_cast<std::uint32_t>(slotsF_);  // dkb's features read F
+  glNamedBufferSubData(state_.id(), 4 * kBudgetSlots, sizeof slotsWord, &slotsWord);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
 
   // 3. Importance.
@@ -208,6 +221,25 @@ void VariableKBuffer::capture(const FrameContext& ctx) {
     glGetNamedBufferSubData(arena_.id(), static_cast<GLintptr>(4 * layout_.lockBase),
                             static_cast<GLsizeiptr>(4 * counts_.size()), counts_.data());
   }
+
+  // 3b. Tail runs, and with them the bounds of k(p).
+  const bool runs = exactTail_ && tailRuns_;
+  const std::uint64_t exactSlots = runs ? findTailRuns(ctx) : totalFragments_ - multiFragment;
+  if (runs) featurePasses += 3;
+  tailRunMap_.clear();
+  if (runs && keepImportance_) {
+    tailRunMap_.resize(static_cast<std::size_t>(pixels()));
+    glGetNamedBufferSubData(arena_.id(), static_cast<GLintptr>(4 * layout_.kBase),
+                            static_cast<GLsizeiptr>(4 * tailRunMap_.size()), tailRunMap_.data());
+  }
+  const AllocationBounds bounds = allocationBounds(slotsF_, nonEmpty_, exactSlots, exactTail_, runs);
+  const std::uint32_t mode = bounds.mode;
+  const bool allFit = totalFragments_ <= budgetSlots;
+  const std::uint32_t search[5] = {static_cast<std::uint32_t>(slotsF_), mode, allFit ? MFR_ALLOC_INFINITY_BITS : 0u,
+                                   MFR_ALLOC_INFINITY_BITS,
+                                   static_cast<std::uint32_t>(allFit ? totalFragments_ : bounds.sumAtZero)};
+  glNamedBufferSubData(state_.id(), 4 * kBudgetSlots, sizeof search, search);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
 
   // 4. Allocation.
   allocate(ctx);
@@ -241,14 +273,43 @@ void VariableKBuffer::capture(const FrameContext& ctx) {
                                 ((mode & MFR_ALLOC_FLOOR_ONE) == 0 ? " (k = 0 allowed: F < non-empty pixels)" : ""));
   stats_.notes.emplace_back("importance", describeImportance());
   stats_.notes.emplace_back("culling", culling_ ? "on" : "off");
+  const std::string bound = runs ? "max(1, n - m), m the final run of one colour" : "n - 1";
   stats_.notes.emplace_back("exact tail", !exactTail_                     ? "off (1 <= k <= n)"
-                                          : (mode & MFR_ALLOC_FILL) != 0u ? "every pixel exact (k >= n - 1)"
-                                                                          : "k <= n - 1");
-  // The least budget at which this frame's hybrid image is exact: Σ max(1, n − 1) slots with the
+                                          : (mode & MFR_ALLOC_FILL) != 0u ? "every pixel exact (k >= " + bound + ")"
+                                                                          : "k <= " + bound);
+  // The least budget at which this frame's hybrid image is exact: Σ max(1, n − m) slots with the
   // bound, every fragment without it.
-  const std::uint64_t exactSlots = exactTail_ ? totalFragments_ - multiFragment : totalFragments_;
-  stats_.notes.emplace_back("exact at", ">= " + mibText(layout_.bytes(std::max<std::uint64_t>(exactSlots, 1))) +
-                                            " MiB (" + std::to_string(exactSlots) + " slots)");
+  const std::uint64_t exactAt = exactTail_ ? exactSlots : totalFragments_;
+  stats_.notes.emplace_back("exact at", ">= " + mibText(layout_.bytes(std::max<std::uint64_t>(exactAt, 1))) + " MiB (" +
+                                            std::to_string(exactAt) + " slots)");
+}
+
+std::uint64_t VariableKBuffer::findTailRuns(const FrameContext& ctx) {
+  ctx.timer.begin("tail runs");
+  clearArena(layout_.tailBase + 3 * layout_.stride, 2 * layout_.stride, 0);  // T(3), T(4)
+  clearArena(layout_.kBase, pixels() + 1, 0);                                // K: m(p)
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  bindArena();
+  {
+    GeometryPassState geometry;
+    setArenaUniforms(runColor_);
+    runColor_.set("uVkFarRegion", farthestDepthRegion());
+    ctx.scene.draw(runColor_, ctx.frame);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    setArenaUniforms(runBreak_);
+    ctx.scene.draw(runBreak_, ctx.frame);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    setArenaUniforms(runLength_);
+    ctx.scene.draw(runLength_, ctx.frame);
+  }
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  setArenaUniforms(runSum_);
+  dispatchPixels(runSum_, 256);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  std::uint32_t exactSlots = 0;
+  glGetNamedBufferSubData(state_.id(), 4 * kExactSlots, sizeof exactSlots, &exactSlots);
+  ctx.timer.end();
+  return exactSlots;
 }
 
 void VariableKBuffer::allocate(const FrameContext& ctx) {

@@ -7,8 +7,11 @@
 //   2. image sums (compute), read back once: Σn and the non-empty pixels fix F = min(F(M), Σn)
 //      and the size of the slot buffer;
 //   3. importance I(p) (the member's compute pass);
+//   3b. with tail_runs: three geometry passes find each pixel's final run of m(p) fragments of
+//      one colour (shaders/budget/tail_run_*), and Σ max(1, n − m) is read back;
 //   4. allocation (compute, shaders/budget/alloc_*.comp, two prefix sums): k(p) by the shared
-//      rule of mfr/budget/k_allocation.hpp — 1 ≤ k(p) ≤ n(p), Σk = F;
+//      rule of mfr/budget/k_allocation.hpp — 1 ≤ k(p) ≤ n(p), Σk = F, no slot for a
+//      fragment of an exactly composited tail while another pixel lacks one;
 //   5. the k+-buffer max-array store into each pixel's k(p) contiguous slots (spin lock on arena
 //      words or interlock), fragments beyond k(p) into the tail sums;
 //   6. resolve (hybrid: core + tail, or oit: core only).
@@ -28,7 +31,8 @@ class VariableKBuffer : public KBufferFamily {
   void resolve(const FrameContext& ctx, const Operation& op) final;
   [[nodiscard]] std::vector<std::uint32_t> capacityMap() const final;
 
-  // The budget parameters every variable-k method has (budget_mib, sync, spin_limit, culling, exact_tail).
+  // The budget parameters every variable-k method has (budget_mib, sync, spin_limit, culling,
+  // exact_tail, tail_runs).
   static std::vector<ParamSpec> budgetParams();
   [[nodiscard]] const VariableKLayout& layout() const { return layout_; }
   // Per-pixel importance of the last frame (GL row order), read back from the arena: valid only
@@ -36,6 +40,9 @@ class VariableKBuffer : public KBufferFamily {
   void setKeepImportance(bool keep) { keepImportance_ = keep; }
   [[nodiscard]] const std::vector<float>& lastImportance() const { return importance_; }
   [[nodiscard]] const std::vector<std::uint32_t>& lastCounts() const { return counts_; }
+  // m(p) of the last frame's tail-run passes (GL row order; empty when tail_runs was off), also
+  // only kept with keepImportance.
+  [[nodiscard]] const std::vector<std::uint32_t>& lastTailRuns() const { return tailRunMap_; }
 
  protected:
   // Member hooks. Shader folder, its configure, its fixed GPU bytes besides the shared ones.
@@ -48,6 +55,10 @@ class VariableKBuffer : public KBufferFamily {
   // bound); returns how many it drew.
   virtual std::uint32_t drawFeatures(const FrameContext& ctx) = 0;
   [[nodiscard]] virtual bool needsDepthRange() const { return false; }
+  // The T(i) region in which drawFeatures leaves each pixel's farthest depth (float bits, 0 where
+  // empty) for the tail-run passes; it must survive computeImportance, and i must be 1 or 2
+  // (T(0) holds the importance, T(3), T(4) and K are the passes' own).
+  [[nodiscard]] virtual std::uint32_t farthestDepthRegion() const = 0;
   // Compute pass writing I(p) into T(0).
   virtual void computeImportance(const FrameContext& ctx) = 0;
   [[nodiscard]] virtual std::string describeImportance() const = 0;
@@ -67,13 +78,17 @@ class VariableKBuffer : public KBufferFamily {
 
  private:
   void allocate(const FrameContext& ctx);
+  // The tail-run passes; returns Σ max(1, n − m).
+  std::uint64_t findTailRuns(const FrameContext& ctx);
 
   bool culling_ = true;
   bool exactTail_ = true;
+  bool tailRuns_ = true;
   bool keepImportance_ = false;
   std::vector<float> importance_;
-  std::vector<std::uint32_t> counts_;
+  std::vector<std::uint32_t> counts_, tailRunMap_;
   gl::Program imageStats_, search_, narrow_, assign_, finish_;
+  gl::Program runColor_, runBreak_, runLength_, runSum_;
   PrefixSum scan_;
   std::uint64_t slotsF_ = 0;  // F of the last frame
   std::uint64_t totalFragments_ = 0, nonEmpty_ = 0;

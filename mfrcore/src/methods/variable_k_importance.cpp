@@ -90,8 +90,8 @@ void VariableKBufferImportance::configureMember(const Params& params) {
 }
 
 void VariableKBufferImportance::clearFeatures() {
-  clearArena(layout_.tailBase, layout_.stride, 0x7F800000u);         // T(0): nearest depth, +inf
-  clearArena(layout_.tailBase + layout_.stride, layout_.stride, 0);  // T(1): Fresnel term
+  clearArena(layout_.tailBase, layout_.stride, 0x7F800000u);             // T(0): nearest depth, +inf
+  clearArena(layout_.tailBase + layout_.stride, 2 * layout_.stride, 0);  // T(1), T(2): Fresnel, farthest depth
 }
 
 std::uint32_t VariableKBufferImportance::drawFeatures(const FrameContext& ctx) {

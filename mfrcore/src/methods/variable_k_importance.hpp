@@ -17,6 +17,7 @@ class VariableKBufferImportance final : public VariableKBuffer {
   void configureMember(const Params& params) override;
   void clearFeatures() override;
   std::uint32_t drawFeatures(const FrameContext& ctx) override;
+  [[nodiscard]] std::uint32_t farthestDepthRegion() const override { return 2; }
   void computeImportance(const FrameContext& ctx) override;
   [[nodiscard]] std::string describeImportance() const override;
 

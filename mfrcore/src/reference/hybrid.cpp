@@ -56,8 +56,8 @@ glm::vec3 compositeHybrid(std::span<const Fragment> sorted, std::uint32_t k, glm
 ImageRGBA8 compositeHybrid(const FragmentLists& lists, std::span<const std::uint32_t> kMap, glm::vec3 background) {
   const std::size_t pixels = static_cast<std::size_t>(lists.width) * lists.height;
   if (kMap.size() != pixels)
-    throw Error("hybrid k(p) map", "has " + std::to_string(kMap.size()) + " entries for " + std::to_string(pixels) +
-                                       " pixels");
+    throw Error("hybrid k(p) map",
+                "has " + std::to_string(kMap.size()) + " entries for " + std::to_string(pixels) + " pixels");
   ImageRGBA8 image(lists.width, lists.height);
   const auto to8 = [](float c) { return static_cast<std::uint8_t>(std::round(std::clamp(c, 0.0f, 1.0f) * 255.0f)); };
   for (int y = 0; y < lists.height; ++y)
@@ -77,17 +77,46 @@ ImageRGBA8 compositeHybrid(const FragmentLists& lists, std::uint32_t k, glm::vec
   return compositeHybrid(lists, kMap, background);
 }
 
-std::uint64_t exactHybridSlots(const FragmentLists& lists) {
+std::vector<std::uint32_t> tailRunLengths(const FragmentLists& lists) {
+  std::vector<std::uint32_t> runs(static_cast<std::size_t>(lists.width) * lists.height, 0u);
+  for (std::size_t p = 0; p < runs.size(); ++p) {
+    const std::span<const Fragment> list = lists.pixel(p);
+    if (list.empty()) continue;
+    // The farthest colour: the largest packed RGBA at the farthest depth (equal depths have no
+    // order), as the GPU's atomicMax picks it; then the fragments strictly behind every fragment
+    // of another colour.
+    const float far = list.back().depth;
+    std::uint32_t farColor = 0;
+    for (const Fragment& f : list)
+      if (f.depth == far) farColor = std::max(farColor, f.color);
+    bool otherColor = false;
+    float otherDepth = 0.0f;
+    for (const Fragment& f : list)
+      if (f.color != farColor) {
+        otherColor = true;
+        otherDepth = std::max(otherDepth, f.depth);
+      }
+    runs[p] = otherColor ? static_cast<std::uint32_t>(std::count_if(
+                               list.begin(), list.end(), [&](const Fragment& f) { return f.depth > otherDepth; }))
+                         : static_cast<std::uint32_t>(list.size());
+  }
+  return runs;
+}
+
+std::uint64_t exactHybridSlots(const FragmentLists& lists, bool tailRuns) {
+  const std::vector<std::uint32_t> runs = tailRuns ? tailRunLengths(lists) : std::vector<std::uint32_t>{};
   std::uint64_t slots = 0;
   for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p) {
     const std::uint32_t n = lists.offsets[p + 1] - lists.offsets[p];
-    slots += n > 1 ? n - 1 : n;
+    const std::uint32_t m = std::max(tailRuns ? runs[p] : 1u, 1u);
+    slots += n > m ? n - m : std::min(n, 1u);
   }
   return slots;
 }
 
 double hybridError(std::span<const Fragment> sorted, std::uint32_t k, glm::vec3 background) {
-  const glm::dvec3 d = glm::dvec3(compositeHybrid(sorted, k, background)) - glm::dvec3(compositeOver(sorted, background));
+  const glm::dvec3 d =
+      glm::dvec3(compositeHybrid(sorted, k, background)) - glm::dvec3(compositeOver(sorted, background));
   return glm::dot(d, d);
 }
 

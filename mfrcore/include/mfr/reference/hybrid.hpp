@@ -51,8 +51,16 @@ ImageRGBA8 compositeHybrid(const FragmentLists& lists, std::uint32_t k, glm::vec
 // ‖hybrid(k) − over(all)‖² of one pixel, in float.
 double hybridError(std::span<const Fragment> sorted, std::uint32_t k, glm::vec3 background);
 
+// m(p) per pixel (image rows, width*height entries): how many of the pixel's farthest fragments
+// share the farthest one's packed RGBA, and lie strictly behind every fragment of another RGBA
+// (0 where n = 0). Hybrid transparency composites such a tail exactly (its weighted average is
+// that colour and (1 − α)^m is the over operator's product), so the core needs max(1, n − m) slots.
+// The variable-k buffers' tail-run passes compute the same map on the GPU.
+std::vector<std::uint32_t> tailRunLengths(const FragmentLists& lists);
+
 // Σ max(1, n(p) − 1) over the non-empty pixels: with that many core slots, k(p) = max(1, n − 1),
-// the hybrid image is exact everywhere (a one-fragment tail composites exactly).
-std::uint64_t exactHybridSlots(const FragmentLists& lists);
+// the hybrid image is exact everywhere (a one-fragment tail composites exactly). With tailRuns,
+// Σ max(1, n(p) − m(p)) for the m of tailRunLengths: the least budget of an exact image.
+std::uint64_t exactHybridSlots(const FragmentLists& lists, bool tailRuns = false);
 
 }  // namespace mfr
