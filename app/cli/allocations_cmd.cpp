@@ -80,6 +80,7 @@ void addAllocations(CLI::App& app) {
         const HybridErrorTable classesByTail = classMeanErrorTable(errors, lastTwoEqual);
         const DkbImageStats stats = dkbImageStats(lists);
         const std::uint64_t total = lists.fragments.size(), exactSlots = exactHybridSlots(lists);
+        const std::uint64_t exactSlotsRuns = exactHybridSlots(lists, true);
         const std::uint64_t nonEmpty = minimumSlots(errors);
         for (BudgetSpec b : budgets) {
           b.resolve(total, exactSlots, pixels);
@@ -87,7 +88,8 @@ void addAllocations(CLI::App& app) {
           std::cout << scenes[s].name << ", " << v << ", " << b.label << ": F = " << F << " slots (" << std::fixed
                     << std::setprecision(1) << 100.0 * static_cast<double>(F) / static_cast<double>(total)
                     << " % of Σn, " << 100.0 * static_cast<double>(F) / static_cast<double>(exactSlots)
-                    << " % of Σ max(1, n − 1))\n";
+                    << " % of Σ max(1, n − 1), " << 100.0 * static_cast<double>(F) / static_cast<double>(exactSlotsRuns)
+                    << " % of Σ max(1, n − m) = " << exactSlotsRuns << ")\n";
           if (F < nonEmpty) {
             std::cout << "  fewer slots than non-empty pixels (" << nonEmpty << "): skipped\n";
             continue;
@@ -112,6 +114,7 @@ void addAllocations(CLI::App& app) {
           row["budget_slots"] = F;
           row["fragments_total"] = total;
           row["exact_slots"] = exactSlots;
+          row["exact_slots_tail_runs"] = exactSlotsRuns;
           for (const auto& [name, k] : allocations) {
             std::uint64_t sum = 0;
             for (std::uint32_t x : k) sum += x;
