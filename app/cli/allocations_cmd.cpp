@@ -46,7 +46,7 @@ void addAllocations(CLI::App& app) {
       "Compare k(p) allocations on the CPU at one budget: dkb, flat, class-optimal, optimal-k (eq. 2 error, RMSE, "
       "FLIP)");
   cmd->add_option("scenes", opt->scenes, "Scenes (model files, .mfrscene, @sample)")->required();
-  cmd->add_option("--budgets", opt->budgets, "Comma-separated budgets, as for mfr evaluate (MiB, kN, fN, eN)")
+  cmd->add_option("--budgets", opt->budgets, "Comma-separated budgets, as for mfr evaluate (MiB, kN, fN, eN, xN)")
       ->capture_default_str();
   cmd->add_option("--views", opt->views, "Comma-separated views")->capture_default_str();
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
@@ -83,7 +83,7 @@ void addAllocations(CLI::App& app) {
         const std::uint64_t exactSlotsRuns = exactHybridSlots(lists, true);
         const std::uint64_t nonEmpty = minimumSlots(errors);
         for (BudgetSpec b : budgets) {
-          b.resolve(total, exactSlots, pixels);
+          b.resolve(total, exactSlots, exactSlotsRuns, pixels);
           const std::uint64_t F = std::min<std::uint64_t>(layout.slotBudget(b.byteCount()), total);
           std::cout << scenes[s].name << ", " << v << ", " << b.label << ": F = " << F << " slots (" << std::fixed
                     << std::setprecision(1) << 100.0 * static_cast<double>(F) / static_cast<double>(total)

@@ -42,11 +42,15 @@ RenderRequest parseMethodSpec(const std::string& spec, int w, int h);
 struct BudgetSpec {
   std::string label;
   double mib = 0.0;
-  double fragmentPercent = 0.0;  // fN, eN
-  bool ofExactSlots = false;     // eN: the percentage is of Σ max(1, n − 1)
-  std::uint64_t bytes = 0;       // kN, fN, eN: the exact byte count (0: mib as the user gave it)
-  // fN, eN: the bytes for a frame with Σn = total and Σ max(1, n − 1) = exactSlots.
-  void resolve(std::uint64_t total, std::uint64_t exactSlots, std::uint64_t pixels);
+  // fN: percent of Σn; eN: of Σ max(1, n − 1); xN: of Σ max(1, n − m), m(p) the final run of one
+  // colour (the slots from which vkb and dkb are exact with their default bounds).
+  enum class Of { Fragments, ExactSlots, ExactSlotsRuns };
+  double fragmentPercent = 0.0;  // fN, eN, xN
+  Of of = Of::Fragments;
+  std::uint64_t bytes = 0;  // kN, fN, eN, xN: the exact byte count (0: mib as the user gave it)
+  // fN, eN, xN: the bytes for a frame with Σn = total, Σ max(1, n − 1) = exactSlots and
+  // Σ max(1, n − m) = exactSlotsRuns.
+  void resolve(std::uint64_t total, std::uint64_t exactSlots, std::uint64_t exactSlotsRuns, std::uint64_t pixels);
   // budget_mib for the methods: exact byte counts half a byte up, so that their floor(MiB · 2^20)
   // gives back those bytes, not one less (a kN budget must hold k = N).
   [[nodiscard]] std::string paramText() const;

@@ -96,14 +96,17 @@ RenderRequest parseMethodSpec(const std::string& spec, int w, int h) {
 BudgetSpec parseBudgetSpec(const std::string& item, std::uint64_t pixels) {
   BudgetSpec b;
   b.label = item;
-  if (!item.empty() && (item[0] == 'f' || item[0] == 'e')) {
+  if (!item.empty() && (item[0] == 'f' || item[0] == 'e' || item[0] == 'x')) {
     const std::optional<double> percent = parseNumber(item.substr(1));
     if (!percent || !(*percent > 0.0) || *percent > 100.0)
-      throw Error("--budgets " + item, item[0] == 'f'
-                                           ? "expected fN with 0 < N <= 100 (% of the frame's fragments)"
-                                           : "expected eN with 0 < N <= 100 (% of the frame's Σ max(1, n − 1))");
+      throw Error("--budgets " + item, item[0] == 'f' ? "expected fN with 0 < N <= 100 (% of the frame's fragments)"
+                                       : item[0] == 'e'
+                                           ? "expected eN with 0 < N <= 100 (% of the frame's Σ max(1, n − 1))"
+                                           : "expected xN with 0 < N <= 100 (% of the frame's Σ max(1, n − m))");
     b.fragmentPercent = *percent;
-    b.ofExactSlots = item[0] == 'e';
+    b.of = item[0] == 'f'   ? BudgetSpec::Of::Fragments
+           : item[0] == 'e' ? BudgetSpec::Of::ExactSlots
+                            : BudgetSpec::Of::ExactSlotsRuns;
     return b;
   }
   if (!item.empty() && item[0] == 'k') {
@@ -119,7 +122,7 @@ BudgetSpec parseBudgetSpec(const std::string& item, std::uint64_t pixels) {
     return b;
   }
   const std::optional<double> mib = parseNumber(item);
-  if (!mib || *mib <= 0.0) throw Error("--budgets " + item, "expected MiB (a positive number), kN, fN or eN");
+  if (!mib || *mib <= 0.0) throw Error("--budgets " + item, "expected MiB (a positive number), kN, fN, eN or xN");
   b.mib = *mib;
   return b;
 }
@@ -131,10 +134,13 @@ std::vector<BudgetSpec> parseBudgetSpecs(const std::string& text, std::uint64_t 
   return budgets;
 }
 
-void BudgetSpec::resolve(std::uint64_t total, std::uint64_t exactSlots, std::uint64_t pixels) {
+void BudgetSpec::resolve(std::uint64_t total, std::uint64_t exactSlots, std::uint64_t exactSlotsRuns,
+                         std::uint64_t pixels) {
   if (!(fragmentPercent > 0.0)) return;
-  const double of = static_cast<double>(ofExactSlots ? exactSlots : total);
-  const auto slots = static_cast<std::uint64_t>(std::ceil(fragmentPercent / 100.0 * of));
+  const double whole = static_cast<double>(of == Of::Fragments    ? total
+                                           : of == Of::ExactSlots ? exactSlots
+                                                                  : exactSlotsRuns);
+  const auto slots = static_cast<std::uint64_t>(std::ceil(fragmentPercent / 100.0 * whole));
   bytes = variableKLayout(pixels).bytes(slots);
   mib = static_cast<double>(bytes) / (1024.0 * 1024.0);
 }

@@ -112,7 +112,8 @@ void addEvaluate(CLI::App& app) {
   cmd->add_option("--budgets", opt->budgets,
                   "Comma-separated budgets: MiB; kN = the memory of a uniform k = N k+-buffer with the tail; fN = the "
                   "memory with which the variable-k layout holds N % of each frame's fragments; eN = N % of its "
-                  "sum of max(1, n - 1), the slots with which hybrid is exact")
+                  "sum of max(1, n - 1), the slots with which hybrid is exact; xN = N % of its sum of max(1, n - m), m "
+                  "the final run of fragments of one colour (the exact threshold with tail_runs)")
       ->capture_default_str();
   cmd->add_option("--views", opt->views, "Comma-separated views")->capture_default_str();
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
@@ -189,7 +190,7 @@ void addEvaluate(CLI::App& app) {
         exactRequest.height = h;
         const ImageRGBA8 gpuExact = gpu.render(camera, exactRequest).image;
         const std::uint64_t total = lists.fragments.size();
-        const std::uint64_t exactSlots = exactHybridSlots(lists);
+        const std::uint64_t exactSlots = exactHybridSlots(lists), exactSlotsRuns = exactHybridSlots(lists, true);
         // --k-by-depth: n(p) of each method's own lists (the GPU's rasterisation, the oracle's rays).
         std::vector<std::uint32_t> gpuDepth, oracleDepth;
         if (opt->kByDepth) {
@@ -197,7 +198,7 @@ void addEvaluate(CLI::App& app) {
           oracleDepth = lists.counts();
         }
         for (BudgetSpec b : budgets) {
-          b.resolve(total, exactSlots, pixels);
+          b.resolve(total, exactSlots, exactSlotsRuns, pixels);
           std::vector<std::pair<std::string, double>> flips, rmses;
           std::vector<std::pair<std::string, std::vector<DepthBucket>>> depthTables;
           for (const std::string& m : methods) {
@@ -212,6 +213,7 @@ void addEvaluate(CLI::App& app) {
             row["budget"] = b.label;
             row["budget_mib"] = b.mib;
             row["exact_slots"] = exactSlots;
+            row["exact_slots_tail_runs"] = exactSlotsRuns;
             row["method"] = m;
             RenderOutput r;
             std::vector<double> times;

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mfr/budget/memory_model.hpp"
 #include "mfr/image.hpp"
 
 namespace fs = std::filesystem;
@@ -301,6 +303,42 @@ TEST_F(Cli, AllocationsCompareAtOneBudget) {
   }
 }
 
+// eN and xN budgets are the given share of the frame's two exact thresholds, Σ max(1, n − 1) and
+// Σ max(1, n − m), both counted on the oracle's lists and written to the JSON. Two boxes of one
+// colour behind a red one, seen face on: every face of a box is shaded alike (|n·l| = 1), so the
+// lists end in runs of 2 or 4 fragments of one colour and the two thresholds differ.
+TEST_F(Cli, EvaluateBudgetsRelativeToTheExactThresholds) {
+  const fs::path scene = file("boxes.mfrscene", R"({"objects": [
+    {"primitive": {"type": "box", "size": [1.6, 1.6, 1.0]}, "color": [0.2, 0.4, 0.9], "opacity": 0.3},
+    {"primitive": {"type": "box", "size": [1.6, 1.6, 1.0]}, "color": [0.2, 0.4, 0.9], "opacity": 0.3,
+     "transform": {"translate": [0.3, 0.2, -2.0]}},
+    {"primitive": {"type": "box", "size": [0.8, 0.8, 0.5]}, "color": [0.9, 0.2, 0.2], "opacity": 0.5,
+     "transform": {"translate": [0.0, 0.0, 2.0]}}],
+    "views": [{"name": "face", "eye": [0, 0, 10], "target": [0, 0, 0], "projection": "orthographic",
+               "height": 3.0}]})");
+  const fs::path json = dir_ / "x.json";
+  const Result r = run("evaluate " + scene.string() +
+                       " -s 40x30 --views face --budgets e60,x60,x100 -r 1 -m vkb --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json results = nlohmann::json::parse(in).at("results");
+  ASSERT_EQ(results.size(), 3u);
+  const mfr::VariableKLayout layout = mfr::variableKLayout(40 * 30);
+  for (const nlohmann::json& row : results) {
+    const std::string budget = row.at("budget");
+    const auto exact = row.at("exact_slots").get<std::uint64_t>();
+    const auto exactRuns = row.at("exact_slots_tail_runs").get<std::uint64_t>();
+    EXPECT_GT(exactRuns, 0u);
+    EXPECT_LT(exactRuns * 10, exact * 8) << "the scene should end its lists in one-colour runs";
+    const double share = std::stod(budget.substr(1)) / 100.0;
+    const auto slots =
+        static_cast<std::uint64_t>(std::ceil(share * static_cast<double>(budget[0] == 'e' ? exact : exactRuns)));
+    const auto bytes = static_cast<std::uint64_t>(std::llround(row.at("budget_mib").get<double>() * 1024.0 * 1024.0));
+    EXPECT_EQ(bytes, layout.bytes(slots)) << budget;
+    EXPECT_LE(row.at("bytes_allocated").get<std::uint64_t>(), bytes) << budget;
+  }
+}
+
 TEST_F(Cli, BudgetCommandsBadInput) {
   // A corrupt dataset, a missing dataset, bad budgets, a bad weights file.
   const fs::path junk = file("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");
@@ -318,6 +356,7 @@ TEST_F(Cli, BudgetCommandsBadInput) {
   for (const auto& [args, mention] :
        std::vector<std::pair<std::string, std::string>>{{"--budgets banana", "--budgets banana"},
                                                         {"--budgets e0", "--budgets e0"},
+                                                        {"--budgets x101", "--budgets x101"},
                                                         {"-m vkb:exact_tail", "--methods vkb:exact_tail"},
                                                         {"-m vkb,nosuch:k=1", "--methods nosuch:k=1"}}) {
     const Result r = run("evaluate @sample -s 16x16 " + args + " --json " + json.string());
