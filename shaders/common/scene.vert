@@ -14,6 +14,10 @@ uniform vec4 uColor;
 
 out vec3 vNormal;
 out vec4 vColor;
+// Multi-pass methods compare a fragment's depth across programs (peeling, the nearest and
+// farthest passes, the tail runs): GLSL guarantees equal positions across programs only for an
+// invariant output.
+invariant gl_Position;
 
 void main() {
   vNormal = uNormalMatrix * aNormal;
