@@ -305,6 +305,30 @@ TEST_P(VariableK, TailRunsMakeOneColourTailsFree) {
   EXPECT_EQ(same, compared);
   EXPECT_GT(longRuns, pixels() / 10);                   // not vacuous: runs of 2..n−1 are common
   ASSERT_LT(exactSlots * 100, exactSlotsOneTail * 90);  // and they save slots
+  // On this scene the runs shape the allocation: GPU k(p) = the CPU rule with the GPU's m(p).
+  method->setKeepImportance(true);
+  std::size_t shapedByRuns = 0;  // pixels whose k the bound max(1, n − 1) alone would change
+  for (double fraction : {0.85, 0.95, 1.3}) {
+    SCOPED_TRACE("fraction " + std::to_string(fraction) + " of Σ max(1, n − m)");
+    const RenderRequest req =
+        budgetRequest(GetParam(), layout.bytes(static_cast<std::uint64_t>(fraction * static_cast<double>(exactSlots))));
+    gpu.render(camera, req);
+    const std::uint64_t F =
+        std::min(layout.slotBudget(budgetOf(req)), std::accumulate(n.begin(), n.end(), std::uint64_t{0}));
+    const ImportanceAllocation cpu =
+        allocateKFromImportance(method->lastImportance(), method->lastCounts(), F, true, method->lastTailRuns());
+    const ImportanceAllocation cpuOneTail = allocateKFromImportance(method->lastImportance(), method->lastCounts(), F);
+    const std::vector<std::uint32_t> k = method->capacityMap();
+    std::size_t differ = 0, differOneTail = 0;
+    for (std::size_t p = 0; p < k.size(); ++p) {
+      differ += k[p] != cpu.k[p];
+      differOneTail += k[p] != cpuOneTail.k[p];
+    }
+    EXPECT_EQ(differ, 0u);
+    if (fraction < 1.0) shapedByRuns += differOneTail;
+  }
+  EXPECT_GT(shapedByRuns, 0u);  // not vacuous: the comparison sees the runs
+  method->setKeepImportance(false);
   const ImageRGBA8 exact = compositeOver(oracle, scene.background);
   for (const bool tailRuns : {true, false}) {
     RenderRequest req = budgetRequest(GetParam(), layout.bytes(exactSlots));
