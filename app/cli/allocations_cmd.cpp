@@ -14,7 +14,6 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
-#include <span>
 
 #include <nlohmann/json.hpp>
 
@@ -31,8 +30,6 @@
 #include "mfr/reference/oracle.hpp"
 
 namespace mfr::cli {
-
-namespace {}  // namespace
 
 void addAllocations(CLI::App& app) {
   struct Options {
@@ -62,6 +59,7 @@ void addAllocations(CLI::App& app) {
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     // Every allocation gets dkb's slots (its layout also holds the weights), so all compete at one F.
     const VariableKLayout layout = variableKLayout(pixels, NeuralImportanceModel::packedBytes());
+    const std::vector<float> flat(pixels, 1.0f);
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
     for (std::size_t s = 0; s < scenes.size(); ++s)
       for (const std::string& v : views) {
@@ -80,7 +78,7 @@ void addAllocations(CLI::App& app) {
         const HybridErrorTable classesByTail = classMeanErrorTable(errors, lastTwoEqual);
         const DkbImageStats stats = dkbImageStats(lists);
         const std::uint64_t total = lists.fragments.size(), exactSlots = exactHybridSlots(lists);
-        const std::uint64_t exactSlotsRuns = exactHybridSlots(lists, true);
+        const std::uint64_t exactSlotsRuns = exactHybridSlots(lists, runs);
         const std::uint64_t nonEmpty = minimumSlots(errors);
         for (BudgetSpec b : budgets) {
           b.resolve(total, exactSlots, exactSlotsRuns, pixels);
@@ -97,13 +95,13 @@ void addAllocations(CLI::App& app) {
           std::vector<float> importance(pixels, 0.0f);
           for (std::size_t p = 0; p < pixels; ++p)
             if (n[p] > 0) importance[p] = neuralImportance(model, dkbFeatures(lists.pixel(p), stats, F), n[p]);
-          const std::vector<std::uint32_t> kd = allocateKFromImportance(importance, n, F, true, {}).k;
+          const std::vector<std::uint32_t> kd = allocateKFromImportance(importance, n, F).k;
           const std::vector<std::uint32_t> ko = optimalKBest(errors, F).k;
           const std::vector<std::pair<std::string, std::vector<std::uint32_t>>> allocations = {
               {"dkb", kd},
               {"dkb+runs", allocateKFromImportance(importance, n, F, true, runs).k},
-              {"flat", allocateKFromImportance(std::vector<float>(pixels, 1.0f), n, F, true, {}).k},
-              {"flat+runs", allocateKFromImportance(std::vector<float>(pixels, 1.0f), n, F, true, runs).k},
+              {"flat", allocateKFromImportance(flat, n, F).k},
+              {"flat+runs", allocateKFromImportance(flat, n, F, true, runs).k},
               {"class-optimal", optimalKBest(classes, F).k},
               {"class-optimal+tail", optimalKBest(classesByTail, F).k},
               {"optimal-k", ko}};

@@ -38,7 +38,8 @@ RenderRequest parseMethodSpec(const std::string& spec, int w, int h);
 // A memory budget of mfr evaluate / mfr allocations: "3.5" MiB; "kN" the bytes of a uniform-k
 // k+-buffer with the tail (fkb's layout) at k = N; "fN" the bytes with which the variable-k layout
 // holds N % of the frame's fragments; "eN" N % of Σ max(1, n − 1), the slots after which hybrid
-// transparency is exact everywhere (fN and eN resolved per frame by resolve()).
+// transparency is exact everywhere; "xN" N % of Σ max(1, n − m) (fN, eN and xN resolved per frame
+// by resolve()).
 struct BudgetSpec {
   std::string label;
   double mib = 0.0;

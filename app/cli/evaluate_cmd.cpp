@@ -47,10 +47,11 @@ std::vector<DepthBucket> kByDepth(std::span<const std::uint32_t> n, std::span<co
   if (n.size() != k.size()) throw Error("--k-by-depth", "the k map and the depth complexity differ in size");
   for (std::size_t p = 0; p < n.size(); ++p) {
     if (n[p] == 0) continue;
-    auto b = std::upper_bound(std::begin(kEdges), std::end(kEdges), n[p]) - std::begin(kEdges) - 1;
-    buckets[static_cast<std::size_t>(b)].pixels += 1;
-    buckets[static_cast<std::size_t>(b)].sumN += n[p];
-    buckets[static_cast<std::size_t>(b)].sumK += k[p];
+    const auto b = std::upper_bound(std::begin(kEdges), std::end(kEdges), n[p]) - std::begin(kEdges) - 1;
+    DepthBucket& bucket = buckets[static_cast<std::size_t>(b)];
+    bucket.pixels += 1;
+    bucket.sumN += n[p];
+    bucket.sumK += k[p];
   }
   return buckets;
 }
@@ -190,7 +191,7 @@ void addEvaluate(CLI::App& app) {
         exactRequest.height = h;
         const ImageRGBA8 gpuExact = gpu.render(camera, exactRequest).image;
         const std::uint64_t total = lists.fragments.size();
-        const std::uint64_t exactSlots = exactHybridSlots(lists), exactSlotsRuns = exactHybridSlots(lists, true);
+        const std::uint64_t exactSlots = exactHybridSlots(lists), exactSlotsRuns = exactHybridSlots(lists, tailRunLengths(lists));
         // --k-by-depth: n(p) of each method's own lists (the GPU's rasterisation, the oracle's rays).
         std::vector<std::uint32_t> gpuDepth, oracleDepth;
         if (opt->kByDepth) {

@@ -2,7 +2,6 @@
 // Visual Computer 2022), budget/allocation.h.] After the search: k_lo(p) = k at λ_lo into K(p),
 // and how much k grows up to λ_hi into T(1, p), whose prefix sum decides which pixels take the
 // F − S(lo) remaining slots. Element W·H of both is 0 (the scans run over W·H + 1 elements).
-#include "budget/allocation.h"
 #include "budget/arena.glsl"
 
 layout(local_size_x = 256) in;

@@ -3,7 +3,6 @@
 // order-independent transparency", The Visual Computer 2022 — our rule, budget/allocation.h.]
 // One round of the λ search: S(c_j) = Σ_p k_{c_j}(p) at the 15 candidates between lo and hi.
 // Importance I(p) is in T(0, p).
-#include "budget/allocation.h"
 #include "budget/arena.glsl"
 
 layout(local_size_x = 256) in;

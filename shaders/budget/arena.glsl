@@ -9,6 +9,7 @@
 //   K(p)      nearest colour (dkb) → tail run m(p) → k(p) → the prefix-sum offsets of the store pass
 #ifndef MFR_ARENA_GLSL
 #define MFR_ARENA_GLSL
+#include "budget/allocation.h"
 #include "common/bindings.h"
 
 layout(std430, binding = MFR_SSBO_ARENA) coherent buffer VariableKArena { uint arena[]; };
@@ -44,13 +45,11 @@ uint vkN(uint p) { return uVkLockBase + p; }
 uint vkT(uint i, uint p) { return uVkTailBase + i * uVkStride + p; }
 uint vkK(uint p) { return uVkKBase + p; }
 
-#ifdef MFR_ALLOCATION_H
-// e(p) of the allocation rule (budget/allocation.h, included before this file): with
-// MFR_ALLOC_RUNS the tail-run passes left m(p) in K(p), which the assign pass then overwrites.
+// e(p) of the allocation rule: with MFR_ALLOC_RUNS the tail-run passes left m(p) in K(p), which
+// the assign pass then overwrites.
 uint vkExactK(uint p, uint n) {
   return mfrAllocExactK(n, (vkAllocMode & MFR_ALLOC_RUNS) != 0u ? arena[vkK(p)] : 1u);
 }
-#endif
 
 // Compute passes over pixels: `size` per work group on a 2D grid (one dimension holds 65535 groups).
 // A macro, so that fragment shaders including this file never see compute built-ins.

@@ -3,7 +3,6 @@
 // Computer 2022, §3.3 — budget/allocation.h.] After the tail-run passes: Σ e(p) = Σ max(1, n − m)
 // into vkExactSlots, the budget from which the frame is exact and where the allocation switches
 // from capping at e(p) to filling above it. Work-group reduction, one global atomic per group.
-#include "budget/allocation.h"
 #include "budget/arena.glsl"
 
 layout(local_size_x = 256) in;

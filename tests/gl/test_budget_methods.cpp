@@ -290,11 +290,15 @@ TEST_P(VariableK, TailRunsMakeOneColourTailsFree) {
   // m(p) on the GPU = the oracle's, wherever the two see the same list length.
   const std::vector<std::uint32_t> oracleN = toGlRows(oracle.counts(), kW, kH);
   const std::vector<std::uint32_t> oracleM = toGlRows(tailRunLengths(oracle), kW, kH);
+  // max(1, n − m), written out here rather than taken from the rule under test.
+  auto exactK = [&](std::size_t p) -> std::uint32_t {
+    const std::uint32_t run = std::max(m[p], 1u);
+    return n[p] > run ? n[p] - run : std::min(n[p], 1u);
+  };
   std::size_t same = 0, compared = 0, longRuns = 0;
   std::uint64_t exactSlots = 0, exactSlotsOneTail = 0;
   for (std::size_t p = 0; p < n.size(); ++p) {
-    const std::uint32_t run = std::max(m[p], 1u);
-    exactSlots += n[p] > run ? n[p] - run : std::min(n[p], 1u);
+    exactSlots += exactK(p);
     exactSlotsOneTail += n[p] > 1 ? n[p] - 1 : n[p];
     if (n[p] != oracleN[p] || n[p] == 0) continue;
     ++compared;
@@ -343,10 +347,7 @@ TEST_P(VariableK, TailRunsMakeOneColourTailsFree) {
     if (tailRuns) {
       const std::vector<std::uint32_t> k = method->capacityMap();
       std::size_t notAtBound = 0;
-      for (std::size_t p = 0; p < n.size(); ++p) {
-        const std::uint32_t run = std::max(m[p], 1u);
-        notAtBound += k[p] != (n[p] > run ? n[p] - run : std::min(n[p], 1u));
-      }
+      for (std::size_t p = 0; p < n.size(); ++p) notAtBound += k[p] != exactK(p);
       EXPECT_EQ(notAtBound, 0u);
       const auto note = std::find_if(out.stats.notes.begin(), out.stats.notes.end(),
                                      [](const auto& kv) { return kv.first == "exact at"; });

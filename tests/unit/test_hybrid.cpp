@@ -134,7 +134,7 @@ TEST(Hybrid, TailRunLengthsAndTheirExactness) {
   const std::vector<std::uint32_t> m = mfr::tailRunLengths(lists);
   EXPECT_EQ(m, (std::vector<std::uint32_t>{0, 1, 3, 3, 1, 0, 2}));
   // max(1, n − max(m, 1)): 0, 1, 2, 1, 2, 2, 2.
-  EXPECT_EQ(mfr::exactHybridSlots(lists, true), 10u);
+  EXPECT_EQ(mfr::exactHybridSlots(lists, m), 10u);
   EXPECT_EQ(mfr::exactHybridSlots(lists), 0u + 1u + 4u + 2u + 2u + 2u + 3u);
   const glm::vec3 bg(0.9f, 0.8f, 0.3f);
   const std::vector<std::uint32_t> k{0, 1, 2, 1, 2, 2, 2};

@@ -9,6 +9,7 @@
 
 #include <glm/gtc/packing.hpp>
 
+#include "budget/glsl_shared.hpp"
 #include "mfr/error.hpp"
 #include "mfr/reference/composite.hpp"
 
@@ -103,14 +104,10 @@ std::vector<std::uint32_t> tailRunLengths(const FragmentLists& lists) {
   return runs;
 }
 
-std::uint64_t exactHybridSlots(const FragmentLists& lists, bool tailRuns) {
-  const std::vector<std::uint32_t> runs = tailRuns ? tailRunLengths(lists) : std::vector<std::uint32_t>{};
+std::uint64_t exactHybridSlots(const FragmentLists& lists, std::span<const std::uint32_t> tailRuns) {
   std::uint64_t slots = 0;
-  for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p) {
-    const std::uint32_t n = lists.offsets[p + 1] - lists.offsets[p];
-    const std::uint32_t m = std::max(tailRuns ? runs[p] : 1u, 1u);
-    slots += n > m ? n - m : std::min(n, 1u);
-  }
+  for (std::size_t p = 0; p + 1 < lists.offsets.size(); ++p)
+    slots += glsl::mfrAllocExactK(lists.offsets[p + 1] - lists.offsets[p], tailRuns.empty() ? 1u : tailRuns[p]);
   return slots;
 }
 

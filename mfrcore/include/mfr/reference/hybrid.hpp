@@ -59,8 +59,8 @@ double hybridError(std::span<const Fragment> sorted, std::uint32_t k, glm::vec3 
 std::vector<std::uint32_t> tailRunLengths(const FragmentLists& lists);
 
 // Σ max(1, n(p) − 1) over the non-empty pixels: with that many core slots, k(p) = max(1, n − 1),
-// the hybrid image is exact everywhere (a one-fragment tail composites exactly). With tailRuns,
-// Σ max(1, n(p) − m(p)) for the m of tailRunLengths: the least budget of an exact image.
-std::uint64_t exactHybridSlots(const FragmentLists& lists, bool tailRuns = false);
+// the hybrid image is exact everywhere (a one-fragment tail composites exactly). Given tailRuns
+// (tailRunLengths(lists)), Σ max(1, n(p) − m(p)): the least budget of an exact image.
+std::uint64_t exactHybridSlots(const FragmentLists& lists, std::span<const std::uint32_t> tailRuns = {});
 
 }  // namespace mfr
