@@ -11,6 +11,8 @@
 
 // Uniform block with the per-frame camera
 #define MFR_UBO_FRAME 0
+// Uniform block with the dkb network's weights (budget/mlp_layout.h)
+#define MFR_UBO_DKB_WEIGHTS 1
 
 // Shader storage buffers
 #define MFR_SSBO_NODES 0      // fragment storage (linked-list nodes, arrays, …)
@@ -24,7 +26,6 @@
 #define MFR_SSBO_LOCKS 8      // per-pixel spin-lock words kept in a buffer (variable-k buffers)
 #define MFR_SSBO_ARENA 9      // per-pixel arena of the variable-k buffers (features, k(p), …)
 #define MFR_SSBO_BUDGET 10    // per-frame budget state: image sums, allocation search, F(M)
-#define MFR_SSBO_WEIGHTS 11   // neural importance: MLP weights
 
 // Image units
 #define MFR_IMAGE_HEADS 0

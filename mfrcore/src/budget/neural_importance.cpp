@@ -23,17 +23,43 @@ namespace detail {
 const std::map<std::string, std::string_view, std::less<>>& embeddedResources();  // generated
 }  // namespace detail
 
+namespace {
+// Float index (in NeuralImportanceModel::weights) of the weight at 8-bit index q, and of row r's
+// bias: the quantised weights are contiguous, the float layout interleaves each layer's biases.
+constexpr int floatIndexOfWeight(int q) {
+  return q < MFR_MLP_Q_W2 ? MFR_MLP_W1 + q
+                          : (q < MFR_MLP_Q_W3 ? MFR_MLP_W2 + (q - MFR_MLP_Q_W2) : MFR_MLP_W3 + (q - MFR_MLP_Q_W3));
+}
+constexpr int floatIndexOfBias(int r) {
+  return r < MFR_MLP_HIDDEN1
+             ? MFR_MLP_B1 + r
+             : (r < MFR_MLP_HIDDEN1 + MFR_MLP_HIDDEN2 ? MFR_MLP_B2 + (r - MFR_MLP_HIDDEN1) : MFR_MLP_B3);
+}
+}  // namespace
+
 namespace glsl {
 namespace {
-thread_local const float* tMlpWeights = nullptr;
+// The model the shared forward pass reads: a quantised one as the GPU does (q and the row's
+// scale), an unquantised one (fresh from training) with scale 1 and the float weights as q.
+thread_local const NeuralImportanceModel* tMlp = nullptr;
+vec4 cpuQuad(int q) {
+  if (!tMlp->quant.empty()) {
+    const std::int8_t* w = tMlp->quant.data() + q;
+    return {static_cast<float>(w[0]), static_cast<float>(w[1]), static_cast<float>(w[2]), static_cast<float>(w[3])};
+  }
+  const float* w = tMlp->weights.data() + floatIndexOfWeight(q);
+  return {w[0], w[1], w[2], w[3]};
+}
 }  // namespace
-#define MFR_MLP_STAT(i) tMlpWeights[i]
-#define MFR_MLP_BIAS(f, b) tMlpWeights[f]
-#define MFR_MLP_ROW_WEIGHT(f, q, r) tMlpWeights[f]
+#define MFR_MLP_STAT(i) tMlp->weights[static_cast<std::size_t>(i)]
+#define MFR_MLP_BIAS(r) tMlp->weights[static_cast<std::size_t>(floatIndexOfBias(r))]
+#define MFR_MLP_SCALE(r) (tMlp->quant.empty() ? 1.0f : tMlp->rowScales[static_cast<std::size_t>(r)])
+#define MFR_MLP_QUAD(q) cpuQuad(q)
 #include "budget/mlp.h"
 #undef MFR_MLP_STAT
 #undef MFR_MLP_BIAS
-#undef MFR_MLP_ROW_WEIGHT
+#undef MFR_MLP_SCALE
+#undef MFR_MLP_QUAD
 }  // namespace glsl
 
 namespace {
@@ -74,16 +100,20 @@ NeuralImportanceModel NeuralImportanceModel::quantised() const {
   if (weights.size() != MFR_MLP_FLOATS) throw Error("dkb weights", "model has the wrong number of weights");
   NeuralImportanceModel m = *this;
   m.rowScales.assign(MFR_MLP_ROWS, 0.0f);
+  m.quant.assign(MFR_MLP_Q_COUNT, 0);
   for (int l = 0; l < 3; ++l) {
     const int rows = kLayerShape[l][0], cols = kLayerShape[l][1];
     for (int r = 0; r < rows; ++r) {
       float* w = m.weights.data() + kLayerWeights[l] + r * cols;
+      std::int8_t* q = m.quant.data() + kLayerQuant[l] + r * cols;
       float maxAbs = 0.0f;
       for (int c = 0; c < cols; ++c) maxAbs = std::max(maxAbs, std::abs(w[c]));
       const float scale = maxAbs / 127.0f;
       m.rowScales[static_cast<std::size_t>(kLayerRows[l] + r)] = scale;
-      for (int c = 0; c < cols; ++c)
-        w[c] = scale > 0.0f ? scale * std::clamp(std::round(w[c] / scale), -127.0f, 127.0f) : 0.0f;
+      for (int c = 0; c < cols; ++c) {
+        q[c] = static_cast<std::int8_t>(scale > 0.0f ? std::clamp(std::round(w[c] / scale), -127.0f, 127.0f) : 0.0f);
+        w[c] = scale * static_cast<float>(q[c]);
+      }
     }
   }
   return m;
@@ -91,7 +121,8 @@ NeuralImportanceModel NeuralImportanceModel::quantised() const {
 
 std::vector<std::uint32_t> NeuralImportanceModel::packedWords() const {
   if (weights.size() != MFR_MLP_FLOATS) throw Error("dkb weights", "model has the wrong number of weights");
-  if (rowScales.size() != MFR_MLP_ROWS) throw Error("dkb weights", "model is not quantised");
+  if (rowScales.size() != MFR_MLP_ROWS || quant.size() != MFR_MLP_Q_COUNT)
+    throw Error("dkb weights", "model is not quantised");
   std::vector<std::uint32_t> words(MFR_MLP_PACKED_WORDS, 0);
   const auto bits = [](float f) {
     std::uint32_t u = 0;
@@ -99,24 +130,14 @@ std::vector<std::uint32_t> NeuralImportanceModel::packedWords() const {
     return u;
   };
   for (std::size_t i = 0; i < MFR_MLP_W1; ++i) words[i] = bits(weights[i]);
-  for (int l = 0; l < 3; ++l) {
-    const int rows = kLayerShape[l][0], cols = kLayerShape[l][1];
-    for (int r = 0; r < rows; ++r) {
-      const int row = kLayerRows[l] + r;
-      const float scale = rowScales[static_cast<std::size_t>(row)];
-      words[static_cast<std::size_t>(MFR_MLP_GPU_BIAS + row)] =
-          bits(weights[static_cast<std::size_t>(kLayerBias[l] + r)]);
-      words[static_cast<std::size_t>(MFR_MLP_GPU_SCALE + row)] = bits(scale);
-      for (int c = 0; c < cols; ++c) {
-        const float w = weights[static_cast<std::size_t>(kLayerWeights[l] + r * cols + c)];
-        const int q = scale > 0.0f ? static_cast<int>(std::round(w / scale)) : 0;
-        if (q < -127 || q > 127) throw Error("dkb weights", "a weight is out of its row's 8-bit range");
-        const int j = kLayerQuant[l] + r * cols + c;
-        words[static_cast<std::size_t>(MFR_MLP_GPU_QUANT + j / 4)] |=
-            static_cast<std::uint32_t>(static_cast<std::uint8_t>(static_cast<std::int8_t>(q))) << (8 * (j % 4));
-      }
-    }
+  for (int row = 0; row < MFR_MLP_ROWS; ++row) {
+    words[static_cast<std::size_t>(MFR_MLP_GPU_BIAS + row)] =
+        bits(weights[static_cast<std::size_t>(floatIndexOfBias(row))]);
+    words[static_cast<std::size_t>(MFR_MLP_GPU_SCALE + row)] = bits(rowScales[static_cast<std::size_t>(row)]);
   }
+  for (std::size_t j = 0; j < quant.size(); ++j)
+    words[static_cast<std::size_t>(MFR_MLP_GPU_QUANT) + j / 4] |=
+        static_cast<std::uint32_t>(static_cast<std::uint8_t>(quant[j])) << (8 * (j % 4));
   return words;
 }
 
@@ -209,10 +230,12 @@ NeuralImportanceModel loadNeuralImportance(const std::string& path) {
 
 float predictNeuralImportance(const NeuralImportanceModel& model, const DkbFeatureVector& f) {
   if (model.weights.size() != MFR_MLP_FLOATS) throw Error("dkb weights", "model has the wrong number of weights");
-  glsl::tMlpWeights = model.weights.data();
+  if (!model.quant.empty() && (model.quant.size() != MFR_MLP_Q_COUNT || model.rowScales.size() != MFR_MLP_ROWS))
+    throw Error("dkb weights", "model is quantised inconsistently");
+  glsl::tMlp = &model;
   const float y = glsl::mfrMlpForward(glm::vec4(f[0], f[1], f[2], f[3]), glm::vec4(f[4], f[5], f[6], f[7]),
                                       glm::vec4(f[8], f[9], f[10], f[11]));
-  glsl::tMlpWeights = nullptr;
+  glsl::tMlp = nullptr;
   return y;
 }
 

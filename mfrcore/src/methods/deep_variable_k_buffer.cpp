@@ -1,6 +1,11 @@
 #include "deep_variable_k_buffer.hpp"
 
+#include "budget/mlp_layout.h"
 #include "common/bindings.h"
+
+// The weights are one std140 uniform block of uvec4 (shaders/methods/dkb/mlp.comp): it must fit the
+// least GL_MAX_UNIFORM_BLOCK_SIZE that OpenGL 4.5 guarantees.
+static_assert(MFR_MLP_PACKED_WORDS % 4 == 0 && 4 * MFR_MLP_PACKED_WORDS <= 16384);
 
 namespace mfr {
 
@@ -68,7 +73,7 @@ std::uint32_t DeepVariableKBuffer::drawFeatures(const FrameContext& ctx) {
 }
 
 void DeepVariableKBuffer::computeImportance(const FrameContext&) {
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_WEIGHTS, weights_.id());
+  glBindBufferBase(GL_UNIFORM_BUFFER, MFR_UBO_DKB_WEIGHTS, weights_.id());
   setArenaUniforms(mlp_);
   mlp_.set("uTarget", model_.predictsFractionOfList() ? 0u : 1u);
   dispatchPixels(mlp_, 64);

@@ -1,6 +1,6 @@
 // Deep hybrid order-independent transparency (Tsopouridis, Fudos, Vasilakis, The Visual Computer
 // 2022, §4): the 12 features of each pixel (budget/features.h) and the network's prediction
-// (budget/mlp.h; weights at MFR_SSBO_WEIGHTS as 8-bit integers with per-row scales), turned into
+// (budget/mlp.h; weights in the uniform block MFR_UBO_DKB_WEIGHTS as 8-bit integers with per-row scales), turned into
 // the importance I(p) in T(0) that the shared allocation rule distributes the budget by. uTarget says what the network predicts:
 // 0 = k(p)/n(p), 1 = k(p)/F(M) (mfrDkbImportance).
 #include "budget/arena.glsl"
@@ -9,15 +9,19 @@
 #include "budget/features.h"
 
 #include "budget/mlp_layout.h"
-layout(std430, binding = MFR_SSBO_WEIGHTS) readonly buffer DkbWeights { uint mlpWords[]; };
-// Statistics, biases and row scales as floats; weights as signed bytes (MFR_MLP_PACKED_WORDS layout).
-#define MFR_MLP_STAT(i) uintBitsToFloat(mlpWords[i])
-#define MFR_MLP_BIAS(f, b) uintBitsToFloat(mlpWords[MFR_MLP_GPU_BIAS + (b)])
-float mlpRowWeight(int q, int row) {
-  int byte = bitfieldExtract(int(mlpWords[MFR_MLP_GPU_QUANT + (q >> 2)]), 8 * (q & 3), 8);  // sign-extends
-  return uintBitsToFloat(mlpWords[MFR_MLP_GPU_SCALE + row]) * float(byte);
+// Statistics, biases and row scales as float words, then the weights as signed bytes, four per word
+// (MFR_MLP_PACKED_WORDS layout), in a uniform block: every invocation reads the same word at once.
+layout(std140, binding = MFR_UBO_DKB_WEIGHTS) uniform DkbWeights { uvec4 mlpWords[MFR_MLP_PACKED_WORDS / 4]; };
+#define MFR_MLP_WORD(i) mlpWords[(i) >> 2][(i) & 3]
+#define MFR_MLP_STAT(i) uintBitsToFloat(MFR_MLP_WORD(i))
+#define MFR_MLP_BIAS(r) uintBitsToFloat(MFR_MLP_WORD(MFR_MLP_GPU_BIAS + (r)))
+#define MFR_MLP_SCALE(r) uintBitsToFloat(MFR_MLP_WORD(MFR_MLP_GPU_SCALE + (r)))
+// Four signed bytes of one word (bitfieldExtract sign-extends).
+vec4 mlpQuad(int q) {
+  int w = int(MFR_MLP_WORD(MFR_MLP_GPU_QUANT + (q >> 2)));
+  return vec4(bitfieldExtract(w, 0, 8), bitfieldExtract(w, 8, 8), bitfieldExtract(w, 16, 8), bitfieldExtract(w, 24, 8));
 }
-#define MFR_MLP_ROW_WEIGHT(f, q, r) mlpRowWeight(q, r)
+#define MFR_MLP_QUAD(q) mlpQuad(q)
 #include "budget/mlp.h"
 
 layout(local_size_x = 64) in;

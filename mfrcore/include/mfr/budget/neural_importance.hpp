@@ -3,8 +3,8 @@
 // order-independent transparency", The Visual Computer 2022, §4): 12 per-pixel features →
 // 128 → 64 → 1 (ReLU, ReLU, sigmoid), standardised inputs. This header holds the model as the GPU
 // reads it (the float layout of shaders/budget/mlp.h), its JSON weights file, the CPU forward pass
-// (same accumulation order as the shader) and the features of exact per-pixel lists (the CPU twin
-// of dkb's feature passes, for training data).
+// (the shader's own code: same accumulation order, 8-bit weights and row scales once quantised) and the features of
+// exact per-pixel lists (the CPU twin of dkb's feature passes, for training data).
 //
 // Weights file (JSON): {"format": "mfr-dkb-weights", "version": 1, "architecture": [12,128,64,1],
 // "target": "k_over_n" | "k_over_budget", "input_mean": [12], "input_std": [12],
@@ -30,6 +30,7 @@ struct NeuralImportanceModel {
   std::string trainingJson = "{}";  // the file's "training" object, verbatim (provenance)
   std::string source;               // the path it was read from, or "built-in"
   std::vector<float> rowScales;     // per output row (MFR_MLP_ROWS) once quantised(), else empty
+  std::vector<std::int8_t> quant;   // every weight's q (MFR_MLP_Q_COUNT, weight = scale(row)·q) once quantised()
 
   [[nodiscard]] bool predictsFractionOfList() const { return target == "k_over_n"; }
   static std::size_t floatCount();
