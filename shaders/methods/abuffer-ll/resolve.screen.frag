@@ -9,10 +9,17 @@ layout(r32ui, binding = MFR_IMAGE_HEADS) uniform readonly uimage2D uHeads;
 
 uint mfrCursorBegin(ivec2 pixel) { return imageLoad(uHeads, pixel).x; }
 
+// A node never links to itself (its next is an older head), so a cursor whose next is itself ends
+// the walk. Measured on llvmpipe: without this check every group of pixels walked to the bound
+// (resolve time proportional to the bound, not to the lists: 197 ms on the dragon at 512² with
+// lists of at most 12, 8 ms with the bound at 64) — so in each group some lane followed such a
+// self-link, most likely a lane whose loads are masked and read 0 (node 0 → node 0). With it the
+// walk stops there: 6.8 ms.
 bool mfrNext(inout uint cursor, out MfrFragment f) {
   if (cursor == MFR_NIL) return false;
   f = MfrFragment(nodeWords[3u * cursor], uintBitsToFloat(nodeWords[3u * cursor + 1u]));
-  cursor = nodeWords[3u * cursor + 2u];
+  uint next = nodeWords[3u * cursor + 2u];
+  cursor = next == cursor ? MFR_NIL : next;
   return true;
 }
 
