@@ -13,19 +13,25 @@ void main() {
   uint t = gl_LocalInvocationIndex;
   if (t < 15u) sSums[t] = 0u;
   barrier();
-  uint p = VK_INVOCATION_PIXEL(256u);
-  if (p < uVkPixels) {
+  // Each invocation sums MFR_ALLOC_SEARCH_PIXELS pixels (strided by the group size, so a group
+  // still reads neighbouring words) before one shared atomic per candidate: the atomics, not the
+  // rule, were the pass's cost.
+  uint sums[15];
+  for (uint j = 0u; j < 15u; ++j) sums[j] = 0u;
+  uint first = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * (256u * MFR_ALLOC_SEARCH_PIXELS) + t;
+  uint lo = vkLo, hi = vkHi, mode = vkAllocMode;
+  for (uint i = 0u; i < MFR_ALLOC_SEARCH_PIXELS; ++i) {
+    uint p = first + i * 256u;
+    if (p >= uVkPixels) break;
     uint n = arena[vkN(p)];
-    if (n > 0u) {
-      float importance = uintBitsToFloat(arena[vkT(0u, p)]);
-      uint e = vkExactK(p, n);
-      uint lo = vkLo, hi = vkHi, mode = vkAllocMode;
-      for (uint j = 1u; j < MFR_ALLOC_SECTIONS; ++j) {
-        uint k = mfrAllocK(uintBitsToFloat(mfrAllocCandidate(lo, hi, j)), importance, n, e, mode);
-        if (k != 0u) atomicAdd(sSums[j - 1u], k);
-      }
-    }
+    if (n == 0u) continue;
+    float importance = uintBitsToFloat(arena[vkT(0u, p)]);
+    uint e = vkExactK(p, n);
+    for (uint j = 1u; j < MFR_ALLOC_SECTIONS; ++j)
+      sums[j - 1u] += mfrAllocK(uintBitsToFloat(mfrAllocCandidate(lo, hi, j)), importance, n, e, mode);
   }
+  for (uint j = 0u; j < 15u; ++j)
+    if (sums[j] != 0u) atomicAdd(sSums[j], sums[j]);
   barrier();
   if (t < 15u && sSums[t] != 0u) atomicAdd(vkSums[t], sSums[t]);
 }

@@ -27,6 +27,7 @@
 
 #define MFR_ALLOC_SECTIONS 16u
 #define MFR_ALLOC_ROUNDS 8u
+#define MFR_ALLOC_SEARCH_PIXELS 8u  // pixels per invocation of a search round (alloc_search.comp)
 #define MFR_ALLOC_INFINITY_BITS 0x7F800000u
 #define MFR_ALLOC_FLOOR_ONE 1u
 #define MFR_ALLOC_CAP_TAIL 2u

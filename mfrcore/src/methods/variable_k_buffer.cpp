@@ -317,7 +317,7 @@ void VariableKBuffer::allocate(const FrameContext& ctx) {
   bindArena();
   for (const gl::Program* p : {&search_, &narrow_, &assign_, &finish_}) setArenaUniforms(*p);
   for (std::uint32_t round = 0; round < MFR_ALLOC_ROUNDS; ++round) {
-    dispatchPixels(search_, 256);
+    dispatchPixels(search_, 256 * MFR_ALLOC_SEARCH_PIXELS);
     narrow_.use();
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
