@@ -165,6 +165,22 @@ void MainWindow::buildMenus() {
   connect(ortho, &QAction::triggered, this, [this] { model_->setCamera(navigation::toggledProjection(model_->camera())); });
   connect(model_, &ViewerModel::viewChanged, ortho,
           [this, ortho] { ortho->setChecked(model_->camera().projection == mfr::Projection::Orthographic); });
+  QAction* fast = viewMenu_->addAction(tr("Fast &Navigation (Reduced Frames While Moving)"));
+  fast->setObjectName(QStringLiteral("fastNavigationAction"));
+  fast->setCheckable(true);
+  fast->setChecked(view_->fastNavigation());
+  connect(fast, &QAction::toggled, this, [this](bool on) {
+    view_->setFastNavigation(on);
+    if (options_.restoreSettings) QSettings().setValue(QStringLiteral("view/fastNavigation"), on);
+  });
+  if (options_.restoreSettings) fast->setChecked(QSettings().value(QStringLiteral("view/fastNavigation"), true).toBool());
+  connect(view_, &RenderView::frameReductionChanged, this, [this](int reduction) {
+    static const QString prefix = tr("Moving:");
+    if (reduction > 1)
+      statusBar()->showMessage(tr("%1 frames at 1/%2 of the resolution until the view stops").arg(prefix).arg(reduction));
+    else if (statusBar()->currentMessage().startsWith(prefix))
+      statusBar()->clearMessage();
+  });
   viewMenu_->addSeparator();
   buildCompareAndDataViewActions();
   viewMenu_->addSeparator();

@@ -2,6 +2,7 @@
 
 #include <QMouseEvent>
 #include <QOpenGLContext>
+#include <QTimer>
 #include <QWheelEvent>
 
 #include <algorithm>
@@ -70,6 +71,13 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
     legends_[side]->setObjectName(QStringLiteral("mapLegend%1").arg(sideName(side)));
     legends_[side]->hide();
   }
+  settle_ = new QTimer(this);
+  settle_->setSingleShot(true);
+  connect(settle_, &QTimer::timeout, this, [this] {
+    navigating_ = false;
+    if (lastReduction_ > 1) update();  // the full frame of where the motion stopped
+  });
+
   splitHandle_ = new SplitHandle(this);
   splitHandle_->setObjectName(QStringLiteral("splitHandle"));
   splitHandle_->hide();
@@ -88,11 +96,12 @@ RenderView::~RenderView() {
 
 void RenderView::releaseGl() {
   for (auto& r : renderers_) r.reset();
-  for (PaneTarget& t : targets_) {
-    if (t.fbo) glDeleteFramebuffers(1, &t.fbo);
-    if (t.texture) glDeleteTextures(1, &t.texture);
-    t = {};
-  }
+  for (auto* targets : {&targets_, &reducedTargets_})
+    for (PaneTarget& t : *targets) {
+      if (t.fbo) glDeleteFramebuffers(1, &t.fbo);
+      if (t.texture) glDeleteTextures(1, &t.texture);
+      t = {};
+    }
   depthCache_ = {};
 }
 
@@ -173,7 +182,11 @@ void RenderView::paintGL() {
   model_.setRenderSize(pixelSize());
   QStringList errors;
   reports_ = std::make_shared<Reports>();
-  if (!renderers_[0] || !model_.hasScene()) {
+  const int wanted = navigationReduction();
+  const int reduction = wanted > 1 && paintReduced(wanted, errors) ? wanted : 1;
+  if (reduction > 1) {
+    // A navigation preview: drawn, not reported (its Stats describe a smaller image).
+  } else if (!renderers_[0] || !model_.hasScene()) {
     clearToBackground();
     maps_ = {};
   } else if (!model_.compareEnabled() && model_.dataView() == DataView::Image && !model_.isCpuMethod(model_.method())) {
@@ -183,6 +196,14 @@ void RenderView::paintGL() {
     clearToBackground();
     for (int side = 0; side < model_.paneCount(); ++side) paintPane(side, errors);
     if (!model_.compareEnabled()) maps_[1] = {};
+  }
+  if (reduction == 1 && !reports_->frames.empty()) {
+    fullFrameMs_ = 0.0;
+    for (const Frame& f : reports_->frames) fullFrameMs_ += f.stats.totalTimeMs();
+  }
+  if (reduction != lastReduction_) {
+    lastReduction_ = reduction;
+    QMetaObject::invokeMethod(this, [this, reduction] { emit frameReductionChanged(reduction); }, Qt::QueuedConnection);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, defaultFramebufferObject());
   errors.removeDuplicates();
@@ -330,8 +351,8 @@ RenderView::DataMap RenderView::computeDataMap(int side, QSize size, const Image
   return map;
 }
 
-RenderView::PaneTarget& RenderView::paneTarget(int side, QSize size) {
-  PaneTarget& t = targets_[side == 1 ? 1 : 0];
+RenderView::PaneTarget& RenderView::targetOf(std::array<PaneTarget, kSides>& targets, int side, QSize size) {
+  PaneTarget& t = targets[side == 1 ? 1 : 0];
   if (t.texture && t.size == size) return t;
   if (t.fbo) glDeleteFramebuffers(1, &t.fbo);
   if (t.texture) glDeleteTextures(1, &t.texture);
@@ -391,12 +412,82 @@ void RenderView::blitPane(int side, const PaneTarget& target) {
   const QRect pane = paneRect(side), shown = paneVisibleRect(side);
   if (shown.isEmpty()) return;
   const int fullHeight = pixelSize().height();
-  // Source: pane-local columns; rows flip from top-down rectangles to GL's bottom-up ones.
-  const int sx0 = shown.left() - pane.left(), sx1 = sx0 + shown.width();
-  const int sy0 = pane.height() - (shown.top() - pane.top() + shown.height()), sy1 = sy0 + shown.height();
+  // Source: pane-local columns; rows flip from top-down rectangles to GL's bottom-up ones. A
+  // navigation preview's target is smaller than the pane: its coordinates scale, and it is
+  // filtered.
+  const double sx = static_cast<double>(target.size.width()) / pane.width();
+  const double sy = static_cast<double>(target.size.height()) / pane.height();
+  const auto scaled = [](int v, double s) { return static_cast<int>(std::lround(v * s)); };
+  const int sx0 = scaled(shown.left() - pane.left(), sx), sx1 = scaled(shown.left() - pane.left() + shown.width(), sx);
+  const int sy0 = scaled(pane.height() - (shown.top() - pane.top() + shown.height()), sy);
+  const int sy1 = scaled(pane.height() - (shown.top() - pane.top()), sy);
   const int dy0 = fullHeight - (shown.top() + shown.height()), dy1 = dy0 + shown.height();
+  const bool same = target.size == pane.size();
   glBlitNamedFramebuffer(target.fbo, defaultFramebufferObject(), sx0, sy0, sx1, sy1, shown.left(), dy0,
-                         shown.left() + shown.width(), dy1, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+                         shown.left() + shown.width(), dy1, GL_COLOR_BUFFER_BIT, same ? GL_NEAREST : GL_LINEAR);
+}
+
+// ---- navigation previews -------------------------------------------------------------------
+
+void RenderView::setFastNavigation(bool on) {
+  fastNavigation_ = on;
+  if (!on && lastReduction_ > 1) update();
+}
+
+int RenderView::navigationReduction() const {
+  if (!navigating_ || !fastNavigation_ || !renderers_[0] || !model_.hasScene()) return 1;
+  // Images only: data maps and heat maps are computed at the full size, CPU panes off the GUI thread.
+  if (model_.dataView() != DataView::Image) return 1;
+  if (model_.compareEnabled() && model_.compareDisplay() != CompareDisplay::Images) return 1;
+  for (int side = 0; side < model_.paneCount(); ++side)
+    if (model_.isCpuMethod(model_.methodOf(side))) return 1;
+  const double f = std::ceil(std::sqrt(fullFrameMs_ / kNavigationFrameMs));
+  return static_cast<int>(std::clamp(f, 1.0, static_cast<double>(kMaxReduction)));
+}
+
+mfr::RenderRequest RenderView::reducedRequest(int side, QSize size, QSize full) const {
+  mfr::RenderRequest request = model_.renderRequest(side, size);
+  const double share = static_cast<double>(size.width()) * size.height() / (static_cast<double>(full.width()) * full.height());
+  if (const mfr::MethodInfo* info = model_.methodInfo(model_.methodOf(side)))
+    for (const mfr::ParamSpec& spec : info->params) {
+      if (!spec.perImage) continue;
+      const auto it = request.params.find(spec.name);
+      const std::string& text = it != request.params.end() ? it->second : spec.defaultValue;
+      bool ok = false;
+      const double value = QString::fromStdString(text).toDouble(&ok);
+      if (ok) request.params[spec.name] = QString::number(value * share, 'g', 12).toStdString();
+    }
+  return request;
+}
+
+// Every pane at 1/reduction of its size, scaled up. False when a pane cannot be drawn so (the
+// caller then draws the full frame, which reports why).
+bool RenderView::paintReduced(int reduction, QStringList& errors) {
+  clearToBackground();
+  for (int side = 0; side < model_.paneCount(); ++side) {
+    if (!uploadSceneIfChanged(side, errors)) return false;
+    const QSize full = model_.paneSize();
+    const QSize size((full.width() + reduction - 1) / reduction, (full.height() + reduction - 1) / reduction);
+    PaneTarget& target = targetOf(reducedTargets_, side, size);
+    try {
+      const mfr::Stats stats = renderer(side).renderTo(target.fbo, model_.camera(), reducedRequest(side, size, full));
+      if (side == 0) previewStats_ = stats;
+    } catch (const std::exception&) {
+      mfr::gl::discardErrors();
+      return false;
+    }
+    blitPane(side, target);
+  }
+  return true;
+}
+
+void RenderView::beginNavigation() {
+  navigating_ = true;
+  settle_->stop();
+}
+
+void RenderView::endNavigation(int settleMs) {
+  settle_->start(settleMs);
 }
 
 // ---- overlays ------------------------------------------------------------------------------
@@ -514,6 +605,7 @@ void RenderView::mousePressEvent(QMouseEvent* event) {
   const bool panGesture = event->button() == Qt::MiddleButton ||
                           (event->button() == Qt::LeftButton && (event->modifiers() & Qt::ShiftModifier));
   drag_ = panGesture ? Drag::Pan : event->button() == Qt::LeftButton ? Drag::Orbit : Drag::None;
+  if (drag_ != Drag::None) beginNavigation();
 }
 
 void RenderView::mouseMoveEvent(QMouseEvent* event) {
@@ -528,12 +620,17 @@ void RenderView::mouseMoveEvent(QMouseEvent* event) {
 }
 
 void RenderView::mouseReleaseEvent(QMouseEvent*) {
+  if (drag_ != Drag::None) endNavigation(150);
   drag_ = Drag::None;
 }
 
 void RenderView::wheelEvent(QWheelEvent* event) {
   if (!model_.hasScene()) return;
   const double steps = event->angleDelta().y() / 120.0;
-  if (steps != 0.0) model_.setCamera(navigation::zoomAt(model_.camera(), event->position(), size(), steps));
+  if (steps != 0.0) {
+    beginNavigation();
+    endNavigation(300);  // wheel steps come apart: the motion has stopped when none follows soon
+    model_.setCamera(navigation::zoomAt(model_.camera(), event->position(), size(), steps));
+  }
   event->accept();
 }

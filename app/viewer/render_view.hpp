@@ -27,6 +27,7 @@
 #include "viewer_model.hpp"
 
 class MapLegend;
+class QTimer;
 class PaneCaption;
 class SplitHandle;
 
@@ -46,6 +47,22 @@ class RenderView final : public QOpenGLWidget {
   // The image size in device pixels.
   [[nodiscard]] QSize pixelSize() const;
 
+  // Fast navigation (on by default): while the camera is dragged or wheeled, and the last full
+  // frame took longer than kNavigationFrameMs of GPU time, each pane is rendered at 1/f of its
+  // width and height (f ≤ kMaxReduction, chosen from that time) and scaled up; parameters that
+  // are memory for the whole image (ParamSpec::perImage: budgets, fixed pools) get the same share
+  // per pixel. Such frames are previews: their Stats are not reported. The full frame follows
+  // when the motion stops.
+  static constexpr double kNavigationFrameMs = 40.0;
+  static constexpr int kMaxReduction = 4;
+  void setFastNavigation(bool on);
+  [[nodiscard]] bool fastNavigation() const { return fastNavigation_; }
+  [[nodiscard]] bool navigating() const { return navigating_; }
+  // The reduction f of the last frame drawn (1: a full frame), and the side-0 Stats of the last
+  // reduced frame.
+  [[nodiscard]] int lastFrameReduction() const { return lastReduction_; }
+  [[nodiscard]] const mfr::Stats& lastPreviewStats() const { return previewStats_; }
+
   // The data map a pane showed in its last frame (image rows top-down).
   struct DataMap {
     DataView kind = DataView::Image;
@@ -63,6 +80,8 @@ class RenderView final : public QOpenGLWidget {
 
  signals:
   void glInitialized();
+  // The reduction of the frames being drawn changed (f > 1: navigation previews; 1: full frames).
+  void frameReductionChanged(int reduction);
 
  protected:
   void initializeGL() override;
@@ -84,11 +103,17 @@ class RenderView final : public QOpenGLWidget {
   bool uploadSceneIfChanged(int side, QStringList& errors);
   void paintSingleImage(QStringList& errors);
   void paintPane(int side, QStringList& errors);
-  PaneTarget& paneTarget(int side, QSize size);
+  PaneTarget& paneTarget(int side, QSize size) { return targetOf(targets_, side, size); }
+  static PaneTarget& targetOf(std::array<PaneTarget, kSides>& targets, int side, QSize size);
   mfr::ImageRGBA8 readBack(const PaneTarget& target) const;
   mfr::ImageRGBA8 readDefaultFramebuffer(QSize size) const;
   void upload(const PaneTarget& target, const mfr::ImageRGBA8& image);
   void blitPane(int side, const PaneTarget& target);
+  [[nodiscard]] int navigationReduction() const;
+  bool paintReduced(int reduction, QStringList& errors);
+  [[nodiscard]] mfr::RenderRequest reducedRequest(int side, QSize size, QSize full) const;
+  void beginNavigation();
+  void endNavigation(int settleMs);
   DataMap computeDataMap(int side, QSize size, const ImageKey& key, bool haveFrame);
   void clearToBackground();
   void releaseGl();
@@ -99,6 +124,7 @@ class RenderView final : public QOpenGLWidget {
   std::array<quint64, kSides> uploadedRevision_{0, 0};
   std::array<QString, kSides> uploadError_;
   std::array<PaneTarget, kSides> targets_;
+  std::array<PaneTarget, kSides> reducedTargets_;  // navigation previews, at 1/f of the pane size
   std::array<DataMap, kSides> maps_;
   std::array<bool, kSides> paneFailed_{false, false};  // the pane's last paint had an error
   // n(p) of the last view (both panes share it when their sizes agree).
@@ -110,6 +136,12 @@ class RenderView final : public QOpenGLWidget {
   QString glInfo_;
   QPoint lastMouse_;
   enum class Drag { None, Orbit, Pan } drag_ = Drag::None;
+  bool fastNavigation_ = true;
+  bool navigating_ = false;
+  QTimer* settle_ = nullptr;  // ends navigation a moment after the last drag or wheel step
+  double fullFrameMs_ = 0.0;  // GPU time of the last full frame, all panes
+  int lastReduction_ = 1;
+  mfr::Stats previewStats_;
 
   // What the frame being painted tells the model, delivered after paintGL.
   struct Frame {

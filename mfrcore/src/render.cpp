@@ -39,7 +39,7 @@ const MethodInfo& optimalKInfo() {
       "eq. 2); the better of its backward greedy and an exact-on-the-convex-hull Lagrangian allocation",
       false,
       {{"budget_mib", "Memory budget M (MiB)", ParamSpec::Type::Float, "16", 0, 65536, {},
-        "the budget of the variable-k buffers' layout (vkb without a network): F(M) slots to allocate"}},
+        "the budget of the variable-k buffers' layout (vkb without a network): F(M) slots to allocate", true}},
       "hybrid"};
   return i;
 }

@@ -766,6 +766,74 @@ class ViewerTest : public QObject {
     QVERIFY(!robustness->isVisible());
   }
 
+  // Fast navigation: while the camera is dragged, a slow method is drawn at a fraction of the
+  // size (its budget scaled with the pixels, nothing reported); when the drag ends the full frame
+  // of the new camera follows and is reported. Off, every frame is full.
+  void fastNavigation() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    RenderView& view = w->view();
+    view.setFixedSize(640, 480);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(640, 480), kTimeoutMs);
+    m.setMethod(QStringLiteral("vkb"));
+    m.setAllParams({});
+    m.setParams({{"budget_mib", "12"}});
+    settle(m);
+    QCOMPARE(QString::fromStdString(m.stats().method), QStringLiteral("vkb"));
+    const double fullMs = m.stats().totalTimeMs();
+    qInfo("vkb full frame at 640x480: %.1f ms of pass time", fullMs);
+    QVERIFY2(fullMs > RenderView::kNavigationFrameMs, "the full frame is too fast to need previews here");
+    const int expected = std::min(RenderView::kMaxReduction,
+                                  static_cast<int>(std::ceil(std::sqrt(fullMs / RenderView::kNavigationFrameMs))));
+    const std::uint64_t fullBytes = m.stats().bytesAllocated;
+    QVERIFY(fullBytes <= static_cast<std::uint64_t>(12 * kMiB));
+
+    for (const bool fast : {true, false}) {
+      w->findChild<QAction*>("fastNavigationAction")->setChecked(fast);
+      QCOMPARE(view.fastNavigation(), fast);
+      const quint64 framesBefore = m.framesRendered();
+      const mfr::Camera before = m.camera();
+      const QPoint centre(view.width() / 2, view.height() / 2);
+      QTest::mousePress(&view, Qt::LeftButton, {}, centre);
+      QTest::mouseMove(&view, centre + QPoint(40, 10));
+      QTRY_VERIFY_WITH_TIMEOUT(glm::length(m.camera().eye - before.eye) > 1e-6, kTimeoutMs);
+      // Draw the frame of the moved camera while the button is still down.
+      const QImage during = view.grabFramebuffer();
+      QCOMPARE(during.size(), view.pixelSize());
+      if (fast) {
+        QCOMPARE(view.lastFrameReduction(), expected);
+        QVERIFY(expected > 1);
+        QCOMPARE(m.framesRendered(), framesBefore);  // previews are not reported
+        // The preview is the same picture, coarser: FLIP against the full frame of this camera.
+        const mfr::ImageRGBA8 full = view.renderImage(view.pixelSize());
+        const double flip = mfr::flip(full, fromQImage(during)).stats.mean;
+        qInfo("preview at 1/%d: FLIP %.4f against the full frame", expected, flip);
+        QVERIFY(flip < 0.15);
+        // The budget followed the pixels: the same share of 12 MiB as of the pixels (within the
+        // method's fixed bytes), never more.
+        const mfr::Stats& preview = view.lastPreviewStats();
+        const QSize small((view.pixelSize().width() + expected - 1) / expected,
+                          (view.pixelSize().height() + expected - 1) / expected);
+        const double share = static_cast<double>(small.width()) * small.height() /
+                             (static_cast<double>(view.pixelSize().width()) * view.pixelSize().height());
+        qInfo("preview budget: %.3f MiB allocated of %.3f MiB", preview.bytesAllocated / kMiB, 12 * share);
+        QVERIFY(preview.bytesAllocated <= static_cast<std::uint64_t>(12 * kMiB * share) + 1);
+        QVERIFY(preview.bytesAllocated >= static_cast<std::uint64_t>(0.95 * 12 * kMiB * share));
+      } else {
+        QCOMPARE(view.lastFrameReduction(), 1);
+        QTRY_VERIFY_WITH_TIMEOUT(m.framesRendered() > framesBefore, kTimeoutMs);
+      }
+      QTest::mouseRelease(&view, Qt::LeftButton, {}, centre + QPoint(40, 10));
+      // The full frame of where the drag stopped follows and is reported.
+      QTRY_VERIFY_WITH_TIMEOUT(!view.navigating() && view.lastFrameReduction() == 1, kTimeoutMs);
+      settle(m);
+      QVERIFY(m.framesRendered() > framesBefore);
+      QCOMPARE(m.stats().bytesAllocated, fullBytes);
+      QCOMPARE(m.frameKey(0).view, m.viewRevision());
+    }
+  }
+
   void navigation() {
     mfr::Camera c;
     c.eye = {0, 0, 5};

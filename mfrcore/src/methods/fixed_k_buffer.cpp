@@ -18,7 +18,8 @@ const MethodInfo& FixedKBuffer::info() const {
                               0,
                               65536,
                               {},
-                              "GPU memory for all of the method's buffers; k is the largest uniform k that fits"}};
+                              "GPU memory for all of the method's buffers; k is the largest uniform k that fits",
+                              true}};
     for (ParamSpec& s : kbufferParams(true, false))
       if (s.name != "k") p.push_back(s);
     for (ParamSpec& s : p)

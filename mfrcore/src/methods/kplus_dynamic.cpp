@@ -13,7 +13,7 @@ const MethodInfo& KPlusBufferDynamic::info() const {
     std::vector<ParamSpec> params = kbufferParams(true, false);
     std::erase_if(params, [](const ParamSpec& p) { return p.name == "k"; });  // chosen per frame
     params.push_back({"budget_mib", "Memory budget M_b (MiB)", ParamSpec::Type::Float, "64", 0, 65536, {},
-                      "GPU memory the method may allocate for a frame (all its buffers)"});
+                      "GPU memory the method may allocate for a frame (all its buffers)", true});
     params.push_back({"robustness", "Robustness ratio R_h", ParamSpec::Type::Float, "0.95", 0, 1, {},
                       "fraction of the frame's fragments to capture: k is the smallest that captures it, "
                       "unless the budget allows less"});

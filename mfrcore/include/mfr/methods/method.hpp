@@ -29,6 +29,9 @@ struct ParamSpec {
   double min = 0, max = 0;   // Int/Float range (inclusive)
   std::vector<std::string> choices;  // Choice
   std::string help;
+  // A memory amount for the whole image (MiB): a frame of fewer pixels that should look like this
+  // one (the viewer's reduced frames while navigating) gets the same share of it per pixel.
+  bool perImage = false;
 };
 
 // Values of a method's parameters, validated against its specs.
