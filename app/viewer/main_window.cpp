@@ -45,7 +45,8 @@ const QString kSessionSuffix = QStringLiteral(".mfrsession");
 
 QString sceneFileFilter() {
   QStringList patterns{QStringLiteral("*.mfrscene")};
-  for (const std::string& ext : mfr::supportedModelExtensions()) patterns << QStringLiteral("*") + QString::fromStdString(ext);
+  for (const std::string& ext : mfr::supportedModelExtensions())
+    patterns << QStringLiteral("*") + QString::fromStdString(ext);
   return QObject::tr("Scenes and models (%1);;mfrview sessions (*.mfrsession);;All files (*)").arg(patterns.join(' '));
 }
 
@@ -97,7 +98,8 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
       applySession(*pendingSession_, *model_);
       if (model_->compareEnabled()) compareDock_->show();
       for (const PluginRecord& r : plugins_.records())
-        if (r.plugin && pendingSession_->plugins.contains(r.id)) r.plugin->loadSettings(pendingSession_->plugins.value(r.id).toObject());
+        if (r.plugin && pendingSession_->plugins.contains(r.id))
+          r.plugin->loadSettings(pendingSession_->plugins.value(r.id).toObject());
       addRecentFile(pendingSessionFile_);
       pendingSession_.reset();
     }
@@ -162,7 +164,8 @@ void MainWindow::buildMenus() {
   QAction* ortho = viewMenu_->addAction(tr("&Orthographic Projection"));
   ortho->setCheckable(true);
   ortho->setShortcut(QKeySequence(Qt::Key_O));
-  connect(ortho, &QAction::triggered, this, [this] { model_->setCamera(navigation::toggledProjection(model_->camera())); });
+  connect(ortho, &QAction::triggered, this,
+          [this] { model_->setCamera(navigation::toggledProjection(model_->camera())); });
   connect(model_, &ViewerModel::viewChanged, ortho,
           [this, ortho] { ortho->setChecked(model_->camera().projection == mfr::Projection::Orthographic); });
   QAction* fast = viewMenu_->addAction(tr("Fast &Navigation (Reduced Frames While Moving)"));
@@ -173,11 +176,13 @@ void MainWindow::buildMenus() {
     view_->setFastNavigation(on);
     if (options_.restoreSettings) QSettings().setValue(QStringLiteral("view/fastNavigation"), on);
   });
-  if (options_.restoreSettings) fast->setChecked(QSettings().value(QStringLiteral("view/fastNavigation"), true).toBool());
+  if (options_.restoreSettings)
+    fast->setChecked(QSettings().value(QStringLiteral("view/fastNavigation"), true).toBool());
   connect(view_, &RenderView::frameReductionChanged, this, [this](int reduction) {
     static const QString prefix = tr("Moving:");
     if (reduction > 1)
-      statusBar()->showMessage(tr("%1 frames at 1/%2 of the resolution until the view stops").arg(prefix).arg(reduction));
+      statusBar()->showMessage(
+          tr("%1 frames at 1/%2 of the resolution until the view stops").arg(prefix).arg(reduction));
     else if (statusBar()->currentMessage().startsWith(prefix))
       statusBar()->clearMessage();
   });
@@ -285,13 +290,15 @@ void MainWindow::buildDocks() {
     panelsMenu_->addAction(d->toggleViewAction());
     return d;
   };
-  QDockWidget* scene = dock(tr("Scene"), QStringLiteral("sceneDock"), new SceneTreePanel(*model_), Qt::LeftDockWidgetArea);
+  QDockWidget* scene =
+      dock(tr("Scene"), QStringLiteral("sceneDock"), new SceneTreePanel(*model_), Qt::LeftDockWidgetArea);
   QDockWidget* method =
       dock(tr("Method"), QStringLiteral("methodDock"), new MethodPanel(*model_), Qt::LeftDockWidgetArea);
   compareDock_ = dock(tr("Compare"), QStringLiteral("compareDock"), new ComparePanel(*model_), Qt::LeftDockWidgetArea);
   tabifyDockWidget(method, compareDock_);
   method->raise();
-  QDockWidget* stats = dock(tr("Statistics"), QStringLiteral("statsDock"), new StatsPanel(*model_), Qt::RightDockWidgetArea);
+  QDockWidget* stats =
+      dock(tr("Statistics"), QStringLiteral("statsDock"), new StatsPanel(*model_), Qt::RightDockWidgetArea);
   // The image gets most of the window; panels start narrow (users widen them as they like).
   // Deferred until the window has its size, or the layout overrides it.
   QTimer::singleShot(0, this, [this, scene, stats] {
@@ -357,8 +364,10 @@ void MainWindow::addRecentFile(const QString& path) {
 // ---- files -------------------------------------------------------------------------------
 
 void MainWindow::open(const QString& path) {
-  if (path.endsWith(kSessionSuffix, Qt::CaseInsensitive)) openSession(path);
-  else openScene(path);
+  if (path.endsWith(kSessionSuffix, Qt::CaseInsensitive))
+    openSession(path);
+  else
+    openScene(path);
 }
 
 void MainWindow::openScene(const QString& path) {
@@ -397,7 +406,8 @@ void MainWindow::chooseFileToOpen() {
 }
 
 void MainWindow::chooseSessionToSave() {
-  QString path = QFileDialog::getSaveFileName(this, tr("Save Session"), QString(), tr("mfrview sessions (*.mfrsession)"));
+  QString path =
+      QFileDialog::getSaveFileName(this, tr("Save Session"), QString(), tr("mfrview sessions (*.mfrsession)"));
   if (path.isEmpty()) return;
   if (!path.endsWith(kSessionSuffix)) path += kSessionSuffix;
   try {
@@ -411,8 +421,9 @@ void MainWindow::chooseSessionToSave() {
 void MainWindow::chooseImageToExport() {
   bool ok = false;
   const QSize current = model_->renderSize();
-  const QString sizeText = QInputDialog::getText(this, tr("Export Image"), tr("Size (width × height, pixels):"), QLineEdit::Normal,
-                                                 QStringLiteral("%1x%2").arg(current.width()).arg(current.height()), &ok);
+  const QString sizeText =
+      QInputDialog::getText(this, tr("Export Image"), tr("Size (width × height, pixels):"), QLineEdit::Normal,
+                            QStringLiteral("%1x%2").arg(current.width()).arg(current.height()), &ok);
   if (!ok) return;
   const QStringList parts = sizeText.split(QLatin1Char('x'));
   const QSize size = parts.size() == 2 ? QSize(parts[0].trimmed().toInt(), parts[1].trimmed().toInt()) : QSize();
@@ -420,7 +431,8 @@ void MainWindow::chooseImageToExport() {
     showError(tr("Cannot export"), tr("size %1: expected WIDTHxHEIGHT, e.g. 1920x1080").arg(sizeText));
     return;
   }
-  QString path = QFileDialog::getSaveFileName(this, tr("Export Image"), QStringLiteral("mfrview.png"), tr("PNG images (*.png)"));
+  QString path =
+      QFileDialog::getSaveFileName(this, tr("Export Image"), QStringLiteral("mfrview.png"), tr("PNG images (*.png)"));
   if (path.isEmpty()) return;
   if (!path.endsWith(QStringLiteral(".png"), Qt::CaseInsensitive)) path += QStringLiteral(".png");
   try {
@@ -437,8 +449,9 @@ void MainWindow::showError(const QString& title, const QString& message) {
   // Window-modal and non-blocking: loading finishes from the event loop, and tests can read it.
   auto* box = new QMessageBox(QMessageBox::Warning, title, message, QMessageBox::Ok, this);
   box->setObjectName(QStringLiteral("errorBox"));
-  box->setInformativeText(model_->hasScene() ? tr("The current scene (%1) stays open.").arg(QString::fromStdString(model_->scene().name))
-                                             : QString());
+  box->setInformativeText(
+      model_->hasScene() ? tr("The current scene (%1) stays open.").arg(QString::fromStdString(model_->scene().name))
+                         : QString());
   box->setAttribute(Qt::WA_DeleteOnClose);
   box->open();
 }
@@ -454,7 +467,8 @@ void MainWindow::showPluginsDialog() {
   for (const PluginRecord& r : plugins_.records()) {
     table->setItem(row, 0, new QTableWidgetItem(r.plugin ? r.name : QFileInfo(r.file).fileName()));
     table->setItem(row, 1, new QTableWidgetItem(r.id));
-    table->setItem(row, 2, new QTableWidgetItem(r.plugin ? tr("loaded — %1").arg(r.description) : tr("failed: %1").arg(r.error)));
+    table->setItem(
+        row, 2, new QTableWidgetItem(r.plugin ? tr("loaded — %1").arg(r.description) : tr("failed: %1").arg(r.error)));
     table->setItem(row, 3, new QTableWidgetItem(r.file));
     ++row;
   }
@@ -467,7 +481,8 @@ void MainWindow::showPluginsDialog() {
 }
 
 void MainWindow::updateTitle() {
-  setWindowTitle(model_->hasScene() ? tr("%1 — mfrview").arg(QString::fromStdString(model_->scene().name)) : tr("mfrview"));
+  setWindowTitle(model_->hasScene() ? tr("%1 — mfrview").arg(QString::fromStdString(model_->scene().name))
+                                    : tr("mfrview"));
 }
 
 void MainWindow::updateFrameInfo() {
@@ -494,7 +509,8 @@ void MainWindow::closeEvent(QCloseEvent* event) {
 }
 
 void MainWindow::dragEnterEvent(QDragEnterEvent* event) {
-  if (event->mimeData()->hasUrls() && !event->mimeData()->urls().isEmpty() && event->mimeData()->urls().first().isLocalFile())
+  if (event->mimeData()->hasUrls() && !event->mimeData()->urls().isEmpty() &&
+      event->mimeData()->urls().first().isLocalFile())
     event->acceptProposedAction();
 }
 

@@ -95,6 +95,7 @@ RenderView::~RenderView() {
 }
 
 void RenderView::releaseGl() {
+  for (auto& r : previewRenderers_) r.reset();  // they share the scene buffers of renderers_
   for (auto& r : renderers_) r.reset();
   for (auto* targets : {&targets_, &reducedTargets_})
     for (PaneTarget& t : *targets) {
@@ -203,7 +204,8 @@ void RenderView::paintGL() {
   }
   if (reduction != lastReduction_) {
     lastReduction_ = reduction;
-    QMetaObject::invokeMethod(this, [this, reduction] { emit frameReductionChanged(reduction); }, Qt::QueuedConnection);
+    QMetaObject::invokeMethod(
+        this, [this, reduction] { emit frameReductionChanged(reduction); }, Qt::QueuedConnection);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, defaultFramebufferObject());
   errors.removeDuplicates();
@@ -447,7 +449,8 @@ int RenderView::navigationReduction() const {
 
 mfr::RenderRequest RenderView::reducedRequest(int side, QSize size, QSize full) const {
   mfr::RenderRequest request = model_.renderRequest(side, size);
-  const double share = static_cast<double>(size.width()) * size.height() / (static_cast<double>(full.width()) * full.height());
+  const double share =
+      static_cast<double>(size.width()) * size.height() / (static_cast<double>(full.width()) * full.height());
   if (const mfr::MethodInfo* info = model_.methodInfo(model_.methodOf(side)))
     for (const mfr::ParamSpec& spec : info->params) {
       if (!spec.perImage) continue;
@@ -469,8 +472,11 @@ bool RenderView::paintReduced(int reduction, QStringList& errors) {
     const QSize full = model_.paneSize();
     const QSize size((full.width() + reduction - 1) / reduction, (full.height() + reduction - 1) / reduction);
     PaneTarget& target = targetOf(reducedTargets_, side, size);
+    auto& preview = previewRenderers_[side == 1 ? 1 : 0];
     try {
-      const mfr::Stats stats = renderer(side).renderTo(target.fbo, model_.camera(), reducedRequest(side, size, full));
+      if (!preview) preview = std::make_unique<mfr::GpuRenderer>();
+      preview->shareScene(renderer(side));
+      const mfr::Stats stats = preview->renderTo(target.fbo, model_.camera(), reducedRequest(side, size, full));
       if (side == 0) previewStats_ = stats;
     } catch (const std::exception&) {
       mfr::gl::discardErrors();

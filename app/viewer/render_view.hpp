@@ -121,6 +121,10 @@ class RenderView final : public QOpenGLWidget {
 
   ViewerModel& model_;
   std::array<std::unique_ptr<mfr::GpuRenderer>, kSides> renderers_;
+  // Navigation previews render with renderers of their own (sharing the panes' scene buffers), so
+  // a preview never changes what a method keeps between frames (e.g. pool=previous's count) or
+  // reallocates the full frame's buffers.
+  std::array<std::unique_ptr<mfr::GpuRenderer>, kSides> previewRenderers_;
   std::array<quint64, kSides> uploadedRevision_{0, 0};
   std::array<QString, kSides> uploadError_;
   std::array<PaneTarget, kSides> targets_;

@@ -16,11 +16,15 @@ bool GpuRenderer::defaultFinishTiming() {
   return gl::queryContextInfo().renderer.find("llvmpipe") != std::string::npos;
 }
 
-Operation oitOperation() { return {"oit", "ops/oit.glsl", nullptr}; }
+Operation oitOperation() {
+  return {"oit", "ops/oit.glsl", nullptr};
+}
 
 // Hybrid transparency (deep hybrid OIT, The Visual Computer 2022, §3.3): core from the resolve's
 // sorted fragments, tail from the k-buffer family's tail SSBO, which the method binds itself.
-static Operation hybridOperation() { return {"hybrid", "ops/hybrid.glsl", nullptr}; }
+static Operation hybridOperation() {
+  return {"hybrid", "ops/hybrid.glsl", nullptr};
+}
 
 GpuRenderer::~GpuRenderer() = default;
 
@@ -28,9 +32,15 @@ GpuRenderer::GpuRenderer(bool finishTiming) : finishTiming_(finishTiming) {}
 
 void GpuRenderer::setScene(const Scene& scene) {
   scene.validate();
-  scene_ = std::make_unique<gl::GpuScene>(scene);
+  scene_ = std::make_shared<const gl::GpuScene>(scene);
   background_ = scene.background;
   gl::checkErrors("scene upload");
+}
+
+void GpuRenderer::shareScene(const GpuRenderer& other) {
+  if (!other.scene_) throw Error("render", "no scene loaded");
+  scene_ = other.scene_;
+  background_ = other.background_;
 }
 
 Method& GpuRenderer::prepare(const RenderRequest& request) {
@@ -48,7 +58,9 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
   if (operation_ == "hybrid") {
     // The tail sums exist only in the k-buffer family's tail hook.
     const auto* kb = dynamic_cast<const KBufferFamily*>(method_.get());
-    if (!kb) throw Error("--op hybrid", "method " + request.method + " keeps no tail (use a k-buffer method with --param tail=true)");
+    if (!kb)
+      throw Error("--op hybrid",
+                  "method " + request.method + " keeps no tail (use a k-buffer method with --param tail=true)");
     if (!kb->tailEnabled()) throw Error("--op hybrid", "needs --param tail=true with method " + request.method);
   }
   gl::checkErrors(("configure " + request.method).c_str());
@@ -126,8 +138,8 @@ std::vector<std::uint32_t> GpuRenderer::depthComplexity(const Camera& camera, in
   validateImageSize("--size", width, height);
   if (!scene_) throw Error("depth complexity", "no scene loaded");
   if (!countProgram_.id())
-    countProgram_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"},
-                                 {GL_FRAGMENT_SHADER, "common/depth_complexity.geom.frag"}});
+    countProgram_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "common/depth_complexity.geom.frag"}});
   const std::size_t pixels = static_cast<std::size_t>(width) * height;
   if (countPixels_ != pixels) {  // kept between calls: the viewer asks again on every view change
     counts_ = gl::createBuffer(pixels * 4);

@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include "camera_navigator.hpp"
@@ -72,8 +73,7 @@ int maxChannelDifference(const mfr::ImageRGBA8& a, const mfr::ImageRGBA8& b) {
 mfr::ImageRGBA8 fromQImage(const QImage& image) {
   const QImage rgba = image.convertToFormat(QImage::Format_RGBA8888);
   mfr::ImageRGBA8 out(rgba.width(), rgba.height());
-  for (int y = 0; y < rgba.height(); ++y)
-    std::copy_n(rgba.constScanLine(y), rgba.width() * 4, out.at(0, y));
+  for (int y = 0; y < rgba.height(); ++y) std::copy_n(rgba.constScanLine(y), rgba.width() * 4, out.at(0, y));
   return out;
 }
 
@@ -164,7 +164,8 @@ class ViewerTest : public QObject {
     if (!QTest::qWaitForWindowExposed(w.get())) return nullptr;
     if (!scene.isEmpty()) {
       w->openScene(scene);
-      if (!QTest::qWaitFor([&] { return w->model().hasScene() && w->model().framesRendered() > 0; }, kTimeoutMs)) return nullptr;
+      if (!QTest::qWaitFor([&] { return w->model().hasScene() && w->model().framesRendered() > 0; }, kTimeoutMs))
+        return nullptr;
       settle(w->model());
     }
     return w;
@@ -209,11 +210,21 @@ class ViewerTest : public QObject {
           QWidget* editor = w->findChild<QWidget*>(QStringLiteral("param-") + QString::fromStdString(spec.name));
           QVERIFY2(editor, qPrintable(name + ": no editor for " + QString::fromStdString(spec.name)));
           switch (spec.type) {
-            case mfr::ParamSpec::Type::Int: QVERIFY(qobject_cast<QSpinBox*>(editor)); break;
-            case mfr::ParamSpec::Type::Float: QVERIFY(qobject_cast<QDoubleSpinBox*>(editor)); break;
-            case mfr::ParamSpec::Type::Bool: QVERIFY(qobject_cast<QCheckBox*>(editor)); break;
-            case mfr::ParamSpec::Type::Choice: QVERIFY(qobject_cast<QComboBox*>(editor)); break;
-            case mfr::ParamSpec::Type::Text: QVERIFY(qobject_cast<QLineEdit*>(editor)); break;
+            case mfr::ParamSpec::Type::Int:
+              QVERIFY(qobject_cast<QSpinBox*>(editor));
+              break;
+            case mfr::ParamSpec::Type::Float:
+              QVERIFY(qobject_cast<QDoubleSpinBox*>(editor));
+              break;
+            case mfr::ParamSpec::Type::Bool:
+              QVERIFY(qobject_cast<QCheckBox*>(editor));
+              break;
+            case mfr::ParamSpec::Type::Choice:
+              QVERIFY(qobject_cast<QComboBox*>(editor));
+              break;
+            case mfr::ParamSpec::Type::Text:
+              QVERIFY(qobject_cast<QLineEdit*>(editor));
+              break;
           }
         }
       }
@@ -233,7 +244,8 @@ class ViewerTest : public QObject {
     auto* slider = w->findChild<QSlider*>("budgetSlider");
     QVERIFY(slider);
     const double pixels = static_cast<double>(m.renderSize().width()) * m.renderSize().height();
-    for (const QString method : {"kplus-array", "abuffer-ll", "abuffer-array", "kplus-dynamic", "kbuffer", "fkb", "vkb", "dkb"}) {
+    for (const QString method :
+         {"kplus-array", "abuffer-ll", "abuffer-array", "kplus-dynamic", "kbuffer", "fkb", "vkb", "dkb"}) {
       m.setMethod(method);
       settle(m);
       quint64 previous = 0;
@@ -247,9 +259,12 @@ class ViewerTest : public QObject {
         QCOMPARE(QString::fromStdString(s.method), method);
         QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
         const double allocated = static_cast<double>(s.bytesAllocated);
-        qInfo("%s at %d MiB (%.0f pixels): %.2f MiB allocated, %.1f %% of fragments captured", qPrintable(method), budget,
-              pixels, allocated / kMiB, 100.0 * static_cast<double>(s.fragmentsStored) / static_cast<double>(s.fragmentsGenerated));
-        QVERIFY2(allocated <= budget * kMiB, qPrintable(QStringLiteral("%1 over budget: %2 MiB > %3 MiB").arg(method).arg(allocated / kMiB).arg(budget)));
+        qInfo("%s at %d MiB (%.0f pixels): %.2f MiB allocated, %.1f %% of fragments captured", qPrintable(method),
+              budget, pixels, allocated / kMiB,
+              100.0 * static_cast<double>(s.fragmentsStored) / static_cast<double>(s.fragmentsGenerated));
+        QVERIFY2(allocated <= budget * kMiB,
+                 qPrintable(
+                     QStringLiteral("%1 over budget: %2 MiB > %3 MiB").arg(method).arg(allocated / kMiB).arg(budget)));
         QVERIFY2(s.bytesAllocated >= previous, "memory does not follow the budget");
         // Fixed-structure methods use most of the budget (one k step of 8 B/pixel at most left).
         if (method == "kplus-array" || method == "abuffer-array" || method == "kbuffer")
@@ -357,12 +372,9 @@ class ViewerTest : public QObject {
   void viewerScreenshotEqualsCli() {
     QTemporaryDir dir;
     const QList<QStringList> cases{
-        {"--method", "abuffer-ll", "--view", "iso"},
-        {"--method", "kbuffer", "-p", "k=6", "--view", "front"},
-        {"--method", "kplus-dynamic", "-p", "budget_mib=2"},
-        {"--method", "wboit", "--view", "iso"},
-        {"--method", "peel-dual", "--view", "iso"},
-        {"--method", "oracle", "--view", "iso"},
+        {"--method", "abuffer-ll", "--view", "iso"},         {"--method", "kbuffer", "-p", "k=6", "--view", "front"},
+        {"--method", "kplus-dynamic", "-p", "budget_mib=2"}, {"--method", "wboit", "--view", "iso"},
+        {"--method", "peel-dual", "--view", "iso"},          {"--method", "oracle", "--view", "iso"},
     };
     int worst = 0;
     for (const QStringList& c : cases) {
@@ -376,7 +388,8 @@ class ViewerTest : public QObject {
       QVERIFY2(diff >= 0 && diff <= 1, qPrintable(c.join(' ')));
       worst = std::max(worst, diff);
     }
-    qInfo("viewer --screenshot vs mfr render: max channel difference %d over %lld cases", worst, static_cast<long long>(cases.size()));
+    qInfo("viewer --screenshot vs mfr render: max channel difference %d over %lld cases", worst,
+          static_cast<long long>(cases.size()));
   }
 
   // The live widget's framebuffer (GpuRenderer::renderTo into QOpenGLWidget's FBO) against the
@@ -389,7 +402,8 @@ class ViewerTest : public QObject {
     QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(256, 192), kTimeoutMs);
     QTemporaryDir dir;
     int worst = 0;
-    for (const auto& [method, param] : {std::pair{"kplus-array", "k=6"}, std::pair{"abuffer-ll", ""}, std::pair{"mboit", ""}}) {
+    for (const auto& [method, param] :
+         {std::pair{"kplus-array", "k=6"}, std::pair{"abuffer-ll", ""}, std::pair{"mboit", ""}}) {
       m.setMethod(method);
       m.setAllParams({});
       if (*param) m.setParams({{"k", "6"}});
@@ -452,9 +466,11 @@ class ViewerTest : public QObject {
     const auto cli = [&](const QStringList& settings, QSize size) {
       const QString png = dir.filePath(QStringLiteral("cli-%1.png").arg(settings.join('_')));
       QString out;
-      const QStringList args = QStringList{"render", "@sample", "--view", "iso", "--size",
-                                           QStringLiteral("%1x%2").arg(size.width()).arg(size.height()), "-o", png} +
-                               settings;
+      const QStringList args =
+          QStringList{"render", "@sample", "--view",
+                      "iso",    "--size",  QStringLiteral("%1x%2").arg(size.width()).arg(size.height()),
+                      "-o",     png} +
+          settings;
       if (runProgram(MFR_CLI, args, &out) != 0) qWarning("%s", qPrintable(out));
       return mfr::readPng(png.toStdString());
     };
@@ -729,7 +745,8 @@ class ViewerTest : public QObject {
     QVERIFY(combo->findData(QStringLiteral("oracle")) < 0);
     QCOMPARE(combo->findData(QStringLiteral("optimal-k")) >= 0, m.methodNames().contains(QStringLiteral("optimal-k")));
     for (const QString& name : m.methodNames())
-      if (name != QLatin1String("oracle") && m.isCpuMethod(name)) QVERIFY2(combo->findData(name) >= 0, qPrintable(name));
+      if (name != QLatin1String("oracle") && m.isCpuMethod(name))
+        QVERIFY2(combo->findData(name) >= 0, qPrintable(name));
 
     const int dynamic = combo->findData(QStringLiteral("kplus-dynamic"));
     QVERIFY(dynamic >= 0);
@@ -831,6 +848,40 @@ class ViewerTest : public QObject {
       QVERIFY(m.framesRendered() > framesBefore);
       QCOMPARE(m.stats().bytesAllocated, fullBytes);
       QCOMPARE(m.frameKey(0).view, m.viewRevision());
+    }
+
+    // Previews leave a method's memory of earlier frames alone: the linked-list A-buffer sizing
+    // its pool from the previous frame's count must not size the first full frame after a drag
+    // from a preview's (a quarter or less of the fragments: that frame would overflow).
+    w->findChild<QAction*>("fastNavigationAction")->setChecked(true);
+    m.setMethod(QStringLiteral("abuffer-ll"));
+    m.setAllParams({});
+    m.setParams({{"pool", "previous"}});
+    settle(m);
+    m.setCamera(m.camera());  // one more full frame: its pool comes from a full frame's count
+    settle(m);
+    QVERIFY(!m.stats().overflow);
+    const double llMs = m.stats().totalTimeMs();
+    qInfo("abuffer-ll (pool=previous) full frame at 640x480: %.1f ms of pass time", llMs);
+    QVERIFY2(llMs > RenderView::kNavigationFrameMs, "the full frame is too fast to need previews here");
+    {
+      const QPoint centre(view.width() / 2, view.height() / 2);
+      QTest::mousePress(&view, Qt::LeftButton, {}, centre);
+      QTest::mouseMove(&view, centre + QPoint(-30, 0));
+      (void)view.grabFramebuffer();
+      QVERIFY(view.lastFrameReduction() > 1);
+      // The first full frame after the drag (later ones would have healed a bad pool).
+      std::optional<mfr::Stats> first;
+      const auto connection = connect(&m, &ViewerModel::frameRendered, this, [&] {
+        if (!first) first = m.stats();
+      });
+      QTest::mouseRelease(&view, Qt::LeftButton, {}, centre + QPoint(-30, 0));
+      QTRY_VERIFY_WITH_TIMEOUT(first.has_value(), kTimeoutMs);
+      disconnect(connection);
+      QCOMPARE(QString::fromStdString(first->method), QStringLiteral("abuffer-ll"));
+      QVERIFY2(!first->overflow && first->fragmentsDropped == 0,
+               qPrintable(QStringLiteral("%1 fragments dropped").arg(first->fragmentsDropped)));
+      settle(m);
     }
   }
 

@@ -18,9 +18,9 @@ namespace mfr {
 struct CapturedLists {
   int width = 0;
   int height = 0;
-  int maxPerPixel = 0;                 // fragments kept per pixel in `fragments`
-  std::vector<std::uint32_t> counts;   // fragments the method holds per pixel
-  std::vector<Fragment> fragments;     // width*height*maxPerPixel, the first min(count, max) valid
+  int maxPerPixel = 0;                // fragments kept per pixel in `fragments`
+  std::vector<std::uint32_t> counts;  // fragments the method holds per pixel
+  std::vector<Fragment> fragments;    // width*height*maxPerPixel, the first min(count, max) valid
   [[nodiscard]] std::uint32_t count(int x, int y) const { return counts[static_cast<std::size_t>(y) * width + x]; }
   [[nodiscard]] const Fragment* pixel(int x, int y) const {
     return &fragments[(static_cast<std::size_t>(y) * width + x) * static_cast<std::size_t>(maxPerPixel)];
@@ -40,6 +40,9 @@ class GpuRenderer {
 
   // Uploads the scene (validated: throws mfr::Error when empty).
   void setScene(const Scene& scene);
+  // Draws the scene `other` uploaded, without a second copy of its buffers (the viewer's preview
+  // renderers); a later setScene on either renderer replaces only its own.
+  void shareScene(const GpuRenderer& other);
   // Renders into the internal framebuffer and reads it back. Throws mfr::Error for an unknown
   // method/operation/parameter or a bad size.
   RenderOutput render(const Camera& camera, const RenderRequest& request);
@@ -63,7 +66,7 @@ class GpuRenderer {
   void ensureFramebuffer(int width, int height);
   FrameContext frameContext(const Camera& camera, int width, int height, gl::PassTimer& timer) const;
 
-  std::unique_ptr<gl::GpuScene> scene_;
+  std::shared_ptr<const gl::GpuScene> scene_;
   glm::vec3 background_{1.0f};
   std::string methodName_;
   std::string operation_ = "oit";  // of the prepared request, "auto" resolved

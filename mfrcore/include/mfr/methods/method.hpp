@@ -22,11 +22,11 @@ namespace mfr {
 // A method parameter, described once: the CLI parses it and the viewer builds its widget from it.
 struct ParamSpec {
   enum class Type { Int, Float, Bool, Choice, Text };  // Text: free text (a file path)
-  std::string name;          // CLI: --param name=value
-  std::string label;         // viewer label
+  std::string name;                                    // CLI: --param name=value
+  std::string label;                                   // viewer label
   Type type = Type::Int;
   std::string defaultValue;
-  double min = 0, max = 0;   // Int/Float range (inclusive)
+  double min = 0, max = 0;           // Int/Float range (inclusive)
   std::vector<std::string> choices;  // Choice
   std::string help;
   // A memory amount for the whole image (MiB): a frame of fewer pixels that should look like this
@@ -39,7 +39,8 @@ class Params {
  public:
   Params() = default;
   // Throws mfr::Error("--param <name>", reason) for an unknown name or a bad value.
-  Params(const std::vector<ParamSpec>& specs, const std::map<std::string, std::string>& values, const std::string& method);
+  Params(const std::vector<ParamSpec>& specs, const std::map<std::string, std::string>& values,
+         const std::string& method);
   [[nodiscard]] long long integer(const std::string& name) const;
   [[nodiscard]] double real(const std::string& name) const;
   [[nodiscard]] bool flag(const std::string& name) const;
@@ -60,8 +61,8 @@ struct MethodInfo {
 
 // What the resolve pass does with each pixel's sorted list.
 struct Operation {
-  std::string name;      // "oit", "dump"
-  std::string glslFile;  // e.g. "ops/oit.glsl": defines OpState, opBegin, opFragment, opEnd
+  std::string name;                              // "oit", "dump"
+  std::string glslFile;                          // e.g. "ops/oit.glsl": defines OpState, opBegin, opFragment, opEnd
   std::function<void(const gl::Program&)> bind;  // uniforms and buffers of the operation
 };
 
