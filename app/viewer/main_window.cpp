@@ -206,7 +206,9 @@ void MainWindow::buildMenus() {
                                 "<tr><td>S</td><td>compare layout: side by side / split</td></tr>"
                                 "<tr><td>D</td><td>compare heat map: images / FLIP / |difference|</td></tr>"
                                 "<tr><td>I, N, K</td><td>image, depth complexity n(p), capacity k(p)</td></tr>"
-                                "<tr><td>B</td><td>data map blended over the image</td></tr></table>"));
+                                "<tr><td>B</td><td>data map blended over the image</td></tr></table>"
+                                "<p>While you drag or wheel, a slow method is drawn at a reduced resolution; the "
+                                "full frame follows when the view stops (View → Fast Navigation).</p>"));
   });
   help->addAction(tr("&About mfrview"), this, [this] {
     QMessageBox::about(this, tr("About mfrview"),
