@@ -39,9 +39,12 @@ void addBench(CLI::App& app) {
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
       "bench", "Benchmark methods side by side: per-pass median time, memory, fragments, RMSE and FLIP vs the oracle");
-  cmd->add_option("scene", opt->scene, "Scene: model file, .mfrscene, @sample or @quads:N[:density[:seed]]")->required();
+  cmd->add_option("scene", opt->scene, "Scene: model file, .mfrscene, @sample or @quads:N[:density[:seed]]")
+      ->required();
   cmd->add_option("--methods,-m", opt->methods, "Comma-separated methods, each name[:key=value…]")->required();
-  cmd->add_option("--repeat,-r", opt->repeat, "Timed frames per method")->capture_default_str()->check(CLI::Range(1, 1000));
+  cmd->add_option("--repeat,-r", opt->repeat, "Timed frames per method")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--warmup", opt->warmup, "Untimed frames first")->capture_default_str()->check(CLI::Range(0, 100));
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view")->capture_default_str();
@@ -75,32 +78,57 @@ void addBench(CLI::App& app) {
     out["size"] = opt->size;
     out["view"] = opt->view;
     out["repeat"] = opt->repeat;
+    out["order"] = "round-robin: frame i of every method, then frame i + 1";
     out["renderer"] = info.renderer;
     out["gl_version"] = info.version;
-    out["timing"] = GpuRenderer::defaultFinishTiming() ? "glFinish + CPU clock per pass (llvmpipe)" : "GPU timestamp queries";
+    out["timing"] =
+        GpuRenderer::defaultFinishTiming() ? "glFinish + CPU clock per pass (llvmpipe)" : "GPU timestamp queries";
     out["oracle_fragments"] = totalFragments;
     out["oracle_ms"] = oracleMs;
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
 
     std::cout << "scene " << scene.name << ", " << opt->size << ", view " << opt->view << ", " << opt->repeat
-              << " frames, renderer: " << info.renderer << "\n";
+              << " frames each (round-robin), renderer: " << info.renderer << "\n";
     std::cout << std::left << std::setw(34) << "method" << std::right << std::setw(11) << "total ms" << std::setw(11)
               << "MiB alloc" << std::setw(10) << "MiB used" << std::setw(11) << "frags" << std::setw(11) << "stored"
-              << std::setw(9) << "RMSE" << std::setw(9) << "FLIP" << "  passes (median ms)\n";
-    for (const RenderRequest& req : requests) {
-      for (int i = 0; i < opt->warmup; ++i) gpu.render(camera, req);
+              << std::setw(9) << "RMSE" << std::setw(9) << "FLIP"
+              << "  passes (median ms)\n";
+    // One renderer per method (sharing the scene), frames interleaved round-robin: a slow spell
+    // of the machine then falls on every method alike, so the ratios between rows hold better
+    // than with one method's frames after another's.
+    struct Run {
+      const RenderRequest* req = nullptr;
+      std::unique_ptr<GpuRenderer> gpu;
       std::vector<std::pair<std::string, std::vector<double>>> perPass;
       std::vector<double> totals;
       RenderOutput last;
-      for (int i = 0; i < opt->repeat; ++i) {
-        last = gpu.render(camera, req);
-        totals.push_back(last.stats.totalTimeMs());
-        for (const auto& [pass, ms] : last.stats.passTimesMs) {
-          auto it = std::find_if(perPass.begin(), perPass.end(), [&](const auto& p) { return p.first == pass; });
-          if (it == perPass.end()) perPass.push_back({pass, {ms}});
-          else it->second.push_back(ms);
+    };
+    std::vector<Run> runs;
+    for (const RenderRequest& req : requests) {
+      Run run{&req, std::make_unique<GpuRenderer>(), {}, {}, {}};
+      run.gpu->shareScene(gpu);
+      runs.push_back(std::move(run));
+    }
+    for (Run& run : runs)
+      for (int i = 0; i < opt->warmup; ++i) run.gpu->render(camera, *run.req);
+    for (int i = 0; i < opt->repeat; ++i)
+      for (Run& run : runs) {
+        run.last = run.gpu->render(camera, *run.req);
+        run.totals.push_back(run.last.stats.totalTimeMs());
+        for (const auto& [pass, ms] : run.last.stats.passTimesMs) {
+          auto it =
+              std::find_if(run.perPass.begin(), run.perPass.end(), [&](const auto& p) { return p.first == pass; });
+          if (it == run.perPass.end())
+            run.perPass.push_back({pass, {ms}});
+          else
+            it->second.push_back(ms);
         }
       }
+    for (Run& run : runs) {
+      const RenderRequest& req = *run.req;
+      const std::vector<double>& totals = run.totals;
+      const auto& perPass = run.perPass;
+      const RenderOutput& last = run.last;
       std::string label = req.method;
       for (const auto& [k, v] : req.params) label += ":" + k + "=" + v;
       nlohmann::ordered_json row;
