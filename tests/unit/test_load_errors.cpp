@@ -580,7 +580,9 @@ TEST(SupportedModelExtensions, ListsEveryFamilyInLowerCase) {
     EXPECT_TRUE(std::none_of(e.begin(), e.end(), [](unsigned char c) { return std::isupper(c); })) << e;
   }
   EXPECT_TRUE(std::is_sorted(exts.begin(), exts.end()));
-  EXPECT_EQ(std::find(exts.begin(), exts.end(), ".step"), exts.end()) << "STEP is not read through assimp";
+  // STEP is listed: Open CASCADE reads it (step_loader); assimp's importer, which reads only
+  // IFC-style STEP, is left out.
+  EXPECT_NE(std::find(exts.begin(), exts.end(), ".step"), exts.end());
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include "obj_loader.hpp"
 #include "off_loader.hpp"
 #include "ply_loader.hpp"
+#include "step_loader.hpp"
 #include "vtk_legacy_loader.hpp"
 #include "vtk_loader.hpp"
 
@@ -30,7 +31,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-enum class Family { Vtk, Ply, Off, Obj, VtkLegacy, Assimp };
+enum class Family { Vtk, Ply, Off, Obj, VtkLegacy, Assimp, Step };
 
 struct Format {
   Family family;
@@ -59,6 +60,8 @@ const std::map<std::string, Format>& formats() {
     t[".vtk"] = {Family::VtkLegacy};
     t[".ply"] = {Family::Ply};
     t[".off"] = {Family::Off};
+    t[".step"] = {Family::Step};
+    t[".stp"] = {Family::Step};
     return t;
   }();
   return table;
@@ -158,8 +161,8 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
     if (gz)
       throw Error(name, "unsupported compressed file type: name it after its contents, e.g. model.ply.gz");
     throw Error(name, "unsupported file type '" + (ext.empty() ? path.filename().string() : lower(ext)) +
-                          "' (supported: .stl .ply .obj .off .vtp .vtk .glb .gltf and the other formats assimp "
-                          "reads, optionally gzip-compressed as .gz)");
+                          "' (supported: .stl .ply .obj .off .vtp .vtk .step .stp .glb .gltf and the other formats "
+                          "assimp reads, optionally gzip-compressed as .gz)");
   }
   const auto& [ext, format] = *found;
   // The part name of single-object formats: the file name without its extension(s).
@@ -206,6 +209,7 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
       return objects;
     }
     case Family::Assimp: return io::readWithAssimp(path, contents, ext, name, progress.part(gz ? 0.3 : 0.0, 0.95));
+    case Family::Step: return io::readStep(path, contents, stem, name, progress.part(gz ? 0.3 : 0.0, 0.95));
   }
   throw Error(name, "unsupported file type");
 }
@@ -255,7 +259,8 @@ std::vector<std::string> supportedModelExtensions() {
   std::set<std::string> out;
   for (const auto& [ext, format] : formats()) out.insert(ext);
   // Compressed variants that parse from memory without side files.
-  for (const char* ext : {".stl", ".ply", ".obj", ".off", ".vtp", ".vtk", ".glb"}) out.insert(std::string(ext) + ".gz");
+  for (const char* ext : {".stl", ".ply", ".obj", ".off", ".vtp", ".vtk", ".glb", ".step", ".stp"})
+    out.insert(std::string(ext) + ".gz");
   return {out.begin(), out.end()};
 }
 

@@ -20,7 +20,8 @@ class LoadCancelled : public Error {
 // Progress of one load, reported on the loading thread: report(fraction) with fraction in [0, 1],
 // non-decreasing, 1 when done. Returning false cancels: the loader stops at that report and
 // throws LoadCancelled. Loaders report at the start and end of every file, per object of a
-// .mfrscene and per mesh of an assimp scene (and assimp's own import progress).
+// .mfrscene, per mesh of an assimp scene (and assimp's own import progress), and for STEP after
+// parsing, during the transfer and per part meshed.
 struct LoadProgress {
   std::function<bool(double fraction)> report;  // empty: no reporting, never cancelled
   double begin = 0.0, end = 1.0;                // the part of the whole load this one covers
@@ -33,8 +34,8 @@ struct LoadProgress {
   [[nodiscard]] LoadProgress part(double from, double to) const;
 };
 
-// Loads a model file — STL, PLY (also .ply.gz), OBJ, OFF, VTP, VTK legacy, glTF/GLB and the other
-// formats assimp reads — into parts. Throws mfr::Error(path, reason) for a missing, unreadable,
+// Loads a model file — STL, PLY (also .ply.gz), OBJ, OFF, VTP, VTK legacy, STEP, glTF/GLB and the
+// other formats assimp reads — into parts. Throws mfr::Error(path, reason) for a missing, unreadable,
 // truncated, corrupt or unsupported file, or one with no triangles; LoadCancelled when cancelled.
 std::vector<Object> loadModel(const std::filesystem::path& path, const LoadProgress& progress = {});
 
