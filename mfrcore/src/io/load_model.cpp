@@ -19,6 +19,7 @@
 #include "assimp_loader.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "molecule_loader.hpp"
 #include "obj_loader.hpp"
 #include "off_loader.hpp"
 #include "ply_loader.hpp"
@@ -30,7 +31,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-enum class Family { Vtk, Ply, Off, Obj, VtkLegacy, Assimp };
+enum class Family { Vtk, Ply, Off, Obj, VtkLegacy, Assimp, Molecule };
 
 struct Format {
   Family family;
@@ -59,6 +60,7 @@ const std::map<std::string, Format>& formats() {
     t[".vtk"] = {Family::VtkLegacy};
     t[".ply"] = {Family::Ply};
     t[".off"] = {Family::Off};
+    for (const char* ext : {".pdb", ".ent", ".cif", ".mmcif"}) t[ext] = {Family::Molecule};  // gemmi
     return t;
   }();
   return table;
@@ -159,7 +161,7 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
       throw Error(name, "unsupported compressed file type: name it after its contents, e.g. model.ply.gz");
     throw Error(name, "unsupported file type '" + (ext.empty() ? path.filename().string() : lower(ext)) +
                           "' (supported: .stl .ply .obj .off .vtp .vtk .glb .gltf and the other formats assimp "
-                          "reads, optionally gzip-compressed as .gz)");
+                          "reads, .pdb .ent .cif .mmcif molecules, optionally gzip-compressed as .gz)");
   }
   const auto& [ext, format] = *found;
   // The part name of single-object formats: the file name without its extension(s).
@@ -206,6 +208,11 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
       return objects;
     }
     case Family::Assimp: return io::readWithAssimp(path, contents, ext, name, progress.part(gz ? 0.3 : 0.0, 0.95));
+    case Family::Molecule: {
+      if (!gz) data = readAll(path, name);
+      const auto molecule = ext == ".pdb" || ext == ".ent" ? io::MoleculeFormat::Pdb : io::MoleculeFormat::Mmcif;
+      return io::readMolecule(data, molecule, name, progress.part(gz ? 0.3 : 0.0, 0.95));
+    }
   }
   throw Error(name, "unsupported file type");
 }
@@ -256,6 +263,7 @@ std::vector<std::string> supportedModelExtensions() {
   for (const auto& [ext, format] : formats()) out.insert(ext);
   // Compressed variants that parse from memory without side files.
   for (const char* ext : {".stl", ".ply", ".obj", ".off", ".vtp", ".vtk", ".glb"}) out.insert(std::string(ext) + ".gz");
+  for (const char* ext : {".pdb", ".ent", ".cif", ".mmcif"}) out.insert(std::string(ext) + ".gz");
   return {out.begin(), out.end()};
 }
 
