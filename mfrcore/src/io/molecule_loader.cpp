@@ -12,13 +12,13 @@
 #include <string_view>
 #include <utility>
 
+#include <gemmi/cif.hpp>
 #include <gemmi/elem.hpp>
 #include <gemmi/mmcif.hpp>
 #include <gemmi/model.hpp>
 #include <gemmi/pdb.hpp>
 #include <gemmi/polyheur.hpp>
 
-#include "cif_reader.hpp"
 #include "mfr/error.hpp"
 
 namespace mfr::io {
@@ -171,7 +171,7 @@ gemmi::Structure parse(const std::string& data, MoleculeFormat format, const std
     if (hasLineNumbersInColumns73To80(data)) options.max_line_length = 72;
     return gemmi::read_pdb_from_memory(data.data(), data.size(), name, options);
   }
-  const gemmi::cif::Document doc = readCif(data, name);
+  const gemmi::cif::Document doc = gemmi::cif::read_memory(data.data(), data.size(), name.c_str());
   if (doc.blocks.empty()) throw Error(name, "no CIF data block (data_...) in the file");
   const gemmi::cif::Block& block = doc.blocks[0];
   if (!block.has_tag("_atom_site.Cartn_x")) {
@@ -187,12 +187,28 @@ gemmi::Structure parse(const std::string& data, MoleculeFormat format, const std
   return gemmi::make_structure(doc);
 }
 
-// gemmi's messages sometimes start with the source name we gave it, and some span lines.
+// gemmi's messages as one line without the source name we gave it; the CIF parser's positions
+// ("12:34: …", "12 in data_X: …") spelled out.
 std::string reason(std::string message, const std::string& name) {
   if (message.rfind(name, 0) == 0) {
     message.erase(0, name.size());
     while (!message.empty() && (message[0] == ':' || message[0] == ' ')) message.erase(0, 1);
   }
+  const auto digitsFrom = [&](std::size_t i) {
+    while (i < message.size() && std::isdigit(static_cast<unsigned char>(message[i])) != 0) ++i;
+    return i;
+  };
+  if (const std::size_t line = digitsFrom(0); line > 0 && line < message.size()) {
+    if (message[line] == ':') {
+      const std::size_t column = digitsFrom(line + 1);
+      if (column > line + 1 && column < message.size() && message[column] == ':')
+        message = "line " + message.substr(0, line) + ", column " + message.substr(line + 1, column - line - 1) +
+                  message.substr(column);
+    } else if (message.compare(line, 4, " in ") == 0) {
+      message = "line " + message;
+    }
+  }
+  if (message.find("Wrong number of values in the loop") != std::string::npos) message += " (truncated or corrupt?)";
   for (char& c : message)
     if (c == '\n' || c == '\r') c = ' ';
   return message.empty() ? "cannot read the structure" : message;
