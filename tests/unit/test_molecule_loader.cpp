@@ -16,6 +16,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "mfr/reference/oracle.hpp"
 
 namespace fs = std::filesystem;
 
@@ -352,6 +353,45 @@ TEST_F(MoleculeLoader, ProgressAndCancel) {
     cancel.report = [&](double) { return calls++ < stopAt; };
     EXPECT_THROW(mfr::loadModel(p, cancel), mfr::LoadCancelled) << "stop at report " << stopAt;
     EXPECT_EQ(calls, stopAt + 1) << "reports after the cancel";
+  }
+}
+
+// A scene file's "color" replaces the element colours (Material::vertexColors false) — its
+// documented meaning, "overrides the file's colours" — while "opacity" alone keeps them; the
+// oracle then shades every fragment of such a part in that colour.
+TEST_F(MoleculeLoader, SceneFileColourReplacesElementColours) {
+  write("tiny.pdb", tinyPdb());
+  const fs::path own =
+      write("own.mfrscene", R"({"objects": [{"file": "tiny.pdb", "color": [0.2, 0.4, 0.9], "opacity": 1}]})");
+  const fs::path see = write("see.mfrscene", R"({"objects": [{"file": "tiny.pdb", "opacity": 1}]})");
+  const mfr::Scene coloured = mfr::loadScene(own), elements = mfr::loadScene(see);
+  ASSERT_EQ(coloured.objects.size(), 4u);
+  ASSERT_EQ(elements.objects.size(), 4u);
+  for (const mfr::Object& o : coloured.objects) {
+    EXPECT_FALSE(o.material.vertexColors) << o.name;
+    EXPECT_EQ(o.material.color, glm::vec4(0.2f, 0.4f, 0.9f, 1.0f));
+  }
+  for (const mfr::Object& o : elements.objects) {
+    EXPECT_TRUE(o.material.vertexColors) << o.name;
+    EXPECT_EQ(o.material.color, glm::vec4(1.0f));
+  }
+  // Looking down −z at the row of atoms: the first layer of every pixel.
+  const auto firstFragments = [](const mfr::Scene& scene) {
+    const mfr::FragmentLists lists = mfr::castFragments(scene, scene.view("fit"), 96, 24);
+    std::vector<std::uint32_t> colours;
+    for (std::size_t i = 0; i + 1 < lists.offsets.size(); ++i)
+      if (lists.offsets[i + 1] > lists.offsets[i]) colours.push_back(lists.fragments[lists.offsets[i]].color);
+    return colours;
+  };
+  std::size_t red = 0;
+  for (const std::uint32_t c : firstFragments(elements)) red += (c & 0xFF) > 3 * ((c >> 16) & 0xFF) + 20;
+  EXPECT_GT(red, 0u) << "oxygens are red";
+  const std::vector<std::uint32_t> own_ = firstFragments(coloured);
+  ASSERT_FALSE(own_.empty());
+  for (const std::uint32_t c : own_) {
+    const double r = c & 0xFF, g = (c >> 8) & 0xFF, b = (c >> 16) & 0xFF;  // (0.2, 0.4, 0.9) × light
+    ASSERT_NEAR(g / r, 2.0, 4.0 / r + 0.02) << std::hex << c;
+    ASSERT_NEAR(b / r, 4.5, 9.0 / r + 0.05) << std::hex << c;
   }
 }
 
