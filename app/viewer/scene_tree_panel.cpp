@@ -21,6 +21,13 @@ QColor colourOf(const mfr::Object& o) {
   return QColor::fromRgbF(o.material.color.r, o.material.color.g, o.material.color.b);
 }
 
+// The colour column's text: the colour's name, or "file colours" while the mesh's per-vertex colours
+// show (multiplied by the swatch's colour, white for molecules).
+QString colourText(const mfr::Object& o) {
+  const bool perVertex = o.material.vertexColors && o.mesh && !o.mesh->colors.empty();
+  return perVertex ? QObject::tr("file colours") : colourOf(o).name();
+}
+
 QIcon swatch(const QColor& colour) {
   QPixmap pixmap(16, 16);
   pixmap.fill(colour);
@@ -58,9 +65,10 @@ void SceneTreePanel::showValues() {
     QTreeWidgetItem* item = tree_->topLevelItem(i);
     const mfr::Object& o = objects[static_cast<std::size_t>(i)];
     item->setCheckState(kName, o.visible ? Qt::Checked : Qt::Unchecked);
-    if (item->text(kColour) != colourOf(o).name()) {
+    if (item->text(kColour) != colourText(o) || item->data(kColour, Qt::UserRole).value<QColor>() != colourOf(o)) {
       item->setIcon(kColour, swatch(colourOf(o)));
-      item->setText(kColour, colourOf(o).name());
+      item->setText(kColour, colourText(o));
+      item->setData(kColour, Qt::UserRole, colourOf(o));
     }
     item->setData(kOpacity, Qt::EditRole, std::round(o.material.color.a * 1000.0) / 1000.0);
   }
@@ -80,8 +88,9 @@ void SceneTreePanel::rebuild() {
     item->setData(kName, Qt::UserRole, static_cast<int>(i));
     item->setCheckState(kName, o.visible ? Qt::Checked : Qt::Unchecked);
     item->setIcon(kColour, swatch(colourOf(o)));
-    item->setText(kColour, colourOf(o).name());
-    item->setToolTip(kColour, tr("Click to change the colour"));
+    item->setText(kColour, colourText(o));
+    item->setData(kColour, Qt::UserRole, colourOf(o));
+    item->setToolTip(kColour, tr("Click to change the colour (a chosen colour replaces the file's colours)"));
     item->setData(kOpacity, Qt::EditRole, std::round(o.material.color.a * 1000.0) / 1000.0);
     item->setToolTip(kOpacity, tr("Double-click to edit (0 = invisible, 1 = opaque)"));
     item->setText(kTriangles, QString::number(o.mesh ? o.mesh->triangleCount() : 0));

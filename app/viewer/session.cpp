@@ -101,7 +101,7 @@ Session captureSession(const ViewerModel& model) {
   s.operation = model.operation();
   s.params = model.allParams();
   for (const mfr::Object& o : model.scene().objects) {
-    s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color});
+    s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color, o.material.vertexColors});
   }
   s.compare.enabled = model.compareEnabled();
   s.compare.layout = model.compareLayout();
@@ -121,7 +121,7 @@ void applySession(const Session& session, ViewerModel& model) {
       const Session::ObjectState& o = session.objects[i];
       const int index = static_cast<int>(i);
       model.setObjectVisible(index, o.visible);
-      model.setObjectMaterial(index, o.color);
+      model.setObjectMaterial(index, o.color, o.vertexColors);
     }
   }
   model.setAllParams(session.params);
@@ -160,7 +160,8 @@ QJsonObject sessionToJson(const Session& s) {
     objects.append(QJsonObject{{"name", o.name},
                                {"visible", o.visible},
                                {"color", QJsonArray{o.color.r, o.color.g, o.color.b}},
-                               {"opacity", o.color.a}});
+                               {"opacity", o.color.a},
+                               {"vertex_colors", o.vertexColors}});
   return {{"format", "mfrview-session"}, {"version", 1},           {"scene", s.scenePath},
           {"camera", camera},            {"method", s.method},     {"operation", s.operation},
           {"params", paramsToJson(s.params)}, {"objects", objects},  {"compare", compare},
@@ -208,7 +209,9 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
     if (c.size() != 3) r.fail(QStringLiteral("objects[%1].color").arg(i), QStringLiteral("expected [r, g, b]"));
     const glm::dvec4 rgba(c[0].toDouble(), c[1].toDouble(), c[2].toDouble(),
                           r.number(o, "opacity", QStringLiteral("objects[%1]").arg(i), 1.0));
-    s.objects.push_back({o.value("name").toString(), o.value("visible").toBool(true), glm::vec4(rgba)});
+    // vertex_colors: absent in sessions written before it existed, when colours always multiplied.
+    s.objects.push_back({o.value("name").toString(), o.value("visible").toBool(true), glm::vec4(rgba),
+                         o.value("vertex_colors").toBool(true)});
   }
   s.plugins = json.value("plugins").toObject();
   return s;

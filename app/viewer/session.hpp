@@ -18,6 +18,7 @@ struct Session {
     QString name;
     bool visible = true;
     glm::vec4 color{1.0f};  // RGB + opacity, the material's floats exactly
+    bool vertexColors = true;  // Material::vertexColors: false once a colour was chosen for the part
   };
   QString scenePath;
   mfr::Camera camera;

@@ -300,8 +300,10 @@ void ViewerModel::setObjectVisible(int index, bool visible) {
 
 void ViewerModel::setObjectColor(int index, const QColor& rgb) {
   if (index < 0 || index >= static_cast<int>(scene_.objects.size())) return;
-  glm::vec4& c = scene_.objects[static_cast<std::size_t>(index)].material.color;
+  mfr::Material& material = scene_.objects[static_cast<std::size_t>(index)].material;
+  glm::vec4& c = material.color;
   c = glm::vec4(static_cast<float>(rgb.redF()), static_cast<float>(rgb.greenF()), static_cast<float>(rgb.blueF()), c.a);
+  material.vertexColors = false;
   sceneEdited();
 }
 
@@ -311,11 +313,12 @@ void ViewerModel::setObjectOpacity(int index, double opacity) {
   sceneEdited();
 }
 
-void ViewerModel::setObjectMaterial(int index, const glm::vec4& rgba) {
+void ViewerModel::setObjectMaterial(int index, const glm::vec4& rgba, bool vertexColors) {
   if (index < 0 || index >= static_cast<int>(scene_.objects.size())) return;
-  glm::vec4& c = scene_.objects[static_cast<std::size_t>(index)].material.color;
-  if (c == rgba) return;
-  c = rgba;
+  mfr::Material& material = scene_.objects[static_cast<std::size_t>(index)].material;
+  if (material.color == rgba && material.vertexColors == vertexColors) return;
+  material.color = rgba;
+  material.vertexColors = vertexColors;
   sceneEdited();
 }
 

@@ -131,9 +131,10 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] const QString& scenePath() const { return scenePath_; }
   [[nodiscard]] quint64 sceneRevision() const { return sceneRevision_; }
   void setObjectVisible(int index, bool visible);
+  // A colour chosen for a part replaces its file's per-vertex colours (Material::vertexColors).
   void setObjectColor(int index, const QColor& rgb);
   void setObjectOpacity(int index, double opacity);
-  void setObjectMaterial(int index, const glm::vec4& rgba);
+  void setObjectMaterial(int index, const glm::vec4& rgba, bool vertexColors = true);
 
   // Camera: setCamera refits near/far around the visible objects, so navigation never clips.
   [[nodiscard]] const mfr::Camera& camera() const { return camera_; }

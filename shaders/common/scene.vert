@@ -1,6 +1,6 @@
 // [Multifragment rendering infrastructure — Vasilakis, Vardis, Papaioannou, "A Survey of Multifragment
-// Rendering", Computer Graphics Forum 39(2), 2020.] Scene vertex shader shared by every capture pass: world-space normal, material × vertex colour,
-// object id. Multifragment capture itself happens in each method's *.geom.frag.
+// Rendering", Computer Graphics Forum 39(2), 2020.] Scene vertex shader shared by every capture pass: world-space normal, material × vertex colour
+// (the material's alone when uVertexColors is 0), object id. Multifragment capture itself happens in each method's *.geom.frag.
 #include "common/bindings.h"
 
 layout(location = MFR_ATTR_POSITION) in vec3 aPosition;
@@ -11,6 +11,7 @@ uniform mat4 uViewProj;
 uniform mat4 uModel;
 uniform mat3 uNormalMatrix;
 uniform vec4 uColor;
+uniform int uVertexColors;  // 0: the object's colour replaces the mesh's per-vertex colours
 
 out vec3 vNormal;
 out vec4 vColor;
@@ -21,6 +22,6 @@ invariant gl_Position;
 
 void main() {
   vNormal = uNormalMatrix * aNormal;
-  vColor = uColor * aColor;
+  vColor = uVertexColors != 0 ? uColor * aColor : uColor;
   gl_Position = uViewProj * (uModel * vec4(aPosition, 1.0));
 }

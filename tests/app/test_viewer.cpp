@@ -335,6 +335,8 @@ class ViewerTest : public QObject {
       m.setCamera(navigation::orbit(m.camera(), QPointF(37, -21), QSize(400, 300)));
       m.setObjectVisible(1, false);
       m.setObjectMaterial(2, glm::vec4(0.2f, 0.6f, 0.9f, 0.45f));
+      m.setObjectColor(3, QColor(200, 40, 40));  // a chosen colour replaces per-vertex colours
+      QVERIFY(!m.scene().objects[3].material.vertexColors);
       settle(m);
       before = w->view().renderImage(size);
       // Compare mode with the second method's own parameters, and the data view.
@@ -356,6 +358,8 @@ class ViewerTest : public QObject {
     settle(m);
     QCOMPARE(m.params().at("k"), std::string("5"));
     QVERIFY(!m.scene().objects[1].visible);
+    QVERIFY(m.scene().objects[2].material.vertexColors);
+    QVERIFY(!m.scene().objects[3].material.vertexColors);
     QVERIFY(m.compareEnabled());
     QCOMPARE(m.methodOf(1), QStringLiteral("kplus-array"));
     QCOMPARE(m.paramsOf(1).at("k"), std::string("3"));

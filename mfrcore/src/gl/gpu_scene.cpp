@@ -44,7 +44,7 @@ GpuScene::GpuScene(const Scene& scene) {
     }
     const glm::mat4 model(o.transform);
     items_.push_back({it->second, model, glm::mat3(glm::transpose(glm::inverse(o.transform))), o.material.color,
-                      static_cast<std::uint32_t>(i)});
+                      o.material.vertexColors, static_cast<std::uint32_t>(i)});
     triangles_ += o.mesh->triangleCount();
   }
 }
@@ -58,6 +58,7 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
     program.set("uModel", item.model);
     program.set("uNormalMatrix", item.normalMatrix);
     program.set("uColor", item.color);
+    program.set("uVertexColors", item.vertexColors ? 1 : 0);
     program.set("uObjectId", item.objectId);
     glBindVertexArray(m.vao.id());
     glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);

@@ -19,6 +19,7 @@
 #include "assimp_loader.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "molecule_loader.hpp"
 #include "obj_loader.hpp"
 #include "off_loader.hpp"
 #include "ply_loader.hpp"
@@ -31,7 +32,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-enum class Family { Vtk, Ply, Off, Obj, VtkLegacy, Assimp, Step };
+enum class Family { Vtk, Ply, Off, Obj, VtkLegacy, Assimp, Step, Molecule };
 
 struct Format {
   Family family;
@@ -62,6 +63,7 @@ const std::map<std::string, Format>& formats() {
     t[".off"] = {Family::Off};
     t[".step"] = {Family::Step};
     t[".stp"] = {Family::Step};
+    for (const char* ext : {".pdb", ".ent", ".cif", ".mmcif"}) t[ext] = {Family::Molecule};  // gemmi
     return t;
   }();
   return table;
@@ -162,7 +164,7 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
       throw Error(name, "unsupported compressed file type: name it after its contents, e.g. model.ply.gz");
     throw Error(name, "unsupported file type '" + (ext.empty() ? path.filename().string() : lower(ext)) +
                           "' (supported: .stl .ply .obj .off .vtp .vtk .step .stp .glb .gltf and the other formats "
-                          "assimp reads, optionally gzip-compressed as .gz)");
+                          "assimp reads, .pdb .ent .cif .mmcif molecules, optionally gzip-compressed as .gz)");
   }
   const auto& [ext, format] = *found;
   // The part name of single-object formats: the file name without its extension(s).
@@ -210,6 +212,11 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
     }
     case Family::Assimp: return io::readWithAssimp(path, contents, ext, name, progress.part(gz ? 0.3 : 0.0, 0.95));
     case Family::Step: return io::readStep(path, contents, stem, name, progress.part(gz ? 0.3 : 0.0, 0.95));
+    case Family::Molecule: {
+      if (!gz) data = readAll(path, name);
+      const auto molecule = ext == ".pdb" || ext == ".ent" ? io::MoleculeFormat::Pdb : io::MoleculeFormat::Mmcif;
+      return io::readMolecule(data, molecule, name, progress.part(gz ? 0.3 : 0.0, 0.95));
+    }
   }
   throw Error(name, "unsupported file type");
 }
@@ -259,7 +266,8 @@ std::vector<std::string> supportedModelExtensions() {
   std::set<std::string> out;
   for (const auto& [ext, format] : formats()) out.insert(ext);
   // Compressed variants that parse from memory without side files.
-  for (const char* ext : {".stl", ".ply", ".obj", ".off", ".vtp", ".vtk", ".glb", ".step", ".stp"})
+  for (const char* ext : {".stl", ".ply", ".obj", ".off", ".vtp", ".vtk", ".glb", ".step", ".stp", ".pdb", ".ent", ".cif",
+                          ".mmcif"})
     out.insert(std::string(ext) + ".gz");
   return {out.begin(), out.end()};
 }

@@ -66,6 +66,7 @@ struct ObjectShading {
   const Mesh* mesh = nullptr;
   glm::dmat3 normalMatrix{1.0};  // inverse transpose of the object transform's linear part
   glm::vec4 materialColor{1.0f};
+  bool vertexColors = true;  // Material::vertexColors
 };
 
 struct Hit {
@@ -199,7 +200,7 @@ std::uint32_t shade(const WorldTriangle& tri, const ObjectShading& obj, double u
   if (!(glm::dot(normal, normal) > 1e-24))
     normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
   glm::vec4 base = obj.materialColor;
-  if (mesh.colors.size() == mesh.positions.size()) {
+  if (obj.vertexColors && mesh.colors.size() == mesh.positions.size()) {
     glm::dvec4 c(0.0);
     for (int k = 0; k < 3; ++k) c += w[k] * glm::dvec4(mesh.colors[tri.vertex[k]]);
     base *= glm::vec4(c);
@@ -232,7 +233,8 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     if (!object.visible || !object.mesh || object.mesh->triangleCount() == 0) continue;
     const Mesh& mesh = *object.mesh;
     mesh.validate(object.name);
-    objects[o] = {&mesh, glm::transpose(glm::inverse(glm::dmat3(object.transform))), object.material.color};
+    objects[o] = {&mesh, glm::transpose(glm::inverse(glm::dmat3(object.transform))), object.material.color,
+                  object.material.vertexColors};
     std::vector<glm::dvec3> world(mesh.positions.size());
     for (std::size_t i = 0; i < world.size(); ++i)
       world[i] = transformPoint(object.transform, glm::dvec3(mesh.positions[i]));

@@ -248,6 +248,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
           part.name = parts.size() == 1 ? objName : objName + "/" + part.name;
           part.transform = xf * part.transform;
           part.material.color = parseColor(r, o, where, part.material.color);
+          if (o.contains("color")) part.material.vertexColors = false;  // replaces the file's colours
           part.visible = visible;
           scene.objects.push_back(std::move(part));
         }

@@ -1,8 +1,8 @@
 #pragma once
 // A scene uploaded to the GPU: one vertex/index buffer pair per distinct mesh, drawn object by
 // object with the per-object uniforms every capture shader receives through
-// shaders/common/scene.vert (uModel, uNormalMatrix, uColor, uObjectId) plus the per-frame uViewProj
-// and uViewDir.
+// shaders/common/scene.vert (uModel, uNormalMatrix, uColor, uVertexColors, uObjectId) plus the
+// per-frame uViewProj and uViewDir.
 #include <map>
 #include <vector>
 
@@ -39,6 +39,7 @@ class GpuScene {
     glm::mat4 model;
     glm::mat3 normalMatrix;
     glm::vec4 color;
+    bool vertexColors;
     std::uint32_t objectId;
   };
   std::vector<GpuMesh> meshes_;

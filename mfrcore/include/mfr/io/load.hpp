@@ -35,7 +35,8 @@ struct LoadProgress {
 };
 
 // Loads a model file — STL, PLY (also .ply.gz), OBJ, OFF, VTP, VTK legacy, STEP, glTF/GLB and the
-// other formats assimp reads — into parts. Throws mfr::Error(path, reason) for a missing, unreadable,
+// other formats assimp reads — into parts; PDB and mmCIF molecules (also .gz) become spheres, one
+// part per chain plus ligands and water. Throws mfr::Error(path, reason) for a missing, unreadable,
 // truncated, corrupt or unsupported file, or one with no triangles; LoadCancelled when cancelled.
 std::vector<Object> loadModel(const std::filesystem::path& path, const LoadProgress& progress = {});
 

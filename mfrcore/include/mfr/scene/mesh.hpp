@@ -28,7 +28,7 @@ struct Bounds {
 
 // Indexed triangle mesh in object space. normals always has one entry per position (loaders
 // compute them when the file has none); colors is empty or one RGBA per position, multiplied
-// with the object's material colour.
+// with the object's material colour (unless the material sets vertexColors false).
 struct Mesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;

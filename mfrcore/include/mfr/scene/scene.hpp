@@ -15,6 +15,10 @@ namespace mfr {
 
 struct Material {
   glm::vec4 color{0.8f, 0.8f, 0.8f, 0.5f};  // RGB display values in [0,1], A = opacity
+  // Whether the mesh's per-vertex colours (Mesh::colors) multiply `color`. False once the part is
+  // given a colour of its own (a scene file's "color", the viewer's colour picker): `color` then
+  // replaces the file's colours, as it does for meshes without any.
+  bool vertexColors = true;
 };
 
 struct Object {
