@@ -55,6 +55,8 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
   // A requested frame quality needs the frame on the CPU: draw it once more and read it back
   // (the widget's framebuffer is not kept between paints).
   connect(&model_, &ViewerModel::frameImageWanted, this, repaint);
+  // Counted on the GPU between frames (queued: the request may come from inside a paint's report).
+  connect(&model_, &ViewerModel::depthComplexityWanted, this, &RenderView::reportDepthComplexity, Qt::QueuedConnection);
   connect(&model_, &ViewerModel::metricsReady, this, [this] {
     // Heat maps are drawn into the image; the captions are widgets.
     if (model_.compareEnabled() && model_.compareDisplay() != CompareDisplay::Images)
@@ -319,24 +321,11 @@ RenderView::DataMap RenderView::computeDataMap(int side, QSize size, const Image
   map.width = size.width();
   map.height = size.height();
   if (map.kind == DataView::DepthComplexity) {
-    const bool cached = depthCache_.scene == model_.sceneRevision() && depthCache_.view == model_.viewRevision() &&
-                        depthCache_.size == size && !depthCache_.values.empty();
-    if (cached) {
-      map.values = depthCache_.values;
-    } else {
-      QStringList errors;
-      if (!uploadSceneIfChanged(side, errors)) {
-        map.note = errors.join(QStringLiteral("; "));
-        return map;
-      }
-      try {
-        map.values = renderer(side).depthComplexity(model_.camera(), size.width(), size.height());
-        depthCache_ = {model_.sceneRevision(), model_.viewRevision(), size, map.values};
-      } catch (const std::exception& e) {
-        mfr::gl::discardErrors();
-        map.note = QString::fromUtf8(e.what());
-        return map;
-      }
+    try {
+      map.values = depthCounts(size);
+    } catch (const std::exception& e) {
+      map.note = QString::fromUtf8(e.what());
+      return map;
     }
   } else {
     // k(p) belongs to the frame just rendered by this pane's renderer.
@@ -351,6 +340,41 @@ RenderView::DataMap RenderView::computeDataMap(int side, QSize size, const Image
   map.minValue = *lo;
   map.maxValue = *hi;
   return map;
+}
+
+const std::vector<std::uint32_t>& RenderView::depthCounts(QSize size) {
+  const bool cached = depthCache_.scene == model_.sceneRevision() && depthCache_.view == model_.viewRevision() &&
+                      depthCache_.size == size && !depthCache_.values.empty();
+  if (!cached) {
+    QStringList errors;
+    if (!uploadSceneIfChanged(0, errors)) throw mfr::Error("depth complexity", errors.join("; ").toStdString());
+    try {
+      depthCache_ = {model_.sceneRevision(), model_.viewRevision(), size,
+                     renderer(0).depthComplexity(model_.camera(), size.width(), size.height())};
+    } catch (...) {
+      mfr::gl::discardErrors();
+      depthCache_ = {};
+      throw;
+    }
+  }
+  return depthCache_.values;
+}
+
+void RenderView::reportDepthComplexity() {
+  if (!renderers_[0] || !model_.hasScene()) return;
+  const QSize size = pixelSize();
+  QVector<quint64> histogram;
+  makeCurrent();
+  try {
+    for (std::uint32_t n : depthCounts(size)) {
+      if (n >= static_cast<std::uint32_t>(histogram.size())) histogram.resize(n + 1);
+      ++histogram[n];
+    }
+  } catch (const std::exception&) {
+    histogram.clear();  // nothing visible: an empty histogram says so
+  }
+  doneCurrent();
+  model_.reportDepthComplexity(histogram, size);
 }
 
 RenderView::PaneTarget& RenderView::targetOf(std::array<PaneTarget, kSides>& targets, int side, QSize size) {

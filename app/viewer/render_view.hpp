@@ -115,6 +115,12 @@ class RenderView final : public QOpenGLWidget {
   void beginNavigation();
   void endNavigation(int settleMs);
   DataMap computeDataMap(int side, QSize size, const ImageKey& key, bool haveFrame);
+  // n(p) of the current view at `size` by the main renderer's count pass, cached per scene, view
+  // and size (both panes of compare mode share it); the context must be current. Throws
+  // mfr::Error.
+  const std::vector<std::uint32_t>& depthCounts(QSize size);
+  // Answers ViewerModel::depthComplexityWanted with the histogram of depthCounts.
+  void reportDepthComplexity();
   void clearToBackground();
   void releaseGl();
   void updateOverlays();

@@ -30,7 +30,6 @@ void runInBackground(QObject* receiver, Work work, Done done) {
 
 // The depth-complexity histogram is about the shape of the data, not the resolution: above this
 // many pixels it is computed on a proportionally smaller image, so it stays interactive.
-constexpr int kMaxDepthComplexityPixels = 320 * 240;
 // CPU images kept (panes and references of the last few views).
 constexpr std::size_t kCpuCacheSize = 6;
 constexpr int kLoadPollMs = 40;
@@ -538,48 +537,15 @@ void ViewerModel::startMetrics(int side, const mfr::ImageRGBA8& reference) {
 }
 
 bool ViewerModel::busy() const {
-  return loading_ || abandonedLoads_ > 0 || cpuRunning_ || depthRunning_ || metricsRunning_[0] || metricsRunning_[1];
+  return loading_ || abandonedLoads_ > 0 || cpuRunning_ || metricsRunning_[0] || metricsRunning_[1];
 }
 
 // ---- depth complexity ---------------------------------------------------------------------
 
 void ViewerModel::requestDepthComplexity() {
-  if (!hasScene_) return;
-  if (depthRunning_) {
-    depthPending_ = true;
-    return;
-  }
-  startDepthComplexity();
+  if (hasScene_) emit depthComplexityWanted();
 }
 
-void ViewerModel::startDepthComplexity() {
-  depthRunning_ = true;
-  depthPending_ = false;
-  QSize size = renderSize_;
-  const double pixels = static_cast<double>(size.width()) * size.height();
-  if (pixels > kMaxDepthComplexityPixels) {
-    const double s = std::sqrt(kMaxDepthComplexityPixels / pixels);
-    size = QSize(std::max(1, static_cast<int>(size.width() * s)), std::max(1, static_cast<int>(size.height() * s)));
-  }
-  struct Result {
-    QVector<quint64> histogram;
-    QSize size;
-  };
-  runInBackground<Result>(
-      this,
-      [scene = scene_, camera = camera_, size]() -> Result {
-        Result r{{}, size};
-        try {
-          const mfr::FragmentLists lists = mfr::castFragments(scene, camera, size.width(), size.height());
-          for (std::uint64_t n : mfr::depthComplexityHistogram(lists)) r.histogram.push_back(n);
-        } catch (const std::exception&) {
-          // Nothing visible: an empty histogram says so.
-        }
-        return r;
-      },
-      [this](const Result& r) {
-        depthRunning_ = false;
-        emit depthComplexityReady(r.histogram, r.size);
-        if (depthPending_) startDepthComplexity();
-      });
+void ViewerModel::reportDepthComplexity(const QVector<quint64>& histogram, QSize size) {
+  emit depthComplexityReady(histogram, size);
 }

@@ -158,6 +158,9 @@ class ViewerModel final : public ViewerContext {
   // Image size of each pane: half the view's width (rounded down) side by side, else all of it.
   [[nodiscard]] QSize paneSize() const;
 
+  // RenderView counts n(p) on the GPU when depthComplexityWanted asks, and reports the histogram.
+  void reportDepthComplexity(const QVector<quint64>& histogram, QSize size);
+
   // RenderView reports each pane's frame (or why it could not draw one).
   void reportFrame(int side, const mfr::Stats& stats);
   void reportFrame(const mfr::Stats& stats) { reportFrame(0, stats); }
@@ -203,7 +206,8 @@ class ViewerModel final : public ViewerContext {
   void secondaryFrameRendered();                    // statsOf(1) describes the new frame
   void cpuImageReady();
   void metricsReady(int side);
-  void frameImageWanted();  // a frame quality was requested: the view reads back what it shows
+  void frameImageWanted();       // a frame quality was requested: the view reads back what it shows
+  void depthComplexityWanted();  // requestDepthComplexity: the view counts n(p) on the GPU
   void renderErrorChanged(const QString& message);
 
  private:
@@ -212,7 +216,6 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] bool metricsWanted(int side) const;
   void sceneEdited();
   void updateSceneGeometry();
-  void startDepthComplexity();
   void startCpuJob();
   void updateMetrics();
   void startMetrics(int side, const mfr::ImageRGBA8& reference);
@@ -269,7 +272,4 @@ class ViewerModel final : public ViewerContext {
   std::array<std::optional<std::pair<ImageKey, mfr::ImageRGBA8>>, kSides> frameImage_;
   std::array<PaneMetrics, kSides> metrics_;
   std::array<bool, kSides> metricsRunning_{false, false};
-
-  bool depthRunning_ = false;
-  bool depthPending_ = false;
 };

@@ -31,10 +31,10 @@ enum class DataView {
 
 // The current frame against the exact image (the oracle's "over" of every fragment), same size.
 struct FrameQuality {
-  bool valid = false;    // computed for the frame now shown
+  bool valid = false;  // computed for the frame now shown
   QString method;
-  double rmse = 0.0;     // mfr::rmse over RGB, 8-bit values scaled to [0,1]
-  double flipMean = 0.0; // mean LDR-FLIP error, 67 pixels per degree
+  double rmse = 0.0;      // mfr::rmse over RGB, 8-bit values scaled to [0,1]
+  double flipMean = 0.0;  // mean LDR-FLIP error, 67 pixels per degree
   double flipMax = 0.0;
 };
 
@@ -65,8 +65,10 @@ class ViewerContext : public QObject {
   [[nodiscard]] virtual const mfr::Stats& stats() const = 0;
   // Pixels of the live image.
   [[nodiscard]] virtual QSize renderSize() const = 0;
-  // Starts (or queues) the exact per-pixel fragment counts of the current view, computed off the
-  // GUI thread by the oracle; depthComplexityReady delivers the histogram.
+  // Asks for the per-pixel fragment counts n(p) of the current view at the image's size, counted
+  // by the GPU's rasterisation (one count pass: what the GPU methods capture; equal to the
+  // oracle's counts on every pixel whose centre is off triangle edges); depthComplexityReady
+  // delivers the histogram soon after, on the GUI thread.
   virtual void requestDepthComplexity() = 0;
   // Starts (or queues) RMSE and FLIP of the current frame against the exact image, computed off
   // the GUI thread; frameQualityReady follows. frameQuality() is valid while it describes the
@@ -79,11 +81,11 @@ class ViewerContext : public QObject {
   virtual void setDataView(DataView view, bool overImage) = 0;
 
  signals:
-  void sceneChanged();                 // a new scene, or an object edited
-  void viewChanged();                  // camera or image size
+  void sceneChanged();  // a new scene, or an object edited
+  void viewChanged();   // camera or image size
   void methodChanged(const QString& method);
   void paramsChanged();
-  void frameRendered();                // stats() describes the new frame
+  void frameRendered();  // stats() describes the new frame
   // histogram[n] = pixels with exactly n fragments; the image size it was computed at.
   void depthComplexityReady(const QVector<quint64>& histogram, QSize size);
   void frameQualityReady();

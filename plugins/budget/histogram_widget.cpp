@@ -32,11 +32,13 @@ void HistogramWidget::paintEvent(QPaintEvent*) {
   const QFontMetrics fm = fontMetrics();
   quint64 largest = 1;
   for (qsizetype n = 1; n < histogram_.size(); ++n) largest = std::max(largest, histogram_[n]);
-  const QRect plot = rect().adjusted(fm.horizontalAdvance(QString::number(largest)) + 10, fm.height() + 8, -10, -2 * fm.height() - 8);
+  const QRect plot =
+      rect().adjusted(fm.horizontalAdvance(QString::number(largest)) + 10, fm.height() + 8, -10, -2 * fm.height() - 8);
   p.setPen(pal.color(QPalette::Text));
   p.drawText(QRect(4, 2, width() - 8, fm.height() + 4), Qt::AlignLeft | Qt::AlignVCenter,
-             histogram_.isEmpty() ? tr("Depth complexity: computing…")
-                                  : tr("Depth complexity n(p), exact (%1×%2)").arg(imageSize_.width()).arg(imageSize_.height()));
+             histogram_.isEmpty()
+                 ? tr("Depth complexity: computing…")
+                 : tr("Depth complexity n(p), GPU count (%1×%2)").arg(imageSize_.width()).arg(imageSize_.height()));
   if (histogram_.size() < 2 || plot.width() < 20 || plot.height() < 20) return;
 
   // Pixels with n ≥ 1 only: empty pixels would dwarf everything and cost no memory per fragment.
@@ -50,7 +52,8 @@ void HistogramWidget::paintEvent(QPaintEvent*) {
   for (int n = 1; n <= maxN; ++n) {
     if (histogram_[n] == 0) continue;
     const double h = plot.height() * std::log10(static_cast<double>(histogram_[n]) + 1.0) / logMax;
-    const QRectF bar(plot.left() + (n - 1) * barWidth, plot.bottom() - h, std::max(1.0, barWidth - (barWidth > 4 ? 1 : 0)), h);
+    const QRectF bar(plot.left() + (n - 1) * barWidth, plot.bottom() - h,
+                     std::max(1.0, barWidth - (barWidth > 4 ? 1 : 0)), h);
     p.fillRect(bar, marker_ > 0 && !variable_ && n > marker_ ? lost : kept);
   }
   // Axes and labels.
@@ -66,13 +69,14 @@ void HistogramWidget::paintEvent(QPaintEvent*) {
              QString::number(maxCount));
   p.drawText(QRect(0, plot.bottom() - fm.height() / 2, plot.left() - 4, fm.height()), Qt::AlignRight | Qt::AlignVCenter,
              QStringLiteral("0"));
-  p.drawText(QRect(plot.left(), plot.bottom() + fm.height() + 4, plot.width(), fm.height()), Qt::AlignHCenter | Qt::AlignTop,
-             tr("fragments per pixel n (pixels, log scale)"));
+  p.drawText(QRect(plot.left(), plot.bottom() + fm.height() + 4, plot.width(), fm.height()),
+             Qt::AlignHCenter | Qt::AlignTop, tr("fragments per pixel n (pixels, log scale)"));
   if (marker_ > 0 && marker_ <= maxN) {
     const int x = static_cast<int>(plot.left() + marker_ * barWidth);
     p.setPen(QPen(QColor(200, 30, 30), 2, Qt::DashLine));
     p.drawLine(x, plot.top(), x, plot.bottom());
     const QString label = variable_ ? tr("max k(p) = %1").arg(marker_) : QStringLiteral("k = %1").arg(marker_);
-    p.drawText(QRect(x + 4, plot.top(), fm.horizontalAdvance(label) + 8, fm.height()), Qt::AlignLeft | Qt::AlignTop, label);
+    p.drawText(QRect(x + 4, plot.top(), fm.horizontalAdvance(label) + 8, fm.height()), Qt::AlignLeft | Qt::AlignTop,
+               label);
   }
 }

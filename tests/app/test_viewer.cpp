@@ -889,6 +889,49 @@ class ViewerTest : public QObject {
     }
   }
 
+  // The budget panel's depth-complexity histogram: every pixel of the image, counted on the GPU;
+  // against the oracle's counts of the same view it differs only by pixels on triangle edges.
+  void depthHistogram() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(240, 180);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(240, 180), kTimeoutMs);
+    m.setCamera(m.scene().view("iso"));
+    settle(m);
+    QSignalSpy ready(&m, &ViewerModel::depthComplexityReady);
+    m.requestDepthComplexity();
+    QTRY_VERIFY_WITH_TIMEOUT(!ready.isEmpty(), kTimeoutMs);
+    const QList<QVariant> args = ready.takeLast();
+    const auto histogram = args.at(0).value<QVector<quint64>>();
+    const QSize size = args.at(1).toSize();
+    QCOMPARE(size, QSize(240, 180));  // the image's own size, no longer a reduced copy
+    quint64 pixels = 0;
+    for (quint64 c : histogram) pixels += c;
+    QCOMPARE(pixels, static_cast<quint64>(240 * 180));
+    const mfr::FragmentLists lists = mfr::castFragments(m.scene(), m.camera(), size.width(), size.height());
+    std::vector<quint64> oracle;
+    std::size_t ambiguous = 0;
+    for (int y = 0; y < size.height(); ++y)
+      for (int x = 0; x < size.width(); ++x) {
+        const std::size_t n = lists.count(x, y);
+        if (n >= oracle.size()) oracle.resize(n + 1);
+        ++oracle[n];
+        ambiguous += lists.isAmbiguous(x, y);
+      }
+    quint64 distance = 0;
+    for (std::size_t n = 0; n < std::max<std::size_t>(oracle.size(), histogram.size()); ++n) {
+      const quint64 a = n < oracle.size() ? oracle[n] : 0,
+                    b = n < static_cast<std::size_t>(histogram.size()) ? histogram[n] : 0;
+      distance += a > b ? a - b : b - a;
+    }
+    qInfo("histogram: %zu bins, L1 distance to the oracle's %llu pixels (%zu pixels on edges)",
+          static_cast<std::size_t>(histogram.size()), static_cast<unsigned long long>(distance), ambiguous);
+    QVERIFY(histogram.size() > 10);      // the sample is deep
+    QVERIFY(distance <= 2 * ambiguous);  // only edge pixels may differ…
+    QVERIFY(distance <= pixels / 100);   // …and few of them do (10 of 43,200 when measured)
+  }
+
   void navigation() {
     mfr::Camera c;
     c.eye = {0, 0, 5};
