@@ -1,11 +1,9 @@
 // The mfr command line end to end: bad input gives one line naming the file or argument and the
 // reason, a non-zero exit, no crash and no output file; good input gives the files.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
+#include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -14,63 +12,38 @@
 
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/image.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-  int exitCode = -1;
-  std::string out;  // stdout + stderr
-};
+using mfr::test::CliResult;
+using mfr::test::runCli;
 
-Result run(const std::string& args) {
-  Result r;
-  const std::string cmd = std::string(MFR_CLI) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-  const int status = pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-  return r;
-}
-
-class Cli : public ::testing::Test {
+class Cli : public mfr::test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("mfr-cli-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path file(const std::string& name, const std::string& content) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << content;
-    return p;
-  }
   // Bad input: exit code non-zero (1 or 2), no crash (< 128), one line mentioning `mention`,
   // and the output file was not created.
   void expectCleanFailure(const std::string& args, const std::string& mention) {
-    const fs::path out = dir_ / "out.png";
-    const Result r = run(args + " -o " + out.string());
+    const fs::path out = dir() / "out.png";
+    const CliResult r = runCli(args + " -o " + out.string());
     EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << "exit " << r.exitCode << ": " << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
     EXPECT_NE(r.out.find(mention), std::string::npos) << "message does not name '" << mention << "': " << r.out;
     EXPECT_EQ(r.out.rfind("mfr: ", 0), 0u) << r.out;
     EXPECT_FALSE(fs::exists(out)) << "partial output left behind";
-    for (const auto& e : fs::directory_iterator(dir_))
+    for (const auto& e : fs::directory_iterator(dir()))
       EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << "temporary left: " << e.path();
   }
-  fs::path dir_;
 };
 
 TEST_F(Cli, MissingFile) {
-  expectCleanFailure("render " + (dir_ / "nope.stl").string(), "nope.stl: no such file");
+  expectCleanFailure("render " + (dir() / "nope.stl").string(), "nope.stl: no such file");
 }
 
 TEST_F(Cli, DirectoryInsteadOfFile) {
-  expectCleanFailure("render " + dir_.string(), dir_.string());
+  expectCleanFailure("render " + dir().string(), dir().string());
 }
 
 TEST_F(Cli, TruncatedBinaryStl) {
@@ -79,28 +52,28 @@ TEST_F(Cli, TruncatedBinaryStl) {
   const std::uint32_t n = 10;
   stl.append(reinterpret_cast<const char*>(&n), 4);
   stl.append(50, '\0');
-  const fs::path p = file("cut.stl", stl);
+  const fs::path p = write("cut.stl", stl);
   expectCleanFailure("render " + p.string(), "cut.stl");
 }
 
 TEST_F(Cli, GarbagePly) {
-  const fs::path p = file("junk.ply", "ply\nformat ascii 1.0\nelement vertex banana\nend_header\n\x01\x02\x03");
+  const fs::path p = write("junk.ply", "ply\nformat ascii 1.0\nelement vertex banana\nend_header\n\x01\x02\x03");
   expectCleanFailure("render " + p.string(), "junk.ply");
 }
 
 TEST_F(Cli, JsonSyntaxError) {
   const fs::path p =
-      file("broken.mfrscene", "{\n  \"objects\": [\n    {\"primitive\": {\"type\": \"sphere\"}\n  ]\n}\n");
+      write("broken.mfrscene", "{\n  \"objects\": [\n    {\"primitive\": {\"type\": \"sphere\"}\n  ]\n}\n");
   expectCleanFailure("render " + p.string(), "broken.mfrscene: JSON syntax error at line 4");
 }
 
 TEST_F(Cli, EmptyScene) {
-  const fs::path p = file("empty.mfrscene", R"({"objects": []})");
+  const fs::path p = write("empty.mfrscene", R"({"objects": []})");
   expectCleanFailure("render " + p.string(), "nothing to render");
 }
 
 TEST_F(Cli, UnknownPrimitiveNamesTheJsonPath) {
-  const fs::path p = file("prim.mfrscene", R"({"objects": [{"primitive": {"type": "teapot"}}]})");
+  const fs::path p = write("prim.mfrscene", R"({"objects": [{"primitive": {"type": "teapot"}}]})");
   expectCleanFailure("render " + p.string(), "objects[0].primitive.type");
 }
 
@@ -126,26 +99,27 @@ TEST_F(Cli, BadMethodParameter) {
 }
 
 TEST_F(Cli, MissingOutputFolder) {
-  const Result r = run("render @sample --size 16x16 -o " + (dir_ / "no" / "such" / "dir.png").string());
+  const CliResult r = runCli("render @sample --size 16x16 -o " + (dir() / "no" / "such" / "dir.png").string());
   EXPECT_EQ(r.exitCode, 1) << r.out;
   EXPECT_NE(r.out.find("folder does not exist"), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, CompareSizeMismatchAndCorruptPng) {
-  mfr::writePng(dir_ / "a.png", mfr::ImageRGBA8(4, 4));
-  mfr::writePng(dir_ / "b.png", mfr::ImageRGBA8(5, 4));
-  Result r = run("compare " + (dir_ / "a.png").string() + " " + (dir_ / "b.png").string());
+  mfr::writePng(dir() / "a.png", mfr::ImageRGBA8(4, 4));
+  mfr::writePng(dir() / "b.png", mfr::ImageRGBA8(5, 4));
+  CliResult r = runCli("compare " + (dir() / "a.png").string() + " " + (dir() / "b.png").string());
   EXPECT_EQ(r.exitCode, 1);
   EXPECT_NE(r.out.find("differs from reference"), std::string::npos) << r.out;
-  const fs::path bad = file("bad.png", "\x89PNG\r\n\x1a\n garbage");
-  r = run("compare " + (dir_ / "a.png").string() + " " + bad.string());
+  const fs::path bad = write("bad.png", "\x89PNG\r\n\x1a\n garbage");
+  r = runCli("compare " + (dir() / "a.png").string() + " " + bad.string());
   EXPECT_EQ(r.exitCode, 1);
   EXPECT_NE(r.out.find("bad.png"), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, RenderWritesImageAndStats) {
-  const fs::path png = dir_ / "s.png", json = dir_ / "s.json";
-  const Result r = run("render @sample --size 48x40 --view front -o " + png.string() + " --stats " + json.string());
+  const fs::path png = dir() / "s.png", json = dir() / "s.json";
+  const CliResult r =
+      runCli("render @sample --size 48x40 --view front -o " + png.string() + " --stats " + json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   const mfr::ImageRGBA8 img = mfr::readPng(png);
   EXPECT_EQ(img.width, 48);
@@ -159,17 +133,17 @@ TEST_F(Cli, RenderWritesImageAndStats) {
 }
 
 TEST_F(Cli, GpuAndOracleImagesAgree) {
-  const fs::path a = dir_ / "oracle.png", b = dir_ / "gpu.png";
-  ASSERT_EQ(run("render @sample --size 64x48 --view iso -o " + a.string()).exitCode, 0);
-  ASSERT_EQ(run("render @sample --size 64x48 --view iso --method abuffer-ll -o " + b.string()).exitCode, 0);
-  const Result r = run("compare " + a.string() + " " + b.string() + " --metric rmse");
+  const fs::path a = dir() / "oracle.png", b = dir() / "gpu.png";
+  ASSERT_EQ(runCli("render @sample --size 64x48 --view iso -o " + a.string()).exitCode, 0);
+  ASSERT_EQ(runCli("render @sample --size 64x48 --view iso --method abuffer-ll -o " + b.string()).exitCode, 0);
+  const CliResult r = runCli("compare " + a.string() + " " + b.string() + " --metric rmse");
   ASSERT_EQ(r.exitCode, 0) << r.out;
   const double e = std::stod(r.out.substr(r.out.find("rmse ") + 5));
   EXPECT_LT(e, 0.02) << r.out;  // edge pixels may differ; everything else is exact
 }
 
 TEST_F(Cli, InfoReportsTrianglesAndHistogram) {
-  const Result r = run("info @quads:7 --size 32x32 --view front");
+  const CliResult r = runCli("info @quads:7 --size 32x32 --view front");
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_NE(r.out.find("parts      7"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("triangles  28"), std::string::npos) << r.out;
@@ -179,9 +153,9 @@ TEST_F(Cli, InfoReportsTrianglesAndHistogram) {
 // The budget commands: dataset → train → render with the trained weights → evaluate, end to end
 // on a tiny image; then their bad input.
 TEST_F(Cli, DatasetTrainRenderEvaluate) {
-  const fs::path data = dir_ / "d.bin", weights = dir_ / "w.json", png = dir_ / "dkb.png", json = dir_ / "e.json";
-  Result r =
-      run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,2,all --sample 0.5 -o " + data.string());
+  const fs::path data = dir() / "d.bin", weights = dir() / "w.json", png = dir() / "dkb.png", json = dir() / "e.json";
+  CliResult r =
+      runCli("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,2,all --sample 0.5 -o " + data.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_NE(r.out.find(" rows"), std::string::npos) << r.out;
   // --skip-exact-budgets leaves out the frames whose budget makes every allocation exact ("all").
@@ -190,23 +164,24 @@ TEST_F(Cli, DatasetTrainRenderEvaluate) {
     for (std::size_t at = out.find("\nsample "); at != std::string::npos; at = out.find("\nsample ", at + 1)) ++count;
     return count;
   };
-  const fs::path cut = dir_ / "cut.bin";
-  Result all =
-      run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,all --sample 0.5 -o " + cut.string());
+  const fs::path cut = dir() / "cut.bin";
+  CliResult all =
+      runCli("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,all --sample 0.5 -o " + cut.string());
   ASSERT_EQ(all.exitCode, 0) << all.out;
   EXPECT_EQ(frames(all.out), 4u) << all.out;
-  all = run("dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,all --sample 0.5 --skip-exact-budgets -o " +
-            cut.string());
+  all = runCli(
+      "dataset @sample --views front,orbit:30:20 -s 40x30 --budgets 1,all --sample 0.5 --skip-exact-budgets -o " +
+      cut.string());
   ASSERT_EQ(all.exitCode, 0) << all.out;
   EXPECT_EQ(frames(all.out), 2u) << all.out;
-  r = run("train " + data.string() + " --epochs 2 --batch 64 -o " + weights.string());
+  r = runCli("train " + data.string() + " --epochs 2 --batch 64 -o " + weights.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_NE(r.out.find("epoch    2"), std::string::npos) << r.out;
-  r = run("render @sample -s 40x30 -m dkb -p budget_mib=0.1 -p weights=" + weights.string() + " -o " + png.string());
+  r = runCli("render @sample -s 40x30 -m dkb -p budget_mib=0.1 -p weights=" + weights.string() + " -o " + png.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_EQ(mfr::readPng(png).width, 40);
-  r = run("evaluate @sample -s 40x30 --views front --budgets k1,f50,e90 -r 1 --weights " + weights.string() +
-          " -m fkb,vkb,vkb:exact_tail=false,dkb,optimal-k --json " + json.string());
+  r = runCli("evaluate @sample -s 40x30 --views front --budgets k1,f50,e90 -r 1 --weights " + weights.string() +
+             " -m fkb,vkb,vkb:exact_tail=false,dkb,optimal-k --json " + json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   for (const char* m : {"fkb", "vkb", "vkb:exact_tail=false", "dkb", "optimal-k", "lowest FLIP"})
     EXPECT_NE(r.out.find(m), std::string::npos) << m;
@@ -224,11 +199,11 @@ TEST_F(Cli, DatasetTrainRenderEvaluate) {
 // capacity two in every pixel; vkb with room for every fragment (1 MiB at 48×36) gives every pixel
 // k = n, so each class's mean k is its mean n.
 TEST_F(Cli, EvaluateKByDepth) {
-  const fs::path json = dir_ / "k.json";
-  const Result r =
-      run("evaluate @sample -s 48x36 --views front --budgets k2,1 -r 1 -m fkb,vkb,optimal-k "
-          "--k-by-depth --json " +
-          json.string());
+  const fs::path json = dir() / "k.json";
+  const CliResult r = runCli(
+      "evaluate @sample -s 48x36 --views front --budgets k2,1 -r 1 -m fkb,vkb,optimal-k "
+      "--k-by-depth --json " +
+      json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_NE(r.out.find("mean k by depth complexity"), std::string::npos) << r.out;
   std::ifstream in(json);
@@ -264,9 +239,9 @@ TEST_F(Cli, EvaluateKByDepth) {
 // the rule-based ones exactly F, the budget used up); optimal-k's eq. 2 error is the least; the
 // cut counts are consistent with each other; RMSE 0 and error 0 when F holds every fragment.
 TEST_F(Cli, AllocationsCompareAtOneBudget) {
-  const fs::path json = dir_ / "a.json";
-  const Result r =
-      run("allocations @sample -s 48x36 --views front,orbit:30:20 --budgets k2,e80,1 --json " + json.string());
+  const fs::path json = dir() / "a.json";
+  const CliResult r =
+      runCli("allocations @sample -s 48x36 --views front,orbit:30:20 --budgets k2,e80,1 --json " + json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   std::ifstream in(json);
   const nlohmann::json results = nlohmann::json::parse(in).at("results");
@@ -293,13 +268,13 @@ TEST_F(Cli, AllocationsCompareAtOneBudget) {
   }
   for (const auto& [args, mention] : std::vector<std::pair<std::string, std::string>>{
            {"@sample -s 16x16 --budgets k0", "--budgets k0"},
-           {(dir_ / "missing.ply").string(), "missing.ply"},
-           {"@sample -s 16x16 --weights " + (dir_ / "none.json").string(), "none.json"}}) {
-    const Result bad = run("allocations " + args + " --json " + (dir_ / "bad.json").string());
+           {(dir() / "missing.ply").string(), "missing.ply"},
+           {"@sample -s 16x16 --weights " + (dir() / "none.json").string(), "none.json"}}) {
+    const CliResult bad = runCli("allocations " + args + " --json " + (dir() / "bad.json").string());
     EXPECT_EQ(bad.exitCode, 1) << bad.out;
     EXPECT_EQ(std::count(bad.out.begin(), bad.out.end(), '\n'), 1) << bad.out;
     EXPECT_NE(bad.out.find(mention), std::string::npos) << bad.out;
-    EXPECT_FALSE(fs::exists(dir_ / "bad.json"));
+    EXPECT_FALSE(fs::exists(dir() / "bad.json"));
   }
 }
 
@@ -308,7 +283,7 @@ TEST_F(Cli, AllocationsCompareAtOneBudget) {
 // colour behind a red one, seen face on: every face of a box is shaded alike (|n·l| = 1), so the
 // lists end in runs of 2 or 4 fragments of one colour and the two thresholds differ.
 TEST_F(Cli, EvaluateBudgetsRelativeToTheExactThresholds) {
-  const fs::path scene = file("boxes.mfrscene", R"({"objects": [
+  const fs::path scene = write("boxes.mfrscene", R"({"objects": [
     {"primitive": {"type": "box", "size": [1.6, 1.6, 1.0]}, "color": [0.2, 0.4, 0.9], "opacity": 0.3},
     {"primitive": {"type": "box", "size": [1.6, 1.6, 1.0]}, "color": [0.2, 0.4, 0.9], "opacity": 0.3,
      "transform": {"translate": [0.3, 0.2, -2.0]}},
@@ -316,9 +291,9 @@ TEST_F(Cli, EvaluateBudgetsRelativeToTheExactThresholds) {
      "transform": {"translate": [0.0, 0.0, 2.0]}}],
     "views": [{"name": "face", "eye": [0, 0, 10], "target": [0, 0, 0], "projection": "orthographic",
                "height": 3.0}]})");
-  const fs::path json = dir_ / "x.json";
-  const Result r = run("evaluate " + scene.string() +
-                       " -s 40x30 --views face --budgets e60,x60,x100 -r 1 -m vkb --json " + json.string());
+  const fs::path json = dir() / "x.json";
+  const CliResult r = runCli("evaluate " + scene.string() +
+                             " -s 40x30 --views face --budgets e60,x60,x100 -r 1 -m vkb --json " + json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   std::ifstream in(json);
   const nlohmann::json results = nlohmann::json::parse(in).at("results");
@@ -341,25 +316,25 @@ TEST_F(Cli, EvaluateBudgetsRelativeToTheExactThresholds) {
 
 TEST_F(Cli, BudgetCommandsBadInput) {
   // A corrupt dataset, a missing dataset, bad budgets, a bad weights file.
-  const fs::path junk = file("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");
+  const fs::path junk = write("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");
   expectCleanFailure("train " + junk.string(), "junk.bin");
-  expectCleanFailure("train " + (dir_ / "missing.bin").string(), "missing.bin");
+  expectCleanFailure("train " + (dir() / "missing.bin").string(), "missing.bin");
   expectCleanFailure("dataset @sample --budgets 0.5", "--budgets 0.5");
   expectCleanFailure("dataset @sample --views nowhere", "view 'nowhere'");
-  const fs::path badWeights = file("w.json", R"({"format":"mfr-dkb-weights","version":1})");
+  const fs::path badWeights = write("w.json", R"({"format":"mfr-dkb-weights","version":1})");
   expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + badWeights.string(), "w.json");
   expectCleanFailure("render @sample -s 16x16 -m vkb -p budget_mib=0", "--param budget_mib=0");
   expectCleanFailure("render @sample -s 16x16 -m fkb -p budget_mib=0.001", "--param budget_mib=0.001");
   expectCleanFailure("render @sample -s 16x16 -m optimal-k --op oit", "--op oit");
   // evaluate writes no PNG; its --json must not appear on failure.
-  const fs::path json = dir_ / "e.json";
+  const fs::path json = dir() / "e.json";
   for (const auto& [args, mention] :
        std::vector<std::pair<std::string, std::string>>{{"--budgets banana", "--budgets banana"},
                                                         {"--budgets e0", "--budgets e0"},
                                                         {"--budgets x101", "--budgets x101"},
                                                         {"-m vkb:exact_tail", "--methods vkb:exact_tail"},
                                                         {"-m vkb,nosuch:k=1", "--methods nosuch:k=1"}}) {
-    const Result r = run("evaluate @sample -s 16x16 " + args + " --json " + json.string());
+    const CliResult r = runCli("evaluate @sample -s 16x16 " + args + " --json " + json.string());
     EXPECT_EQ(r.exitCode, 1) << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
     EXPECT_NE(r.out.find(mention), std::string::npos) << r.out;

@@ -2,12 +2,8 @@
 // output file (Open CASCADE's own messages must not reach the terminal); a real CAD part renders
 // with the oracle and with a GPU method alike, with more than one fragment in some pixels.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -16,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mfr/image.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 
@@ -24,65 +21,42 @@ namespace {
 const fs::path kLinkrods = "/usr/share/opencascade/data/step/linkrods.step";
 const fs::path kScrew = "/usr/share/opencascade/data/step/screw.step";
 
-struct Result {
-  int exitCode = -1;
-  std::string out;  // stdout + stderr
-};
+using mfr::test::CliResult;
+using mfr::test::runCli;
 
-Result run(const std::string& args) {
-  Result r;
-  const std::string cmd = std::string(MFR_CLI) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-  const int status = pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
-  return r;
-}
-
-class CliStep : public ::testing::Test {
+class CliStep : public mfr::test::TempDirTest {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("mfr-cli-step-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    TempDirTest::SetUp();
     if (!fs::exists(kLinkrods) || !fs::exists(kScrew))
       ADD_FAILURE() << "missing the occt-misc STEP samples (scripts/setup installs them)";
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path file(const std::string& name, const std::string& content) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary) << content;
-    return p;
-  }
-  void expectOneLineFailure(const Result& r, const std::string& mention) {
+  void expectOneLineFailure(const CliResult& r, const std::string& mention) {
     EXPECT_EQ(r.exitCode, 1) << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
     EXPECT_EQ(r.out.rfind("mfr: ", 0), 0u) << r.out;
     EXPECT_NE(r.out.find(mention), std::string::npos) << r.out;
   }
-  fs::path dir_;
 };
 
 TEST_F(CliStep, BadFilesFailWithOneLine) {
   std::ifstream in(kScrew, std::ios::binary);
   const std::string screw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const fs::path cut = file("cut.step", screw.substr(0, screw.size() / 3));
-  const fs::path junk = file("junk.stp", "ISO-10303-21;\nthis is not STEP at all\n");
+  const fs::path cut = write("cut.step", screw.substr(0, screw.size() / 3));
+  const fs::path junk = write("junk.stp", "ISO-10303-21;\nthis is not STEP at all\n");
   for (const fs::path& bad : {cut, junk}) {
     SCOPED_TRACE(bad.filename().string());
-    expectOneLineFailure(run("info " + bad.string()), bad.string() + ": not a readable STEP file");
-    const fs::path png = dir_ / "out.png";
-    expectOneLineFailure(run("render " + bad.string() + " -s 16x16 -o " + png.string()), bad.string());
+    expectOneLineFailure(runCli("info " + bad.string()), bad.string() + ": not a readable STEP file");
+    const fs::path png = dir() / "out.png";
+    expectOneLineFailure(runCli("render " + bad.string() + " -s 16x16 -o " + png.string()), bad.string());
     EXPECT_FALSE(fs::exists(png)) << "partial output left behind";
   }
 }
 
 TEST_F(CliStep, LinkrodsRendersWithOracleAndGpu) {
-  const fs::path json = dir_ / "info.json", oracle = dir_ / "oracle.png", gpu = dir_ / "gpu.png",
-                 stats = dir_ / "stats.json";
-  Result r = run("info " + kLinkrods.string() + " -s 48x48 --view iso --json " + json.string());
+  const fs::path json = dir() / "info.json", oracle = dir() / "oracle.png", gpu = dir() / "gpu.png",
+                 stats = dir() / "stats.json";
+  CliResult r = runCli("info " + kLinkrods.string() + " -s 48x48 --view iso --json " + json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   std::ifstream in(json);
   const nlohmann::json info = nlohmann::json::parse(in);
@@ -91,10 +65,10 @@ TEST_F(CliStep, LinkrodsRendersWithOracleAndGpu) {
   // Seen through, a solid is entered and left: two or more fragments in some pixels.
   EXPECT_GE(info.at("depth_complexity").at("max").get<int>(), 2);
 
-  ASSERT_EQ(run("render " + kLinkrods.string() + " -s 48x48 --view iso --opacity 0.4 -o " + oracle.string()).exitCode,
-            0);
-  r = run("render " + kLinkrods.string() + " -s 48x48 --view iso --opacity 0.4 -m abuffer-ll -o " + gpu.string() +
-          " --stats " + stats.string());
+  ASSERT_EQ(
+      runCli("render " + kLinkrods.string() + " -s 48x48 --view iso --opacity 0.4 -o " + oracle.string()).exitCode, 0);
+  r = runCli("render " + kLinkrods.string() + " -s 48x48 --view iso --opacity 0.4 -m abuffer-ll -o " + gpu.string() +
+             " --stats " + stats.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   const mfr::ImageRGBA8 a = mfr::readPng(oracle), b = mfr::readPng(gpu);
   int covered = 0;
@@ -109,7 +83,7 @@ TEST_F(CliStep, LinkrodsRendersWithOracleAndGpu) {
   const nlohmann::json s = nlohmann::json::parse(statsIn);
   // More fragments than covered pixels: some pixel holds two or more.
   EXPECT_GT(s.at("fragments_stored").get<int>(), covered);
-  r = run("compare " + oracle.string() + " " + gpu.string() + " --metric rmse");
+  r = runCli("compare " + oracle.string() + " " + gpu.string() + " --metric rmse");
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_LT(std::stod(r.out.substr(r.out.find("rmse ") + 5)), 0.02) << r.out;
 }

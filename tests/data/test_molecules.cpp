@@ -5,7 +5,6 @@
 // _atom_site rows of the first model split by the _entity table's types. Both keep the first
 // alternative location at each residue position. A missing file is a failure, not a skip.
 #include <gtest/gtest.h>
-#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -25,10 +24,13 @@
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/reference/oracle.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
+
+using mfr::test::expectLoadError;
 
 const fs::path kPymolDemo = "/usr/share/pymol/data/demo";
 const fs::path kBiopython = "/usr/share/doc/python-biopython-doc/Tests/PDB";
@@ -388,54 +390,27 @@ TEST(Molecules, Mmcif1a8oModifiedResiduesStayInTheChain) {
 
 // ---- damaged copies ---------------------------------------------------------------------------
 
-class DamagedMolecules : public ::testing::Test {
- protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "mfr-test-molecules-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  fs::path write(const std::string& name, const std::string& bytes) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    return p;
-  }
-  static void expectError(const fs::path& path, const std::string& reason) {
-    try {
-      mfr::loadModel(path);
-      ADD_FAILURE() << path << " loaded";
-    } catch (const mfr::Error& e) {
-      const std::string what = e.what();
-      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-      EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << what;
-      EXPECT_NE(what.find(reason), std::string::npos) << "expected '" << reason << "' in: " << what;
-    }
-  }
-  fs::path dir_;
-};
+class DamagedMolecules : public mfr::test::TempDirTest {};
 
 TEST_F(DamagedMolecules, TruncatedCorruptAndEmptied) {
   const std::string pdb = readText(requireFile(kPymolDemo / "1tii.pdb", "Debian package pymol-data"));
   ASSERT_FALSE(pdb.empty());
   // Cut in the middle of a record halfway through the coordinates.
   const std::size_t middle = pdb.find("\nATOM", (pdb.find("\nATOM") + pdb.rfind("\nATOM")) / 2) + 1 + 35;
-  expectError(write("1tii-cut.pdb", pdb.substr(0, middle)),
-              "truncated file: the last ATOM/HETATM record ends at column 35");
+  expectLoadError(write("1tii-cut.pdb", pdb.substr(0, middle)),
+                  "truncated file: the last ATOM/HETATM record ends at column 35");
   // Every coordinate record removed.
   std::string header;
   std::istringstream in(pdb);
   for (std::string line; std::getline(in, line);)
     if (line.rfind("ATOM", 0) != 0 && line.rfind("HETATM", 0) != 0) header += line + "\n";
-  expectError(write("1tii-header.pdb", header), "no atoms");
+  expectLoadError(write("1tii-header.pdb", header), "no atoms");
 
   const std::string cif = readText(requireFile(kBiopython / "4CUP.cif.gz", "Debian package python-biopython-doc"));
   ASSERT_FALSE(cif.empty());
   const std::size_t row = cif.find("\nATOM", (cif.find("\nATOM") + cif.rfind("\nHETATM")) / 2) + 1 + 30;
-  expectError(write("4cup-cut.cif", cif.substr(0, row)), "Wrong number of values in the loop (truncated or corrupt?)");
+  expectLoadError(write("4cup-cut.cif", cif.substr(0, row)),
+                  "Wrong number of values in the loop (truncated or corrupt?)");
   // A coordinate that is no number.
   const std::size_t x = cif.find("\nATOM");
   std::istringstream first(cif.substr(x + 1, cif.find('\n', x + 1) - x - 1));
@@ -444,7 +419,7 @@ TEST_F(DamagedMolecules, TruncatedCorruptAndEmptied) {
   std::string nan = cif;
   const std::size_t xAt = nan.find(" " + fields[10] + " ", x);
   nan.replace(xAt + 1, fields[10].size(), "nan");
-  expectError(write("4cup-nan.cif", nan), "not finite");
+  expectLoadError(write("4cup-nan.cif", nan), "not finite");
 }
 
 // ---- rendering: the exact fragment lists of a structure ------------------------------------------

@@ -5,8 +5,6 @@
 // scripts/setup installs all of them.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +18,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 
@@ -56,24 +55,7 @@ fs::path requireFile(const fs::path& path, const std::string& package) {
   return path;
 }
 
-// A fresh temporary folder, removed at the end of the test.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "mfr-test-data-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) != nullptr) path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    if (!path_.empty()) fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  [[nodiscard]] const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
+using mfr::test::TempDir;
 
 // CGAL's demo meshes ship inside one tarball; the test extracts just the file it needs.
 fs::path extractCgalMesh(const TempDir& dir, const std::string& file) {

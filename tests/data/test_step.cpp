@@ -11,7 +11,6 @@
 // cancellation.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -56,6 +55,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 
@@ -68,27 +68,8 @@ constexpr double kRelativeDeflection = 1e-3;
 const fs::path kLinkrods = "/usr/share/opencascade/data/step/linkrods.step";
 const fs::path kScrew = "/usr/share/opencascade/data/step/screw.step";
 
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "mfr-test-step-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) != nullptr) path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    if (!path_.empty()) fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  [[nodiscard]] const fs::path& path() const { return path_; }
-  [[nodiscard]] fs::path write(const std::string& name, const std::string& bytes) const {
-    std::ofstream(path_ / name, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    return path_ / name;
-  }
-
- private:
-  fs::path path_;
-};
+using mfr::test::expectLoadError;
+using mfr::test::TempDir;
 
 std::string readText(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -525,42 +506,27 @@ TEST(StepFiles, GzippedAndUpperCaseNames) {
 
 // ---- bad input ---------------------------------------------------------------------------------------
 
-void expectError(const fs::path& path, const std::string& reason) {
-  try {
-    const auto objects = mfr::loadModel(path);
-    ADD_FAILURE() << path << ": loaded " << objects.size() << " parts, expected an error about '" << reason << "'";
-  } catch (const mfr::LoadCancelled&) {
-    ADD_FAILURE() << path << ": cancelled";
-  } catch (const mfr::Error& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.find('\n'), std::string::npos) << "not one line: " << what;
-    EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << "does not start with the path: " << what;
-    EXPECT_NE(what.find(reason), std::string::npos) << "expected '" << reason << "' in: " << what;
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << path << ": non-mfr exception: " << e.what();
-  }
-}
-
 TEST(StepBadInput, OneLineErrorsNamingTheFile) {
   TempDir dir;
   const std::string screw = readText(requireFile(kScrew));
   ASSERT_GT(screw.size(), 1000u);
-  expectError(dir.path() / "missing.step", "no such file");
-  expectError(dir.write("empty.step", ""), "empty file");
-  expectError(dir.write("garbage.step", "hello, this is not STEP\n\x01\x02\x03"), "not a readable STEP file");
-  expectError(dir.write("binary.stp", std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16)), "not a readable STEP file");
+  expectLoadError(dir.path() / "missing.step", "no such file");
+  expectLoadError(dir.write("empty.step", ""), "empty file");
+  expectLoadError(dir.write("garbage.step", "hello, this is not STEP\n\x01\x02\x03"), "not a readable STEP file");
+  expectLoadError(dir.write("binary.stp", std::string("\x89PNG\r\n\x1a\n\0\0\0\rIHDR", 16)),
+                  "not a readable STEP file");
   // Cut in the middle of the DATA section: the parser sees an unterminated entity.
-  expectError(dir.write("half.step", screw.substr(0, screw.size() / 2)), "not a readable STEP file (line ");
+  expectLoadError(dir.write("half.step", screw.substr(0, screw.size() / 2)), "not a readable STEP file (line ");
   // Valid syntax without any product or solid.
-  expectError(dir.write("point.step",
-                        "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\n"
-                        "FILE_NAME('p','',(''),(''),'','','');\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\nENDSEC;\n"
-                        "DATA;\n#1=CARTESIAN_POINT('',(0.,0.,0.));\nENDSEC;\nEND-ISO-10303-21;\n"),
-              "no shapes");
+  expectLoadError(dir.write("point.step",
+                            "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\n"
+                            "FILE_NAME('p','',(''),(''),'','','');\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\nENDSEC;\n"
+                            "DATA;\n#1=CARTESIAN_POINT('',(0.,0.,0.));\nENDSEC;\nEND-ISO-10303-21;\n"),
+                  "no shapes");
   // A product whose shape is one edge: nothing to draw.
   const fs::path wire = dir.path() / "wire.step";
   ASSERT_TRUE(writeDemo(wire, /*edgeOnly=*/true));
-  expectError(wire, "no surfaces");
+  expectLoadError(wire, "no surfaces");
 }
 
 // Truncations anywhere and damaged bytes: an error or a model, never a crash, hang or foreign

@@ -21,13 +21,6 @@ INSTANTIATE_TEST_SUITE_P(ABufferFixedArray, ExactMethod,
 
 namespace {
 
-int channelDiff(std::uint32_t a, std::uint32_t b) {
-  int m = 0;
-  for (int c = 0; c < 4; ++c)
-    m = std::max(m, std::abs(static_cast<int>((a >> (8 * c)) & 0xFF) - static_cast<int>((b >> (8 * c)) & 0xFF)));
-  return m;
-}
-
 // True when `kept` (sorted) is a sub-list of `all` (sorted): each kept fragment matches a distinct
 // fragment of the pixel in depth (relative 1e-5) and colour (2/255).
 bool isSubList(const Fragment* kept, std::uint32_t n, std::span<const Fragment> all) {
@@ -103,7 +96,8 @@ TEST(ABufferFixedArray, OverflowIsCountedAndKeepsSlotsOfEachPixel) {
                      std::to_string(lists.count(x, y)) + ", oracle " + std::to_string(n);
         ++countBad;
       } else if (!isSubList(lists.pixel(x, y), lists.count(x, y), oracle.pixel(x, y))) {
-        if (firstBad.empty()) firstBad = "pixel (" + std::to_string(x) + "," + std::to_string(y) + "): foreign fragment";
+        if (firstBad.empty())
+          firstBad = "pixel (" + std::to_string(x) + "," + std::to_string(y) + "): foreign fragment";
         ++subsetBad;
       }
     }

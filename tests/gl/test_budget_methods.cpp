@@ -33,14 +33,8 @@ namespace {
 constexpr int kW = 96, kH = 72;
 constexpr double kMiB = 1024.0 * 1024.0;
 
-struct Reference {
-  Scene scene = makeSampleScene();
-  Camera camera = scene.view("front");
-  FragmentLists oracle = castFragments(scene, camera, kW, kH);
-};
-const Reference& reference() {
-  static const Reference r;
-  return r;
+const SampleReference& reference() {
+  return sampleReference("front", kW, kH);
 }
 
 std::uint64_t pixels() {
@@ -74,7 +68,7 @@ class VariableK : public ::testing::TestWithParam<std::string> {};
 // GPU k(p) = the CPU rule on the GPU's importance and n(p), for several budgets.
 TEST_P(VariableK, AllocationEqualsTheCpuRule) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
@@ -123,7 +117,7 @@ TEST_P(VariableK, AllocationEqualsTheCpuRule) {
 // The budget is never exceeded; absurd budgets are refused with one line or handled.
 TEST_P(VariableK, NeverExceedsTheBudget) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
@@ -158,7 +152,7 @@ TEST_P(VariableK, NeverExceedsTheBudget) {
 // The hybrid image equals the oracle's hybrid composite with the GPU's own k(p) map.
 TEST_P(VariableK, HybridEqualsTheOracleForTheSameKMap) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
@@ -186,7 +180,7 @@ TEST_P(VariableK, HybridEqualsTheOracleForTheSameKMap) {
 // slots on last fragments instead and leave other pixels with a longer tail at the same budget.
 TEST_P(VariableK, ExactTailMakesTheLastFragmentsFree) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
@@ -364,7 +358,7 @@ INSTANTIATE_TEST_SUITE_P(Budget, VariableK, ::testing::Values("vkb", "dkb"));
 
 TEST(FixedKUnderBudget, LargestUniformKAndTheOracleHybrid) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const KBufferMemoryModel model = kplusArrayMemoryModel(pixels());
@@ -387,7 +381,7 @@ TEST(FixedKUnderBudget, LargestUniformKAndTheOracleHybrid) {
 // run through the same network (the weights shipped in resources/dkb/weights.json).
 TEST(DeepVariableK, GpuImportanceEqualsTheCpuNetworkOnTheOracleLists) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const VariableKLayout layout = variableKLayout(pixels(), memberFixed("dkb"));
@@ -428,7 +422,7 @@ TEST(DeepVariableK, GpuImportanceEqualsTheCpuNetworkOnTheOracleLists) {
 // error of vkb's and dkb's own k(p) maps, evaluated on the same exact lists.
 TEST(OptimalKReference, BelowTheVariableKMethods) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const HybridErrorTable errors = hybridErrorTable(ref.oracle, ref.scene.background);

@@ -13,34 +13,18 @@
 namespace mfr::test {
 namespace {
 
+// The method's lists and image against the oracle (expectGpuMatchesOracle), nothing dropped.
 void checkAgainstOracle(const Scene& scene, const Camera& camera, int w, int h, const ExactCase& c) {
-  context();
-  const FragmentLists oracle = castFragments(scene, camera, w, h);
-  const ImageRGBA8 expected = compositeOver(oracle, scene.background);
-
-  GpuRenderer gpu;
-  gpu.setScene(scene);
   RenderRequest req;
   req.method = c.method;
   req.params = c.params;
   req.width = w;
   req.height = h;
-  const int keep = static_cast<int>(std::max<std::uint32_t>(oracle.maxCount(), 1));
-  const CapturedLists lists = gpu.capture(camera, req, keep);
-  const ListComparison lc = compareLists(oracle, lists);
-  EXPECT_GT(lc.compared, lc.pixels * 7 / 10) << "too many ambiguous pixels";
-  EXPECT_EQ(lc.countMismatches, 0u) << lc.firstMismatch;
-  EXPECT_EQ(lc.depthMismatches, 0u) << lc.firstMismatch;
-  EXPECT_EQ(lc.colorMismatches, 0u) << lc.firstMismatch;
-
-  const RenderOutput out = gpu.render(camera, req);
-  const ImageComparison ic = compareImages(oracle, expected, out.image, 2);
-  EXPECT_GE(ic.fraction(), 0.999) << (ic.compared - ic.within) << " of " << ic.compared
-                                  << " pixels differ by more than 2/255; max " << ic.maxDifference;
-  EXPECT_FALSE(out.stats.overflow);
-  EXPECT_EQ(out.stats.fragmentsDropped, 0u);
-  ::testing::Test::RecordProperty("ambiguous_pixels", static_cast<int>(lc.pixels - lc.compared));
-  ::testing::Test::RecordProperty("pixels_off_by_more_than_2", static_cast<int>(ic.compared - ic.within));
+  const OracleMatch m = expectGpuMatchesOracle(scene, camera, req);
+  EXPECT_FALSE(m.out.stats.overflow);
+  EXPECT_EQ(m.out.stats.fragmentsDropped, 0u);
+  ::testing::Test::RecordProperty("ambiguous_pixels", static_cast<int>(m.lists.pixels - m.lists.compared));
+  ::testing::Test::RecordProperty("pixels_off_by_more_than_2", static_cast<int>(m.image.compared - m.image.within));
 }
 
 TEST_P(ExactMethod, SampleMatchesOracle) {

@@ -4,12 +4,12 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 
 #include "gl_fixture.hpp"
 #include "mfr/error.hpp"
 #include "mfr/gl/program.hpp"
 #include "mfr/gl/timer.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 
@@ -19,18 +19,17 @@ namespace {
 // Points MFR_SHADER_DIR at a temporary folder for the test's lifetime.
 class ShaderDir {
  public:
-  ShaderDir() : dir_(fs::temp_directory_path() / ("mfr-shaders-" + std::to_string(::getpid()))) {
-    fs::create_directories(dir_ / "lib");
-    ::setenv("MFR_SHADER_DIR", dir_.c_str(), 1);
+  ShaderDir() {
+    fs::create_directories(tmp_.path() / "lib");
+    ::setenv("MFR_SHADER_DIR", tmp_.path().c_str(), 1);
   }
-  ~ShaderDir() {
-    ::unsetenv("MFR_SHADER_DIR");
-    fs::remove_all(dir_);
-  }
-  void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name) << text; }
+  ~ShaderDir() { ::unsetenv("MFR_SHADER_DIR"); }
+  ShaderDir(const ShaderDir&) = delete;
+  ShaderDir& operator=(const ShaderDir&) = delete;
+  void write(const std::string& name, const std::string& text) const { tmp_.write(name, text); }
 
  private:
-  fs::path dir_;
+  TempDir tmp_;
 };
 
 TEST(GlInfrastructure, ContextIsOpenGL45Core) {
@@ -47,7 +46,7 @@ TEST(GlInfrastructure, ContextIsOpenGL45Core) {
 
 TEST(GlInfrastructure, DebugOutputBecomesAnError) {
   context();
-  gl::checkErrors("before");  // clean slate
+  gl::checkErrors("before");              // clean slate
   glBindBuffer(GL_ARRAY_BUFFER, 987654);  // not a buffer name: GL_INVALID_OPERATION
   try {
     gl::checkErrors("bad bind");

@@ -18,14 +18,8 @@ namespace {
 
 constexpr int kW = 96, kH = 72;
 
-struct Reference {
-  Scene scene = makeSampleScene();
-  Camera camera = scene.view("front");
-  FragmentLists oracle = castFragments(scene, camera, kW, kH);
-};
-const Reference& reference() {
-  static const Reference r;
-  return r;
+const SampleReference& reference() {
+  return sampleReference("front", kW, kH);
 }
 
 RenderRequest hybridRequest(const std::string& method, int k, bool tail = true) {
@@ -42,7 +36,7 @@ class HybridGpu : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(HybridGpu, EqualsTheOracleHybrid) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   for (int k : {1, 2, 4, 8}) {
@@ -78,7 +72,7 @@ INSTANTIATE_TEST_SUITE_P(Hybrid, HybridGpu, ::testing::Values("kplus-array", "kp
 
 TEST(Hybrid, RefusedWithoutATail) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   EXPECT_THROW(gpu.render(ref.camera, hybridRequest("kplus-array", 4, false)), Error);
@@ -103,7 +97,7 @@ TEST(Hybrid, RefusedWithoutATail) {
 // chosen uniform k fits (Stats::bytesAllocated = M(k) ≤ M) and k + 1 would not.
 TEST(Hybrid, UniformKForABudgetFits) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const std::uint64_t pixels = static_cast<std::uint64_t>(kW) * kH;

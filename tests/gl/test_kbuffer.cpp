@@ -32,7 +32,9 @@ struct Variant {
   std::string label;
 };
 
-void PrintTo(const Variant& v, std::ostream* os) { *os << v.label; }
+void PrintTo(const Variant& v, std::ostream* os) {
+  *os << v.label;
+}
 
 const std::vector<Variant>& variants() {
   static const std::vector<Variant> v{
@@ -49,15 +51,8 @@ const std::vector<Variant>& variants() {
 }
 
 // The sample scene, its front camera and its oracle at kW x kH, computed once.
-struct Reference {
-  Scene scene = makeSampleScene();
-  Camera camera = scene.view("front");
-  FragmentLists oracle = castFragments(scene, camera, kW, kH);
-  ImageRGBA8 image = compositeOver(oracle, scene.background);
-};
-const Reference& reference() {
-  static const Reference r;
-  return r;
+const SampleReference& reference() {
+  return sampleReference("front", kW, kH);
 }
 
 RenderRequest request(const std::string& method, std::map<std::string, std::string> params, int k) {
@@ -70,7 +65,9 @@ RenderRequest request(const std::string& method, std::map<std::string, std::stri
   return req;
 }
 
-std::uint64_t pixels() { return static_cast<std::uint64_t>(kW) * kH; }
+std::uint64_t pixels() {
+  return static_cast<std::uint64_t>(kW) * kH;
+}
 
 class KBufferVariant : public ::testing::TestWithParam<Variant> {};
 
@@ -78,7 +75,7 @@ class KBufferVariant : public ::testing::TestWithParam<Variant> {};
 // no fragment was lost to the spin lock.
 TEST_P(KBufferVariant, CapturesTheKNearest) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   for (int k : {1, 2, 4, 8, 16, 32}) {
@@ -127,13 +124,14 @@ TEST_P(KBufferVariant, CapturesTheKNearestOnRealModels) {
 // k = 1 is a z-buffer: the nearest fragment's colour over the background.
 TEST_P(KBufferVariant, KOneIsAZBuffer) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   ImageRGBA8 zbuffer(kW, kH);
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
       const auto all = ref.oracle.pixel(x, y);
       const glm::vec3 c = compositeOver(all.first(std::min<std::size_t>(all.size(), 1)), ref.scene.background);
-      for (int ch = 0; ch < 3; ++ch) zbuffer.at(x, y)[ch] = static_cast<std::uint8_t>(std::lround(std::clamp(c[ch], 0.0f, 1.0f) * 255.0f));
+      for (int ch = 0; ch < 3; ++ch)
+        zbuffer.at(x, y)[ch] = static_cast<std::uint8_t>(std::lround(std::clamp(c[ch], 0.0f, 1.0f) * 255.0f));
       zbuffer.at(x, y)[3] = 255;
     }
   GpuRenderer gpu;
@@ -146,7 +144,7 @@ TEST_P(KBufferVariant, KOneIsAZBuffer) {
 // k >= max n(p): the A-buffer image, nothing dropped.
 TEST_P(KBufferVariant, LargeKIsTheABuffer) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   const int k = static_cast<int>(ref.oracle.maxCount()) + 2;  // margin for edge pixels
   ASSERT_LE(k, 256);
   GpuRenderer gpu;
@@ -165,7 +163,7 @@ TEST_P(KBufferVariant, LargeKIsTheABuffer) {
 // max-array), 20 bytes of tail sums per pixel (tail on), 32 bytes of statistics counters.
 TEST_P(KBufferVariant, MemoryAccountingMatchesFormula) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   for (bool tail : {false, true}) {
@@ -197,7 +195,7 @@ TEST_P(KBufferVariant, MemoryAccountingMatchesFormula) {
 // with the 2/255 tolerance of the list comparison, per fragment).
 TEST_P(KBufferVariant, TailHoldsTheFragmentsBeyondK) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   gl::GpuScene scene(ref.scene);
   std::unique_ptr<Method> method = createMethod(GetParam().method);
   auto params = GetParam().params;
@@ -248,11 +246,13 @@ TEST_P(KBufferVariant, TailHoldsTheFragmentsBeyondK) {
       // Per fragment, colour and alpha may differ by 2/255: |Δ(c·α)| <= 2·255 + 2·255 + 4.
       bool ok = t.count == n && std::llabs(static_cast<std::int64_t>(t.alpha) - expect[3]) <= 2 * n;
       for (int ch = 0; ch < 3; ++ch)
-        ok = ok && std::llabs(static_cast<std::int64_t>(t.colorAlpha[ch]) - expect[ch]) <= 1024 * static_cast<std::int64_t>(n);
+        ok = ok && std::llabs(static_cast<std::int64_t>(t.colorAlpha[ch]) - expect[ch]) <=
+                       1024 * static_cast<std::int64_t>(n);
       nonEmpty += n > 0;
       if (!ok && ++bad == 1)
         first = "pixel (" + std::to_string(x) + "," + std::to_string(y) + "): count " + std::to_string(t.count) +
-                " oracle " + std::to_string(n) + ", Σα " + std::to_string(t.alpha) + " oracle " + std::to_string(expect[3]);
+                " oracle " + std::to_string(n) + ", Σα " + std::to_string(t.alpha) + " oracle " +
+                std::to_string(expect[3]);
     }
   EXPECT_GT(nonEmpty, compared / 10) << "the scene should have deep pixels";
   EXPECT_EQ(bad, 0u) << first;
@@ -264,19 +264,19 @@ INSTANTIATE_TEST_SUITE_P(KBuffer, KBufferVariant, ::testing::ValuesIn(variants()
                          [](const ::testing::TestParamInfo<Variant>& p) { return p.param.label; });
 
 // Large k through the shared exact-method tests (counts, depths, colours, images, real models).
-INSTANTIATE_TEST_SUITE_P(KBufferLargeK, ExactMethod,
-                         ::testing::Values(ExactCase{"kplus-array", {{"k", "256"}, {"revised", "true"}}, "k256_revised"},
-                                           ExactCase{"kplus-heap", {{"k", "256"}}, "k256"},
-                                           ExactCase{"kpeel", {{"k", "4"}}, "k4"},
-                                           ExactCase{"kplus-sbuffer", {{"k", "256"}}, "k256"},
-                                           ExactCase{"kplus-dynamic", {{"robustness", "1"}, {"budget_mib", "256"}}, "full"}),
-                         exactCaseName);
+INSTANTIATE_TEST_SUITE_P(
+    KBufferLargeK, ExactMethod,
+    ::testing::Values(ExactCase{"kplus-array", {{"k", "256"}, {"revised", "true"}}, "k256_revised"},
+                      ExactCase{"kplus-heap", {{"k", "256"}}, "k256"}, ExactCase{"kpeel", {{"k", "4"}}, "k4"},
+                      ExactCase{"kplus-sbuffer", {{"k", "256"}}, "k256"},
+                      ExactCase{"kplus-dynamic", {{"robustness", "1"}, {"budget_mib", "256"}}, "full"}),
+    exactCaseName);
 
 // Interlock: used where the driver has it, refused with a clear message where it does not
 // (llvmpipe).
 TEST(KBuffer, InterlockIsUsedOrRefused) {
   const bool has = context().info().fragmentShaderInterlock;
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   for (const char* method : {"kbuffer", "kplus-array", "kplus-heap", "kpeel", "kplus-sbuffer", "kplus-dynamic"}) {
@@ -299,7 +299,7 @@ TEST(KBuffer, InterlockIsUsedOrRefused) {
 
 TEST(KBuffer, BadParametersAreRefused) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   EXPECT_THROW(gpu.render(ref.camera, request("kplus-array", {}, 0)), Error);
@@ -312,7 +312,7 @@ TEST(KBuffer, BadParametersAreRefused) {
 // fails a lock.
 TEST(KPeeling, EqualsTheABufferForEveryK) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   for (int k : {1, 2, 4, 8, 16, 32}) {
@@ -323,7 +323,8 @@ TEST(KPeeling, EqualsTheABufferForEveryK) {
     EXPECT_EQ(out.stats.fragmentsStored, out.stats.fragmentsGenerated);
     EXPECT_EQ(out.stats.lockFailures, 0u);
     EXPECT_FALSE(out.stats.overflow);
-    const std::uint32_t iterations = (ref.oracle.maxCount() + static_cast<std::uint32_t>(k) - 1) / static_cast<std::uint32_t>(k);
+    const std::uint32_t iterations =
+        (ref.oracle.maxCount() + static_cast<std::uint32_t>(k) - 1) / static_cast<std::uint32_t>(k);
     EXPECT_NEAR(out.stats.passes, 1.0 + iterations, 1.0);  // rasterised max n(p) may differ by one at edges
     EXPECT_EQ(out.stats.bytesAllocated, pixels() * (16u * k + 32u + 4u) + 32u);
   }
@@ -333,7 +334,7 @@ TEST(KPeeling, EqualsTheABufferForEveryK) {
 // as overflow; an operation that is neither oit nor stateless is refused.
 TEST(KPeeling, IterationBoundAndOperationsAreEnforced) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const RenderOutput out = gpu.render(ref.camera, request("kpeel", {{"max_iterations", "2"}}, 1));
@@ -355,12 +356,13 @@ TEST(KPeeling, IterationBoundAndOperationsAreEnforced) {
 // Per-pixel lists through the dump operation (stateless, so it streams across the iterations).
 TEST(KPeeling, DumpListsEqualTheOracleForSmallK) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   for (int k : {1, 3}) {
     SCOPED_TRACE("k=" + std::to_string(k));
-    const CapturedLists lists = gpu.capture(ref.camera, request("kpeel", {}, k), static_cast<int>(ref.oracle.maxCount()));
+    const CapturedLists lists =
+        gpu.capture(ref.camera, request("kpeel", {}, k), static_cast<int>(ref.oracle.maxCount()));
     const ListComparison lc = compareLists(ref.oracle, lists);
     EXPECT_EQ(lc.countMismatches, 0u) << lc.firstMismatch;
     EXPECT_EQ(lc.depthMismatches, 0u) << lc.firstMismatch;
@@ -376,8 +378,11 @@ TEST(KPeeling, TiesAtEqualDepthAreCompositedOnce) {
   Scene scene;
   scene.name = "ties";
   const auto quad = std::make_shared<const Mesh>(makePlane(2.0, 2.0));
-  const glm::vec4 colors[5] = {{0.9f, 0.2f, 0.2f, 0.5f}, {0.2f, 0.9f, 0.2f, 0.5f}, {0.2f, 0.2f, 0.9f, 0.5f},
-                               {0.9f, 0.9f, 0.2f, 0.5f}, {0.5f, 0.5f, 0.5f, 0.3f}};
+  const glm::vec4 colors[5] = {{0.9f, 0.2f, 0.2f, 0.5f},
+                               {0.2f, 0.9f, 0.2f, 0.5f},
+                               {0.2f, 0.2f, 0.9f, 0.5f},
+                               {0.9f, 0.9f, 0.2f, 0.5f},
+                               {0.5f, 0.5f, 0.5f, 0.3f}};
   for (int i = 0; i < 5; ++i) {
     Object o;
     o.name = "quad" + std::to_string(i);

@@ -15,15 +15,8 @@ namespace {
 constexpr int kW = 96, kH = 72;
 constexpr std::uint64_t kPixels = static_cast<std::uint64_t>(kW) * kH;
 
-struct Reference {
-  Scene scene = makeSampleScene();
-  Camera camera = scene.view("front");
-  FragmentLists oracle = castFragments(scene, camera, kW, kH);
-  ImageRGBA8 image = compositeOver(oracle, scene.background);
-};
-const Reference& reference() {
-  static const Reference r;
-  return r;
+const SampleReference& reference() {
+  return sampleReference("front", kW, kH);
 }
 
 RenderRequest request(std::map<std::string, std::string> params) {
@@ -37,7 +30,9 @@ RenderRequest request(std::map<std::string, std::string> params) {
 
 // The model kplus-dynamic checks the budget against (spin lock, tail off): per pixel 8k + 4 (n(p)) +
 // 4 (semaphore), fixed 32 (counters) + 258·4 (histogram).
-KBufferMemoryModel model() { return {kPixels, 8, 8, 32 + 258 * 4}; }
+KBufferMemoryModel model() {
+  return {kPixels, 8, 8, 32 + 258 * 4};
+}
 
 std::string note(const Stats& s, const std::string& key) {
   for (const auto& [k, v] : s.notes)
@@ -47,27 +42,29 @@ std::string note(const Stats& s, const std::string& key) {
 
 TEST(KPlusDynamic, RobustnessPicksTheKOfTheHistogram) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const std::vector<std::uint64_t> histogram = depthComplexityHistogram(ref.oracle);
   for (double r : {0.3, 0.6, 0.9}) {
     SCOPED_TRACE("R_h=" + std::to_string(r));
     const DynamicKChoice expected = selectDynamicK(histogram, 0, 1ull << 30, r, model());
-    const RenderOutput out = gpu.render(ref.camera, request({{"robustness", std::to_string(r)}, {"budget_mib", "1024"}}));
+    const RenderOutput out =
+        gpu.render(ref.camera, request({{"robustness", std::to_string(r)}, {"budget_mib", "1024"}}));
     // The rasteriser and the oracle may differ at a few edge pixels: allow one step of k.
     EXPECT_NEAR(static_cast<double>(out.stats.kMax), static_cast<double>(expected.k), 1.0);
     EXPECT_NE(note(out.stats, "k chosen").find("robustness"), std::string::npos) << note(out.stats, "k chosen");
     EXPECT_EQ(out.stats.bytesAllocated, model().bytes(out.stats.kMax));
     EXPECT_EQ(out.stats.lockFailures, 0u);
-    const double captured = static_cast<double>(out.stats.fragmentsStored) / static_cast<double>(out.stats.fragmentsGenerated);
+    const double captured =
+        static_cast<double>(out.stats.fragmentsStored) / static_cast<double>(out.stats.fragmentsGenerated);
     EXPECT_GE(captured, r - 1e-9);
   }
 }
 
 TEST(KPlusDynamic, FullRobustnessIsTheABuffer) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const RenderOutput out = gpu.render(ref.camera, request({{"robustness", "1"}, {"budget_mib", "1024"}}));
@@ -79,14 +76,15 @@ TEST(KPlusDynamic, FullRobustnessIsTheABuffer) {
 
 TEST(KPlusDynamic, BudgetIsNeverExceededAndNearlyUsed) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   for (double mib : {0.2, 0.5, 0.8}) {
     SCOPED_TRACE("budget " + std::to_string(mib) + " MiB");
     const std::uint64_t budget = static_cast<std::uint64_t>(mib * 1024 * 1024);
     for (const char* structure : {"array", "heap"}) {
-      const RenderRequest req = request({{"robustness", "1"}, {"budget_mib", std::to_string(mib)}, {"structure", structure}});
+      const RenderRequest req =
+          request({{"robustness", "1"}, {"budget_mib", std::to_string(mib)}, {"structure", structure}});
       const RenderOutput out = gpu.render(ref.camera, req);
       EXPECT_LE(out.stats.bytesAllocated, budget);
       EXPECT_GT(out.stats.bytesAllocated + kPixels * 8, budget) << "one more slot per pixel would still fit";
@@ -104,7 +102,7 @@ TEST(KPlusDynamic, BudgetIsNeverExceededAndNearlyUsed) {
 
 TEST(KPlusDynamic, BudgetBelowOneSlotIsRefused) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   try {

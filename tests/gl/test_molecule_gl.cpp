@@ -16,26 +16,11 @@ const char* const kPept = "/usr/share/pymol/data/demo/pept.pdb";
 
 void expectGpuEqualsOracle(const Scene& scene, const std::string& method) {
   SCOPED_TRACE(method);
-  context();
-  const Camera camera = scene.view("fit");
-  const int w = 72, h = 56;
-  const FragmentLists oracle = castFragments(scene, camera, w, h);
-  GpuRenderer gpu;
-  gpu.setScene(scene);
   RenderRequest req;
   req.method = method;
-  req.width = w;
-  req.height = h;
-  const CapturedLists lists = gpu.capture(camera, req, static_cast<int>(std::max<std::uint32_t>(oracle.maxCount(), 1)));
-  const ListComparison lc = compareLists(oracle, lists);
-  EXPECT_GT(lc.compared, lc.pixels * 7 / 10) << "too many ambiguous pixels";
-  EXPECT_EQ(lc.countMismatches, 0u) << lc.firstMismatch;
-  EXPECT_EQ(lc.depthMismatches, 0u) << lc.firstMismatch;
-  EXPECT_EQ(lc.colorMismatches, 0u) << lc.firstMismatch;
-  const RenderOutput out = gpu.render(camera, req);
-  const ImageComparison ic = compareImages(oracle, compositeOver(oracle, scene.background), out.image, 2);
-  EXPECT_GE(ic.fraction(), 0.999) << (ic.compared - ic.within) << " of " << ic.compared << " pixels differ; max "
-                                  << ic.maxDifference;
+  req.width = 72;
+  req.height = 56;
+  expectGpuMatchesOracle(scene, scene.view("fit"), req);
 }
 
 // Red and blue of a packed fragment colour (R in the low byte).

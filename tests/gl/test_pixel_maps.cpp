@@ -13,19 +13,13 @@ namespace {
 
 constexpr int kW = 80, kH = 64;
 
-struct Reference {
-  Scene scene = makeSampleScene();
-  Camera camera = scene.view("iso");
-  FragmentLists oracle = castFragments(scene, camera, kW, kH);
-};
-const Reference& reference() {
-  static const Reference r;
-  return r;
+const SampleReference& reference() {
+  return sampleReference("iso", kW, kH);
 }
 
 TEST(PixelMaps, DepthComplexityEqualsTheOracle) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const std::vector<std::uint32_t> n = gpu.depthComplexity(ref.camera, kW, kH);
@@ -46,7 +40,7 @@ TEST(PixelMaps, DepthComplexityEqualsTheOracle) {
 
 TEST(PixelMaps, KMapIsTheCapacityOfTheLastFrame) {
   context();
-  const Reference& ref = reference();
+  const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   EXPECT_TRUE(gpu.kMap().empty());  // before any frame

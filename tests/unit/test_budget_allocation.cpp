@@ -17,6 +17,7 @@
 
 #include "budget/mlp_layout.h"
 
+#include "fragments.hpp"
 #include "mfr/budget/dataset.hpp"
 #include "mfr/budget/k_allocation.hpp"
 #include "mfr/budget/memory_model.hpp"
@@ -25,8 +26,11 @@
 #include "mfr/error.hpp"
 #include "mfr/io_util.hpp"
 #include "mfr/scene/sample.hpp"
+#include "test_files.hpp"
 
 namespace {
+
+using mfr::test::frag;
 
 std::uint64_t sum(const std::vector<std::uint32_t>& v) {
   return std::accumulate(v.begin(), v.end(), std::uint64_t{0});
@@ -137,13 +141,6 @@ TEST(KAllocation, BadImportancesCountAsTheFloor) {
   EXPECT_EQ(paper.assigned, 12u);
   EXPECT_EQ(paper.k[3], 5u);  // the papers' bounds: up to n
   EXPECT_THROW(mfr::allocateKFromImportance(importance, std::vector<std::uint32_t>{1, 2}, 3), mfr::Error);
-}
-
-mfr::Fragment frag(float depth, std::uint32_t r, std::uint32_t g, std::uint32_t b, std::uint32_t a) {
-  mfr::Fragment f;
-  f.depth = depth;
-  f.color = r | (g << 8) | (b << 16) | (a << 24);
-  return f;
 }
 
 TEST(DkbFeatures, HandMadeList) {
@@ -274,8 +271,8 @@ TEST(DkbDataset, FramesFileRoundTripAndCorruptFiles) {
   }
   EXPECT_LE(sumK, static_cast<double>(2 * nonEmpty));
   d.metadata = R"({"test":true})";
-  const auto dir = std::filesystem::temp_directory_path() / "mfr-dataset-test";
-  std::filesystem::create_directories(dir);
+  const mfr::test::TempDir tmp;
+  const std::filesystem::path& dir = tmp.path();
   const auto path = dir / "d.bin";
   mfr::writeDataset(path, d);
   const mfr::DkbDataset back = mfr::readDataset(path);
@@ -293,7 +290,6 @@ TEST(DkbDataset, FramesFileRoundTripAndCorruptFiles) {
       EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
     }
   }
-  std::filesystem::remove_all(dir);
 }
 
 // --sample-by: Pixels draws every non-empty pixel with probability s; DeepPixels draws a pixel of

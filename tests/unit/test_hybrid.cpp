@@ -9,18 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "fragments.hpp"
 #include "mfr/error.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/hybrid.hpp"
 
 namespace {
 
-mfr::Fragment frag(float depth, std::uint32_t r, std::uint32_t g, std::uint32_t b, std::uint32_t a) {
-  mfr::Fragment f;
-  f.depth = depth;
-  f.color = r | (g << 8) | (b << 16) | (a << 24);
-  return f;
-}
+using mfr::test::frag;
 
 // Red α=0.4, green α=0.2, blue α=0.6 (α of 102, 51, 153 out of 255), white background.
 std::vector<mfr::Fragment> threeFragments() {

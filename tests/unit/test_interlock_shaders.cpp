@@ -7,15 +7,12 @@
 // interlock must be rejected (so the check can fail). glslang 12 knows only the ARB spelling; the
 // NV and INTEL ones are not checked here.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <string>
 
 #include "mfr/gl/program.hpp"
+#include "test_files.hpp"
 
 namespace {
 
@@ -25,19 +22,10 @@ struct Compiled {
 };
 
 Compiled glslang(const std::string& source, const std::string& name) {
-  const auto path =
-      std::filesystem::temp_directory_path() / ("mfr-" + std::to_string(::getpid()) + "-" + name + ".frag");
-  std::ofstream(path) << source;
-  Compiled c;
-  FILE* pipe = popen((std::string(MFR_GLSLANG) + " " + path.string() + " 2>&1").c_str(), "r");
-  if (pipe) {
-    std::array<char, 4096> buf{};
-    while (fgets(buf.data(), buf.size(), pipe)) c.log += buf.data();
-    const int status = pclose(pipe);
-    c.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  }
-  std::filesystem::remove(path);
-  return c;
+  const mfr::test::TempDir tmp;
+  const std::filesystem::path path = tmp.write(name + ".frag", source);
+  const mfr::test::CliResult r = mfr::test::runCommand(std::string(MFR_GLSLANG) + " " + path.string());
+  return {r.exitCode, r.out};
 }
 
 struct Variant {

@@ -2,12 +2,9 @@
 // file and the reason, with no crash, hang, abort or library exception. Plus small hand-written
 // files of every loader family with known triangle counts and bounds.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <sys/stat.h>
-#include <unistd.h>
-#include <zlib.h>
 
 #include <algorithm>
 #include <bit>
@@ -24,57 +21,17 @@
 
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-class LoadModel : public ::testing::Test {
- protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "mfr-test-load-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::permissions(dir_, fs::perms::owner_all, fs::perm_options::add, ec);
-    fs::remove_all(dir_, ec);
-  }
+using mfr::test::expectLoadError;
 
-  fs::path write(const std::string& name, const std::string& bytes) {
-    const fs::path p = dir_ / name;
-    std::ofstream out(p, std::ios::binary);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    return p;
-  }
-
-  fs::path writeGz(const std::string& name, const std::string& bytes) {
-    const fs::path p = dir_ / name;
-    gzFile gz = gzopen(p.c_str(), "wb");
-    EXPECT_NE(gz, nullptr);
-    EXPECT_EQ(gzwrite(gz, bytes.data(), static_cast<unsigned>(bytes.size())), static_cast<int>(bytes.size()));
-    gzclose(gz);
-    return p;
-  }
-
-  // Expects mfr::Error with a one-line message that names the path and contains `reason`.
-  static void expectError(const fs::path& path, const std::string& reason) {
-    try {
-      const auto objects = mfr::loadModel(path);
-      ADD_FAILURE() << path << ": loaded " << objects.size() << " objects, expected an error about '" << reason << "'";
-    } catch (const mfr::Error& e) {
-      const std::string what = e.what();
-      EXPECT_EQ(what.find('\n'), std::string::npos) << "not one line: " << what;
-      EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << "does not start with the path: " << what;
-      EXPECT_NE(what.find(reason), std::string::npos) << "expected '" << reason << "' in: " << what;
-    } catch (const std::exception& e) {
-      ADD_FAILURE() << path << ": non-mfr exception: " << e.what();
-    }
-  }
-
-  fs::path dir_;
-};
+// A fresh folder per test; UnreadableFile takes permissions from it, which TempDirTest restores
+// before removing it.
+class LoadModel : public mfr::test::TempDirTest {};
 
 std::string le32(std::uint32_t v) {
   std::string s(4, '\0');
@@ -94,7 +51,8 @@ std::string binaryStl(std::uint32_t declared, std::uint32_t present) {
   s.replace(0, 12, "binary model");
   s += le32(declared);
   for (std::uint32_t t = 0; t < present; ++t) {
-    const float v[12] = {0, 0, 1, 0, 0, static_cast<float>(t), 1, 0, static_cast<float>(t), 0, 1, static_cast<float>(t)};
+    const float v[12] = {
+        0, 0, 1, 0, 0, static_cast<float>(t), 1, 0, static_cast<float>(t), 0, 1, static_cast<float>(t)};
     for (float x : v) s += f32(x);
     s += std::string(2, '\0');
   }
@@ -140,22 +98,24 @@ void expectUsableNormals(const mfr::Mesh& mesh) {
 
 // ---- failures ----------------------------------------------------------------------------------
 
-TEST_F(LoadModel, MissingFile) { expectError(dir_ / "nothing.stl", "no such file"); }
+TEST_F(LoadModel, MissingFile) {
+  expectLoadError(dir() / "nothing.stl", "no such file");
+}
 
 TEST_F(LoadModel, DirectoryInsteadOfFile) {
-  fs::create_directory(dir_ / "folder.stl");
-  expectError(dir_ / "folder.stl", "is a directory");
+  fs::create_directory(dir() / "folder.stl");
+  expectLoadError(dir() / "folder.stl", "is a directory");
 }
 
 TEST_F(LoadModel, UnreadableFile) {
   const fs::path p = write("locked.stl", kAsciiStl);
   fs::permissions(p, fs::perms::none);
   if (::geteuid() != 0) {
-    expectError(p, "cannot read file");
+    expectLoadError(p, "cannot read file");
     return;
   }
   // Permission bits do not stop root: check as user "nobody" in a child process.
-  fs::permissions(dir_, fs::perms::owner_all | fs::perms::others_read | fs::perms::others_exec);
+  fs::permissions(dir(), fs::perms::owner_all | fs::perms::others_read | fs::perms::others_exec);
   const pid_t child = ::fork();
   ASSERT_GE(child, 0);
   if (child == 0) {
@@ -177,49 +137,51 @@ TEST_F(LoadModel, UnreadableFile) {
 }
 
 TEST_F(LoadModel, FifoDoesNotBlock) {
-  const fs::path p = dir_ / "pipe.stl";
+  const fs::path p = dir() / "pipe.stl";
   ASSERT_EQ(::mkfifo(p.c_str(), 0600), 0);
-  expectError(p, "not a regular file");
+  expectLoadError(p, "not a regular file");
 }
 
 TEST_F(LoadModel, EmptyFiles) {
   for (const char* name : {"empty.stl", "empty.ply", "empty.obj", "empty.off", "empty.glb", "empty.vtp"})
-    expectError(write(name, ""), "empty file");
+    expectLoadError(write(name, ""), "empty file");
 }
 
 TEST_F(LoadModel, TruncatedBinaryStl) {
-  expectError(write("truncated.stl", binaryStl(10, 3)), "truncated binary STL (234 of 584 bytes for 10 triangles)");
+  expectLoadError(write("truncated.stl", binaryStl(10, 3)), "truncated binary STL (234 of 584 bytes for 10 triangles)");
 }
 
-TEST_F(LoadModel, StlShorterThanHeader) { expectError(write("short.stl", std::string(40, '\x01')), "not an STL file"); }
+TEST_F(LoadModel, StlShorterThanHeader) {
+  expectLoadError(write("short.stl", std::string(40, '\x01')), "not an STL file");
+}
 
 TEST_F(LoadModel, GarbageAsciiStl) {
-  expectError(write("garbage.stl", "solid junk\nthis is not\nan stl\n"), "cannot read STL");
+  expectLoadError(write("garbage.stl", "solid junk\nthis is not\nan stl\n"), "cannot read STL");
 }
 
 TEST_F(LoadModel, GarbagePly) {
   std::string junk;
   for (int i = 0; i < 20; ++i) junk += std::string("no ply here \x01\x02\xff\n", 17);
-  expectError(write("garbage.ply", junk), "not a PLY file");
+  expectLoadError(write("garbage.ply", junk), "not a PLY file");
 }
 
 TEST_F(LoadModel, PlyBadHeaderLine) {
-  expectError(write("header.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty flaot x\nend_header\n"),
-              "bad PLY header line 4 'property flaot x': unknown property type");
-  expectError(write("element.ply", "ply\nformat ascii 1.0\nelement vertex many\nend_header\n"),
-              "bad PLY header line 3 'element vertex many': bad element count");
-  expectError(write("format.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n"), "unknown format");
+  expectLoadError(write("header.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty flaot x\nend_header\n"),
+                  "bad PLY header line 4 'property flaot x': unknown property type");
+  expectLoadError(write("element.ply", "ply\nformat ascii 1.0\nelement vertex many\nend_header\n"),
+                  "bad PLY header line 3 'element vertex many': bad element count");
+  expectLoadError(write("format.ply", "ply\nformat binary_middle_endian 1.0\nend_header\n"), "unknown format");
 }
 
 TEST_F(LoadModel, PlyWithoutEndHeader) {
-  expectError(write("noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"), "no end_header");
+  expectLoadError(write("noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"), "no end_header");
 }
 
 TEST_F(LoadModel, PlyHeaderClaimsMoreVerticesThanPresent) {
   const std::string ply =
       "ply\nformat ascii 1.0\nelement vertex 100\nproperty float x\nproperty float y\nproperty float z\n"
       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
-  expectError(write("short.ply", ply), "declares 100 'vertex' items");
+  expectLoadError(write("short.ply", ply), "declares 100 'vertex' items");
 }
 
 TEST_F(LoadModel, PlyDataEndsEarly) {
@@ -227,7 +189,7 @@ TEST_F(LoadModel, PlyDataEndsEarly) {
   const std::string ply =
       "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
       "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
-  expectError(write("early.ply", ply), "unexpected end of data");
+  expectLoadError(write("early.ply", ply), "unexpected end of data");
 }
 
 TEST_F(LoadModel, BinaryPlyTruncated) {
@@ -237,7 +199,7 @@ TEST_F(LoadModel, BinaryPlyTruncated) {
   for (int i = 0; i < 9; ++i) ply += f32(0.5f);
   ply += '\x03';
   ply += le32(0) + le32(1);  // the third index is missing
-  expectError(write("truncated_bin.ply", ply), "unexpected end of data");
+  expectLoadError(write("truncated_bin.ply", ply), "unexpected end of data");
 }
 
 TEST_F(LoadModel, PlyHugeVertexCountDoesNotAllocate) {
@@ -245,43 +207,49 @@ TEST_F(LoadModel, PlyHugeVertexCountDoesNotAllocate) {
       "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
       "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n" +
       std::string(64, '\0');
-  expectError(write("huge.ply", ply), "declares 4000000000 'vertex' items");
+  expectLoadError(write("huge.ply", ply), "declares 4000000000 'vertex' items");
 }
 
 TEST_F(LoadModel, PlyFaceIndexOutOfRange) {
-  expectError(write("badindex.ply", std::string(kPlyHeader3) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"),
-              "face 0 refers to vertex 7 but there are 3 vertices");
+  expectLoadError(write("badindex.ply", std::string(kPlyHeader3) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n"),
+                  "face 0 refers to vertex 7 but there are 3 vertices");
 }
 
 TEST_F(LoadModel, PlyNegativeIndex) {
-  expectError(write("negative.ply", std::string(kPlyHeader3) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n"), "bad vertex index");
+  expectLoadError(write("negative.ply", std::string(kPlyHeader3) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n"),
+                  "bad vertex index");
 }
 
 TEST_F(LoadModel, ObjIndexOutOfRange) {
-  expectError(write("badindex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "refers to vertex");
+  expectLoadError(write("badindex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"), "refers to vertex");
 }
 
 TEST_F(LoadModel, ObjBadNormalIndexDoesNotCrash) {
   // vtkOBJReader crashed on this (normal index 1 and texture index 1 that do not exist).
-  expectError(write("crash.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nvn 0 0 1\nf 1 2 3 4\n"
-                                 "f 1//1 2//1 55/1\nf 2 3 3\n"),
-              "line 8: face refers to vertex 55 but there are 5 vertices");
+  expectLoadError(write("crash.obj",
+                        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nvn 0 0 1\nf 1 2 3 4\n"
+                        "f 1//1 2//1 55/1\nf 2 3 3\n"),
+                  "line 8: face refers to vertex 55 but there are 5 vertices");
   const auto objects = mfr::loadModel(write("fine.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/7/9 2/7/9 3/7/9\n"));
   EXPECT_EQ(objects.at(0).mesh->triangleCount(), 1u);
 }
 
-TEST_F(LoadModel, ObjMalformedFace) { expectError(write("face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n"), "line 4: malformed face corner 'x'"); }
+TEST_F(LoadModel, ObjMalformedFace) {
+  expectLoadError(write("face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n"), "line 4: malformed face corner 'x'");
+}
 
 TEST_F(LoadModel, ObjNegativeIndexOutOfRange) {
-  expectError(write("badrelative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9\n"), "refers to vertex");
+  expectLoadError(write("badrelative.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -9\n"), "refers to vertex");
 }
 
 TEST_F(LoadModel, UnsupportedExtension) {
-  expectError(write("model.xyz", "1 2 3\n"), "unsupported file type '.xyz'");
-  expectError(write("README", "text\n"), "unsupported file type 'README'");
+  expectLoadError(write("model.xyz", "1 2 3\n"), "unsupported file type '.xyz'");
+  expectLoadError(write("README", "text\n"), "unsupported file type 'README'");
 }
 
-TEST_F(LoadModel, GzThatIsNotGzip) { expectError(write("fake.ply.gz", kPlyHeader3), "not a gzip file"); }
+TEST_F(LoadModel, GzThatIsNotGzip) {
+  expectLoadError(write("fake.ply.gz", kPlyHeader3), "not a gzip file");
+}
 
 TEST_F(LoadModel, TruncatedGzip) {
   std::string ply = std::string(kPlyHeader3) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
@@ -291,66 +259,77 @@ TEST_F(LoadModel, TruncatedGzip) {
   std::string bytes(static_cast<std::size_t>(fs::file_size(full)), '\0');
   in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   ASSERT_GT(bytes.size(), 40u);
-  expectError(write("cut.ply.gz", bytes.substr(0, bytes.size() / 2)), "gzip");
+  expectLoadError(write("cut.ply.gz", bytes.substr(0, bytes.size() / 2)), "gzip");
 }
 
-TEST_F(LoadModel, GzWithoutInnerExtension) { expectError(writeGz("model.gz", kAsciiStl), "unsupported compressed file type"); }
+TEST_F(LoadModel, GzWithoutInnerExtension) {
+  expectLoadError(writeGz("model.gz", kAsciiStl), "unsupported compressed file type");
+}
 
 TEST_F(LoadModel, NanCoordinates) {
-  expectError(write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), "non-finite coordinate");
-  expectError(write("nan.ply", std::string(kPlyHeader3) + "0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n"), "non-finite coordinate");
-  expectError(write("nan.stl",
-                    "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\nvertex 0 1 0\n"
-                    "endloop\nendfacet\nendsolid x\n"),
-              "non-finite coordinate");
+  expectLoadError(write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), "non-finite coordinate");
+  expectLoadError(write("nan.ply", std::string(kPlyHeader3) + "0 0 0\nnan 0 0\n0 1 0\n3 0 1 2\n"),
+                  "non-finite coordinate");
+  expectLoadError(write("nan.stl",
+                        "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\nvertex 0 1 0\n"
+                        "endloop\nendfacet\nendsolid x\n"),
+                  "non-finite coordinate");
   // CGAL's OFF scanner does not parse "nan" at all.
-  expectError(write("nan.off", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n"), "malformed or truncated OFF");
-  expectError(write("malformed.obj", "v 0 0 0\nv 1x 0 0\nv 0 1 0\nf 1 2 3\n"), "line 2: malformed number '1x'");
+  expectLoadError(write("nan.off", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n"), "malformed or truncated OFF");
+  expectLoadError(write("malformed.obj", "v 0 0 0\nv 1x 0 0\nv 0 1 0\nf 1 2 3\n"), "line 2: malformed number '1x'");
 }
 
 TEST_F(LoadModel, ZeroTriangles) {
-  expectError(write("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n"), "no triangles");
-  expectError(write("points.ply",
-                    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                    "end_header\n0 0 0\n1 0 0\n0 1 0\n"),
-              "no triangles");
-  expectError(write("nofacets.stl", "solid x\nendsolid x\n"), "no triangles");
-  expectError(write("zero.stl", binaryStl(0, 0)), "no triangles");
-  expectError(write("nofaces.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n"), "no triangles");
-  expectError(write("edge.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n"), "no triangles");
-  expectError(write("vertsonly.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"), "no triangles");
+  expectLoadError(write("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\n"), "no triangles");
+  expectLoadError(
+      write("points.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "end_header\n0 0 0\n1 0 0\n0 1 0\n"),
+      "no triangles");
+  expectLoadError(write("nofacets.stl", "solid x\nendsolid x\n"), "no triangles");
+  expectLoadError(write("zero.stl", binaryStl(0, 0)), "no triangles");
+  expectLoadError(write("nofaces.off", "OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n"), "no triangles");
+  expectLoadError(write("edge.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n"), "no triangles");
+  expectLoadError(write("vertsonly.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"), "no triangles");
 }
 
 TEST_F(LoadModel, GarbageOff) {
-  expectError(write("garbage.off", "this is not an off file\n"), "not an OFF file");
-  expectError(write("counts.off", "OFF\n300 100 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "declares 300 vertices");
-  expectError(write("badface.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 9\n"), "malformed or truncated OFF");
+  expectLoadError(write("garbage.off", "this is not an off file\n"), "not an OFF file");
+  expectLoadError(write("counts.off", "OFF\n300 100 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "declares 300 vertices");
+  expectLoadError(write("badface.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 9\n"),
+                  "malformed or truncated OFF");
 }
 
-TEST_F(LoadModel, GarbageVtp) { expectError(write("garbage.vtp", "<VTKFile type=\"PolyData\"> bogus"), "cannot read VTP"); }
+TEST_F(LoadModel, GarbageVtp) {
+  expectLoadError(write("garbage.vtp", "<VTKFile type=\"PolyData\"> bogus"), "cannot read VTP");
+}
 
 TEST_F(LoadModel, GarbageLegacyVtk) {
-  expectError(write("garbage.vtk", "not a vtk file at all\n"), "not a legacy VTK file");
-  expectError(write("short.vtk",
-                    "# vtk DataFile Version 3.0\nshort\nASCII\nDATASET POLYDATA\nPOINTS 10 float\n0 0 0\n1 0 0\n"),
-              "header declares 10 points but only 13 bytes follow");
-  expectError(write("early.vtk",
-                    "# vtk DataFile Version 3.0\nshort\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0\n1 0 0\n1 1"),
-              "unexpected end of data");
+  expectLoadError(write("garbage.vtk", "not a vtk file at all\n"), "not a legacy VTK file");
+  expectLoadError(
+      write("short.vtk", "# vtk DataFile Version 3.0\nshort\nASCII\nDATASET POLYDATA\nPOINTS 10 float\n0 0 0\n1 0 0\n"),
+      "header declares 10 points but only 13 bytes follow");
+  expectLoadError(
+      write("early.vtk",
+            "# vtk DataFile Version 3.0\nshort\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0\n1 0 0\n1 1"),
+      "unexpected end of data");
   // A mangled keyword line made vtkPolyDataReader read from a closed stream and crash.
-  expectError(write("mangled.vtk",
-                    "# vtk DataFile Version 3.0\nq\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n0 0 0E1 0 0\n1 1 1\n"
-                    "0 1 1\nPOLYGONS 1 5\xee" "4 0 1 2 3\n"),
-              "bad number 'POLYGONS'");
-  expectError(write("grid.vtk", "# vtk DataFile Version 3.0\ng\nASCII\nDATASET STRUCTURED_POINTS\n"),
-              "dataset type 'STRUCTURED_POINTS' is not supported");
-  expectError(write("badid.vtk",
-                    "# vtk DataFile Version 3.0\nq\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
-                    "POLYGONS 1 4\n3 0 1 3\n"),
-              "face 0 refers to vertex 3 but there are 3 vertices");
+  expectLoadError(write("mangled.vtk",
+                        "# vtk DataFile Version 3.0\nq\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n0 0 0E1 0 0\n1 1 1\n"
+                        "0 1 1\nPOLYGONS 1 5\xee"
+                        "4 0 1 2 3\n"),
+                  "bad number 'POLYGONS'");
+  expectLoadError(write("grid.vtk", "# vtk DataFile Version 3.0\ng\nASCII\nDATASET STRUCTURED_POINTS\n"),
+                  "dataset type 'STRUCTURED_POINTS' is not supported");
+  expectLoadError(write("badid.vtk",
+                        "# vtk DataFile Version 3.0\nq\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+                        "POLYGONS 1 4\n3 0 1 3\n"),
+                  "face 0 refers to vertex 3 but there are 3 vertices");
 }
 
-TEST_F(LoadModel, GarbageGlb) { expectError(write("garbage.glb", "glTF but not really, just text\n"), "cannot read glb"); }
+TEST_F(LoadModel, GarbageGlb) {
+  expectLoadError(write("garbage.glb", "glTF but not really, just text\n"), "cannot read glb");
+}
 
 // ---- small valid files ------------------------------------------------------------------------
 
@@ -384,7 +363,8 @@ TEST_F(LoadModel, ObjQuadsAreTriangulatedAndCreasesSplit) {
                     c = mesh.positions[mesh.indices[3 * t + 2]];
     const glm::vec3 faceNormal = glm::normalize(glm::cross(b - a, c - a));
     for (int k = 0; k < 3; ++k)
-      EXPECT_GT(std::abs(glm::dot(faceNormal, mesh.normals[mesh.indices[3 * t + static_cast<std::size_t>(k)]])), 0.999f);
+      EXPECT_GT(std::abs(glm::dot(faceNormal, mesh.normals[mesh.indices[3 * t + static_cast<std::size_t>(k)]])),
+                0.999f);
   }
 }
 
@@ -430,7 +410,8 @@ TEST_F(LoadModel, AsciiPlyWithColors) {
   for (const glm::vec4& c : mesh.colors)
     seen.insert({static_cast<int>(std::lround(c.r * 255)), static_cast<int>(std::lround(c.g * 255)),
                  static_cast<int>(std::lround(c.b * 255)), static_cast<int>(std::lround(c.a * 255))});
-  EXPECT_EQ(seen, (std::set<std::vector<int>>{{255, 0, 0, 255}, {0, 255, 0, 255}, {0, 0, 255, 255}, {255, 255, 255, 51}}));
+  EXPECT_EQ(seen,
+            (std::set<std::vector<int>>{{255, 0, 0, 255}, {0, 255, 0, 255}, {0, 0, 255, 255}, {255, 255, 255, 51}}));
 }
 
 TEST_F(LoadModel, BinaryBigEndianPly) {
@@ -462,7 +443,7 @@ TEST_F(LoadModel, GzippedPlyAndStl) {
   EXPECT_EQ(triangles(stlObjects), 4u);
   EXPECT_EQ(mfr::loadModel(writeGz("cube.obj.gz", kCubeObj))[0].mesh->triangleCount(), 12u);
   EXPECT_EQ(mfr::loadModel(writeGz("three.stl.gz", binaryStl(3, 3)))[0].mesh->triangleCount(), 3u);
-  expectError(writeGz("truncated.stl.gz", binaryStl(10, 3)), "truncated binary STL");
+  expectLoadError(writeGz("truncated.stl.gz", binaryStl(10, 3)), "truncated binary STL");
 }
 
 TEST_F(LoadModel, OffWithPolygonsCommentsAndColors) {

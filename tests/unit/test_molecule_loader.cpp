@@ -3,8 +3,6 @@
 // tessellation rule, progress and cancelling; and every kind of bad input as one mfr::Error that
 // names the file. The expected numbers are counted by hand from the files written here.
 #include <gtest/gtest.h>
-#include <unistd.h>
-#include <zlib.h>
 
 #include <cmath>
 #include <cstdio>
@@ -17,6 +15,7 @@
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/reference/oracle.hpp"
+#include "test_files.hpp"
 
 namespace fs = std::filesystem;
 
@@ -118,48 +117,9 @@ std::string tinyCif(const std::string& x0 = "0.000") {
   return s + "#\n";
 }
 
-class MoleculeLoader : public ::testing::Test {
- protected:
-  void SetUp() override {
-    std::string pattern = (fs::temp_directory_path() / "mfr-test-molecule-XXXXXX").string();
-    ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(dir_, ec);
-  }
-  fs::path write(const std::string& name, const std::string& bytes) {
-    const fs::path p = dir_ / name;
-    std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    return p;
-  }
-  fs::path writeGz(const std::string& name, const std::string& bytes) {
-    const fs::path p = dir_ / name;
-    gzFile gz = gzopen(p.c_str(), "wb");
-    EXPECT_NE(gz, nullptr);
-    EXPECT_EQ(gzwrite(gz, bytes.data(), static_cast<unsigned>(bytes.size())), static_cast<int>(bytes.size()));
-    gzclose(gz);
-    return p;
-  }
-  // One-line mfr::Error that starts with the path and contains `reason`.
-  static void expectError(const fs::path& path, const std::string& reason) {
-    try {
-      const auto objects = mfr::loadModel(path);
-      ADD_FAILURE() << path << ": loaded " << objects.size() << " parts, expected an error about '" << reason << "'";
-    } catch (const mfr::LoadCancelled&) {
-      ADD_FAILURE() << path << ": cancelled?";
-    } catch (const mfr::Error& e) {
-      const std::string what = e.what();
-      EXPECT_EQ(what.find('\n'), std::string::npos) << "not one line: " << what;
-      EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << "does not start with the path: " << what;
-      EXPECT_NE(what.find(reason), std::string::npos) << "expected '" << reason << "' in: " << what;
-    } catch (const std::exception& e) {
-      ADD_FAILURE() << path << ": non-mfr exception: " << e.what();
-    }
-  }
-  fs::path dir_;
-};
+using mfr::test::expectLoadError;
+
+class MoleculeLoader : public mfr::test::TempDirTest {};
 
 // Per part: name → atoms, from the triangle count at 320 triangles (level 2) per sphere.
 std::map<std::string, std::size_t> atomsPerPart(const std::vector<mfr::Object>& objects, std::size_t perSphere = 320) {
@@ -398,31 +358,31 @@ TEST_F(MoleculeLoader, SceneFileColourReplacesElementColours) {
 // ---- bad input ----------------------------------------------------------------------------------
 
 TEST_F(MoleculeLoader, MissingAndEmpty) {
-  expectError(dir_ / "nothing.pdb", "no such file");
-  expectError(write("empty.pdb", ""), "empty file");
-  expectError(write("empty.cif", ""), "empty file");
-  expectError(writeGz("empty.cif.gz", ""), "empty file");
-  expectError(write("blank.cif", "  \n# only a comment\n"), "no CIF data block");
+  expectLoadError(dir() / "nothing.pdb", "no such file");
+  expectLoadError(write("empty.pdb", ""), "empty file");
+  expectLoadError(write("empty.cif", ""), "empty file");
+  expectLoadError(writeGz("empty.cif.gz", ""), "empty file");
+  expectLoadError(write("blank.cif", "  \n# only a comment\n"), "no CIF data block");
 }
 
 TEST_F(MoleculeLoader, GarbageAndNoAtoms) {
   std::string binary;
   for (int i = 0; i < 4096; ++i) binary += static_cast<char>((i * 7919) % 251);
-  expectError(write("binary.pdb", binary), "no atoms");
-  expectError(write("binary.cif", binary), "binary.cif: line 1, column 1: expected block header (data_)");
-  expectError(write("header.pdb", "HEADER    NOTHING HERE\nREMARK   2 RESOLUTION. 2.0 ANGSTROMS.\nEND\n"),
-              "no atoms (no ATOM or HETATM records");
-  expectError(write("text.cif", "this is not a CIF file\n"), "expected block header (data_)");
-  expectError(write("noatoms.cif", "data_X\n_entry.id X\nloop_\n_entity.id\n_entity.type\n1 polymer\n"),
-              "no atoms: not a macromolecular mmCIF file");
-  expectError(write("nacl.cif",
-                    "data_nacl\n_cell_length_a 5.64\n_symmetry_space_group_name_H-M 'F m -3 m'\nloop_\n"
-                    "_atom_site_label\n_atom_site_fract_x\n_atom_site_fract_y\n_atom_site_fract_z\n"
-                    "Na1 0 0 0\nCl1 0.5 0.5 0.5\n"),
-              "a small-molecule CIF");
+  expectLoadError(write("binary.pdb", binary), "no atoms");
+  expectLoadError(write("binary.cif", binary), "binary.cif: line 1, column 1: expected block header (data_)");
+  expectLoadError(write("header.pdb", "HEADER    NOTHING HERE\nREMARK   2 RESOLUTION. 2.0 ANGSTROMS.\nEND\n"),
+                  "no atoms (no ATOM or HETATM records");
+  expectLoadError(write("text.cif", "this is not a CIF file\n"), "expected block header (data_)");
+  expectLoadError(write("noatoms.cif", "data_X\n_entry.id X\nloop_\n_entity.id\n_entity.type\n1 polymer\n"),
+                  "no atoms: not a macromolecular mmCIF file");
+  expectLoadError(write("nacl.cif",
+                        "data_nacl\n_cell_length_a 5.64\n_symmetry_space_group_name_H-M 'F m -3 m'\nloop_\n"
+                        "_atom_site_label\n_atom_site_fract_x\n_atom_site_fract_y\n_atom_site_fract_z\n"
+                        "Na1 0 0 0\nCl1 0.5 0.5 0.5\n"),
+                  "a small-molecule CIF");
   // An mmCIF file named .pdb, and a PDB file named .cif.
-  expectError(write("cif.pdb", tinyCif()), "perhaps it is cif not pdb");
-  expectError(write("pdb.cif", tinyPdb()), "expected block header (data_)");
+  expectLoadError(write("cif.pdb", tinyCif()), "perhaps it is cif not pdb");
+  expectLoadError(write("pdb.cif", tinyPdb()), "expected block header (data_)");
 }
 
 TEST_F(MoleculeLoader, Truncated) {
@@ -431,46 +391,48 @@ TEST_F(MoleculeLoader, Truncated) {
   // complete): the last record is shorter than the one before.
   const std::size_t tenth = pdb.find("ATOM     10");
   ASSERT_NE(tenth, std::string::npos);
-  expectError(write("cut40.pdb", pdb.substr(0, tenth + 40)),
-              "truncated file: the last ATOM/HETATM record ends at column 40 (the one before has 80)");
-  expectError(write("cut60.pdb", pdb.substr(0, tenth + 60)),
-              "truncated file: the last ATOM/HETATM record ends at column 60");
+  expectLoadError(write("cut40.pdb", pdb.substr(0, tenth + 40)),
+                  "truncated file: the last ATOM/HETATM record ends at column 40 (the one before has 80)");
+  expectLoadError(write("cut60.pdb", pdb.substr(0, tenth + 60)),
+                  "truncated file: the last ATOM/HETATM record ends at column 60");
   // A short record inside the file: gemmi's own check.
   std::string shortLine = pdb;
   shortLine.erase(tenth + 40, 40);
-  expectError(write("short.pdb", shortLine), "The line is too short to be correct");
+  expectLoadError(write("short.pdb", shortLine), "The line is too short to be correct");
   const std::string cif = tinyCif();
   const std::size_t row = cif.find("\nATOM 12 ");
   ASSERT_NE(row, std::string::npos);
-  expectError(write("cut.cif", cif.substr(0, row + 20)), "Wrong number of values in the loop (truncated or corrupt?)");
-  expectError(write("quote.cif", cif.substr(0, cif.find("quotes") + 3)), "line 4, column 46: unterminated 'string'");
-  expectError(write("field.cif", cif.substr(0, cif.find("two lines") + 4)), "unterminated text field");
+  expectLoadError(write("cut.cif", cif.substr(0, row + 20)),
+                  "Wrong number of values in the loop (truncated or corrupt?)");
+  expectLoadError(write("quote.cif", cif.substr(0, cif.find("quotes") + 3)),
+                  "line 4, column 46: unterminated 'string'");
+  expectLoadError(write("field.cif", cif.substr(0, cif.find("two lines") + 4)), "unterminated text field");
   // A cut gzip stream.
   const fs::path whole = writeGz("whole.pdb.gz", pdb);
   std::ifstream in(whole, std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  expectError(write("cut.pdb.gz", bytes.substr(0, bytes.size() / 2)), "gzip");
+  expectLoadError(write("cut.pdb.gz", bytes.substr(0, bytes.size() / 2)), "gzip");
 }
 
 TEST_F(MoleculeLoader, AbsurdCoordinates) {
-  expectError(write("nan.cif", tinyCif("nan")), "), not finite or beyond ±100000 Å");
-  expectError(write("unknown.cif", tinyCif("?")), "not finite or beyond");
-  expectError(write("huge.cif", tinyCif("1e30")), "has coordinates (1e+30, 0, ");
+  expectLoadError(write("nan.cif", tinyCif("nan")), "), not finite or beyond ±100000 Å");
+  expectLoadError(write("unknown.cif", tinyCif("?")), "not finite or beyond");
+  expectLoadError(write("huge.cif", tinyCif("1e30")), "has coordinates (1e+30, 0, ");
   std::string pdb = tinyPdb();
   pdb.replace(pdb.find("ATOM      1") + 30, 8, "99999999");  // x of the first atom
-  expectError(write("huge.pdb", pdb), "atom 1 (N of ALA 1, chain 'A') has coordinates (1e+08, 0, ");
+  expectLoadError(write("huge.pdb", pdb), "atom 1 (N of ALA 1, chain 'A') has coordinates (1e+08, 0, ");
 }
 
 TEST_F(MoleculeLoader, BrokenMmcifSyntax) {
   const std::string head = "data_X\nloop_\n_atom_site.id\n_atom_site.Cartn_x\n";
   // gemmi's CIF parser (PEGTL) and its checks, positions spelled out.
-  expectError(write("tag.cif", "data_X\n_entry.id\n_entry.title x\n"), "line 2 in data_X: _entry.id has no value");
-  expectError(write("loop.cif", "data_X\nloop_\n1 2 3\n"), "line 3, column 1: parse error");
-  expectError(write("stop.cif", "data_X\nstop_\n"), "line 2, column 1: parse error");
-  expectError(write("value.cif", "data_X\n_a 1 2\n"), "line 2, column 6: parse error");
-  expectError(write("dup.cif", "data_X\n_a 1\n_A 2\n"), "line 3 in data_X: duplicate tag _A");
-  expectError(write("frame.cif", "data_X\nsave_f\n_a 1\n"), "line 4, column 1: parse error");
-  expectError(write("columns.cif", head + "1 0.0\n"), "mmCIF _atom_site has no _atom_site.type_symbol column");
+  expectLoadError(write("tag.cif", "data_X\n_entry.id\n_entry.title x\n"), "line 2 in data_X: _entry.id has no value");
+  expectLoadError(write("loop.cif", "data_X\nloop_\n1 2 3\n"), "line 3, column 1: parse error");
+  expectLoadError(write("stop.cif", "data_X\nstop_\n"), "line 2, column 1: parse error");
+  expectLoadError(write("value.cif", "data_X\n_a 1 2\n"), "line 2, column 6: parse error");
+  expectLoadError(write("dup.cif", "data_X\n_a 1\n_A 2\n"), "line 3 in data_X: duplicate tag _A");
+  expectLoadError(write("frame.cif", "data_X\nsave_f\n_a 1\n"), "line 4, column 1: parse error");
+  expectLoadError(write("columns.cif", head + "1 0.0\n"), "mmCIF _atom_site has no _atom_site.type_symbol column");
 }
 
 }  // namespace

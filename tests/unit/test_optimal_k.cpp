@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "fragments.hpp"
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/budget/optimal_k.hpp"
 #include "mfr/error.hpp"
@@ -21,12 +22,7 @@
 
 namespace {
 
-mfr::Fragment frag(float depth, std::uint32_t r, std::uint32_t g, std::uint32_t b, std::uint32_t a) {
-  mfr::Fragment f;
-  f.depth = depth;
-  f.color = r | (g << 8) | (b << 16) | (a << 24);
-  return f;
-}
+using mfr::test::frag;
 
 // A 1-row image whose pixel p holds lists[p] (sorted by construction).
 mfr::FragmentLists makeLists(const std::vector<std::vector<mfr::Fragment>>& lists) {
