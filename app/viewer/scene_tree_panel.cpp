@@ -2,6 +2,7 @@
 
 #include <QColorDialog>
 #include <QHeaderView>
+#include <QMenu>
 #include <QPixmap>
 #include <QTreeWidget>
 #include <QVBoxLayout>
@@ -52,6 +53,19 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   layout->addWidget(tree_);
   connect(tree_, &QTreeWidget::itemChanged, this, &SceneTreePanel::itemChanged);
   connect(tree_, &QTreeWidget::itemClicked, this, &SceneTreePanel::itemClicked);
+  // Right-click: back to the file's colour (a molecule's element colours) after choosing one.
+  tree_->setContextMenuPolicy(Qt::CustomContextMenu);
+  connect(tree_, &QWidget::customContextMenuRequested, this, [this](const QPoint& at) {
+    QTreeWidgetItem* item = tree_->itemAt(at);
+    if (!item) return;
+    const int index = item->data(kName, Qt::UserRole).toInt();
+    QMenu menu(this);
+    QAction* reset =
+        menu.addAction(tr("Reset Colour to the File's"), this, [this, index] { model_.resetObjectColor(index); });
+    reset->setObjectName(QStringLiteral("resetColourAction"));
+    reset->setEnabled(model_.objectColorEdited(index));
+    menu.exec(tree_->viewport()->mapToGlobal(at));
+  });
   connect(&model_, &ViewerModel::sceneLoaded, this, &SceneTreePanel::rebuild);
   // Edits from elsewhere (a session's overrides, plugins) show up in the rows.
   connect(&model_, &ViewerModel::sceneChanged, this, &SceneTreePanel::showValues);
@@ -90,7 +104,8 @@ void SceneTreePanel::rebuild() {
     item->setIcon(kColour, swatch(colourOf(o)));
     item->setText(kColour, colourText(o));
     item->setData(kColour, Qt::UserRole, colourOf(o));
-    item->setToolTip(kColour, tr("Click to change the colour (a chosen colour replaces the file's colours)"));
+    item->setToolTip(kColour, tr("Click to change the colour (a chosen colour replaces the file's colours; "
+                                 "right-click to go back to them)"));
     item->setData(kOpacity, Qt::EditRole, std::round(o.material.color.a * 1000.0) / 1000.0);
     item->setToolTip(kOpacity, tr("Double-click to edit (0 = invisible, 1 = opaque)"));
     item->setText(kTriangles, QString::number(o.mesh ? o.mesh->triangleCount() : 0));

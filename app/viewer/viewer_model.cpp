@@ -267,6 +267,8 @@ void ViewerModel::cancelLoad() {
 
 void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
   scene_ = std::move(scene);
+  loadedMaterials_.clear();
+  for (const mfr::Object& o : scene_.objects) loadedMaterials_.push_back(o.material);
   scenePath_ = path;
   hasScene_ = true;
   ++sceneRevision_;
@@ -304,6 +306,24 @@ void ViewerModel::setObjectColor(int index, const QColor& rgb) {
   c = glm::vec4(static_cast<float>(rgb.redF()), static_cast<float>(rgb.greenF()), static_cast<float>(rgb.blueF()), c.a);
   material.vertexColors = false;
   sceneEdited();
+}
+
+void ViewerModel::resetObjectColor(int index) {
+  if (!objectColorEdited(index)) return;
+  const auto i = static_cast<std::size_t>(index);
+  mfr::Material& material = scene_.objects[i].material;
+  material.color = glm::vec4(glm::vec3(loadedMaterials_[i].color), material.color.a);
+  material.vertexColors = loadedMaterials_[i].vertexColors;
+  sceneEdited();
+}
+
+bool ViewerModel::objectColorEdited(int index) const {
+  if (index < 0 || index >= static_cast<int>(scene_.objects.size()) || loadedMaterials_.size() != scene_.objects.size())
+    return false;
+  const auto i = static_cast<std::size_t>(index);
+  const mfr::Material& now = scene_.objects[i].material;
+  return glm::vec3(now.color) != glm::vec3(loadedMaterials_[i].color) ||
+         now.vertexColors != loadedMaterials_[i].vertexColors;
 }
 
 void ViewerModel::setObjectOpacity(int index, double opacity) {

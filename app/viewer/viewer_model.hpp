@@ -133,6 +133,10 @@ class ViewerModel final : public ViewerContext {
   void setObjectVisible(int index, bool visible);
   // A colour chosen for a part replaces its file's per-vertex colours (Material::vertexColors).
   void setObjectColor(int index, const QColor& rgb);
+  // The colour the part had when its scene was loaded (its file's per-vertex colours, e.g. a
+  // molecule's element colours, included); the opacity stays as it is.
+  void resetObjectColor(int index);
+  [[nodiscard]] bool objectColorEdited(int index) const;
   void setObjectOpacity(int index, double opacity);
   void setObjectMaterial(int index, const glm::vec4& rgba, bool vertexColors = true);
 
@@ -222,6 +226,7 @@ class ViewerModel final : public ViewerContext {
   void pollLoadProgress();
 
   mfr::Scene scene_;
+  std::vector<mfr::Material> loadedMaterials_;  // of scene_'s objects as loaded, for resetObjectColor
   bool hasScene_ = false;
   QString scenePath_;
   quint64 sceneRevision_ = 0;

@@ -932,6 +932,33 @@ class ViewerTest : public QObject {
     QVERIFY(distance <= pixels / 100);   // …and few of them do (10 of 43,200 when measured)
   }
 
+  // A part given a colour of its own shows that colour instead of its file's per-vertex colours
+  // (a molecule's element colours); resetting brings the file's colours back, pixel for pixel.
+  void resetColour() {
+    auto w = openWindow(QStringLiteral("/usr/share/pymol/data/demo/pept.pdb"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(200, 150);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(200, 150), kTimeoutMs);
+    settle(m);
+    QVERIFY(!m.scene().objects.empty() && !m.scene().objects[0].mesh->colors.empty());
+    QVERIFY(!m.objectColorEdited(0));
+    const mfr::ImageRGBA8 before = fromQImage(w->view().grabFramebuffer());
+    m.setObjectColor(0, QColor(30, 60, 200));
+    QVERIFY(m.objectColorEdited(0));
+    QVERIFY(!m.scene().objects[0].material.vertexColors);
+    settle(m);
+    const mfr::ImageRGBA8 recoloured = fromQImage(w->view().grabFramebuffer());
+    QVERIFY(maxChannelDifference(before, recoloured) > 50);  // element colours gone
+    const float opacity = m.scene().objects[0].material.color.a;
+    m.resetObjectColor(0);
+    QVERIFY(!m.objectColorEdited(0));
+    QVERIFY(m.scene().objects[0].material.vertexColors);
+    QCOMPARE(m.scene().objects[0].material.color.a, opacity);
+    settle(m);
+    QCOMPARE(maxChannelDifference(before, fromQImage(w->view().grabFramebuffer())), 0);
+  }
+
   void navigation() {
     mfr::Camera c;
     c.eye = {0, 0, 5};
