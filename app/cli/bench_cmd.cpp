@@ -35,6 +35,7 @@ void addBench(CLI::App& app) {
     int repeat = 5, warmup = 1;
     double opacity = -1.0;
     bool noQuality = false;
+    bool sequential = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -50,6 +51,9 @@ void addBench(CLI::App& app) {
   cmd->add_option("--view", opt->view, "Named view")->capture_default_str();
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--no-quality", opt->noQuality, "Skip the oracle and the RMSE/FLIP columns");
+  cmd->add_flag("--sequential", opt->sequential,
+                "All frames of one method, then the next, each freeing its buffers before the next starts "
+                "(for methods whose buffers do not fit the GPU together); default: round-robin");
   cmd->add_option("--json", opt->json, "Write all results as JSON");
   cmd->callback([opt] {
     const auto [w, h] = parseSize("--size", opt->size);
@@ -78,7 +82,8 @@ void addBench(CLI::App& app) {
     out["size"] = opt->size;
     out["view"] = opt->view;
     out["repeat"] = opt->repeat;
-    out["order"] = "round-robin: frame i of every method, then frame i + 1";
+    out["order"] = opt->sequential ? "sequential: every frame of one method, then the next method"
+                                   : "round-robin: frame i of every method, then frame i + 1";
     out["renderer"] = info.renderer;
     out["gl_version"] = info.version;
     out["timing"] =
@@ -88,14 +93,16 @@ void addBench(CLI::App& app) {
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
 
     std::cout << "scene " << scene.name << ", " << opt->size << ", view " << opt->view << ", " << opt->repeat
-              << " frames each (round-robin), renderer: " << info.renderer << "\n";
+              << " frames each (" << (opt->sequential ? "sequential" : "round-robin")
+              << "), renderer: " << info.renderer << "\n";
     std::cout << std::left << std::setw(34) << "method" << std::right << std::setw(11) << "total ms" << std::setw(11)
               << "MiB alloc" << std::setw(10) << "MiB used" << std::setw(11) << "frags" << std::setw(11) << "stored"
               << std::setw(9) << "RMSE" << std::setw(9) << "FLIP"
               << "  passes (median ms)\n";
     // One renderer per method (sharing the scene), frames interleaved round-robin: a slow spell
     // of the machine then falls on every method alike, so the ratios between rows hold better
-    // than with one method's frames after another's.
+    // than with one method's frames after another's. The price is every method's buffers at once;
+    // --sequential runs one method at a time and frees its buffers before the next.
     struct Run {
       const RenderRequest* req = nullptr;
       std::unique_ptr<GpuRenderer> gpu;
@@ -109,21 +116,29 @@ void addBench(CLI::App& app) {
       run.gpu->shareScene(gpu);
       runs.push_back(std::move(run));
     }
-    for (Run& run : runs)
-      for (int i = 0; i < opt->warmup; ++i) run.gpu->render(camera, *run.req);
-    for (int i = 0; i < opt->repeat; ++i)
-      for (Run& run : runs) {
-        run.last = run.gpu->render(camera, *run.req);
-        run.totals.push_back(run.last.stats.totalTimeMs());
-        for (const auto& [pass, ms] : run.last.stats.passTimesMs) {
-          auto it =
-              std::find_if(run.perPass.begin(), run.perPass.end(), [&](const auto& p) { return p.first == pass; });
-          if (it == run.perPass.end())
-            run.perPass.push_back({pass, {ms}});
-          else
-            it->second.push_back(ms);
-        }
+    const auto frame = [&](Run& run) {
+      run.last = run.gpu->render(camera, *run.req);
+      run.totals.push_back(run.last.stats.totalTimeMs());
+      for (const auto& [pass, ms] : run.last.stats.passTimesMs) {
+        auto it = std::find_if(run.perPass.begin(), run.perPass.end(), [&](const auto& p) { return p.first == pass; });
+        if (it == run.perPass.end())
+          run.perPass.push_back({pass, {ms}});
+        else
+          it->second.push_back(ms);
       }
+    };
+    if (opt->sequential) {
+      for (Run& run : runs) {
+        for (int i = 0; i < opt->warmup; ++i) run.gpu->render(camera, *run.req);
+        for (int i = 0; i < opt->repeat; ++i) frame(run);
+        run.gpu.reset();  // its buffers go before the next method allocates
+      }
+    } else {
+      for (Run& run : runs)
+        for (int i = 0; i < opt->warmup; ++i) run.gpu->render(camera, *run.req);
+      for (int i = 0; i < opt->repeat; ++i)
+        for (Run& run : runs) frame(run);
+    }
     for (Run& run : runs) {
       const RenderRequest& req = *run.req;
       const std::vector<double>& totals = run.totals;

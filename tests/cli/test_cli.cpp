@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -140,6 +141,43 @@ TEST_F(Cli, GpuAndOracleImagesAgree) {
   ASSERT_EQ(r.exitCode, 0) << r.out;
   const double e = std::stod(r.out.substr(r.out.find("rmse ") + 5));
   EXPECT_LT(e, 0.02) << r.out;  // edge pixels may differ; everything else is exact
+}
+
+// mfr bench: one row per method in the order given, with memory, fragments and quality that do not
+// depend on the frame order (round-robin by default, --sequential on request), the exact method
+// below the approximate one against the oracle, and a bad method refused before any JSON exists.
+TEST_F(Cli, BenchRowsAndOrders) {
+  const std::string methods = " -m abuffer-ll,kplus-array:k=2 -r 2 --size 64x48 --view iso";
+  std::map<std::string, nlohmann::json> runs;
+  for (const std::string order : {"round-robin", "sequential"}) {
+    const fs::path json = dir() / (order + ".json");
+    const CliResult r =
+        runCli("bench @sample" + methods + (order == "sequential" ? " --sequential" : "") + " --json " + json.string());
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_NE(r.out.find("(" + order + ")"), std::string::npos) << r.out;
+    std::ifstream in(json);
+    runs[order] = nlohmann::json::parse(in);
+    EXPECT_EQ(runs[order].at("order").get<std::string>().rfind(order, 0), 0u);
+    const nlohmann::json& rows = runs[order].at("results");
+    ASSERT_EQ(rows.size(), 2u);
+    EXPECT_EQ(rows[0].at("method"), "abuffer-ll");
+    EXPECT_EQ(rows[1].at("method"), "kplus-array:k=2");
+    for (const nlohmann::json& row : rows) {
+      EXPECT_GT(row.at("median_total_ms").get<double>(), 0.0);
+      EXPECT_GT(row.at("bytes_allocated").get<std::uint64_t>(), 0u);
+      EXPECT_EQ(row.at("fragments_generated"), runs[order].at("oracle_fragments")) << row.at("method");
+    }
+    EXPECT_LT(rows[0].at("rmse").get<double>(), 0.01);                                     // every fragment
+    EXPECT_GT(rows[1].at("rmse").get<double>(), rows[0].at("rmse").get<double>() + 0.01);  // two of them
+  }
+  for (std::size_t i = 0; i < 2; ++i)
+    for (const char* key : {"bytes_allocated", "fragments_stored", "rmse", "flip_mean"})
+      EXPECT_EQ(runs["round-robin"]["results"][i][key], runs["sequential"]["results"][i][key]) << key;
+  const fs::path json = dir() / "bad.json";
+  const CliResult r = runCli("bench @sample -m abuffer-ll,magic --size 16x16 --json " + json.string());
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find("magic"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(json));
 }
 
 TEST_F(Cli, InfoReportsTrianglesAndHistogram) {
