@@ -127,15 +127,17 @@ void addBench(CLI::App& app) {
           it->second.push_back(ms);
       }
     };
+    const auto warmUp = [&](Run& run) {
+      for (int i = 0; i < opt->warmup; ++i) run.gpu->render(camera, *run.req);
+    };
     if (opt->sequential) {
       for (Run& run : runs) {
-        for (int i = 0; i < opt->warmup; ++i) run.gpu->render(camera, *run.req);
+        warmUp(run);
         for (int i = 0; i < opt->repeat; ++i) frame(run);
         run.gpu.reset();  // its buffers go before the next method allocates
       }
     } else {
-      for (Run& run : runs)
-        for (int i = 0; i < opt->warmup; ++i) run.gpu->render(camera, *run.req);
+      for (Run& run : runs) warmUp(run);
       for (int i = 0; i < opt->repeat; ++i)
         for (Run& run : runs) frame(run);
     }

@@ -200,10 +200,6 @@ void RenderView::paintGL() {
     for (int side = 0; side < model_.paneCount(); ++side) paintPane(side, errors);
     if (!model_.compareEnabled()) maps_[1] = {};
   }
-  if (reduction == 1 && !reports_->frames.empty()) {
-    fullFrameMs_ = 0.0;
-    for (const Frame& f : reports_->frames) fullFrameMs_ += f.stats.totalTimeMs();
-  }
   if (reduction != lastReduction_) {
     lastReduction_ = reduction;
     QMetaObject::invokeMethod(
@@ -467,7 +463,9 @@ int RenderView::navigationReduction() const {
   if (model_.compareEnabled() && model_.compareDisplay() != CompareDisplay::Images) return 1;
   for (int side = 0; side < model_.paneCount(); ++side)
     if (model_.isCpuMethod(model_.methodOf(side))) return 1;
-  const double f = std::ceil(std::sqrt(fullFrameMs_ / kNavigationFrameMs));
+  double fullFrameMs = 0.0;  // the last full frame's GPU time, all panes (previews are not reported)
+  for (int side = 0; side < model_.paneCount(); ++side) fullFrameMs += model_.statsOf(side).totalTimeMs();
+  const double f = std::ceil(std::sqrt(fullFrameMs / kNavigationFrameMs));
   return static_cast<int>(std::clamp(f, 1.0, static_cast<double>(kMaxReduction)));
 }
 

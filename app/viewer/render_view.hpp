@@ -149,7 +149,6 @@ class RenderView final : public QOpenGLWidget {
   bool fastNavigation_ = true;
   bool navigating_ = false;
   QTimer* settle_ = nullptr;  // ends navigation a moment after the last drag or wheel step
-  double fullFrameMs_ = 0.0;  // GPU time of the last full frame, all panes
   int lastReduction_ = 1;
   mfr::Stats previewStats_;
 
