@@ -407,6 +407,43 @@ TEST(OracleThreads, ResultDoesNotDependOnThreadCount) {
   }
 }
 
+// The oracle keeps the last scene's AABB tree between calls; a changed scene must never be
+// served the old geometry: moving, hiding or editing a part in place (same Mesh object, same
+// sizes) each changes the lists as the geometry says.
+TEST(OracleCache, ChangedScenesNeverGetTheLastGeometry) {
+  const Camera camera = frontCamera(Projection::Orthographic);  // 8 world units over 64 px
+  auto mesh = std::make_shared<Mesh>(makeSphere(1.0));
+  Scene scene;
+  scene.name = "cache";
+  Object o;
+  o.name = "ball";
+  o.mesh = mesh;
+  scene.objects.push_back(o);
+  // Pixel (32, 31) looks along x, y ≈ 0.06: front hit at z ≈ r, window depth (10 − z − 1) / 19.
+  const auto frontDepth = [&](const Scene& s) {
+    const FragmentLists lists = castFragments(s, camera, 64, 64);
+    return lists.count(32, 31) == 0 ? -1.0 : static_cast<double>(lists.pixel(32, 31)[0].depth);
+  };
+  EXPECT_NEAR(frontDepth(scene), 8.0 / 19.0, 0.002);
+  EXPECT_NEAR(frontDepth(scene), 8.0 / 19.0, 0.002);  // from the kept tree
+
+  Scene moved = scene;
+  moved.objects[0].transform = translate(0.0, 0.0, 2.0);
+  EXPECT_NEAR(frontDepth(moved), 6.0 / 19.0, 0.002);
+
+  Scene hidden = scene;
+  hidden.objects[0].visible = false;
+  addObject(hidden, makeSphere(3.0), glm::dmat4(1.0), {1.0f, 1.0f, 1.0f, 0.5f});
+  EXPECT_NEAR(frontDepth(hidden), 6.0 / 19.0, 0.002);
+  hidden.objects[0].visible = true;
+  hidden.objects[1].visible = false;
+  EXPECT_NEAR(frontDepth(hidden), 8.0 / 19.0, 0.002);
+
+  EXPECT_NEAR(frontDepth(scene), 8.0 / 19.0, 0.002);
+  for (glm::vec3& p : mesh->positions) p *= 2.0f;  // the same Mesh, edited where it lies
+  EXPECT_NEAR(frontDepth(scene), 7.0 / 19.0, 0.002);
+}
+
 TEST(OracleErrors, BadSizesAndEmptyScenesThrow) {
   const Scene scene = nestedSpheres();
   const Camera camera = frontCamera(Projection::Perspective);
