@@ -20,7 +20,10 @@ void addRender(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method and write a PNG (and stats JSON)");
   cmd->add_option("scene", opt->scene, "Scene: model file, .mfrscene, or @sample")->required();
   cmd->add_option("--method,-m", opt->method, "Construction method (see mfr info --methods)")->capture_default_str();
-  cmd->add_option("--op", opt->op, "Operation on the sorted lists: auto (the method's own: hybrid for fkb, vkb, dkb, optimal-k; else oit), oit, hybrid")->capture_default_str();
+  cmd->add_option("--op", opt->op,
+                  "Operation on the sorted lists: auto (the method's own: hybrid for fkb, vkb, dkb, optimal-k; else "
+                  "oit), oit, hybrid, csg (the scene's CSG tree, opaque; oracle and the A-buffers)")
+      ->capture_default_str();
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");

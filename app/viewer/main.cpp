@@ -50,7 +50,9 @@ CommandLine parseCommandLine(const QApplication& app) {
   parser.addVersionOption();
   parser.addPositionalArgument(QStringLiteral("scene"), QStringLiteral("Model file, .mfrscene, .mfrsession or @sample (default)"));
   const QCommandLineOption method({QStringLiteral("m"), QStringLiteral("method")}, QStringLiteral("Render method."), QStringLiteral("name"));
-  const QCommandLineOption op(QStringLiteral("op"), QStringLiteral("Operation: auto (the method's own), oit or hybrid."), QStringLiteral("name"));
+  const QCommandLineOption op(QStringLiteral("op"),
+                              QStringLiteral("Operation: auto (the method's own), oit, hybrid or csg."),
+                              QStringLiteral("name"));
   const QCommandLineOption param({QStringLiteral("p"), QStringLiteral("param")}, QStringLiteral("Method parameter (repeatable)."), QStringLiteral("name=value"));
   const QCommandLineOption view(QStringLiteral("view"), QStringLiteral("Named view of the scene, or 'fit'."), QStringLiteral("name"));
   const QCommandLineOption size({QStringLiteral("s"), QStringLiteral("size")}, QStringLiteral("Image size for --screenshot (default 800x600)."), QStringLiteral("WxH"));

@@ -44,6 +44,7 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
   operationCombo_->addItem(tr("auto — the method's own (hybrid for the budget methods)"), QStringLiteral("auto"));
   operationCombo_->addItem(tr("oit — composite \"over\""), QStringLiteral("oit"));
   operationCombo_->addItem(tr("hybrid — exact core + averaged tail"), QStringLiteral("hybrid"));
+  operationCombo_->addItem(tr("csg — the scene's CSG tree as opaque solids"), QStringLiteral("csg"));
   top->addRow(tr("Method"), methodCombo_);
   top->addRow(tr("Operation"), operationCombo_);
   layout->addLayout(top);

@@ -385,10 +385,12 @@ ImageKey ViewerModel::frameKey(int side) const {
   return imageKey(renderRequest(side, paneSize()));
 }
 
-mfr::RenderRequest ViewerModel::referenceRequest() const {
+mfr::RenderRequest ViewerModel::referenceRequest(int side) const {
   mfr::RenderRequest request;
   request.method = "oracle";
-  request.operation = "oit";  // exact "over" of every fragment, whatever the panes' operation
+  // Exact "over" of every fragment, whatever the pane's transparency operation; the exact CSG
+  // image for a pane showing CSG.
+  request.operation = operationOf(side) == QLatin1String("csg") ? "csg" : "oit";
   request.width = paneSize().width();
   request.height = paneSize().height();
   return request;
@@ -513,7 +515,7 @@ void ViewerModel::updateMetrics() {
     if (!metricsWanted(side) || metricsCurrent(side) || metricsRunning_[index(side)]) continue;
     const auto& frame = frameImage_[index(side)];
     if (!frame || frame->first != frameKey(side)) continue;  // the view reads it back when it draws
-    const CpuImage* reference = cpuImage(CpuSlot::Reference, referenceRequest());
+    const CpuImage* reference = cpuImage(CpuSlot::Reference, referenceRequest(side));
     if (!reference) return;  // cpuImageReady calls again
     if (!reference->error.isEmpty()) {
       PaneMetrics failed;

@@ -172,9 +172,10 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] const QString& renderError() const { return renderError_; }
   [[nodiscard]] quint64 framesRendered() const { return framesRendered_; }
 
-  // What the pane of `side` shows now, and the exact reference image of the panes' size.
+  // What the pane of `side` shows now, and its exact reference image (the oracle's "over", or its
+  // CSG for a pane showing CSG).
   [[nodiscard]] ImageKey frameKey(int side) const;
-  [[nodiscard]] mfr::RenderRequest referenceRequest() const;
+  [[nodiscard]] mfr::RenderRequest referenceRequest(int side) const;
   // Metrics are computed for both panes in compare mode, and for side 0 when a frame quality was
   // requested. The view reads a frame back only when wantsFrameImage says so.
   [[nodiscard]] bool wantsFrameImage(int side) const;

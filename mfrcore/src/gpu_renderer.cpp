@@ -34,6 +34,8 @@ void GpuRenderer::setScene(const Scene& scene) {
   scene.validate();
   scene_ = std::make_shared<const gl::GpuScene>(scene);
   background_ = scene.background;
+  csg_ = scene.csg;
+  sceneName_ = scene.name;
   gl::checkErrors("scene upload");
 }
 
@@ -41,13 +43,16 @@ void GpuRenderer::shareScene(const GpuRenderer& other) {
   if (!other.scene_) throw Error("render", "no scene loaded");
   scene_ = other.scene_;
   background_ = other.background_;
+  csg_ = other.csg_;
+  sceneName_ = other.sceneName_;
 }
 
 Method& GpuRenderer::prepare(const RenderRequest& request) {
   validateImageSize("--size", request.width, request.height);
   if (!scene_) throw Error("render", "no scene loaded");
-  if (request.operation != "oit" && request.operation != "hybrid" && request.operation != "auto")
-    throw Error("--op " + request.operation, "unknown operation (available: auto, oit, hybrid)");
+  if (request.operation != "oit" && request.operation != "hybrid" && request.operation != "csg" &&
+      request.operation != "auto")
+    throw Error("--op " + request.operation, "unknown operation (available: auto, oit, hybrid, csg)");
   if (!method_ || methodName_ != request.method) {
     method_ = createMethod(request.method);
     methodName_ = request.method;
@@ -63,6 +68,17 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
                   "method " + request.method + " keeps no tail (use a k-buffer method with --param tail=true)");
     if (!kb->tailEnabled()) throw Error("--op hybrid", "needs --param tail=true with method " + request.method);
   }
+  if (operation_ == "csg") {
+    if (csg_.empty())
+      throw Error("--op csg", "scene '" + sceneName_ + "' has no CSG tree (a \"csg\" key in an .mfrscene file)");
+    if (!method_->info().objectPayload) {
+      std::string list;
+      for (const RegistryEntry& e : methodRegistry())
+        if (const MethodInfo* info = findMethodInfo(e.name); info && info->objectPayload)
+          list += (list.empty() ? "" : ", ") + e.name;
+      throw Error("--op csg", "method " + request.method + " cannot store object ids (use " + list + ")");
+    }
+  }
   gl::checkErrors(("configure " + request.method).c_str());
   return *method_;
 }
@@ -72,6 +88,7 @@ FrameContext GpuRenderer::frameContext(const Camera& camera, int width, int heig
   const double aspect = static_cast<double>(width) / height;
   frame.viewProj = glm::mat4(camera.projectionMatrix(aspect) * camera.viewMatrix());
   frame.viewDir = glm::vec3(camera.forward());
+  frame.payload = operation_ == "csg" ? MFR_PAYLOAD_OBJECT : MFR_PAYLOAD_COLOR;
   return FrameContext{*scene_, frame, background_, width, height, timer};
 }
 
@@ -85,14 +102,58 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   gl::checkErrors(("capture " + request.method).c_str());
   glBindFramebuffer(GL_FRAMEBUFFER, target);
   glViewport(0, 0, request.width, request.height);
-  method.resolve(ctx, operation_ == "hybrid" ? hybridOperation() : oitOperation());
+  if (operation_ == "csg")
+    renderCsg(ctx, method);
+  else
+    method.resolve(ctx, operation_ == "hybrid" ? hybridOperation() : oitOperation());
   gl::checkErrors(("resolve " + request.method).c_str());
   Stats stats = method.stats();
+  if (operation_ == "csg") {
+    // The operation's own buffer: each pixel's visible (object + 1, depth), 8 bytes.
+    const std::uint64_t csgBytes = 8ull * static_cast<std::uint64_t>(request.width) * request.height;
+    stats.bytesAllocated += csgBytes;
+    stats.bytesUsed += csgBytes;
+    stats.passes += 1;  // the shading pass
+    stats.notes.emplace_back("csg buffer (bytes)", std::to_string(csgBytes));
+  }
   lastWidth_ = request.width;
   lastHeight_ = request.height;
   stats.operation = operation_;
   stats.passTimesMs = timer.collect();
   return stats;
+}
+
+// Image-space CSG: the method's resolve runs ops/csg.glsl, which records each pixel's visible
+// surface (object + 1, depth bits) and writes the background; then the scene is drawn once more
+// and only the recorded fragment of each pixel writes its shaded colour (ops/csg_shade.geom.frag).
+void GpuRenderer::renderCsg(const FrameContext& ctx, Method& method) {
+  const std::size_t pixels = static_cast<std::size_t>(ctx.width) * ctx.height;
+  if (csgPixels_ != pixels) {
+    csgVisible_ = gl::createBuffer(pixels * 8);
+    csgPixels_ = pixels;
+  }
+  const std::vector<std::uint32_t> program = csg_.program();
+  const std::vector<std::uint32_t> primitives = csg_.primitives();
+  const Operation csg{"csg", "ops/csg.glsl", [&](const gl::Program& p) {
+                        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_CSG, csgVisible_.id());
+                        p.set("uCsgWidth", ctx.width);
+                        p.set("uCsgProgramLength", static_cast<unsigned>(program.size()));
+                        p.set("uCsgPrimitiveCount", static_cast<unsigned>(primitives.size()));
+                        p.set("uCsgProgram", std::span<const std::uint32_t>(program));
+                        p.set("uCsgPrimitives", std::span<const std::uint32_t>(primitives));
+                      }};
+  method.resolve(ctx, csg);
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  if (!csgShade_.id())
+    csgShade_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "ops/csg_shade.geom.frag"}});
+  GeometryPassState state(true, false);  // colour writes on, no depth test: one fragment per pixel passes
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_CSG, csgVisible_.id());
+  csgShade_.set("uCsgWidth", ctx.width);
+  gl::FrameUniforms frame = ctx.frame;
+  frame.payload = MFR_PAYLOAD_COLOR;
+  ctx.timer.begin("csg shade");
+  ctx.scene.draw(csgShade_, frame);
+  ctx.timer.end();
 }
 
 void GpuRenderer::ensureFramebuffer(int width, int height) {

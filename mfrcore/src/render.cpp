@@ -65,8 +65,8 @@ namespace {
 // optimal-k: the oracle's exact lists, the F(M) of the variable-k layout at this size, the best
 // allocation of optimalKBest, composited by the CPU hybrid operation.
 RenderOutput renderOptimalK(const Scene& scene, const Camera& camera, const RenderRequest& request) {
-  if (request.operation == "oit")
-    throw Error("--op oit", "optimal-k is a hybrid-transparency reference: use --op hybrid (or auto)");
+  if (request.operation == "oit" || request.operation == "csg")
+    throw Error("--op " + request.operation, "optimal-k is a hybrid-transparency reference: use --op hybrid (or auto)");
   const Params params(optimalKInfo().params, request.params, "optimal-k");
   const auto budgetBytes = static_cast<std::uint64_t>(std::floor(params.real("budget_mib") * 1024.0 * 1024.0));
   const std::uint64_t pixels = static_cast<std::uint64_t>(request.width) * static_cast<std::uint64_t>(request.height);
@@ -131,8 +131,9 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     for (const auto& m : methods) list += (list.empty() ? "" : ", ") + m;
     throw Error("--method " + request.method, "unknown method (available: " + list + ")");
   }
-  if (request.operation != "oit" && request.operation != "hybrid" && request.operation != "auto")
-    throw Error("--op " + request.operation, "unknown operation (available: auto, oit, hybrid)");
+  if (request.operation != "oit" && request.operation != "hybrid" && request.operation != "csg" &&
+      request.operation != "auto")
+    throw Error("--op " + request.operation, "unknown operation (available: auto, oit, hybrid, csg)");
   if (request.method == "optimal-k") return renderOptimalK(scene, camera, request);
   if (request.method != "oracle") {
     GpuRenderer& gpu = headlessRenderer();
@@ -154,6 +155,10 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
       throw Error("--param k=" + k->second, "not a non-negative integer");
     }
     out.image = compositeHybrid(lists, static_cast<std::uint32_t>(value), scene.background);
+  } else if (request.operation == "csg") {
+    if (scene.csg.empty())
+      throw Error("--op csg", "scene '" + scene.name + "' has no CSG tree (a \"csg\" key in an .mfrscene file)");
+    out.image = compositeCsg(lists, scene.csg, scene.background);
   } else {
     out.image = compositeOver(lists, scene.background);
   }

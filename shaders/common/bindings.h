@@ -26,6 +26,7 @@
 #define MFR_SSBO_LOCKS 8      // per-pixel spin-lock words kept in a buffer (variable-k buffers)
 #define MFR_SSBO_ARENA 9      // per-pixel arena of the variable-k buffers (features, k(p), …)
 #define MFR_SSBO_BUDGET 10    // per-frame budget state: image sums, allocation search, F(M)
+#define MFR_SSBO_CSG 11       // operation "csg": per-pixel visible surface (object id, depth)
 
 // Image units
 #define MFR_IMAGE_HEADS 0
@@ -53,5 +54,18 @@
 // Local array size used by the resolve pass to gather one pixel's fragments before sorting;
 // longer lists are sorted in l+-depth-sorting rounds (k+-buffer paper, §4.4).
 #define MFR_RESOLVE_LOCAL 64
+
+// Image-space CSG (operation "csg"): the tree is a postfix program over a bit stack; a word holds
+// the opcode in its low byte and, for a primitive, the primitive's bit (0..31) in the next byte.
+#define MFR_CSG_PRIMITIVE 0u
+#define MFR_CSG_UNION 1u
+#define MFR_CSG_INTERSECTION 2u
+#define MFR_CSG_DIFFERENCE 3u
+#define MFR_CSG_MAX_PRIMITIVES 32  // inside states fit one uint
+#define MFR_CSG_MAX_PROGRAM 64     // postfix words; the stack depth is at most 32 as well
+// Capture payload "object": the colour word of a stored fragment holds objectId·2 + frontFacing
+// (the CSG operation's classification needs them, not the colour; 8 bytes per fragment still).
+#define MFR_PAYLOAD_COLOR 0
+#define MFR_PAYLOAD_OBJECT 1
 
 #endif

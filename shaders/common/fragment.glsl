@@ -9,7 +9,14 @@ in vec3 vNormal;
 in vec4 vColor;
 uniform vec3 uViewDir;
 uniform uint uObjectId;
+// MFR_PAYLOAD_COLOR: the shaded colour; MFR_PAYLOAD_OBJECT: objectId·2 + frontFacing in the colour
+// word (operations that classify fragments by object, such as "csg", need that, not the colour).
+uniform int uPayload;
 
 vec4 mfrShadedColor() { return mfrShade(vColor, vNormal, uViewDir); }
 
-MfrFragment mfrCurrentFragment() { return MfrFragment(packUnorm4x8(mfrShadedColor()), gl_FragCoord.z); }
+MfrFragment mfrCurrentFragment() {
+  uint word = uPayload == MFR_PAYLOAD_OBJECT ? uObjectId * 2u + (gl_FrontFacing ? 1u : 0u)
+                                             : packUnorm4x8(mfrShadedColor());
+  return MfrFragment(word, gl_FragCoord.z);
+}

@@ -396,6 +396,33 @@ class ViewerTest : public QObject {
           static_cast<long long>(cases.size()));
   }
 
+  // Operation "csg" on the built-in CSG sample: the viewer's screenshot equals mfr render's, and
+  // the frame's quality is measured against the oracle's CSG image (against its "over" image the
+  // opaque drilled block would be far off).
+  void csgOperation() {
+    QTemporaryDir dir;
+    const QString viewerPng = dir.filePath("viewer.png"), cliPng = dir.filePath("cli.png");
+    const QStringList common{"--size", "200x150", "--method", "abuffer-sbuffer", "--op", "csg", "--view", "iso"};
+    QString out;
+    QCOMPARE(runProgram(MFRVIEW, QStringList{"@csg", "--screenshot", viewerPng} + common, &out), 0);
+    QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@csg", "-o", cliPng} + common, &out), 0);
+    const int diff = maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString()));
+    QVERIFY2(diff >= 0 && diff <= 1, qPrintable(QString::number(diff)));
+
+    auto w = openWindow(QStringLiteral("@csg"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    m.setMethod("abuffer-sbuffer");
+    m.setOperation(QStringLiteral("csg"));
+    m.setCamera(m.scene().view("iso"));
+    settle(m);
+    QCOMPARE(QString::fromStdString(m.stats().operation), QStringLiteral("csg"));
+    m.requestFrameQuality();
+    QTRY_VERIFY_WITH_TIMEOUT(m.frameQuality().valid, kTimeoutMs);
+    qInfo("@csg abuffer-sbuffer csg: RMSE %.6f against the oracle's CSG", m.frameQuality().rmse);
+    QVERIFY(m.frameQuality().rmse < 0.02);
+  }
+
   // The live widget's framebuffer (GpuRenderer::renderTo into QOpenGLWidget's FBO) against the
   // CLI at the widget's size.
   void widgetEqualsCli() {

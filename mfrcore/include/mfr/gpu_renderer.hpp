@@ -78,6 +78,14 @@ class GpuRenderer {
   int fboWidth_ = 0, fboHeight_ = 0;
   gl::Buffer counts_;  // depthComplexity's per-pixel counters
   std::size_t countPixels_ = 0;
+  // Operation "csg": the scene's tree, the per-pixel visible (object + 1, depth) of the resolve,
+  // and the shading pass that draws it.
+  void renderCsg(const FrameContext& ctx, Method& method);
+  CsgTree csg_;
+  std::string sceneName_;
+  gl::Buffer csgVisible_;
+  std::size_t csgPixels_ = 0;
+  gl::Program csgShade_;
   bool finishTiming_ = false;
 };
 

@@ -53,6 +53,7 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
   program.use();
   program.set("uViewProj", frame.viewProj);
   program.set("uViewDir", frame.viewDir);
+  program.set("uPayload", frame.payload);
   for (const DrawItem& item : items_) {
     const GpuMesh& m = meshes_[item.mesh];
     program.set("uModel", item.model);

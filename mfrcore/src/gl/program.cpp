@@ -175,6 +175,9 @@ void Program::set(const char* name, const glm::ivec2& v) const { glProgramUnifor
 void Program::set(const char* name, const glm::mat4& v) const {
   glProgramUniformMatrix4fv(id_, location(name), 1, GL_FALSE, glm::value_ptr(v));
 }
+void Program::set(const char* name, std::span<const std::uint32_t> v) const {
+  glProgramUniform1uiv(id_, location(name), static_cast<GLsizei>(v.size()), v.data());
+}
 void Program::set(const char* name, const glm::mat3& v) const {
   glProgramUniformMatrix3fv(id_, location(name), 1, GL_FALSE, glm::value_ptr(v));
 }

@@ -25,6 +25,7 @@ namespace {
 Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadProgress& progress) {
   const std::string text = path.string();
   if (text == "@sample") return makeSampleScene();
+  if (text == "@csg") return makeCsgSampleScene();
   if (text.rfind("@quads:", 0) == 0) {
     // @quads:N[:density[:seed]]
     int layers = 0;
@@ -35,7 +36,8 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadPro
     if (got < 1 || got > 3) throw Error(text, "expected @quads:N[:density[:seed]]");
     return makeQuadsScene(layers, density, seed);
   }
-  if (!text.empty() && text[0] == '@') throw Error(text, "unknown built-in scene (@sample, @quads:N[:density[:seed]])");
+  if (!text.empty() && text[0] == '@')
+    throw Error(text, "unknown built-in scene (@sample, @csg, @quads:N[:density[:seed]])");
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   Scene scene;

@@ -31,7 +31,9 @@ const MethodInfo& ABufferFixedArray::info() const {
       true,
       {{"slots", "Fragments per pixel", ParamSpec::Type::Int, "32", 0, kMaxSlots, {},
         "array capacity per pixel; fragments beyond it are dropped and counted. 0: size from a count pass to the "
-        "largest per-pixel count"}}};
+        "largest per-pixel count"}},
+      "oit",
+      true};
   return i;
 }
 

@@ -19,7 +19,9 @@ const MethodInfo& ABufferLinkedList::info() const {
       true,
       {{"pool", "Pool sizing", ParamSpec::Type::Choice, "count", 0, 0, {"count", "previous", "fixed"},
         "count: exact count pass first; previous: last frame's count + 10 %; fixed: pool_mib"},
-       {"pool_mib", "Fixed pool (MiB)", ParamSpec::Type::Float, "64", 0, 65536, {}, "node pool size when pool=fixed", true}}};
+       {"pool_mib", "Fixed pool (MiB)", ParamSpec::Type::Float, "64", 0, 65536, {}, "node pool size when pool=fixed", true}},
+      "oit",
+      true};
   return i;
 }
 

@@ -24,7 +24,9 @@ const MethodInfo& ABufferSBuffer::info() const {
         "count: this frame's scanned total (one 4-byte read-back between the scan and the store pass); previous: "
         "last frame's total + 10 % (no read-back before storing; overflow is counted); fixed: pool_mib"},
        {"pool_mib", "Fixed fragment buffer (MiB)", ParamSpec::Type::Float, "64", 0, 65536, {},
-        "fragment buffer size when pool=fixed", true}}};
+        "fragment buffer size when pool=fixed", true}},
+      "oit",
+      true};
   return i;
 }
 

@@ -1,11 +1,14 @@
-// Exact operations on the oracle's sorted lists: front-to-back "over" compositing and depth
-// complexity (the per-pixel fragment count n(p) and its histogram).
+// Exact operations on the oracle's sorted lists: front-to-back "over" compositing, image-space CSG
+// (each pixel's visible fragment, csgVisibleFragment) and depth complexity (the per-pixel fragment
+// count n(p) and its histogram).
 #include "mfr/reference/composite.hpp"
 
 #include <algorithm>
 #include <cmath>
 
 #include <glm/gtc/packing.hpp>
+
+#include "mfr/error.hpp"
 
 namespace mfr {
 
@@ -32,17 +35,38 @@ glm::vec3 compositeOver(std::span<const Fragment> sorted, const glm::vec3& backg
   return colour + transmittance * background;
 }
 
+namespace {
+
+// Display value → 8 bits, as every composite image rounds.
+std::uint8_t to8(float c) {
+  return static_cast<std::uint8_t>(std::round(std::clamp(c, 0.0f, 1.0f) * 255.0f));
+}
+
+void store(ImageRGBA8& image, int x, int y, const glm::vec3& c) {
+  std::uint8_t* p = image.at(x, y);
+  p[0] = to8(c.r);
+  p[1] = to8(c.g);
+  p[2] = to8(c.b);
+  p[3] = 255;
+}
+
+}  // namespace
+
 ImageRGBA8 compositeOver(const FragmentLists& lists, const glm::vec3& background) {
   ImageRGBA8 image(lists.width, lists.height);
-  const auto to8 = [](float c) { return static_cast<std::uint8_t>(std::round(std::clamp(c, 0.0f, 1.0f) * 255.0f)); };
+  for (int y = 0; y < lists.height; ++y)
+    for (int x = 0; x < lists.width; ++x) store(image, x, y, compositeOver(lists.pixel(x, y), background));
+  return image;
+}
+
+ImageRGBA8 compositeCsg(const FragmentLists& lists, const CsgTree& tree, const glm::vec3& background) {
+  if (tree.empty()) throw Error("operation csg", "the scene has no CSG tree");
+  ImageRGBA8 image(lists.width, lists.height);
   for (int y = 0; y < lists.height; ++y)
     for (int x = 0; x < lists.width; ++x) {
-      const glm::vec3 c = compositeOver(lists.pixel(x, y), background);
-      std::uint8_t* p = image.at(x, y);
-      p[0] = to8(c.r);
-      p[1] = to8(c.g);
-      p[2] = to8(c.b);
-      p[3] = 255;
+      const std::span<const Fragment> sorted = lists.pixel(x, y);
+      const std::optional<std::size_t> visible = csgVisibleFragment(tree, sorted);
+      store(image, x, y, visible ? glm::vec3(glm::unpackUnorm4x8(sorted[*visible].color)) : background);
     }
   return image;
 }

@@ -46,6 +46,41 @@ Scene makeSampleScene() {
   return s;
 }
 
+Scene makeCsgSampleScene() {
+  Scene s;
+  s.name = "csg";
+  s.background = glm::vec3(1.0f);
+  const auto add = [&](const std::string& name, Mesh mesh, const glm::vec4& color, const glm::dmat4& xf) {
+    Object o;
+    o.name = name;
+    o.mesh = std::make_shared<const Mesh>(std::move(mesh));
+    o.material.color = color;
+    o.transform = xf;
+    s.objects.push_back(std::move(o));
+  };
+  const glm::dmat4 id(1.0);
+  add("block", makeBox({2.0, 1.4, 2.0}), {0.70f, 0.72f, 0.78f, 1.0f}, id);
+  add("ball", makeSphere(1.32, 96, 48), {0.95f, 0.70f, 0.35f, 1.0f}, id);
+  // Drills longer than the block, so no cap is coplanar with a face (coincident faces are undefined).
+  add("drill x", makeCylinder(0.38, 3.0, 64), {0.90f, 0.30f, 0.30f, 1.0f},
+      glm::rotate(id, glm::radians(90.0), glm::dvec3(0, 0, 1)));
+  add("drill z", makeCylinder(0.25, 3.0, 64), {0.30f, 0.45f, 0.90f, 1.0f},
+      glm::translate(id, glm::dvec3(0.45, 0.2, 0.0)) * glm::rotate(id, glm::radians(90.0), glm::dvec3(1, 0, 0)));
+  const auto primitive = [](std::uint32_t object) { return CsgNode{CsgNode::Op::Primitive, object, {}}; };
+  CsgNode rounded{CsgNode::Op::Intersection, 0, {primitive(0), primitive(1)}};
+  s.csg.root = CsgNode{CsgNode::Op::Difference, 0, {rounded, primitive(2), primitive(3)}};
+
+  Camera iso;
+  iso.eye = {3.1, 2.3, 3.7};
+  iso.target = {0.0, 0.0, 0.0};
+  iso.fovyDegrees = 35.0;
+  s.views.push_back({"iso", s.fit(iso)});
+  Camera front = iso;
+  front.eye = {0.3, 0.25, 4.0};
+  s.views.push_back({"front", s.fit(front)});
+  return s;
+}
+
 Scene makeQuadsScene(int layers, double density, std::uint32_t seed) {
   if (layers < 1 || layers > 4096) throw Error("@quads", "layer count must be in [1, 4096]");
   if (!(density > 0.0) || density > 1.0) throw Error("@quads", "pixel density must be in (0, 1]");

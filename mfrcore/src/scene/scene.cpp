@@ -50,6 +50,7 @@ std::size_t Scene::triangleCount() const {
 
 void Scene::validate() const {
   if (triangleCount() == 0) throw Error("scene '" + name + "'", "nothing to render (no visible triangles)");
+  validateCsg(*this);
 }
 
 std::vector<std::string> Scene::viewNames() const {

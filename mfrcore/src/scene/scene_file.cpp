@@ -9,6 +9,7 @@
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
+#include "mfr/scene/csg.hpp"
 #include "mfr/scene/primitives.hpp"
 #include "mfr/scene/sample.hpp"
 
@@ -187,6 +188,41 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
   return c;
 }
 
+// A CSG node: an object's name, or {"union" | "intersection" | "difference": [≥ 2 nodes]}.
+CsgNode parseCsgNode(const Reader& r, const json& j, const std::string& where, const Scene& scene) {
+  CsgNode node;
+  if (j.is_string()) {
+    const std::string name = j.get<std::string>();
+    std::size_t matches = 0;
+    for (std::size_t i = 0; i < scene.objects.size(); ++i)
+      if (scene.objects[i].name == name) {
+        node.object = static_cast<std::uint32_t>(i);
+        ++matches;
+      }
+    if (matches == 0) r.fail(where, "no object named '" + name + "'");
+    if (matches > 1) r.fail(where, std::to_string(matches) + " objects are named '" + name + "' (must be unique)");
+    return node;
+  }
+  static const char* const kExpected =
+      "expected an object's name or an object with one key: union, intersection or difference";
+  if (!j.is_object() || j.size() != 1) r.fail(where, kExpected);
+  const std::string key = j.begin().key();
+  if (key == "union")
+    node.op = CsgNode::Op::Union;
+  else if (key == "intersection")
+    node.op = CsgNode::Op::Intersection;
+  else if (key == "difference")
+    node.op = CsgNode::Op::Difference;
+  else
+    r.fail(where + "." + key, std::string("unknown CSG operator (") + kExpected + ")");
+  const json& operands = j.begin().value();
+  if (!operands.is_array() || operands.size() < 2)
+    r.fail(where + "." + key, "expected an array of at least 2 operands");
+  for (std::size_t i = 0; i < operands.size(); ++i)
+    node.children.push_back(parseCsgNode(r, operands[i], where + "." + key + "[" + std::to_string(i) + "]", scene));
+  return node;
+}
+
 }  // namespace
 
 Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseDir, const std::string& name,
@@ -254,6 +290,14 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
         }
       }
       objectProgress.step(1.0);
+    }
+  }
+  if (doc.contains("csg")) {
+    scene.csg.root = parseCsgNode(r, doc["csg"], "csg", scene);
+    try {
+      validateCsg(scene);  // closed meshes, limits
+    } catch (const Error& e) {
+      r.fail("csg", e.what());
     }
   }
   const Bounds bounds = scene.bounds();

@@ -4,6 +4,7 @@
 // Sources may use #include "path" (relative to shaders/) and receive injected #defines.
 // Compile errors are reported as "shaders/<file>:<line>: <message>".
 #include <map>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -57,6 +58,8 @@ class Program {
   void set(const char* name, const glm::ivec2& v) const;
   void set(const char* name, const glm::mat4& v) const;
   void set(const char* name, const glm::mat3& v) const;
+  // A uint array uniform from its first element on.
+  void set(const char* name, std::span<const std::uint32_t> v) const;
 
  private:
   GLint location(const char* name) const;

@@ -57,6 +57,9 @@ struct MethodInfo {
   bool exact = true;  // captures every fragment (given enough memory/passes)
   std::vector<ParamSpec> params;
   std::string preferredOperation = "oit";  // what --op auto runs ("hybrid" for the budget methods)
+  // Its capture stores every fragment through mfrCurrentFragment() and leaves colours alone until
+  // the resolve, so it can carry object ids instead (MFR_PAYLOAD_OBJECT): the operation "csg".
+  bool objectPayload = false;
 };
 
 // What the resolve pass does with each pixel's sorted list.

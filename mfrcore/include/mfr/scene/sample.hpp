@@ -13,6 +13,11 @@ Scene makeSampleScene();
 // `layers` view-aligned quads at random depths, all covering the same centred rectangle whose
 // area is `density` (pixel density p_d, in (0,1]) of the image, so every covered pixel has
 // exactly n = layers fragments. Orthographic view "front" looking down −Z.
+// The built-in CSG sample ("@csg"): a block rounded by a sphere and drilled through twice,
+// (block ∩ ball) − drill x − drill z, as a CSG tree over four closed solids; the bores show the
+// drills' colours (the cut faces are theirs). Views "iso" and "front".
+Scene makeCsgSampleScene();
+
 Scene makeQuadsScene(int layers, double density = 1.0, std::uint32_t seed = 1);
 
 }  // namespace mfr

@@ -9,6 +9,7 @@
 #include <glm/glm.hpp>
 
 #include "mfr/scene/camera.hpp"
+#include "mfr/scene/csg.hpp"
 #include "mfr/scene/mesh.hpp"
 
 namespace mfr {
@@ -39,6 +40,7 @@ struct Scene {
   std::vector<Object> objects;
   std::vector<NamedView> views;  // the scene's own views; "fit" is always available besides
   glm::vec3 background{1.0f, 1.0f, 1.0f};
+  CsgTree csg;  // image-space CSG over some objects (operation "csg"); empty: none
 
   [[nodiscard]] Bounds bounds() const;  // world bounds of visible objects
   // Radius of the smallest sphere around bounds().center() holding every visible vertex.
