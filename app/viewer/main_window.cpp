@@ -309,14 +309,22 @@ void MainWindow::buildDocks() {
 }
 
 void MainWindow::buildPluginDocks() {
+  // Plugin panels share one tabbed dock under the statistics, the first plugin's tab in front, so
+  // each new plugin does not take height from the others (or width from the image).
+  QDockWidget* first = nullptr;
   for (const PluginRecord& r : plugins_.records()) {
     if (!r.plugin) continue;
     auto* d = new QDockWidget(r.name, this);
     d->setObjectName(QStringLiteral("plugin-") + r.id);
     d->setWidget(r.plugin->createPanel(*model_, d));
     addDockWidget(Qt::RightDockWidgetArea, d);
+    if (first)
+      tabifyDockWidget(first, d);
+    else
+      first = d;
     panelsMenu_->addAction(d->toggleViewAction());
   }
+  if (first) first->raise();
 }
 
 void MainWindow::buildStatusBar() {

@@ -14,6 +14,7 @@
 #include "mfr/methods/registry.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/oracle.hpp"
+#include "mfr/scene/scene_file.hpp"
 
 namespace {
 
@@ -288,6 +289,29 @@ void ViewerModel::updateSceneGeometry() {
 void ViewerModel::sceneEdited() {
   ++sceneRevision_;
   emit sceneChanged();
+}
+
+QStringList ViewerModel::objectNames() const {
+  QStringList names;
+  for (const mfr::Object& o : scene_.objects) names << QString::fromStdString(o.name);
+  return names;
+}
+
+QString ViewerModel::csgTree() const {
+  return QString::fromStdString(mfr::csgText(scene_.csg, scene_));
+}
+
+QString ViewerModel::setCsgTree(const QString& json) {
+  if (!hasScene_) return tr("no scene loaded");
+  try {
+    mfr::CsgTree tree = mfr::parseCsgText(json.toStdString(), scene_);
+    if (mfr::csgText(tree, scene_) == mfr::csgText(scene_.csg, scene_)) return {};
+    scene_.csg = std::move(tree);
+  } catch (const std::exception& e) {
+    return QString::fromUtf8(e.what());
+  }
+  sceneEdited();
+  return {};
 }
 
 void ViewerModel::setObjectVisible(int index, bool visible) {

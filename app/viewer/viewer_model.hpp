@@ -110,8 +110,11 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] const mfr::Stats& statsOf(int side) const { return stats_[index(side)]; }
 
   // Side-0 shorthands.
-  [[nodiscard]] QString operation() const { return operationOf(0); }
-  void setOperation(const QString& operation) { setOperationOf(0, operation); }
+  [[nodiscard]] QString operation() const override { return operationOf(0); }
+  void setOperation(const QString& operation) override { setOperationOf(0, operation); }
+  [[nodiscard]] QStringList objectNames() const override;
+  [[nodiscard]] QString csgTree() const override;
+  QString setCsgTree(const QString& json) override;
   [[nodiscard]] const ParamsByMethod& allParams() const { return allParamsOf(0); }
   void setAllParams(ParamsByMethod params) { setAllParamsOf(0, std::move(params)); }
   [[nodiscard]] mfr::RenderRequest renderRequest(QSize size) const { return renderRequest(0, size); }
@@ -205,7 +208,6 @@ class ViewerModel final : public ViewerContext {
   void sceneLoaded();  // followed by sceneChanged
   void loadFailed(const QString& path, const QString& message);
   void loadCancelled();
-  void operationChanged(const QString& operation);  // side 0
   void sideChanged(int side);                       // method, operation or parameters of a side
   void compareChanged();                            // enabled, layout, split or display
   void secondaryFrameRendered();                    // statsOf(1) describes the new frame

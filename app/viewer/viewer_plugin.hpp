@@ -79,6 +79,17 @@ class ViewerContext : public QObject {
   [[nodiscard]] virtual DataView dataView() const = 0;
   [[nodiscard]] virtual bool dataViewOverImage() const = 0;
   virtual void setDataView(DataView view, bool overImage) = 0;
+  // Operation of the main view: "auto", "oit", "hybrid" or "csg".
+  [[nodiscard]] virtual QString operation() const = 0;
+  virtual void setOperation(const QString& operation) = 0;
+  // The scene's object names, in object-id order.
+  [[nodiscard]] virtual QStringList objectNames() const = 0;
+  // The scene's CSG tree as the JSON text of a scene file's "csg" value (docs/scene-format.md);
+  // empty when there is none.
+  [[nodiscard]] virtual QString csgTree() const = 0;
+  // Replaces the tree (blank text removes it) and re-renders; returns an empty string, or the
+  // one-line reason the text was refused (the tree is then unchanged).
+  virtual QString setCsgTree(const QString& json) = 0;
 
  signals:
   void sceneChanged();  // a new scene, or an object edited
@@ -90,6 +101,7 @@ class ViewerContext : public QObject {
   void depthComplexityReady(const QVector<quint64>& histogram, QSize size);
   void frameQualityReady();
   void dataViewChanged();
+  void operationChanged(const QString& operation);
 };
 
 class MfrViewerPlugin {
@@ -106,5 +118,6 @@ class MfrViewerPlugin {
 };
 
 // 1.1: frame quality and data views in ViewerContext (plugins built for 1.0 are refused).
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.1"
+// 1.2: operation, object names and the CSG tree.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.2"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -225,6 +225,37 @@ CsgNode parseCsgNode(const Reader& r, const json& j, const std::string& where, c
 
 }  // namespace
 
+namespace {
+json csgJson(const CsgNode& node, const Scene& scene) {
+  if (node.op == CsgNode::Op::Primitive) return scene.objects.at(node.object).name;
+  json operands = json::array();
+  for (const CsgNode& child : node.children) operands.push_back(csgJson(child, scene));
+  const char* key = node.op == CsgNode::Op::Union          ? "union"
+                    : node.op == CsgNode::Op::Intersection ? "intersection"
+                                                           : "difference";
+  return json{{key, operands}};
+}
+}  // namespace
+
+CsgTree parseCsgText(const std::string& text, const Scene& scene) {
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos) return {};
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw Error("CSG tree", std::string("not JSON: ") + e.what());
+  }
+  const Reader r("CSG tree");
+  Scene checked = scene;
+  checked.csg.root = parseCsgNode(r, j, "csg", scene);
+  validateCsg(checked);
+  return checked.csg;
+}
+
+std::string csgText(const CsgTree& tree, const Scene& scene) {
+  return tree.empty() ? std::string() : csgJson(*tree.root, scene).dump();
+}
+
 Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseDir, const std::string& name,
                      const LoadProgress& progress) {
   json doc;
