@@ -470,6 +470,22 @@ class ViewerTest : public QObject {
     QVERIFY(mfr::rmse(oracleCsg(), block) < 0.02);
     QVERIFY(mfr::rmse(drilled, block) > 0.02);  // the ball no longer rounds the corners
 
+    // Sessions keep the edited tree and the operation.
+    QTemporaryDir dir;
+    const QString sessionPath = dir.filePath("csg.mfrsession");
+    w->saveSession(sessionPath);
+    {
+      auto again = openWindow(QString());
+      QVERIFY(again);
+      again->openSession(sessionPath);
+      ViewerModel& a = again->model();
+      QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.framesRendered() > 0, kTimeoutMs);
+      QTRY_COMPARE_WITH_TIMEOUT(QString::fromStdString(mfr::csgText(a.scene().csg, a.scene())),
+                                QStringLiteral("{\"difference\":[\"block\",\"drill x\"]}"), kTimeoutMs);
+      QCOMPARE(a.operation(), QStringLiteral("csg"));
+      QVERIFY(again->findChild<QCheckBox*>("csgShow")->isChecked());
+    }
+
     text->setPlainText(QStringLiteral("{\"union\": [\"block\"]}"));
     w->findChild<QPushButton*>("csgApply")->click();
     QVERIFY2(error->text().contains("at least 2"), qPrintable(error->text()));

@@ -716,6 +716,34 @@ TEST(CsgAgainstCgal, NestedTreeAndAnOrdinarySurface) {
   compareBothViews(scene, reference, 1450);
 }
 
+// The viewer's text form of a tree (parseCsgText / csgText): names in, names out, blank is no
+// tree, and what the scene file refuses is refused here too, with the JSON path.
+TEST(CsgText, RoundTripAndErrors) {
+  Scene scene;
+  scene.name = "text";
+  addObject(scene, "block", makeBox(glm::dvec3(2.0, 1.0, 1.0)), glm::dmat4(1.0));
+  addObject(scene, "drill \"x\"", makeCylinder(0.2, 3.0, 16), glm::dmat4(1.0));
+  addObject(scene, "sheet", makePlane(1.0, 1.0), glm::dmat4(1.0));
+  const std::string text = R"({"difference":["block",{"union":["drill \"x\"","block"]}]})";
+  const CsgTree t = parseCsgText(text, scene);
+  EXPECT_EQ(t.primitives(), (std::vector<std::uint32_t>{0, 1}));
+  EXPECT_EQ(csgText(t, scene), text);
+  EXPECT_TRUE(parseCsgText(" \n\t", scene).empty());
+  EXPECT_EQ(csgText(CsgTree{}, scene), "");
+  const auto refused = [&](const std::string& bad, const std::string& mention) {
+    try {
+      (void)parseCsgText(bad, scene);
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(mention), std::string::npos) << e.what();
+    }
+  };
+  refused(R"({"union": ["block"]})", "csg.union");
+  refused(R"({"union": ["block", "nope"]})", "no object named 'nope'");
+  refused(R"({"union": ["block", )", "not JSON");
+  refused(R"({"difference": ["block", "sheet"]})", "not a closed surface");
+}
+
 TEST(CsgAgainstCgal, ThreeOperandDifference) {
   // block − drill x − drill y, a left-deep chain, against two CGAL differences.
   Scene scene;
