@@ -64,12 +64,14 @@ void addBench(CLI::App& app) {
     const Camera camera = scene.view(opt->view);
 
     ImageRGBA8 reference;
+    ImageRGBA8 csgReference;  // the oracle's CSG image, for rows with op=csg
     double oracleMs = 0.0;
     std::uint64_t totalFragments = 0;
     if (!opt->noQuality) {
       const auto t0 = std::chrono::steady_clock::now();
       const FragmentLists lists = castFragments(scene, camera, w, h);
       reference = compositeOver(lists, scene.background);
+      if (!scene.csg.empty()) csgReference = compositeCsg(lists, scene.csg, scene.background);
       oracleMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       totalFragments = lists.fragments.size();
     }
@@ -148,6 +150,7 @@ void addBench(CLI::App& app) {
       const RenderOutput& last = run.last;
       std::string label = req.method;
       for (const auto& [k, v] : req.params) label += ":" + k + "=" + v;
+      if (req.operation != "auto") label += ":op=" + req.operation;
       nlohmann::ordered_json row;
       row["method"] = label;
       row["median_total_ms"] = median(totals);
@@ -166,8 +169,9 @@ void addBench(CLI::App& app) {
       row["passes"] = last.stats.passes;
       std::string rmseText = "-", flipText = "-";
       if (!opt->noQuality) {
-        const double e = rmse(reference, last.image);
-        const FlipResult f = flip(reference, last.image);
+        const ImageRGBA8& exact = req.operation == "csg" ? csgReference : reference;
+        const double e = rmse(exact, last.image);
+        const FlipResult f = flip(exact, last.image);
         row["rmse"] = e;
         row["flip_mean"] = f.stats.mean;
         std::ostringstream a, b;

@@ -8,6 +8,8 @@
 #include <fstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "mfr/image.hpp"
 #include "test_files.hpp"
 
@@ -74,6 +76,24 @@ TEST_F(CliCsg, SceneFileTreeRenders) {
     const std::uint8_t* covered = mfr::readPng(oit).at(24, 24);
     EXPECT_LT(int(covered[0]) + covered[1] + covered[2], 3 * 250);  // "over": the drill's cap
   }
+}
+
+// mfr bench with op=csg: the row is labelled with it and measured against the oracle's CSG image
+// (against its "over" image the bores would count as errors), the plain row against "over".
+TEST_F(CliCsg, BenchMeasuresCsgRowsAgainstTheOraclesCsg) {
+  const fs::path json = dir() / "bench.json";
+  const CliResult r = runCli("bench @csg --view iso --size 96x80 -r 1 -m abuffer-ll,abuffer-ll:op=csg --json " +
+                             json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["results"].size(), 2u);
+  EXPECT_EQ(j["results"][0]["method"], "abuffer-ll");
+  EXPECT_EQ(j["results"][1]["method"], "abuffer-ll:op=csg");
+  EXPECT_LT(j["results"][0]["rmse"].get<double>(), 0.01);  // opaque solids: "over" is the nearest surface
+  EXPECT_LT(j["results"][1]["rmse"].get<double>(), 0.02);  // edge pixels only
+  EXPECT_EQ(j["results"][1]["bytes_allocated"].get<std::uint64_t>(),
+            j["results"][0]["bytes_allocated"].get<std::uint64_t>() + 8u * 96u * 80u);
 }
 
 TEST_F(CliCsg, BadInputIsOneLine) {
