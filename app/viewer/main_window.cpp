@@ -94,6 +94,10 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
     addRecentFile(model_->scenePath());
     rebuildNamedViews();
     updateTitle();
+    // A scene that brings a CSG tree puts the CSG panel (plugin "csg") in front: its switch is
+    // how to see the tree as solids.
+    if (!model_->scene().csg.empty())
+      if (auto* csgDock = findChild<QDockWidget*>(QStringLiteral("plugin-csg"))) csgDock->raise();
     if (pendingSession_) {
       applySession(*pendingSession_, *model_);
       if (model_->compareEnabled()) compareDock_->show();
