@@ -71,7 +71,7 @@ void addBench(CLI::App& app) {
       const auto t0 = std::chrono::steady_clock::now();
       const FragmentLists lists = castFragments(scene, camera, w, h);
       reference = compositeOver(lists, scene.background);
-      if (!scene.csg.empty()) csgReference = compositeCsg(lists, scene.csg, scene.background);
+      if (!scene.csg.empty()) csgReference = compositeCsg(lists, scene);
       oracleMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
       totalFragments = lists.fragments.size();
     }

@@ -35,6 +35,7 @@ void GpuRenderer::setScene(const Scene& scene) {
   scene_ = std::make_shared<const gl::GpuScene>(scene);
   background_ = scene.background;
   csg_ = scene.csg;
+  csgMirrored_ = csgMirroredPrimitives(scene);
   sceneName_ = scene.name;
   gl::checkErrors("scene upload");
 }
@@ -44,6 +45,7 @@ void GpuRenderer::shareScene(const GpuRenderer& other) {
   scene_ = other.scene_;
   background_ = other.background_;
   csg_ = other.csg_;
+  csgMirrored_ = other.csgMirrored_;
   sceneName_ = other.sceneName_;
 }
 
@@ -139,6 +141,7 @@ void GpuRenderer::renderCsg(const FrameContext& ctx, Method& method) {
                         p.set("uCsgWidth", ctx.width);
                         p.set("uCsgProgramLength", static_cast<unsigned>(program.size()));
                         p.set("uCsgPrimitiveCount", static_cast<unsigned>(primitives.size()));
+                        p.set("uCsgMirrored", csgMirrored_);
                         p.set("uCsgProgram", std::span<const std::uint32_t>(program));
                         p.set("uCsgPrimitives", std::span<const std::uint32_t>(primitives));
                       }};

@@ -158,7 +158,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
   } else if (request.operation == "csg") {
     if (scene.csg.empty())
       throw Error("--op csg", "scene '" + scene.name + "' has no CSG tree (a \"csg\" key in an .mfrscene file)");
-    out.image = compositeCsg(lists, scene.csg, scene.background);
+    out.image = compositeCsg(lists, scene);
   } else {
     out.image = compositeOver(lists, scene.background);
   }

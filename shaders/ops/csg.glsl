@@ -15,6 +15,7 @@ uniform uint uCsgProgram[MFR_CSG_MAX_PROGRAM];  // postfix words (bindings.h)
 uniform uint uCsgProgramLength;
 uniform uint uCsgPrimitives[MFR_CSG_MAX_PRIMITIVES];  // object id of primitive bit i
 uniform uint uCsgPrimitiveCount;
+uniform uint uCsgMirrored;  // bit i: primitive i's transform mirrors, its facings are reversed
 
 struct OpState {
   uint mask;     // bit i: inside primitive i
@@ -65,7 +66,8 @@ void opFragment(inout OpState s, MfrFragment f, uint position) {
   bool visible = bit == 32u;
   if (!visible) {
     bool before = csgInside(s.mask);
-    s.mask = front ? (s.mask | (1u << bit)) : (s.mask & ~(1u << bit));
+    bool entering = front != (((uCsgMirrored >> bit) & 1u) != 0u);
+    s.mask = entering ? (s.mask | (1u << bit)) : (s.mask & ~(1u << bit));
     visible = !before && csgInside(s.mask);
   }
   if (visible) {

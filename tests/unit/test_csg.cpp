@@ -229,8 +229,10 @@ TEST(CsgComposite, OpaqueVisibleColourOrBackground) {
                      frag(0.2f, 1, true, 0x11223344u),  frag(0.6f, 1, false, 0x11223344u)};
   lists.offsets = {0, 4, 6};
   lists.flags = {0, 0};
-  const CsgTree aMinusB = tree(node(Op::Difference, {prim(0), prim(1)}));
-  const ImageRGBA8 image = compositeCsg(lists, aMinusB, glm::vec3(0.1f, 0.5f, 0.9f));
+  Scene scene;  // no objects: compositeCsg reads the tree and the background (and transforms)
+  scene.csg = tree(node(Op::Difference, {prim(0), prim(1)}));
+  scene.background = glm::vec3(0.1f, 0.5f, 0.9f);
+  const ImageRGBA8 image = compositeCsg(lists, scene);
   ASSERT_EQ(image.width, 2);
   ASSERT_EQ(image.height, 1);
   EXPECT_EQ(image.at(0, 0)[0], 0x33);
@@ -242,7 +244,8 @@ TEST(CsgComposite, OpaqueVisibleColourOrBackground) {
   EXPECT_EQ(image.at(1, 0)[2], 230);
   EXPECT_EQ(image.at(1, 0)[3], 255);
   // No tree: an error, not an image.
-  EXPECT_THROW(compositeCsg(lists, CsgTree{}, glm::vec3(1.0f)), Error);
+  scene.csg = CsgTree{};
+  EXPECT_THROW(compositeCsg(lists, scene), Error);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -604,7 +607,7 @@ Comparison compare(const Scene& csgScene, const Scene& reference, const Camera& 
       ++c.compared;
       const auto sorted = lists.pixel(x, y);
       const auto want = expected.pixel(x, y);
-      const std::optional<std::size_t> got = csgVisibleFragment(csgScene.csg, sorted);
+      const std::optional<std::size_t> got = csgVisibleFragment(csgScene.csg, sorted, csgMirroredPrimitives(csgScene));
       bool same = got.has_value() == !want.empty();
       if (same && got) {
         ++c.hits;
@@ -742,6 +745,24 @@ TEST(CsgText, RoundTripAndErrors) {
   refused(R"({"union": ["block", "nope"]})", "no object named 'nope'");
   refused(R"({"union": ["block", )", "not JSON");
   refused(R"({"difference": ["block", "sheet"]})", "not a closed surface");
+}
+
+// A mirrored part (negative determinant, as CAD assemblies instance left and right parts): its
+// winding and so every reported facing are reversed; the classification flips them back. The
+// drill is symmetric under x → −x about its axis, so the mirrored drill fills the same volume as
+// the plain one, whose CGAL difference is the reference.
+TEST(CsgAgainstCgal, MirroredPartStaysASolid) {
+  Scene scene;
+  scene.name = "block - mirrored drill";
+  addObject(scene, "block", makeBox(glm::dvec3(3.0, 2.0, 2.2)), rotate(10.0, {0.0, 1.0, 0.0}));
+  const glm::dmat4 drill = rotate(90.0, {0.0, 0.0, 1.0}) * translate(0.0, 0.0, 0.3);
+  addObject(scene, "drill", makeCylinder(0.55, 4.0, 32), drill * glm::scale(glm::dmat4(1.0), {-1.0, 1.0, 1.0}));
+  scene.csg = tree(node(Op::Difference, {prim(0), prim(1)}));
+  EXPECT_EQ(csgMirroredPrimitives(scene), 2u);
+  Object plain = scene.objects[1];
+  plain.transform = drill;
+  const SurfaceMesh solid = boolean(Boolean::Difference, toCgal(scene.objects[0]), toCgal(plain));
+  compareBothViews(scene, referenceScene(scene.name, solid), 1500);
 }
 
 TEST(CsgAgainstCgal, ThreeOperandDifference) {

@@ -82,6 +82,7 @@ class GpuRenderer {
   // and the shading pass that draws it.
   void renderCsg(const FrameContext& ctx, Method& method);
   CsgTree csg_;
+  std::uint32_t csgMirrored_ = 0;  // csgMirroredPrimitives of the scene
   std::string sceneName_;
   gl::Buffer csgVisible_;
   std::size_t csgPixels_ = 0;

@@ -59,13 +59,16 @@ ImageRGBA8 compositeOver(const FragmentLists& lists, const glm::vec3& background
   return image;
 }
 
-ImageRGBA8 compositeCsg(const FragmentLists& lists, const CsgTree& tree, const glm::vec3& background) {
+ImageRGBA8 compositeCsg(const FragmentLists& lists, const Scene& scene) {
+  const CsgTree& tree = scene.csg;
+  const glm::vec3& background = scene.background;
   if (tree.empty()) throw Error("operation csg", "the scene has no CSG tree");
+  const std::uint32_t mirrored = csgMirroredPrimitives(scene);
   ImageRGBA8 image(lists.width, lists.height);
   for (int y = 0; y < lists.height; ++y)
     for (int x = 0; x < lists.width; ++x) {
       const std::span<const Fragment> sorted = lists.pixel(x, y);
-      const std::optional<std::size_t> visible = csgVisibleFragment(tree, sorted);
+      const std::optional<std::size_t> visible = csgVisibleFragment(tree, sorted, mirrored);
       store(image, x, y, visible ? glm::vec3(glm::unpackUnorm4x8(sorted[*visible].color)) : background);
     }
   return image;

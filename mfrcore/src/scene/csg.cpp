@@ -212,7 +212,8 @@ bool CsgTree::inside(std::uint32_t insideMask) const {
   return evaluate(program(), insideMask, stack);
 }
 
-std::optional<std::size_t> csgVisibleFragment(const CsgTree& tree, std::span<const Fragment> sorted) {
+std::optional<std::size_t> csgVisibleFragment(const CsgTree& tree, std::span<const Fragment> sorted,
+                                              std::uint32_t mirrored) {
   if (sorted.empty()) return std::nullopt;
   const std::vector<std::uint32_t> primitives = tree.primitives();
   const std::vector<std::uint32_t> program = tree.program();
@@ -226,12 +227,23 @@ std::optional<std::size_t> csgVisibleFragment(const CsgTree& tree, std::span<con
     if (it == primitives.end()) return i;  // an ordinary opaque surface
     const auto bit = static_cast<std::uint32_t>(it - primitives.begin());
     if (bit >= 32) continue;  // beyond MFR_CSG_MAX_PRIMITIVES: validateCsg refuses such trees
-    mask = f.frontFacing ? mask | 1u << bit : mask & ~(1u << bit);
+    const bool entering = f.frontFacing != (((mirrored >> bit) & 1u) != 0);
+    mask = entering ? mask | 1u << bit : mask & ~(1u << bit);
     const bool after = evaluate(program, mask, stack);
     if (!inside && after) return i;
     inside = after;
   }
   return std::nullopt;
+}
+
+std::uint32_t csgMirroredPrimitives(const Scene& scene) {
+  std::uint32_t mask = 0;
+  const std::vector<std::uint32_t> primitives = scene.csg.primitives();
+  for (std::size_t i = 0; i < primitives.size() && i < MFR_CSG_MAX_PRIMITIVES; ++i)
+    if (primitives[i] < scene.objects.size() &&
+        glm::determinant(glm::dmat3(scene.objects[primitives[i]].transform)) < 0.0)
+      mask |= 1u << i;
+  return mask;
 }
 
 void validateCsg(const Scene& scene) {

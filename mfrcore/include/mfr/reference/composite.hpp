@@ -16,11 +16,12 @@ namespace mfr {
 glm::vec3 compositeOver(std::span<const Fragment> sorted, const glm::vec3& background);
 ImageRGBA8 compositeOver(const FragmentLists& lists, const glm::vec3& background);
 
-// Image-space CSG (scene.csg, rule of csgVisibleFragment): each pixel shows its visible
-// fragment's colour as an opaque surface (RGB of the stored colour, its opacity ignored: solids),
-// the background where there is none; rounded to 8 bits, alpha 255. Throws mfr::Error when
-// the scene has no CSG tree.
-ImageRGBA8 compositeCsg(const FragmentLists& lists, const CsgTree& tree, const glm::vec3& background);
+// Image-space CSG (scene.csg, rule of csgVisibleFragment with the scene's mirrored primitives):
+// each pixel shows its visible fragment's colour as an opaque surface (RGB of the stored colour,
+// its opacity ignored: solids), the scene's background where there is none; rounded to 8 bits,
+// alpha 255. The lists must be the oracle's for this scene. Throws mfr::Error when the scene has
+// no CSG tree.
+ImageRGBA8 compositeCsg(const FragmentLists& lists, const Scene& scene);
 
 // Depth complexity n(p) per pixel (as a 1-channel float image) and its histogram:
 // histogram[n] = number of pixels with exactly n fragments (size maxCount+1).

@@ -40,7 +40,15 @@ struct CsgTree {
 // fragment of a primitive sets its bit, a back-facing one clears it; the visible fragment is the
 // first at which the solid goes from outside to inside, or the first fragment of an object that
 // is not in the tree (drawn as an ordinary opaque surface). Returns its index, or nothing.
-std::optional<std::size_t> csgVisibleFragment(const CsgTree& tree, std::span<const Fragment> sorted);
+// Bit i of `mirrored` reverses the facings of primitive i (csgMirroredPrimitives).
+std::optional<std::size_t> csgVisibleFragment(const CsgTree& tree, std::span<const Fragment> sorted,
+                                              std::uint32_t mirrored = 0);
+
+// Bit i set: the transform of primitive i (CsgTree::primitives()) mirrors (negative determinant),
+// which reverses its triangles' winding and so every facing the rasteriser and the oracle report
+// for it; the classification flips those, so that a mirrored part (common in CAD assemblies)
+// stays a solid instead of turning inside out.
+std::uint32_t csgMirroredPrimitives(const Scene& scene);
 
 // Throws mfr::Error naming the scene or object when the tree refers to a missing object, has more
 // than MFR_CSG_MAX_PRIMITIVES primitives or more than MFR_CSG_MAX_PROGRAM program words, or a
