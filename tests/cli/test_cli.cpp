@@ -22,22 +22,7 @@ namespace {
 using mfr::test::CliResult;
 using mfr::test::runCli;
 
-class Cli : public mfr::test::TempDirTest {
- protected:
-  // Bad input: exit code non-zero (1 or 2), no crash (< 128), one line mentioning `mention`,
-  // and the output file was not created.
-  void expectCleanFailure(const std::string& args, const std::string& mention) {
-    const fs::path out = dir() / "out.png";
-    const CliResult r = runCli(args + " -o " + out.string());
-    EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << "exit " << r.exitCode << ": " << r.out;
-    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
-    EXPECT_NE(r.out.find(mention), std::string::npos) << "message does not name '" << mention << "': " << r.out;
-    EXPECT_EQ(r.out.rfind("mfr: ", 0), 0u) << r.out;
-    EXPECT_FALSE(fs::exists(out)) << "partial output left behind";
-    for (const auto& e : fs::directory_iterator(dir()))
-      EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << "temporary left: " << e.path();
-  }
-};
+using Cli = mfr::test::CliTest;
 
 TEST_F(Cli, MissingFile) {
   expectCleanFailure("render " + (dir() / "nope.stl").string(), "nope.stl: no such file");

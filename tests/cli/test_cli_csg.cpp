@@ -20,16 +20,8 @@ namespace {
 using mfr::test::CliResult;
 using mfr::test::runCli;
 
-class CliCsg : public mfr::test::TempDirTest {
+class CliCsg : public mfr::test::CliTest {
  protected:
-  void expectCleanFailure(const std::string& args, const std::string& mention) {
-    const fs::path out = dir() / "out.png";
-    const CliResult r = runCli(args + " -o " + out.string());
-    EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << "exit " << r.exitCode << ": " << r.out;
-    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
-    EXPECT_NE(r.out.find(mention), std::string::npos) << "message does not name '" << mention << "': " << r.out;
-    EXPECT_FALSE(fs::exists(out)) << "partial output left behind";
-  }
   fs::path writeScene(const std::string& text) {
     const fs::path p = dir() / "part.mfrscene";
     std::ofstream(p) << text;

@@ -7,6 +7,7 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <cstdio>
@@ -140,6 +141,24 @@ inline CliResult runCommand(const std::string& command) {
 inline CliResult runCli(const std::string& args) {
   return runCommand(std::string(MFR_CLI) + " " + args);
 }
+
+// A temporary folder and the check every bad-input case of the command line makes.
+class CliTest : public TempDirTest {
+ protected:
+  // Bad input: exit code non-zero (1 or 2), no crash (< 128), one line starting "mfr: " that
+  // mentions `mention`, and neither the output file (-o, in dir()) nor a temporary of it left.
+  void expectCleanFailure(const std::string& args, const std::string& mention) {
+    const std::filesystem::path out = dir() / "out.png";
+    const CliResult r = runCli(args + " -o " + out.string());
+    EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << "exit " << r.exitCode << ": " << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    EXPECT_NE(r.out.find(mention), std::string::npos) << "message does not name '" << mention << "': " << r.out;
+    EXPECT_EQ(r.out.rfind("mfr: ", 0), 0u) << r.out;
+    EXPECT_FALSE(std::filesystem::exists(out)) << "partial output left behind";
+    for (const auto& e : std::filesystem::directory_iterator(dir()))
+      EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << "temporary left: " << e.path();
+  }
+};
 #endif
 
 }  // namespace mfr::test

@@ -8,18 +8,24 @@
 #include "mfr/scene/primitives.hpp"
 
 namespace mfr {
+namespace {
+// Adds a generated part to a built-in scene.
+void addPart(Scene& s, const std::string& name, Mesh mesh, const glm::vec4& color, const glm::dmat4& xf) {
+  Object o;
+  o.name = name;
+  o.mesh = std::make_shared<const Mesh>(std::move(mesh));
+  o.material.color = color;
+  o.transform = xf;
+  s.objects.push_back(std::move(o));
+}
+}  // namespace
 
 Scene makeSampleScene() {
   Scene s;
   s.name = "sample";
   s.background = glm::vec3(1.0f);
   const auto add = [&](const std::string& name, Mesh mesh, const glm::vec4& color, const glm::dmat4& xf = glm::dmat4(1.0)) {
-    Object o;
-    o.name = name;
-    o.mesh = std::make_shared<const Mesh>(std::move(mesh));
-    o.material.color = color;
-    o.transform = xf;
-    s.objects.push_back(std::move(o));
+    addPart(s, name, std::move(mesh), color, xf);
   };
   // Three nested shells (6 layers), two interlocking tori crossing them, and a tangle of tubes
   // inside: a ray through the centre meets 20–40 surfaces — the kind of depth complexity that
@@ -51,12 +57,7 @@ Scene makeCsgSampleScene() {
   s.name = "csg";
   s.background = glm::vec3(1.0f);
   const auto add = [&](const std::string& name, Mesh mesh, const glm::vec4& color, const glm::dmat4& xf) {
-    Object o;
-    o.name = name;
-    o.mesh = std::make_shared<const Mesh>(std::move(mesh));
-    o.material.color = color;
-    o.transform = xf;
-    s.objects.push_back(std::move(o));
+    addPart(s, name, std::move(mesh), color, xf);
   };
   const glm::dmat4 id(1.0);
   add("block", makeBox({2.0, 1.4, 2.0}), {0.70f, 0.72f, 0.78f, 1.0f}, id);
