@@ -24,9 +24,8 @@ Scene makeSampleScene() {
   Scene s;
   s.name = "sample";
   s.background = glm::vec3(1.0f);
-  const auto add = [&](const std::string& name, Mesh mesh, const glm::vec4& color, const glm::dmat4& xf = glm::dmat4(1.0)) {
-    addPart(s, name, std::move(mesh), color, xf);
-  };
+  const auto add = [&](const std::string& name, Mesh mesh, const glm::vec4& color,
+                       const glm::dmat4& xf = glm::dmat4(1.0)) { addPart(s, name, std::move(mesh), color, xf); };
   // Three nested shells (6 layers), two interlocking tori crossing them, and a tangle of tubes
   // inside: a ray through the centre meets 20–40 surfaces — the kind of depth complexity that
   // separates exact from approximate methods.
