@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -163,8 +164,32 @@ void markSegment(const glm::dvec2& a, const glm::dvec2& b, double eps, int width
     if (!(xLo <= xHi)) continue;
     const std::size_t rowBase = static_cast<std::size_t>(height - 1 - row) * width;  // image rows top-down
     for (int col = static_cast<int>(xLo); col <= static_cast<int>(xHi); ++col)
-      if (distanceToSegment(glm::dvec2(col + 0.5, yc), a, b) <= eps) flags[rowBase + col] |= FragmentLists::kEdge;
+      if (distanceToSegment(glm::dvec2(col + 0.5, yc), a, b) <= eps)  // several threads mark flags at once
+        std::atomic_ref<std::uint8_t>(flags[rowBase + col]).fetch_or(FragmentLists::kEdge, std::memory_order_relaxed);
   }
+}
+
+// Calls work(i) for i in [0, count) on `threads` threads (this one included), items handed out in
+// chunks of `chunk`; the first exception stops the others and is rethrown here.
+void runParallel(unsigned threads, std::size_t count, std::size_t chunk, const std::function<void(std::size_t)>& work) {
+  std::atomic<std::size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failureMutex;
+  const auto worker = [&] {
+    try {
+      for (std::size_t begin = next.fetch_add(chunk); begin < count; begin = next.fetch_add(chunk))
+        for (std::size_t i = begin; i < std::min(count, begin + chunk); ++i) work(i);
+    } catch (...) {
+      const std::lock_guard lock(failureMutex);
+      if (!failure) failure = std::current_exception();
+      next = count;  // stop the others early
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned i = 1; i < threads; ++i) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
 }
 
 // Ray/triangle intersection (Möller–Trumbore) in double: ray parameter t and barycentrics (u, v)
@@ -398,14 +423,18 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   const std::size_t pixelCount = static_cast<std::size_t>(width) * height;
   lists.flags.assign(pixelCount, 0);
 
+  unsigned threadCount =
+      options.threads > 0 ? static_cast<unsigned>(options.threads) : std::thread::hardware_concurrency();
+  threadCount = std::max(threadCount, 1u);
+
   // Edge pass (2D, window space) — also decides which triangles GL would draw as nothing.
   std::vector<std::uint8_t> screenDegenerate(triangles.size(), 0);
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
+  runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
     const std::vector<glm::dvec2> poly = windowPolygon(triangles[t], viewProj, width, height);
     screenDegenerate[t] = polygonArea(poly) < kMinScreenArea ? 1 : 0;
     for (std::size_t i = 0; i < poly.size(); ++i)
       markSegment(poly[i], poly[(i + 1) % poly.size()], options.edgeEpsilon, width, height, lists.flags);
-  }
+  });
 
   const glm::vec3 viewDir(camera.forward());
   std::vector<std::vector<Fragment>> rowFragments(static_cast<std::size_t>(height));
@@ -464,27 +493,12 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     }
   };
 
-  unsigned threadCount = options.threads > 0 ? static_cast<unsigned>(options.threads) : std::thread::hardware_concurrency();
-  threadCount = std::clamp(threadCount, 1u, static_cast<unsigned>(height));
-  std::atomic<int> nextRow{0};
-  std::exception_ptr failure;
-  std::mutex failureMutex;
-  const auto worker = [&] {
-    try {
-      std::vector<std::uint32_t> candidates;
-      std::vector<Hit> hits;
-      for (int y = nextRow++; y < height; y = nextRow++) castRow(y, candidates, hits);
-    } catch (...) {
-      const std::lock_guard lock(failureMutex);
-      if (!failure) failure = std::current_exception();
-      nextRow = height;  // stop the others early
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned i = 1; i < threadCount; ++i) pool.emplace_back(worker);
-  worker();
-  for (std::thread& t : pool) t.join();
-  if (failure) std::rethrow_exception(failure);
+  runParallel(std::min(threadCount, static_cast<unsigned>(height)), static_cast<std::size_t>(height), 1,
+              [&](std::size_t y) {
+                thread_local std::vector<std::uint32_t> candidates;
+                thread_local std::vector<Hit> hits;
+                castRow(static_cast<int>(y), candidates, hits);
+              });
 
   lists.offsets.resize(pixelCount + 1);
   std::size_t total = 0;
