@@ -65,11 +65,12 @@ void addBench(CLI::App& app) {
 
     ImageRGBA8 reference;
     ImageRGBA8 csgReference;  // the oracle's CSG image, for rows with op=csg
+    FragmentLists lists;      // for rows with op=zthickness (each row's own thickness)
     double oracleMs = 0.0;
     std::uint64_t totalFragments = 0;
     if (!opt->noQuality) {
       const auto t0 = std::chrono::steady_clock::now();
-      const FragmentLists lists = castFragments(scene, camera, w, h);
+      lists = castFragments(scene, camera, w, h);
       reference = compositeOver(lists, scene.background);
       if (!scene.csg.empty()) csgReference = compositeCsg(lists, scene);
       oracleMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -151,6 +152,11 @@ void addBench(CLI::App& app) {
       std::string label = req.method;
       for (const auto& [k, v] : req.params) label += ":" + k + "=" + v;
       if (req.operation != "auto") label += ":op=" + req.operation;
+      if (req.thickness > 0.0) {
+        std::ostringstream t;
+        t << req.thickness;
+        label += ":thickness=" + t.str();
+      }
       nlohmann::ordered_json row;
       row["method"] = label;
       row["median_total_ms"] = median(totals);
@@ -169,7 +175,11 @@ void addBench(CLI::App& app) {
       row["passes"] = last.stats.passes;
       std::string rmseText = "-", flipText = "-";
       if (!opt->noQuality) {
-        const ImageRGBA8& exact = req.operation == "csg" ? csgReference : reference;
+        const ImageRGBA8 exact =
+            req.operation == "csg" ? csgReference
+            : req.operation == "zthickness"
+                ? compositeZThickness(lists, camera, zThicknessOf(req, scene.bounds()), scene.background)
+                : reference;
         const double e = rmse(exact, last.image);
         const FlipResult f = flip(exact, last.image);
         row["rmse"] = e;

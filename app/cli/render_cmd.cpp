@@ -1,3 +1,4 @@
+#include <cmath>
 #include <iostream>
 #include <memory>
 
@@ -15,6 +16,7 @@ void addRender(CLI::App& app) {
     std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats;
     std::vector<std::string> params;
     double opacity = -1.0;
+    double thickness = 0.0;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method and write a PNG (and stats JSON)");
@@ -22,8 +24,12 @@ void addRender(CLI::App& app) {
   cmd->add_option("--method,-m", opt->method, "Construction method (see mfr info --methods)")->capture_default_str();
   cmd->add_option("--op", opt->op,
                   "Operation on the sorted lists: auto (the method's own: hybrid for fkb, vkb, dkb, optimal-k; else "
-                  "oit), oit, hybrid, csg (the scene's CSG tree, opaque; oracle and the A-buffers)")
+                  "oit), oit, hybrid, csg (the scene's CSG tree, opaque; oracle and the A-buffers), zthickness "
+                  "(z-thickness blending: surfaces closer than --thickness blend; oracle, A-buffers, k-buffers)")
       ->capture_default_str();
+  CLI::Option* thicknessOption =
+      cmd->add_option("--thickness", opt->thickness,
+                      "Operation zthickness: slab thickness in scene units (default: 1 % of the scene's diagonal)");
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
@@ -31,13 +37,16 @@ void addRender(CLI::App& app) {
   cmd->add_option("--stats", opt->stats, "Write Stats as JSON to this file");
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1): see through opaque CAD parts")
       ->check(CLI::Range(0.0, 1.0));
-  cmd->callback([opt] {
+  cmd->callback([opt, thicknessOption] {
     const auto [w, h] = parseSize("--size", opt->size);
     RenderRequest req;
     req.method = opt->method;
     req.operation = opt->op;
     req.width = w;
     req.height = h;
+    if (thicknessOption->count() > 0 && !(opt->thickness > 0.0 && std::isfinite(opt->thickness)))
+      throw Error("--thickness", "must be a positive length in scene units");
+    req.thickness = opt->thickness;
     for (const std::string& p : opt->params) {
       const auto eq = p.find('=');
       if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");

@@ -37,6 +37,7 @@ void GpuRenderer::setScene(const Scene& scene) {
   csg_ = scene.csg;
   csgMirrored_ = csgMirroredPrimitives(scene);
   sceneName_ = scene.name;
+  sceneBounds_ = scene.bounds();
   gl::checkErrors("scene upload");
 }
 
@@ -47,19 +48,19 @@ void GpuRenderer::shareScene(const GpuRenderer& other) {
   csg_ = other.csg_;
   csgMirrored_ = other.csgMirrored_;
   sceneName_ = other.sceneName_;
+  sceneBounds_ = other.sceneBounds_;
 }
 
 Method& GpuRenderer::prepare(const RenderRequest& request) {
   validateImageSize("--size", request.width, request.height);
   if (!scene_) throw Error("render", "no scene loaded");
-  if (request.operation != "oit" && request.operation != "hybrid" && request.operation != "csg" &&
-      request.operation != "auto")
-    throw Error("--op " + request.operation, "unknown operation (available: auto, oit, hybrid, csg)");
+  validateOperation(request.operation);
   if (!method_ || methodName_ != request.method) {
     method_ = createMethod(request.method);
     methodName_ = request.method;
   }
   operation_ = request.operation == "auto" ? method_->info().preferredOperation : request.operation;
+  thickness_ = zThicknessOf(request, sceneBounds_);
   const Params params(method_->info().params, request.params, request.method);
   method_->configure(request.width, request.height, params);
   if (operation_ == "hybrid") {
@@ -104,10 +105,18 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   gl::checkErrors(("capture " + request.method).c_str());
   glBindFramebuffer(GL_FRAMEBUFFER, target);
   glViewport(0, 0, request.width, request.height);
-  if (operation_ == "csg")
+  if (operation_ == "csg") {
     renderCsg(ctx, method);
-  else
+  } else if (operation_ == "zthickness") {
+    const glm::vec4 toEye(camera.depthToEye());
+    const float thickness = static_cast<float>(thickness_);
+    method.resolve(ctx, Operation{"zthickness", "ops/zthickness.glsl", [&](const gl::Program& p) {
+                                    p.set("uZThickness", thickness);
+                                    p.set("uDepthToEye", toEye);
+                                  }});
+  } else {
     method.resolve(ctx, operation_ == "hybrid" ? hybridOperation() : oitOperation());
+  }
   gl::checkErrors(("resolve " + request.method).c_str());
   Stats stats = method.stats();
   if (operation_ == "csg") {
@@ -118,6 +127,7 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
     stats.passes += 1;  // the shading pass
     stats.notes.emplace_back("csg buffer (bytes)", std::to_string(csgBytes));
   }
+  if (operation_ == "zthickness") stats.notes.emplace_back("z-thickness", std::to_string(thickness_));
   lastWidth_ = request.width;
   lastHeight_ = request.height;
   stats.operation = operation_;

@@ -24,6 +24,30 @@ void validateImageSize(const std::string& what, int width, int height) {
   if (width > 16384 || height > 16384) throw Error(what, "image size above 16384 pixels per side");
 }
 
+const std::string& operationNames() {
+  static const std::string names = "auto, oit, hybrid, csg, zthickness";
+  return names;
+}
+
+void validateOperation(const std::string& operation) {
+  for (const char* name : {"auto", "oit", "hybrid", "csg", "zthickness"})
+    if (operation == name) return;
+  throw Error("--op " + operation, "unknown operation (available: " + operationNames() + ")");
+}
+
+double zThicknessDefault(const Bounds& sceneBounds) {
+  return sceneBounds.valid() ? 0.01 * glm::length(sceneBounds.max - sceneBounds.min) : 0.01;
+}
+
+double zThicknessOf(const RenderRequest& request, const Bounds& sceneBounds) {
+  if (!std::isfinite(request.thickness) || request.thickness < 0.0)
+    throw Error("--thickness",
+                "must be a positive length in scene units (got " + std::to_string(request.thickness) + ")");
+  if (request.thickness > 0.0) return request.thickness;
+  const double d = zThicknessDefault(sceneBounds);
+  return d > 0.0 ? d : 0.01;  // a flat or point-like scene still gets a usable slab
+}
+
 std::vector<std::string> availableMethods() {
   std::vector<std::string> names{"oracle"};
   for (const RegistryEntry& e : methodRegistry()) names.push_back(e.name);
@@ -65,7 +89,7 @@ namespace {
 // optimal-k: the oracle's exact lists, the F(M) of the variable-k layout at this size, the best
 // allocation of optimalKBest, composited by the CPU hybrid operation.
 RenderOutput renderOptimalK(const Scene& scene, const Camera& camera, const RenderRequest& request) {
-  if (request.operation == "oit" || request.operation == "csg")
+  if (request.operation != "hybrid" && request.operation != "auto")
     throw Error("--op " + request.operation, "optimal-k is a hybrid-transparency reference: use --op hybrid (or auto)");
   const Params params(optimalKInfo().params, request.params, "optimal-k");
   const auto budgetBytes = static_cast<std::uint64_t>(std::floor(params.real("budget_mib") * 1024.0 * 1024.0));
@@ -131,9 +155,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     for (const auto& m : methods) list += (list.empty() ? "" : ", ") + m;
     throw Error("--method " + request.method, "unknown method (available: " + list + ")");
   }
-  if (request.operation != "oit" && request.operation != "hybrid" && request.operation != "csg" &&
-      request.operation != "auto")
-    throw Error("--op " + request.operation, "unknown operation (available: auto, oit, hybrid, csg)");
+  validateOperation(request.operation);
   if (request.method == "optimal-k") return renderOptimalK(scene, camera, request);
   if (request.method != "oracle") {
     GpuRenderer& gpu = headlessRenderer();
@@ -155,6 +177,10 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
       throw Error("--param k=" + k->second, "not a non-negative integer");
     }
     out.image = compositeHybrid(lists, static_cast<std::uint32_t>(value), scene.background);
+  } else if (request.operation == "zthickness") {
+    const double thickness = zThicknessOf(request, scene.bounds());
+    out.image = compositeZThickness(lists, camera, thickness, scene.background);
+    out.stats.notes.emplace_back("z-thickness", std::to_string(thickness));
   } else if (request.operation == "csg") {
     if (scene.csg.empty())
       throw Error("--op csg", "scene '" + scene.name + "' has no CSG tree (a \"csg\" key in an .mfrscene file)");

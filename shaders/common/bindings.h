@@ -68,4 +68,11 @@
 #define MFR_PAYLOAD_COLOR 0
 #define MFR_PAYLOAD_OBJECT 1
 
+// Z-thickness blending (operation "zthickness"): a pixel's slabs still open at one depth are kept in
+// a window of this many entries (a newer slab beyond it is merged into the newest entry, so the
+// loop stays bounded); opacities are clamped below 1 so that every slab has a finite extinction
+// (an opaque surface reaches 1 - 1/1024 over its thickness).
+#define MFR_ZTHICK_WINDOW 16
+#define MFR_ZTHICK_MAX_ALPHA (1.0 - 1.0 / 1024.0)
+
 #endif

@@ -84,6 +84,8 @@ class GpuRenderer {
   CsgTree csg_;
   std::uint32_t csgMirrored_ = 0;  // csgMirroredPrimitives of the scene
   std::string sceneName_;
+  Bounds sceneBounds_;
+  double thickness_ = 0.0;  // operation "zthickness" of the prepared request (scene units)
   gl::Buffer csgVisible_;
   std::size_t csgPixels_ = 0;
   gl::Program csgShade_;

@@ -16,11 +16,23 @@ namespace mfr {
 
 struct RenderRequest {
   std::string method = "oracle";
-  std::string operation = "oit";  // "oit", "hybrid", or "auto": the method's preferred one
+  std::string operation = "oit";  // "oit", "hybrid", "csg", "zthickness", or "auto": the method's preferred one
   int width = 512;
   int height = 512;
   std::map<std::string, std::string> params;  // method parameters by name (k, budget_mib, …)
+  // Operation "zthickness": slab thickness in scene units; 0 picks zThicknessDefault of the scene.
+  double thickness = 0.0;
 };
+
+// The operations render() and GpuRenderer accept, for messages: "auto, oit, hybrid, csg, zthickness".
+const std::string& operationNames();
+// Throws mfr::Error("--op <name>", …) for a name not in operationNames().
+void validateOperation(const std::string& operation);
+// The default z-thickness: 1 % of the diagonal of the scene's bounds.
+double zThicknessDefault(const Bounds& sceneBounds);
+// The thickness a request asks for (its own, or the default); throws mfr::Error("--thickness", …)
+// for a negative, infinite or NaN value.
+double zThicknessOf(const RenderRequest& request, const Bounds& sceneBounds);
 
 struct RenderOutput {
   ImageRGBA8 image;

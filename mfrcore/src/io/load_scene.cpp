@@ -26,6 +26,7 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadPro
   const std::string text = path.string();
   if (text == "@sample") return makeSampleScene();
   if (text == "@csg") return makeCsgSampleScene();
+  if (text == "@intersect") return makeIntersectingSampleScene();
   if (text.rfind("@quads:", 0) == 0) {
     // @quads:N[:density[:seed]]
     int layers = 0;
@@ -37,7 +38,7 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadPro
     return makeQuadsScene(layers, density, seed);
   }
   if (!text.empty() && text[0] == '@')
-    throw Error(text, "unknown built-in scene (@sample, @csg, @quads:N[:density[:seed]])");
+    throw Error(text, "unknown built-in scene (@sample, @csg, @intersect, @quads:N[:density[:seed]])");
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   Scene scene;

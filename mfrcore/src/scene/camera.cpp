@@ -18,6 +18,11 @@ glm::dmat4 Camera::projectionMatrix(double aspect) const {
   return glm::perspective(glm::radians(fovyDegrees), aspect, nearPlane, farPlane);
 }
 
+glm::dvec4 Camera::depthToEye() const {
+  const glm::dmat4 inverse = glm::inverse(projectionMatrix(1.0));
+  return {inverse[2][2], inverse[3][2], inverse[2][3], inverse[3][3]};
+}
+
 glm::dvec3 Camera::forward() const {
   const glm::dvec3 d = target - eye;
   const double len = glm::length(d);

@@ -81,6 +81,36 @@ Scene makeCsgSampleScene() {
   return s;
 }
 
+Scene makeIntersectingSampleScene() {
+  Scene s;
+  s.name = "intersect";
+  s.background = glm::vec3(1.0f);
+  const glm::dmat4 id(1.0);
+  // Two versions of one surface a few hundredths apart (a design and its scan): they cross each
+  // other along curves, where "over" cuts hard edges and z-thickness blends.
+  addPart(s, "design", makeSphere(1.0, 96, 48), {0.25f, 0.45f, 0.90f, 0.45f}, id);
+  addPart(s, "scan", makeSphere(0.99, 96, 48), {0.95f, 0.55f, 0.15f, 0.45f},
+          glm::translate(id, glm::dvec3(0.045, 0.03, 0.02)) * glm::scale(id, glm::dvec3(1.0, 1.04, 0.98)));
+  // A plate imported twice (a duplicated CAD part, different colours): coincident faces.
+  const Mesh plate = makeBox({2.8, 0.1, 1.8});
+  const glm::dmat4 below = glm::translate(id, glm::dvec3(0.0, -1.25, 0.0));
+  addPart(s, "plate", plate, {0.55f, 0.57f, 0.60f, 0.7f}, below);
+  addPart(s, "plate (copy)", plate, {0.20f, 0.65f, 0.30f, 0.7f}, below);
+  // A ring through the plate: surfaces crossing at a steep angle.
+  addPart(s, "ring", makeTorus(0.45, 0.08, 96, 24), {0.80f, 0.20f, 0.45f, 0.8f},
+          glm::translate(id, glm::dvec3(0.9, -1.25, 0.3)) * glm::rotate(id, glm::radians(90.0), glm::dvec3(1, 0, 0)));
+  Camera iso;
+  iso.eye = {2.6, 1.6, 4.4};
+  iso.target = {0.0, -0.4, 0.0};
+  iso.fovyDegrees = 35.0;
+  s.views.push_back({"iso", s.fit(iso)});
+  Camera front = iso;
+  front.eye = {0.0, -0.2, 5.0};
+  front.target = {0.0, -0.2, 0.0};
+  s.views.push_back({"front", s.fit(front)});
+  return s;
+}
+
 Scene makeQuadsScene(int layers, double density, std::uint32_t seed) {
   if (layers < 1 || layers > 4096) throw Error("@quads", "layer count must be in [1, 4096]");
   if (!(density > 0.0) || density > 1.0) throw Error("@quads", "pixel density must be in (0, 1]");

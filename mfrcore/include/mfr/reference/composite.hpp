@@ -16,6 +16,19 @@ namespace mfr {
 glm::vec3 compositeOver(std::span<const Fragment> sorted, const glm::vec3& background);
 ImageRGBA8 compositeOver(const FragmentLists& lists, const glm::vec3& background);
 
+// Z-thickness blending (Kim & Kye, CGF 40(7) 2021; shaders/ops/zthickness.glsl is the same
+// definition, in the same float arithmetic): each fragment is a slab of `thickness` (world units
+// along the view axis) behind its surface, extinction σ = -ln(1 - α)/thickness with α clamped to
+// MFR_ZTHICK_MAX_ALPHA, emission σ·rgb; the piecewise-constant medium is integrated exactly
+// front to back, then the background. Slabs further apart than the thickness give "over"; overlapping
+// slabs blend order-independently. At most MFR_ZTHICK_WINDOW slabs are open at once (a newer one
+// is merged into the newest open slab). depthToEye: Camera::depthToEye().
+glm::vec3 compositeZThickness(std::span<const Fragment> sorted, const glm::vec4& depthToEye, float thickness,
+                              const glm::vec3& background);
+// The image; throws mfr::Error("--thickness", …) unless thickness is finite and > 0.
+ImageRGBA8 compositeZThickness(const FragmentLists& lists, const Camera& camera, double thickness,
+                               const glm::vec3& background);
+
 // Image-space CSG (scene.csg, rule of csgVisibleFragment with the scene's mirrored primitives):
 // each pixel shows its visible fragment's colour as an opaque surface (RGB of the stored colour,
 // its opacity ignored: solids), the scene's background where there is none; rounded to 8 bits,

@@ -22,6 +22,10 @@ struct Camera {
 
   [[nodiscard]] glm::dmat4 viewMatrix() const;
   [[nodiscard]] glm::dmat4 projectionMatrix(double aspect) const;
+  // Window depth d in [0,1] → eye depth (distance along the view axis, > 0 in front of the eye):
+  // z = -(a·ndc + b)/(c·ndc + e) with ndc = 2d - 1; returns (a, b, c, e), from the inverse
+  // projection (the z row does not depend on the aspect ratio or on x, y).
+  [[nodiscard]] glm::dvec4 depthToEye() const;
   // Unit vector from eye towards target: also the headlight direction.
   [[nodiscard]] glm::dvec3 forward() const;
 

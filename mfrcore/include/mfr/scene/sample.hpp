@@ -18,6 +18,11 @@ Scene makeSampleScene();
 // drills' colours (the cut faces are theirs). Views "iso" and "front".
 Scene makeCsgSampleScene();
 
+// The built-in intersecting-surfaces sample ("@intersect", for the operation zthickness): two
+// translucent versions of a sphere a few hundredths apart that cross each other, a plate loaded
+// twice (coincident faces, different colours) and a ring through it. Views "iso" and "front".
+Scene makeIntersectingSampleScene();
+
 Scene makeQuadsScene(int layers, double density = 1.0, std::uint32_t seed = 1);
 
 }  // namespace mfr
