@@ -175,9 +175,12 @@ void addBench(CLI::App& app) {
       row["passes"] = last.stats.passes;
       std::string rmseText = "-", flipText = "-";
       if (!opt->noQuality) {
+        // The reference of the operation the row ran ("auto": the method's own).
+        const MethodInfo* rowInfo = findMethodInfo(req.method);
+        const std::string op = req.operation == "auto" && rowInfo ? rowInfo->preferredOperation : req.operation;
         const ImageRGBA8 exact =
-            req.operation == "csg" ? csgReference
-            : req.operation == "zthickness"
+            op == "csg" ? csgReference
+            : op == "zthickness"
                 ? compositeZThickness(lists, camera, zThicknessOf(req, scene.bounds()), scene.background)
                 : reference;
         const double e = rmse(exact, last.image);

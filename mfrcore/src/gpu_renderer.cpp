@@ -92,7 +92,14 @@ FrameContext GpuRenderer::frameContext(const Camera& camera, int width, int heig
   frame.viewProj = glm::mat4(camera.projectionMatrix(aspect) * camera.viewMatrix());
   frame.viewDir = glm::vec3(camera.forward());
   frame.payload = operation_ == "csg" ? MFR_PAYLOAD_OBJECT : MFR_PAYLOAD_COLOR;
-  return FrameContext{*scene_, frame, background_, width, height, timer};
+  return FrameContext{*scene_,
+                      frame,
+                      background_,
+                      width,
+                      height,
+                      timer,
+                      static_cast<float>(thickness_),
+                      glm::vec4(camera.depthToEye())};
 }
 
 Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderRequest& request) {
@@ -108,11 +115,9 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   if (operation_ == "csg") {
     renderCsg(ctx, method);
   } else if (operation_ == "zthickness") {
-    const glm::vec4 toEye(camera.depthToEye());
-    const float thickness = static_cast<float>(thickness_);
     method.resolve(ctx, Operation{"zthickness", "ops/zthickness.glsl", [&](const gl::Program& p) {
-                                    p.set("uZThickness", thickness);
-                                    p.set("uDepthToEye", toEye);
+                                    p.set("uZThickness", ctx.zThickness);
+                                    p.set("uDepthToEye", ctx.depthToEye);
                                   }});
   } else {
     method.resolve(ctx, operation_ == "hybrid" ? hybridOperation() : oitOperation());

@@ -74,5 +74,7 @@
 // (an opaque surface reaches 1 - 1/1024 over its thickness).
 #define MFR_ZTHICK_WINDOW 16
 #define MFR_ZTHICK_MAX_ALPHA (1.0 - 1.0 / 1024.0)
+// kbuffer-zmerge: the largest k (its store pass compares all pairs of k + 1 segments).
+#define MFR_ZMERGE_MAX_K 32
 
 #endif

@@ -52,15 +52,18 @@ TEST_F(CliZThickness, OracleAndGpuAgreeAndTheThicknessMatters) {
 TEST_F(CliZThickness, BenchMeasuresRowsAgainstTheOraclesZThickness) {
   const fs::path json = dir() / "bench.json";
   const CliResult r = runCli(
-      "bench @intersect --view iso --size 96x80 -r 1 -m abuffer-ll,abuffer-ll:op=zthickness:thickness=0.2 --json " +
+      "bench @intersect --view iso --size 96x80 -r 1 -m "
+      "abuffer-ll,abuffer-ll:op=zthickness:thickness=0.2,kbuffer-zmerge:k=32 --json " +
       json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   std::ifstream in(json);
   const nlohmann::json j = nlohmann::json::parse(in);
-  ASSERT_EQ(j["results"].size(), 2u);
+  ASSERT_EQ(j["results"].size(), 3u);
   EXPECT_EQ(j["results"][1]["method"], "abuffer-ll:op=zthickness:thickness=0.2");
   EXPECT_LT(j["results"][1]["rmse"].get<double>(), 0.01);  // against "over" it would be far larger
   EXPECT_EQ(j["results"][1]["notes"]["z-thickness"], "0.200000");
+  // A method whose own operation is zthickness ("auto") is measured against that image too.
+  EXPECT_LT(j["results"][2]["rmse"].get<double>(), 0.005);
 }
 
 TEST_F(CliZThickness, BadInputIsOneLine) {
@@ -71,6 +74,8 @@ TEST_F(CliZThickness, BadInputIsOneLine) {
   expectCleanFailure("render @intersect --op zthickness --method wboit", "wboit");
   expectCleanFailure("render @intersect --op zthickness --method optimal-k", "optimal-k");
   expectCleanFailure("render @intersect --op thick", "zthickness");  // the list of operations
+  expectCleanFailure("render @intersect --op oit --method kbuffer-zmerge", "zthickness only");
+  expectCleanFailure("render @intersect --method kbuffer-zmerge -p k=33", "k");
   const fs::path json = dir() / "b.json";
   const CliResult bench = runCli("bench @intersect -m abuffer-ll:op=zthickness:thickness=-2 --json " + json.string());
   EXPECT_NE(bench.exitCode, 0);

@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "common/bindings.h"
 #include "gl_fixture.hpp"
 #include "mfr/error.hpp"
 #include "mfr/reference/composite.hpp"
@@ -110,6 +111,96 @@ TEST(ZThicknessGpu, CoincidentPartsLookTheSameInEitherDrawOrder) {
   EXPECT_LE(maxDiff("zthickness"), 1);
 }
 
+// kbuffer-zmerge with a slot for every fragment merges nothing: its own resolve of the stored
+// segments must then give the operation's image (the oracle's), coincident faces included.
+TEST(ZThicknessMergeKBuffer, WithRoomForEveryFragmentEqualsTheOracle) {
+  context();
+  const Scene scene = makeIntersectingSampleScene();
+  const int w = 128, h = 112;
+  GpuRenderer gpu;
+  gpu.setScene(scene);
+  for (const char* view : {"iso", "front"}) {
+    SCOPED_TRACE(view);
+    const Camera camera = scene.view(view);
+    const FragmentLists oracle = castFragments(scene, camera, w, h);
+    ASSERT_LE(oracle.maxCount(), static_cast<std::uint32_t>(MFR_ZMERGE_MAX_K));
+    RenderRequest req;
+    req.method = "kbuffer-zmerge";
+    req.operation = "auto";
+    req.width = w;
+    req.height = h;
+    req.params["k"] = std::to_string(oracle.maxCount());
+    const RenderOutput out = gpu.render(camera, req);
+    EXPECT_EQ(out.stats.operation, "zthickness");
+    const auto merges =
+        std::find_if(out.stats.notes.begin(), out.stats.notes.end(), [](const auto& n) { return n.first == "merges"; });
+    ASSERT_NE(merges, out.stats.notes.end());
+    EXPECT_EQ(merges->second, "0");
+    const ImageRGBA8 expected =
+        compositeZThickness(oracle, camera, zThicknessOf(req, scene.bounds()), scene.background);
+    const TieComparison c = compareOffEdges(oracle, expected, out.image, 2);
+    EXPECT_GT(c.ties, 400u);
+    EXPECT_GE(static_cast<double>(c.within) / c.compared, 0.999)
+        << c.compared - c.within << " pixels off by more than 2/255, max " << c.maxDifference;
+    EXPECT_EQ(c.tiesWithin, c.ties);
+  }
+}
+
+// Merging keeps every pixel's opacity: a merged segment's optical depth is the sum of its parts',
+// so the transmittance Π(1 - α_i) of all the pixel's fragments (α clamped as the operation does)
+// survives any number of merges, while a k-buffer that drops fragments loses it. Measured through
+// the image: rendered over a black and over a white background, the difference is the
+// transmittance.
+TEST(ZThicknessMergeKBuffer, MergingKeepsEveryPixelsOpacity) {
+  context();
+  const int w = 128, h = 128;
+  Scene black = sampleReference("front", w, h).scene, white = black;
+  black.background = glm::vec3(0.0f);
+  white.background = glm::vec3(1.0f);
+  const Camera camera = black.view("front");
+  const FragmentLists& oracle = sampleReference("front", w, h).oracle;
+  GpuRenderer onBlack, onWhite;
+  onBlack.setScene(black);
+  onWhite.setScene(white);
+  const auto wrongPixels = [&](const RenderRequest& req, std::size_t& deep) {
+    const ImageRGBA8 b = onBlack.render(camera, req).image, t = onWhite.render(camera, req).image;
+    std::size_t wrong = 0;
+    deep = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (oracle.isEdge(x, y)) continue;
+        double transmittance = 1.0;
+        for (const Fragment& f : oracle.pixel(x, y))
+          transmittance *= 1.0 - std::min<double>((f.color >> 24) / 255.0, MFR_ZTHICK_MAX_ALPHA);
+        deep += oracle.count(x, y) > 4u;
+        for (int ch = 0; ch < 3; ++ch) {
+          const int measured = int(t.at(x, y)[ch]) - int(b.at(x, y)[ch]);
+          if (std::abs(measured - transmittance * 255.0) > 2.5) {
+            ++wrong;
+            break;
+          }
+        }
+      }
+    return wrong;
+  };
+  for (const char* k : {"1", "2", "4"}) {
+    SCOPED_TRACE(std::string("k = ") + k);
+    RenderRequest merge;
+    merge.method = "kbuffer-zmerge";
+    merge.operation = "zthickness";
+    merge.width = w;
+    merge.height = h;
+    merge.params["k"] = k;
+    std::size_t deep = 0;
+    EXPECT_EQ(wrongPixels(merge, deep), 0u);
+    EXPECT_GT(deep, 2000u);  // pixels with more fragments than slots: merging happened there
+    // The k nearest alone (kplus-array) lose the rest's opacity: the check can fail.
+    RenderRequest drop = merge;
+    drop.method = "kplus-array";
+    EXPECT_GT(wrongPixels(drop, deep), 1000u);
+  }
+}
+
 TEST(ZThicknessGpu, MethodsWithoutSortedListsRefuseIt) {
   context();
   GpuRenderer gpu;
@@ -120,6 +211,16 @@ TEST(ZThicknessGpu, MethodsWithoutSortedListsRefuseIt) {
     RenderRequest req;
     req.method = method;
     req.operation = "zthickness";
+    req.width = 32;
+    req.height = 32;
+    EXPECT_THROW((void)gpu.render(camera, req), Error);
+  }
+  // kbuffer-zmerge keeps segments, not fragments: every other operation is refused.
+  for (const char* op : {"oit", "hybrid", "csg"}) {
+    SCOPED_TRACE(op);
+    RenderRequest req;
+    req.method = "kbuffer-zmerge";
+    req.operation = op;
     req.width = 32;
     req.height = 32;
     EXPECT_THROW((void)gpu.render(camera, req), Error);

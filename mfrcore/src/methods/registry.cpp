@@ -9,6 +9,7 @@
 #include "fixed_k_buffer.hpp"
 #include "k_peeling.hpp"
 #include "kbuffer.hpp"
+#include "kbuffer_zmerge.hpp"
 #include "kplus_array.hpp"
 #include "kplus_dynamic.hpp"
 #include "kplus_heap.hpp"
@@ -44,6 +45,7 @@ const std::vector<RegistryEntry>& methodRegistry() {
       {"fkb", make<FixedKBuffer>},
       {"vkb", make<VariableKBufferImportance>},
       {"dkb", make<DeepVariableKBuffer>},
+      {"kbuffer-zmerge", make<KBufferZThicknessMerge>},
   };
   return entries;
 }

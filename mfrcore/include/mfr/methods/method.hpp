@@ -76,6 +76,10 @@ struct FrameContext {
   int width = 0;
   int height = 0;
   gl::PassTimer& timer;
+  // Operation "zthickness": slab thickness (scene units) and window depth → eye depth
+  // (Camera::depthToEye), for methods that merge slabs already while they capture.
+  float zThickness = 0.0f;
+  glm::vec4 depthToEye{0.0f};
 };
 
 class Method {
