@@ -10,6 +10,7 @@
 #include <QSurfaceFormat>
 #include <QTimer>
 
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <map>
@@ -27,6 +28,7 @@ struct CommandLine {
   std::map<QString, QJsonObject> pluginSettings;  // by plugin id
   QSize size{800, 600}, windowSize;
   std::map<std::string, std::string> params;
+  double thickness = 0.0;  // --thickness (operation zthickness); 0: the scene's default
 };
 
 [[noreturn]] void fail(const QString& message, int code) {
@@ -51,8 +53,12 @@ CommandLine parseCommandLine(const QApplication& app) {
   parser.addPositionalArgument(QStringLiteral("scene"), QStringLiteral("Model file, .mfrscene, .mfrsession or @sample (default)"));
   const QCommandLineOption method({QStringLiteral("m"), QStringLiteral("method")}, QStringLiteral("Render method."), QStringLiteral("name"));
   const QCommandLineOption op(QStringLiteral("op"),
-                              QStringLiteral("Operation: auto (the method's own), oit, hybrid or csg."),
+                              QStringLiteral("Operation: auto (the method's own), oit, hybrid, csg or zthickness."),
                               QStringLiteral("name"));
+  const QCommandLineOption thickness(
+      QStringLiteral("thickness"),
+      QStringLiteral("Operation zthickness: slab thickness in scene units (default: 1 % of the scene's diagonal)."),
+      QStringLiteral("length"));
   const QCommandLineOption param({QStringLiteral("p"), QStringLiteral("param")}, QStringLiteral("Method parameter (repeatable)."), QStringLiteral("name=value"));
   const QCommandLineOption view(QStringLiteral("view"), QStringLiteral("Named view of the scene, or 'fit'."), QStringLiteral("name"));
   const QCommandLineOption size({QStringLiteral("s"), QStringLiteral("size")}, QStringLiteral("Image size for --screenshot (default 800x600)."), QStringLiteral("WxH"));
@@ -62,7 +68,8 @@ CommandLine parseCommandLine(const QApplication& app) {
   const QCommandLineOption pluginSettings(QStringLiteral("plugin-settings"),
                                          QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
                                          QStringLiteral("id={json}"));
-  parser.addOptions({method, op, param, view, size, screenshot, windowScreenshot, windowSize, pluginSettings});
+  parser.addOptions(
+      {method, op, thickness, param, view, size, screenshot, windowScreenshot, windowSize, pluginSettings});
   parser.process(app);
 
   CommandLine cl;
@@ -71,6 +78,12 @@ CommandLine parseCommandLine(const QApplication& app) {
   if (cl.scene.endsWith(QStringLiteral(".mfrsession"), Qt::CaseInsensitive)) cl.session = cl.scene;
   cl.method = parser.value(method);
   cl.op = parser.value(op);
+  if (parser.isSet(thickness)) {
+    bool ok = false;
+    cl.thickness = parser.value(thickness).toDouble(&ok);
+    if (!ok || !(cl.thickness > 0.0) || !std::isfinite(cl.thickness))
+      fail(QStringLiteral("--thickness %1: must be a positive length in scene units").arg(parser.value(thickness)), 2);
+  }
   cl.view = parser.value(view);
   cl.screenshot = parser.value(screenshot);
   cl.windowScreenshot = parser.value(windowScreenshot);
@@ -124,6 +137,8 @@ int main(int argc, char** argv) {
   QObject::connect(&model, &ViewerModel::sceneLoaded, &window, [&] {
     if (applied) return;
     applied = true;
+    // A new scene starts at the default thickness (scene units): --thickness applies to this one.
+    if (cl.thickness > 0.0) model.setZThickness(cl.thickness);
     if (!cl.view.isEmpty()) {
       try {
         model.setCamera(model.scene().view(cl.view.toStdString()));

@@ -98,6 +98,10 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
     // how to see the tree as solids.
     if (!model_->scene().csg.empty())
       if (auto* csgDock = findChild<QDockWidget*>(QStringLiteral("plugin-csg"))) csgDock->raise();
+    // The intersecting-surfaces sample is about z-thickness blending: the Ghosting panel (plugin
+    // "ghosting") has its switch and thickness.
+    if (model_->scenePath() == QLatin1String("@intersect"))
+      if (auto* ghostDock = findChild<QDockWidget*>(QStringLiteral("plugin-ghosting"))) ghostDock->raise();
     if (pendingSession_) {
       applySession(*pendingSession_, *model_);
       if (model_->compareEnabled()) compareDock_->show();

@@ -45,8 +45,21 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
   operationCombo_->addItem(tr("oit — composite \"over\""), QStringLiteral("oit"));
   operationCombo_->addItem(tr("hybrid — exact core + averaged tail"), QStringLiteral("hybrid"));
   operationCombo_->addItem(tr("csg — the scene's CSG tree as opaque solids"), QStringLiteral("csg"));
+  operationCombo_->addItem(tr("zthickness — blend surfaces closer than a thickness"), QStringLiteral("zthickness"));
+  // Operation zthickness: the slab thickness (scene units, shared by both panes); the minimum, 0,
+  // reads "default" and follows the scene (1 % of its diagonal).
+  thickness_ = new QDoubleSpinBox;
+  thickness_->setObjectName(objectName(QStringLiteral("zThickness")));
+  thickness_->setDecimals(6);
+  thickness_->setRange(0.0, 1.0e9);
+  thickness_->setKeyboardTracking(false);
+  thickness_->setToolTip(
+      tr("Each fragment is a slab this thick (scene units) behind its surface: surfaces closer than this "
+         "blend without z-fighting, surfaces further apart composite \"over\". 0: 1 % of the scene's diagonal."));
   top->addRow(tr("Method"), methodCombo_);
   top->addRow(tr("Operation"), operationCombo_);
+  top->addRow(tr("Thickness"), thickness_);
+  topLayout_ = top;
   layout->addLayout(top);
 
   description_ = new QLabel;
@@ -73,6 +86,9 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
           [this](int index) { model_.setMethodOf(side_, methodCombo_->itemData(index).toString()); });
   connect(operationCombo_, &QComboBox::currentIndexChanged, this,
           [this](int index) { model_.setOperationOf(side_, operationCombo_->itemData(index).toString()); });
+  connect(thickness_, &QDoubleSpinBox::valueChanged, this, [this](double v) { model_.setZThickness(v); });
+  connect(&model_, &ViewerModel::zThicknessChanged, this, &MethodPanel::showThickness);
+  connect(&model_, &ViewerModel::sceneChanged, this, &MethodPanel::showThickness);  // the default follows the scene
   connect(&model_, &ViewerModel::sideChanged, this, [this](int changed) {
     if (changed != side_) return;
     syncMethodCombo();
@@ -81,6 +97,16 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
   });
   syncMethodCombo();
   rebuildParameters();
+  showThickness();
+}
+
+void MethodPanel::showThickness() {
+  const QSignalBlocker block(thickness_);
+  const double fallback = model_.zThicknessDefault();
+  thickness_->setSpecialValueText(tr("default (%1)").arg(fallback, 0, 'g', 4));
+  thickness_->setSingleStep(std::max(1.0e-6, fallback / 10.0));
+  thickness_->setValue(model_.zThickness());
+  topLayout_->setRowVisible(thickness_, model_.operationOf(side_) == QLatin1String("zthickness"));
 }
 
 QString MethodPanel::objectName(const QString& base) const {
@@ -91,6 +117,7 @@ void MethodPanel::syncMethodCombo() {
   const QSignalBlocker block(methodCombo_), blockOp(operationCombo_);
   methodCombo_->setCurrentIndex(methodCombo_->findData(model_.methodOf(side_)));
   operationCombo_->setCurrentIndex(operationCombo_->findData(model_.operationOf(side_)));
+  if (thickness_) topLayout_->setRowVisible(thickness_, model_.operationOf(side_) == QLatin1String("zthickness"));
 }
 
 void MethodPanel::rebuildParameters() {

@@ -1,7 +1,8 @@
 #pragma once
 // The method dock: every render method, the operation, and one widget per parameter generated
 // from the method's ParamSpec list (Int → spin box, Float → double spin box, Bool → check box,
-// Choice → combo box), so a new method needs no viewer code. One panel per side: side 0 edits
+// Choice → combo box), so a new method needs no viewer code. With the operation zthickness a
+// Thickness row appears (ViewerModel::zThickness, shared by both sides). One panel per side: side 0 edits
 // the main method, side 1 the second method of compare mode (its widgets' object names carry a
 // "B" suffix: methodComboB, param-k-B, …).
 #include <QWidget>
@@ -10,6 +11,7 @@
 #include <string>
 
 class QComboBox;
+class QDoubleSpinBox;
 class QFormLayout;
 class QLabel;
 class ViewerModel;
@@ -24,6 +26,7 @@ class MethodPanel final : public QWidget {
   void rebuildParameters();
   void showParameterValues();
   void syncMethodCombo();
+  void showThickness();
 
   [[nodiscard]] QString objectName(const QString& base) const;
 
@@ -32,6 +35,8 @@ class MethodPanel final : public QWidget {
   QString shownMethod_;  // whose editors are built
   QComboBox* methodCombo_ = nullptr;
   QComboBox* operationCombo_ = nullptr;
+  QDoubleSpinBox* thickness_ = nullptr;  // operation zthickness (ViewerModel::zThickness)
+  QFormLayout* topLayout_ = nullptr;
   QLabel* description_ = nullptr;
   QWidget* paramsBox_ = nullptr;
   QFormLayout* paramsLayout_ = nullptr;

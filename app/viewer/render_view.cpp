@@ -536,8 +536,12 @@ void RenderView::updateOverlays() {
     PaneCaption* caption = captions_[side];
     if (compare && shown) {
       const PaneMetrics& m = model_.metrics(side);
-      QStringList lines{QStringLiteral("%1 · %2 (%3)")
-                            .arg(QLatin1String(sideName(side)), model_.methodOf(side), model_.operationOf(side))};
+      QString operation = model_.operationOf(side);
+      if (operation == QLatin1String("zthickness"))
+        operation += QStringLiteral(" %1").arg(
+            model_.zThickness() > 0.0 ? model_.zThickness() : model_.zThicknessDefault(), 0, 'g', 4);
+      QStringList lines{
+          QStringLiteral("%1 · %2 (%3)").arg(QLatin1String(sideName(side)), model_.methodOf(side), operation)};
       if (paneFailed_[side])
         lines << tr("cannot render (see the status bar)");
       else if (!model_.metricsCurrent(side))

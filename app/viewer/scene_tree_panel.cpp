@@ -123,7 +123,8 @@ void SceneTreePanel::itemChanged(QTreeWidgetItem* item, int column) {
     model_.setObjectVisible(index, item->checkState(kName) == Qt::Checked);
   } else if (column == kOpacity) {
     const double opacity = std::clamp(item->data(kOpacity, Qt::EditRole).toDouble(), 0.0, 1.0);
-    model_.setObjectOpacity(index, opacity);  // sceneChanged shows the clamped value
+    model_.setObjectOpacity(index, opacity);
+    showValues();  // the clamped value, also when it was the part's opacity already (no sceneChanged)
   }
 }
 

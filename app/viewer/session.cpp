@@ -8,6 +8,7 @@
 #include <QSaveFile>
 
 #include <algorithm>
+#include <cmath>
 
 #include "mfr/error.hpp"
 #include "viewer_model.hpp"
@@ -99,6 +100,7 @@ Session captureSession(const ViewerModel& model) {
   s.camera = model.camera();
   s.method = model.method();
   s.operation = model.operation();
+  s.thickness = model.zThickness();
   s.params = model.allParams();
   for (const mfr::Object& o : model.scene().objects) {
     s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color, o.material.vertexColors});
@@ -125,6 +127,7 @@ void applySession(const Session& session, ViewerModel& model) {
     }
   }
   model.setAllParams(session.params);
+  model.setZThickness(session.thickness);
   if (!session.operation.isEmpty()) model.setOperation(session.operation);
   if (!session.method.isEmpty()) model.setMethod(session.method);
   model.setAllParamsOf(1, session.compare.params);
@@ -162,9 +165,11 @@ QJsonObject sessionToJson(const Session& s) {
                                {"color", QJsonArray{o.color.r, o.color.g, o.color.b}},
                                {"opacity", o.color.a},
                                {"vertex_colors", o.vertexColors}});
-  return {{"format", "mfrview-session"}, {"version", 1},           {"scene", s.scenePath},
-          {"camera", camera},            {"method", s.method},     {"operation", s.operation},
-          {"params", paramsToJson(s.params)}, {"objects", objects},  {"compare", compare},
+  return {{"format", "mfrview-session"}, {"version", 1},
+          {"scene", s.scenePath},        {"camera", camera},
+          {"method", s.method},          {"operation", s.operation},
+          {"thickness", s.thickness},    {"params", paramsToJson(s.params)},
+          {"objects", objects},          {"compare", compare},
           {"data_view", dataView},       {"plugins", s.plugins}};
 }
 
@@ -189,6 +194,12 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   s.camera.farPlane = r.number(cam, "far", "camera", s.camera.farPlane);
   s.method = json.value("method").toString();
   s.operation = json.value("operation").toString();
+  // Optional (sessions written before the operation zthickness have none: the default).
+  if (json.contains("thickness") && !json.value("thickness").isDouble())
+    r.fail(QStringLiteral("thickness"), QStringLiteral("expected a number"));
+  s.thickness = json.value("thickness").toDouble(0.0);
+  if (!std::isfinite(s.thickness) || s.thickness < 0.0)
+    r.fail(QStringLiteral("thickness"), QStringLiteral("expected a length >= 0 in scene units (0: the default)"));
   s.params = r.params(json.value("params").toObject(), QStringLiteral("params"));
   // Optional (sessions written before compare mode have neither).
   const QJsonObject compare = json.value("compare").toObject();

@@ -1,5 +1,6 @@
 #pragma once
-// Session files (.mfrsession, JSON): the scene's path, camera, method and operation, the
+// Session files (.mfrsession, JSON): the scene's path, camera, method and operation (with the
+// z-thickness), the
 // parameters of every method the user set, per-object overrides, compare mode (with the second
 // method's own parameters), the data view and each plugin's settings.
 // Doubles are written shortest-round-trip, so a reloaded session renders the same image.
@@ -24,6 +25,7 @@ struct Session {
   mfr::Camera camera;
   QString method;
   QString operation;
+  double thickness = 0.0;  // operation zthickness, scene units, both sides; 0 = the scene's default
   std::map<std::string, std::map<std::string, std::string>> params;  // per method
   std::vector<ObjectState> objects;                                  // by object index
   struct CompareState {

@@ -141,7 +141,46 @@ mfr::RenderRequest ViewerModel::renderRequest(int side, QSize size) const {
   request.width = size.width();
   request.height = size.height();
   request.params = paramsOf(side);
+  request.thickness = thickness_;
   return request;
+}
+
+void ViewerModel::setZThickness(double thickness) {
+  if (!std::isfinite(thickness) || thickness < 0.0 || thickness == thickness_) return;
+  thickness_ = thickness;
+  emit zThicknessChanged(thickness_);
+  for (int side = 0; side < kSides; ++side)
+    if (operationOf(side) == QLatin1String("zthickness")) emit sideChanged(side);
+}
+
+double ViewerModel::zThicknessDefault() const {
+  return mfr::zThicknessOf(mfr::RenderRequest{}, bounds_);  // what the renderers make of thickness 0
+}
+
+bool ViewerModel::supportsOperation(const QString& method, const QString& operation) const {
+  if (method == QLatin1String("oracle")) return true;
+  const mfr::MethodInfo* info = methodInfo(method);
+  if (!info) return false;
+  if (operation == QLatin1String("auto")) return true;
+  if (isCpuMethod(method)) return operation.toStdString() == info->preferredOperation;  // optimal-k: hybrid
+  // kbuffer-zmerge keeps merged z-thickness segments, not fragments: its own operation only.
+  if (info->preferredOperation == "zthickness") return operation == QLatin1String("zthickness");
+  if (operation == QLatin1String("oit")) return true;
+  if (operation == QLatin1String("csg")) return info->objectPayload;
+  if (operation == QLatin1String("hybrid")) {
+    // The k-buffer family's tail (with its parameter "tail" on).
+    return info->preferredOperation == "hybrid" ||
+           std::any_of(info->params.begin(), info->params.end(),
+                       [](const mfr::ParamSpec& p) { return p.name == "tail"; });
+  }
+  if (operation == QLatin1String("zthickness")) {
+    // Every method that resolves sorted per-pixel lists; the peeling methods composite while they
+    // peel and WBOIT / MBOIT keep no lists (their resolve refuses any operation but oit).
+    static const QStringList kNoLists{QStringLiteral("peel-f2b"), QStringLiteral("peel-dual"), QStringLiteral("kpeel"),
+                                      QStringLiteral("wboit"), QStringLiteral("mboit")};
+    return !kNoLists.contains(method);
+  }
+  return false;
 }
 
 // ---- compare mode and data views ----------------------------------------------------------
@@ -274,6 +313,11 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
   hasScene_ = true;
   ++sceneRevision_;
   updateSceneGeometry();
+  // The z-thickness is a length in the old scene's units: the new one starts at its own default.
+  if (thickness_ != 0.0) {
+    thickness_ = 0.0;
+    emit zThicknessChanged(thickness_);
+  }
   camera_ = scene_.views.empty() ? scene_.view("fit") : scene_.views.front().camera;
   ++viewRevision_;
   emit sceneLoaded();
@@ -350,10 +394,31 @@ bool ViewerModel::objectColorEdited(int index) const {
          now.vertexColors != loadedMaterials_[i].vertexColors;
 }
 
+double ViewerModel::objectOpacity(int index) const {
+  if (index < 0 || index >= static_cast<int>(scene_.objects.size())) return -1.0;
+  return scene_.objects[static_cast<std::size_t>(index)].material.color.a;
+}
+
 void ViewerModel::setObjectOpacity(int index, double opacity) {
-  if (index < 0 || index >= static_cast<int>(scene_.objects.size())) return;
-  scene_.objects[static_cast<std::size_t>(index)].material.color.a = static_cast<float>(std::clamp(opacity, 0.0, 1.0));
-  sceneEdited();
+  setObjectOpacities({{index, opacity}});
+}
+
+void ViewerModel::setObjectOpacities(const QMap<int, double>& opacities) {
+  bool changed = false;
+  for (auto it = opacities.begin(); it != opacities.end(); ++it) {
+    if (it.key() < 0 || it.key() >= static_cast<int>(scene_.objects.size()) || std::isnan(it.value())) continue;
+    float& alpha = scene_.objects[static_cast<std::size_t>(it.key())].material.color.a;
+    const auto value = static_cast<float>(std::clamp(it.value(), 0.0, 1.0));
+    if (alpha == value) continue;
+    alpha = value;
+    changed = true;
+  }
+  if (changed) sceneEdited();
+}
+
+double ViewerModel::loadedObjectOpacity(int index) const {
+  if (index < 0 || index >= static_cast<int>(loadedMaterials_.size())) return -1.0;
+  return loadedMaterials_[static_cast<std::size_t>(index)].color.a;
 }
 
 void ViewerModel::setObjectMaterial(int index, const glm::vec4& rgba, bool vertexColors) {
@@ -402,6 +467,8 @@ void ViewerModel::reportRenderError(const QString& message) {
 ImageKey ViewerModel::imageKey(const mfr::RenderRequest& request) const {
   std::string text = request.method + ";" + request.operation;
   for (const auto& [name, value] : request.params) text += ";" + name + "=" + value;
+  if (request.operation == "zthickness")
+    text += ";thickness=" + QString::number(request.thickness, 'g', 17).toStdString();
   return {sceneRevision_, viewRevision_, QSize(request.width, request.height), text};
 }
 
@@ -413,8 +480,13 @@ mfr::RenderRequest ViewerModel::referenceRequest(int side) const {
   mfr::RenderRequest request;
   request.method = "oracle";
   // Exact "over" of every fragment, whatever the pane's transparency operation; the exact CSG
-  // image for a pane showing CSG.
-  request.operation = operationOf(side) == QLatin1String("csg") ? "csg" : "oit";
+  // image for a pane showing CSG, the exact z-thickness image (same thickness) for one showing
+  // zthickness.
+  const QString operation = operationOf(side);
+  request.operation = operation == QLatin1String("csg") || operation == QLatin1String("zthickness")
+                          ? operation.toStdString()
+                          : std::string("oit");
+  request.thickness = thickness_;
   request.width = paneSize().width();
   request.height = paneSize().height();
   return request;

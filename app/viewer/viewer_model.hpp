@@ -115,6 +115,12 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] QStringList objectNames() const override;
   [[nodiscard]] QString csgTree() const override;
   QString setCsgTree(const QString& json) override;
+  [[nodiscard]] bool supportsOperation(const QString& method, const QString& operation) const override;
+  // The z-thickness of every pane (RenderRequest::thickness; 0 = the scene's default). A new
+  // scene (setScene) starts at 0.
+  [[nodiscard]] double zThickness() const override { return thickness_; }
+  void setZThickness(double thickness) override;
+  [[nodiscard]] double zThicknessDefault() const override;
   [[nodiscard]] const ParamsByMethod& allParams() const { return allParamsOf(0); }
   void setAllParams(ParamsByMethod params) { setAllParamsOf(0, std::move(params)); }
   [[nodiscard]] mfr::RenderRequest renderRequest(QSize size) const { return renderRequest(0, size); }
@@ -140,7 +146,10 @@ class ViewerModel final : public ViewerContext {
   // molecule's element colours, included); the opacity stays as it is.
   void resetObjectColor(int index);
   [[nodiscard]] bool objectColorEdited(int index) const;
-  void setObjectOpacity(int index, double opacity);
+  [[nodiscard]] double objectOpacity(int index) const override;
+  void setObjectOpacity(int index, double opacity) override;
+  void setObjectOpacities(const QMap<int, double>& opacities) override;
+  [[nodiscard]] double loadedObjectOpacity(int index) const override;
   void setObjectMaterial(int index, const glm::vec4& rgba, bool vertexColors = true);
 
   // Camera: setCamera refits near/far around the visible objects, so navigation never clips.
@@ -176,7 +185,7 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] quint64 framesRendered() const { return framesRendered_; }
 
   // What the pane of `side` shows now, and its exact reference image (the oracle's "over", or its
-  // CSG for a pane showing CSG).
+  // CSG / z-thickness image, same thickness, for a pane showing that operation).
   [[nodiscard]] ImageKey frameKey(int side) const;
   [[nodiscard]] mfr::RenderRequest referenceRequest(int side) const;
   // Metrics are computed for both panes in compare mode, and for side 0 when a frame quality was
@@ -243,6 +252,7 @@ class ViewerModel final : public ViewerContext {
   std::array<QString, kSides> methods_{QStringLiteral("abuffer-ll"), QStringLiteral("kplus-array")};
   std::array<QString, kSides> operations_{QStringLiteral("auto"), QStringLiteral("auto")};
   std::array<ParamsByMethod, kSides> params_;
+  double thickness_ = 0.0;  // operation zthickness, scene units; 0 = mfr::zThicknessDefault
 
   bool compare_ = false;
   CompareLayout layout_ = CompareLayout::SideBySide;

@@ -7,6 +7,7 @@
 // mfrcore's headers, not its library; its signals' meta-object comes from the executable, which
 // is linked with exported symbols (CMake ENABLE_EXPORTS).
 #include <QJsonObject>
+#include <QMap>
 #include <QObject>
 #include <QSize>
 #include <QString>
@@ -29,7 +30,8 @@ enum class DataView {
   Capacity,         // k(p): the method's per-pixel capacity in the last frame
 };
 
-// The current frame against the exact image (the oracle's "over" of every fragment), same size.
+// The current frame against the exact image, same size: the oracle's "over" of every fragment,
+// or its CSG / z-thickness image (same thickness) while the frame shows that operation.
 struct FrameQuality {
   bool valid = false;  // computed for the frame now shown
   QString method;
@@ -79,9 +81,12 @@ class ViewerContext : public QObject {
   [[nodiscard]] virtual DataView dataView() const = 0;
   [[nodiscard]] virtual bool dataViewOverImage() const = 0;
   virtual void setDataView(DataView view, bool overImage) = 0;
-  // Operation of the main view: "auto", "oit", "hybrid" or "csg".
+  // Operation of the main view: "auto", "oit", "hybrid", "csg" or "zthickness".
   [[nodiscard]] virtual QString operation() const = 0;
   virtual void setOperation(const QString& operation) = 0;
+  // Whether `method` can run `operation` (1.3; the oracle runs them all; csg needs object ids, hybrid
+  // a k-buffer's tail, zthickness sorted lists: not the peeling methods, WBOIT or MBOIT).
+  [[nodiscard]] virtual bool supportsOperation(const QString& method, const QString& operation) const = 0;
   // The scene's object names, in object-id order.
   [[nodiscard]] virtual QStringList objectNames() const = 0;
   // The scene's CSG tree as the JSON text of a scene file's "csg" value (docs/scene-format.md);
@@ -90,6 +95,24 @@ class ViewerContext : public QObject {
   // Replaces the tree (blank text removes it) and re-renders; returns an empty string, or the
   // one-line reason the text was refused (the tree is then unchanged).
   virtual QString setCsgTree(const QString& json) = 0;
+
+  // Operation "zthickness" (1.3): the slab thickness in scene units, used by every pane (and by
+  // the exact reference of a pane showing zthickness); 0 means zThicknessDefault().
+  [[nodiscard]] virtual double zThickness() const = 0;
+  // Re-renders; a negative, infinite or NaN value is ignored.
+  virtual void setZThickness(double thickness) = 0;
+  // The default of the current scene: 1 % of its bounding box's diagonal (mfr::zThicknessDefault).
+  [[nodiscard]] virtual double zThicknessDefault() const = 0;
+
+  // Per-object opacity (1.3), by object id (the index in objectNames()): the same edit as the
+  // scene tree's Opacity column, so every pane, CPU images included, sees it. Values are clamped
+  // to 0 … 1; an unknown id reads -1 and is ignored when set.
+  [[nodiscard]] virtual double objectOpacity(int objectId) const = 0;
+  virtual void setObjectOpacity(int objectId, double opacity) = 0;
+  // Several at once (one re-render): objectId → opacity.
+  virtual void setObjectOpacities(const QMap<int, double>& opacities) = 0;
+  // The opacity the object had when its scene was loaded.
+  [[nodiscard]] virtual double loadedObjectOpacity(int objectId) const = 0;
 
  signals:
   void sceneChanged();  // a new scene, or an object edited
@@ -102,6 +125,7 @@ class ViewerContext : public QObject {
   void frameQualityReady();
   void dataViewChanged();
   void operationChanged(const QString& operation);
+  void zThicknessChanged(double thickness);  // zThickness(), 0 = the default
 };
 
 class MfrViewerPlugin {
@@ -119,5 +143,6 @@ class MfrViewerPlugin {
 
 // 1.1: frame quality and data views in ViewerContext (plugins built for 1.0 are refused).
 // 1.2: operation, object names and the CSG tree.
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.2"
+// 1.3: operation zthickness and its thickness, supportsOperation, per-object opacity.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.3"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -5,6 +5,7 @@
 #include <QComboBox>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
+#include <QJsonArray>
 #include <QLineEdit>
 #include <QListWidget>
 #include <QMessageBox>
@@ -496,6 +497,294 @@ class ViewerTest : public QObject {
     QVERIFY(m.scene().csg.empty());
     QVERIFY(!show->isChecked());
     QCOMPARE(m.operation(), QStringLiteral("auto"));
+  }
+
+  // Operation "zthickness" on the intersecting-surfaces sample: `mfrview --screenshot` equals
+  // `mfr render` (an explicit thickness and the default one) and differs from "over"; the live
+  // frame notes its thickness, is measured against the oracle's z-thickness image of the same
+  // thickness (compare mode: the oracle's own pane is then exact), and every method the viewer
+  // says can run zthickness does, the others refuse it.
+  void zthicknessOperation() {
+    QTemporaryDir dir;
+    const auto png = [&](const QString& name) { return dir.filePath(name); };
+    QString out;
+    const QList<QStringList> cases{
+        {"--method", "abuffer-ll", "--op", "zthickness", "--thickness", "0.05", "--view", "iso"},
+        {"--method", "kbuffer", "-p", "k=16", "--op", "zthickness", "--view", "front"},
+    };
+    for (const QStringList& c : cases) {
+      const QStringList common = QStringList{"--size", "200x150"} + c;
+      QCOMPARE(runProgram(MFRVIEW, QStringList{"@intersect", "--screenshot", png("viewer.png")} + common, &out), 0);
+      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@intersect", "-o", png("cli.png")} + common, &out), 0);
+      const mfr::ImageRGBA8 viewer = mfr::readPng(png("viewer.png").toStdString());
+      const int diff = maxChannelDifference(viewer, mfr::readPng(png("cli.png").toStdString()));
+      qInfo("@intersect %s: viewer vs mfr render max channel difference %d", qPrintable(c.join(' ')), diff);
+      QVERIFY2(diff >= 0 && diff <= 1, qPrintable(c.join(' ') + ": " + QString::number(diff)));
+      QStringList oit = common;
+      oit[oit.indexOf("zthickness")] = "oit";
+      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@intersect", "-o", png("oit.png")} + oit, &out), 0);
+      const double fromOit = mfr::rmse(viewer, mfr::readPng(png("oit.png").toStdString()));
+      qInfo("  RMSE against --op oit: %.5f", fromOit);
+      QVERIFY(fromOit > 0.005);
+    }
+    // A thickness the CLI would refuse ends a scripted viewer run too.
+    QCOMPARE(runProgram(MFRVIEW, {"@intersect", "--screenshot", png("bad.png"), "--op", "zthickness", "--thickness=-1"},
+                        &out),
+             2);
+    QVERIFY2(out.contains("--thickness"), qPrintable(out));
+
+    auto w = openWindow(QStringLiteral("@intersect"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(240, 160);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(240, 160), kTimeoutMs);
+    m.setMethod("abuffer-ll");
+    m.setCamera(m.scene().view("iso"));
+    auto* operation = w->findChild<QComboBox*>("operationCombo");
+    auto* thickness = w->findChild<QDoubleSpinBox*>("zThickness");
+    QVERIFY(operation && thickness);
+    operation->setCurrentIndex(operation->findData(QStringLiteral("zthickness")));
+    QCOMPARE(m.operation(), QStringLiteral("zthickness"));
+    thickness->setValue(0.05);
+    QCOMPARE(m.zThickness(), 0.05);
+    QCOMPARE(m.renderRequest(QSize(8, 8)).thickness, 0.05);
+    settle(m);
+    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    QCOMPARE(QString::fromStdString(m.stats().operation), QStringLiteral("zthickness"));
+    const auto note = [&m]() -> std::string {
+      for (const auto& [name, value] : m.stats().notes)
+        if (name == "z-thickness") return value;
+      return {};
+    };
+    QCOMPARE(note(), std::to_string(0.05));
+    // The default (thickness 0) is 1 % of the diagonal, as the renderers make it.
+    const mfr::Bounds b = m.scene().bounds();
+    QVERIFY(std::abs(m.zThicknessDefault() - 0.01 * glm::length(b.max - b.min)) < 1e-12);
+    m.setZThickness(0.0);
+    settle(m);
+    QCOMPARE(note(), std::to_string(m.zThicknessDefault()));
+    QVERIFY(thickness->specialValueText().contains("default"));
+    m.setZThickness(0.05);
+
+    // Frame quality against the oracle's z-thickness image of the same thickness.
+    const auto oracle = [&m](const std::string& op, QSize size) {
+      mfr::RenderRequest request;
+      request.operation = op;
+      request.thickness = m.zThickness();
+      request.width = size.width();
+      request.height = size.height();
+      return mfr::render(m.scene(), m.camera(), request).image;
+    };
+    QCOMPARE(m.referenceRequest(0).operation, std::string("zthickness"));
+    QCOMPARE(m.referenceRequest(0).thickness, 0.05);
+    settle(m);
+    m.requestFrameQuality();
+    QTRY_VERIFY_WITH_TIMEOUT(m.frameQuality().valid, kTimeoutMs);
+    const mfr::ImageRGBA8 frame = w->view().renderImage(m.renderSize());
+    const double exact = mfr::rmse(oracle("zthickness", m.renderSize()), frame);
+    const double fromOit = mfr::rmse(oracle("oit", m.renderSize()), frame);
+    qInfo("@intersect abuffer-ll zthickness 0.05: frame quality RMSE %.6f (recomputed %.6f; against oit %.6f)",
+          m.frameQuality().rmse, exact, fromOit);
+    QVERIFY(std::abs(m.frameQuality().rmse - exact) < 1e-9);
+    QVERIFY(std::abs(m.frameQuality().rmse - fromOit) > 1e-4);
+
+    // Compare mode: side B the oracle with zthickness, measured against itself: exact.
+    m.setOperationOf(1, QStringLiteral("zthickness"));
+    m.setMethodOf(1, QStringLiteral("oracle"));
+    m.setCompareEnabled(true);
+    settle(m);
+    QTRY_VERIFY_WITH_TIMEOUT(m.metricsCurrent(0) && m.metricsCurrent(1), kTimeoutMs);
+    QVERIFY2(m.metrics(0).valid && m.metrics(1).valid, qPrintable(m.metrics(0).error + m.metrics(1).error));
+    qInfo("compare: abuffer-ll RMSE %.6f, oracle RMSE %.6f", m.metrics(0).rmse, m.metrics(1).rmse);
+    QCOMPARE(m.metrics(1).rmse, 0.0);
+    QVERIFY(std::abs(m.metrics(0).rmse -
+                     mfr::rmse(oracle("zthickness", m.paneSize()), crop(fromQImage(w->view().grabFramebuffer()),
+                                                                        QRect(QPoint(0, 0), m.paneSize())))) < 1e-9);
+    // Another thickness is another image, re-rendered and re-measured.
+    const PaneMetrics before = m.metrics(0);
+    m.setZThickness(0.3);
+    QVERIFY(!m.metricsCurrent(0) && !m.metricsCurrent(1));
+    settle(m);
+    QTRY_VERIFY_WITH_TIMEOUT(m.metricsCurrent(0) && m.metricsCurrent(1), kTimeoutMs);
+    QCOMPARE(m.metrics(1).rmse, 0.0);
+    QVERIFY(m.metrics(0).key != before.key);
+    m.setCompareEnabled(false);
+
+    // supportsOperation says which methods can run it: exactly those that do.
+    w->view().setFixedSize(96, 64);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(96, 64), kTimeoutMs);
+    for (const mfr::RegistryEntry& e : mfr::methodRegistry()) {
+      const QString name = QString::fromStdString(e.name);
+      m.setMethod(name);
+      settle(m);
+      const bool supported = m.supportsOperation(name, QStringLiteral("zthickness"));
+      qInfo("%s: supports zthickness %d; render error: %s", e.name.c_str(), supported, qPrintable(m.renderError()));
+      QVERIFY2(m.renderError().isEmpty() == supported, qPrintable(name + ": " + m.renderError()));
+      if (supported) QCOMPARE(QString::fromStdString(m.stats().operation), QStringLiteral("zthickness"));
+    }
+    QVERIFY(m.supportsOperation(QStringLiteral("oracle"), QStringLiteral("zthickness")));
+  }
+
+  // The Ghosting plugin on @intersect: the blend switch (picking an A-buffer for a method without
+  // sorted lists, and back), the thickness slider and spin box driving the frame's z-thickness,
+  // ghosting of the parts not in focus (and their opacities back), and its settings in sessions.
+  void ghostingPanel() {
+    auto w = openWindow(QStringLiteral("@intersect"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(200, 150);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(200, 150), kTimeoutMs);
+    QVERIFY2(w->findChild<QDockWidget*>("plugin-ghosting"), "ghosting plugin not loaded");
+    auto* blend = w->findChild<QCheckBox*>("ghostBlend");
+    auto* slider = w->findChild<QSlider*>("ghostThicknessSlider");
+    auto* units = w->findChild<QDoubleSpinBox*>("ghostThickness");
+    auto* parts = w->findChild<QListWidget*>("ghostParts");
+    auto* ghost = w->findChild<QCheckBox*>("ghostOthers");
+    auto* opacity = w->findChild<QSlider*>("ghostOpacity");
+    auto* restore = w->findChild<QPushButton*>("ghostRestore");
+    QVERIFY(blend && slider && units && parts && ghost && opacity && restore);
+    const auto note = [&m]() -> std::string {
+      for (const auto& [name, value] : m.stats().notes)
+        if (name == "z-thickness") return value;
+      return {};
+    };
+
+    // The switch: wboit keeps no lists, so the panel takes abuffer-ll; off, both come back.
+    m.setMethod("wboit");
+    m.setOperation("oit");
+    m.setCamera(m.scene().view("iso"));
+    QVERIFY(!blend->isChecked());
+    blend->setChecked(true);
+    QCOMPARE(m.operation(), QStringLiteral("zthickness"));
+    QCOMPARE(m.method(), QStringLiteral("abuffer-ll"));
+    settle(m);
+    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    QCOMPARE(QString::fromStdString(m.stats().operation), QStringLiteral("zthickness"));
+    QCOMPARE(note(), std::to_string(m.zThicknessDefault()));
+    QCOMPARE(units->value(), std::round(m.zThicknessDefault() * 1e6) / 1e6);  // shown at the default
+    const mfr::ImageRGBA8 thin = w->view().renderImage(m.renderSize());
+    blend->setChecked(false);
+    QCOMPARE(m.operation(), QStringLiteral("oit"));
+    QCOMPARE(m.method(), QStringLiteral("wboit"));
+    // A method with sorted lists is kept; the operation menu's zthickness checks the switch.
+    m.setMethod("kplus-array");
+    blend->setChecked(true);
+    QCOMPARE(m.method(), QStringLiteral("kplus-array"));
+    m.setOperation("auto");
+    QVERIFY(!blend->isChecked());
+    m.setOperation("zthickness");
+    QVERIFY(blend->isChecked());
+    m.setMethod("abuffer-ll");
+
+    // Thickness: the log slider in % of the diagonal, the spin box in scene units.
+    const double diagonal = m.zThicknessDefault() / 0.01;
+    slider->setValue(slider->maximum());  // 10 %
+    QVERIFY(std::abs(m.zThickness() - 0.1 * diagonal) < 1e-9 * diagonal);
+    QCOMPARE(m.renderRequest(QSize(8, 8)).thickness, m.zThickness());
+    settle(m);
+    QCOMPARE(note(), std::to_string(m.zThickness()));
+    const mfr::ImageRGBA8 thick = w->view().renderImage(m.renderSize());
+    qInfo("thickness 1 %% vs 10 %% of the diagonal: RMSE %.5f", mfr::rmse(thin, thick));
+    QVERIFY(mfr::rmse(thin, thick) > 0.002);
+    slider->setValue(0);  // 0.05 %
+    QVERIFY(std::abs(m.zThickness() - 0.0005 * diagonal) < 1e-9 * diagonal);
+    units->setValue(0.04);
+    QCOMPARE(m.zThickness(), 0.04);
+    const int expected =
+        static_cast<int>(std::lround(std::log(0.04 / diagonal * 100.0 / 0.05) / std::log(200.0) * 1000.0));
+    QCOMPARE(slider->value(), expected);
+    settle(m);
+    QCOMPARE(note(), std::to_string(0.04));
+    w->findChild<QPushButton*>("ghostThicknessDefault")->click();
+    QCOMPARE(m.zThickness(), 0.0);
+    m.setZThickness(0.04);
+    QCOMPARE(units->value(), 0.04);
+
+    // Ghosting: "design" in focus, every other part at the slider's opacity; a part edited before
+    // gets its own opacity back when ghosting goes off; Restore brings the loaded ones.
+    const QStringList names = m.objectNames();
+    std::vector<double> loaded;
+    for (int i = 0; i < names.size(); ++i) loaded.push_back(m.objectOpacity(i));
+    QCOMPARE(parts->count(), static_cast<int>(names.size()));
+    const int design = static_cast<int>(names.indexOf("design")), ring = static_cast<int>(names.indexOf("ring"));
+    QVERIFY(design >= 0 && ring >= 0);
+    m.setObjectOpacity(ring, 0.6);
+    parts->item(design)->setCheckState(Qt::Checked);
+    const quint64 revision = m.sceneRevision();
+    ghost->setChecked(true);
+    QCOMPARE(m.sceneRevision(), revision + 1);  // one edit for all parts: one re-render
+    const auto opacities = [&] {
+      std::vector<double> now;
+      for (int i = 0; i < names.size(); ++i) now.push_back(m.objectOpacity(i));
+      return now;
+    };
+    const auto allOthersAt = [&](double value) {
+      for (int i = 0; i < names.size(); ++i)
+        if (i != design && std::abs(m.objectOpacity(i) - value) > 1e-6) return false;
+      return std::abs(m.objectOpacity(design) - loaded[static_cast<std::size_t>(design)]) < 1e-6;
+    };
+    QVERIFY(allOthersAt(0.15));
+    QCOMPARE(opacity->value(), 15);
+    opacity->setValue(40);
+    QVERIFY(allOthersAt(0.40));
+    settle(m);
+    const mfr::ImageRGBA8 ghosted = w->view().renderImage(m.renderSize());
+    QVERIFY(mfr::rmse(ghosted, thick) > 0.002);
+    // "ring" into focus: its own opacity (0.6) back at once.
+    parts->item(ring)->setCheckState(Qt::Checked);
+    QVERIFY(std::abs(m.objectOpacity(ring) - 0.6) < 1e-6);
+    parts->item(ring)->setCheckState(Qt::Unchecked);
+    QVERIFY(std::abs(m.objectOpacity(ring) - 0.4) < 1e-6);
+    ghost->setChecked(false);
+    for (int i = 0; i < names.size(); ++i)
+      QVERIFY(std::abs(m.objectOpacity(i) - (i == ring ? 0.6 : loaded[static_cast<std::size_t>(i)])) < 1e-6);
+    ghost->setChecked(true);
+    restore->click();
+    QVERIFY(!ghost->isChecked());
+    for (int i = 0; i < names.size(); ++i)
+      QVERIFY(std::abs(m.objectOpacity(i) - loaded[static_cast<std::size_t>(i)]) < 1e-6);
+    // The scene tree shows the panel's edits.
+    m.setObjectOpacity(ring, 0.6);
+    ghost->setChecked(true);
+    auto* tree = w->findChild<QTreeWidget*>("sceneTree");
+    QCOMPARE(tree->topLevelItem(ring)->data(2, Qt::EditRole).toDouble(), 0.4);
+
+    // Sessions: the thickness, the operation, the focus, ghosting with its opacity (and what the
+    // ghosted parts had before); the plugin's settings are its saveSettings.
+    const std::vector<double> ghostedOpacities = opacities();
+    QTemporaryDir dir;
+    const QString sessionPath = dir.filePath("ghost.mfrsession");
+    w->saveSession(sessionPath);
+    {
+      auto again = openWindow(QString());
+      QVERIFY(again);
+      again->openSession(sessionPath);
+      ViewerModel& a = again->model();
+      QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.framesRendered() > 0, kTimeoutMs);
+      auto* ghost2 = again->findChild<QCheckBox*>("ghostOthers");
+      auto* parts2 = again->findChild<QListWidget*>("ghostParts");
+      QTRY_VERIFY_WITH_TIMEOUT(ghost2->isChecked(), kTimeoutMs);
+      QCOMPARE(a.operation(), QStringLiteral("zthickness"));
+      QCOMPARE(a.zThickness(), 0.04);
+      QVERIFY(again->findChild<QCheckBox*>("ghostBlend")->isChecked());
+      QCOMPARE(again->findChild<QDoubleSpinBox*>("ghostThickness")->value(), 0.04);
+      QCOMPARE(again->findChild<QSlider*>("ghostOpacity")->value(), 40);
+      QCOMPARE(parts2->item(design)->checkState(), Qt::Checked);
+      QCOMPARE(parts2->item(ring)->checkState(), Qt::Unchecked);
+      for (int i = 0; i < names.size(); ++i)
+        QVERIFY(std::abs(a.objectOpacity(i) - ghostedOpacities[static_cast<std::size_t>(i)]) < 1e-6);
+      // Ghosting off there gives every part the opacity it had before ghosting (ring: 0.6).
+      ghost2->setChecked(false);
+      for (int i = 0; i < names.size(); ++i)
+        QVERIFY(std::abs(a.objectOpacity(i) - (i == ring ? 0.6 : loaded[static_cast<std::size_t>(i)])) < 1e-6);
+      const QJsonObject settings = [&] {
+        for (const PluginRecord& r : again->plugins().records())
+          if (r.id == "ghosting") return r.plugin->saveSettings();
+        return QJsonObject{};
+      }();
+      QCOMPARE(settings.value("ghost").toBool(true), false);
+      QCOMPARE(settings.value("focus").toArray(), QJsonArray{"design"});
+    }
   }
 
   // The live widget's framebuffer (GpuRenderer::renderTo into QOpenGLWidget's FBO) against the

@@ -1,0 +1,285 @@
+#include "ghosting_panel.hpp"
+
+#include <QCheckBox>
+#include <QDoubleSpinBox>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QJsonArray>
+#include <QLabel>
+#include <QListWidget>
+#include <QPushButton>
+#include <QSignalBlocker>
+#include <QSlider>
+#include <QVBoxLayout>
+
+#include <algorithm>
+#include <cmath>
+
+#include "viewer_plugin.hpp"
+
+namespace {
+
+const QString kZThickness = QStringLiteral("zthickness");
+
+// Slider position ↔ % of the diagonal, logarithmic between the panel's limits.
+double percentAt(int position) {
+  const double f = static_cast<double>(position) / GhostingPanel::kSliderSteps;
+  return GhostingPanel::kMinPercent * std::pow(GhostingPanel::kMaxPercent / GhostingPanel::kMinPercent, f);
+}
+
+int positionOf(double percent) {
+  const double f = std::log(percent / GhostingPanel::kMinPercent) /
+                   std::log(GhostingPanel::kMaxPercent / GhostingPanel::kMinPercent);
+  return static_cast<int>(std::lround(std::clamp(f, 0.0, 1.0) * GhostingPanel::kSliderSteps));
+}
+
+}  // namespace
+
+GhostingPanel::GhostingPanel(ViewerContext& context, QWidget* parent) : QWidget(parent), context_(context) {
+  setObjectName(QStringLiteral("ghostingPanel"));
+  auto* layout = new QVBoxLayout(this);
+
+  // ---- z-thickness blending
+  blend_ = new QCheckBox(tr("Blend intersecting surfaces (z-thickness)"));
+  blend_->setObjectName(QStringLiteral("ghostBlend"));
+  blend_->setToolTip(
+      tr("Operation zthickness: every fragment is a slab of the thickness below behind its surface. Surfaces "
+         "closer than that (intersecting, or the same part loaded twice) blend without z-fighting; surfaces "
+         "further apart composite \"over\". Needs sorted lists: an A-buffer, a k-buffer or the oracle."));
+  layout->addWidget(blend_);
+  blendNote_ = new QLabel;
+  blendNote_->setObjectName(QStringLiteral("ghostBlendNote"));
+  blendNote_->setWordWrap(true);
+  blendNote_->setStyleSheet(QStringLiteral("color: #b00020;"));
+  blendNote_->hide();
+  layout->addWidget(blendNote_);
+
+  auto* form = new QFormLayout;
+  thicknessSlider_ = new QSlider(Qt::Horizontal);
+  thicknessSlider_->setObjectName(QStringLiteral("ghostThicknessSlider"));
+  thicknessSlider_->setRange(0, kSliderSteps);
+  thicknessSlider_->setToolTip(
+      tr("Slab thickness, %1 % … %2 % of the scene's diagonal (logarithmic)").arg(kMinPercent).arg(kMaxPercent));
+  thicknessPercent_ = new QLabel;
+  thicknessPercent_->setObjectName(QStringLiteral("ghostThicknessPercent"));
+  thicknessPercent_->setMinimumWidth(fontMetrics().horizontalAdvance(QStringLiteral("10.00 %")));
+  auto* sliderRow = new QHBoxLayout;
+  sliderRow->addWidget(thicknessSlider_, 1);
+  sliderRow->addWidget(thicknessPercent_);
+  form->addRow(tr("Thickness"), sliderRow);
+  thickness_ = new QDoubleSpinBox;
+  thickness_->setObjectName(QStringLiteral("ghostThickness"));
+  thickness_->setDecimals(6);
+  thickness_->setRange(1.0e-6, 1.0e9);
+  thickness_->setKeyboardTracking(false);
+  thickness_->setToolTip(tr("Slab thickness in scene units"));
+  auto* reset = new QPushButton(tr("Default"));
+  reset->setObjectName(QStringLiteral("ghostThicknessDefault"));
+  reset->setToolTip(tr("1 % of the scene's diagonal"));
+  auto* unitsRow = new QHBoxLayout;
+  unitsRow->addWidget(thickness_, 1);
+  unitsRow->addWidget(reset);
+  form->addRow(tr("Scene units"), unitsRow);
+  layout->addLayout(form);
+
+  // ---- ghosting
+  layout->addWidget(new QLabel(tr("Parts in focus (keep their opacity):")));
+  parts_ = new QListWidget;
+  parts_->setObjectName(QStringLiteral("ghostParts"));
+  parts_->setMaximumHeight(160);
+  layout->addWidget(parts_);
+  ghost_ = new QCheckBox(tr("Ghost the other parts"));
+  ghost_->setObjectName(QStringLiteral("ghostOthers"));
+  ghost_->setToolTip(tr("Every part not in focus gets the opacity of the slider; off, each gets its own back"));
+  layout->addWidget(ghost_);
+  auto* ghostRow = new QHBoxLayout;
+  ghostSlider_ = new QSlider(Qt::Horizontal);
+  ghostSlider_->setObjectName(QStringLiteral("ghostOpacity"));
+  ghostSlider_->setRange(2, 100);  // opacity in hundredths
+  ghostSlider_->setValue(static_cast<int>(std::lround(kDefaultGhostOpacity * 100.0)));
+  ghostSlider_->setToolTip(tr("Opacity of the ghosted parts (0.02 … 1)"));
+  ghostValue_ = new QLabel;
+  ghostValue_->setMinimumWidth(fontMetrics().horizontalAdvance(QStringLiteral("0.00")));
+  ghostRow->addWidget(new QLabel(tr("Opacity")));
+  ghostRow->addWidget(ghostSlider_, 1);
+  ghostRow->addWidget(ghostValue_);
+  layout->addLayout(ghostRow);
+  auto* restore = new QPushButton(tr("Restore Opacities"));
+  restore->setObjectName(QStringLiteral("ghostRestore"));
+  restore->setToolTip(tr("Every part back to its opacity as loaded; ghosting off"));
+  layout->addWidget(restore, 0, Qt::AlignLeft);
+  layout->addStretch();
+
+  connect(blend_, &QCheckBox::toggled, this, &GhostingPanel::setBlend);
+  connect(&context_, &ViewerContext::operationChanged, this, &GhostingPanel::showBlendState);
+  connect(&context_, &ViewerContext::methodChanged, this, &GhostingPanel::showBlendState);
+  connect(thicknessSlider_, &QSlider::valueChanged, this, &GhostingPanel::thicknessFromSlider);
+  connect(thickness_, &QDoubleSpinBox::valueChanged, this, [this](double v) { context_.setZThickness(v); });
+  connect(reset, &QPushButton::clicked, this, [this] { context_.setZThickness(0.0); });
+  connect(&context_, &ViewerContext::zThicknessChanged, this, &GhostingPanel::showThickness);
+  connect(&context_, &ViewerContext::sceneChanged, this, &GhostingPanel::sceneChanged);
+  connect(parts_, &QListWidget::itemChanged, this, &GhostingPanel::applyGhosting);
+  connect(ghost_, &QCheckBox::toggled, this, &GhostingPanel::applyGhosting);
+  connect(ghostSlider_, &QSlider::valueChanged, this, [this] {
+    ghostValue_->setText(QString::number(ghostOpacity(), 'f', 2));
+    if (ghost_->isChecked()) applyGhosting();
+  });
+  connect(restore, &QPushButton::clicked, this, &GhostingPanel::restoreOpacities);
+  ghostValue_->setText(QString::number(ghostOpacity(), 'f', 2));
+  sceneChanged();
+  showBlendState();
+}
+
+double GhostingPanel::diagonal() const {
+  return context_.zThicknessDefault() / 0.01;  // the default is 1 % of the diagonal
+}
+
+double GhostingPanel::ghostOpacity() const {
+  return ghostSlider_->value() / 100.0;
+}
+
+bool GhostingPanel::isFocus(int objectId) const {
+  const QListWidgetItem* item = parts_->item(objectId);
+  return item && item->checkState() == Qt::Checked;
+}
+
+void GhostingPanel::sceneChanged() {
+  const QStringList names = context_.hasScene() ? context_.objectNames() : QStringList{};
+  if (names != names_) {
+    // Another scene: nothing of it is ghosted yet.
+    names_ = names;
+    saved_.clear();
+    const QSignalBlocker blockList(parts_), blockGhost(ghost_);
+    ghost_->setChecked(false);
+    parts_->clear();
+    for (const QString& name : names) {
+      auto* item = new QListWidgetItem(name, parts_);
+      item->setFlags(item->flags() | Qt::ItemIsUserCheckable);
+      item->setCheckState(Qt::Unchecked);
+    }
+  }
+  showThickness();  // the default follows the scene's size
+}
+
+// ---- z-thickness ----------------------------------------------------------------------------
+
+void GhostingPanel::setBlend(bool on) {
+  const QString operation = context_.operation();
+  if (!on) {
+    if (operation == kZThickness) {
+      if (!previousMethod_.isEmpty() && context_.method() == QLatin1String(kBlendMethod))
+        context_.setMethod(previousMethod_);
+      context_.setOperation(previousOperation_.isEmpty() ? QStringLiteral("auto") : previousOperation_);
+    }
+    previousMethod_.clear();
+    showBlendState();
+    return;
+  }
+  if (operation != kZThickness) previousOperation_ = operation;
+  const QString method = context_.method();
+  if (!context_.supportsOperation(method, kZThickness)) {
+    previousMethod_ = method;
+    context_.setMethod(QLatin1String(kBlendMethod));
+  }
+  context_.setOperation(kZThickness);
+  showBlendState();
+}
+
+void GhostingPanel::showBlendState() {
+  const bool on = context_.operation() == kZThickness;
+  {
+    const QSignalBlocker block(blend_);
+    blend_->setChecked(on);
+  }
+  const QString method = context_.method();
+  const bool refused = on && !context_.supportsOperation(method, kZThickness);
+  blendNote_->setText(refused ? tr("%1 keeps no sorted lists and cannot blend: choose an A-buffer, a k-buffer "
+                                   "or the oracle.")
+                                    .arg(method)
+                              : QString());
+  blendNote_->setVisible(refused);
+}
+
+void GhostingPanel::showThickness() {
+  const double diag = diagonal();
+  const double value = context_.zThickness() > 0.0 ? context_.zThickness() : context_.zThicknessDefault();
+  const double percent = diag > 0.0 ? 100.0 * value / diag : 1.0;
+  const QSignalBlocker blockSlider(thicknessSlider_), blockBox(thickness_);
+  thicknessSlider_->setValue(positionOf(percent));
+  thickness_->setSingleStep(std::max(1.0e-6, diag * 0.001));
+  thickness_->setValue(value);
+  thicknessPercent_->setText(QStringLiteral("%1 %").arg(percent, 0, 'f', percent < 0.1 ? 3 : 2));
+}
+
+void GhostingPanel::thicknessFromSlider(int position) {
+  context_.setZThickness(percentAt(position) / 100.0 * diagonal());
+}
+
+// ---- ghosting -------------------------------------------------------------------------------
+
+void GhostingPanel::applyGhosting() {
+  const bool ghosting = ghost_->isChecked();
+  QMap<int, double> changes;
+  for (int id = 0; id < parts_->count(); ++id) {
+    if (ghosting && !isFocus(id)) {
+      if (!saved_.contains(id)) saved_.insert(id, context_.objectOpacity(id));
+      changes.insert(id, ghostOpacity());
+    } else if (saved_.contains(id)) {
+      changes.insert(id, saved_.take(id));  // in focus again, or ghosting off: its own opacity back
+    }
+  }
+  context_.setObjectOpacities(changes);
+}
+
+void GhostingPanel::restoreOpacities() {
+  {
+    const QSignalBlocker block(ghost_);
+    ghost_->setChecked(false);
+  }
+  saved_.clear();
+  QMap<int, double> original;
+  for (int id = 0; id < parts_->count(); ++id) original.insert(id, context_.loadedObjectOpacity(id));
+  context_.setObjectOpacities(original);
+}
+
+// ---- settings -------------------------------------------------------------------------------
+
+QJsonObject GhostingPanel::saveSettings() const {
+  QJsonArray focus;
+  QJsonObject ghosted;
+  for (int id = 0; id < parts_->count(); ++id) {
+    if (isFocus(id)) focus.append(parts_->item(id)->text());
+    if (saved_.contains(id)) ghosted.insert(parts_->item(id)->text(), saved_.value(id));
+  }
+  return {{QStringLiteral("focus"), focus},
+          {QStringLiteral("ghost"), ghost_->isChecked()},
+          {QStringLiteral("ghost_opacity"), ghostOpacity()},
+          {QStringLiteral("ghosted"), ghosted},
+          {QStringLiteral("previous_operation"), previousOperation_},
+          {QStringLiteral("previous_method"), previousMethod_}};
+}
+
+void GhostingPanel::loadSettings(const QJsonObject& settings) {
+  if (!context_.hasScene()) return;
+  sceneChanged();  // the list of this scene's parts (sessions load settings before sceneChanged)
+  previousOperation_ = settings.value(QStringLiteral("previous_operation")).toString();
+  previousMethod_ = settings.value(QStringLiteral("previous_method")).toString();
+  const QStringList focus = settings.value(QStringLiteral("focus")).toVariant().toStringList();
+  const QJsonObject ghosted = settings.value(QStringLiteral("ghosted")).toObject();
+  {
+    const QSignalBlocker blockList(parts_), blockGhost(ghost_), blockSlider(ghostSlider_);
+    const double opacity = settings.value(QStringLiteral("ghost_opacity")).toDouble(kDefaultGhostOpacity);
+    ghostSlider_->setValue(static_cast<int>(std::lround(std::clamp(opacity, 0.02, 1.0) * 100.0)));
+    ghostValue_->setText(QString::number(ghostOpacity(), 'f', 2));
+    saved_.clear();
+    for (int id = 0; id < parts_->count(); ++id) {
+      QListWidgetItem* item = parts_->item(id);
+      item->setCheckState(focus.contains(item->text()) ? Qt::Checked : Qt::Unchecked);
+      // The opacities the session's ghosted parts had before (the session's objects hold the ghosted ones).
+      if (ghosted.contains(item->text())) saved_.insert(id, ghosted.value(item->text()).toDouble());
+    }
+    ghost_->setChecked(settings.value(QStringLiteral("ghost")).toBool(false));
+  }
+  applyGhosting();
+  showBlendState();
+}
