@@ -43,7 +43,7 @@ void KBufferZThicknessMerge::configure(int width, int height, const Params& para
   const std::uint64_t pixels = static_cast<std::uint64_t>(width) * height;
   if (pixels * k > maxStorageElements(kSegmentBytes))
     throw Error("--param k=" + std::to_string(k), std::to_string(width) + "x" + std::to_string(height) +
-                                                      " pixels x k segments x 16 bytes exceed the largest shader "
+                                                      " pixels x k segments x 12 bytes exceed the largest shader "
                                                       "storage block of this GL context");
   if (width != width_ || height != height_ || k != k_ || !segments_) {
     width_ = width;
@@ -65,8 +65,8 @@ void KBufferZThicknessMerge::capture(const FrameContext& ctx) {
   if (!(ctx.zThickness > 0.0f)) throw Error("--thickness", "kbuffer-zmerge needs a positive z-thickness");
   stats_ = Stats{};
   const GLuint zero = 0;
-  const GLuint empty[4] = {0x7F800000u, 0x7F800000u, 0u, 0u};  // front = +inf: an empty slot
-  glClearNamedBufferData(segments_.id(), GL_RGBA32UI, GL_RGBA_INTEGER, GL_UNSIGNED_INT, empty);
+  const GLuint empty = 0x7F800000u;  // every word +inf bits: front = +inf marks an empty slot
+  glClearNamedBufferData(segments_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &empty);
   glClearNamedBufferData(counters_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   glClearTexImage(locks_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);

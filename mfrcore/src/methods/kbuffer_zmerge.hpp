@@ -10,7 +10,7 @@ namespace mfr {
 
 class KBufferZThicknessMerge final : public Method {
  public:
-  static constexpr std::uint64_t kSegmentBytes = 16;  // front, back, (r, g), (b, optical depth)
+  static constexpr std::uint64_t kSegmentBytes = 12;  // front, (length, optical depth) halves, RGBA8
   static constexpr std::uint64_t kCounterBytes = 32;
 
   [[nodiscard]] const MethodInfo& info() const override;

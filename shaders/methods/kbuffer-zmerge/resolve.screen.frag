@@ -4,7 +4,7 @@
 // constant between segment ends: integrated exactly front to back (Beer–Lambert per interval,
 // the σ-weighted colour), then the background — the model of the operation "zthickness"
 // (shaders/ops/zthickness.glsl), which it equals while no segment was merged.
-#define ZM_ACCESS readonly
+#define ZM_READONLY
 #include "methods/kbuffer-zmerge/segments.glsl"
 
 uniform vec3 uBackground;
@@ -17,9 +17,8 @@ void main() {
   uint n = 0u;
   float position = 3.4e38;
   for (uint i = 0u; i < min(uZmK, uint(MFR_ZMERGE_MAX_K)); ++i) {
-    uvec4 v = zmSegments[zmSlot(pixel, i)];
-    if (v.x == ZM_EMPTY) break;
-    Segment s = zmUnpack(v);
+    if (zmEmpty(zmSlot(pixel, i))) break;
+    Segment s = zmLoad(zmSlot(pixel, i));
     front[n] = s.front;
     back[n] = s.back;
     sigma[n] = s.opticalDepth / max(s.back - s.front, 1e-30);

@@ -2,15 +2,19 @@
 // Merging for Multi-Fragment Rendering", Computer Graphics Forum 40(7) 2021: storage shared by the
 // store and resolve passes. Each of a pixel's k slots holds a ray segment [front, back] (eye depths)
 // of uniform medium: optical depth D = ∫σ (a fragment's own: -ln(1 - α)) and colour c (the
-// D-weighted mean of what was merged into it). 16 bytes: front, back (float bits), (c.r, c.g),
-// (c.b, D) as half pairs. Slot i of pixel p at zmSegments[i·P + p] (slice-major, as the k-buffers);
-// used slots are 0..m-1, an empty slot has front = +inf.
+// D-weighted mean of what was merged into it). 12 bytes, as in the paper: front (float bits),
+// (back - front, D) as a half pair, c as RGBA8. Slot i of pixel p is segment i·P + p (slice-major,
+// as the k-buffers), words 3·segment … 3·segment + 2; used slots are 0..m-1, an empty slot has
+// front = +inf.
 #include "common/bindings.h"
 
-#ifndef ZM_ACCESS
+// ZM_READONLY: the resolve pass only reads the segments.
+#ifdef ZM_READONLY
+#define ZM_ACCESS readonly
+#else
 #define ZM_ACCESS coherent
 #endif
-layout(std430, binding = MFR_SSBO_NODES) ZM_ACCESS buffer ZMergeSegments { uvec4 zmSegments[]; };
+layout(std430, binding = MFR_SSBO_NODES) ZM_ACCESS buffer ZMergeSegments { uint zmWords[]; };
 
 uniform int uZmWidth;
 uniform uint uZmPixels;
@@ -26,13 +30,18 @@ struct Segment {
 
 uint zmPixel(ivec2 p) { return uint(p.y) * uint(uZmWidth) + uint(p.x); }
 uint zmSlot(uint pixel, uint i) { return i * uZmPixels + pixel; }
+bool zmEmpty(uint slot) { return zmWords[3u * slot] == ZM_EMPTY; }
 
-Segment zmUnpack(uvec4 v) {
-  vec2 rg = unpackHalf2x16(v.z), bd = unpackHalf2x16(v.w);
-  return Segment(uintBitsToFloat(v.x), uintBitsToFloat(v.y), bd.y, vec3(rg, bd.x));
+Segment zmLoad(uint slot) {
+  float front = uintBitsToFloat(zmWords[3u * slot]);
+  vec2 lengthDepth = unpackHalf2x16(zmWords[3u * slot + 1u]);
+  return Segment(front, front + lengthDepth.x, lengthDepth.y, unpackUnorm4x8(zmWords[3u * slot + 2u]).rgb);
 }
 
-uvec4 zmPack(Segment s) {
-  return uvec4(floatBitsToUint(s.front), floatBitsToUint(s.back), packHalf2x16(s.color.rg),
-               packHalf2x16(vec2(s.color.b, s.opticalDepth)));
+#ifndef ZM_READONLY
+void zmStore(uint slot, Segment s) {
+  zmWords[3u * slot] = floatBitsToUint(s.front);
+  zmWords[3u * slot + 1u] = packHalf2x16(vec2(s.back - s.front, s.opticalDepth));
+  zmWords[3u * slot + 2u] = packUnorm4x8(vec4(s.color, 0.0));
 }
+#endif

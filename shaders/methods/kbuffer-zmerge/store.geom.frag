@@ -53,13 +53,12 @@ void kbInsert() {
   Segment s[MFR_ZMERGE_MAX_K + 1];
   uint used = 0u;
   for (uint i = 0u; i < uZmK; ++i) {
-    uvec4 v = zmSegments[zmSlot(gPixel, i)];
-    if (v.x == ZM_EMPTY) break;
-    s[i] = zmUnpack(v);
+    if (zmEmpty(zmSlot(gPixel, i))) break;
+    s[i] = zmLoad(zmSlot(gPixel, i));
     ++used;
   }
   if (used < uZmK) {
-    zmSegments[zmSlot(gPixel, used)] = zmPack(gSegment);
+    zmStore(zmSlot(gPixel, used), gSegment);
     return;
   }
   s[used] = gSegment;
@@ -94,7 +93,7 @@ void kbInsert() {
     bi = min(f1, f2);
     bj = max(f1, f2);
   }
-  zmSegments[zmSlot(gPixel, bi)] = zmPack(zmMerge(s[bi], s[bj]));
-  if (bj < used) zmSegments[zmSlot(gPixel, bj)] = zmPack(gSegment);  // the new one takes the freed slot
+  zmStore(zmSlot(gPixel, bi), zmMerge(s[bi], s[bj]));
+  if (bj < used) zmStore(zmSlot(gPixel, bj), gSegment);  // the new one takes the freed slot
   atomicAdd(zmMerges, 1u);
 }
