@@ -8,9 +8,8 @@
 // Same arithmetic, in the same order, as the oracle's compositeZThickness
 // (mfrcore/src/reference/composite.cpp).
 uniform vec3 uBackground;
+#include "common/eye_depth.glsl"
 uniform float uZThickness;  // τ > 0, world units
-// Window depth → eye depth: z = -(a·ndc + b)/(c·ndc + d) with ndc = 2·depth - 1 (inverse projection).
-uniform vec4 uDepthToEye;
 
 struct OpState {
   vec3 color;
@@ -24,11 +23,6 @@ struct OpState {
 float gSlabEnd[MFR_ZTHICK_WINDOW];
 float gSlabSigma[MFR_ZTHICK_WINDOW];
 vec3 gSlabEmission[MFR_ZTHICK_WINDOW];
-
-float zthickEyeDepth(float depth) {
-  float ndc = 2.0 * depth - 1.0;
-  return -(uDepthToEye.x * ndc + uDepthToEye.y) / (uDepthToEye.z * ndc + uDepthToEye.w);
-}
 
 void opBegin(inout OpState s, ivec2 pixel) {
   s.color = vec3(0.0);
@@ -69,7 +63,7 @@ void opFragment(inout OpState s, MfrFragment f, uint position) {
   vec4 c = unpackUnorm4x8(f.color);
   float alpha = min(c.a, float(MFR_ZTHICK_MAX_ALPHA));
   if (alpha <= 0.0) return;
-  float z = zthickEyeDepth(f.depth);
+  float z = mfrEyeDepth(f.depth);
   zthickCloseUntil(s, z);
   if (s.count == 0u) s.position = z;  // nothing open: the medium is empty up to z
   zthickIntegrate(s, z);

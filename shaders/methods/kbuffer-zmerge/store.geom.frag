@@ -19,8 +19,8 @@ layout(std430, binding = MFR_SSBO_COUNTER) buffer ZMergeCounters {
   uint zmReserved[4];
 };
 
+#include "common/eye_depth.glsl"
 uniform float uZThickness;
-uniform vec4 uDepthToEye;
 
 Segment gSegment;  // the current fragment's slab
 uint gPixel;
@@ -28,8 +28,7 @@ uint gPixel;
 void kbBegin() {
   MfrFragment f = mfrCurrentFragment();
   vec4 c = unpackUnorm4x8(f.color);
-  float ndc = 2.0 * f.depth - 1.0;
-  float z = -(uDepthToEye.x * ndc + uDepthToEye.y) / (uDepthToEye.z * ndc + uDepthToEye.w);
+  float z = mfrEyeDepth(f.depth);
   gSegment = Segment(z, z + uZThickness, -log(1.0 - min(c.a, float(MFR_ZTHICK_MAX_ALPHA))), vec3(c));
   gPixel = zmPixel(ivec2(gl_FragCoord.xy));
   atomicAdd(zmGenerated, 1u);
