@@ -157,6 +157,11 @@ void addBench(CLI::App& app) {
         t << req.thickness;
         label += ":thickness=" + t.str();
       }
+      if (req.volumeStep > 0.0) {
+        std::ostringstream t;
+        t << req.volumeStep;
+        label += ":step=" + t.str();
+      }
       nlohmann::ordered_json row;
       row["method"] = label;
       row["median_total_ms"] = median(totals);
@@ -177,12 +182,14 @@ void addBench(CLI::App& app) {
       if (!opt->noQuality) {
         // The reference of the operation the row ran ("auto": the method's own).
         const MethodInfo* rowInfo = findMethodInfo(req.method);
-        const std::string op = req.operation == "auto" && rowInfo ? rowInfo->preferredOperation : req.operation;
+        const std::string op = effectiveOperation(req.operation, rowInfo, scene.visibleVolume() != nullptr);
         const ImageRGBA8 exact =
             op == "csg" ? csgReference
             : op == "zthickness"
                 ? compositeZThickness(lists, camera, zThicknessOf(req, scene.bounds()), scene.background)
-                : reference;
+            : op == "volume" ? compositeVolume(lists, camera, *scene.visibleVolume(),
+                                               volumeStepOf(req, *scene.visibleVolume()), scene.background)
+                             : reference;
         const double e = rmse(exact, last.image);
         const FlipResult f = flip(exact, last.image);
         row["rmse"] = e;

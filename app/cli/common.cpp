@@ -88,6 +88,13 @@ RenderRequest parseMethodSpec(const std::string& spec, int w, int h) {
       r.operation = part.substr(eq + 1);
       continue;
     }
+    if (part.substr(0, eq) == "step") {
+      const std::optional<double> t = parseNumber(part.substr(eq + 1));
+      if (!t || !(*t > 0.0) || !std::isfinite(*t))
+        throw Error("--methods " + spec, "step must be a positive length in scene units");
+      r.volumeStep = *t;
+      continue;
+    }
     if (part.substr(0, eq) == "thickness") {
       const std::optional<double> t = parseNumber(part.substr(eq + 1));
       if (!t || !(*t > 0.0) || !std::isfinite(*t))

@@ -54,6 +54,26 @@ void addInfo(CLI::App& app) {
                 << o.material.color.a << ")\n";
     }
     if (shown < scene.objects.size()) std::cout << "  … " << scene.objects.size() - shown << " more parts\n";
+    nlohmann::ordered_json volumes = nlohmann::ordered_json::array();
+    for (const Volume& v : scene.volumes) {
+      const glm::ivec3 d = v.grid->dims;
+      const glm::vec2 range = v.grid->range();
+      const Bounds vb = v.bounds();
+      volumes.push_back({{"name", v.name},
+                         {"dims", {d.x, d.y, d.z}},
+                         {"spacing", {v.spacing.x, v.spacing.y, v.spacing.z}},
+                         {"range", {range.x, range.y}},
+                         {"bounds", {{"min", {vb.min.x, vb.min.y, vb.min.z}}, {"max", {vb.max.x, vb.max.y, vb.max.z}}}},
+                         {"transfer_range", {v.transfer.low(), v.transfer.high()}},
+                         {"unit_distance", v.transfer.unitDistance},
+                         {"default_step", v.defaultStep()},
+                         {"visible", v.visible}});
+      std::cout << "  volume: " << v.name << " (" << d.x << "x" << d.y << "x" << d.z << " points, spacing "
+                << v.spacing.x << " " << v.spacing.y << " " << v.spacing.z << ", values " << range.x << " … " << range.y
+                << ", transfer " << v.transfer.low() << " … " << v.transfer.high() << " per " << v.transfer.unitDistance
+                << ", default step " << v.defaultStep() << (v.visible ? "" : ", hidden") << ")\n";
+    }
+    j["volumes"] = volumes;
     if (!opt->noHistogram) {
       const FragmentLists lists = castFragments(scene, scene.view(opt->view), w, h);
       const std::vector<std::uint64_t> hist = depthComplexityHistogram(lists);

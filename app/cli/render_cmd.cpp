@@ -17,6 +17,7 @@ void addRender(CLI::App& app) {
     std::vector<std::string> params;
     double opacity = -1.0;
     double thickness = 0.0;
+    double step = 0.0;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method and write a PNG (and stats JSON)");
@@ -25,11 +26,15 @@ void addRender(CLI::App& app) {
   cmd->add_option("--op", opt->op,
                   "Operation on the sorted lists: auto (the method's own: hybrid for fkb, vkb, dkb, optimal-k; else "
                   "oit), oit, hybrid, csg (the scene's CSG tree, opaque; oracle and the A-buffers), zthickness "
-                  "(z-thickness blending: surfaces closer than --thickness blend; oracle, A-buffers, k-buffers)")
+                  "(z-thickness blending: surfaces closer than --thickness blend; oracle, A-buffers, k-buffers), "
+                  "volume (the scene's volume ray-marched between the sorted surfaces; auto picks it for a scene "
+                  "with a volume; oracle, A-buffers, k-buffers)")
       ->capture_default_str();
   CLI::Option* thicknessOption =
       cmd->add_option("--thickness", opt->thickness,
                       "Operation zthickness: slab thickness in scene units (default: 1 % of the scene's diagonal)");
+  CLI::Option* stepOption = cmd->add_option(
+      "--step", opt->step, "Operation volume: ray-march step in scene units (default: half the volume's grid spacing)");
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
@@ -37,7 +42,7 @@ void addRender(CLI::App& app) {
   cmd->add_option("--stats", opt->stats, "Write Stats as JSON to this file");
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1): see through opaque CAD parts")
       ->check(CLI::Range(0.0, 1.0));
-  cmd->callback([opt, thicknessOption] {
+  cmd->callback([opt, thicknessOption, stepOption] {
     const auto [w, h] = parseSize("--size", opt->size);
     RenderRequest req;
     req.method = opt->method;
@@ -47,6 +52,9 @@ void addRender(CLI::App& app) {
     if (thicknessOption->count() > 0 && !(opt->thickness > 0.0 && std::isfinite(opt->thickness)))
       throw Error("--thickness", "must be a positive length in scene units");
     req.thickness = opt->thickness;
+    if (stepOption->count() > 0 && !(opt->step > 0.0 && std::isfinite(opt->step)))
+      throw Error("--step", "must be a positive length in scene units");
+    req.volumeStep = opt->step;
     for (const std::string& p : opt->params) {
       const auto eq = p.find('=');
       if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");

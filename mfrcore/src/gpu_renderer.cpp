@@ -7,6 +7,7 @@
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
 #include "mfr/methods/registry.hpp"
+#include "mfr/reference/composite.hpp"
 #include "methods/kbuffer_common.hpp"
 #include "methods/method_util.hpp"
 
@@ -26,7 +27,38 @@ static Operation hybridOperation() {
   return {"hybrid", "ops/hybrid.glsl", nullptr};
 }
 
+struct GpuRenderer::GpuVolume {
+  Volume volume;
+  gl::Texture grid;      // R32F, dims
+  gl::Texture transfer;  // RGBA32F, MFR_VOLUME_TF_SIZE: (rgb, σ)
+  std::size_t bytes = 0;
+};
+
 GpuRenderer::~GpuRenderer() = default;
+
+void GpuRenderer::uploadVolume(const Scene& scene) {
+  const Volume* v = scene.visibleVolume();
+  if (!v) {
+    volume_.reset();
+    return;
+  }
+  auto gpu = std::make_shared<GpuVolume>();
+  gpu->volume = *v;
+  const glm::ivec3 d = v->grid->dims;
+  if (volume_ && volume_->volume.grid == v->grid) {
+    gpu->grid = std::move(volume_->grid);  // same samples: keep the texture
+  } else {
+    volume_.reset();  // free the old grid before allocating the new one
+    gpu->grid = gl::createTexture3D(GL_R32F, d.x, d.y, d.z);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTextureSubImage3D(gpu->grid.id(), 0, 0, 0, 0, d.x, d.y, d.z, GL_RED, GL_FLOAT, v->grid->values.data());
+  }
+  const std::vector<glm::vec4> table = v->transfer.table();
+  gpu->transfer = gl::createTexture1D(GL_RGBA32F, MFR_VOLUME_TF_SIZE);
+  glTextureSubImage1D(gpu->transfer.id(), 0, 0, MFR_VOLUME_TF_SIZE, GL_RGBA, GL_FLOAT, table.data());
+  gpu->bytes = v->grid->values.size() * sizeof(float) + table.size() * sizeof(glm::vec4);
+  volume_ = std::move(gpu);
+}
 
 GpuRenderer::GpuRenderer(bool finishTiming) : finishTiming_(finishTiming) {}
 
@@ -38,6 +70,7 @@ void GpuRenderer::setScene(const Scene& scene) {
   csgMirrored_ = csgMirroredPrimitives(scene);
   sceneName_ = scene.name;
   sceneBounds_ = scene.bounds();
+  uploadVolume(scene);
   gl::checkErrors("scene upload");
 }
 
@@ -49,6 +82,7 @@ void GpuRenderer::shareScene(const GpuRenderer& other) {
   csgMirrored_ = other.csgMirrored_;
   sceneName_ = other.sceneName_;
   sceneBounds_ = other.sceneBounds_;
+  volume_ = other.volume_;
 }
 
 Method& GpuRenderer::prepare(const RenderRequest& request) {
@@ -59,8 +93,12 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
     method_ = createMethod(request.method);
     methodName_ = request.method;
   }
-  operation_ = request.operation == "auto" ? method_->info().preferredOperation : request.operation;
+  operation_ = effectiveOperation(request.operation, &method_->info(), volume_ != nullptr);
   thickness_ = zThicknessOf(request, sceneBounds_);
+  if (operation_ == "volume") {
+    if (!volume_) throw Error("--op volume", "scene '" + sceneName_ + "' has no visible volume");
+    volumeStep_ = volumeStepOf(request, volume_->volume);
+  }
   const Params params(method_->info().params, request.params, request.method);
   method_->configure(request.width, request.height, params);
   if (operation_ == "hybrid") {
@@ -114,6 +152,19 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   glViewport(0, 0, request.width, request.height);
   if (operation_ == "csg") {
     renderCsg(ctx, method);
+  } else if (operation_ == "volume") {
+    const VolumeRaySetup setup = volumeRaySetup(volume_->volume, camera, request.width, request.height, volumeStep_);
+    method.resolve(ctx, Operation{"volume", "ops/volume.glsl", [&](const gl::Program& p) {
+                                    p.set("uInvViewProj", setup.invViewProj);
+                                    p.set("uViewport", setup.viewport);
+                                    p.set("uWorldToGrid", setup.worldToGrid);
+                                    p.set("uGridDims", setup.dims);
+                                    p.set("uVolumeStep", setup.step);
+                                    p.set("uTfLow", setup.tfLow);
+                                    p.set("uTfHigh", setup.tfHigh);
+                                    glBindTextureUnit(MFR_TEX_VOLUME, volume_->grid.id());
+                                    glBindTextureUnit(MFR_TEX_VOLUME_TF, volume_->transfer.id());
+                                  }});
   } else if (operation_ == "zthickness") {
     method.resolve(ctx, Operation{"zthickness", "ops/zthickness.glsl", [&](const gl::Program& p) {
                                     p.set("uZThickness", ctx.zThickness);
@@ -133,6 +184,12 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
     stats.notes.emplace_back("csg buffer (bytes)", std::to_string(csgBytes));
   }
   if (operation_ == "zthickness") stats.notes.emplace_back("z-thickness", std::to_string(thickness_));
+  if (operation_ == "volume") {
+    stats.notes.emplace_back("volume step", std::to_string(volumeStep_));
+    stats.notes.emplace_back("volume (bytes)", std::to_string(volume_->bytes));
+  } else if (volume_) {
+    stats.notes.emplace_back("volume", "not drawn (operation " + operation_ + ")");
+  }
   lastWidth_ = request.width;
   lastHeight_ = request.height;
   stats.operation = operation_;

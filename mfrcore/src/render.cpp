@@ -25,12 +25,12 @@ void validateImageSize(const std::string& what, int width, int height) {
 }
 
 const std::string& operationNames() {
-  static const std::string names = "auto, oit, hybrid, csg, zthickness";
+  static const std::string names = "auto, oit, hybrid, csg, zthickness, volume";
   return names;
 }
 
 void validateOperation(const std::string& operation) {
-  for (const char* name : {"auto", "oit", "hybrid", "csg", "zthickness"})
+  for (const char* name : {"auto", "oit", "hybrid", "csg", "zthickness", "volume"})
     if (operation == name) return;
   throw Error("--op " + operation, "unknown operation (available: " + operationNames() + ")");
 }
@@ -46,6 +46,19 @@ double zThicknessOf(const RenderRequest& request, const Bounds& sceneBounds) {
   if (request.thickness > 0.0) return request.thickness;
   const double d = zThicknessDefault(sceneBounds);
   return d > 0.0 ? d : 0.01;  // a flat or point-like scene still gets a usable slab
+}
+
+double volumeStepOf(const RenderRequest& request, const Volume& volume) {
+  if (!std::isfinite(request.volumeStep) || request.volumeStep < 0.0)
+    throw Error("--step", "must be a positive length in scene units (got " + std::to_string(request.volumeStep) + ")");
+  return request.volumeStep > 0.0 ? request.volumeStep : volume.defaultStep();
+}
+
+std::string effectiveOperation(const std::string& operation, const MethodInfo* info, bool sceneHasVolume) {
+  if (operation != "auto") return operation;
+  const std::string preferred = info ? info->preferredOperation : "oit";
+  if (sceneHasVolume && preferred == "oit" && (!info || info->sortedLists)) return "volume";
+  return preferred;
 }
 
 std::vector<std::string> availableMethods() {
@@ -165,8 +178,9 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     return out;
   }
   RenderOutput out;
+  const std::string operation = effectiveOperation(request.operation, nullptr, scene.visibleVolume() != nullptr);
   const FragmentLists lists = castFragments(scene, camera, request.width, request.height);
-  if (request.operation == "hybrid") {
+  if (operation == "hybrid") {
     // The exact hybrid image for a uniform core size: --method oracle --op hybrid -p k=N.
     const auto k = request.params.find("k");
     if (k == request.params.end()) throw Error("--op hybrid", "the oracle needs --param k=N (core size)");
@@ -177,19 +191,27 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
       throw Error("--param k=" + k->second, "not a non-negative integer");
     }
     out.image = compositeHybrid(lists, static_cast<std::uint32_t>(value), scene.background);
-  } else if (request.operation == "zthickness") {
+  } else if (operation == "volume") {
+    const Volume* volume = scene.visibleVolume();
+    if (!volume) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");
+    const double step = volumeStepOf(request, *volume);
+    out.image = compositeVolume(lists, camera, *volume, step, scene.background);
+    out.stats.notes.emplace_back("volume step", std::to_string(step));
+  } else if (operation == "zthickness") {
     const double thickness = zThicknessOf(request, scene.bounds());
     out.image = compositeZThickness(lists, camera, thickness, scene.background);
     out.stats.notes.emplace_back("z-thickness", std::to_string(thickness));
-  } else if (request.operation == "csg") {
+  } else if (operation == "csg") {
     if (scene.csg.empty())
       throw Error("--op csg", "scene '" + scene.name + "' has no CSG tree (a \"csg\" key in an .mfrscene file)");
     out.image = compositeCsg(lists, scene);
   } else {
     out.image = compositeOver(lists, scene.background);
   }
+  if (operation != "volume" && scene.visibleVolume())
+    out.stats.notes.emplace_back("volume", "not drawn (operation " + operation + ")");
   out.stats.method = "oracle";
-  out.stats.operation = request.operation;
+  out.stats.operation = operation;
   out.stats.sync = "none";
   out.stats.fragmentsGenerated = lists.fragments.size();
   out.stats.fragmentsStored = lists.fragments.size();

@@ -39,6 +39,8 @@
 #define MFR_TEX_AUX0 1
 #define MFR_TEX_AUX1 2
 #define MFR_TEX_AUX2 3
+#define MFR_TEX_VOLUME 4     // operation "volume": the scalar grid (R32F, texelFetch)
+#define MFR_TEX_VOLUME_TF 5  // operation "volume": the transfer-function table (RGBA32F, 1D)
 
 // Invalid index / end of a linked list
 #define MFR_NIL 0xFFFFFFFFu
@@ -74,6 +76,14 @@
 // (an opaque surface reaches 1 - 1/1024 over its thickness).
 #define MFR_ZTHICK_WINDOW 16
 #define MFR_ZTHICK_MAX_ALPHA (1.0 - 1.0 / 1024.0)
+// Operation "volume" (shaders/ops/volume.glsl, mfr/scene/volume.hpp): the transfer function is a
+// table of this many (rgb, extinction) entries; a pixel's ray takes at most MFR_VOLUME_MAX_STEPS
+// steps through the volume (a longer chord gets a longer step), and marching stops once the
+// transmittance is below MFR_VOLUME_MIN_TRANSMITTANCE (what is left changes no 8-bit value).
+#define MFR_VOLUME_TF_SIZE 256
+#define MFR_VOLUME_MAX_STEPS 4096
+#define MFR_VOLUME_MIN_TRANSMITTANCE (1.0 / 4096.0)
+#define MFR_VOLUME_MAX_ALPHA (1.0 - 1.0 / 1024.0)
 // kbuffer-zmerge: the largest k (its store pass compares all pairs of k + 1 segments).
 #define MFR_ZMERGE_MAX_K 32
 

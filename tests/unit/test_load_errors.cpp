@@ -319,8 +319,9 @@ TEST_F(LoadModel, GarbageLegacyVtk) {
                         "0 1 1\nPOLYGONS 1 5\xee"
                         "4 0 1 2 3\n"),
                   "bad number 'POLYGONS'");
+  // STRUCTURED_POINTS is a volume (loadVolume), not a model.
   expectLoadError(write("grid.vtk", "# vtk DataFile Version 3.0\ng\nASCII\nDATASET STRUCTURED_POINTS\n"),
-                  "dataset type 'STRUCTURED_POINTS' is not supported");
+                  "is a volume file, not a model");
   expectLoadError(write("badid.vtk",
                         "# vtk DataFile Version 3.0\nq\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
                         "POLYGONS 1 4\n3 0 1 3\n"),

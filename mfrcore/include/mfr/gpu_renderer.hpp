@@ -86,6 +86,12 @@ class GpuRenderer {
   std::string sceneName_;
   Bounds sceneBounds_;
   double thickness_ = 0.0;  // operation "zthickness" of the prepared request (scene units)
+  // Operation "volume": the scene's visible volume on the GPU (shared with shareScene; a new
+  // scene with the same grid keeps the grid texture and uploads only the transfer table).
+  struct GpuVolume;
+  std::shared_ptr<GpuVolume> volume_;
+  double volumeStep_ = 0.0;  // of the prepared request (scene units)
+  void uploadVolume(const Scene& scene);
   gl::Buffer csgVisible_;
   std::size_t csgPixels_ = 0;
   gl::Program csgShade_;

@@ -16,15 +16,19 @@ namespace mfr {
 
 struct RenderRequest {
   std::string method = "oracle";
-  std::string operation = "oit";  // "oit", "hybrid", "csg", "zthickness", or "auto": the method's preferred one
+  // "oit", "hybrid", "csg", "zthickness", "volume", or "auto": the method's preferred one — or
+  // "volume" for a scene with a visible volume (effectiveOperation)
+  std::string operation = "oit";
   int width = 512;
   int height = 512;
   std::map<std::string, std::string> params;  // method parameters by name (k, budget_mib, …)
   // Operation "zthickness": slab thickness in scene units; 0 picks zThicknessDefault of the scene.
   double thickness = 0.0;
+  // Operation "volume": ray-march step in scene units; 0 picks the volume's defaultStep().
+  double volumeStep = 0.0;
 };
 
-// The operations render() and GpuRenderer accept, for messages: "auto, oit, hybrid, csg, zthickness".
+// The operations render() and GpuRenderer accept, for messages: "auto, oit, hybrid, csg, zthickness, volume".
 const std::string& operationNames();
 // Throws mfr::Error("--op <name>", …) for a name not in operationNames().
 void validateOperation(const std::string& operation);
@@ -33,6 +37,13 @@ double zThicknessDefault(const Bounds& sceneBounds);
 // The thickness a request asks for (its own, or the default); throws mfr::Error("--thickness", …)
 // for a negative, infinite or NaN value.
 double zThicknessOf(const RenderRequest& request, const Bounds& sceneBounds);
+// The step a request asks for (its own, or the volume's default); throws mfr::Error("--step", …)
+// for a negative, infinite or NaN value.
+double volumeStepOf(const RenderRequest& request, const Volume& volume);
+// What a request's operation means for a method (info; nullptr: the oracle) on a scene with or
+// without a visible volume: "auto" is the method's preferredOperation, except that a scene with a
+// volume gets "volume" from every method that prefers "oit" and resolves sorted lists.
+std::string effectiveOperation(const std::string& operation, const MethodInfo* info, bool sceneHasVolume);
 
 struct RenderOutput {
   ImageRGBA8 image;

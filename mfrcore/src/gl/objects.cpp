@@ -21,6 +21,28 @@ Texture createTexture2D(GLenum internalFormat, int width, int height) {
   return Texture(id);
 }
 
+Texture createTexture1D(GLenum internalFormat, int width) {
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_1D, 1, &id);
+  glTextureStorage1D(id, 1, internalFormat, width);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  return Texture(id);
+}
+
+Texture createTexture3D(GLenum internalFormat, int width, int height, int depth) {
+  GLuint id = 0;
+  glCreateTextures(GL_TEXTURE_3D, 1, &id);
+  glTextureStorage3D(id, 1, internalFormat, width, height, depth);
+  glTextureParameteri(id, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(id, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(id, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+  return Texture(id);
+}
+
 VertexArray createVertexArray() {
   GLuint id = 0;
   glCreateVertexArrays(1, &id);

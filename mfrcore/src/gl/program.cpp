@@ -172,6 +172,9 @@ void Program::set(const char* name, const glm::vec2& v) const { glProgramUniform
 void Program::set(const char* name, const glm::vec3& v) const { glProgramUniform3fv(id_, location(name), 1, glm::value_ptr(v)); }
 void Program::set(const char* name, const glm::vec4& v) const { glProgramUniform4fv(id_, location(name), 1, glm::value_ptr(v)); }
 void Program::set(const char* name, const glm::ivec2& v) const { glProgramUniform2iv(id_, location(name), 1, glm::value_ptr(v)); }
+void Program::set(const char* name, const glm::ivec3& v) const {
+  glProgramUniform3iv(id_, location(name), 1, glm::value_ptr(v));
+}
 void Program::set(const char* name, const glm::mat4& v) const {
   glProgramUniformMatrix4fv(id_, location(name), 1, GL_FALSE, glm::value_ptr(v));
 }

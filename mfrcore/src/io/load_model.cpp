@@ -153,6 +153,9 @@ std::vector<Object> singleObject(Mesh mesh, const std::string& partName) {
 
 std::vector<Object> load(const fs::path& path, const std::string& name, const LoadProgress& progress) {
   checkReadable(path, name);
+  if (isVolumeFile(path))
+    throw Error(name,
+                "is a volume file, not a model: open it as a scene, or list it under \"volumes\" in a .mfrscene file");
 
   std::string fileName = lower(path.filename().string());
   const bool gz = endsWith(fileName, ".gz");

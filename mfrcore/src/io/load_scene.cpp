@@ -27,6 +27,7 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadPro
   if (text == "@sample") return makeSampleScene();
   if (text == "@csg") return makeCsgSampleScene();
   if (text == "@intersect") return makeIntersectingSampleScene();
+  if (text == "@volume") return makeVolumeSampleScene();
   if (text.rfind("@quads:", 0) == 0) {
     // @quads:N[:density[:seed]]
     int layers = 0;
@@ -38,7 +39,7 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadPro
     return makeQuadsScene(layers, density, seed);
   }
   if (!text.empty() && text[0] == '@')
-    throw Error(text, "unknown built-in scene (@sample, @csg, @intersect, @quads:N[:density[:seed]])");
+    throw Error(text, "unknown built-in scene (@sample, @csg, @intersect, @volume, @quads:N[:density[:seed]])");
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   Scene scene;
@@ -46,7 +47,10 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadPro
     scene = readSceneFile(path, progress);
   } else {
     scene.name = path.filename().string();
-    scene.objects = loadModel(path, progress);
+    if (isVolumeFile(path))
+      scene.volumes.push_back(loadVolume(path, progress));
+    else
+      scene.objects = loadModel(path, progress);
     Camera front;
     front.eye = {0.0, 0.0, 1.0};
     front.target = {0.0, 0.0, 0.0};

@@ -46,12 +46,7 @@ constexpr const char* kSoupColorArray = "mfr_colors";
 // We install a window that prints nothing and hands each message to the load running on the
 // same thread, so a failed read can name VTK's reason in its one-line mfr::Error.
 
-struct VtkMessage {
-  bool error = false;  // else a warning
-  std::string text;
-};
-
-thread_local std::vector<VtkMessage>* tlMessages = nullptr;
+thread_local std::vector<VtkMessages::Message>* tlMessages = nullptr;
 
 class QuietOutputWindow final : public vtkOutputWindow {
  public:
@@ -105,40 +100,37 @@ std::string cleanMessage(std::string_view text) {
   return out;
 }
 
-// Collects the VTK messages of one read (RAII: restores the previous collector).
-class VtkMessages {
- public:
-  VtkMessages() : previous_(tlMessages) {
-    silenceVtk();
-    tlMessages = &messages_;
-  }
-  ~VtkMessages() { tlMessages = previous_; }
-  VtkMessages(const VtkMessages&) = delete;
-  VtkMessages& operator=(const VtkMessages&) = delete;
+}  // namespace
 
-  [[nodiscard]] bool hasError() const {
-    return std::any_of(messages_.begin(), messages_.end(), [](const VtkMessage& m) { return m.error; });
-  }
-  [[nodiscard]] bool hasWarning() const {
-    return std::any_of(messages_.begin(), messages_.end(), [](const VtkMessage& m) { return !m.error; });
-  }
-  // The most specific message: the first error (else warning) that is not the executive's
-  // generic "returned failure for request" dump.
-  [[nodiscard]] std::string reason() const {
-    for (const bool wantError : {true, false})
-      for (const VtkMessage& m : messages_)
-        if (m.error == wantError && m.text.find("returned failure for request") == std::string::npos) {
-          std::string r = cleanMessage(m.text);
-          if (!r.empty()) return r;
-        }
-    return {};
-  }
-  void clear() { messages_.clear(); }
+// ---------------------------------------------------------------------------------------------
+VtkMessages::VtkMessages() : previous_(tlMessages) {
+  silenceVtk();
+  tlMessages = &messages_;
+}
 
- private:
-  std::vector<VtkMessage> messages_;
-  std::vector<VtkMessage>* previous_;
-};
+VtkMessages::~VtkMessages() {
+  tlMessages = previous_;
+}
+
+bool VtkMessages::hasError() const {
+  return std::any_of(messages_.begin(), messages_.end(), [](const Message& m) { return m.error; });
+}
+
+bool VtkMessages::hasWarning() const {
+  return std::any_of(messages_.begin(), messages_.end(), [](const Message& m) { return !m.error; });
+}
+
+std::string VtkMessages::reason() const {
+  for (const bool wantError : {true, false})
+    for (const Message& m : messages_)
+      if (m.error == wantError && m.text.find("returned failure for request") == std::string::npos) {
+        std::string r = cleanMessage(m.text);
+        if (!r.empty()) return r;
+      }
+  return {};
+}
+
+namespace {
 
 // ---------------------------------------------------------------------------------------------
 // A temporary copy of decompressed bytes, for the VTK readers that only read named files.

@@ -39,6 +39,33 @@ Mesh meshFromSoup(const PolygonSoup& soup, const std::string& name);
 // colors and indices change too.
 void computeFeatureNormals(Mesh& mesh, const std::string& name);
 
+// Collects the VTK messages of one read on this thread (RAII: restores the previous collector).
+// VTK prints through a global output window; the first VtkMessages installs one that prints
+// nothing, so a failed read names VTK's reason in its one-line mfr::Error instead.
+class VtkMessages {
+ public:
+  struct Message {
+    bool error = false;  // else a warning
+    std::string text;
+  };
+
+  VtkMessages();
+  ~VtkMessages();
+  VtkMessages(const VtkMessages&) = delete;
+  VtkMessages& operator=(const VtkMessages&) = delete;
+
+  [[nodiscard]] bool hasError() const;
+  [[nodiscard]] bool hasWarning() const;
+  // The most specific message: the first error (else warning) that is not the executive's
+  // generic "returned failure for request" dump; "" when there is none.
+  [[nodiscard]] std::string reason() const;
+  void clear() { messages_.clear(); }
+
+ private:
+  std::vector<Message> messages_;
+  std::vector<Message>* previous_;
+};
+
 // STL and VTP; OBJ and legacy .vtk have parsers of their own (obj_loader, vtk_legacy_loader)
 // because VTK's readers crash on malformed input.
 enum class VtkFormat { Stl, Vtp };

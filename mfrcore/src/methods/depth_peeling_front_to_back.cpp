@@ -30,8 +30,17 @@ const MethodInfo& DepthPeelingFrontToBack::info() const {
       "Front-to-back depth peeling",
       "Everitt: Interactive Order-Independent Transparency. NVIDIA technical report, 2001",
       true,
-      {{"max_passes", "Max. peeling passes", ParamSpec::Type::Int, "64", 1, 1024, {},
-        "layers peeled at most (one geometry pass each); deeper fragments are reported as overflow"}}};
+      {{"max_passes",
+        "Max. peeling passes",
+        ParamSpec::Type::Int,
+        "64",
+        1,
+        1024,
+        {},
+        "layers peeled at most (one geometry pass each); deeper fragments are reported as overflow"}},
+      "oit",
+      false,
+      false};
   return i;
 }
 

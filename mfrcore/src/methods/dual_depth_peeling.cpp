@@ -32,8 +32,18 @@ const MethodInfo& DualDepthPeeling::info() const {
       "Dual depth peeling",
       "Bavoil, Myers: Order Independent Transparency with Dual Depth Peeling. NVIDIA technical report, 2008",
       true,
-      {{"max_passes", "Max. peeling passes", ParamSpec::Type::Int, "32", 1, 1024, {},
-        "peel passes at most, two layers each (plus the initialisation pass); deeper fragments are reported as overflow"}}};
+      {{"max_passes",
+        "Max. peeling passes",
+        ParamSpec::Type::Int,
+        "32",
+        1,
+        1024,
+        {},
+        "peel passes at most, two layers each (plus the initialisation pass); deeper fragments are reported as "
+        "overflow"}},
+      "oit",
+      false,
+      false};
   return i;
 }
 

@@ -15,10 +15,15 @@ const MethodInfo& KPeeling::info() const {
     params.push_back({"max_iterations", "Most peeling iterations", ParamSpec::Type::Int, "1024", 1, 65535, {},
                       "bound on the geometry passes; beyond ceil(max n(p) / k) > this, the farthest fragments are "
                       "dropped and reported as overflow"});
-    return MethodInfo{"kpeel", "k-peeling (multi-pass k-buffer)",
+    return MethodInfo{"kpeel",
+                      "k-peeling (multi-pass k-buffer)",
                       "Bavoil, Callahan, Lefohn, Comba, Silva: Multi-fragment effects on the GPU using the k-buffer. "
                       "I3D 2007 (multi-pass k-buffer)",
-                      true, params};
+                      true,
+                      params,
+                      "oit",
+                      false,
+                      false};
   }();
   return i;
 }

@@ -33,6 +33,7 @@ const MethodInfo& KBufferZThicknessMerge::info() const {
         {},
         "lock attempts per fragment before it is dropped (counted in lockFailures)"}},
       "zthickness",
+      false,
       false};
   return i;
 }

@@ -44,11 +44,26 @@ const MethodInfo& WeightedBlendedOit::info() const {
       "Weighted blended order-independent transparency",
       "McGuire, Bavoil: Weighted Blended Order-Independent Transparency. JCGT 2(2), 2013",
       false,
-      {{"weight", "Weight function", ParamSpec::Type::Choice, "eq7", 0, 0, {"eq7", "eq8", "eq9", "eq10", "none"},
+      {{"weight",
+        "Weight function",
+        ParamSpec::Type::Choice,
+        "eq7",
+        0,
+        0,
+        {"eq7", "eq8", "eq9", "eq10", "none"},
         "the paper's depth weights w(z, α): eq7–eq9 of view depth |z| (tuned for 0.1 ≤ |z| ≤ 500 scene units), "
         "eq10 of window depth; none: w = 1 (plain weighted average)"},
-       {"revealage", "Revealage format", ParamSpec::Type::Choice, "r8", 0, 0, {"r8", "r16f"},
-        "render target of the revealage product Π(1 − α): r8 as in the paper, or r16f"}}};
+       {"revealage",
+        "Revealage format",
+        ParamSpec::Type::Choice,
+        "r8",
+        0,
+        0,
+        {"r8", "r16f"},
+        "render target of the revealage product Π(1 − α): r8 as in the paper, or r16f"}},
+      "oit",
+      false,
+      false};
   return i;
 }
 

@@ -145,6 +145,125 @@ ImageRGBA8 compositeZThickness(const FragmentLists& lists, const Camera& camera,
   return image;
 }
 
+VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int width, int height, double step) {
+  VolumeRaySetup s;
+  const double aspect = static_cast<double>(width) / height;
+  s.invViewProj = glm::mat4(glm::inverse(camera.projectionMatrix(aspect) * camera.viewMatrix()));
+  s.viewport = glm::vec2(static_cast<float>(width), static_cast<float>(height));
+  s.worldToGrid = glm::mat4(glm::inverse(volume.gridToWorld()));
+  s.dims = volume.grid->dims;
+  s.step = static_cast<float>(step > 0.0 ? step : volume.defaultStep());
+  s.tfLow = static_cast<float>(volume.transfer.low());
+  s.tfHigh = static_cast<float>(volume.transfer.high());
+  s.table = volume.transfer.table();
+  return s;
+}
+
+namespace {
+
+// The per-pixel state of shaders/ops/volume.glsl, step for step.
+struct VolumeMarcher {
+  const VolumeRaySetup& setup;
+  const VolumeGrid& grid;
+  glm::vec3 color{0.0f};
+  float transmittance = 1.0f;
+  glm::vec2 ndc{0.0f};
+  glm::vec3 rayStart{0.0f}, rayDir{0.0f}, gridStart{0.0f}, gridDir{0.0f};
+  float tEnter = 0.0f, tExit = 0.0f, step = 0.0f, t = 0.0f;
+  int next = 1;
+
+  [[nodiscard]] glm::vec3 unproject(float ndcZ) const {
+    const glm::vec4 p = setup.invViewProj * glm::vec4(ndc, ndcZ, 1.0f);
+    return glm::vec3(p) / p.w;
+  }
+
+  [[nodiscard]] glm::vec4 transfer(float v) const {
+    const float u = std::clamp((v - setup.tfLow) / (setup.tfHigh - setup.tfLow), 0.0f, 1.0f) *
+                    static_cast<float>(MFR_VOLUME_TF_SIZE - 1);
+    const int i = std::min(static_cast<int>(u), MFR_VOLUME_TF_SIZE - 2);
+    const float f = u - static_cast<float>(i);
+    return glm::mix(setup.table[static_cast<std::size_t>(i)], setup.table[static_cast<std::size_t>(i) + 1], f);
+  }
+
+  void begin(int glX, int glY) {
+    ndc = (glm::vec2(static_cast<float>(glX), static_cast<float>(glY)) + 0.5f) / setup.viewport * 2.0f - 1.0f;
+    rayStart = unproject(-1.0f);
+    const glm::vec3 rayEnd = unproject(1.0f);
+    const float rayLength = glm::distance(rayEnd, rayStart);
+    rayDir = (rayEnd - rayStart) / rayLength;
+    gridStart = glm::vec3(setup.worldToGrid * glm::vec4(rayStart, 1.0f));
+    gridDir = glm::vec3(setup.worldToGrid * glm::vec4(rayDir, 0.0f));
+    float t0 = 0.0f, t1 = rayLength;
+    const glm::vec3 last = glm::vec3(setup.dims - 1);
+    for (int a = 0; a < 3; ++a) {
+      if (std::abs(gridDir[a]) < 1e-30f) {
+        if (gridStart[a] < 0.0f || gridStart[a] > last[a]) t1 = -1.0f;
+      } else {
+        const float ta = (0.0f - gridStart[a]) / gridDir[a];
+        const float tb = (last[a] - gridStart[a]) / gridDir[a];
+        t0 = std::max(t0, std::min(ta, tb));
+        t1 = std::min(t1, std::max(ta, tb));
+      }
+    }
+    tEnter = t0;
+    tExit = std::max(t1, t0);
+    step = std::max(setup.step, (tExit - tEnter) / static_cast<float>(MFR_VOLUME_MAX_STEPS));
+    t = tEnter;
+    next = 1;
+  }
+
+  void march(float tTo) {
+    tTo = std::min(tTo, tExit);
+    for (int it = 0;
+         it < MFR_VOLUME_MAX_STEPS + 2 && t < tTo && transmittance >= static_cast<float>(MFR_VOLUME_MIN_TRANSMITTANCE);
+         ++it) {
+      const float boundary = tEnter + static_cast<float>(next) * step;
+      const float end = std::min(boundary, tTo);
+      if (end > t) {
+        const glm::vec4 m = transfer(grid.sample(gridStart + gridDir * (0.5f * (t + end))));
+        if (m.a > 0.0f) {
+          const float absorbed = 1.0f - std::exp(-m.a * (end - t));
+          color += transmittance * absorbed * glm::vec3(m);
+          transmittance *= 1.0f - absorbed;
+        }
+        t = end;
+      }
+      if (end >= boundary) ++next;
+    }
+  }
+
+  void fragment(const Fragment& f) {
+    march(glm::dot(unproject(2.0f * f.depth - 1.0f) - rayStart, rayDir));
+    const glm::vec4 c = glm::unpackUnorm4x8(f.color);
+    color += transmittance * c.a * glm::vec3(c);
+    transmittance *= 1.0f - c.a;
+  }
+};
+
+}  // namespace
+
+glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, const VolumeRaySetup& setup,
+                          const VolumeGrid& grid, const glm::vec3& background) {
+  VolumeMarcher m{setup, grid};
+  m.begin(glX, glY);
+  for (const Fragment& f : sorted) m.fragment(f);
+  m.march(m.tExit);
+  return m.color + m.transmittance * background;
+}
+
+ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, const Volume& volume, double step,
+                           const glm::vec3& background) {
+  volume.validate();
+  if (!std::isfinite(step) || step < 0.0)
+    throw Error("--step", "must be a positive length in scene units (got " + std::to_string(step) + ")");
+  const VolumeRaySetup setup = volumeRaySetup(volume, camera, lists.width, lists.height, step);
+  ImageRGBA8 image(lists.width, lists.height);
+  for (int y = 0; y < lists.height; ++y)
+    for (int x = 0; x < lists.width; ++x)
+      store(image, x, y, compositeVolume(lists.pixel(x, y), x, lists.height - 1 - y, setup, *volume.grid, background));
+  return image;
+}
+
 ImageRGBA8 compositeCsg(const FragmentLists& lists, const Scene& scene) {
   const CsgTree& tree = scene.csg;
   const glm::vec3& background = scene.background;

@@ -415,13 +415,17 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   const std::vector<WorldTriangle>& triangles = geometry->triangles;
   const std::vector<CgalTriangle>& cgalTriangles = geometry->cgalTriangles;
   const Tree& tree = geometry->tree;
-  if (triangles.empty()) throw Error("scene '" + scene.name + "'", "nothing to render (no visible triangles)");
-
   FragmentLists lists;
   lists.width = width;
   lists.height = height;
   const std::size_t pixelCount = static_cast<std::size_t>(width) * height;
   lists.flags.assign(pixelCount, 0);
+  if (triangles.empty()) {
+    // A scene of volumes only: every list is empty.
+    if (!scene.visibleVolume()) throw Error("scene '" + scene.name + "'", "nothing to render (no visible triangles)");
+    lists.offsets.assign(pixelCount + 1, 0);
+    return lists;
+  }
 
   unsigned threadCount =
       options.threads > 0 ? static_cast<unsigned>(options.threads) : std::thread::hardware_concurrency();

@@ -111,6 +111,62 @@ Scene makeIntersectingSampleScene() {
   return s;
 }
 
+Scene makeVolumeSampleScene() {
+  Scene s;
+  s.name = "volume";
+  s.background = glm::vec3(1.0f);
+  // The field on [-1, 1]³: a dense Gaussian core, a hollow shell at radius 0.75 and six blobs on
+  // a ring of radius 0.5 in the xz-plane. Values in [0, ~1].
+  constexpr int n = 96;
+  auto grid = std::make_shared<VolumeGrid>();
+  grid->dims = glm::ivec3(n);
+  grid->values.resize(static_cast<std::size_t>(n) * n * n);
+  const double h = 2.0 / (n - 1);
+  std::size_t at = 0;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const glm::dvec3 p(-1.0 + i * h, -1.0 + j * h, -1.0 + k * h);
+        const double r = glm::length(p);
+        double v = std::exp(-r * r / (2 * 0.24 * 0.24)) + 0.4 * std::exp(-(r - 0.75) * (r - 0.75) / (2 * 0.05 * 0.05));
+        for (int b = 0; b < 6; ++b) {
+          const double a = b * 3.14159265358979 / 3.0;
+          const glm::dvec3 c(0.5 * std::cos(a), 0.0, 0.5 * std::sin(a));
+          const double d2 = glm::dot(p - c, p - c);
+          v += 0.85 * std::exp(-d2 / (2 * 0.11 * 0.11));
+        }
+        grid->values[at++] = static_cast<float>(v);
+      }
+  Volume vol;
+  vol.name = "field";
+  vol.grid = std::move(grid);
+  vol.origin = glm::dvec3(-1.0);
+  vol.spacing = glm::dvec3(h);
+  vol.transfer.unitDistance = 0.1;
+  vol.transfer.points = {{0.0, {0.0f, 0.0f, 0.0f, 0.0f}},     {0.15, {0.20f, 0.40f, 0.90f, 0.0f}},
+                         {0.4, {0.25f, 0.55f, 0.95f, 0.12f}}, {0.6, {0.30f, 0.85f, 0.55f, 0.3f}},
+                         {0.8, {1.00f, 0.70f, 0.15f, 0.6f}},  {1.0, {0.90f, 0.15f, 0.25f, 0.95f}}};
+  s.volumes.push_back(std::move(vol));
+
+  const glm::dmat4 id(1.0);
+  addPart(s, "plate", makeBox({2.6, 0.04, 2.6}), {0.55f, 0.60f, 0.70f, 0.35f},
+          glm::translate(id, glm::dvec3(0.0, -0.1, 0.0)));
+  addPart(s, "rod", makeCylinder(0.06, 2.6), {0.85f, 0.15f, 0.20f, 0.8f},
+          glm::rotate(id, glm::radians(90.0), glm::dvec3(0, 0, 1)) *
+              glm::rotate(id, glm::radians(25.0), glm::dvec3(1, 0, 0)));
+  addPart(s, "sphere", makeSphere(0.4, 64, 32), {0.95f, 0.85f, 0.30f, 0.5f},
+          glm::translate(id, glm::dvec3(0.9, 0.5, 0.3)));
+  Camera iso;
+  iso.eye = {2.6, 1.8, 3.6};
+  iso.target = {0.0, 0.0, 0.0};
+  iso.fovyDegrees = 35.0;
+  s.views.push_back({"iso", s.fit(iso)});
+  Camera front = iso;
+  front.eye = {0.3, 0.2, 5.0};
+  s.views.push_back({"front", s.fit(front)});
+  return s;
+}
+
 Scene makeQuadsScene(int layers, double density, std::uint32_t seed) {
   if (layers < 1 || layers > 4096) throw Error("@quads", "layer count must be in [1, 4096]");
   if (!(density > 0.0) || density > 1.0) throw Error("@quads", "pixel density must be in (0, 1]");

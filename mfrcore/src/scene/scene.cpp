@@ -23,6 +23,8 @@ Bounds Scene::bounds() const {
       b.extend(glm::dvec3(o.transform * glm::dvec4(corner, 1.0)));
     }
   }
+  for (const Volume& v : volumes)
+    if (v.visible) b.extend(v.bounds());
   return b;
 }
 
@@ -33,6 +35,16 @@ double Scene::boundingRadius() const {
     if (!o.visible || !o.mesh) continue;
     for (const glm::vec3& p : o.mesh->positions) {
       const glm::dvec3 d = glm::dvec3(o.transform * glm::dvec4(glm::dvec3(p), 1.0)) - c;
+      r2 = std::max(r2, glm::dot(d, d));
+    }
+  }
+  for (const Volume& v : volumes) {
+    if (!v.visible || !v.grid) continue;
+    const glm::dmat4 toWorld = v.gridToWorld();
+    const glm::dvec3 last(v.grid->dims - 1);
+    for (int i = 0; i < 8; ++i) {
+      const glm::dvec3 corner((i & 1) ? last.x : 0.0, (i & 2) ? last.y : 0.0, (i & 4) ? last.z : 0.0);
+      const glm::dvec3 d = glm::dvec3(toWorld * glm::dvec4(corner, 1.0)) - c;
       r2 = std::max(r2, glm::dot(d, d));
     }
   }
@@ -48,8 +60,22 @@ std::size_t Scene::triangleCount() const {
   return n;
 }
 
+const Volume* Scene::visibleVolume() const {
+  for (const Volume& v : volumes)
+    if (v.visible) return &v;
+  return nullptr;
+}
+
 void Scene::validate() const {
-  if (triangleCount() == 0) throw Error("scene '" + name + "'", "nothing to render (no visible triangles)");
+  std::size_t visibleVolumes = 0;
+  for (const Volume& v : volumes) {
+    v.validate();
+    visibleVolumes += v.visible ? 1 : 0;
+  }
+  if (triangleCount() == 0 && visibleVolumes == 0)
+    throw Error("scene '" + name + "'", "nothing to render (no visible triangles or volume)");
+  if (visibleVolumes > 1)
+    throw Error("scene '" + name + "'", std::to_string(visibleVolumes) + " visible volumes: at most one can be drawn");
   validateCsg(*this);
 }
 

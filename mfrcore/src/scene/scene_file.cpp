@@ -1,6 +1,7 @@
 // The .mfrscene format: see docs/scene-format.md. Every error names the file and the JSON path.
 #include "mfr/scene/scene_file.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -188,6 +189,87 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
   return c;
 }
 
+// A volume's "transfer": {"preset", "range", "unit_distance"} or {"points", "unit_distance"}; the
+// defaults (data range, diagonal / 50) come from the loaded volume's defaultTransfer().
+TransferFunction parseTransfer(const Reader& r, const json& t, const std::string& where, const Volume& volume) {
+  r.object(t, where);
+  const TransferFunction fallback = volume.transfer;
+  const double unitDistance = r.positive(t, "unit_distance", where, fallback.unitDistance);
+  if (t.contains("preset") == t.contains("points")) r.fail(where, "needs exactly one of 'preset' or 'points'");
+  TransferFunction tf;
+  if (t.contains("preset")) {
+    const std::string preset = r.string(t, "preset", where, "");
+    const auto& names = transferPresetNames();
+    if (std::find(names.begin(), names.end(), preset) == names.end()) {
+      std::string list;
+      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+      r.fail(where + ".preset", "unknown preset '" + preset + "' (" + list + ")");
+    }
+    double low = fallback.low(), high = fallback.high();
+    if (t.contains("range")) {
+      const json& range = t["range"];
+      if (!range.is_array() || range.size() != 2) r.fail(where + ".range", "expected [low, high]");
+      low = r.number(range[0], where + ".range[0]");
+      high = r.number(range[1], where + ".range[1]");
+      if (!(high > low)) r.fail(where + ".range", "high must be greater than low");
+    }
+    tf = transferPreset(preset, low, high, unitDistance);
+  } else {
+    if (t.contains("range")) r.fail(where + ".range", "only with 'preset' (the points give their own values)");
+    const json& points = t["points"];
+    if (!points.is_array() || points.size() < 2) r.fail(where + ".points", "expected an array of at least 2 points");
+    tf.unitDistance = unitDistance;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const std::string at = where + ".points[" + std::to_string(i) + "]";
+      const json& p = points[i];
+      if (!p.is_array() || p.size() != 5) r.fail(at, "expected [value, r, g, b, a]");
+      TransferPoint point;
+      point.value = r.number(p[0], at + "[0]");
+      for (std::size_t c = 1; c < 5; ++c) {
+        const double v = r.number(p[c], at + "[" + std::to_string(c) + "]");
+        if (v < 0 || v > 1) r.fail(at + "[" + std::to_string(c) + "]", "colour and opacity must be in [0,1]");
+        point.color[static_cast<int>(c - 1)] = static_cast<float>(v);
+      }
+      if (i > 0 && point.value < tf.points.back().value)
+        r.fail(at + "[0]", "values must ascend (" + std::to_string(point.value) + " after " +
+                               std::to_string(tf.points.back().value) + ")");
+      tf.points.push_back(point);
+    }
+    if (!(tf.high() > tf.low())) r.fail(where + ".points", "the last value must be greater than the first");
+  }
+  return tf;
+}
+
+Volume parseVolume(const Reader& r, const json& j, const std::string& where, const std::filesystem::path& baseDir,
+                   const LoadProgress& progress) {
+  const json& v = r.object(j, where);
+  if (!v.contains("file")) r.fail(where, "needs 'file' (a volume file)");
+  const std::string file = r.string(v, "file", where, "");
+  const glm::dmat4 xf =
+      v.contains("transform") ? parseTransform(r, v["transform"], where + ".transform") : glm::dmat4(1.0);
+  if (v.contains("visible") && !v["visible"].is_boolean()) r.fail(where + ".visible", "expected true or false");
+  Volume volume;
+  try {
+    volume = loadVolume(baseDir / file, progress);  // its errors name the volume file
+  } catch (const LoadCancelled&) {
+    throw;
+  } catch (const Error& e) {
+    r.fail(where + ".file", e.what());
+  }
+  volume.name = r.string(v, "name", where, volume.name);
+  volume.transform = xf * volume.transform;
+  volume.visible = v.value("visible", true);
+  // The defaults are relative to where the volume now is: its world diagonal.
+  volume.transfer = defaultTransfer(*volume.grid, volume.bounds());
+  if (v.contains("transfer")) volume.transfer = parseTransfer(r, v["transfer"], where + ".transfer", volume);
+  try {
+    volume.validate();
+  } catch (const Error& e) {
+    r.fail(where, e.what());
+  }
+  return volume;
+}
+
 // A CSG node: an object's name, or {"union" | "intersection" | "difference": [≥ 2 nodes]}.
 CsgNode parseCsgNode(const Reader& r, const json& j, const std::string& where, const Scene& scene) {
   CsgNode node;
@@ -281,13 +363,19 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
   if (doc.contains("background")) scene.background = glm::vec3(r.vec3(doc["background"], "background"));
   if (doc.value("sample", false)) scene = makeSampleScene();
 
+  // One equal part of the progress per object and per volume.
+  const auto items = [&](const char* key) { return doc.contains(key) && doc[key].is_array() ? doc[key].size() : 0; };
+  const std::size_t objectCount = items("objects"), itemCount = objectCount + items("volumes");
+  const auto itemProgress = [&](std::size_t item) {
+    const double count = static_cast<double>(itemCount);
+    return progress.part(static_cast<double>(item) / count, static_cast<double>(item + 1) / count);
+  };
+
   if (doc.contains("objects")) {
     const json& objects = doc["objects"];
     if (!objects.is_array()) r.fail("objects", "expected an array");
     for (std::size_t i = 0; i < objects.size(); ++i) {
-      const double count = static_cast<double>(objects.size());
-      const LoadProgress objectProgress =
-          progress.part(static_cast<double>(i) / count, static_cast<double>(i + 1) / count);
+      const LoadProgress objectProgress = itemProgress(i);
       objectProgress.step(0.0);
       const std::string where = "objects[" + std::to_string(i) + "]";
       const json& o = r.object(objects[i], where);
@@ -321,6 +409,19 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
         }
       }
       objectProgress.step(1.0);
+    }
+  }
+  if (doc.contains("volumes")) {
+    const json& volumes = doc["volumes"];
+    if (!volumes.is_array()) r.fail("volumes", "expected an array");
+    for (std::size_t i = 0; i < volumes.size(); ++i) {
+      const std::string where = "volumes[" + std::to_string(i) + "]";
+      Volume volume = parseVolume(r, volumes[i], where, baseDir, itemProgress(objectCount + i));
+      if (volume.visible && scene.visibleVolume() != nullptr)
+        r.fail(where + ".visible",
+               "volume '" + scene.visibleVolume()->name +
+                   "' is visible already: at most one volume can be drawn (set \"visible\": false)");
+      scene.volumes.push_back(std::move(volume));
     }
   }
   if (doc.contains("csg")) {

@@ -53,6 +53,9 @@ using Query = Handle<detail::deleteQuery>;
 Buffer createBuffer(std::size_t bytes, const void* data = nullptr, GLbitfield flags = GL_DYNAMIC_STORAGE_BIT);
 // Immutable 2D texture (glTextureStorage2D).
 Texture createTexture2D(GLenum internalFormat, int width, int height);
+// Immutable 1D and 3D textures, nearest filtering, clamped (read with texelFetch).
+Texture createTexture1D(GLenum internalFormat, int width);
+Texture createTexture3D(GLenum internalFormat, int width, int height, int depth);
 VertexArray createVertexArray();
 Framebuffer createFramebuffer();
 Query createQuery(GLenum target);

@@ -56,6 +56,7 @@ class Program {
   void set(const char* name, const glm::vec3& v) const;
   void set(const char* name, const glm::vec4& v) const;
   void set(const char* name, const glm::ivec2& v) const;
+  void set(const char* name, const glm::ivec3& v) const;
   void set(const char* name, const glm::mat4& v) const;
   void set(const char* name, const glm::mat3& v) const;
   // A uint array uniform from its first element on.

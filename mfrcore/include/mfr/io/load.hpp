@@ -19,9 +19,9 @@ class LoadCancelled : public Error {
 
 // Progress of one load, reported on the loading thread: report(fraction) with fraction in [0, 1],
 // non-decreasing, 1 when done. Returning false cancels: the loader stops at that report and
-// throws LoadCancelled. Loaders report at the start and end of every file, per object of a
-// .mfrscene, per mesh of an assimp scene (and assimp's own import progress), and for STEP after
-// parsing, during the transfer and per part meshed.
+// throws LoadCancelled. Loaders report at the start and end of every file, per object and per
+// volume of a .mfrscene, per mesh of an assimp scene (and assimp's own import progress), and for
+// STEP after parsing, during the transfer and per part meshed.
 struct LoadProgress {
   std::function<bool(double fraction)> report;  // empty: no reporting, never cancelled
   double begin = 0.0, end = 1.0;                // the part of the whole load this one covers
@@ -43,8 +43,24 @@ std::vector<Object> loadModel(const std::filesystem::path& path, const LoadProgr
 // File extensions loadModel accepts (lower case, with dot; ".ply.gz" included).
 std::vector<std::string> supportedModelExtensions();
 
+// Loads a scalar volume — VTK image data (.vti), legacy VTK STRUCTURED_POINTS (.vtk), MetaImage
+// (.mhd/.mha), NRRD (.nrrd/.nhdr) and INRIMAGE (.inr, .inr.gz) — named after the file, with its
+// origin and spacing, the first component of its first point-data scalar array as float, and
+// defaultTransfer(). Throws mfr::Error(path, reason) for a missing, unreadable, truncated, corrupt,
+// too large or unsupported file; LoadCancelled when cancelled.
+Volume loadVolume(const std::filesystem::path& path, const LoadProgress& progress = {});
+
+// File extensions loadVolume accepts (lower case, with dot; ".inr.gz" included). ".vtk" is both a
+// model and a volume extension: see isVolumeFile.
+std::vector<std::string> supportedVolumeExtensions();
+
+// Whether `path` names a volume by its extension; a legacy .vtk file is a volume when its header
+// says DATASET STRUCTURED_POINTS (else it is a model for loadModel).
+bool isVolumeFile(const std::filesystem::path& path);
+
 // A scene from any supported file: .mfrscene → the scene it describes; a model → its parts with
-// a default view fitted to them. Throws mfr::Error naming the file, or LoadCancelled.
+// default views ("front", "iso") fitted to them; a volume file → a scene of that one volume with
+// the same views. Throws mfr::Error naming the file, or LoadCancelled.
 Scene loadScene(const std::filesystem::path& path, const LoadProgress& progress = {});
 
 }  // namespace mfr

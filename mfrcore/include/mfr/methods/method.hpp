@@ -60,6 +60,11 @@ struct MethodInfo {
   // Its capture stores every fragment through mfrCurrentFragment() and leaves colours alone until
   // the resolve, so it can carry object ids instead (MFR_PAYLOAD_OBJECT): the operation "csg".
   bool objectPayload = false;
+  // Its resolve hands each pixel's whole sorted list to the operation (resolve.glsl and the
+  // k-buffer family's resolve), so it runs the list operations "zthickness" and "volume". False for
+  // the peeling methods (they composite while they peel), WBOIT, MBOIT (no lists) and
+  // kbuffer-zmerge (merged segments).
+  bool sortedLists = true;
 };
 
 // What the resolve pass does with each pixel's sorted list.

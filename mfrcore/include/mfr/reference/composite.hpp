@@ -8,6 +8,7 @@
 #include "mfr/image.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "mfr/scene/csg.hpp"
+#include "mfr/scene/volume.hpp"
 
 namespace mfr {
 
@@ -28,6 +29,31 @@ glm::vec3 compositeZThickness(std::span<const Fragment> sorted, const glm::vec4&
 // The image; throws mfr::Error("--thickness", …) unless thickness is finite and > 0.
 ImageRGBA8 compositeZThickness(const FragmentLists& lists, const Camera& camera, double thickness,
                                const glm::vec3& background);
+
+// Operation "volume" (shaders/ops/volume.glsl is the same definition, in the same float arithmetic):
+// the volume's emission-absorption integral ray-marched between the pixel's sorted surface
+// fragments, each surface composited with "over" at its exact depth. The ray of a pixel runs from
+// its centre on the near plane to the far plane (t in world units); inside the volume's box,
+// interval boundaries lie every `step` from the entry point, cut further at surfaces, and each
+// interval takes the (rgb, σ) of the transfer table at its midpoint's trilinear sample:
+// C += T·(1 - e^(-σ·Δ))·rgb, T ·= e^(-σ·Δ). Marching stops once T < MFR_VOLUME_MIN_TRANSMITTANCE;
+// a chord longer than MFR_VOLUME_MAX_STEPS steps gets a longer step.
+struct VolumeRaySetup {
+  glm::mat4 invViewProj{1.0f};  // NDC → world (computed in double, rounded to float)
+  glm::vec2 viewport{0.0f};
+  glm::mat4 worldToGrid{1.0f};
+  glm::ivec3 dims{0};
+  float step = 0.0f;  // world units
+  float tfLow = 0.0f, tfHigh = 1.0f;
+  std::vector<glm::vec4> table;  // TransferFunction::table()
+};
+// The values both renderers use; step ≤ 0 picks Volume::defaultStep().
+VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int width, int height, double step);
+// One pixel; (glX, glY) in GL window coordinates (row 0 at the bottom).
+glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, const VolumeRaySetup& setup,
+                          const VolumeGrid& grid, const glm::vec3& background);
+ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, const Volume& volume, double step,
+                           const glm::vec3& background);
 
 // Image-space CSG (scene.csg, rule of csgVisibleFragment with the scene's mirrored primitives):
 // each pixel shows its visible fragment's colour as an opaque surface (RGB of the stored colour,

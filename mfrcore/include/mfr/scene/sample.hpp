@@ -23,6 +23,12 @@ Scene makeCsgSampleScene();
 // twice (coincident faces, different colours) and a ring through it. Views "iso" and "front".
 Scene makeIntersectingSampleScene();
 
+// The built-in volume sample ("@volume", for the operation "volume"): a 96³ analytic field (a
+// dense core, a hollow shell and a ring of blobs) with translucent surfaces crossing it — a
+// plate cutting through the middle, a rod piercing it and a sphere half inside — so surfaces in
+// front of, inside and behind the medium all occur. Views "iso" and "front".
+Scene makeVolumeSampleScene();
+
 Scene makeQuadsScene(int layers, double density = 1.0, std::uint32_t seed = 1);
 
 }  // namespace mfr

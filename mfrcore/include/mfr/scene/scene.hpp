@@ -1,5 +1,5 @@
 #pragma once
-// A scene: objects (mesh + transform + material), named views and a background.
+// A scene: objects (mesh + transform + material), volumes, named views and a background.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -11,6 +11,7 @@
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/csg.hpp"
 #include "mfr/scene/mesh.hpp"
+#include "mfr/scene/volume.hpp"
 
 namespace mfr {
 
@@ -41,15 +42,21 @@ struct Scene {
   std::vector<NamedView> views;  // the scene's own views; "fit" is always available besides
   glm::vec3 background{1.0f, 1.0f, 1.0f};
   CsgTree csg;  // image-space CSG over some objects (operation "csg"); empty: none
+  // Scalar volumes composited with the surfaces by the operation "volume"; at most one visible.
+  std::vector<Volume> volumes;
 
-  [[nodiscard]] Bounds bounds() const;  // world bounds of visible objects
-  // Radius of the smallest sphere around bounds().center() holding every visible vertex.
+  [[nodiscard]] Bounds bounds() const;  // world bounds of visible objects and volumes
+  // Radius of the smallest sphere around bounds().center() holding every visible vertex and
+  // volume corner.
   [[nodiscard]] double boundingRadius() const;
   // Camera with the direction and up of `base`, framing the visible objects.
   [[nodiscard]] Camera fit(const Camera& base) const;
   [[nodiscard]] std::size_t triangleCount() const;
   // Object ids are indices into objects; GPU and oracle both report them.
-  // Throws mfr::Error when there is nothing visible to draw.
+  // The visible volume, or nullptr.
+  [[nodiscard]] const Volume* visibleVolume() const;
+  // Throws mfr::Error when there is nothing visible to draw (no triangles, no volume), when more
+  // than one volume is visible, or for an invalid volume.
   void validate() const;
   // The named view, or the fit-all view for "fit" / empty name. Throws mfr::Error listing the
   // available names for an unknown one.

@@ -1,0 +1,634 @@
+// Scalar volume files: VTK's image readers (.vti, legacy .vtk STRUCTURED_POINTS, MetaImage, NRRD)
+// and CGAL's ImageIO (INRIMAGE, also gzip-compressed). Both check what the header declares before
+// the samples are read, so a huge or truncated file fails early, and whatever goes wrong leaves
+// as one mfr::Error("<path>", "<one-line reason>").
+#include "volume_loader.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <new>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <unistd.h>
+#include <zlib.h>
+
+#include <CGAL/ImageIO.h>
+#include <CGAL/ImageIO/inr.h>
+#include <glm/gtc/matrix_transform.hpp>
+#include <vtkAlgorithm.h>
+#include <vtkCallbackCommand.h>
+#include <vtkCellData.h>
+#include <vtkCommand.h>
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkInformation.h>
+#include <vtkMatrix3x3.h>
+#include <vtkMetaImageReader.h>
+#include <vtkNew.h>
+#include <vtkNrrdReader.h>
+#include <vtkPointData.h>
+#include <vtkSmartPointer.h>
+#include <vtkStreamingDemandDrivenPipeline.h>
+#include <vtkStructuredPointsReader.h>
+#include <vtkXMLImageDataReader.h>
+
+#include "mfr/error.hpp"
+#include "vtk_loader.hpp"
+
+namespace mfr::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// VolumeGrid::validate's limits; checked before any sample is read.
+constexpr std::int64_t kMaxPointsPerAxis = VolumeGrid::kMaxPointsPerAxis;
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+struct Extension {
+  const char* ext;
+  VolumeFormat format;
+};
+
+constexpr std::array<Extension, 8> kExtensions{{{".inr.gz", VolumeFormat::Inrimage},
+                                                {".nrrd", VolumeFormat::Nrrd},
+                                                {".nhdr", VolumeFormat::Nrrd},
+                                                {".vti", VolumeFormat::Vti},
+                                                {".vtk", VolumeFormat::LegacyVtk},
+                                                {".mhd", VolumeFormat::MetaImage},
+                                                {".mha", VolumeFormat::MetaImage},
+                                                {".inr", VolumeFormat::Inrimage}}};
+
+std::optional<VolumeFormat> formatByName(const fs::path& path) {
+  const std::string name = lower(path.filename().string());
+  for (const Extension& e : kExtensions) {
+    const std::string ext = e.ext;
+    if (name.size() > ext.size() && endsWith(name, ext)) return e.format;
+  }
+  return std::nullopt;
+}
+
+// The DATASET type of a legacy .vtk file (upper case), or "" when its first lines do not say.
+// Layout: "# vtk DataFile Version x.y", a title line, ASCII | BINARY, "DATASET <type>".
+std::string legacyDataset(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return {};
+  std::string line;
+  for (int i = 0; i < 8 && std::getline(in, line); ++i) {
+    if (line.size() > 1024) line.resize(1024);
+    std::string upper = line;
+    std::transform(upper.begin(), upper.end(), upper.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+    if (i == 0 && upper.rfind("# VTK DATAFILE", 0) != 0) return {};
+    if (i < 2) continue;  // the title may say anything
+    const std::size_t at = upper.find("DATASET");
+    if (at == std::string::npos) continue;
+    std::size_t p = at + 7;
+    while (p < upper.size() && std::isspace(static_cast<unsigned char>(upper[p]))) ++p;
+    std::size_t q = p;
+    while (q < upper.size() && !std::isspace(static_cast<unsigned char>(upper[q]))) ++q;
+    return upper.substr(p, q - p);
+  }
+  return {};
+}
+
+void checkReadable(const fs::path& path, const std::string& name) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (st.type() == fs::file_type::not_found) throw Error(name, "no such file");
+  if (ec) throw Error(name, "cannot access file: " + ec.message());
+  if (fs::is_directory(st)) throw Error(name, "is a directory, not a volume file");
+  if (!fs::is_regular_file(st)) throw Error(name, "not a regular file");
+  if (::access(path.c_str(), R_OK) != 0) throw Error(name, std::string("cannot read file: ") + std::strerror(errno));
+  std::ifstream probe(path, std::ios::binary);
+  if (!probe) throw Error(name, "cannot open file for reading");
+  if (fs::file_size(path, ec) == 0 && !ec) throw Error(name, "empty file");
+}
+
+std::string oneLine(std::string s) {
+  for (char& c : s)
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  s.erase(std::unique(s.begin(), s.end(), [](char a, char b) { return a == ' ' && b == ' '; }), s.end());
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  return s;
+}
+
+std::string dimsText(const std::array<std::int64_t, 3>& d) {
+  return std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" + std::to_string(d[2]);
+}
+
+// The declared size, before anything is allocated for it.
+void checkDims(const std::array<std::int64_t, 3>& d, const std::string& name) {
+  for (const std::int64_t n : d) {
+    if (n < 2) throw Error(name, "volume needs at least 2 points per axis (the file declares " + dimsText(d) + ")");
+    if (n > kMaxPointsPerAxis)
+      throw Error(name, "volume of " + dimsText(d) + " points is larger than " + std::to_string(kMaxPointsPerAxis) +
+                            " points per axis");
+  }
+  if (static_cast<std::size_t>(d[0]) * static_cast<std::size_t>(d[1]) * static_cast<std::size_t>(d[2]) >
+      VolumeGrid::kMaxPoints)
+    throw Error(name, "volume of " + dimsText(d) + " points is larger than 2^30 points (4 GiB of samples)");
+}
+
+std::size_t pointCount(const glm::ivec3& dims) {
+  return static_cast<std::size_t>(dims.x) * static_cast<std::size_t>(dims.y) * static_cast<std::size_t>(dims.z);
+}
+
+// Reports progress every few million samples of a conversion loop.
+constexpr std::size_t kProgressChunk = std::size_t{1} << 22;
+
+// ---------------------------------------------------------------------------------------------
+// VTK
+
+const char* formatLabel(VolumeFormat format) {
+  switch (format) {
+    case VolumeFormat::Vti:
+      return "VTK image data (.vti)";
+    case VolumeFormat::LegacyVtk:
+      return "legacy VTK structured points";
+    case VolumeFormat::MetaImage:
+      return "MetaImage";
+    case VolumeFormat::Nrrd:
+      return "NRRD";
+    case VolumeFormat::Inrimage:
+      return "INRIMAGE";
+  }
+  return "volume";
+}
+
+vtkSmartPointer<vtkAlgorithm> makeReader(VolumeFormat format, const std::string& file) {
+  switch (format) {
+    case VolumeFormat::Vti: {
+      auto r = vtkSmartPointer<vtkXMLImageDataReader>::New();
+      r->SetFileName(file.c_str());
+      return r;
+    }
+    case VolumeFormat::LegacyVtk: {
+      auto r = vtkSmartPointer<vtkStructuredPointsReader>::New();
+      r->SetFileName(file.c_str());
+      r->ReadAllScalarsOn();
+      return r;
+    }
+    case VolumeFormat::MetaImage: {
+      auto r = vtkSmartPointer<vtkMetaImageReader>::New();
+      r->SetFileName(file.c_str());
+      return r;
+    }
+    case VolumeFormat::Nrrd: {
+      auto r = vtkSmartPointer<vtkNrrdReader>::New();
+      r->SetFileName(file.c_str());
+      return r;
+    }
+    case VolumeFormat::Inrimage:
+      break;
+  }
+  return nullptr;
+}
+
+// Passes VTK's progress on (never backwards: readers restart it per array) and aborts the reader
+// when the load is cancelled.
+struct ProgressRelay {
+  const LoadProgress* progress = nullptr;
+  bool cancelled = false;
+  double last = 0.0;
+
+  static void callback(vtkObject* caller, unsigned long, void* clientData, void*) {
+    auto* self = static_cast<ProgressRelay*>(clientData);
+    auto* algorithm = vtkAlgorithm::SafeDownCast(caller);
+    if (self == nullptr || algorithm == nullptr || self->cancelled) return;
+    self->last = std::max(self->last, std::clamp(algorithm->GetProgress(), 0.0, 1.0));
+    if (!self->progress->tryStep(0.1 + 0.6 * self->last)) {
+      self->cancelled = true;
+      algorithm->AbortExecuteOn();
+    }
+  }
+};
+
+// MetaIO (inside vtkMetaImageReader) reports problems such as a missing or short data file on
+// std::cerr, and the reader returns the image anyway. While a MetaImage file is read, std::cerr
+// goes into a string (one read at a time), which then decides and explains the failure.
+class CerrCapture {
+ public:
+  CerrCapture() : lock_(mutex()), previous_(std::cerr.rdbuf(buffer_.rdbuf())) {}
+  ~CerrCapture() { std::cerr.rdbuf(previous_); }
+  CerrCapture(const CerrCapture&) = delete;
+  CerrCapture& operator=(const CerrCapture&) = delete;
+
+  [[nodiscard]] std::string text() const { return buffer_.str(); }
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::unique_lock<std::mutex> lock_;
+  std::ostringstream buffer_;
+  std::streambuf* previous_;
+};
+
+// vtkNrrdReader trusts its header: a header whose last line has no newline makes it loop forever
+// (reading one data file name after another until memory runs out), an empty "data file" or
+// spacings without sizes index an empty vector, a file pattern goes to snprintf as the format,
+// and ASCII data is read without checking the stream (a short file gives garbage). This looks at
+// the header as vtkNrrdReader will see it — the first 4 MiB up to a NUL byte, cut after the first
+// blank line — and refuses those cases before the reader runs.
+void checkNrrdHeader(const fs::path& path, const std::string& name) {
+  std::ifstream in(path, std::ios::binary);
+  std::string text(0x400000 - 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  text.resize(std::min(text.find('\0'), text.size()));
+  for (std::size_t p = text.find('\n', 1); p != std::string::npos; p = text.find('\n', p + 1)) {
+    if (p + 1 < text.size() && text[p + 1] == '\n') {
+      text.resize(p + 2);
+      break;
+    }
+    if (p + 2 < text.size() && text[p + 1] == '\r' && text[p + 2] == '\n') {
+      text.resize(p + 3);
+      break;
+    }
+  }
+  if (text.rfind("NRRD", 0) != 0) throw Error(name, "not a NRRD file (it does not start with NRRD)");
+  if (text.back() != '\n') throw Error(name, "NRRD header does not end (no blank line after it, or a NUL byte in it)");
+  std::istringstream lines(text);
+  std::string line;
+  std::getline(lines, line);  // the magic
+  long dimension = 0;
+  bool sizes = false;
+  while (std::getline(lines, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) break;
+    const std::size_t colon = line.find(": ");
+    if (line[0] == '#' || colon == std::string::npos) continue;
+    const std::string field = line.substr(0, colon);
+    std::istringstream value(line.substr(colon + 2));
+    std::vector<std::string> tokens;
+    for (std::string t; value >> t;) tokens.push_back(t);
+    if (field == "dimension" || field == "space dimension") {
+      dimension = tokens.empty() ? 0 : std::atol(tokens[0].c_str());
+    } else if (field == "space") {
+      dimension = 3;
+    } else if (field == "sizes") {
+      if (dimension < 1 || dimension > 16) throw Error(name, "NRRD 'sizes' without a valid 'dimension' before it");
+      if (static_cast<long>(tokens.size()) != dimension)
+        throw Error(name, "NRRD 'sizes' has " + std::to_string(tokens.size()) + " values for dimension " +
+                              std::to_string(dimension));
+      for (const std::string& t : tokens)
+        if (t.find_first_not_of("0123456789") != std::string::npos || std::atol(t.c_str()) < 1)
+          throw Error(name, "NRRD 'sizes' must be positive integers (got '" + t + "')");
+      sizes = true;
+    } else if (field == "encoding") {
+      const std::string encoding = tokens.empty() ? std::string() : lower(tokens[0]);
+      if (encoding == "ascii" || encoding == "txt" || encoding == "text")
+        throw Error(name, "NRRD with ASCII encoding is not supported (use raw or gzip)");
+    } else if (field == "data file" || field == "datafile") {
+      if (tokens.empty()) throw Error(name, "NRRD 'data file' is empty");
+      if (tokens.size() > 1 || tokens[0] == "LIST")
+        throw Error(name, "NRRD data split into several files is not supported");
+    }
+  }
+  if (!sizes) throw Error(name, "NRRD header has no 'sizes'");
+}
+
+// The sample array: the point data's active scalars, else its first numeric array.
+vtkDataArray* sampleArray(vtkImageData* image, const std::string& name) {
+  vtkPointData* pd = image->GetPointData();
+  if (pd != nullptr) {
+    if (vtkDataArray* s = pd->GetScalars(); s != nullptr) return s;
+    for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+      if (vtkDataArray* a = pd->GetArray(i); a != nullptr) return a;
+  }
+  vtkCellData* cd = image->GetCellData();
+  if (cd != nullptr && cd->GetNumberOfArrays() > 0)
+    throw Error(name, "image has only cell data; a volume needs a point-data scalar array");
+  throw Error(name, "image has no point-data scalar array");
+}
+
+}  // namespace
+
+Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::string& name,
+                         const LoadProgress& progress) {
+  const std::string label = formatLabel(format);
+  if (format == VolumeFormat::Nrrd) checkNrrdHeader(path, name);
+  VtkMessages messages;  // before the reader: VTK's output window goes quiet
+  std::optional<CerrCapture> metaIo;
+  if (format == VolumeFormat::MetaImage) metaIo.emplace();
+  const std::string file = path.string();
+  vtkSmartPointer<vtkAlgorithm> reader = makeReader(format, file);
+  if (!reader) throw Error(name, "internal error: no VTK reader for " + label);
+  ProgressRelay relay{&progress};
+  vtkNew<vtkCallbackCommand> onProgress;
+  onProgress->SetCallback(&ProgressRelay::callback);
+  onProgress->SetClientData(&relay);
+  reader->AddObserver(vtkCommand::ProgressEvent, onProgress);
+
+  // Reading the samples, the readers report short or unreadable data as warnings ("Error reading
+  // binary data!", "File operation failed") and return what they have: warnings fail there.
+  // Header warnings (NRRD's unknown fields) do not.
+  bool readingData = false;
+  const auto failed = [&] {
+    return reader->GetErrorCode() != 0 || messages.hasError() || (readingData && messages.hasWarning()) ||
+           (metaIo && !metaIo->text().empty());
+  };
+  const auto fail = [&](const std::string& what) {
+    std::string reason = messages.reason();
+    if (reason.empty() && metaIo) reason = oneLine(metaIo->text());
+    throw Error(name, what + (reason.empty() ? "" : ": " + reason));
+  };
+
+  // The header first: the extent it declares is checked before the samples are allocated.
+  reader->UpdateInformation();
+  if (failed()) fail("cannot read " + label + " header");
+  vtkInformation* info = reader->GetOutputInformation(0);
+  if (info == nullptr || !info->Has(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT()))
+    fail("cannot read " + label + " header (no extent)");
+  int extent[6];
+  info->Get(vtkStreamingDemandDrivenPipeline::WHOLE_EXTENT(), extent);
+  const std::array<std::int64_t, 3> declared{std::int64_t{extent[1]} - extent[0] + 1,
+                                             std::int64_t{extent[3]} - extent[2] + 1,
+                                             std::int64_t{extent[5]} - extent[4] + 1};
+  checkDims(declared, name);
+  progress.step(0.1);
+
+  messages.clear();
+  readingData = true;
+  reader->Update();
+  if (relay.cancelled) throw LoadCancelled();
+  if (failed()) fail("cannot read " + label);
+  vtkImageData* image = vtkImageData::SafeDownCast(reader->GetOutputDataObject(0));
+  if (image == nullptr) fail("cannot read " + label + " (no image data)");
+  int dims[3];
+  image->GetDimensions(dims);
+  const std::array<std::int64_t, 3> got{dims[0], dims[1], dims[2]};
+  if (got != declared)
+    fail("cannot read " + label + " (read " + dimsText(got) + " points of the " + dimsText(declared) + " declared)");
+  vtkDataArray* array = sampleArray(image, name);
+  const glm::ivec3 gridDims(dims[0], dims[1], dims[2]);
+  const std::size_t n = pointCount(gridDims);
+  if (array->GetNumberOfComponents() < 1 || array->GetNumberOfTuples() != static_cast<vtkIdType>(n))
+    throw Error(name, "scalar array '" + std::string(array->GetName() ? array->GetName() : "") + "' has " +
+                          std::to_string(array->GetNumberOfTuples()) + " values for " + std::to_string(n) +
+                          " points (truncated?)");
+  progress.step(0.7);
+
+  auto grid = std::make_shared<VolumeGrid>();
+  grid->dims = gridDims;
+  grid->values.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    grid->values[i] = static_cast<float>(array->GetComponent(static_cast<vtkIdType>(i), 0));
+    if ((i + 1) % kProgressChunk == 0) progress.step(0.7 + 0.25 * static_cast<double>(i + 1) / static_cast<double>(n));
+  }
+
+  // VTK: point (i, j, k) of the extent is at origin + D·(spacing ⊙ (i, j, k)), D the direction
+  // matrix. Our grid counts from the extent's first point with positive spacings; the rest (the
+  // start of the extent, signs of spacings, D) goes into origin and transform.
+  double o[3], s[3];
+  image->GetOrigin(o);
+  image->GetSpacing(s);
+  glm::dmat3 direction(1.0);
+  if (vtkMatrix3x3* m = image->GetDirectionMatrix(); m != nullptr)
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) direction[c][r] = m->GetElement(r, c);
+  int start[3];
+  image->GetExtent(extent);
+  start[0] = extent[0];
+  start[1] = extent[2];
+  start[2] = extent[4];
+  glm::dvec3 spacing, first;
+  glm::dmat3 axes = direction;
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(s[a]) || s[a] == 0.0 || !std::isfinite(o[a]))
+      throw Error(name, "spacing must be non-zero and finite, the origin finite (spacing " + std::to_string(s[0]) +
+                            " " + std::to_string(s[1]) + " " + std::to_string(s[2]) + ")");
+    spacing[a] = std::abs(s[a]);
+    first[a] = s[a] * start[a];
+    if (s[a] < 0.0) axes[a] = -axes[a];
+  }
+  Volume volume;
+  volume.grid = std::move(grid);
+  volume.origin = glm::dvec3(o[0], o[1], o[2]) + direction * first;
+  volume.spacing = spacing;
+  if (axes != glm::dmat3(1.0))
+    volume.transform = glm::translate(glm::dmat4(1.0), volume.origin) * glm::dmat4(axes) *
+                       glm::translate(glm::dmat4(1.0), -volume.origin);
+  return volume;
+}
+
+// ---------------------------------------------------------------------------------------------
+// CGAL ImageIO
+
+namespace {
+
+// ImageIO keeps its list of formats in globals that it fills on first use.
+std::mutex& imageIoMutex() {
+  static std::mutex m;
+  return m;
+}
+
+template <typename T>
+void convertSamples(const void* data, std::size_t n, std::size_t stride, std::vector<float>& out,
+                    const LoadProgress& progress) {
+  out.resize(n);
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < n; ++i) {
+    T v;
+    std::memcpy(&v, bytes + i * stride, sizeof(T));
+    out[i] = static_cast<float>(v);
+    if ((i + 1) % kProgressChunk == 0) progress.step(0.7 + 0.25 * static_cast<double>(i + 1) / static_cast<double>(n));
+  }
+}
+
+// The magic bytes of an INRIMAGE file, read through zlib (which passes uncompressed bytes through).
+void checkInrimageMagic(const fs::path& path, const std::string& name, bool gz) {
+  if (gz) {
+    std::ifstream in(path, std::ios::binary);
+    unsigned char magic[2] = {0, 0};
+    in.read(reinterpret_cast<char*>(magic), 2);
+    if (in.gcount() != 2 || magic[0] != 0x1f || magic[1] != 0x8b)
+      throw Error(name, "not a gzip file (bad magic bytes)");
+  }
+  gzFile f = gzopen(path.c_str(), "rb");
+  if (f == nullptr) throw Error(name, "cannot open file for reading");
+  const std::unique_ptr<gzFile_s, int (*)(gzFile)> closer(f, gzclose);
+  static constexpr std::string_view kMagic = "#INRIMAGE-4#{";
+  char head[16] = {};
+  const int got = gzread(f, head, static_cast<unsigned>(kMagic.size()));
+  if (got < 0) throw Error(name, "corrupt gzip data");
+  if (std::string_view(head, static_cast<std::size_t>(got)) != kMagic)
+    throw Error(name, "not an INRIMAGE file (it does not start with #INRIMAGE-4#{)");
+}
+
+}  // namespace
+
+Volume readInrimage(const fs::path& path, const std::string& name, const LoadProgress& progress) {
+  const bool gz = endsWith(lower(path.filename().string()), ".gz");
+  checkInrimageMagic(path, name, gz);
+  // ImageIO reads standard input for the names "-" and "<".
+  const std::string file = fs::absolute(path).string();
+
+  std::lock_guard<std::mutex> lock(imageIoMutex());
+  // ImageIO's own readers, without _readImageHeader's search over formats, which prints each
+  // failure to stderr: open (through zlib), then the INRIMAGE header reader, which does not.
+  const std::unique_ptr<_image, void (*)(_image*)> im(_initImage(), _freeImage);
+  if (!im) throw Error(name, "out of memory");
+  _openReadImage(im.get(), file.c_str());
+  if (im->fd == nullptr || im->openMode == OM_CLOSE) throw Error(name, "cannot open file for reading");
+  if (readInrimageHeader(file.c_str(), im.get()) < 0) throw Error(name, "corrupt or unsupported INRIMAGE header");
+
+  // ImageIO's header check passed: positive sizes and voxel sizes, a known word kind.
+  const std::array<std::int64_t, 3> declared{static_cast<std::int64_t>(std::min<std::size_t>(im->xdim, INT64_MAX)),
+                                             static_cast<std::int64_t>(std::min<std::size_t>(im->ydim, INT64_MAX)),
+                                             static_cast<std::int64_t>(std::min<std::size_t>(im->zdim, INT64_MAX))};
+  checkDims(declared, name);
+  if (im->vdim < 1 || im->vdim > 64)
+    throw Error(name, "unsupported number of components per voxel (" + std::to_string(im->vdim) + ")");
+  if (!(im->vx > 0.0) || !(im->vy > 0.0) || !(im->vz > 0.0) || !std::isfinite(im->vx) || !std::isfinite(im->vy) ||
+      !std::isfinite(im->vz))
+    throw Error(name, "voxel size (VX, VY, VZ) must be positive and finite");
+  const std::size_t wdim = im->wdim;
+  const bool isFloat = im->wordKind == WK_FLOAT;
+  const bool isSigned = im->sign == SGN_SIGNED;
+  if (isFloat ? (wdim != 4 && wdim != 8)
+              : (im->wordKind != WK_FIXED || (wdim != 1 && wdim != 2 && wdim != 4 && wdim != 8)))
+    throw Error(name,
+                "unsupported voxel type (" + std::to_string(8 * wdim) + "-bit " + (isFloat ? "float" : "fixed") + ")");
+
+  const glm::ivec3 dims(static_cast<int>(declared[0]), static_cast<int>(declared[1]), static_cast<int>(declared[2]));
+  const std::size_t n = pointCount(dims);
+  const std::uint64_t bytes = static_cast<std::uint64_t>(n) * im->vdim * wdim;
+  // Uncompressed: the file must hold all the samples its header declares.
+  if (gzdirect(im->fd) == 1) {
+    const z_off_t headerEnd = gztell(im->fd);
+    std::error_code ec;
+    const std::uintmax_t size = fs::file_size(path, ec);
+    if (!ec && headerEnd >= 0 && size - static_cast<std::uintmax_t>(headerEnd) < bytes)
+      throw Error(name, "truncated INRIMAGE file (" + std::to_string(size - static_cast<std::uintmax_t>(headerEnd)) +
+                            " of " + std::to_string(bytes) + " bytes of voxel data)");
+  }
+  progress.step(0.1);
+  if (_readImageData(im.get()) < 0)
+    throw Error(name, gz ? "truncated or corrupt INRIMAGE data (gzip stream ends early or is damaged)"
+                         : "truncated INRIMAGE file (cannot read " + std::to_string(bytes) + " bytes of voxel data)");
+  progress.step(0.7);
+
+  auto grid = std::make_shared<VolumeGrid>();
+  grid->dims = dims;
+  const std::size_t stride = im->vdim * wdim;  // interlaced components: the first one
+  const void* data = im->data;
+  if (isFloat) {
+    if (wdim == 4)
+      convertSamples<float>(data, n, stride, grid->values, progress);
+    else
+      convertSamples<double>(data, n, stride, grid->values, progress);
+  } else if (isSigned) {
+    if (wdim == 1)
+      convertSamples<std::int8_t>(data, n, stride, grid->values, progress);
+    else if (wdim == 2)
+      convertSamples<std::int16_t>(data, n, stride, grid->values, progress);
+    else if (wdim == 4)
+      convertSamples<std::int32_t>(data, n, stride, grid->values, progress);
+    else
+      convertSamples<std::int64_t>(data, n, stride, grid->values, progress);
+  } else {
+    if (wdim == 1)
+      convertSamples<std::uint8_t>(data, n, stride, grid->values, progress);
+    else if (wdim == 2)
+      convertSamples<std::uint16_t>(data, n, stride, grid->values, progress);
+    else if (wdim == 4)
+      convertSamples<std::uint32_t>(data, n, stride, grid->values, progress);
+    else
+      convertSamples<std::uint64_t>(data, n, stride, grid->values, progress);
+  }
+
+  Volume volume;
+  volume.grid = std::move(grid);
+  volume.origin = glm::dvec3(im->tx, im->ty, im->tz);
+  volume.spacing = glm::dvec3(im->vx, im->vy, im->vz);
+  return volume;
+}
+
+std::optional<VolumeFormat> volumeFormat(const fs::path& path) {
+  const std::optional<VolumeFormat> format = formatByName(path);
+  if (format == VolumeFormat::LegacyVtk && legacyDataset(path) != "STRUCTURED_POINTS") return std::nullopt;
+  return format;
+}
+
+}  // namespace mfr::io
+
+namespace mfr {
+
+Volume loadVolume(const std::filesystem::path& path, const LoadProgress& progress) {
+  const std::string name = path.string();
+  try {
+    progress.step(0.0);
+    io::checkReadable(path, name);
+    const std::optional<io::VolumeFormat> format = io::formatByName(path);
+    if (!format) {
+      std::string list;
+      for (const std::string& ext : supportedVolumeExtensions()) list += (list.empty() ? "" : " ") + ext;
+      const std::string ext = path.extension().string();
+      throw Error(name, "unsupported volume file type '" + (ext.empty() ? path.filename().string() : io::lower(ext)) +
+                            "' (supported: " + list + ")");
+    }
+    if (*format == io::VolumeFormat::LegacyVtk) {
+      const std::string dataset = io::legacyDataset(path);
+      if (dataset.empty()) throw Error(name, "not a legacy VTK file (no '# vtk DataFile' header with a DATASET line)");
+      if (dataset != "STRUCTURED_POINTS")
+        throw Error(name, "legacy VTK DATASET " + dataset + " is not a volume (expected STRUCTURED_POINTS)");
+    }
+    Volume volume = *format == io::VolumeFormat::Inrimage ? io::readInrimage(path, name, progress)
+                                                          : io::readVolumeWithVtk(*format, path, name, progress);
+    volume.name = path.filename().string();
+    volume.grid->validate(name);
+    volume.transfer = defaultTransfer(*volume.grid, volume.bounds());
+    volume.validate();
+    progress.step(1.0);
+    return volume;
+  } catch (const LoadCancelled&) {
+    throw;
+  } catch (const Error& e) {
+    std::string message = io::oneLine(e.what());
+    if (message.rfind(name, 0) != 0) message = name + ": " + message;
+    throw Error(message);
+  } catch (const std::bad_alloc&) {
+    throw Error(name, "out of memory while loading");
+  } catch (const std::exception& e) {
+    throw Error(name, io::oneLine(e.what()));
+  } catch (...) {
+    throw Error(name, "unknown error while loading");
+  }
+}
+
+std::vector<std::string> supportedVolumeExtensions() {
+  std::set<std::string> out;
+  for (const io::Extension& e : io::kExtensions) out.insert(e.ext);
+  return {out.begin(), out.end()};
+}
+
+bool isVolumeFile(const std::filesystem::path& path) {
+  return io::volumeFormat(path).has_value();
+}
+
+}  // namespace mfr

@@ -1,0 +1,99 @@
+// mfr render --op volume end to end: the oracle and the GPU agree on the built-in volume sample,
+// "auto" picks the volume for a scene that has one, --step reaches the image and the stats, mfr
+// bench measures volume rows against the oracle's volume image, and bad input fails with one line.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using mfr::test::CliResult;
+using mfr::test::runCli;
+
+class CliVolume : public mfr::test::CliTest {
+ protected:
+  double rmseOf(const fs::path& a, const fs::path& b) {
+    const CliResult r = runCli("compare " + a.string() + " " + b.string() + " --metric rmse");
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    return std::stod(r.out.substr(r.out.find("rmse ") + 5));
+  }
+};
+
+TEST_F(CliVolume, OracleAndGpuAgreeAndTheStepMatters) {
+  const std::string common = "render @volume --view iso --size 96x80";
+  const fs::path oracle = dir() / "oracle.png", gpu = dir() / "gpu.png", coarse = dir() / "coarse.png",
+                 over = dir() / "over.png", stats = dir() / "stats.json";
+  ASSERT_EQ(runCli(common + " -o " + oracle.string()).exitCode, 0);  // auto: volume
+  const CliResult g =
+      runCli(common + " -m abuffer-sbuffer --op volume -o " + gpu.string() + " --stats " + stats.string());
+  ASSERT_EQ(g.exitCode, 0) << g.out;
+  EXPECT_LT(rmseOf(oracle, gpu), 0.01);  // edge pixels only
+  ASSERT_EQ(runCli(common + " -m abuffer-sbuffer --step 0.4 -o " + coarse.string()).exitCode, 0);
+  ASSERT_EQ(runCli(common + " -m abuffer-sbuffer --op oit -o " + over.string()).exitCode, 0);
+  EXPECT_GT(rmseOf(gpu, coarse), 0.003);
+  EXPECT_GT(rmseOf(gpu, over), 0.02);  // the medium
+  std::ifstream in(stats);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["operation"], "volume");
+  // Default step: half the sample's grid spacing, 2/95 / 2.
+  EXPECT_NEAR(std::stod(j["notes"]["volume step"].get<std::string>()), 1.0 / 95.0, 1e-5) << j.dump();
+  EXPECT_EQ(j["notes"]["volume (bytes)"], std::to_string(96 * 96 * 96 * 4 + 256 * 16));
+}
+
+TEST_F(CliVolume, BenchMeasuresRowsAgainstTheOraclesVolumeImage) {
+  const fs::path json = dir() / "bench.json";
+  const CliResult r = runCli(
+      "bench @volume --view iso --size 96x80 -r 1 -m abuffer-ll,abuffer-ll:op=oit,kplus-array:k=64:step=0.05 --json " +
+      json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["results"].size(), 3u);
+  EXPECT_LT(j["results"][0]["rmse"].get<double>(), 0.01);
+  // op=oit leaves the volume out and is measured against "over": also close, but a different image.
+  EXPECT_EQ(j["results"][1]["notes"]["volume"], "not drawn (operation oit)");
+  EXPECT_LT(j["results"][1]["rmse"].get<double>(), 0.01);
+  EXPECT_EQ(j["results"][2]["method"], "kplus-array:k=64:step=0.05");
+  EXPECT_EQ(j["results"][2]["notes"]["volume step"], "0.050000");
+  EXPECT_LT(j["results"][2]["rmse"].get<double>(), 0.01);
+}
+
+TEST_F(CliVolume, InfoDescribesTheVolume) {
+  const fs::path json = dir() / "info.json";
+  const CliResult r = runCli("info @volume --no-histogram --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("volume: field (96x96x96 points"), std::string::npos) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["volumes"].size(), 1u);
+  EXPECT_EQ(j["volumes"][0]["dims"], nlohmann::json({96, 96, 96}));
+  EXPECT_NEAR(j["volumes"][0]["bounds"]["max"][0].get<double>(), 1.0, 1e-9);
+  EXPECT_NEAR(j["volumes"][0]["range"][1].get<double>(), 1.0, 0.01);  // the core's peak (blobs add a little)
+}
+
+TEST_F(CliVolume, BadInputIsOneLine) {
+  expectCleanFailure("render @volume --step -1", "--step");
+  expectCleanFailure("render @volume --step 0", "--step");
+  expectCleanFailure("render @volume --step nan", "--step");
+  expectCleanFailure("render @volume --op volume --method peel-dual", "peel-dual");
+  expectCleanFailure("render @volume --op volume --method mboit", "mboit");
+  expectCleanFailure("render @sample --op volume", "no visible volume");
+  expectCleanFailure("render @sample --op volume --method abuffer-ll", "no visible volume");
+  const fs::path json = dir() / "b.json";
+  const CliResult bench = runCli("bench @volume -m abuffer-ll:step=-3 --json " + json.string());
+  EXPECT_NE(bench.exitCode, 0);
+  EXPECT_EQ(std::count(bench.out.begin(), bench.out.end(), '\n'), 1) << bench.out;
+  EXPECT_NE(bench.out.find("step"), std::string::npos) << bench.out;
+  EXPECT_FALSE(fs::exists(json));
+}
+
+}  // namespace

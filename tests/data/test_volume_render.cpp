@@ -1,0 +1,89 @@
+// Operation "volume" on a real file: CGAL's demo CT volume skull_2.9.inr (64³ floats, anisotropic
+// spacing) with the "bone" transfer function, a probe sphere inside it and a translucent plate
+// cutting through it, rendered by GPU methods and by the oracle: they must agree as on the
+// generated sample (tests/gl/test_volume.cpp), from a perspective and an orthographic view.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include "gl_fixture.hpp"
+#include "mfr/reference/composite.hpp"
+#include "mfr/scene/scene_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace mfr::test {
+namespace {
+
+fs::path cgalImages() {
+  const char* env = std::getenv("MFR_TESTDATA_DIR");
+  const fs::path data = env != nullptr && *env != '\0' ? fs::path(env) : fs::path(MFR_FETCHED_DATA_DIR);
+  return data / "cgal" / "data" / "images";
+}
+
+constexpr const char* kScene = R"({
+  "background": [1, 1, 1],
+  "objects": [
+    { "name": "probe", "primitive": { "type": "sphere", "radius": 40 }, "color": [0.9, 0.2, 0.2, 0.6],
+      "transform": { "translate": [124, 124, 160] } },
+    { "name": "cut", "primitive": { "type": "box", "size": [300, 300, 4] }, "color": [0.3, 0.5, 0.9, 0.3],
+      "transform": { "translate": [124, 124, 115] } }
+  ],
+  "volumes": [ { "file": "skull_2.9.inr", "transfer": { "preset": "bone", "unit_distance": 6 } } ],
+  "views": [
+    { "name": "oblique", "eye": [500, 350, 600], "target": [124, 124, 115], "fit": true },
+    { "name": "side", "eye": [600, 124, 115], "target": [124, 124, 115], "projection": "orthographic",
+      "height": 320 }
+  ]
+})";
+
+TEST(VolumeRealFile, SkullWithSurfacesInsideOnGpuEqualsTheOracle) {
+  context();
+  const fs::path dir = cgalImages();
+  ASSERT_TRUE(fs::exists(dir / "skull_2.9.inr")) << "missing " << dir << " (scripts/setup extracts it)";
+  const Scene scene = parseSceneFile(kScene, dir, "skull test scene");
+  ASSERT_NE(scene.visibleVolume(), nullptr);
+  const int w = 128, h = 112;
+  GpuRenderer gpu;
+  gpu.setScene(scene);
+  for (const char* view : {"oblique", "side"}) {
+    const Camera camera = scene.view(view);
+    const FragmentLists oracle = castFragments(scene, camera, w, h);
+    RenderRequest req;
+    req.operation = "volume";
+    req.width = w;
+    req.height = h;
+    const ImageRGBA8 expected =
+        compositeVolume(oracle, camera, *scene.visibleVolume(), scene.visibleVolume()->defaultStep(), scene.background);
+    for (const char* method : {"abuffer-ll", "abuffer-sbuffer"}) {
+      SCOPED_TRACE(std::string(view) + " " + method);
+      req.method = method;
+      const ImageRGBA8 actual = gpu.render(camera, req).image;
+      std::size_t compared = 0, within = 0, medium = 0;
+      int maxDifference = 0;
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          if (oracle.isEdge(x, y)) continue;
+          int diff = 0;
+          for (int c = 0; c < 3; ++c)
+            diff = std::max(diff, std::abs(int(expected.at(x, y)[c]) - int(actual.at(x, y)[c])));
+          ++compared;
+          within += diff <= 2;
+          maxDifference = std::max(maxDifference, diff);
+          // The bone's colour (white to warm) where no surface covers the pixel.
+          medium += oracle.count(x, y) == 0 && expected.at(x, y)[2] < 235;
+        }
+      EXPECT_GT(compared, static_cast<std::size_t>(w * h) * 9 / 10);
+      EXPECT_GE(static_cast<double>(within) / compared, 0.999)
+          << compared - within << " pixels off by more than 2/255, max " << maxDifference;
+      if (std::string(view) == "side") {
+        EXPECT_GT(medium, 200u);  // (the plate covers the skull in the oblique view)
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mfr::test

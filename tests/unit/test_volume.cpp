@@ -1,0 +1,249 @@
+// Operation "volume" on the CPU (compositeVolume, the oracle the GPU is compared with) against
+// references that share none of its code: Beer–Lambert closed forms for homogeneous media with
+// surfaces in front of, inside and behind them; the optical depth of a linearly varying medium,
+// which the midpoint rule integrates exactly whatever the step; and the second-order convergence
+// of a quadratic medium. The rays are computed here independently (orthographic: along −z).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include <glm/gtc/packing.hpp>
+
+#include "common/bindings.h"
+#include "mfr/error.hpp"
+#include "mfr/reference/composite.hpp"
+#include "mfr/scene/camera.hpp"
+#include "mfr/scene/volume.hpp"
+
+namespace mfr::test {
+namespace {
+
+// The box [-1, 1]³ sampled by an n³ grid with values f(x, y, z).
+template <class F>
+Volume boxVolume(int n, F f) {
+  auto grid = std::make_shared<VolumeGrid>();
+  grid->dims = glm::ivec3(n);
+  const double h = 2.0 / (n - 1);
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) grid->values.push_back(static_cast<float>(f(-1 + i * h, -1 + j * h, -1 + k * h)));
+  Volume v;
+  v.name = "box";
+  v.grid = grid;
+  v.origin = glm::dvec3(-1.0);
+  v.spacing = glm::dvec3(h);
+  return v;
+}
+
+// One colour and opacity for every value in [lo, hi].
+TransferFunction uniformTransfer(glm::vec4 color, double unitDistance, double lo = 0.0, double hi = 1.0) {
+  TransferFunction tf;
+  tf.unitDistance = unitDistance;
+  tf.points = {{lo, color}, {hi, color}};
+  return tf;
+}
+
+// Orthographic camera looking down −z from z = 3; near plane at z = 2.5, far at z = −3.
+Camera frontCamera() {
+  Camera c;
+  c.projection = Projection::Orthographic;
+  c.eye = {0.0, 0.0, 3.0};
+  c.target = {0.0, 0.0, 0.0};
+  c.orthoHeight = 3.0;
+  c.nearPlane = 0.5;
+  c.farPlane = 6.0;
+  return c;
+}
+
+// Window depth of world depth z on the front camera (square image).
+float windowDepth(const Camera& c, double z) {
+  const glm::dvec4 clip = c.projectionMatrix(1.0) * c.viewMatrix() * glm::dvec4(0.0, 0.0, z, 1.0);
+  return static_cast<float>(0.5 * clip.z / clip.w + 0.5);
+}
+
+Fragment surface(const Camera& c, double z, glm::vec4 color) {
+  Fragment f;
+  f.depth = windowDepth(c, z);
+  f.color = glm::packUnorm4x8(color);
+  return f;
+}
+
+constexpr int kSize = 33;  // odd: the centre pixel's ray is the z axis
+const int kCentre = kSize / 2;
+
+glm::vec3 centrePixel(std::span<const Fragment> sorted, const Volume& v, double step, glm::vec3 background) {
+  const VolumeRaySetup setup = volumeRaySetup(v, frontCamera(), kSize, kSize, step);
+  return compositeVolume(sorted, kCentre, kCentre, setup, *v.grid, background);
+}
+
+void expectNear(glm::vec3 a, glm::vec3 b, float tolerance) {
+  EXPECT_NEAR(a.r, b.r, tolerance);
+  EXPECT_NEAR(a.g, b.g, tolerance);
+  EXPECT_NEAR(a.b, b.b, tolerance);
+}
+
+TEST(VolumeTransfer, TableHoldsColourAndExtinctionOfTheControlPoints) {
+  TransferFunction tf;
+  tf.unitDistance = 0.5;
+  tf.points = {{10.0, {0.0f, 0.0f, 1.0f, 0.0f}}, {20.0, {1.0f, 0.0f, 0.0f, 0.5f}}, {30.0, {1.0f, 1.0f, 1.0f, 1.0f}}};
+  const std::vector<glm::vec4> t = tf.table();
+  ASSERT_EQ(t.size(), static_cast<std::size_t>(MFR_VOLUME_TF_SIZE));
+  EXPECT_NEAR(t.front().a, 0.0f, 1e-7);
+  EXPECT_NEAR(t.front().b, 1.0f, 1e-7);
+  // The last entry: opacity 1 clamped to MFR_VOLUME_MAX_ALPHA, σ = -ln(1 - α)/unit.
+  EXPECT_NEAR(t.back().a, -std::log(1.0 / 1024.0) / 0.5, 1e-4);
+  // Entry e sits at 10 + 20·e/255; the one nearest 20 interpolates the middle point's neighbours.
+  const int e = 127;  // value 19.96…
+  const double v = 10.0 + 20.0 * e / 255.0;
+  const double alpha = 0.5 * (v - 10.0) / 10.0;
+  EXPECT_NEAR(t[e].a, -std::log(1.0 - alpha) / 0.5, 1e-5);
+  EXPECT_NEAR(t[e].r, (v - 10.0) / 10.0, 1e-6);
+  EXPECT_NO_THROW(tf.validate("tf"));
+  tf.points[1].value = 40.0;
+  EXPECT_THROW(tf.validate("tf"), Error);  // not ascending
+  tf.points = {{1.0, glm::vec4(0.5f)}, {1.0, glm::vec4(0.5f)}};
+  EXPECT_THROW(tf.validate("tf"), Error);  // empty range
+}
+
+TEST(VolumeComposite, HomogeneousMediumIsBeerLambert) {
+  const glm::vec4 medium(0.2f, 0.6f, 0.9f, 0.3f);
+  Volume v = boxVolume(5, [](double, double, double) { return 0.5; });
+  v.transfer = uniformTransfer(medium, 0.25);
+  const double sigma = -std::log(1.0 - 0.3) / 0.25;
+  const glm::vec3 bg(1.0f, 0.9f, 0.8f);
+  // Chord through the box along z: 2 world units.
+  const double tr = std::exp(-sigma * 2.0);
+  const glm::vec3 expected = glm::vec3(medium) * static_cast<float>(1.0 - tr) + bg * static_cast<float>(tr);
+  for (const double step : {0.0, 0.013, 0.7, 5.0}) {  // any step: the medium is constant
+    SCOPED_TRACE(step);
+    expectNear(centrePixel({}, v, step, bg), expected, 2e-5f);
+  }
+}
+
+TEST(VolumeComposite, SurfacesInFrontInsideAndBehindTheMediumAtTheirExactDepths) {
+  const glm::vec4 medium(0.9f, 0.3f, 0.1f, 0.4f);
+  Volume v = boxVolume(4, [](double, double, double) { return 0.2; });
+  v.transfer = uniformTransfer(medium, 1.0);
+  const double sigma = -std::log(1.0 - 0.4);
+  const glm::vec3 bg(0.0f);
+  const Camera cam = frontCamera();
+  const glm::vec4 front(0.1f, 0.8f, 0.2f, 0.5f), inside(0.2f, 0.2f, 1.0f, 0.6f), behind(1.0f, 1.0f, 1.0f, 0.7f);
+  // Colours after 8-bit packing, as the fragments carry them.
+  const glm::vec4 f = glm::unpackUnorm4x8(glm::packUnorm4x8(front));
+  const glm::vec4 s = glm::unpackUnorm4x8(glm::packUnorm4x8(inside));
+  const glm::vec4 b = glm::unpackUnorm4x8(glm::packUnorm4x8(behind));
+  const std::vector<Fragment> sorted{surface(cam, 1.7, front), surface(cam, 0.3, inside), surface(cam, -2.0, behind)};
+  // Front surface, 0.7 of medium (z 1 → 0.3), the inner surface, 1.3 of medium, the back one.
+  const double t1 = std::exp(-sigma * 0.7), t2 = std::exp(-sigma * 1.3);
+  glm::dvec3 c = glm::dvec3(b) * double(b.a);         // behind, over black
+  c = glm::dvec3(medium) * (1.0 - t2) + t2 * c;       // back part of the medium
+  c = glm::dvec3(s) * double(s.a) + (1.0 - s.a) * c;  // the inner surface
+  c = glm::dvec3(medium) * (1.0 - t1) + t1 * c;       // front part of the medium
+  c = glm::dvec3(f) * double(f.a) + (1.0 - f.a) * c;  // the front surface
+  for (const double step : {0.0, 0.05, 0.31}) {
+    SCOPED_TRACE(step);
+    expectNear(centrePixel(sorted, v, step, bg), glm::vec3(c), 2e-5f);
+  }
+}
+
+// σ linear in z: the midpoint rule integrates it exactly whatever the step, so the colour of a
+// white medium over black is 1 - e^(-τ) with τ the closed-form integral.
+TEST(VolumeComposite, LinearMediumHasTheClosedFormOpticalDepth) {
+  Volume v = boxVolume(9, [](double, double, double z) { return 0.5 * (z + 1.0); });  // 0 at z = −1, 1 at z = 1
+  // Control points with σ(s) = 3s at every table entry: opacity 1 - e^(-3s·unit).
+  v.transfer.unitDistance = 0.5;
+  for (int e = 0; e < MFR_VOLUME_TF_SIZE; ++e) {
+    const double s = e / double(MFR_VOLUME_TF_SIZE - 1);
+    v.transfer.points.push_back({s, {1.0f, 1.0f, 1.0f, static_cast<float>(1.0 - std::exp(-3.0 * s * 0.5))}});
+  }
+  const Camera cam = frontCamera();
+  // τ over the whole chord: ∫_{-1}^{1} 3·(z + 1)/2 dz = 3.
+  for (const double step : {0.0, 0.037, 0.4, 1.3}) {
+    SCOPED_TRACE(step);
+    expectNear(centrePixel({}, v, step, glm::vec3(0.0f)), glm::vec3(static_cast<float>(1.0 - std::exp(-3.0))), 2e-5f);
+    // An opaque black surface at z = 0.2 cuts the chord: τ = ∫_{0.2}^{1} 1.5(z + 1) dz = 1.5·(2 - 0.72)
+    const std::vector<Fragment> wall{surface(cam, 0.2, {0.0f, 0.0f, 0.0f, 1.0f})};
+    const double tau = 1.5 * ((0.5 * 1.0 + 1.0) - (0.5 * 0.04 + 0.2));
+    expectNear(centrePixel(wall, v, step, glm::vec3(1.0f)), glm::vec3(static_cast<float>(1.0 - std::exp(-tau))), 2e-5f);
+  }
+}
+
+// σ quadratic in z: the midpoint rule's error is O(step²), so halving the step divides the error by
+// about 4 (the closed-form optical depth of ∫ 2·((z+1)/2)² dz over [-1, 1] is 4/3).
+TEST(VolumeComposite, QuadraticMediumConvergesAtSecondOrder) {
+  Volume v = boxVolume(3, [](double, double, double z) { return 0.5 * (z + 1.0); });
+  v.transfer.unitDistance = 1.0;
+  for (int e = 0; e < MFR_VOLUME_TF_SIZE; ++e) {
+    const double s = e / double(MFR_VOLUME_TF_SIZE - 1);
+    v.transfer.points.push_back({s, {1.0f, 1.0f, 1.0f, static_cast<float>(1.0 - std::exp(-2.0 * s * s))}});
+  }
+  const double exact = 1.0 - std::exp(-4.0 / 3.0);
+  double previous = 0.0;
+  for (const double step : {0.5, 0.25, 0.125}) {
+    const double error = std::abs(centrePixel({}, v, step, glm::vec3(0.0f)).r - exact);
+    if (previous > 0.0) {
+      EXPECT_GT(previous / error, 3.0) << "step " << step;
+      EXPECT_LT(previous / error, 5.0) << "step " << step;
+    }
+    previous = error;
+  }
+  EXPECT_LT(previous, 1e-3);
+}
+
+// Outside the box's projection a ray meets no medium; a step far below the chord / MFR_VOLUME_MAX_STEPS
+// is lengthened (the loop stays bounded) and the result still converged; a dense medium stops the
+// march once nothing shows through.
+TEST(VolumeComposite, MissesTinyStepsAndOpaqueMedia) {
+  const glm::vec4 medium(0.5f, 0.5f, 0.5f, 0.2f);
+  Volume v = boxVolume(5, [](double, double, double) { return 0.5; });
+  v.transfer = uniformTransfer(medium, 1.0);
+  const glm::vec3 bg(0.25f, 0.5f, 0.75f);
+  const VolumeRaySetup setup = volumeRaySetup(v, frontCamera(), kSize, kSize, 0.0);
+  expectNear(compositeVolume({}, 0, 0, setup, *v.grid, bg), bg, 0.0f);  // corner pixel: outside the box
+  const double tr = std::exp(std::log(0.8) * 2.0);
+  const glm::vec3 expected = glm::vec3(medium) * static_cast<float>(1.0 - tr) + bg * static_cast<float>(tr);
+  expectNear(centrePixel({}, v, 1e-9, bg), expected, 2e-5f);
+  v.transfer = uniformTransfer({0.3f, 0.6f, 0.9f, 1.0f}, 0.001);
+  const std::vector<Fragment> hidden{surface(frontCamera(), -0.5, {1.0f, 0.0f, 0.0f, 1.0f})};
+  expectNear(centrePixel(hidden, v, 0.0, bg), glm::vec3(0.3f, 0.6f, 0.9f), 1e-3f);
+}
+
+TEST(VolumeModel, BoundsStepAndValidation) {
+  Volume v = boxVolume(5, [](double x, double, double) { return x; });
+  v.transfer = uniformTransfer(glm::vec4(0.5f), 1.0);
+  EXPECT_NEAR(v.bounds().min.x, -1.0, 1e-12);
+  EXPECT_NEAR(v.bounds().max.z, 1.0, 1e-12);
+  EXPECT_NEAR(v.defaultStep(), 0.25, 1e-12);
+  EXPECT_NEAR(v.grid->sample({1.5f, 0.0f, 0.0f}), -0.25f, 1e-6f);  // trilinear between x = -0.5 and 0
+  EXPECT_NEAR(v.grid->sample({-3.0f, 9.0f, 0.0f}), -1.0f, 1e-6f);  // clamped
+  EXPECT_NO_THROW(v.validate());
+  Volume bad = v;
+  bad.spacing.y = 0.0;
+  EXPECT_THROW(bad.validate(), Error);
+  auto flat = std::make_shared<VolumeGrid>(*v.grid);
+  flat->dims.z = 1;
+  bad = v;
+  bad.grid = flat;
+  EXPECT_THROW(bad.validate(), Error);
+  auto nan = std::make_shared<VolumeGrid>(*v.grid);
+  nan->values[7] = std::nanf("");
+  bad = v;
+  bad.grid = nan;
+  EXPECT_THROW(bad.validate(), Error);
+  auto huge = std::make_shared<VolumeGrid>();
+  huge->dims = {2048, 2048, 300};  // 1.26·10⁹ points: refused before the (empty) values are looked at
+  bad = v;
+  bad.grid = huge;
+  try {
+    bad.validate();
+    ADD_FAILURE() << "a grid of more than 2^30 points was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("2^30"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(transferPreset("rainbow", 0, 1, 1), Error);
+  for (const std::string& name : transferPresetNames()) EXPECT_NO_THROW(transferPreset(name, 0, 1, 1).validate(name));
+}
+
+}  // namespace
+}  // namespace mfr::test

@@ -1,0 +1,641 @@
+// Scalar volumes from small hand-written files: loadVolume on every format (INRIMAGE, .vti,
+// legacy .vtk, MetaImage, NRRD) with known values, origin and spacing; bad input that must end in
+// one mfr::Error naming the file (never a crash, a hang or a huge allocation); loadScene and
+// loadModel on volume files; and the "volumes" of .mfrscene files with their JSON-path errors.
+// tests/data/test_volume_files.cpp reads real files and files written by VTK's own writers.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
+#include "mfr/scene/scene_file.hpp"
+#include "mfr/scene/volume.hpp"
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+class VolumeLoading : public mfr::test::TempDirTest {};
+
+// Expects loadVolume(path) to throw one mfr::Error: one line, starting "<path>: ", containing reason.
+void expectVolumeError(const fs::path& path, const std::string& reason) {
+  try {
+    const mfr::Volume v = mfr::loadVolume(path);
+    ADD_FAILURE() << path << ": loaded a volume of " << v.grid->dims.x << "x" << v.grid->dims.y << "x" << v.grid->dims.z
+                  << ", expected an error about '" << reason << "'";
+  } catch (const mfr::LoadCancelled&) {
+    ADD_FAILURE() << path << ": cancelled";
+  } catch (const mfr::Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.find('\n'), std::string::npos) << "not one line: " << what;
+    EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << "does not start with the path: " << what;
+    EXPECT_NE(what.find(reason), std::string::npos) << "expected '" << reason << "' in: " << what;
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << path << ": non-mfr exception: " << e.what();
+  }
+}
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const mfr::LoadCancelled&) {
+    return "cancelled";
+  } catch (const mfr::Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// ---- writers for the formats, each from its specification ---------------------------------------
+
+// The analytic field the small files hold: distinct at every point, exact in float.
+float field(int i, int j, int k) {
+  return static_cast<float>(i + 10 * j + 100 * k) - 37.5f;
+}
+
+// INRIMAGE: "#INRIMAGE-4#{" lines KEY=VALUE, padded with newlines to a multiple of 256 bytes that
+// ends in "##}\n", then the raw samples, x fastest.
+std::string inrHeader(const std::string& fields) {
+  std::string h = "#INRIMAGE-4#{\n" + fields;
+  const std::size_t size = (h.size() + 4 + 255) / 256 * 256;
+  h += std::string(size - h.size() - 4, '\n');
+  return h + "##}\n";
+}
+
+template <typename T>
+std::string bytesOf(T v, bool bigEndian) {
+  std::string s(sizeof(T), '\0');
+  std::memcpy(s.data(), &v, sizeof(T));
+  if (bigEndian) std::reverse(s.begin(), s.end());
+  return s;
+}
+
+// A 4x3x2 INRIMAGE of signed 16-bit big-endian samples field()+0.5 with voxel size and origin.
+std::string smallInr() {
+  std::string s = inrHeader(
+      "XDIM=4\nYDIM=3\nZDIM=2\nVDIM=1\nTYPE=signed fixed\nPIXSIZE=16 bits\nSCALE=2**0\nCPU=sun\n"
+      "VX=0.5\nVY=1.25\nVZ=2\nTX=1\nTY=-2\nTZ=3.5\n");
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i) s += bytesOf(static_cast<std::int16_t>(field(i, j, k) + 0.5f), true);
+  return s;
+}
+
+// VTK XML image data with ASCII arrays.
+std::string vti(const std::string& extent, const std::string& origin, const std::string& spacing,
+                const std::string& pointData, const std::string& cellData = "") {
+  return "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+         "  <ImageData WholeExtent=\"" +
+         extent + "\" Origin=\"" + origin + "\" Spacing=\"" + spacing +
+         "\">\n"
+         "    <Piece Extent=\"" +
+         extent + "\">\n      <PointData>" + pointData + "</PointData>\n      <CellData>" + cellData +
+         "</CellData>\n    </Piece>\n  </ImageData>\n</VTKFile>\n";
+}
+
+std::string asciiValues(int nx, int ny, int nz) {
+  std::ostringstream out;
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) out << field(i, j, k) << ' ';
+  return out.str();
+}
+
+std::string dataArray(const std::string& type, const std::string& name, const std::string& values) {
+  return "<DataArray type=\"" + type + "\" Name=\"" + name + "\" format=\"ascii\">" + values + "</DataArray>";
+}
+
+// 3x3x3, values 0…26 (x fastest), unit spacing, origin 0: the volume of the scene-file tests.
+std::string cubeVti() {
+  std::string values;
+  for (int v = 0; v < 27; ++v) values += std::to_string(v) + " ";
+  return vti("0 2 0 2 0 2", "0 0 0", "1 1 1", dataArray("Float32", "density", values));
+}
+
+void expectField(const mfr::Volume& v, glm::ivec3 dims, float offset = 0.0f) {
+  ASSERT_TRUE(v.grid);
+  ASSERT_EQ(v.grid->dims, dims);
+  ASSERT_EQ(v.grid->values.size(), static_cast<std::size_t>(dims.x * dims.y * dims.z));
+  for (int k = 0; k < dims.z; ++k)
+    for (int j = 0; j < dims.y; ++j)
+      for (int i = 0; i < dims.x; ++i)
+        ASSERT_EQ(v.grid->at(i, j, k), field(i, j, k) + offset) << i << " " << j << " " << k;
+}
+
+void expectVec(const glm::dvec3& got, const glm::dvec3& want, double tolerance = 1e-12) {
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], want[a], tolerance) << "axis " << a;
+}
+
+// ---- every format, small and exact ---------------------------------------------------------------
+
+TEST_F(VolumeLoading, InrimageBigEndianShortWithOrigin) {
+  const mfr::Volume v = mfr::loadVolume(write("small.inr", smallInr()));
+  EXPECT_EQ(v.name, "small.inr");
+  expectField(v, {4, 3, 2}, 0.5f);
+  expectVec(v.spacing, {0.5, 1.25, 2.0});
+  expectVec(v.origin, {1.0, -2.0, 3.5});
+  EXPECT_EQ(v.transform, glm::dmat4(1.0));
+}
+
+TEST_F(VolumeLoading, GzippedInrimage) {
+  const mfr::Volume v = mfr::loadVolume(writeGz("small.inr.gz", smallInr()));
+  EXPECT_EQ(v.name, "small.inr.gz");
+  expectField(v, {4, 3, 2}, 0.5f);
+}
+
+TEST_F(VolumeLoading, InrimageVectorsTakeTheFirstComponent) {
+  std::string s = inrHeader("XDIM=2\nYDIM=2\nZDIM=2\nVDIM=2\nTYPE=float\nPIXSIZE=32 bits\nCPU=pc\nVX=1\nVY=1\nVZ=1\n");
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) s += bytesOf(field(i, j, k), false) + bytesOf(1e6f, false);
+  expectField(mfr::loadVolume(write("vector.inr", s)), {2, 2, 2});
+}
+
+TEST_F(VolumeLoading, VtiAsciiWithExtentNotAtZero) {
+  // Points of the extent 2…5 × -1…1 × 0…1: the first one is at origin + spacing·(2, -1, 0).
+  const mfr::Volume v = mfr::loadVolume(
+      write("grid.vti", vti("2 5 -1 1 0 1", "1 2 3", "0.5 0.25 2", dataArray("Float64", "f", asciiValues(4, 3, 2)))));
+  expectField(v, {4, 3, 2});
+  expectVec(v.spacing, {0.5, 0.25, 2.0});
+  expectVec(v.origin, {2.0, 1.75, 3.0});
+  expectVec(v.bounds().min, {2.0, 1.75, 3.0});
+  expectVec(v.bounds().max, {3.5, 2.25, 5.0});
+}
+
+TEST_F(VolumeLoading, VtiTakesTheActiveScalarsElseTheFirstArray) {
+  std::string ones;
+  for (int n = 0; n < 24; ++n) ones += "1 ";
+  const std::string arrays = dataArray("Int32", "ones", ones) + dataArray("Float32", "f", asciiValues(4, 3, 2));
+  // No active scalars: the first array.
+  const mfr::Volume a = mfr::loadVolume(write("first.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", arrays)));
+  EXPECT_EQ(a.grid->range(), glm::vec2(1.0f, 1.0f));
+  // Scalars="f": that one.
+  std::string withActive = vti("0 3 0 2 0 1", "0 0 0", "1 1 1", arrays);
+  withActive.replace(withActive.find("<PointData>"), 11, "<PointData Scalars=\"f\">");
+  expectField(mfr::loadVolume(write("active.vti", withActive)), {4, 3, 2});
+}
+
+TEST_F(VolumeLoading, LegacyStructuredPointsAscii) {
+  std::string s =
+      "# vtk DataFile Version 3.0\nsmall grid\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\n"
+      "ORIGIN -1 0 2.5\nSPACING 0.5 2 0.25\nPOINT_DATA 24\nSCALARS f float 1\nLOOKUP_TABLE default\n" +
+      asciiValues(4, 3, 2) + "\n";
+  const fs::path p = write("grid.vtk", s);
+  EXPECT_TRUE(mfr::isVolumeFile(p));
+  const mfr::Volume v = mfr::loadVolume(p);
+  expectField(v, {4, 3, 2});
+  expectVec(v.origin, {-1.0, 0.0, 2.5});
+  expectVec(v.spacing, {0.5, 2.0, 0.25});
+}
+
+TEST_F(VolumeLoading, MetaImageWithSeparateRawFile) {
+  std::string raw;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i) raw += bytesOf(static_cast<std::uint16_t>(field(i, j, k) + 100.5f), false);
+  write("grid.raw", raw);
+  const fs::path p = write("grid.mhd",
+                           "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_USHORT\n"
+                           "ElementSpacing = 0.5 0.25 4\nOffset = 10 20 30\nBinaryData = True\n"
+                           "BinaryDataByteOrderMSB = False\nElementDataFile = grid.raw\n");
+  const mfr::Volume v = mfr::loadVolume(p);
+  expectField(v, {4, 3, 2}, 100.5f);
+  expectVec(v.origin, {10.0, 20.0, 30.0});
+  expectVec(v.spacing, {0.5, 0.25, 4.0});
+}
+
+// NRRD does not tell vector components from axes: VTK takes a first axis of 9 or fewer samples
+// for components, so these grids are 10 wide.
+std::string nrrdRaw() {
+  std::string raw;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 10; ++i) raw += bytesOf(field(i, j, k), false);
+  return raw;
+}
+
+const char* kNrrdHeader = "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3 2\nspacings: 0.5 1 1.5\nendian: little\n";
+
+TEST_F(VolumeLoading, NrrdRawGzipAndDetachedHeader) {
+  const std::string raw = nrrdRaw();
+  const mfr::Volume attached =
+      mfr::loadVolume(write("grid.nrrd", std::string(kNrrdHeader) + "encoding: raw\n\n" + raw));
+  expectField(attached, {10, 3, 2});
+  expectVec(attached.spacing, {0.5, 1.0, 1.5});
+  write("grid.raw", raw);
+  const mfr::Volume detached =
+      mfr::loadVolume(write("grid.nhdr", std::string(kNrrdHeader) + "encoding: raw\ndata file: grid.raw\n"));
+  expectField(detached, {10, 3, 2});
+  std::ifstream in(writeGz("data.gz", raw), std::ios::binary);
+  const std::string gz{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  expectField(mfr::loadVolume(write("packed.nrrd", std::string(kNrrdHeader) + "encoding: gzip\n\n" + gz)), {10, 3, 2});
+}
+
+TEST_F(VolumeLoading, DefaultTransferIsGrayscaleOverTheDataRange) {
+  const mfr::Volume v = mfr::loadVolume(write("cube.vti", cubeVti()));
+  const mfr::TransferFunction want = mfr::transferPreset("grayscale", 0.0, 26.0, std::sqrt(12.0) / 50.0);
+  ASSERT_EQ(v.transfer.points.size(), want.points.size());
+  for (std::size_t i = 0; i < want.points.size(); ++i) {
+    EXPECT_EQ(v.transfer.points[i].value, want.points[i].value);
+    EXPECT_EQ(v.transfer.points[i].color, want.points[i].color);
+  }
+  EXPECT_NEAR(v.transfer.unitDistance, std::sqrt(12.0) / 50.0, 1e-12);
+  // A constant grid: the range widened by 1.
+  mfr::VolumeGrid flat;
+  flat.dims = {2, 2, 2};
+  flat.values.assign(8, 3.0f);
+  mfr::Bounds b;
+  b.extend(glm::dvec3(0.0));
+  b.extend(glm::dvec3(3.0, 4.0, 0.0));
+  const mfr::TransferFunction f = mfr::defaultTransfer(flat, b);
+  EXPECT_EQ(f.low(), 3.0);
+  EXPECT_EQ(f.high(), 4.0);
+  EXPECT_NEAR(f.unitDistance, 0.1, 1e-12);
+}
+
+TEST_F(VolumeLoading, ProgressStartsAndEndsAndCancels) {
+  const fs::path p = write("small.inr", smallInr());
+  std::vector<double> reports;
+  mfr::LoadProgress progress{[&](double f) {
+    reports.push_back(f);
+    return true;
+  }};
+  (void)mfr::loadVolume(p, progress);
+  ASSERT_GE(reports.size(), 2u);
+  EXPECT_EQ(reports.front(), 0.0);
+  EXPECT_EQ(reports.back(), 1.0);
+  EXPECT_TRUE(std::is_sorted(reports.begin(), reports.end()));
+  for (const fs::path& file : {p, write("cube.vti", cubeVti())}) {
+    int calls = 0;
+    const mfr::LoadProgress cancelSecond{[&](double) { return ++calls < 2; }};
+    EXPECT_THROW((void)mfr::loadVolume(file, cancelSecond), mfr::LoadCancelled) << file;
+  }
+}
+
+TEST_F(VolumeLoading, ExtensionsAndVolumeFileDetection) {
+  const std::vector<std::string> exts = mfr::supportedVolumeExtensions();
+  for (const char* e : {".vti", ".vtk", ".mhd", ".mha", ".nrrd", ".nhdr", ".inr", ".inr.gz"})
+    EXPECT_NE(std::find(exts.begin(), exts.end(), e), exts.end()) << e;
+  EXPECT_TRUE(std::is_sorted(exts.begin(), exts.end()));
+  EXPECT_TRUE(mfr::isVolumeFile("x.VTI"));
+  EXPECT_TRUE(mfr::isVolumeFile("dir/x.Inr.Gz"));
+  EXPECT_FALSE(mfr::isVolumeFile("x.stl"));
+  EXPECT_FALSE(mfr::isVolumeFile("x.gz"));
+  // .vtk by its DATASET line: a missing file or a POLYDATA one stays a model.
+  EXPECT_FALSE(mfr::isVolumeFile(dir() / "missing.vtk"));
+  EXPECT_FALSE(mfr::isVolumeFile(write("mesh.vtk", "# vtk DataFile Version 3.0\nm\nASCII\nDATASET POLYDATA\n")));
+  EXPECT_TRUE(
+      mfr::isVolumeFile(write("grid.vtk", "# vtk DataFile Version 3.0\nm\nBINARY\ndataset structured_points\n")));
+}
+
+// ---- bad input -----------------------------------------------------------------------------------
+
+TEST_F(VolumeLoading, MissingEmptyDirectoryUnsupported) {
+  expectVolumeError(dir() / "nothing.vti", "no such file");
+  expectVolumeError(dir() / "nothing.inr", "no such file");
+  for (const char* name : {"empty.vti", "empty.inr", "empty.inr.gz", "empty.mhd", "empty.nrrd", "empty.vtk"})
+    expectVolumeError(write(name, ""), "empty file");
+  fs::create_directory(dir() / "folder.vti");
+  expectVolumeError(dir() / "folder.vti", "is a directory");
+  expectVolumeError(write("values.xyz", "1 2 3"), "unsupported volume file type '.xyz'");
+  expectVolumeError(write("mesh.stl", "solid x\nendsolid x\n"), "unsupported volume file type '.stl'");
+  expectVolumeError(write("mesh.vtk", "# vtk DataFile Version 3.0\nm\nASCII\nDATASET POLYDATA\nPOINTS 0 float\n"),
+                    "legacy VTK DATASET POLYDATA is not a volume");
+  expectVolumeError(write("text.vtk", "hello\n"), "not a legacy VTK file");
+}
+
+TEST_F(VolumeLoading, TruncatedInrimage) {
+  const std::string whole = smallInr();
+  const std::size_t header = 256;
+  expectVolumeError(write("header-only.inr", whole.substr(0, header)), "truncated INRIMAGE file (0 of 48 bytes");
+  expectVolumeError(write("half.inr", whole.substr(0, header + 24)), "truncated INRIMAGE file (24 of 48 bytes");
+  expectVolumeError(write("header-cut.inr", whole.substr(0, 100)), "corrupt or unsupported INRIMAGE header");
+  expectVolumeError(writeGz("half.inr.gz", whole.substr(0, header + 24)), "truncated or corrupt INRIMAGE data");
+  expectVolumeError(writeGz("header-only.inr.gz", whole.substr(0, header)), "truncated or corrupt INRIMAGE data");
+  // A gzip stream cut short.
+  const fs::path gz = writeGz("full.inr.gz", whole);
+  std::string bytes;
+  {
+    std::ifstream in(gz, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  expectVolumeError(write("cut.inr.gz", bytes.substr(0, bytes.size() / 2)), "INRIMAGE");
+  expectVolumeError(write("plain.inr.gz", whole), "not a gzip file");
+}
+
+TEST_F(VolumeLoading, CorruptInrimageHeaders) {
+  const auto withFields = [](const std::string& fields) { return inrHeader(fields) + std::string(64, '\0'); };
+  expectVolumeError(write("magic.inr", "#INRIMAGE-5#{\n" + std::string(300, '\n')), "not an INRIMAGE file");
+  expectVolumeError(write("text.inr", "just some text\n"), "not an INRIMAGE file");
+  expectVolumeError(write("type.inr", withFields("XDIM=2\nYDIM=2\nZDIM=2\nTYPE=complex\nPIXSIZE=8 bits\nCPU=pc\n")),
+                    "corrupt or unsupported INRIMAGE header");
+  expectVolumeError(write("xdim.inr", withFields("XDIM=two\nYDIM=2\nZDIM=2\nTYPE=float\nPIXSIZE=32 bits\nCPU=pc\n")),
+                    "corrupt or unsupported INRIMAGE header");
+  expectVolumeError(write("pixsize.inr", withFields("XDIM=2\nYDIM=2\nZDIM=2\nTYPE=float\nPIXSIZE=12 bits\nCPU=pc\n")),
+                    "corrupt or unsupported INRIMAGE header");
+  expectVolumeError(write("flat.inr", withFields("XDIM=4\nYDIM=4\nZDIM=1\nTYPE=float\nPIXSIZE=32 bits\nCPU=pc\n")),
+                    "at least 2 points per axis (the file declares 4x4x1)");
+  // Declared sizes are checked before anything is allocated or read.
+  expectVolumeError(write("huge.inr", withFields("XDIM=100000\nYDIM=100000\nZDIM=100000\nTYPE=float\nPIXSIZE=32 bits\n"
+                                                 "CPU=pc\n")),
+                    "larger than 2048 points per axis");
+  expectVolumeError(write("total.inr", withFields("XDIM=2048\nYDIM=2048\nZDIM=512\nTYPE=float\nPIXSIZE=32 bits\n"
+                                                  "CPU=pc\n")),
+                    "larger than 2^30 points");
+  expectVolumeError(write("negative.inr", withFields("XDIM=-5\nYDIM=2\nZDIM=2\nTYPE=float\nPIXSIZE=32 bits\nCPU=pc\n")),
+                    "larger than 2048 points per axis");
+  expectVolumeError(write("nan.inr", inrHeader("XDIM=2\nYDIM=2\nZDIM=2\nTYPE=float\nPIXSIZE=32 bits\nCPU=pc\n") +
+                                         std::string(28, '\0') + bytesOf(std::nanf(""), false)),
+                    "non-finite value");
+}
+
+TEST_F(VolumeLoading, BadVti) {
+  std::string cells;
+  for (int n = 0; n < 6; ++n) cells += "1 ";
+  expectVolumeError(write("cells.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", "", dataArray("Float32", "c", cells))),
+                    "only cell data");
+  expectVolumeError(write("nodata.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", "")), "no point-data scalar array");
+  expectVolumeError(write("short.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", dataArray("Float32", "f", "1 2 3"))),
+                    "cannot read VTK image data (.vti)");
+  const std::string whole = cubeVti();
+  expectVolumeError(write("cut.vti", whole.substr(0, whole.size() / 2)), "cannot read VTK image data (.vti)");
+  expectVolumeError(write("garbage.vti", "<VTKFile type=\"ImageData\"> bogus"), "cannot read VTK image data (.vti)");
+  expectVolumeError(
+      write("flat.vti", vti("0 3 0 2 0 0", "0 0 0", "1 1 1", dataArray("Float32", "f", asciiValues(4, 3, 1)))),
+      "at least 2 points per axis (the file declares 4x3x1)");
+  expectVolumeError(write("huge.vti", vti("0 99999 0 99999 0 99999", "0 0 0", "1 1 1", dataArray("Float32", "f", "1"))),
+                    "larger than 2048 points per axis");
+  expectVolumeError(
+      write("zero.vti", vti("0 3 0 2 0 1", "0 0 0", "1 0 1", dataArray("Float32", "f", asciiValues(4, 3, 2)))),
+      "spacing must be non-zero");
+}
+
+TEST_F(VolumeLoading, BadLegacyMetaImageAndNrrd) {
+  const std::string head =
+      "# vtk DataFile Version 3.0\ng\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\n"
+      "ORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 24\nSCALARS f float 1\nLOOKUP_TABLE default\n";
+  expectVolumeError(write("cut.vtk", head + std::string(40, '\0')), "cannot read legacy VTK structured points");
+  expectVolumeError(write("nodata.vtk", head.substr(0, head.find("POINT_DATA"))), "no point-data scalar array");
+  expectVolumeError(write("huge.vtk",
+                          "# vtk DataFile Version 3.0\ng\nBINARY\nDATASET STRUCTURED_POINTS\n"
+                          "DIMENSIONS 100000 100000 100000\nSPACING 1 1 1\nORIGIN 0 0 0\nPOINT_DATA 5\n"),
+                    "larger than 2048 points per axis");
+
+  const std::string mhd =
+      "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_FLOAT\n"
+      "ElementSpacing = 1 1 1\nBinaryData = True\nElementDataFile = data.raw\n";
+  expectVolumeError(write("noraw.mhd", mhd), "cannot read MetaImage");
+  write("data.raw", std::string(40, '\0'));
+  expectVolumeError(write("short.mhd", mhd), "cannot read MetaImage");
+  expectVolumeError(write("garbage.mhd", "this is not a header\n"), "cannot read MetaImage");
+  expectVolumeError(write("huge.mha",
+                          "ObjectType = Image\nNDims = 3\nDimSize = 5000 5000 5000\nElementType = MET_FLOAT\n"
+                          "ElementDataFile = LOCAL\n"),
+                    "larger than 2048 points per axis");
+
+  const std::string nrrd = std::string(kNrrdHeader) + "encoding: raw\n\n";
+  expectVolumeError(write("short.nrrd", nrrd + std::string(200, '\0')), "cannot read NRRD");
+  expectVolumeError(write("type.nrrd", "NRRD0004\ntype: complex\ndimension: 3\nsizes: 10 3 2\n\n"), "cannot read NRRD");
+  expectVolumeError(write("nothing.nrrd", "NRRD0004\nthis: is not\n"), "NRRD header has no 'sizes'");
+  // Headers that made vtkNrrdReader loop forever or index an empty vector.
+  expectVolumeError(write("open.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3 2"),
+                    "NRRD header does not end");
+  expectVolumeError(write("open.nhdr", std::string(kNrrdHeader) + "data file: grid.raw"), "NRRD header does not end");
+  expectVolumeError(write("nul.nrrd", std::string("NRRD0004\ntype: float\0\ndimension: 3\n\n")),
+                    "NRRD header does not end");
+  expectVolumeError(write("nosizes.nrrd", "NRRD0004\ntype: float\ndimension: 3\nspacings: 0 1 1\n\n"),
+                    "NRRD header has no 'sizes'");
+  expectVolumeError(write("empty-file.nhdr", std::string(kNrrdHeader) + "data file: \n"), "NRRD 'data file' is empty");
+  expectVolumeError(write("pattern.nhdr", std::string(kNrrdHeader) + "data file: slice%s.raw 1 2 1\n"),
+                    "NRRD data split into several files is not supported");
+  expectVolumeError(write("sizes.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3\n\n"),
+                    "NRRD 'sizes' has 2 values for dimension 3");
+  expectVolumeError(write("ascii.nrrd", std::string(kNrrdHeader) + "encoding: ascii\n\n1 2 3\n"),
+                    "NRRD with ASCII encoding is not supported");
+  std::ifstream in(writeGz("data.gz", nrrdRaw()), std::ios::binary);
+  const std::string gz{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  expectVolumeError(write("cut.nrrd", std::string(kNrrdHeader) + "encoding: gzip\n\n" + gz.substr(0, gz.size() / 2)),
+                    "cannot read NRRD");
+  expectVolumeError(write("huge.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 9999 9999 9999\nencoding: raw\n\n"),
+                    "larger than 2048 points per axis");
+}
+
+// Cut every file after every prefix length and flip bytes: always a clean mfr::Error or a volume,
+// never a crash (a crash ends the test program) or another exception.
+TEST_F(VolumeLoading, TruncatedAndCorruptedFilesNeverCrash) {
+  std::string raw;
+  for (int v = 0; v < 24; ++v) raw += bytesOf(static_cast<float>(v), true);
+  const std::vector<std::pair<std::string, std::string>> files{
+      {"a.inr", smallInr()},
+      {"a.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", dataArray("Float32", "f", asciiValues(4, 3, 2)))},
+      {"a.vtk",
+       "# vtk DataFile Version 3.0\ng\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\nORIGIN 0 0 0\n"
+       "SPACING 1 1 1\nPOINT_DATA 24\nSCALARS f float 1\nLOOKUP_TABLE default\n" +
+           raw + "\n"},
+      {"a.mha",
+       "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_FLOAT\nBinaryDataByteOrderMSB = True\n"
+       "ElementDataFile = LOCAL\n" +
+           raw},
+      {"a.nrrd", std::string(kNrrdHeader) + "encoding: raw\n\n" + nrrdRaw()}};
+  std::uint32_t seed = 12345;
+  const auto next = [&] { return seed = seed * 1664525u + 1013904223u; };
+  for (const auto& [name, whole] : files) {
+    ASSERT_NO_THROW((void)mfr::loadVolume(write(name, whole))) << name;
+    std::vector<std::string> variants;
+    for (std::size_t cut = 1; cut < whole.size(); cut += 1 + whole.size() / 97)
+      variants.push_back(whole.substr(0, cut));
+    for (int n = 0; n < 100; ++n) {
+      std::string v = whole;
+      for (int flips = 0; flips < 3; ++flips) v[next() % v.size()] = static_cast<char>(next() >> 24);
+      variants.push_back(v);
+    }
+    for (std::size_t i = 0; i < variants.size(); ++i) {
+      const fs::path p = write(name, variants[i]);
+      try {
+        (void)mfr::loadVolume(p);
+      } catch (const mfr::Error& e) {
+        const std::string what = e.what();
+        EXPECT_EQ(what.rfind(p.string() + ": ", 0), 0u) << what;
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+      } catch (const std::exception& e) {
+        ADD_FAILURE() << name << " variant " << i << ": " << e.what();
+      }
+    }
+  }
+}
+
+// ---- loadScene and loadModel on volume files -----------------------------------------------------
+
+TEST_F(VolumeLoading, LoadSceneOnAVolumeFile) {
+  const fs::path p = write("cube.vti", cubeVti());
+  const mfr::Scene scene = mfr::loadScene(p);
+  EXPECT_EQ(scene.name, "cube.vti");
+  EXPECT_TRUE(scene.objects.empty());
+  ASSERT_EQ(scene.volumes.size(), 1u);
+  EXPECT_EQ(scene.visibleVolume(), &scene.volumes[0]);
+  ASSERT_EQ(scene.views.size(), 2u);
+  EXPECT_EQ(scene.views[0].name, "front");
+  EXPECT_EQ(scene.views[1].name, "iso");
+  EXPECT_NO_THROW(scene.validate());
+  // The views frame the volume: its centre is on the view axis.
+  const glm::dvec3 c = scene.bounds().center();
+  expectVec(c, {1.0, 1.0, 1.0});
+  for (const auto& view : scene.views) {
+    const glm::dvec3 toCentre = glm::normalize(c - view.camera.eye);
+    EXPECT_NEAR(glm::dot(toCentre, view.camera.forward()), 1.0, 1e-9) << view.name;
+  }
+}
+
+TEST_F(VolumeLoading, LoadModelSaysItIsAVolume) {
+  mfr::test::expectLoadError(write("cube.vti", cubeVti()), "is a volume file, not a model");
+  mfr::test::expectLoadError(write("grid.vtk", "# vtk DataFile Version 3.0\ng\nASCII\nDATASET STRUCTURED_POINTS\n"),
+                             "is a volume file, not a model");
+  mfr::test::expectLoadError(write("head.inr.gz", "x"), "is a volume file, not a model");
+}
+
+// ---- .mfrscene "volumes" -------------------------------------------------------------------------
+
+class SceneVolumes : public mfr::test::TempDirTest {
+ protected:
+  void SetUp() override {
+    TempDirTest::SetUp();
+    write("cube.vti", cubeVti());
+  }
+  mfr::Scene parse(const std::string& json) const { return mfr::parseSceneFile(json, dir(), "vol.mfrscene"); }
+  std::string errorOfScene(const std::string& json) const {
+    return errorOf([&] { (void)parse(json); });
+  }
+};
+
+TEST_F(SceneVolumes, PresetOverTheDataRange) {
+  const mfr::Scene s = parse(R"({"volumes": [{"file": "cube.vti", "transfer": {"preset": "bone"}}]})");
+  ASSERT_EQ(s.volumes.size(), 1u);
+  const mfr::Volume& v = s.volumes[0];
+  EXPECT_EQ(v.name, "cube.vti");
+  EXPECT_TRUE(v.visible);
+  const mfr::TransferFunction want = mfr::transferPreset("bone", 0.0, 26.0, std::sqrt(12.0) / 50.0);
+  ASSERT_EQ(v.transfer.points.size(), want.points.size());
+  for (std::size_t i = 0; i < want.points.size(); ++i) {
+    EXPECT_DOUBLE_EQ(v.transfer.points[i].value, want.points[i].value);
+    EXPECT_EQ(v.transfer.points[i].color, want.points[i].color);
+  }
+  EXPECT_NEAR(v.transfer.unitDistance, std::sqrt(12.0) / 50.0, 1e-12);
+  EXPECT_NO_THROW(s.validate());
+}
+
+TEST_F(SceneVolumes, PresetWithRangeUnitDistanceTransformAndName) {
+  const mfr::Scene s = parse(R"({"volumes": [{"name": "fog", "file": "cube.vti",
+      "transform": {"translate": [1, 2, 3], "scale": 2},
+      "transfer": {"preset": "fire", "range": [5, 20], "unit_distance": 0.5}}]})");
+  const mfr::Volume& v = s.volumes.at(0);
+  EXPECT_EQ(v.name, "fog");
+  EXPECT_DOUBLE_EQ(v.transfer.low(), 5.0);
+  EXPECT_DOUBLE_EQ(v.transfer.high(), 20.0);
+  EXPECT_EQ(v.transfer.unitDistance, 0.5);
+  expectVec(v.bounds().min, {1.0, 2.0, 3.0});
+  expectVec(v.bounds().max, {5.0, 6.0, 7.0});
+}
+
+TEST_F(SceneVolumes, DefaultTransferFollowsTheTransform) {
+  const mfr::Scene s = parse(R"({"volumes": [{"file": "cube.vti", "transform": {"scale": 10}}]})");
+  EXPECT_NEAR(s.volumes.at(0).transfer.unitDistance, 10.0 * std::sqrt(12.0) / 50.0, 1e-9);
+  EXPECT_EQ(s.volumes.at(0).transfer.points.front().color, glm::vec4(0.0f));  // grayscale
+}
+
+TEST_F(SceneVolumes, ExplicitPoints) {
+  const mfr::Scene s = parse(R"({"volumes": [{"file": "cube.vti", "transfer": {
+      "points": [[0, 0, 0, 0, 0], [10, 1, 0.5, 0, 0.25], [10, 1, 1, 0, 0.5], [26, 1, 1, 1, 1]], "unit_distance": 2}}]})");
+  const mfr::TransferFunction& tf = s.volumes.at(0).transfer;
+  ASSERT_EQ(tf.points.size(), 4u);
+  EXPECT_EQ(tf.points[1].value, 10.0);
+  EXPECT_EQ(tf.points[1].color, glm::vec4(1.0f, 0.5f, 0.0f, 0.25f));
+  EXPECT_EQ(tf.points[3].value, 26.0);
+  EXPECT_EQ(tf.unitDistance, 2.0);
+}
+
+TEST_F(SceneVolumes, VolumesWithObjectsAndAHiddenSecondVolume) {
+  std::vector<double> reports;
+  const mfr::LoadProgress progress{[&](double f) {
+    reports.push_back(f);
+    return true;
+  }};
+  const mfr::Scene s = mfr::parseSceneFile(R"({"objects": [{"primitive": {"type": "box"}}],
+      "volumes": [{"file": "cube.vti"}, {"file": "cube.vti", "name": "spare", "visible": false}],
+      "views": [{"name": "all", "fit": true}]})",
+                                           dir(), "vol.mfrscene", progress);
+  ASSERT_EQ(s.objects.size(), 1u);
+  ASSERT_EQ(s.volumes.size(), 2u);
+  EXPECT_FALSE(s.volumes[1].visible);
+  EXPECT_EQ(s.visibleVolume(), &s.volumes[0]);
+  EXPECT_NO_THROW(s.validate());
+  // The fitted view and the bounds include the volume (box: ±0.5, volume: 0…2).
+  expectVec(s.bounds().max, {2.0, 2.0, 2.0});
+  // Three equal parts: the object, then each volume from its start to its end.
+  EXPECT_TRUE(std::is_sorted(reports.begin(), reports.end()));
+  for (const double mark : {1.0 / 3.0, 2.0 / 3.0, 1.0})
+    EXPECT_NE(std::find_if(reports.begin(), reports.end(), [&](double f) { return std::abs(f - mark) < 1e-12; }),
+              reports.end())
+        << mark;
+}
+
+TEST_F(SceneVolumes, OnlyAVolumeIsAScene) {
+  write("only.mfrscene", R"({"volumes": [{"file": "cube.vti"}], "views": [{"name": "v", "eye": [0, 0, 9]}]})");
+  const mfr::Scene s = mfr::loadScene(dir() / "only.mfrscene");
+  EXPECT_TRUE(s.objects.empty());
+  EXPECT_EQ(s.volumes.size(), 1u);
+}
+
+TEST_F(SceneVolumes, ErrorsNameTheJsonPath) {
+  const auto expectError = [&](const std::string& json, const std::string& path, const std::string& reason) {
+    const std::string what = errorOfScene(json);
+    EXPECT_EQ(what.rfind("vol.mfrscene: " + path + ": ", 0), 0u) << what;
+    EXPECT_NE(what.find(reason), std::string::npos) << "expected '" << reason << "' in: " << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  };
+  expectError(R"({"volumes": {"file": "cube.vti"}})", "volumes", "expected an array");
+  expectError(R"({"volumes": [{"name": "x"}]})", "volumes[0]", "needs 'file'");
+  expectError(R"({"volumes": [{"file": "none.vti"}]})", "volumes[0].file",
+              (dir() / "none.vti").string() + ": no such file");
+  expectError(R"({"volumes": [{"file": "cube.vti", "transfer": {"preset": "bones"}}]})", "volumes[0].transfer.preset",
+              "unknown preset 'bones' (grayscale, bone, fire, cool-warm)");
+  expectError(R"({"volumes": [{"file": "cube.vti", "transfer": {"preset": "bone", "range": [9, 2]}}]})",
+              "volumes[0].transfer.range", "high must be greater than low");
+  expectError(R"({"volumes": [{"file": "cube.vti", "transfer": {"preset": "bone", "unit_distance": 0}}]})",
+              "volumes[0].transfer.unit_distance", "must be > 0");
+  expectError(
+      R"({"volumes": [{"file": "cube.vti", "transfer": {"points": [[0, 0, 0, 0, 0], [5, 1, 1, 1, 1], [3, 1, 1, 1, 1]]}}]})",
+      "volumes[0].transfer.points[2][0]", "values must ascend");
+  expectError(R"({"volumes": [{"file": "cube.vti", "transfer": {"points": [[0, 0, 0, 0, 0], [5, 1, 1, 1, 2]]}}]})",
+              "volumes[0].transfer.points[1][4]", "must be in [0,1]");
+  expectError(R"({"volumes": [{"file": "cube.vti", "transfer": {"points": [[0, 0, 0, 0], [5, 1, 1, 1, 1]]}}]})",
+              "volumes[0].transfer.points[0]", "expected [value, r, g, b, a]");
+  expectError(R"({"volumes": [{"file": "cube.vti", "transfer": {"points": [[4, 0, 0, 0, 0], [4, 1, 1, 1, 1]]}}]})",
+              "volumes[0].transfer.points", "greater than the first");
+  expectError(R"({"volumes": [{"file": "cube.vti", "transfer": {"points": [[0, 0, 0, 0, 0]]}}]})",
+              "volumes[0].transfer.points", "at least 2 points");
+  expectError(R"({"volumes": [{"file": "cube.vti", "transfer": {"preset": "bone", "points": []}}]})",
+              "volumes[0].transfer", "exactly one of 'preset' or 'points'");
+  expectError(R"({"volumes": [{"file": "cube.vti", "transfer": {}}]})", "volumes[0].transfer",
+              "exactly one of 'preset' or 'points'");
+  expectError(R"({"volumes": [{"file": "cube.vti", "transform": {"scale": 0}}]})", "volumes[0].transform.scale",
+              "zero scale");
+  expectError(R"({"volumes": [{"file": "cube.vti", "visible": "yes"}]})", "volumes[0].visible",
+              "expected true or false");
+  expectError(R"({"volumes": [{"file": "cube.vti"}, {"file": "cube.vti", "name": "second"}]})", "volumes[1].visible",
+              "at most one volume can be drawn");
+}
+
+}  // namespace
