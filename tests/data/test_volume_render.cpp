@@ -9,6 +9,7 @@
 #include <string>
 
 #include "gl_fixture.hpp"
+#include "image_compare.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/scene/scene_file.hpp"
 
@@ -61,20 +62,13 @@ TEST(VolumeRealFile, SkullWithSurfacesInsideOnGpuEqualsTheOracle) {
       SCOPED_TRACE(std::string(view) + " " + method);
       req.method = method;
       const ImageRGBA8 actual = gpu.render(camera, req).image;
-      std::size_t compared = 0, within = 0, medium = 0;
-      int maxDifference = 0;
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-          if (oracle.isEdge(x, y)) continue;
-          int diff = 0;
-          for (int c = 0; c < 3; ++c)
-            diff = std::max(diff, std::abs(int(expected.at(x, y)[c]) - int(actual.at(x, y)[c])));
-          ++compared;
-          within += diff <= 2;
-          maxDifference = std::max(maxDifference, diff);
-          // The bone's colour (white to warm) where no surface covers the pixel.
-          medium += oracle.count(x, y) == 0 && expected.at(x, y)[2] < 235;
-        }
+      std::size_t medium = 0;
+      // The bone's colour (white to warm) where no surface covers the pixel.
+      const OffEdgeComparison c = compareOffEdges(oracle, expected, actual, 2, [&](int x, int y, int) {
+        medium += oracle.count(x, y) == 0 && expected.at(x, y)[2] < 235;
+      });
+      const std::size_t compared = c.compared, within = c.within;
+      const int maxDifference = c.maxDifference;
       EXPECT_GT(compared, static_cast<std::size_t>(w * h) * 9 / 10);
       EXPECT_GE(static_cast<double>(within) / compared, 0.999)
           << compared - within << " pixels off by more than 2/255, max " << maxDifference;

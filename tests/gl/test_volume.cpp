@@ -9,6 +9,7 @@
 #include <string>
 
 #include "gl_fixture.hpp"
+#include "image_compare.hpp"
 #include "mfr/error.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/scene/sample.hpp"
@@ -16,28 +17,22 @@
 namespace mfr::test {
 namespace {
 
-struct Comparison {
-  std::size_t compared = 0, within = 0, volumeOnly = 0;
-  int maxDifference = 0;
+struct Comparison : OffEdgeComparison {
+  std::size_t volumeOnly = 0;  // compared pixels no surface covers but the medium colours
 };
 
 Comparison compareOffEdges(const FragmentLists& oracle, const ImageRGBA8& expected, const ImageRGBA8& actual,
                            const glm::vec3& background, int tolerance) {
   Comparison c;
-  for (int y = 0; y < oracle.height; ++y)
-    for (int x = 0; x < oracle.width; ++x) {
-      if (oracle.isEdge(x, y)) continue;
-      int diff = 0;
-      for (int ch = 0; ch < 3; ++ch)
-        diff = std::max(diff, std::abs(int(expected.at(x, y)[ch]) - int(actual.at(x, y)[ch])));
-      ++c.compared;
-      const bool coloured = expected.at(x, y)[0] != std::lround(background.r * 255.0f) ||
-                            expected.at(x, y)[1] != std::lround(background.g * 255.0f) ||
-                            expected.at(x, y)[2] != std::lround(background.b * 255.0f);
-      if (oracle.count(x, y) == 0 && coloured) ++c.volumeOnly;
-      c.maxDifference = std::max(c.maxDifference, diff);
-      if (diff <= tolerance) ++c.within;
-    }
+  const auto isBackground = [&](int x, int y) {
+    return expected.at(x, y)[0] == std::lround(background.r * 255.0f) &&
+           expected.at(x, y)[1] == std::lround(background.g * 255.0f) &&
+           expected.at(x, y)[2] == std::lround(background.b * 255.0f);
+  };
+  static_cast<OffEdgeComparison&>(c) =
+      test::compareOffEdges(oracle, expected, actual, tolerance, [&](int x, int y, int) {
+        if (oracle.count(x, y) == 0 && !isBackground(x, y)) ++c.volumeOnly;
+      });
   return c;
 }
 

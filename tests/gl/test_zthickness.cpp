@@ -11,6 +11,7 @@
 
 #include "common/bindings.h"
 #include "gl_fixture.hpp"
+#include "image_compare.hpp"
 #include "mfr/error.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/scene/sample.hpp"
@@ -18,30 +19,19 @@
 namespace mfr::test {
 namespace {
 
-struct TieComparison {
-  std::size_t compared = 0, within = 0, ties = 0, tiesWithin = 0;
-  int maxDifference = 0;
+struct TieComparison : OffEdgeComparison {
+  std::size_t ties = 0, tiesWithin = 0;  // compared pixels with coincident fragments
 };
 
-// Every pixel except those on a projected triangle edge (rasterisation tie rules decide there).
 TieComparison compareOffEdges(const FragmentLists& oracle, const ImageRGBA8& expected, const ImageRGBA8& actual,
                               int tolerance) {
   TieComparison c;
-  for (int y = 0; y < oracle.height; ++y)
-    for (int x = 0; x < oracle.width; ++x) {
-      if (oracle.isEdge(x, y)) continue;
-      int diff = 0;
-      for (int ch = 0; ch < 3; ++ch)
-        diff = std::max(diff, std::abs(int(expected.at(x, y)[ch]) - int(actual.at(x, y)[ch])));
-      const bool tie = (oracle.flags[oracle.index(x, y)] & FragmentLists::kDepthTie) != 0;
-      ++c.compared;
-      c.ties += tie;
-      c.maxDifference = std::max(c.maxDifference, diff);
-      if (diff <= tolerance) {
-        ++c.within;
-        c.tiesWithin += tie;
-      }
-    }
+  static_cast<OffEdgeComparison&>(c) =
+      test::compareOffEdges(oracle, expected, actual, tolerance, [&](int x, int y, int diff) {
+        const bool tie = (oracle.flags[oracle.index(x, y)] & FragmentLists::kDepthTie) != 0;
+        c.ties += tie;
+        c.tiesWithin += tie && diff <= tolerance;
+      });
   return c;
 }
 

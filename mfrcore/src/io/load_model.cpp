@@ -17,6 +17,7 @@
 #include <zlib.h>
 
 #include "assimp_loader.hpp"
+#include "file_checks.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "molecule_loader.hpp"
@@ -78,28 +79,6 @@ std::optional<std::pair<std::string, Format>> match(const std::string& lowerName
   return best;
 }
 
-std::string oneLine(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
-  s.erase(std::unique(s.begin(), s.end(), [](char a, char b) { return a == ' ' && b == ' '; }), s.end());
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
-}
-
-void checkReadable(const fs::path& path, const std::string& name) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (st.type() == fs::file_type::not_found) throw Error(name, "no such file");
-  if (ec) throw Error(name, "cannot access file: " + ec.message());
-  if (fs::is_directory(st)) throw Error(name, "is a directory, not a model file");
-  // FIFOs and devices would block or never end.
-  if (!fs::is_regular_file(st)) throw Error(name, "not a regular file");
-  if (::access(path.c_str(), R_OK) != 0) throw Error(name, std::string("cannot read file: ") + std::strerror(errno));
-  std::ifstream probe(path, std::ios::binary);
-  if (!probe) throw Error(name, "cannot open file for reading");
-  if (fs::file_size(path, ec) == 0 && !ec) throw Error(name, "empty file");
-}
-
 std::string readAll(const fs::path& path, const std::string& name) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(name, "cannot open file for reading");
@@ -152,7 +131,7 @@ std::vector<Object> singleObject(Mesh mesh, const std::string& partName) {
 }
 
 std::vector<Object> load(const fs::path& path, const std::string& name, const LoadProgress& progress) {
-  checkReadable(path, name);
+  io::checkReadable(path, name, "model");
   if (isVolumeFile(path))
     throw Error(name,
                 "is a volume file, not a model: open it as a scene, or list it under \"volumes\" in a .mfrscene file");
@@ -228,7 +207,7 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
 
 std::vector<Object> loadModel(const fs::path& path, const LoadProgress& progress) {
   const std::string name = path.string();
-  try {
+  return io::withFileErrors(name, [&] {
     progress.step(0.0);
     std::vector<Object> objects = load(path, name, progress);
     if (objects.empty()) throw Error(name, "no triangles");
@@ -250,19 +229,7 @@ std::vector<Object> loadModel(const fs::path& path, const LoadProgress& progress
     }
     progress.step(1.0);
     return objects;
-  } catch (const LoadCancelled&) {
-    throw;
-  } catch (const Error& e) {
-    std::string message = oneLine(e.what());
-    if (message.rfind(name, 0) != 0) message = name + ": " + message;
-    throw Error(message);
-  } catch (const std::bad_alloc&) {
-    throw Error(name, "out of memory while loading");
-  } catch (const std::exception& e) {
-    throw Error(name, oneLine(e.what()));
-  } catch (...) {
-    throw Error(name, "unknown error while loading");
-  }
+  });
 }
 
 std::vector<std::string> supportedModelExtensions() {

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "invesalius_loader.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/scene/sample.hpp"
@@ -46,11 +47,15 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadPro
   if (ext == ".mfrscene" || ext == ".json") {
     scene = readSceneFile(path, progress);
   } else {
-    scene.name = path.filename().string();
-    if (isVolumeFile(path))
-      scene.volumes.push_back(loadVolume(path, progress));
-    else
-      scene.objects = loadModel(path, progress);
+    if (ext == ".inv3") {  // a volume with its segmented surfaces
+      scene = io::loadInvesaliusScene(path, progress);
+    } else {
+      scene.name = path.filename().string();
+      if (isVolumeFile(path))
+        scene.volumes.push_back(loadVolume(path, progress));
+      else
+        scene.objects = loadModel(path, progress);
+    }
     Camera front;
     front.eye = {0.0, 0.0, 1.0};
     front.target = {0.0, 0.0, 0.0};

@@ -48,6 +48,8 @@
 #include <vtkXMLImageDataReader.h>
 
 #include "mfr/error.hpp"
+#include "file_checks.hpp"
+#include "invesalius_loader.hpp"
 #include "vtk_loader.hpp"
 
 namespace mfr::io {
@@ -72,14 +74,15 @@ struct Extension {
   VolumeFormat format;
 };
 
-constexpr std::array<Extension, 8> kExtensions{{{".inr.gz", VolumeFormat::Inrimage},
+constexpr std::array<Extension, 9> kExtensions{{{".inr.gz", VolumeFormat::Inrimage},
                                                 {".nrrd", VolumeFormat::Nrrd},
                                                 {".nhdr", VolumeFormat::Nrrd},
                                                 {".vti", VolumeFormat::Vti},
                                                 {".vtk", VolumeFormat::LegacyVtk},
                                                 {".mhd", VolumeFormat::MetaImage},
                                                 {".mha", VolumeFormat::MetaImage},
-                                                {".inr", VolumeFormat::Inrimage}}};
+                                                {".inr", VolumeFormat::Inrimage},
+                                                {".inv3", VolumeFormat::Invesalius}}};
 
 std::optional<VolumeFormat> formatByName(const fs::path& path) {
   const std::string name = lower(path.filename().string());
@@ -114,50 +117,13 @@ std::string legacyDataset(const fs::path& path) {
   return {};
 }
 
-void checkReadable(const fs::path& path, const std::string& name) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (st.type() == fs::file_type::not_found) throw Error(name, "no such file");
-  if (ec) throw Error(name, "cannot access file: " + ec.message());
-  if (fs::is_directory(st)) throw Error(name, "is a directory, not a volume file");
-  if (!fs::is_regular_file(st)) throw Error(name, "not a regular file");
-  if (::access(path.c_str(), R_OK) != 0) throw Error(name, std::string("cannot read file: ") + std::strerror(errno));
-  std::ifstream probe(path, std::ios::binary);
-  if (!probe) throw Error(name, "cannot open file for reading");
-  if (fs::file_size(path, ec) == 0 && !ec) throw Error(name, "empty file");
-}
-
-std::string oneLine(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
-  s.erase(std::unique(s.begin(), s.end(), [](char a, char b) { return a == ' ' && b == ' '; }), s.end());
-  while (!s.empty() && s.back() == ' ') s.pop_back();
-  return s;
-}
-
 std::string dimsText(const std::array<std::int64_t, 3>& d) {
   return std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" + std::to_string(d[2]);
-}
-
-// The declared size, before anything is allocated for it.
-void checkDims(const std::array<std::int64_t, 3>& d, const std::string& name) {
-  for (const std::int64_t n : d) {
-    if (n < 2) throw Error(name, "volume needs at least 2 points per axis (the file declares " + dimsText(d) + ")");
-    if (n > kMaxPointsPerAxis)
-      throw Error(name, "volume of " + dimsText(d) + " points is larger than " + std::to_string(kMaxPointsPerAxis) +
-                            " points per axis");
-  }
-  if (static_cast<std::size_t>(d[0]) * static_cast<std::size_t>(d[1]) * static_cast<std::size_t>(d[2]) >
-      VolumeGrid::kMaxPoints)
-    throw Error(name, "volume of " + dimsText(d) + " points is larger than 2^30 points (4 GiB of samples)");
 }
 
 std::size_t pointCount(const glm::ivec3& dims) {
   return static_cast<std::size_t>(dims.x) * static_cast<std::size_t>(dims.y) * static_cast<std::size_t>(dims.z);
 }
-
-// Reports progress every few million samples of a conversion loop.
-constexpr std::size_t kProgressChunk = std::size_t{1} << 22;
 
 // ---------------------------------------------------------------------------------------------
 // VTK
@@ -174,6 +140,8 @@ const char* formatLabel(VolumeFormat format) {
       return "NRRD";
     case VolumeFormat::Inrimage:
       return "INRIMAGE";
+    case VolumeFormat::Invesalius:
+      return "InVesalius project";
   }
   return "volume";
 }
@@ -202,6 +170,7 @@ vtkSmartPointer<vtkAlgorithm> makeReader(VolumeFormat format, const std::string&
       return r;
     }
     case VolumeFormat::Inrimage:
+    case VolumeFormat::Invesalius:
       break;
   }
   return nullptr;
@@ -328,6 +297,19 @@ vtkDataArray* sampleArray(vtkImageData* image, const std::string& name) {
 
 }  // namespace
 
+// The declared size, before anything is allocated for it.
+void checkDims(const std::array<std::int64_t, 3>& d, const std::string& name) {
+  for (const std::int64_t n : d) {
+    if (n < 2) throw Error(name, "volume needs at least 2 points per axis (the file declares " + dimsText(d) + ")");
+    if (n > kMaxPointsPerAxis)
+      throw Error(name, "volume of " + dimsText(d) + " points is larger than " + std::to_string(kMaxPointsPerAxis) +
+                            " points per axis");
+  }
+  if (static_cast<std::size_t>(d[0]) * static_cast<std::size_t>(d[1]) * static_cast<std::size_t>(d[2]) >
+      VolumeGrid::kMaxPoints)
+    throw Error(name, "volume of " + dimsText(d) + " points is larger than 2^30 points (4 GiB of samples)");
+}
+
 Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::string& name,
                          const LoadProgress& progress) {
   const std::string label = formatLabel(format);
@@ -445,19 +427,6 @@ namespace {
 std::mutex& imageIoMutex() {
   static std::mutex m;
   return m;
-}
-
-template <typename T>
-void convertSamples(const void* data, std::size_t n, std::size_t stride, std::vector<float>& out,
-                    const LoadProgress& progress) {
-  out.resize(n);
-  const auto* bytes = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < n; ++i) {
-    T v;
-    std::memcpy(&v, bytes + i * stride, sizeof(T));
-    out[i] = static_cast<float>(v);
-    if ((i + 1) % kProgressChunk == 0) progress.step(0.7 + 0.25 * static_cast<double>(i + 1) / static_cast<double>(n));
-  }
 }
 
 // The magic bytes of an INRIMAGE file, read through zlib (which passes uncompressed bytes through).
@@ -581,9 +550,9 @@ namespace mfr {
 
 Volume loadVolume(const std::filesystem::path& path, const LoadProgress& progress) {
   const std::string name = path.string();
-  try {
+  return io::withFileErrors(name, [&] {
     progress.step(0.0);
-    io::checkReadable(path, name);
+    io::checkReadable(path, name, "volume");
     const std::optional<io::VolumeFormat> format = io::formatByName(path);
     if (!format) {
       std::string list;
@@ -599,26 +568,17 @@ Volume loadVolume(const std::filesystem::path& path, const LoadProgress& progres
         throw Error(name, "legacy VTK DATASET " + dataset + " is not a volume (expected STRUCTURED_POINTS)");
     }
     Volume volume = *format == io::VolumeFormat::Inrimage ? io::readInrimage(path, name, progress)
-                                                          : io::readVolumeWithVtk(*format, path, name, progress);
+                    : *format == io::VolumeFormat::Invesalius
+                        ? io::readInvesaliusProject(path, name, false, progress).volume
+                        : io::readVolumeWithVtk(*format, path, name, progress);
     volume.name = path.filename().string();
     volume.grid->validate(name);
-    volume.transfer = defaultTransfer(*volume.grid, volume.bounds());
+    // Formats that store no display settings get the default; an InVesalius project has its own.
+    if (volume.transfer.points.empty()) volume.transfer = defaultTransfer(*volume.grid, volume.bounds());
     volume.validate();
     progress.step(1.0);
     return volume;
-  } catch (const LoadCancelled&) {
-    throw;
-  } catch (const Error& e) {
-    std::string message = io::oneLine(e.what());
-    if (message.rfind(name, 0) != 0) message = name + ": " + message;
-    throw Error(message);
-  } catch (const std::bad_alloc&) {
-    throw Error(name, "out of memory while loading");
-  } catch (const std::exception& e) {
-    throw Error(name, io::oneLine(e.what()));
-  } catch (...) {
-    throw Error(name, "unknown error while loading");
-  }
+  });
 }
 
 std::vector<std::string> supportedVolumeExtensions() {

@@ -1,0 +1,45 @@
+#pragma once
+// Checks shared by the model and volume loaders: a file is looked at before any library reads it,
+// so that missing, unreadable, empty or special files get one line naming them, never a hang.
+#include <filesystem>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
+
+namespace mfr::io {
+
+// Throws mfr::Error(name, reason) unless path is a readable, non-empty regular file. `kind` is
+// what the caller expected ("model", "volume") and appears in the directory message.
+void checkReadable(const std::filesystem::path& path, const std::string& name, std::string_view kind);
+
+// A library's (possibly multi-line) message as one line: newlines and tabs become spaces, runs of
+// spaces collapse, trailing spaces go.
+std::string oneLine(std::string s);
+
+// Runs load() and turns whatever it throws into one mfr::Error line that starts with the file's
+// name: library messages are folded into one line, bad_alloc and unknown exceptions named;
+// LoadCancelled passes through.
+template <class Load>
+auto withFileErrors(const std::string& name, Load&& load) -> decltype(load()) {
+  try {
+    return load();
+  } catch (const LoadCancelled&) {
+    throw;
+  } catch (const Error& e) {
+    std::string message = oneLine(e.what());
+    if (message.rfind(name, 0) != 0) message = name + ": " + message;
+    throw Error(message);
+  } catch (const std::bad_alloc&) {
+    throw Error(name, "out of memory while loading");
+  } catch (const std::exception& e) {
+    throw Error(name, oneLine(e.what()));
+  } catch (...) {
+    throw Error(name, "unknown error while loading");
+  }
+}
+
+}  // namespace mfr::io
