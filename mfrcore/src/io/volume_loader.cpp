@@ -50,6 +50,7 @@
 #include "mfr/error.hpp"
 #include "file_checks.hpp"
 #include "invesalius_loader.hpp"
+#include "openvdb_loader.hpp"
 #include "vtk_loader.hpp"
 
 namespace mfr::io {
@@ -74,15 +75,16 @@ struct Extension {
   VolumeFormat format;
 };
 
-constexpr std::array<Extension, 9> kExtensions{{{".inr.gz", VolumeFormat::Inrimage},
-                                                {".nrrd", VolumeFormat::Nrrd},
-                                                {".nhdr", VolumeFormat::Nrrd},
-                                                {".vti", VolumeFormat::Vti},
-                                                {".vtk", VolumeFormat::LegacyVtk},
-                                                {".mhd", VolumeFormat::MetaImage},
-                                                {".mha", VolumeFormat::MetaImage},
-                                                {".inr", VolumeFormat::Inrimage},
-                                                {".inv3", VolumeFormat::Invesalius}}};
+constexpr std::array<Extension, 10> kExtensions{{{".inr.gz", VolumeFormat::Inrimage},
+                                                 {".nrrd", VolumeFormat::Nrrd},
+                                                 {".nhdr", VolumeFormat::Nrrd},
+                                                 {".vti", VolumeFormat::Vti},
+                                                 {".vtk", VolumeFormat::LegacyVtk},
+                                                 {".mhd", VolumeFormat::MetaImage},
+                                                 {".mha", VolumeFormat::MetaImage},
+                                                 {".inr", VolumeFormat::Inrimage},
+                                                 {".inv3", VolumeFormat::Invesalius},
+                                                 {".vdb", VolumeFormat::OpenVdb}}};
 
 std::optional<VolumeFormat> formatByName(const fs::path& path) {
   const std::string name = lower(path.filename().string());
@@ -142,6 +144,8 @@ const char* formatLabel(VolumeFormat format) {
       return "INRIMAGE";
     case VolumeFormat::Invesalius:
       return "InVesalius project";
+    case VolumeFormat::OpenVdb:
+      return "OpenVDB";
   }
   return "volume";
 }
@@ -171,6 +175,7 @@ vtkSmartPointer<vtkAlgorithm> makeReader(VolumeFormat format, const std::string&
     }
     case VolumeFormat::Inrimage:
     case VolumeFormat::Invesalius:
+    case VolumeFormat::OpenVdb:
       break;
   }
   return nullptr;
@@ -567,10 +572,21 @@ Volume loadVolume(const std::filesystem::path& path, const LoadProgress& progres
       if (dataset != "STRUCTURED_POINTS")
         throw Error(name, "legacy VTK DATASET " + dataset + " is not a volume (expected STRUCTURED_POINTS)");
     }
-    Volume volume = *format == io::VolumeFormat::Inrimage ? io::readInrimage(path, name, progress)
-                    : *format == io::VolumeFormat::Invesalius
-                        ? io::readInvesaliusProject(path, name, false, progress).volume
-                        : io::readVolumeWithVtk(*format, path, name, progress);
+    Volume volume;
+    switch (*format) {
+      case io::VolumeFormat::Inrimage:
+        volume = io::readInrimage(path, name, progress);
+        break;
+      case io::VolumeFormat::Invesalius:
+        volume = io::readInvesaliusProject(path, name, false, progress).volume;
+        break;
+      case io::VolumeFormat::OpenVdb:
+        volume = io::readOpenVdb(path, name, progress);
+        break;
+      default:
+        volume = io::readVolumeWithVtk(*format, path, name, progress);
+        break;
+    }
     volume.name = path.filename().string();
     volume.grid->validate(name);
     // Formats that store no display settings get the default; an InVesalius project has its own.

@@ -15,7 +15,7 @@
 
 namespace mfr::io {
 
-enum class VolumeFormat { Vti, LegacyVtk, MetaImage, Nrrd, Inrimage, Invesalius };
+enum class VolumeFormat { Vti, LegacyVtk, MetaImage, Nrrd, Inrimage, Invesalius, OpenVdb };
 
 // The volume format `path` names by its extension (case-insensitive); a .vtk file only when its
 // header says DATASET STRUCTURED_POINTS. nullopt: not a volume file.

@@ -1,0 +1,102 @@
+#include "openvdb_loader.hpp"
+
+#include <array>
+#include <cstdint>
+#include <fstream>
+#include <mutex>
+
+#include <openvdb/io/File.h>
+#include <openvdb/openvdb.h>
+
+#include "mfr/error.hpp"
+#include "volume_loader.hpp"
+
+namespace mfr::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// An OpenVDB file starts with the 64-bit magic number 0x56444220 ("VDB " as little-endian bytes).
+void checkMagic(const fs::path& path, const std::string& name) {
+  std::ifstream in(path, std::ios::binary);
+  std::array<unsigned char, 8> head{};
+  in.read(reinterpret_cast<char*>(head.data()), 8);
+  if (in.gcount() != 8 || head != std::array<unsigned char, 8>{0x20, 0x42, 0x44, 0x56, 0, 0, 0, 0})
+    throw Error(name, "not an OpenVDB file (bad magic number)");
+}
+
+bool scalar(const openvdb::GridBase& g) {
+  return g.isType<openvdb::FloatGrid>() || g.isType<openvdb::DoubleGrid>();
+}
+
+template <typename GridT>
+void copyDense(const GridT& grid, const openvdb::CoordBBox& box, std::vector<float>& out,
+               const LoadProgress& progress) {
+  const openvdb::Coord d = box.dim();
+  out.resize(static_cast<std::size_t>(d.x()) * static_cast<std::size_t>(d.y()) * static_cast<std::size_t>(d.z()));
+  const auto acc = grid.getConstAccessor();
+  std::size_t n = 0;
+  for (int k = box.min().z(); k <= box.max().z(); ++k) {
+    for (int j = box.min().y(); j <= box.max().y(); ++j)
+      for (int i = box.min().x(); i <= box.max().x(); ++i)
+        out[n++] = static_cast<float>(acc.getValue(openvdb::Coord(i, j, k)));
+    progress.step(0.5 + 0.45 * static_cast<double>(n) / static_cast<double>(out.size()));
+  }
+}
+
+}  // namespace
+
+Volume readOpenVdb(const fs::path& path, const std::string& name, const LoadProgress& progress) {
+  static std::once_flag initialized;
+  std::call_once(initialized, [] { openvdb::initialize(); });
+  checkMagic(path, name);
+
+  openvdb::io::File file(path.string());
+  file.open(false);  // no delayed loading: the file is read now, not when voxels are touched
+  const openvdb::GridPtrVecPtr headers = file.readAllGridMetadata();
+  std::string chosen, list;
+  bool found = false;
+  for (const openvdb::GridBase::Ptr& g : *headers) {
+    list += (list.empty() ? "" : ", ") + g->getName() + " (" + g->valueType() + ")";
+    if (!scalar(*g)) continue;
+    if (!found || g->getName() == "density") chosen = g->getName();
+    found = true;
+    if (g->getName() == "density") break;
+  }
+  if (!found)
+    throw Error(name,
+                "no float or double grid in the file" + (list.empty() ? std::string() : " (it has " + list + ")"));
+  progress.step(0.1);
+  const openvdb::GridBase::Ptr base = file.readGrid(chosen);
+  file.close();
+  progress.step(0.5);
+
+  const std::string label = "grid '" + chosen + "'";
+  const openvdb::CoordBBox box = base->evalActiveVoxelBoundingBox();
+  if (box.empty()) throw Error(name, label + " has no active voxels");
+  const openvdb::Coord d = box.dim();
+  checkDims({d.x(), d.y(), d.z()}, name);
+  const openvdb::math::Transform& transform = base->transform();
+  if (!transform.isLinear()) throw Error(name, label + " has a non-linear (frustum) transform, which is not supported");
+
+  auto grid = std::make_shared<VolumeGrid>();
+  grid->dims = glm::ivec3(d.x(), d.y(), d.z());
+  if (base->isType<openvdb::FloatGrid>())
+    copyDense(*openvdb::gridConstPtrCast<openvdb::FloatGrid>(base), box, grid->values, progress);
+  else
+    copyDense(*openvdb::gridConstPtrCast<openvdb::DoubleGrid>(base), box, grid->values, progress);
+
+  Volume volume;
+  volume.name = chosen.empty() ? path.filename().string() : chosen;
+  volume.grid = std::move(grid);
+  // Grid point (i, j, k) is voxel box.min + (i, j, k); OpenVDB maps index to world as a row
+  // vector times its matrix, glm as the matrix times a column vector: transposed.
+  volume.origin = glm::dvec3(box.min().x(), box.min().y(), box.min().z());
+  volume.spacing = glm::dvec3(1.0);
+  const openvdb::Mat4d m = transform.baseMap()->getAffineMap()->getMat4();
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) volume.transform[c][r] = m(c, r);
+  return volume;
+}
+
+}  // namespace mfr::io

@@ -1,0 +1,19 @@
+#pragma once
+// OpenVDB files (.vdb, private to mfrcore/io), read with the OpenVDB library: a sparse float or
+// double grid — a fog volume's density, a level set's signed distance — made dense over the
+// bounding box of its active voxels (inactive voxels inside it take their background or tile
+// value, as OpenVDB's own accessors give them), placed in the world by the grid's linear transform.
+#include <filesystem>
+#include <string>
+
+#include "mfr/io/load.hpp"
+#include "mfr/scene/volume.hpp"
+
+namespace mfr::io {
+
+// Reads the grid named "density" if the file has one, else its first float or double grid. The
+// name is the grid's, the transfer function left empty. Checks the dense size against
+// VolumeGrid's limits before allocating. Throws mfr::Error(name, reason), LoadCancelled.
+Volume readOpenVdb(const std::filesystem::path& path, const std::string& name, const LoadProgress& progress);
+
+}  // namespace mfr::io

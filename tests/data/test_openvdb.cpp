@@ -1,0 +1,129 @@
+// OpenVDB volumes (.vdb) made by OpenVDB's own command-line tool, vdb_tool (Debian
+// libopenvdb-tools; no real .vdb file is packaged): spheres as level sets and as fog volumes, off
+// the origin and with anisotropic placement, loaded by loadVolume and checked against the sphere
+// itself — where the signed distance crosses zero and the fog crosses one half, along each axis —
+// and against vdb_print's report of the same file; bad files end in one error naming the file.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <regex>
+#include <string>
+
+#include "mfr/io/load.hpp"
+#include "mfr/io_util.hpp"
+#include "mfr/scene/volume.hpp"
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+
+namespace mfr::test {
+namespace {
+
+class OpenVdbFiles : public TempDirTest {
+ protected:
+  fs::path make(const std::string& actions, const std::string& file) {
+    const fs::path out = dir() / file;
+    const CliResult r = runCommand("vdb_tool -quiet " + actions + " -write '" + out.string() + "'");
+    EXPECT_EQ(r.exitCode, 0) << "vdb_tool (Debian libopenvdb-tools; scripts/setup installs it): " << r.out;
+    return out;
+  }
+};
+
+double sampleWorld(const Volume& v, const glm::dvec3& p) {
+  const glm::dvec4 g = glm::inverse(v.gridToWorld()) * glm::dvec4(p, 1.0);
+  return v.grid->sample(glm::vec3(g));
+}
+
+// The distance from `centre` along `dir` at which the field first crosses `level` (from below when
+// rising, else from above), found by marching in steps of `step` and interpolating linearly.
+double crossing(const Volume& v, const glm::dvec3& centre, const glm::dvec3& dir, double level, double reach,
+                double step) {
+  double previous = sampleWorld(v, centre);
+  for (double t = step; t <= reach; t += step) {
+    const double value = sampleWorld(v, centre + t * dir);
+    if ((previous - level) * (value - level) <= 0.0 && previous != value)
+      return t - step + step * (level - previous) / (value - previous);
+    previous = value;
+  }
+  return -1.0;
+}
+
+TEST_F(OpenVdbFiles, LevelSetAndFogSpheresCrossWhereTheSphereIs) {
+  const glm::dvec3 centre(1.5, -2.0, 0.75);
+  const double radius = 2.0, voxel = 0.1;
+  const std::string sphere = "-sphere radius=2 voxel=0.1 'center=(1.5,-2,0.75)'";
+  const fs::path levelSet = make(sphere, "ls.vdb");
+  const fs::path fog = make(sphere + " -ls2fog", "fog.vdb");
+  const Volume ls = loadVolume(levelSet);
+  const Volume fv = loadVolume(fog);
+  // The same sphere made at the origin and moved by its grid's transform (not by its voxels).
+  const Volume moved =
+      loadVolume(make("-sphere radius=2 voxel=0.1 -transform 'translate=(1.5,-2,0.75)' vdb=0 keep=0", "moved.vdb"));
+  EXPECT_NEAR(moved.gridToWorld()[3].x, 1.5 - 2.0 - 3 * voxel, 1.5 * voxel);  // the box's corner
+
+  // vdb_print's own account of each file: the dense box is the active voxels' bounding box.
+  for (const auto& [path, volume] : {std::pair{levelSet, &ls}, std::pair{fog, &fv}}) {
+    const CliResult r = runCommand("vdb_print -l '" + path.string() + "'");
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(r.out, m, std::regex(R"(Dimensions of active voxels:\s+(\d+) x (\d+) x (\d+))")))
+        << r.out;
+    EXPECT_EQ(volume->grid->dims, glm::ivec3(std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3])));
+    const Bounds b = volume->bounds();
+    EXPECT_NEAR(b.min.x, centre.x - radius, 4 * voxel);  // the narrow band reaches ~3 voxels out
+    EXPECT_NEAR(b.max.y, centre.y + radius, 4 * voxel);
+  }
+  EXPECT_NEAR(glm::length(glm::dvec3(ls.gridToWorld()[0])), voxel,
+              1e-6);  // voxel size (float in the file) on every axis
+  EXPECT_NEAR(glm::length(glm::dvec3(ls.gridToWorld()[2])), voxel, 1e-6);
+
+  // Deep inside: the level set's inside value (negative), the fog's density 1.
+  EXPECT_LT(sampleWorld(ls, centre), 0.0);
+  EXPECT_FLOAT_EQ(static_cast<float>(sampleWorld(fv, centre)), 1.0f);
+  for (const glm::dvec3 dir : {glm::dvec3(1, 0, 0), glm::dvec3(-1, 0, 0), glm::dvec3(0, 1, 0), glm::dvec3(0, 0, -1),
+                               glm::normalize(glm::dvec3(1, 1, 1))}) {
+    SCOPED_TRACE(dir.x + 10 * dir.y + 100 * dir.z);
+    // The signed distance is zero on the sphere (to a small fraction of a voxel). The fog is
+    // OpenVDB's sdfToFogVolume: 0 on and outside the surface, rising linearly to 1 across the
+    // interior band (vdb_tool's default width: 3 voxels), so one half 1.5 voxels inside.
+    EXPECT_NEAR(crossing(ls, centre, dir, 0.0, 3.0, 0.01), radius, 0.2 * voxel);
+    EXPECT_NEAR(crossing(moved, centre, dir, 0.0, 3.0, 0.01), radius, 0.2 * voxel);
+    EXPECT_NEAR(crossing(fv, centre, dir, 0.5, 3.0, 0.01), radius - 1.5 * voxel, 0.2 * voxel);
+  }
+}
+
+TEST_F(OpenVdbFiles, SceneOfAVdbFile) {
+  const fs::path fog = make("-sphere radius=1 voxel=0.05 -ls2fog", "ball.vdb");
+  EXPECT_TRUE(isVolumeFile(fog));
+  const Scene scene = loadScene(fog);
+  ASSERT_EQ(scene.volumes.size(), 1u);
+  EXPECT_EQ(scene.volumes[0].name, "ball.vdb");
+  EXPECT_NEAR(scene.volumes[0].transfer.high(), 1.0, 1e-6);  // grayscale over the density's range
+  EXPECT_NEAR(scene.volumes[0].defaultStep(), 0.025, 1e-6);
+}
+
+TEST_F(OpenVdbFiles, BadFilesAreOneLineErrors) {
+  const auto expectError = [](const fs::path& path, const std::string& reason) {
+    try {
+      (void)loadVolume(path);
+      ADD_FAILURE() << path << ": loaded, expected '" << reason << "'";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+      EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << what;
+      EXPECT_NE(what.find(reason), std::string::npos) << what;
+    }
+  };
+  expectError(write("text.vdb", "not a VDB file at all, just text\n"), "not an OpenVDB file");
+  const fs::path good = make("-sphere radius=1 voxel=0.1 -ls2fog", "good.vdb");
+  const std::string bytes = readFile(good);
+  for (std::size_t cut = 8; cut < bytes.size(); cut += std::max<std::size_t>(1, bytes.size() / 30)) {
+    SCOPED_TRACE(cut);
+    const fs::path p = write("cut" + std::to_string(cut) + ".vdb", bytes.substr(0, cut));
+    expectError(p, p.string());
+  }
+}
+
+}  // namespace
+}  // namespace mfr::test
