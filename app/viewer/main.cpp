@@ -29,6 +29,7 @@ struct CommandLine {
   QSize size{800, 600}, windowSize;
   std::map<std::string, std::string> params;
   double thickness = 0.0;  // --thickness (operation zthickness); 0: the scene's default
+  double step = 0.0;       // --step (operation volume); 0: the volume's default
 };
 
 [[noreturn]] void fail(const QString& message, int code) {
@@ -52,12 +53,18 @@ CommandLine parseCommandLine(const QApplication& app) {
   parser.addVersionOption();
   parser.addPositionalArgument(QStringLiteral("scene"), QStringLiteral("Model file, .mfrscene, .mfrsession or @sample (default)"));
   const QCommandLineOption method({QStringLiteral("m"), QStringLiteral("method")}, QStringLiteral("Render method."), QStringLiteral("name"));
-  const QCommandLineOption op(QStringLiteral("op"),
-                              QStringLiteral("Operation: auto (the method's own), oit, hybrid, csg or zthickness."),
-                              QStringLiteral("name"));
+  const QCommandLineOption op(
+      QStringLiteral("op"),
+      QStringLiteral("Operation: auto (the method's own; volume on a scene with a volume), oit, hybrid, "
+                     "csg, zthickness or volume."),
+      QStringLiteral("name"));
   const QCommandLineOption thickness(
       QStringLiteral("thickness"),
       QStringLiteral("Operation zthickness: slab thickness in scene units (default: 1 % of the scene's diagonal)."),
+      QStringLiteral("length"));
+  const QCommandLineOption step(
+      QStringLiteral("step"),
+      QStringLiteral("Operation volume: ray-march step in scene units (default: half the volume's grid spacing)."),
       QStringLiteral("length"));
   const QCommandLineOption param({QStringLiteral("p"), QStringLiteral("param")}, QStringLiteral("Method parameter (repeatable)."), QStringLiteral("name=value"));
   const QCommandLineOption view(QStringLiteral("view"), QStringLiteral("Named view of the scene, or 'fit'."), QStringLiteral("name"));
@@ -69,7 +76,7 @@ CommandLine parseCommandLine(const QApplication& app) {
                                          QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
                                          QStringLiteral("id={json}"));
   parser.addOptions(
-      {method, op, thickness, param, view, size, screenshot, windowScreenshot, windowSize, pluginSettings});
+      {method, op, thickness, step, param, view, size, screenshot, windowScreenshot, windowSize, pluginSettings});
   parser.process(app);
 
   CommandLine cl;
@@ -83,6 +90,12 @@ CommandLine parseCommandLine(const QApplication& app) {
     cl.thickness = parser.value(thickness).toDouble(&ok);
     if (!ok || !(cl.thickness > 0.0) || !std::isfinite(cl.thickness))
       fail(QStringLiteral("--thickness %1: must be a positive length in scene units").arg(parser.value(thickness)), 2);
+  }
+  if (parser.isSet(step)) {
+    bool ok = false;
+    cl.step = parser.value(step).toDouble(&ok);
+    if (!ok || !(cl.step > 0.0) || !std::isfinite(cl.step))
+      fail(QStringLiteral("--step %1: must be a positive length in scene units").arg(parser.value(step)), 2);
   }
   cl.view = parser.value(view);
   cl.screenshot = parser.value(screenshot);
@@ -139,6 +152,7 @@ int main(int argc, char** argv) {
     applied = true;
     // A new scene starts at the default thickness (scene units): --thickness applies to this one.
     if (cl.thickness > 0.0) model.setZThickness(cl.thickness);
+    if (cl.step > 0.0) model.setVolumeStep(cl.step);  // likewise the volume step
     if (!cl.view.isEmpty()) {
       try {
         model.setCamera(model.scene().view(cl.view.toStdString()));

@@ -47,7 +47,13 @@ QString sceneFileFilter() {
   QStringList patterns{QStringLiteral("*.mfrscene")};
   for (const std::string& ext : mfr::supportedModelExtensions())
     patterns << QStringLiteral("*") + QString::fromStdString(ext);
-  return QObject::tr("Scenes and models (%1);;mfrview sessions (*.mfrsession);;All files (*)").arg(patterns.join(' '));
+  QStringList volumes;
+  for (const std::string& ext : mfr::supportedVolumeExtensions()) {
+    volumes << QStringLiteral("*") + QString::fromStdString(ext);
+    if (!patterns.contains(volumes.back())) patterns << volumes.back();
+  }
+  return QObject::tr("Scenes, models and volumes (%1);;Volumes (%2);;mfrview sessions (*.mfrsession);;All files (*)")
+      .arg(patterns.join(' '), volumes.join(' '));
 }
 
 }  // namespace
@@ -102,6 +108,9 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
     // "ghosting") has its switch and thickness.
     if (model_->scenePath() == QLatin1String("@intersect"))
       if (auto* ghostDock = findChild<QDockWidget*>(QStringLiteral("plugin-ghosting"))) ghostDock->raise();
+    // A scene with a volume: the Volume panel (plugin "hybridvolume") has its transfer function and step.
+    if (!model_->scene().volumes.empty())
+      if (auto* volumeDock = findChild<QDockWidget*>(QStringLiteral("plugin-hybridvolume"))) volumeDock->raise();
     if (pendingSession_) {
       applySession(*pendingSession_, *model_);
       if (model_->compareEnabled()) compareDock_->show();

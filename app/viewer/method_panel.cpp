@@ -4,6 +4,7 @@
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
+#include <QHBoxLayout>
 #include <QLabel>
 #include <QLineEdit>
 #include <QPushButton>
@@ -46,6 +47,7 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
   operationCombo_->addItem(tr("hybrid — exact core + averaged tail"), QStringLiteral("hybrid"));
   operationCombo_->addItem(tr("csg — the scene's CSG tree as opaque solids"), QStringLiteral("csg"));
   operationCombo_->addItem(tr("zthickness — blend surfaces closer than a thickness"), QStringLiteral("zthickness"));
+  operationCombo_->addItem(tr("volume — the scene's volume between the sorted surfaces"), QStringLiteral("volume"));
   // Operation zthickness: the slab thickness (scene units, shared by both panes); the minimum, 0,
   // reads "default" and follows the scene (1 % of its diagonal).
   thickness_ = new QDoubleSpinBox;
@@ -56,9 +58,28 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
   thickness_->setToolTip(
       tr("Each fragment is a slab this thick (scene units) behind its surface: surfaces closer than this "
          "blend without z-fighting, surfaces further apart composite \"over\". 0: 1 % of the scene's diagonal."));
+  // Operation volume: the ray-march step (scene units, shared by both panes); 0 reads "default"
+  // and follows the volume (half its smallest grid spacing).
+  step_ = new QDoubleSpinBox;
+  step_->setObjectName(objectName(QStringLiteral("volumeStep")));
+  step_->setDecimals(6);
+  step_->setRange(0.0, 1.0e9);
+  step_->setKeyboardTracking(false);
+  step_->setToolTip(
+      tr("Operation volume: distance between the volume's samples along each ray, in scene units "
+         "(smaller: more exact and slower). 0: half the volume's smallest grid spacing."));
+  auto* stepDefault = new QPushButton(tr("Default"));
+  stepDefault->setObjectName(objectName(QStringLiteral("volumeStepDefault")));
+  stepDefault->setToolTip(tr("Half the volume's smallest grid spacing"));
+  stepRow_ = new QWidget;
+  auto* stepLayout = new QHBoxLayout(stepRow_);
+  stepLayout->setContentsMargins(0, 0, 0, 0);
+  stepLayout->addWidget(step_, 1);
+  stepLayout->addWidget(stepDefault);
   top->addRow(tr("Method"), methodCombo_);
   top->addRow(tr("Operation"), operationCombo_);
   top->addRow(tr("Thickness"), thickness_);
+  top->addRow(tr("Step"), stepRow_);
   topLayout_ = top;
   layout->addLayout(top);
 
@@ -87,6 +108,12 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
   connect(operationCombo_, &QComboBox::currentIndexChanged, this,
           [this](int index) { model_.setOperationOf(side_, operationCombo_->itemData(index).toString()); });
   connect(thickness_, &QDoubleSpinBox::valueChanged, this, [this](double v) { model_.setZThickness(v); });
+  connect(step_, &QDoubleSpinBox::valueChanged, this, [this](double v) { model_.setVolumeStep(v); });
+  connect(stepDefault, &QPushButton::clicked, this, [this] { model_.setVolumeStep(0.0); });
+  connect(&model_, &ViewerModel::volumeChanged, this, [this] {
+    syncMethodCombo();  // what "auto" runs follows the volume's visibility
+    showStep();
+  });
   connect(&model_, &ViewerModel::zThicknessChanged, this, &MethodPanel::showThickness);
   connect(&model_, &ViewerModel::sceneChanged, this, &MethodPanel::showThickness);  // the default follows the scene
   connect(&model_, &ViewerModel::sideChanged, this, [this](int changed) {
@@ -98,6 +125,16 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
   syncMethodCombo();
   rebuildParameters();
   showThickness();
+  showStep();
+}
+
+void MethodPanel::showStep() {
+  const QSignalBlocker block(step_);
+  const double fallback = model_.volumeStepDefault();
+  step_->setSpecialValueText(tr("default (%1)").arg(fallback, 0, 'g', 4));
+  step_->setSingleStep(std::max(1.0e-6, fallback / 10.0));
+  step_->setValue(model_.volumeStep());
+  topLayout_->setRowVisible(stepRow_, model_.effectiveOperationOf(side_) == QLatin1String("volume"));
 }
 
 void MethodPanel::showThickness() {
@@ -117,7 +154,11 @@ void MethodPanel::syncMethodCombo() {
   const QSignalBlocker block(methodCombo_), blockOp(operationCombo_);
   methodCombo_->setCurrentIndex(methodCombo_->findData(model_.methodOf(side_)));
   operationCombo_->setCurrentIndex(operationCombo_->findData(model_.operationOf(side_)));
+  // What "auto" runs now (a scene with a visible volume: "volume" for the methods with sorted lists).
+  operationCombo_->setItemText(
+      0, tr("auto — the method's own (now: %1)").arg(model_.resolvedOperation(side_, QStringLiteral("auto"))));
   if (thickness_) topLayout_->setRowVisible(thickness_, model_.operationOf(side_) == QLatin1String("zthickness"));
+  if (stepRow_) topLayout_->setRowVisible(stepRow_, model_.effectiveOperationOf(side_) == QLatin1String("volume"));
 }
 
 void MethodPanel::rebuildParameters() {

@@ -540,6 +540,11 @@ void RenderView::updateOverlays() {
       if (operation == QLatin1String("zthickness"))
         operation += QStringLiteral(" %1").arg(
             model_.zThickness() > 0.0 ? model_.zThickness() : model_.zThicknessDefault(), 0, 'g', 4);
+      const QString effective = model_.effectiveOperationOf(side);
+      if (effective != model_.operationOf(side)) operation += QStringLiteral(" → ") + effective;
+      if (effective == QLatin1String("volume"))
+        operation += QStringLiteral(", step %1")
+                         .arg(model_.volumeStep() > 0.0 ? model_.volumeStep() : model_.volumeStepDefault(), 0, 'g', 4);
       QStringList lines{
           QStringLiteral("%1 · %2 (%3)").arg(QLatin1String(sideName(side)), model_.methodOf(side), operation)};
       if (paneFailed_[side])

@@ -57,7 +57,7 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   tree_->setContextMenuPolicy(Qt::CustomContextMenu);
   connect(tree_, &QWidget::customContextMenuRequested, this, [this](const QPoint& at) {
     QTreeWidgetItem* item = tree_->itemAt(at);
-    if (!item) return;
+    if (!item || item->data(kName, Qt::UserRole).toInt() < 0) return;  // a volume row
     const int index = item->data(kName, Qt::UserRole).toInt();
     QMenu menu(this);
     QAction* reset =
@@ -71,11 +71,23 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   connect(&model_, &ViewerModel::sceneChanged, this, &SceneTreePanel::showValues);
 }
 
+namespace {
+// Volume rows follow the object rows; their UserRole is -1 - the volume's index.
+int volumeOfRow(const QTreeWidgetItem* item) {
+  const int index = item->data(kName, Qt::UserRole).toInt();
+  return index < 0 ? -1 - index : -1;
+}
+}  // namespace
+
 void SceneTreePanel::showValues() {
   const auto& objects = model_.scene().objects;
-  if (tree_->topLevelItemCount() != static_cast<int>(objects.size())) return;
+  const auto& volumes = model_.scene().volumes;
+  if (tree_->topLevelItemCount() != static_cast<int>(objects.size() + volumes.size())) return;
   const QSignalBlocker block(tree_);
-  for (int i = 0; i < tree_->topLevelItemCount(); ++i) {
+  for (std::size_t v = 0; v < volumes.size(); ++v)
+    tree_->topLevelItem(static_cast<int>(objects.size() + v))
+        ->setCheckState(kName, volumes[v].visible ? Qt::Checked : Qt::Unchecked);
+  for (int i = 0; i < static_cast<int>(objects.size()); ++i) {
     QTreeWidgetItem* item = tree_->topLevelItem(i);
     const mfr::Object& o = objects[static_cast<std::size_t>(i)];
     item->setCheckState(kName, o.visible ? Qt::Checked : Qt::Unchecked);
@@ -112,12 +124,32 @@ void SceneTreePanel::rebuild() {
     item->setTextAlignment(kTriangles, Qt::AlignRight | Qt::AlignVCenter);
     items.push_back(item);
   }
+  // The scene's volumes (operation volume): name, grid size, visibility (at most one shows).
+  const auto& volumes = model_.scene().volumes;
+  for (std::size_t v = 0; v < volumes.size(); ++v) {
+    const mfr::Volume& volume = volumes[v];
+    auto* item = new QTreeWidgetItem;
+    item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsUserCheckable);
+    item->setText(kName,
+                  tr("%1 (volume)")
+                      .arg(QString::fromStdString(volume.name.empty() ? "volume " + std::to_string(v) : volume.name)));
+    item->setData(kName, Qt::UserRole, -1 - static_cast<int>(v));
+    item->setCheckState(kName, volume.visible ? Qt::Checked : Qt::Unchecked);
+    const glm::ivec3 d = volume.grid ? volume.grid->dims : glm::ivec3(0);
+    item->setText(kColour, QStringLiteral("%1×%2×%3").arg(d.x).arg(d.y).arg(d.z));
+    item->setToolTip(kName, tr("Drawn by the operation volume; checking it hides the scene's other volumes"));
+    items.push_back(item);
+  }
   tree_->addTopLevelItems(items);
   rebuilding_ = false;
 }
 
 void SceneTreePanel::itemChanged(QTreeWidgetItem* item, int column) {
   if (rebuilding_) return;
+  if (const int volume = volumeOfRow(item); volume >= 0) {
+    if (column == kName) model_.setVolumeVisibleAt(volume, item->checkState(kName) == Qt::Checked);
+    return;
+  }
   const int index = item->data(kName, Qt::UserRole).toInt();
   if (column == kName) {
     model_.setObjectVisible(index, item->checkState(kName) == Qt::Checked);
@@ -129,7 +161,7 @@ void SceneTreePanel::itemChanged(QTreeWidgetItem* item, int column) {
 }
 
 void SceneTreePanel::itemClicked(QTreeWidgetItem* item, int column) {
-  if (column != kColour) return;
+  if (column != kColour || volumeOfRow(item) >= 0) return;
   const int index = item->data(kName, Qt::UserRole).toInt();
   const QColor initial = colourOf(model_.scene().objects[static_cast<std::size_t>(index)]);
   const QColor chosen = QColorDialog::getColor(initial, this, tr("Colour of %1").arg(item->text(kName)));

@@ -1,6 +1,6 @@
 #pragma once
 // The scene dock: one row per object with a visibility check box, a colour swatch (click to
-// change) and an editable opacity.
+// change) and an editable opacity, then one row per volume (name, grid size, visibility).
 #include <QWidget>
 
 class QTreeWidget;

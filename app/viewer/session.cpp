@@ -101,6 +101,9 @@ Session captureSession(const ViewerModel& model) {
   s.method = model.method();
   s.operation = model.operation();
   s.thickness = model.zThickness();
+  s.volumeStep = model.volumeStep();
+  for (const mfr::Volume& v : model.scene().volumes)
+    s.volumes.push_back({QString::fromStdString(v.name), v.visible, v.transfer});
   s.params = model.allParams();
   for (const mfr::Object& o : model.scene().objects) {
     s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color, o.material.vertexColors});
@@ -128,6 +131,10 @@ void applySession(const Session& session, ViewerModel& model) {
   }
   model.setAllParams(session.params);
   model.setZThickness(session.thickness);
+  if (session.volumes.size() == model.scene().volumes.size())
+    for (std::size_t i = 0; i < session.volumes.size(); ++i)
+      model.setVolumeStateAt(static_cast<int>(i), session.volumes[i].visible, session.volumes[i].transfer);
+  model.setVolumeStep(session.volumeStep);
   if (!session.operation.isEmpty()) model.setOperation(session.operation);
   if (!session.method.isEmpty()) model.setMethod(session.method);
   model.setAllParamsOf(1, session.compare.params);
@@ -158,6 +165,16 @@ QJsonObject sessionToJson(const Session& s) {
                             {"operation", s.compare.operation},
                             {"params", paramsToJson(s.compare.params)}};
   const QJsonObject dataView{{"mode", nameOf(kDataViews, s.dataView)}, {"over_image", s.dataOverImage}};
+  QJsonArray volumes;
+  for (const Session::VolumeState& v : s.volumes) {
+    QJsonArray points;
+    for (const mfr::TransferPoint& p : v.transfer.points)
+      points.append(QJsonArray{p.value, p.color.r, p.color.g, p.color.b, p.color.a});
+    volumes.append(
+        QJsonObject{{"name", v.name},
+                    {"visible", v.visible},
+                    {"transfer", QJsonObject{{"unit_distance", v.transfer.unitDistance}, {"points", points}}}});
+  }
   QJsonArray objects;
   for (const Session::ObjectState& o : s.objects)
     objects.append(QJsonObject{{"name", o.name},
@@ -168,7 +185,8 @@ QJsonObject sessionToJson(const Session& s) {
   return {{"format", "mfrview-session"}, {"version", 1},
           {"scene", s.scenePath},        {"camera", camera},
           {"method", s.method},          {"operation", s.operation},
-          {"thickness", s.thickness},    {"params", paramsToJson(s.params)},
+          {"thickness", s.thickness},    {"volume_step", s.volumeStep},
+          {"volumes", volumes},          {"params", paramsToJson(s.params)},
           {"objects", objects},          {"compare", compare},
           {"data_view", dataView},       {"plugins", s.plugins}};
 }
@@ -200,6 +218,34 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   s.thickness = json.value("thickness").toDouble(0.0);
   if (!std::isfinite(s.thickness) || s.thickness < 0.0)
     r.fail(QStringLiteral("thickness"), QStringLiteral("expected a length >= 0 in scene units (0: the default)"));
+  // Optional (sessions written before the operation volume have neither).
+  if (json.contains("volume_step") && !json.value("volume_step").isDouble())
+    r.fail(QStringLiteral("volume_step"), QStringLiteral("expected a number"));
+  s.volumeStep = json.value("volume_step").toDouble(0.0);
+  if (!std::isfinite(s.volumeStep) || s.volumeStep < 0.0)
+    r.fail(QStringLiteral("volume_step"), QStringLiteral("expected a length >= 0 in scene units (0: the default)"));
+  const QJsonArray volumes = json.value("volumes").toArray();
+  for (qsizetype i = 0; i < volumes.size(); ++i) {
+    const QJsonObject v = volumes[i].toObject();
+    const QString where = QStringLiteral("volumes[%1].transfer").arg(i);
+    const QJsonObject t = v.value("transfer").toObject();
+    Session::VolumeState state{v.value("name").toString(), v.value("visible").toBool(true), {}};
+    state.transfer.unitDistance = r.number(t, "unit_distance", where, 1.0);
+    const QJsonArray points = t.value("points").toArray();
+    for (qsizetype j = 0; j < points.size(); ++j) {
+      const QJsonArray p = points[j].toArray();
+      if (p.size() != 5)
+        r.fail(where + QStringLiteral(".points[%1]").arg(j), QStringLiteral("expected [value, r, g, b, a]"));
+      state.transfer.points.push_back(
+          {p[0].toDouble(), glm::vec4(glm::dvec4(p[1].toDouble(), p[2].toDouble(), p[3].toDouble(), p[4].toDouble()))});
+    }
+    try {
+      state.transfer.validate("transfer function");
+    } catch (const std::exception& e) {
+      r.fail(where, QString::fromUtf8(e.what()));
+    }
+    s.volumes.push_back(std::move(state));
+  }
   s.params = r.params(json.value("params").toObject(), QStringLiteral("params"));
   // Optional (sessions written before compare mode have neither).
   const QJsonObject compare = json.value("compare").toObject();

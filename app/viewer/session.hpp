@@ -1,6 +1,6 @@
 #pragma once
 // Session files (.mfrsession, JSON): the scene's path, camera, method and operation (with the
-// z-thickness), the
+// z-thickness and the volume step), the scene's volumes (visibility, transfer function), the
 // parameters of every method the user set, per-object overrides, compare mode (with the second
 // method's own parameters), the data view and each plugin's settings.
 // Doubles are written shortest-round-trip, so a reloaded session renders the same image.
@@ -26,6 +26,13 @@ struct Session {
   QString method;
   QString operation;
   double thickness = 0.0;  // operation zthickness, scene units, both sides; 0 = the scene's default
+  double volumeStep = 0.0;  // operation volume, scene units, both sides; 0 = the volume's default
+  struct VolumeState {
+    QString name;
+    bool visible = true;
+    mfr::TransferFunction transfer;
+  };
+  std::vector<VolumeState> volumes;                                  // by volume index
   std::map<std::string, std::map<std::string, std::string>> params;  // per method
   std::vector<ObjectState> objects;                                  // by object index
   struct CompareState {

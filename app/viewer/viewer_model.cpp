@@ -142,6 +142,7 @@ mfr::RenderRequest ViewerModel::renderRequest(int side, QSize size) const {
   request.height = size.height();
   request.params = paramsOf(side);
   request.thickness = thickness_;
+  request.volumeStep = volumeStep_;
   return request;
 }
 
@@ -163,8 +164,9 @@ bool ViewerModel::supportsOperation(const QString& method, const QString& operat
   if (!info) return false;
   if (operation == QLatin1String("auto")) return true;
   if (isCpuMethod(method)) return operation.toStdString() == info->preferredOperation;  // optimal-k: hybrid
-  // kbuffer-zmerge keeps merged z-thickness segments, not fragments: its own operation only.
-  if (info->preferredOperation == "zthickness") return operation == QLatin1String("zthickness");
+  // A method whose own operation is not a list operation on fragments (kbuffer-zmerge keeps merged
+  // z-thickness segments) runs that one only.
+  if (info->preferredOperation == "zthickness" && !info->sortedLists) return operation == QLatin1String("zthickness");
   if (operation == QLatin1String("oit")) return true;
   if (operation == QLatin1String("csg")) return info->objectPayload;
   if (operation == QLatin1String("hybrid")) {
@@ -173,14 +175,174 @@ bool ViewerModel::supportsOperation(const QString& method, const QString& operat
            std::any_of(info->params.begin(), info->params.end(),
                        [](const mfr::ParamSpec& p) { return p.name == "tail"; });
   }
-  if (operation == QLatin1String("zthickness")) {
-    // Every method that resolves sorted per-pixel lists; the peeling methods composite while they
-    // peel and WBOIT / MBOIT keep no lists (their resolve refuses any operation but oit).
-    static const QStringList kNoLists{QStringLiteral("peel-f2b"), QStringLiteral("peel-dual"), QStringLiteral("kpeel"),
-                                      QStringLiteral("wboit"), QStringLiteral("mboit")};
-    return !kNoLists.contains(method);
-  }
+  // The list operations: every method whose resolve hands each pixel's sorted list to the
+  // operation; the peeling methods composite while they peel and WBOIT / MBOIT keep no lists.
+  if (operation == QLatin1String("zthickness") || operation == QLatin1String("volume")) return info->sortedLists;
   return false;
+}
+
+QString ViewerModel::resolvedOperation(int side, const QString& operation) const {
+  const QString method = methodOf(side);
+  return QString::fromStdString(
+      mfr::effectiveOperation(operation.toStdString(), method == QLatin1String("oracle") ? nullptr : methodInfo(method),
+                              scene_.visibleVolume() != nullptr));
+}
+
+// ---- volume --------------------------------------------------------------------------------
+
+int ViewerModel::volumeIndex() const {
+  if (!hasScene_ || scene_.volumes.empty()) return -1;
+  for (std::size_t i = 0; i < scene_.volumes.size(); ++i)
+    if (scene_.volumes[i].visible) return static_cast<int>(i);
+  return 0;
+}
+
+QString ViewerModel::volumeName() const {
+  const int i = volumeIndex();
+  return i < 0 ? QString() : QString::fromStdString(scene_.volumes[static_cast<std::size_t>(i)].name);
+}
+
+glm::ivec3 ViewerModel::volumeDims() const {
+  const int i = volumeIndex();
+  if (i < 0) return glm::ivec3(0);
+  const auto& grid = scene_.volumes[static_cast<std::size_t>(i)].grid;
+  return grid ? grid->dims : glm::ivec3(0);
+}
+
+glm::dvec3 ViewerModel::volumeSpacing() const {
+  const int i = volumeIndex();
+  return i < 0 ? glm::dvec3(0.0) : scene_.volumes[static_cast<std::size_t>(i)].spacing;
+}
+
+mfr::Bounds ViewerModel::volumeBounds() const {
+  const int i = volumeIndex();
+  return i < 0 ? mfr::Bounds{} : scene_.volumes[static_cast<std::size_t>(i)].bounds();
+}
+
+glm::dvec2 ViewerModel::volumeValueRange() const {
+  const int i = volumeIndex();
+  return i < 0 || static_cast<std::size_t>(i) >= volumeRanges_.size() ? glm::dvec2(0.0)
+                                                                      : volumeRanges_[static_cast<std::size_t>(i)];
+}
+
+bool ViewerModel::volumeVisible() const {
+  const int i = volumeIndex();
+  return i >= 0 && scene_.volumes[static_cast<std::size_t>(i)].visible;
+}
+
+void ViewerModel::setVolumeVisible(bool visible) {
+  setVolumeVisibleAt(volumeIndex(), visible);
+}
+
+void ViewerModel::setVolumeVisibleAt(int index, bool visible) {
+  if (index < 0 || index >= static_cast<int>(scene_.volumes.size())) return;
+  bool changed = false;
+  for (std::size_t i = 0; i < scene_.volumes.size(); ++i) {
+    const bool want = static_cast<int>(i) == index ? visible : (visible ? false : scene_.volumes[i].visible);
+    if (scene_.volumes[i].visible == want) continue;
+    scene_.volumes[i].visible = want;
+    changed = true;
+  }
+  if (!changed) return;
+  updateSceneGeometry();
+  volumeEdited();
+}
+
+void ViewerModel::setVolumeStateAt(int index, bool visible, const mfr::TransferFunction& transfer) {
+  if (index < 0 || index >= static_cast<int>(scene_.volumes.size())) return;
+  try {
+    transfer.validate("transfer function");
+    scene_.volumes[static_cast<std::size_t>(index)].transfer = transfer;
+  } catch (const std::exception&) {
+    // keeps the loaded one
+  }
+  scene_.volumes[static_cast<std::size_t>(index)].visible = visible;
+  if (visible)
+    for (std::size_t i = 0; i < scene_.volumes.size(); ++i)
+      if (static_cast<int>(i) != index) scene_.volumes[i].visible = false;
+  updateSceneGeometry();
+  volumeEdited();
+}
+
+mfr::TransferFunction ViewerModel::transferFunction() const {
+  const int i = volumeIndex();
+  return i < 0 ? mfr::TransferFunction{} : scene_.volumes[static_cast<std::size_t>(i)].transfer;
+}
+
+mfr::TransferFunction ViewerModel::loadedTransferFunction() const {
+  const int i = volumeIndex();
+  return i < 0 || static_cast<std::size_t>(i) >= loadedTransfers_.size()
+             ? mfr::TransferFunction{}
+             : loadedTransfers_[static_cast<std::size_t>(i)];
+}
+
+namespace {
+bool sameTransfer(const mfr::TransferFunction& a, const mfr::TransferFunction& b) {
+  if (a.unitDistance != b.unitDistance || a.points.size() != b.points.size()) return false;
+  for (std::size_t i = 0; i < a.points.size(); ++i)
+    if (a.points[i].value != b.points[i].value || a.points[i].color != b.points[i].color) return false;
+  return true;
+}
+}  // namespace
+
+QString ViewerModel::setTransferFunction(const mfr::TransferFunction& transfer) {
+  const int i = volumeIndex();
+  if (i < 0) return tr("the scene has no volume");
+  try {
+    transfer.validate("transfer function");
+  } catch (const std::exception& e) {
+    // "transfer function: <reason>", one line.
+    return QString::fromUtf8(e.what()).split(QLatin1Char('\n')).front();
+  }
+  mfr::TransferFunction& current = scene_.volumes[static_cast<std::size_t>(i)].transfer;
+  if (sameTransfer(current, transfer)) return {};
+  current = transfer;
+  volumeEdited();
+  return {};
+}
+
+QStringList ViewerModel::transferPresetNames() const {
+  QStringList names;
+  for (const std::string& name : mfr::transferPresetNames()) names << QString::fromStdString(name);
+  return names;
+}
+
+mfr::TransferFunction ViewerModel::transferPreset(const QString& name, double low, double high,
+                                                  double unitDistance) const {
+  try {
+    return mfr::transferPreset(name.toStdString(), low, high, unitDistance);
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
+std::vector<glm::vec4> ViewerModel::transferTable(const mfr::TransferFunction& transfer) const {
+  try {
+    transfer.validate("transfer function");
+    return transfer.table();
+  } catch (const std::exception&) {
+    return {};
+  }
+}
+
+void ViewerModel::setVolumeStep(double step) {
+  if (!std::isfinite(step) || step < 0.0 || step == volumeStep_) return;
+  volumeStep_ = step;
+  emit volumeChanged();
+  for (int side = 0; side < kSides; ++side)
+    if (effectiveOperationOf(side) == QLatin1String("volume")) emit sideChanged(side);
+}
+
+double ViewerModel::volumeStepDefault() const {
+  const int i = volumeIndex();
+  return i < 0 ? 0.0 : scene_.volumes[static_cast<std::size_t>(i)].defaultStep();
+}
+
+void ViewerModel::volumeEdited() {
+  sceneEdited();
+  emit volumeChanged();
+  // "auto" may now resolve to another operation: the method panels show it.
+  for (int side = 0; side < kSides; ++side) emit sideChanged(side);
 }
 
 // ---- compare mode and data views ----------------------------------------------------------
@@ -318,11 +480,20 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
     thickness_ = 0.0;
     emit zThicknessChanged(thickness_);
   }
+  // So is the volume step; the loaded transfer functions are what "As Loaded" brings back.
+  volumeStep_ = 0.0;
+  loadedTransfers_.clear();
+  volumeRanges_.clear();
+  for (const mfr::Volume& v : scene_.volumes) {
+    loadedTransfers_.push_back(v.transfer);
+    volumeRanges_.push_back(v.grid ? glm::dvec2(v.grid->range()) : glm::dvec2(0.0));
+  }
   camera_ = scene_.views.empty() ? scene_.view("fit") : scene_.views.front().camera;
   ++viewRevision_;
   emit sceneLoaded();
   emit sceneChanged();
   emit viewChanged();
+  emit volumeChanged();
 }
 
 void ViewerModel::updateSceneGeometry() {
@@ -469,6 +640,10 @@ ImageKey ViewerModel::imageKey(const mfr::RenderRequest& request) const {
   for (const auto& [name, value] : request.params) text += ";" + name + "=" + value;
   if (request.operation == "zthickness")
     text += ";thickness=" + QString::number(request.thickness, 'g', 17).toStdString();
+  // The step matters to images of the operation volume, "auto" included where it resolves to it.
+  const mfr::MethodInfo* info = request.method == "oracle" ? nullptr : mfr::findMethodInfo(request.method);
+  if (mfr::effectiveOperation(request.operation, info, scene_.visibleVolume() != nullptr) == "volume")
+    text += ";step=" + QString::number(request.volumeStep, 'g', 17).toStdString();
   return {sceneRevision_, viewRevision_, QSize(request.width, request.height), text};
 }
 
@@ -481,12 +656,15 @@ mfr::RenderRequest ViewerModel::referenceRequest(int side) const {
   request.method = "oracle";
   // Exact "over" of every fragment, whatever the pane's transparency operation; the exact CSG
   // image for a pane showing CSG, the exact z-thickness image (same thickness) for one showing
-  // zthickness.
-  const QString operation = operationOf(side);
-  request.operation = operation == QLatin1String("csg") || operation == QLatin1String("zthickness")
+  // zthickness, the exact volume image (same step, the current transfer function: the scene's) for
+  // one showing volume — "auto" resolved, so a volume scene's "auto" is measured against the volume.
+  const QString operation = effectiveOperationOf(side);
+  request.operation = operation == QLatin1String("csg") || operation == QLatin1String("zthickness") ||
+                              operation == QLatin1String("volume")
                           ? operation.toStdString()
                           : std::string("oit");
   request.thickness = thickness_;
+  request.volumeStep = volumeStep_;
   request.width = paneSize().width();
   request.height = paneSize().height();
   return request;

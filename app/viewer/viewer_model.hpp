@@ -121,6 +121,40 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] double zThickness() const override { return thickness_; }
   void setZThickness(double thickness) override;
   [[nodiscard]] double zThicknessDefault() const override;
+  // The operation a side runs now: its operation with "auto" resolved for its method and the scene
+  // (mfr::effectiveOperation).
+  [[nodiscard]] QString effectiveOperationOf(int side) const { return resolvedOperation(side, operationOf(side)); }
+  // What `operation` would mean for the side's method on this scene.
+  [[nodiscard]] QString resolvedOperation(int side, const QString& operation) const;
+  [[nodiscard]] QString effectiveOperation() const override { return effectiveOperationOf(0); }
+
+  // The scalar volume (ViewerContext 1.4); the step is shared by both sides. A new scene (setScene)
+  // starts at step 0 (the default).
+  [[nodiscard]] bool hasVolume() const override { return volumeIndex() >= 0; }
+  [[nodiscard]] QString volumeName() const override;
+  [[nodiscard]] glm::ivec3 volumeDims() const override;
+  [[nodiscard]] glm::dvec3 volumeSpacing() const override;
+  [[nodiscard]] mfr::Bounds volumeBounds() const override;
+  [[nodiscard]] glm::dvec2 volumeValueRange() const override;
+  [[nodiscard]] bool volumeVisible() const override;
+  void setVolumeVisible(bool visible) override;
+  [[nodiscard]] mfr::TransferFunction transferFunction() const override;
+  [[nodiscard]] mfr::TransferFunction loadedTransferFunction() const override;
+  QString setTransferFunction(const mfr::TransferFunction& transfer) override;
+  [[nodiscard]] QStringList transferPresetNames() const override;
+  [[nodiscard]] mfr::TransferFunction transferPreset(const QString& name, double low, double high,
+                                                     double unitDistance) const override;
+  [[nodiscard]] std::vector<glm::vec4> transferTable(const mfr::TransferFunction& transfer) const override;
+  [[nodiscard]] double volumeStep() const override { return volumeStep_; }
+  void setVolumeStep(double step) override;
+  [[nodiscard]] double volumeStepDefault() const override;
+  // Every volume of the scene by index (the scene tree, sessions): showing one hides the others.
+  void setVolumeVisibleAt(int index, bool visible);
+  // A session's volume state: visibility and transfer function (an invalid one is ignored).
+  void setVolumeStateAt(int index, bool visible, const mfr::TransferFunction& transfer);
+  // The index of "the volume": the visible one, else the first; -1 without volumes.
+  [[nodiscard]] int volumeIndex() const;
+
   [[nodiscard]] const ParamsByMethod& allParams() const { return allParamsOf(0); }
   void setAllParams(ParamsByMethod params) { setAllParamsOf(0, std::move(params)); }
   [[nodiscard]] mfr::RenderRequest renderRequest(QSize size) const { return renderRequest(0, size); }
@@ -185,7 +219,8 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] quint64 framesRendered() const { return framesRendered_; }
 
   // What the pane of `side` shows now, and its exact reference image (the oracle's "over", or its
-  // CSG / z-thickness image, same thickness, for a pane showing that operation).
+  // CSG / z-thickness / volume image, same thickness or step, for a pane showing that operation,
+  // "auto" resolved).
   [[nodiscard]] ImageKey frameKey(int side) const;
   [[nodiscard]] mfr::RenderRequest referenceRequest(int side) const;
   // Metrics are computed for both panes in compare mode, and for side 0 when a frame quality was
@@ -236,6 +271,7 @@ class ViewerModel final : public ViewerContext {
   void updateMetrics();
   void startMetrics(int side, const mfr::ImageRGBA8& reference);
   void pollLoadProgress();
+  void volumeEdited();
 
   mfr::Scene scene_;
   std::vector<mfr::Material> loadedMaterials_;  // of scene_'s objects as loaded, for resetObjectColor
@@ -253,6 +289,9 @@ class ViewerModel final : public ViewerContext {
   std::array<QString, kSides> operations_{QStringLiteral("auto"), QStringLiteral("auto")};
   std::array<ParamsByMethod, kSides> params_;
   double thickness_ = 0.0;  // operation zthickness, scene units; 0 = mfr::zThicknessDefault
+  double volumeStep_ = 0.0;                             // operation volume, scene units; 0 = the volume's defaultStep()
+  std::vector<mfr::TransferFunction> loadedTransfers_;  // of scene_'s volumes as loaded
+  std::vector<glm::dvec2> volumeRanges_;                // of scene_'s volumes' grids
 
   bool compare_ = false;
   CompareLayout layout_ = CompareLayout::SideBySide;

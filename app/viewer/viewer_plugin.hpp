@@ -17,9 +17,14 @@
 
 #include <map>
 #include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
 
 #include "mfr/methods/method.hpp"
 #include "mfr/methods/stats.hpp"
+#include "mfr/scene/mesh.hpp"
+#include "mfr/scene/volume.hpp"
 
 class QWidget;
 
@@ -31,7 +36,8 @@ enum class DataView {
 };
 
 // The current frame against the exact image, same size: the oracle's "over" of every fragment,
-// or its CSG / z-thickness image (same thickness) while the frame shows that operation.
+// or its CSG / z-thickness / volume image (same thickness, step and transfer function) while the
+// frame shows that operation.
 struct FrameQuality {
   bool valid = false;  // computed for the frame now shown
   QString method;
@@ -81,11 +87,14 @@ class ViewerContext : public QObject {
   [[nodiscard]] virtual DataView dataView() const = 0;
   [[nodiscard]] virtual bool dataViewOverImage() const = 0;
   virtual void setDataView(DataView view, bool overImage) = 0;
-  // Operation of the main view: "auto", "oit", "hybrid", "csg" or "zthickness".
+  // Operation of the main view: "auto", "oit", "hybrid", "csg", "zthickness" or "volume". "auto"
+  // is the method's own, or "volume" on a scene with a visible volume for a method with sorted
+  // lists (mfr::effectiveOperation); effectiveOperation() says which.
   [[nodiscard]] virtual QString operation() const = 0;
   virtual void setOperation(const QString& operation) = 0;
   // Whether `method` can run `operation` (1.3; the oracle runs them all; csg needs object ids, hybrid
-  // a k-buffer's tail, zthickness sorted lists: not the peeling methods, WBOIT or MBOIT).
+  // a k-buffer's tail, zthickness and volume sorted lists, MethodInfo::sortedLists: not the peeling
+  // methods, WBOIT, MBOIT or kbuffer-zmerge, which runs zthickness only).
   [[nodiscard]] virtual bool supportsOperation(const QString& method, const QString& operation) const = 0;
   // The scene's object names, in object-id order.
   [[nodiscard]] virtual QStringList objectNames() const = 0;
@@ -114,6 +123,45 @@ class ViewerContext : public QObject {
   // The opacity the object had when its scene was loaded.
   [[nodiscard]] virtual double loadedObjectOpacity(int objectId) const = 0;
 
+  // ---- Scalar volume, operation "volume" (1.4) ----
+  // "The volume" is the scene's visible volume, or its first one while every volume is hidden
+  // (a scene shows at most one). Without a volume the getters read empty values and the setters
+  // do nothing (setTransferFunction returns a reason).
+  // The operation the main view runs now: operation() with "auto" resolved.
+  [[nodiscard]] virtual QString effectiveOperation() const = 0;
+  [[nodiscard]] virtual bool hasVolume() const = 0;
+  [[nodiscard]] virtual QString volumeName() const = 0;
+  [[nodiscard]] virtual glm::ivec3 volumeDims() const = 0;     // grid points per axis; 0 without a volume
+  [[nodiscard]] virtual glm::dvec3 volumeSpacing() const = 0;  // object-space distance between points
+  [[nodiscard]] virtual mfr::Bounds volumeBounds() const = 0;  // world bounds of the grid's domain
+  // Smallest and largest sample (VolumeGrid::range, computed once per scene).
+  [[nodiscard]] virtual glm::dvec2 volumeValueRange() const = 0;
+  // Whether it is drawn (Volume::visible); showing it hides any other volume of the scene.
+  [[nodiscard]] virtual bool volumeVisible() const = 0;
+  virtual void setVolumeVisible(bool visible) = 0;
+  // Its transfer function (every pane and the exact reference use it), and the one it had when the
+  // scene was loaded.
+  [[nodiscard]] virtual mfr::TransferFunction transferFunction() const = 0;
+  [[nodiscard]] virtual mfr::TransferFunction loadedTransferFunction() const = 0;
+  // Replaces it and re-renders; returns an empty string, or the one-line reason an invalid function
+  // (fewer than two points, values not ascending or an empty range, colour or opacity outside
+  // 0 … 1, a unit distance not positive) was refused; nothing changes then.
+  virtual QString setTransferFunction(const mfr::TransferFunction& transfer) = 0;
+  // mfr::transferPresetNames, and preset `name` over [low, high] with the given unit distance
+  // (no points for an unknown name).
+  [[nodiscard]] virtual QStringList transferPresetNames() const = 0;
+  [[nodiscard]] virtual mfr::TransferFunction transferPreset(const QString& name, double low, double high,
+                                                             double unitDistance) const = 0;
+  // TransferFunction::table(): MFR_VOLUME_TF_SIZE (256) entries (rgb, extinction per scene unit)
+  // evenly spaced over [low(), high()], for previews; empty for an invalid function.
+  [[nodiscard]] virtual std::vector<glm::vec4> transferTable(const mfr::TransferFunction& transfer) const = 0;
+  // The ray-march step of every pane (RenderRequest::volumeStep, scene units; 0 means
+  // volumeStepDefault()). A new scene starts at 0; a negative, infinite or NaN value is ignored.
+  [[nodiscard]] virtual double volumeStep() const = 0;
+  virtual void setVolumeStep(double step) = 0;
+  // Volume::defaultStep(): half the smallest world distance between grid points (0 without a volume).
+  [[nodiscard]] virtual double volumeStepDefault() const = 0;
+
  signals:
   void sceneChanged();  // a new scene, or an object edited
   void viewChanged();   // camera or image size
@@ -126,6 +174,7 @@ class ViewerContext : public QObject {
   void dataViewChanged();
   void operationChanged(const QString& operation);
   void zThicknessChanged(double thickness);  // zThickness(), 0 = the default
+  void volumeChanged();                      // 1.4: a new scene, or the volume's visibility, transfer function or step
 };
 
 class MfrViewerPlugin {
@@ -144,5 +193,7 @@ class MfrViewerPlugin {
 // 1.1: frame quality and data views in ViewerContext (plugins built for 1.0 are refused).
 // 1.2: operation, object names and the CSG tree.
 // 1.3: operation zthickness and its thickness, supportsOperation, per-object opacity.
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.3"
+// 1.4: the scalar volume (operation volume): presence, dims, bounds, visibility, transfer function
+//      (presets, table), ray-march step, effectiveOperation, volumeChanged.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.4"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -787,6 +787,421 @@ class ViewerTest : public QObject {
     }
   }
 
+  // Operation "volume" on the built-in volume sample: `mfrview --screenshot` equals `mfr render`
+  // exactly (an explicit step, the default step, "auto" resolving to volume; three methods) and
+  // differs from "over"; bad steps end a scripted run; the live frame notes its step, the method
+  // panel's Step row drives it, and the frame quality is measured against the oracle's volume
+  // image with the same step and the current transfer function (compare mode: the oracle's own
+  // pane is exact).
+  void volumeOperation() {
+    QTemporaryDir dir;
+    const auto png = [&](const QString& name) { return dir.filePath(name); };
+    QString out;
+    const QList<QStringList> cases{
+        {"--method", "abuffer-ll", "--op", "volume", "--step", "0.02", "--view", "iso"},
+        {"--method", "kbuffer", "-p", "k=16", "--op", "volume", "--view", "front"},
+        {"--method", "abuffer-sbuffer", "--op", "auto", "--step", "0.03", "--view", "iso"},
+    };
+    for (const QStringList& c : cases) {
+      const QStringList common = QStringList{"--size", "200x150"} + c;
+      QCOMPARE(runProgram(MFRVIEW, QStringList{"@volume", "--screenshot", png("viewer.png")} + common, &out), 0);
+      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@volume", "-o", png("cli.png")} + common, &out), 0);
+      const mfr::ImageRGBA8 viewer = mfr::readPng(png("viewer.png").toStdString());
+      const int diff = maxChannelDifference(viewer, mfr::readPng(png("cli.png").toStdString()));
+      qInfo("@volume %s: viewer vs mfr render max channel difference %d", qPrintable(c.join(' ')), diff);
+      QVERIFY2(diff == 0, qPrintable(c.join(' ') + ": " + QString::number(diff)));
+      QStringList oit = common;
+      oit[oit.indexOf("--op") + 1] = "oit";
+      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@volume", "-o", png("oit.png")} + oit, &out), 0);
+      const double fromOit = mfr::rmse(viewer, mfr::readPng(png("oit.png").toStdString()));
+      qInfo("  RMSE against --op oit: %.5f", fromOit);
+      QVERIFY(fromOit > 0.005);
+    }
+    // The step matters: another step, another image (the viewer passes it on).
+    QCOMPARE(
+        runProgram(MFRVIEW,
+                   {"@volume", "--screenshot", png("a.png"), "--size", "200x150", "--op", "volume", "--step", "0.2"},
+                   &out),
+        0);
+    QCOMPARE(
+        runProgram(MFRVIEW, {"@volume", "--screenshot", png("b.png"), "--size", "200x150", "--op", "volume"}, &out), 0);
+    QVERIFY(maxChannelDifference(mfr::readPng(png("a.png").toStdString()), mfr::readPng(png("b.png").toStdString())) >
+            0);
+    // Steps the CLI would refuse end a scripted viewer run too, with a one-line error.
+    for (const QString& bad : {QStringLiteral("--step=0"), QStringLiteral("--step=-1"), QStringLiteral("--step=nan")}) {
+      QCOMPARE(runProgram(MFRVIEW, {"@volume", "--screenshot", png("bad.png"), "--op", "volume", bad}, &out), 2);
+      QVERIFY2(out.contains("mfrview: --step"), qPrintable(out));
+    }
+
+    auto w = openWindow(QStringLiteral("@volume"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(200, 150);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(200, 150), kTimeoutMs);
+    m.setMethod("abuffer-ll");
+    m.setCamera(m.scene().view("iso"));
+    const auto note = [&m](const char* key) -> std::string {
+      for (const auto& [name, value] : m.stats().notes)
+        if (name == key) return value;
+      return {};
+    };
+    // "auto" on a volume scene runs volume, and the panel says so.
+    auto* operation = w->findChild<QComboBox*>("operationCombo");
+    auto* step = w->findChild<QDoubleSpinBox*>("volumeStep");
+    QVERIFY(operation && step);
+    QCOMPARE(m.operation(), QStringLiteral("auto"));
+    settle(m);
+    QCOMPARE(QString::fromStdString(m.stats().operation), QStringLiteral("volume"));
+    QCOMPARE(m.effectiveOperation(), QStringLiteral("volume"));
+    QVERIFY2(operation->itemText(0).contains("volume"), qPrintable(operation->itemText(0)));
+    QVERIFY(step->isVisibleTo(w.get()));
+    operation->setCurrentIndex(operation->findData(QStringLiteral("volume")));
+    QCOMPARE(m.operation(), QStringLiteral("volume"));
+    step->setValue(0.02);
+    QCOMPARE(m.volumeStep(), 0.02);
+    QCOMPARE(m.renderRequest(QSize(8, 8)).volumeStep, 0.02);
+    settle(m);
+    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    QCOMPARE(note("volume step"), std::to_string(0.02));
+    QVERIFY(std::stoull(note("volume (bytes)")) >= 96ull * 96 * 96 * 4);
+    // The default (step 0) is the volume's defaultStep(), as the renderers make it.
+    QCOMPARE(m.volumeStepDefault(), m.scene().visibleVolume()->defaultStep());
+    w->findChild<QPushButton*>("volumeStepDefault")->click();
+    QCOMPARE(m.volumeStep(), 0.0);
+    settle(m);
+    QCOMPARE(note("volume step"), std::to_string(m.volumeStepDefault()));
+    QVERIFY(step->specialValueText().contains("default"));
+    // Another operation hides the row.
+    m.setOperation("oit");
+    QVERIFY(!step->isVisibleTo(w.get()));
+    m.setOperation("volume");
+    m.setVolumeStep(0.02);
+
+    // Frame quality against the oracle's volume image of the same step and transfer function.
+    const auto oracle = [&m](const std::string& op, QSize size) {
+      mfr::RenderRequest request;
+      request.operation = op;
+      request.volumeStep = m.volumeStep();
+      request.width = size.width();
+      request.height = size.height();
+      return mfr::render(m.scene(), m.camera(), request).image;
+    };
+    QCOMPARE(m.referenceRequest(0).operation, std::string("volume"));
+    QCOMPARE(m.referenceRequest(0).volumeStep, 0.02);
+    settle(m);
+    m.requestFrameQuality();
+    QTRY_VERIFY_WITH_TIMEOUT(m.frameQuality().valid, kTimeoutMs);
+    const mfr::ImageRGBA8 frame = w->view().renderImage(m.renderSize());
+    const double quality = m.frameQuality().rmse;
+    const double exact = mfr::rmse(oracle("volume", m.renderSize()), frame);
+    const double fromOit = mfr::rmse(oracle("oit", m.renderSize()), frame);
+    qInfo("@volume abuffer-ll volume 0.02: frame quality RMSE %.6f (recomputed %.6f; against oit %.6f)", quality, exact,
+          fromOit);
+    QVERIFY(quality < 0.002);
+    QVERIFY(std::abs(quality - exact) < 1e-9);
+    QVERIFY(fromOit > 0.005);
+    // Another transfer function: another frame, measured against the oracle with the new one.
+    const mfr::ImageRGBA8 oldOracle = oracle("volume", m.renderSize());
+    const mfr::TransferFunction loaded = m.transferFunction();
+    QVERIFY(m.setTransferFunction(mfr::transferPreset("fire", 0.0, 1.2, loaded.unitDistance)).isEmpty());
+    QVERIFY(!m.metricsCurrent(0));
+    settle(m);
+    m.requestFrameQuality();
+    QTRY_VERIFY_WITH_TIMEOUT(m.frameQuality().valid, kTimeoutMs);
+    const mfr::ImageRGBA8 fire = w->view().renderImage(m.renderSize());
+    qInfo("fire: frame quality RMSE %.6f (against the old transfer function's oracle %.6f)", m.frameQuality().rmse,
+          mfr::rmse(oldOracle, fire));
+    QVERIFY(m.frameQuality().rmse < 0.002);
+    QVERIFY(m.frameQuality().rmse != quality);
+    QVERIFY(std::abs(m.frameQuality().rmse - mfr::rmse(oracle("volume", m.renderSize()), fire)) < 1e-9);
+    QVERIFY(mfr::rmse(oldOracle, fire) > 0.01);
+
+    // Compare mode: side B the oracle with volume (auto resolves to it), measured against itself.
+    m.setMethodOf(1, QStringLiteral("oracle"));
+    m.setCompareEnabled(true);
+    settle(m);
+    QTRY_VERIFY_WITH_TIMEOUT(m.metricsCurrent(0) && m.metricsCurrent(1), kTimeoutMs);
+    QVERIFY2(m.metrics(0).valid && m.metrics(1).valid, qPrintable(m.metrics(0).error + m.metrics(1).error));
+    QCOMPARE(m.referenceRequest(1).operation, std::string("volume"));
+    QCOMPARE(m.metrics(1).rmse, 0.0);
+    // Another step re-renders and re-measures both panes.
+    const PaneMetrics before = m.metrics(0);
+    m.setVolumeStep(0.04);
+    QVERIFY(!m.metricsCurrent(0) && !m.metricsCurrent(1));
+    settle(m);
+    QTRY_VERIFY_WITH_TIMEOUT(m.metricsCurrent(0) && m.metricsCurrent(1), kTimeoutMs);
+    QCOMPARE(m.metrics(1).rmse, 0.0);
+    QVERIFY(m.metrics(0).key != before.key);
+    QVERIFY(m.metrics(0).rmse < 0.002);
+    m.setCompareEnabled(false);
+  }
+
+  // supportsOperation(method, "volume") is what each method does with the operation: every method
+  // it admits renders the volume, every other one refuses it (sorted lists, MethodInfo::sortedLists).
+  void volumeSupport() {
+    auto w = openWindow(QStringLiteral("@volume"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(96, 64);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(96, 64), kTimeoutMs);
+    m.setOperation(QStringLiteral("volume"));
+    int supportedCount = 0, refusedCount = 0;
+    for (const mfr::RegistryEntry& e : mfr::methodRegistry()) {
+      const QString name = QString::fromStdString(e.name);
+      m.setMethod(name);
+      settle(m);
+      const bool supported = m.supportsOperation(name, QStringLiteral("volume"));
+      qInfo("%s: supports volume %d; render error: %s", e.name.c_str(), supported, qPrintable(m.renderError()));
+      QVERIFY2(m.renderError().isEmpty() == supported, qPrintable(name + ": " + m.renderError()));
+      if (supported) {
+        QCOMPARE(QString::fromStdString(m.stats().operation), QStringLiteral("volume"));
+        ++supportedCount;
+      } else {
+        ++refusedCount;
+      }
+      QCOMPARE(supported, m.methodInfo(name)->sortedLists);
+    }
+    QVERIFY(supportedCount > 0 && refusedCount > 0);
+    QVERIFY(m.supportsOperation(QStringLiteral("oracle"), QStringLiteral("volume")));
+    QVERIFY(!m.supportsOperation(QStringLiteral("no-such-method"), QStringLiteral("volume")));
+  }
+
+  // The Volume plugin on @volume: the show switch (abuffer-sbuffer for a method without sorted
+  // lists, and back), presets, window and opacity scale changing the transfer function and the
+  // image, the preview, the step controls and the info line from the frame's notes, refusals of
+  // invalid functions, As Loaded, and its settings in sessions.
+  void volumePanel() {
+    auto w = openWindow(QStringLiteral("@volume"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(200, 150);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(200, 150), kTimeoutMs);
+    QVERIFY2(w->findChild<QDockWidget*>("plugin-hybridvolume"), "hybridvolume plugin not loaded");
+    auto* show = w->findChild<QCheckBox*>("hvShow");
+    auto* preset = w->findChild<QComboBox*>("hvPreset");
+    auto* windowMin = w->findChild<QDoubleSpinBox*>("hvWindowMin");
+    auto* windowMax = w->findChild<QDoubleSpinBox*>("hvWindowMax");
+    auto* opacity = w->findChild<QSlider*>("hvOpacity");
+    auto* asLoaded = w->findChild<QPushButton*>("hvAsLoaded");
+    auto* preview = w->findChild<QLabel*>("hvPreview");
+    auto* error = w->findChild<QLabel*>("hvError");
+    auto* stepSlider = w->findChild<QSlider*>("hvStepSlider");
+    auto* step = w->findChild<QDoubleSpinBox*>("hvStep");
+    auto* stepDefault = w->findChild<QPushButton*>("hvStepDefault");
+    auto* info = w->findChild<QLabel*>("hvInfo");
+    QVERIFY(show && preset && windowMin && windowMax && opacity && asLoaded && preview && error && stepSlider && step &&
+            stepDefault && info);
+    const auto note = [&m](const char* key) -> std::string {
+      for (const auto& [name, value] : m.stats().notes)
+        if (name == key) return value;
+      return {};
+    };
+    const auto previewImage = [&] { return preview->pixmap().toImage(); };
+    m.setCamera(m.scene().view("iso"));
+    // The scene's own function, shown as Custom over its own range; "auto" already runs volume.
+    QVERIFY(show->isChecked());
+    QCOMPARE(preset->currentData().toString(), QStringLiteral("Custom"));
+    QCOMPARE(windowMin->value(), m.transferFunction().low());
+    QCOMPARE(windowMax->value(), m.transferFunction().high());
+
+    // The switch: wboit keeps no lists, so the panel takes abuffer-sbuffer; off, both come back
+    // and the volume is hidden.
+    m.setMethod("wboit");
+    m.setOperation("oit");
+    QVERIFY(!show->isChecked());
+    show->setChecked(true);
+    QCOMPARE(m.method(), QStringLiteral("abuffer-sbuffer"));
+    QCOMPARE(m.operation(), QStringLiteral("volume"));
+    QVERIFY(m.volumeVisible());
+    settle(m);
+    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    QCOMPARE(QString::fromStdString(m.stats().operation), QStringLiteral("volume"));
+    show->setChecked(false);
+    QCOMPARE(m.method(), QStringLiteral("wboit"));
+    QCOMPARE(m.operation(), QStringLiteral("oit"));
+    QVERIFY(!m.volumeVisible());
+    QVERIFY(!m.scene().visibleVolume());
+    settle(m);
+    QVERIFY(note("volume step").empty());
+    // A method with sorted lists is kept.
+    m.setMethod("abuffer-ll");
+    show->setChecked(true);
+    QCOMPARE(m.method(), QStringLiteral("abuffer-ll"));
+    QCOMPARE(m.effectiveOperation(), QStringLiteral("volume"));
+    settle(m);
+    QVERIFY2(info->text().contains("96×96×96") && info->text().contains("MiB"), qPrintable(info->text()));
+    QVERIFY2(info->text().contains(QString::number(std::stod(note("volume step")), 'g', 5)), qPrintable(info->text()));
+    const mfr::ImageRGBA8 original = w->view().renderImage(m.renderSize());
+    const QImage originalPreview = previewImage();
+    const mfr::TransferFunction loaded = m.loadedTransferFunction();
+
+    // Preset: the function over the window, another image and preview.
+    preset->setCurrentIndex(preset->findData(QStringLiteral("fire")));
+    {
+      const mfr::TransferFunction expected =
+          mfr::transferPreset("fire", windowMin->value(), windowMax->value(), loaded.unitDistance);
+      const mfr::TransferFunction now = m.transferFunction();
+      QCOMPARE(now.points.size(), expected.points.size());
+      for (std::size_t i = 0; i < now.points.size(); ++i) {
+        QCOMPARE(now.points[i].value, expected.points[i].value);
+        QVERIFY(now.points[i].color == expected.points[i].color);
+      }
+    }
+    settle(m);
+    const mfr::ImageRGBA8 fire = w->view().renderImage(m.renderSize());
+    qInfo("loaded vs fire: RMSE %.5f", mfr::rmse(original, fire));
+    QVERIFY(mfr::rmse(original, fire) > 0.005);
+    QVERIFY(previewImage() != originalPreview);
+    // Window: the function's range follows it.
+    windowMax->setValue(0.6);
+    QCOMPARE(m.transferFunction().high(), 0.6);
+    settle(m);
+    const mfr::ImageRGBA8 narrow = w->view().renderImage(m.renderSize());
+    QVERIFY(mfr::rmse(fire, narrow) > 0.002);
+    // Opacity scale: the extinction times the scale (unit distance divided by it).
+    opacity->setValue(opacity->maximum());
+    QVERIFY(std::abs(m.transferFunction().unitDistance - loaded.unitDistance / 20.0) < 1e-12);
+    settle(m);
+    const mfr::ImageRGBA8 dense = w->view().renderImage(m.renderSize());
+    QVERIFY(mfr::rmse(narrow, dense) > 0.002);
+
+    // Invalid functions are refused with one line, and nothing changes.
+    const mfr::TransferFunction current = m.transferFunction();
+    const quint64 revision = m.sceneRevision();
+    const auto unchanged = [&] {
+      const mfr::TransferFunction now = m.transferFunction();
+      if (now.points.size() != current.points.size() || now.unitDistance != current.unitDistance) return false;
+      for (std::size_t i = 0; i < now.points.size(); ++i)
+        if (now.points[i].value != current.points[i].value || now.points[i].color != current.points[i].color)
+          return false;
+      return m.sceneRevision() == revision;
+    };
+    QString reason = m.setTransferFunction(mfr::TransferFunction{});
+    QVERIFY2(reason.contains("two points") && !reason.contains('\n'), qPrintable(reason));
+    QVERIFY(unchanged());
+    mfr::TransferFunction unsorted = current;
+    std::swap(unsorted.points.front(), unsorted.points.back());
+    reason = m.setTransferFunction(unsorted);
+    QVERIFY2(reason.contains("ascend"), qPrintable(reason));
+    QVERIFY(unchanged());
+    mfr::TransferFunction negative = current;
+    negative.points[1].color.a = -0.5f;
+    reason = m.setTransferFunction(negative);
+    QVERIFY2(reason.contains("[0, 1]"), qPrintable(reason));
+    QVERIFY(unchanged());
+    mfr::TransferFunction badUnit = current;
+    badUnit.unitDistance = 0.0;
+    QVERIFY(!m.setTransferFunction(badUnit).isEmpty());
+    QVERIFY(unchanged());
+    // The panel's window the wrong way round: refused there, shown in its error line.
+    windowMin->setValue(0.9);
+    QVERIFY(error->isVisibleTo(w.get()) && !error->text().isEmpty());
+    QVERIFY(unchanged());
+    windowMin->setValue(0.0);
+    QVERIFY(!error->isVisibleTo(w.get()));
+
+    // Step: spin box, slider (10× the default at its end), Default; the frame notes it.
+    step->setValue(0.03);
+    QCOMPARE(m.volumeStep(), 0.03);
+    settle(m);
+    QCOMPARE(note("volume step"), std::to_string(0.03));
+    QVERIFY2(info->text().contains("0.03"), qPrintable(info->text()));
+    stepSlider->setValue(stepSlider->maximum());
+    QVERIFY(std::abs(m.volumeStep() - 10.0 * m.volumeStepDefault()) < 1e-12);
+    stepDefault->click();
+    QCOMPARE(m.volumeStep(), 0.0);
+    QVERIFY(std::abs(step->value() - m.volumeStepDefault()) < 1e-6);
+    // The method panel's Step row shows the same step.
+    m.setVolumeStep(0.025);
+    QCOMPARE(w->findChild<QDoubleSpinBox*>("volumeStep")->value(), 0.025);
+    QCOMPARE(step->value(), 0.025);
+
+    // Sessions: the transfer function, the panel's preset, window and scale, the step.
+    preset->setCurrentIndex(preset->findData(QStringLiteral("bone")));
+    windowMax->setValue(1.1);
+    opacity->setValue(700);
+    settle(m);
+    const mfr::TransferFunction saved = m.transferFunction();
+    const mfr::ImageRGBA8 before = w->view().renderImage(m.renderSize());
+    QTemporaryDir dir;
+    const QString sessionPath = dir.filePath("volume.mfrsession");
+    w->saveSession(sessionPath);
+    {
+      auto again = openWindow(QString());
+      QVERIFY(again);
+      again->view().setFixedSize(200, 150);
+      again->openSession(sessionPath);
+      ViewerModel& a = again->model();
+      QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.framesRendered() > 0, kTimeoutMs);
+      QTRY_COMPARE_WITH_TIMEOUT(a.volumeStep(), 0.025, kTimeoutMs);
+      settle(a);
+      const mfr::TransferFunction restored = a.transferFunction();
+      QCOMPARE(restored.points.size(), saved.points.size());
+      QCOMPARE(restored.unitDistance, saved.unitDistance);
+      for (std::size_t i = 0; i < saved.points.size(); ++i) {
+        QCOMPARE(restored.points[i].value, saved.points[i].value);
+        QVERIFY(restored.points[i].color == saved.points[i].color);
+      }
+      QCOMPARE(again->findChild<QComboBox*>("hvPreset")->currentData().toString(), QStringLiteral("bone"));
+      QCOMPARE(again->findChild<QDoubleSpinBox*>("hvWindowMax")->value(), 1.1);
+      QCOMPARE(again->findChild<QSlider*>("hvOpacity")->value(), 700);
+      QCOMPARE(again->findChild<QDoubleSpinBox*>("hvStep")->value(), 0.025);
+      QVERIFY(again->findChild<QCheckBox*>("hvShow")->isChecked());
+      QCOMPARE(maxChannelDifference(before, again->view().renderImage(a.renderSize())), 0);
+    }
+    // The viewer's own session keys ("volume_step", "volumes") restore the step and the function
+    // without the plugin's settings too.
+    {
+      QFile file(sessionPath);
+      QVERIFY(file.open(QIODevice::ReadOnly));
+      QJsonObject json = QJsonDocument::fromJson(file.readAll()).object();
+      QCOMPARE(json.value("volume_step").toDouble(), 0.025);
+      json.remove("plugins");
+      const QString bare = dir.filePath("bare.mfrsession");
+      QFile out(bare);
+      QVERIFY(out.open(QIODevice::WriteOnly));
+      out.write(QJsonDocument(json).toJson());
+      out.close();
+      auto again = openWindow(QString());
+      QVERIFY(again);
+      again->openSession(bare);
+      ViewerModel& a = again->model();
+      QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.framesRendered() > 0, kTimeoutMs);
+      settle(a);
+      QCOMPARE(a.volumeStep(), 0.025);
+      const mfr::TransferFunction restored = a.transferFunction();
+      QCOMPARE(restored.points.size(), saved.points.size());
+      QCOMPARE(restored.unitDistance, saved.unitDistance);
+      for (std::size_t i = 0; i < saved.points.size(); ++i) QCOMPARE(restored.points[i].value, saved.points[i].value);
+    }
+
+    // As Loaded: the scene's own function, Custom over its own range again (at the default step:
+    // the original image exactly).
+    stepDefault->click();
+    asLoaded->click();
+    {
+      const mfr::TransferFunction now = m.transferFunction();
+      QCOMPARE(now.points.size(), loaded.points.size());
+      QCOMPARE(now.unitDistance, loaded.unitDistance);
+      for (std::size_t i = 0; i < now.points.size(); ++i) QCOMPARE(now.points[i].value, loaded.points[i].value);
+    }
+    QCOMPARE(preset->currentData().toString(), QStringLiteral("Custom"));
+    QCOMPARE(windowMax->value(), loaded.high());
+    settle(m);
+    QCOMPARE(maxChannelDifference(original, w->view().renderImage(m.renderSize())), 0);
+    QVERIFY(previewImage() == originalPreview);
+
+    // The scene tree lists the volume with its grid size; unchecking it hides the volume.
+    auto* tree = w->findChild<QTreeWidget*>("sceneTree");
+    const int row = static_cast<int>(m.scene().objects.size());
+    QCOMPARE(tree->topLevelItemCount(), row + 1);
+    QVERIFY(tree->topLevelItem(row)->text(0).contains("field"));
+    QCOMPARE(tree->topLevelItem(row)->text(1), QStringLiteral("96×96×96"));
+    tree->topLevelItem(row)->setCheckState(0, Qt::Unchecked);
+    QVERIFY(!m.volumeVisible());
+    QVERIFY(!show->isChecked());
+  }
+
   // The live widget's framebuffer (GpuRenderer::renderTo into QOpenGLWidget's FBO) against the
   // CLI at the widget's size.
   void widgetEqualsCli() {

@@ -1,0 +1,456 @@
+#include "hybridvolume_panel.hpp"
+
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QFormLayout>
+#include <QHBoxLayout>
+#include <QJsonArray>
+#include <QLabel>
+#include <QPainter>
+#include <QPixmap>
+#include <QPushButton>
+#include <QSignalBlocker>
+#include <QSlider>
+#include <QVBoxLayout>
+
+#include <algorithm>
+#include <cmath>
+
+#include "viewer_plugin.hpp"
+
+namespace {
+
+const QString kVolume = QStringLiteral("volume");
+const QString kCustom = QStringLiteral("Custom");
+
+// Slider position ↔ value, logarithmic between lo and hi.
+double logAt(int position, double lo, double hi) {
+  return lo * std::pow(hi / lo, static_cast<double>(position) / HybridVolumePanel::kSliderSteps);
+}
+
+int logPosition(double value, double lo, double hi) {
+  if (!(value > 0.0)) return 0;
+  const double f = std::log(value / lo) / std::log(hi / lo);
+  return static_cast<int>(std::lround(std::clamp(f, 0.0, 1.0) * HybridVolumePanel::kSliderSteps));
+}
+
+bool sameTransfer(const mfr::TransferFunction& a, const mfr::TransferFunction& b) {
+  if (a.unitDistance != b.unitDistance || a.points.size() != b.points.size()) return false;
+  for (std::size_t i = 0; i < a.points.size(); ++i)
+    if (a.points[i].value != b.points[i].value || a.points[i].color != b.points[i].color) return false;
+  return true;
+}
+
+QJsonObject transferToJson(const mfr::TransferFunction& t) {
+  QJsonArray points;
+  for (const mfr::TransferPoint& p : t.points)
+    points.append(QJsonArray{p.value, p.color.r, p.color.g, p.color.b, p.color.a});
+  return {{QStringLiteral("unit_distance"), t.unitDistance}, {QStringLiteral("points"), points}};
+}
+
+mfr::TransferFunction transferFromJson(const QJsonObject& json) {
+  mfr::TransferFunction t;
+  t.unitDistance = json.value(QStringLiteral("unit_distance")).toDouble(1.0);
+  for (const QJsonValue& v : json.value(QStringLiteral("points")).toArray()) {
+    const QJsonArray p = v.toArray();
+    if (p.size() != 5) continue;
+    t.points.push_back(
+        {p[0].toDouble(), glm::vec4(glm::dvec4(p[1].toDouble(), p[2].toDouble(), p[3].toDouble(), p[4].toDouble()))});
+  }
+  return t;
+}
+
+QString bytesText(double bytes) {
+  if (bytes >= 1024.0 * 1024.0) return QStringLiteral("%1 MiB").arg(bytes / (1024.0 * 1024.0), 0, 'f', 1);
+  if (bytes >= 1024.0) return QStringLiteral("%1 KiB").arg(bytes / 1024.0, 0, 'f', 1);
+  return QStringLiteral("%1 B").arg(bytes);
+}
+
+}  // namespace
+
+HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : QWidget(parent), context_(context) {
+  setObjectName(QStringLiteral("hybridVolumePanel"));
+  auto* layout = new QVBoxLayout(this);
+
+  show_ = new QCheckBox(tr("Show volume"));
+  show_->setObjectName(QStringLiteral("hvShow"));
+  show_->setToolTip(
+      tr("Operation volume: the scene's volume ray-marched between each pixel's sorted surface "
+         "fragments, every surface at its own depth. Needs sorted lists: an A-buffer, a k-buffer "
+         "or the oracle (abuffer-sbuffer is chosen for a method without them)."));
+  layout->addWidget(show_);
+  note_ = new QLabel;
+  note_->setObjectName(QStringLiteral("hvNote"));
+  note_->setWordWrap(true);
+  note_->setStyleSheet(QStringLiteral("color: #b00020;"));
+  note_->hide();
+  layout->addWidget(note_);
+
+  controls_ = new QWidget;
+  auto* form = new QFormLayout(controls_);
+  form->setContentsMargins(0, 0, 0, 0);
+  preset_ = new QComboBox;
+  preset_->setObjectName(QStringLiteral("hvPreset"));
+  for (const QString& name : context_.transferPresetNames()) preset_->addItem(name, name);
+  preset_->addItem(tr("Custom"), kCustom);
+  preset_->setToolTip(
+      tr("Transfer function: a preset over the window, or Custom (the scene's own function, or "
+         "one set elsewhere, stretched onto the window)"));
+  form->addRow(tr("Transfer"), preset_);
+
+  windowMin_ = new QDoubleSpinBox;
+  windowMin_->setObjectName(QStringLiteral("hvWindowMin"));
+  windowMax_ = new QDoubleSpinBox;
+  windowMax_->setObjectName(QStringLiteral("hvWindowMax"));
+  for (QDoubleSpinBox* box : {windowMin_, windowMax_}) {
+    box->setDecimals(4);
+    box->setRange(-1.0e12, 1.0e12);
+    box->setKeyboardTracking(false);
+  }
+  windowMin_->setToolTip(tr("Scalar value the transfer function starts at (below: its first colour)"));
+  windowMax_->setToolTip(tr("Scalar value the transfer function ends at (above: its last colour)"));
+  auto* windowRow = new QHBoxLayout;
+  windowRow->addWidget(windowMin_, 1);
+  windowRow->addWidget(new QLabel(QStringLiteral("…")));
+  windowRow->addWidget(windowMax_, 1);
+  form->addRow(tr("Window"), windowRow);
+
+  opacity_ = new QSlider(Qt::Horizontal);
+  opacity_->setObjectName(QStringLiteral("hvOpacity"));
+  opacity_->setRange(0, kSliderSteps);
+  opacity_->setValue(logPosition(1.0, kMinScale, kMaxScale));
+  opacity_->setToolTip(
+      tr("Opacity scale %1× … %2× (logarithmic): multiplies the extinction, as a shorter unit distance would")
+          .arg(kMinScale)
+          .arg(kMaxScale));
+  opacityValue_ = new QLabel;
+  opacityValue_->setObjectName(QStringLiteral("hvOpacityValue"));
+  opacityValue_->setMinimumWidth(fontMetrics().horizontalAdvance(QStringLiteral("20.00×")));
+  auto* opacityRow = new QHBoxLayout;
+  opacityRow->addWidget(opacity_, 1);
+  opacityRow->addWidget(opacityValue_);
+  form->addRow(tr("Opacity"), opacityRow);
+
+  preview_ = new QLabel;
+  preview_->setObjectName(QStringLiteral("hvPreview"));
+  preview_->setMinimumHeight(28);
+  preview_->setScaledContents(true);
+  preview_->setToolTip(
+      tr("The transfer function's table over the window: colour over a checkerboard by the "
+         "opacity of one unit distance, and that opacity as a curve"));
+  auto* asLoaded = new QPushButton(tr("As Loaded"));
+  asLoaded->setObjectName(QStringLiteral("hvAsLoaded"));
+  asLoaded->setToolTip(tr("The scene's own transfer function back"));
+  form->addRow(preview_);
+  form->addRow(QString(), asLoaded);
+  error_ = new QLabel;
+  error_->setObjectName(QStringLiteral("hvError"));
+  error_->setWordWrap(true);
+  error_->setStyleSheet(QStringLiteral("color: #b00020;"));
+  error_->hide();
+  form->addRow(error_);
+
+  stepSlider_ = new QSlider(Qt::Horizontal);
+  stepSlider_->setObjectName(QStringLiteral("hvStepSlider"));
+  stepSlider_->setRange(0, kSliderSteps);
+  stepSlider_->setToolTip(
+      tr("Ray-march step, %1× … %2× the default (logarithmic)").arg(kMinStepFactor).arg(kMaxStepFactor));
+  form->addRow(tr("Step"), stepSlider_);
+  step_ = new QDoubleSpinBox;
+  step_->setObjectName(QStringLiteral("hvStep"));
+  step_->setDecimals(6);
+  step_->setRange(1.0e-6, 1.0e9);
+  step_->setKeyboardTracking(false);
+  step_->setToolTip(tr("Ray-march step in scene units"));
+  auto* stepDefault = new QPushButton(tr("Default"));
+  stepDefault->setObjectName(QStringLiteral("hvStepDefault"));
+  stepDefault->setToolTip(tr("Half the volume's smallest grid spacing"));
+  auto* stepRow = new QHBoxLayout;
+  stepRow->addWidget(step_, 1);
+  stepRow->addWidget(stepDefault);
+  form->addRow(tr("Scene units"), stepRow);
+  layout->addWidget(controls_);
+
+  info_ = new QLabel;
+  info_->setObjectName(QStringLiteral("hvInfo"));
+  info_->setWordWrap(true);
+  info_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  layout->addWidget(info_);
+  layout->addStretch();
+
+  connect(show_, &QCheckBox::toggled, this, &HybridVolumePanel::setShow);
+  connect(&context_, &ViewerContext::operationChanged, this, &HybridVolumePanel::showState);
+  connect(&context_, &ViewerContext::methodChanged, this, &HybridVolumePanel::showState);
+  connect(&context_, &ViewerContext::volumeChanged, this, &HybridVolumePanel::volumeChanged);
+  connect(&context_, &ViewerContext::frameRendered, this, &HybridVolumePanel::showInfo);
+  connect(preset_, &QComboBox::currentIndexChanged, this, &HybridVolumePanel::applyTransfer);
+  connect(windowMin_, &QDoubleSpinBox::valueChanged, this, &HybridVolumePanel::applyTransfer);
+  connect(windowMax_, &QDoubleSpinBox::valueChanged, this, &HybridVolumePanel::applyTransfer);
+  connect(opacity_, &QSlider::valueChanged, this, [this] {
+    showScaleValue();
+    applyTransfer();
+  });
+  connect(asLoaded, &QPushButton::clicked, this, [this] {
+    const QString reason = context_.setTransferFunction(context_.loadedTransferFunction());
+    error_->setText(reason);
+    error_->setVisible(!reason.isEmpty());
+    resetToCurrent();
+  });
+  connect(stepSlider_, &QSlider::valueChanged, this, &HybridVolumePanel::stepFromSlider);
+  connect(step_, &QDoubleSpinBox::valueChanged, this, [this](double v) { context_.setVolumeStep(v); });
+  connect(stepDefault, &QPushButton::clicked, this, [this] { context_.setVolumeStep(0.0); });
+  showScaleValue();
+  volumeChanged();
+}
+
+double HybridVolumePanel::opacityScale() const {
+  return logAt(opacity_->value(), kMinScale, kMaxScale);
+}
+
+void HybridVolumePanel::showScaleValue() {
+  opacityValue_->setText(QStringLiteral("%1×").arg(opacityScale(), 0, 'f', 2));
+}
+
+// ---- the volume and its transfer function ---------------------------------------------------
+
+void HybridVolumePanel::volumeChanged() {
+  const bool has = context_.hasScene() && context_.hasVolume();
+  controls_->setEnabled(has);
+  show_->setEnabled(has);
+  if (!has) {
+    sceneKey_.clear();
+    info_->setText(tr("The scene has no volume: open a .vti, .vtk, .mhd/.mha, .nrrd or .inr file, or @volume."));
+    showState();
+    return;
+  }
+  const glm::ivec3 d = context_.volumeDims();
+  const mfr::TransferFunction loaded = context_.loadedTransferFunction();
+  QString key = QStringLiteral("%1|%2x%3x%4|%5")
+                    .arg(context_.volumeName())
+                    .arg(d.x)
+                    .arg(d.y)
+                    .arg(d.z)
+                    .arg(loaded.unitDistance, 0, 'g', 17);
+  for (const mfr::TransferPoint& p : loaded.points) key += QStringLiteral("|%1").arg(p.value, 0, 'g', 17);
+  // Another volume, or a function set elsewhere (a session, another plugin): Custom from it.
+  if (key != sceneKey_ || !sameTransfer(context_.transferFunction(), applied_)) {
+    sceneKey_ = key;
+    resetToCurrent();
+  }
+  showPreview();
+  showStep();
+  showState();
+  showInfo();
+}
+
+void HybridVolumePanel::resetToCurrent() {
+  base_ = context_.transferFunction();
+  applied_ = base_;
+  const QSignalBlocker blockPreset(preset_), blockMin(windowMin_), blockMax(windowMax_), blockOpacity(opacity_);
+  preset_->setCurrentIndex(preset_->findData(kCustom));
+  if (!base_.points.empty()) {
+    const double span = std::max(std::abs(base_.high() - base_.low()), 1e-12);
+    for (QDoubleSpinBox* box : {windowMin_, windowMax_})
+      box->setSingleStep(std::pow(10.0, std::floor(std::log10(span)) - 1.0));
+    windowMin_->setValue(base_.low());
+    windowMax_->setValue(base_.high());
+  }
+  opacity_->setValue(logPosition(1.0, kMinScale, kMaxScale));
+  showScaleValue();
+  showPreview();
+}
+
+mfr::TransferFunction HybridVolumePanel::composed() const {
+  const double lo = windowMin_->value(), hi = windowMax_->value();
+  const double unit = base_.unitDistance / opacityScale();
+  const QString mode = preset_->currentData().toString();
+  if (mode != kCustom) return context_.transferPreset(mode, lo, hi, unit);
+  mfr::TransferFunction t = base_;
+  t.unitDistance = unit;
+  if (base_.points.size() >= 2 && base_.high() > base_.low()) {
+    const double from = base_.low(), span = base_.high() - base_.low();
+    for (mfr::TransferPoint& p : t.points) p.value = lo + (p.value - from) / span * (hi - lo);
+  }
+  return t;
+}
+
+void HybridVolumePanel::applyTransfer() {
+  if (!context_.hasVolume()) return;
+  QString reason;
+  if (!(windowMin_->value() < windowMax_->value())) {
+    reason = tr("window: the minimum must be below the maximum");
+  } else {
+    const mfr::TransferFunction t = composed();
+    applied_ = t;  // before the call: volumeChanged must see it as the panel's own
+    reason = context_.setTransferFunction(t);
+    if (!reason.isEmpty()) applied_ = context_.transferFunction();
+  }
+  error_->setText(reason);
+  error_->setVisible(!reason.isEmpty());
+  showPreview();
+}
+
+void HybridVolumePanel::showPreview() {
+  const mfr::TransferFunction t = context_.transferFunction();
+  const std::vector<glm::vec4> table = context_.transferTable(t);
+  constexpr int kHeight = 28;
+  QPixmap pixmap(256, kHeight);
+  pixmap.fill(Qt::white);
+  if (!table.empty()) {
+    QPainter painter(&pixmap);
+    const int n = static_cast<int>(table.size());
+    QPolygonF curve;
+    for (int x = 0; x < 256; ++x) {
+      const glm::vec4 e = table[static_cast<std::size_t>(x * n / 256)];
+      const double a = 1.0 - std::exp(-static_cast<double>(e.w) * t.unitDistance);
+      for (int y = 0; y < kHeight; y += 7) {
+        const bool dark = ((x / 7) + (y / 7)) % 2 == 0;
+        const double bg = dark ? 0.6 : 0.9;
+        const auto channel = [&](float c) { return static_cast<int>(std::lround(255.0 * (a * c + (1.0 - a) * bg))); };
+        painter.fillRect(x, y, 1, 7, QColor(channel(e.r), channel(e.g), channel(e.b)));
+      }
+      curve << QPointF(x, (kHeight - 1) * (1.0 - a));
+    }
+    painter.setPen(QPen(Qt::black, 1));
+    painter.drawPolyline(curve);
+  }
+  preview_->setPixmap(pixmap);
+}
+
+// ---- show switch ---------------------------------------------------------------------------
+
+void HybridVolumePanel::setShow(bool on) {
+  if (!context_.hasVolume()) {
+    showState();
+    return;
+  }
+  if (!on) {
+    if (!previousMethod_.isEmpty() && context_.method() == QLatin1String(kVolumeMethod))
+      context_.setMethod(previousMethod_);
+    if (context_.operation() == kVolume)
+      context_.setOperation(previousOperation_.isEmpty() ? QStringLiteral("auto") : previousOperation_);
+    previousMethod_.clear();
+    previousOperation_.clear();
+    context_.setVolumeVisible(false);
+    showState();
+    return;
+  }
+  const QString method = context_.method(), operation = context_.operation();
+  context_.setVolumeVisible(true);
+  if (context_.effectiveOperation() != kVolume) {
+    if (!context_.supportsOperation(method, kVolume)) {
+      previousMethod_ = method;
+      context_.setMethod(QLatin1String(kVolumeMethod));
+    }
+    if (context_.effectiveOperation() != kVolume) {
+      previousOperation_ = operation;
+      context_.setOperation(kVolume);
+    }
+  }
+  showState();
+}
+
+void HybridVolumePanel::showState() {
+  const bool on = context_.hasVolume() && context_.volumeVisible() && context_.effectiveOperation() == kVolume;
+  {
+    const QSignalBlocker block(show_);
+    show_->setChecked(on);
+  }
+  const QString method = context_.method();
+  const bool refused = context_.operation() == kVolume && !context_.supportsOperation(method, kVolume);
+  note_->setText(refused ? tr("%1 keeps no sorted lists and cannot composite the volume: choose an A-buffer, a "
+                              "k-buffer or the oracle.")
+                               .arg(method)
+                         : QString());
+  note_->setVisible(refused);
+}
+
+// ---- step ----------------------------------------------------------------------------------
+
+void HybridVolumePanel::showStep() {
+  const double fallback = context_.volumeStepDefault();
+  const double value = context_.volumeStep() > 0.0 ? context_.volumeStep() : fallback;
+  const QSignalBlocker blockSlider(stepSlider_), blockBox(step_);
+  if (fallback > 0.0) stepSlider_->setValue(logPosition(value / fallback, kMinStepFactor, kMaxStepFactor));
+  step_->setSingleStep(std::max(1.0e-6, fallback / 10.0));
+  step_->setValue(value);
+}
+
+void HybridVolumePanel::stepFromSlider(int position) {
+  const double fallback = context_.volumeStepDefault();
+  if (fallback > 0.0) context_.setVolumeStep(logAt(position, kMinStepFactor, kMaxStepFactor) * fallback);
+}
+
+void HybridVolumePanel::showInfo() {
+  if (!context_.hasVolume()) return;
+  const glm::ivec3 d = context_.volumeDims();
+  const glm::dvec3 s = context_.volumeSpacing();
+  const glm::dvec2 r = context_.volumeValueRange();
+  QStringList lines;
+  lines << tr("%1: %2×%3×%4 points, spacing %5 × %6 × %7")
+               .arg(context_.volumeName())
+               .arg(d.x)
+               .arg(d.y)
+               .arg(d.z)
+               .arg(s.x, 0, 'g', 4)
+               .arg(s.y, 0, 'g', 4)
+               .arg(s.z, 0, 'g', 4);
+  lines << tr("values %1 … %2").arg(r.x, 0, 'g', 5).arg(r.y, 0, 'g', 5);
+  QString step, bytes;
+  for (const auto& [name, value] : context_.stats().notes) {
+    if (name == "volume step") step = QString::fromStdString(value);
+    if (name == "volume (bytes)") bytes = QString::fromStdString(value);
+  }
+  if (!step.isEmpty()) {
+    QString line = tr("last frame: step %1").arg(step.toDouble(), 0, 'g', 5);
+    if (!bytes.isEmpty()) line += tr(", %1 on the GPU").arg(bytesText(bytes.toDouble()));
+    lines << line;
+  } else {
+    lines << tr("last frame: volume not drawn (step %1)")
+                 .arg(context_.volumeStep() > 0.0 ? context_.volumeStep() : context_.volumeStepDefault(), 0, 'g', 5);
+  }
+  info_->setText(lines.join(QLatin1Char('\n')));
+}
+
+// ---- settings -------------------------------------------------------------------------------
+
+QJsonObject HybridVolumePanel::saveSettings() const {
+  return {{QStringLiteral("show"), show_->isChecked()},
+          {QStringLiteral("preset"), preset_->currentData().toString()},
+          {QStringLiteral("window"), QJsonArray{windowMin_->value(), windowMax_->value()}},
+          {QStringLiteral("opacity_scale"), opacityScale()},
+          {QStringLiteral("base"), transferToJson(base_)},
+          {QStringLiteral("step"), context_.volumeStep()},
+          {QStringLiteral("previous_operation"), previousOperation_},
+          {QStringLiteral("previous_method"), previousMethod_}};
+}
+
+void HybridVolumePanel::loadSettings(const QJsonObject& settings) {
+  if (!context_.hasScene() || !context_.hasVolume()) return;
+  volumeChanged();  // this scene's volume (sessions load settings after their own state)
+  previousOperation_ = settings.value(QStringLiteral("previous_operation")).toString();
+  previousMethod_ = settings.value(QStringLiteral("previous_method")).toString();
+  const mfr::TransferFunction base = transferFromJson(settings.value(QStringLiteral("base")).toObject());
+  if (!context_.transferTable(base).empty()) base_ = base;
+  {
+    const QSignalBlocker blockPreset(preset_), blockMin(windowMin_), blockMax(windowMax_), blockOpacity(opacity_);
+    const int preset = preset_->findData(settings.value(QStringLiteral("preset")).toString(kCustom));
+    preset_->setCurrentIndex(preset >= 0 ? preset : preset_->findData(kCustom));
+    const QJsonArray window = settings.value(QStringLiteral("window")).toArray();
+    if (window.size() == 2) {
+      windowMin_->setValue(window[0].toDouble());
+      windowMax_->setValue(window[1].toDouble());
+    }
+    const double scale = settings.value(QStringLiteral("opacity_scale")).toDouble(1.0);
+    opacity_->setValue(logPosition(scale, kMinScale, kMaxScale));
+    showScaleValue();
+  }
+  applyTransfer();  // the session's own function again (no change), or --plugin-settings' one
+  if (settings.contains(QStringLiteral("step")))
+    context_.setVolumeStep(settings.value(QStringLiteral("step")).toDouble());
+  if (settings.contains(QStringLiteral("show")) &&
+      settings.value(QStringLiteral("show")).toBool() != show_->isChecked())
+    setShow(settings.value(QStringLiteral("show")).toBool());
+  showState();
+}
