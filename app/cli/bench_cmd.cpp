@@ -162,6 +162,7 @@ void addBench(CLI::App& app) {
         t << req.volumeStep;
         label += ":step=" + t.str();
       }
+      if (req.volumeShading) label += std::string(":shade=") + (*req.volumeShading ? "1" : "0");
       nlohmann::ordered_json row;
       row["method"] = label;
       row["median_total_ms"] = median(totals);
@@ -187,7 +188,7 @@ void addBench(CLI::App& app) {
             op == "csg" ? csgReference
             : op == "zthickness"
                 ? compositeZThickness(lists, camera, zThicknessOf(req, scene.bounds()), scene.background)
-            : op == "volume" ? compositeVolume(lists, camera, *scene.visibleVolume(),
+            : op == "volume" ? compositeVolume(lists, camera, volumeAsRequested(req, *scene.visibleVolume()),
                                                volumeStepOf(req, *scene.visibleVolume()), scene.background)
                              : reference;
         const double e = rmse(exact, last.image);

@@ -95,6 +95,12 @@ RenderRequest parseMethodSpec(const std::string& spec, int w, int h) {
       r.volumeStep = *t;
       continue;
     }
+    if (part.substr(0, eq) == "shade") {
+      const std::string v = part.substr(eq + 1);
+      if (v != "0" && v != "1") throw Error("--methods " + spec, "shade must be 0 or 1");
+      r.volumeShading = v == "1";
+      continue;
+    }
     if (part.substr(0, eq) == "thickness") {
       const std::optional<double> t = parseNumber(part.substr(eq + 1));
       if (!t || !(*t > 0.0) || !std::isfinite(*t))

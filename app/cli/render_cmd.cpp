@@ -18,6 +18,7 @@ void addRender(CLI::App& app) {
     double opacity = -1.0;
     double thickness = 0.0;
     double step = 0.0;
+    bool shade = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method and write a PNG (and stats JSON)");
@@ -35,6 +36,9 @@ void addRender(CLI::App& app) {
                       "Operation zthickness: slab thickness in scene units (default: 1 % of the scene's diagonal)");
   CLI::Option* stepOption = cmd->add_option(
       "--step", opt->step, "Operation volume: ray-march step in scene units (default: half the volume's grid spacing)");
+  cmd->add_flag("--shade", opt->shade,
+                "Operation volume: shade the volume by its gradient with a headlight (boundaries inside the medium "
+                "read as surfaces)");
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
@@ -61,6 +65,10 @@ void addRender(CLI::App& app) {
       req.params[p.substr(0, eq)] = p.substr(eq + 1);
     }
     const Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
+    if (opt->shade) {
+      if (scene.volumes.empty()) throw Error("--shade", "scene '" + scene.name + "' has no volume");
+      req.volumeShading = true;
+    }
     const Camera camera = scene.view(opt->view);
     const RenderOutput out = render(scene, camera, req);
     // Both outputs are produced before either is written, and each is written atomically.

@@ -103,7 +103,7 @@ Session captureSession(const ViewerModel& model) {
   s.thickness = model.zThickness();
   s.volumeStep = model.volumeStep();
   for (const mfr::Volume& v : model.scene().volumes)
-    s.volumes.push_back({QString::fromStdString(v.name), v.visible, v.transfer});
+    s.volumes.push_back({QString::fromStdString(v.name), v.visible, v.transfer, v.shading});
   s.params = model.allParams();
   for (const mfr::Object& o : model.scene().objects) {
     s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color, o.material.vertexColors});
@@ -133,7 +133,8 @@ void applySession(const Session& session, ViewerModel& model) {
   model.setZThickness(session.thickness);
   if (session.volumes.size() == model.scene().volumes.size())
     for (std::size_t i = 0; i < session.volumes.size(); ++i)
-      model.setVolumeStateAt(static_cast<int>(i), session.volumes[i].visible, session.volumes[i].transfer);
+      model.setVolumeStateAt(static_cast<int>(i), session.volumes[i].visible, session.volumes[i].transfer,
+                             session.volumes[i].shading);
   model.setVolumeStep(session.volumeStep);
   if (!session.operation.isEmpty()) model.setOperation(session.operation);
   if (!session.method.isEmpty()) model.setMethod(session.method);
@@ -173,6 +174,7 @@ QJsonObject sessionToJson(const Session& s) {
     volumes.append(
         QJsonObject{{"name", v.name},
                     {"visible", v.visible},
+                    {"shading", v.shading},
                     {"transfer", QJsonObject{{"unit_distance", v.transfer.unitDistance}, {"points", points}}}});
   }
   QJsonArray objects;
@@ -229,7 +231,8 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
     const QJsonObject v = volumes[i].toObject();
     const QString where = QStringLiteral("volumes[%1].transfer").arg(i);
     const QJsonObject t = v.value("transfer").toObject();
-    Session::VolumeState state{v.value("name").toString(), v.value("visible").toBool(true), {}};
+    Session::VolumeState state{
+        v.value("name").toString(), v.value("visible").toBool(true), {}, v.value("shading").toBool(false)};
     state.transfer.unitDistance = r.number(t, "unit_distance", where, 1.0);
     const QJsonArray points = t.value("points").toArray();
     for (qsizetype j = 0; j < points.size(); ++j) {

@@ -31,6 +31,7 @@ struct Session {
     QString name;
     bool visible = true;
     mfr::TransferFunction transfer;
+    bool shading = false;  // Volume::shading
   };
   std::vector<VolumeState> volumes;                                  // by volume index
   std::map<std::string, std::map<std::string, std::string>> params;  // per method

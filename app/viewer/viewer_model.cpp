@@ -248,8 +248,21 @@ void ViewerModel::setVolumeVisibleAt(int index, bool visible) {
   volumeEdited();
 }
 
-void ViewerModel::setVolumeStateAt(int index, bool visible, const mfr::TransferFunction& transfer) {
+bool ViewerModel::volumeShading() const {
+  const int i = volumeIndex();
+  return i >= 0 && scene_.volumes[static_cast<std::size_t>(i)].shading;
+}
+
+void ViewerModel::setVolumeShading(bool shading) {
+  const int i = volumeIndex();
+  if (i < 0 || scene_.volumes[static_cast<std::size_t>(i)].shading == shading) return;
+  scene_.volumes[static_cast<std::size_t>(i)].shading = shading;
+  volumeEdited();
+}
+
+void ViewerModel::setVolumeStateAt(int index, bool visible, const mfr::TransferFunction& transfer, bool shading) {
   if (index < 0 || index >= static_cast<int>(scene_.volumes.size())) return;
+  scene_.volumes[static_cast<std::size_t>(index)].shading = shading;
   try {
     transfer.validate("transfer function");
     scene_.volumes[static_cast<std::size_t>(index)].transfer = transfer;

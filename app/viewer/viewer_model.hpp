@@ -138,6 +138,8 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] glm::dvec2 volumeValueRange() const override;
   [[nodiscard]] bool volumeVisible() const override;
   void setVolumeVisible(bool visible) override;
+  [[nodiscard]] bool volumeShading() const override;
+  void setVolumeShading(bool shading) override;
   [[nodiscard]] mfr::TransferFunction transferFunction() const override;
   [[nodiscard]] mfr::TransferFunction loadedTransferFunction() const override;
   QString setTransferFunction(const mfr::TransferFunction& transfer) override;
@@ -151,7 +153,7 @@ class ViewerModel final : public ViewerContext {
   // Every volume of the scene by index (the scene tree, sessions): showing one hides the others.
   void setVolumeVisibleAt(int index, bool visible);
   // A session's volume state: visibility and transfer function (an invalid one is ignored).
-  void setVolumeStateAt(int index, bool visible, const mfr::TransferFunction& transfer);
+  void setVolumeStateAt(int index, bool visible, const mfr::TransferFunction& transfer, bool shading);
   // The index of "the volume": the visible one, else the first; -1 without volumes.
   [[nodiscard]] int volumeIndex() const;
 

@@ -139,6 +139,10 @@ class ViewerContext : public QObject {
   // Whether it is drawn (Volume::visible); showing it hides any other volume of the scene.
   [[nodiscard]] virtual bool volumeVisible() const = 0;
   virtual void setVolumeVisible(bool visible) = 0;
+  // Gradient shading with a headlight (Volume::shading): boundaries inside the medium read as
+  // surfaces; off: pure emission-absorption.
+  [[nodiscard]] virtual bool volumeShading() const = 0;
+  virtual void setVolumeShading(bool shading) = 0;
   // Its transfer function (every pane and the exact reference use it), and the one it had when the
   // scene was loaded.
   [[nodiscard]] virtual mfr::TransferFunction transferFunction() const = 0;
@@ -194,6 +198,6 @@ class MfrViewerPlugin {
 // 1.2: operation, object names and the CSG tree.
 // 1.3: operation zthickness and its thickness, supportsOperation, per-object opacity.
 // 1.4: the scalar volume (operation volume): presence, dims, bounds, visibility, transfer function
-//      (presets, table), ray-march step, effectiveOperation, volumeChanged.
+//      (presets, table), ray-march step, shading, effectiveOperation, volumeChanged.
 #define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.4"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

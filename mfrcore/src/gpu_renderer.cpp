@@ -98,6 +98,7 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
   if (operation_ == "volume") {
     if (!volume_) throw Error("--op volume", "scene '" + sceneName_ + "' has no visible volume");
     volumeStep_ = volumeStepOf(request, volume_->volume);
+    volumeShading_ = request.volumeShading.value_or(volume_->volume.shading);
   }
   const Params params(method_->info().params, request.params, request.method);
   method_->configure(request.width, request.height, params);
@@ -162,6 +163,7 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
                                     p.set("uVolumeStep", setup.step);
                                     p.set("uTfLow", setup.tfLow);
                                     p.set("uTfHigh", setup.tfHigh);
+                                    p.set("uVolumeShading", volumeShading_ ? 1 : 0);
                                     glBindTextureUnit(MFR_TEX_VOLUME, volume_->grid.id());
                                     glBindTextureUnit(MFR_TEX_VOLUME_TF, volume_->transfer.id());
                                   }});
@@ -187,6 +189,7 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   if (operation_ == "volume") {
     stats.notes.emplace_back("volume step", std::to_string(volumeStep_));
     stats.notes.emplace_back("volume (bytes)", std::to_string(volume_->bytes));
+    stats.notes.emplace_back("volume shading", volumeShading_ ? "on" : "off");
   } else if (volume_) {
     stats.notes.emplace_back("volume", "not drawn (operation " + operation_ + ")");
   }

@@ -48,6 +48,12 @@ double zThicknessOf(const RenderRequest& request, const Bounds& sceneBounds) {
   return d > 0.0 ? d : 0.01;  // a flat or point-like scene still gets a usable slab
 }
 
+Volume volumeAsRequested(const RenderRequest& request, const Volume& volume) {
+  Volume v = volume;
+  v.shading = request.volumeShading.value_or(volume.shading);
+  return v;
+}
+
 double volumeStepOf(const RenderRequest& request, const Volume& volume) {
   if (!std::isfinite(request.volumeStep) || request.volumeStep < 0.0)
     throw Error("--step", "must be a positive length in scene units (got " + std::to_string(request.volumeStep) + ")");
@@ -195,8 +201,10 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     const Volume* volume = scene.visibleVolume();
     if (!volume) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");
     const double step = volumeStepOf(request, *volume);
-    out.image = compositeVolume(lists, camera, *volume, step, scene.background);
+    const Volume drawn = volumeAsRequested(request, *volume);
+    out.image = compositeVolume(lists, camera, drawn, step, scene.background);
     out.stats.notes.emplace_back("volume step", std::to_string(step));
+    out.stats.notes.emplace_back("volume shading", drawn.shading ? "on" : "off");
   } else if (operation == "zthickness") {
     const double thickness = zThicknessOf(request, scene.bounds());
     out.image = compositeZThickness(lists, camera, thickness, scene.background);

@@ -131,6 +131,12 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   opacityRow->addWidget(opacity_, 1);
   opacityRow->addWidget(opacityValue_);
   form->addRow(tr("Opacity"), opacityRow);
+  shade_ = new QCheckBox(tr("Gradient lighting"));
+  shade_->setObjectName(QStringLiteral("hvShade"));
+  shade_->setToolTip(
+      tr("Shade the medium by its gradient with a headlight (Levoy 1988): boundaries inside the "
+         "volume read as surfaces; homogeneous regions stay unshaded"));
+  form->addRow(tr("Shading"), shade_);
 
   preview_ = new QLabel;
   preview_->setObjectName(QStringLiteral("hvPreview"));
@@ -180,6 +186,7 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   layout->addStretch();
 
   connect(show_, &QCheckBox::toggled, this, &HybridVolumePanel::setShow);
+  connect(shade_, &QCheckBox::toggled, this, [this](bool on) { context_.setVolumeShading(on); });
   connect(&context_, &ViewerContext::operationChanged, this, &HybridVolumePanel::showState);
   connect(&context_, &ViewerContext::methodChanged, this, &HybridVolumePanel::showState);
   connect(&context_, &ViewerContext::volumeChanged, this, &HybridVolumePanel::volumeChanged);
@@ -237,6 +244,10 @@ void HybridVolumePanel::volumeChanged() {
   if (key != sceneKey_ || !sameTransfer(context_.transferFunction(), applied_)) {
     sceneKey_ = key;
     resetToCurrent();
+  }
+  {
+    const QSignalBlocker blockShade(shade_);
+    shade_->setChecked(context_.volumeShading());
   }
   showPreview();
   showStep();
@@ -420,6 +431,7 @@ QJsonObject HybridVolumePanel::saveSettings() const {
           {QStringLiteral("preset"), preset_->currentData().toString()},
           {QStringLiteral("window"), QJsonArray{windowMin_->value(), windowMax_->value()}},
           {QStringLiteral("opacity_scale"), opacityScale()},
+          {QStringLiteral("shading"), shade_->isChecked()},
           {QStringLiteral("base"), transferToJson(base_)},
           {QStringLiteral("step"), context_.volumeStep()},
           {QStringLiteral("previous_operation"), previousOperation_},
@@ -447,6 +459,8 @@ void HybridVolumePanel::loadSettings(const QJsonObject& settings) {
     showScaleValue();
   }
   applyTransfer();  // the session's own function again (no change), or --plugin-settings' one
+  if (settings.contains(QStringLiteral("shading")))
+    context_.setVolumeShading(settings.value(QStringLiteral("shading")).toBool());
   if (settings.contains(QStringLiteral("step")))
     context_.setVolumeStep(settings.value(QStringLiteral("step")).toDouble());
   if (settings.contains(QStringLiteral("show")) &&

@@ -63,6 +63,7 @@ class HybridVolumePanel final : public QWidget {
   QDoubleSpinBox* windowMin_ = nullptr;
   QDoubleSpinBox* windowMax_ = nullptr;
   QSlider* opacity_ = nullptr;
+  QCheckBox* shade_ = nullptr;
   QLabel* opacityValue_ = nullptr;
   QLabel* preview_ = nullptr;
   QLabel* error_ = nullptr;

@@ -84,6 +84,14 @@
 #define MFR_VOLUME_MAX_STEPS 4096
 #define MFR_VOLUME_MIN_TRANSMITTANCE (1.0 / 4096.0)
 #define MFR_VOLUME_MAX_ALPHA (1.0 - 1.0 / 1024.0)
+// Shaded volumes (Volume::shading; Levoy, "Display of Surfaces from Volume Data", IEEE CG&A 8(3)
+// 1988): a sample's emission is scaled by mix(1, AMBIENT + DIFFUSE·|n·v|, w), n the normalised
+// world gradient (central differences one grid unit apart), v the ray, w = g/(g + EDGE·range) with
+// g the gradient's length per grid unit and range the transfer function's [low, high]: homogeneous
+// regions, whose normals are noise, stay unshaded.
+#define MFR_VOLUME_AMBIENT 0.3
+#define MFR_VOLUME_DIFFUSE 0.7
+#define MFR_VOLUME_SHADE_EDGE 0.02
 // kbuffer-zmerge: the largest k (its store pass compares all pairs of k + 1 segments).
 #define MFR_ZMERGE_MAX_K 32
 

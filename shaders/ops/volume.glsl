@@ -6,7 +6,8 @@
 // 1995) is ray-marched over each interval, and each surface is composited with "over" at its exact
 // depth — not at the nearest sample — so surfaces inside the medium are hidden by just the medium
 // in front of them. Steps lie on a grid of uVolumeStep from the ray's entry into the volume's box;
-// an interval cut by a surface is integrated in two parts, each with its midpoint's sample.
+// an interval cut by a surface is integrated in two parts, each with its midpoint's sample. A
+// shaded volume scales each sample's emission by its gradient lighting (volumeShade).
 // Same definition and float arithmetic as the oracle's compositeVolume
 // (mfrcore/src/reference/composite.cpp).
 uniform vec3 uBackground;
@@ -17,6 +18,7 @@ uniform ivec3 uGridDims;
 uniform float uVolumeStep;   // world units along the ray
 uniform float uTfLow;        // scalar of the first transfer-table entry
 uniform float uTfHigh;       // scalar of the last one
+uniform int uVolumeShading;  // Volume::shading
 layout(binding = MFR_TEX_VOLUME) uniform sampler3D uVolume;       // R32F, read with texelFetch
 layout(binding = MFR_TEX_VOLUME_TF) uniform sampler1D uTransfer;  // (rgb, σ), MFR_VOLUME_TF_SIZE
 
@@ -60,6 +62,22 @@ vec4 volumeTransfer(float v) {
   int i = min(int(u), MFR_VOLUME_TF_SIZE - 2);
   float f = u - float(i);
   return mix(texelFetch(uTransfer, i, 0), texelFetch(uTransfer, i + 1, 0), f);
+}
+
+// The emission factor of a shaded volume at grid point g (MFR_VOLUME_AMBIENT in common/bindings.h;
+// Levoy 1988): headlight diffuse on the normalised world gradient, faded out where the gradient
+// is small against the transfer function's range.
+float volumeShade(vec3 g, vec3 rayDir) {
+  vec3 gradient = 0.5 * vec3(volumeSample(g + vec3(1.0, 0.0, 0.0)) - volumeSample(g - vec3(1.0, 0.0, 0.0)),
+                             volumeSample(g + vec3(0.0, 1.0, 0.0)) - volumeSample(g - vec3(0.0, 1.0, 0.0)),
+                             volumeSample(g + vec3(0.0, 0.0, 1.0)) - volumeSample(g - vec3(0.0, 0.0, 1.0)));
+  float perCell = length(gradient);
+  if (!(perCell > 0.0)) return 1.0;
+  vec3 world = transpose(mat3(uWorldToGrid)) * gradient;
+  float facing = abs(dot(world, rayDir)) / length(world);
+  float lit = float(MFR_VOLUME_AMBIENT) + float(MFR_VOLUME_DIFFUSE) * facing;
+  float w = perCell / (perCell + float(MFR_VOLUME_SHADE_EDGE) * (uTfHigh - uTfLow));
+  return mix(1.0, lit, w);
 }
 
 vec3 volumeUnproject(vec2 ndc, float ndcZ) {
@@ -106,10 +124,11 @@ void volumeMarch(inout OpState s, float tTo) {
     float boundary = s.tEnter + float(s.next) * s.step;
     float end = min(boundary, tTo);
     if (end > s.t) {
-      vec4 m = volumeTransfer(volumeSample(s.gridStart + s.gridDir * (0.5 * (s.t + end))));
+      vec3 g = s.gridStart + s.gridDir * (0.5 * (s.t + end));
+      vec4 m = volumeTransfer(volumeSample(g));
       if (m.a > 0.0) {
         float absorbed = 1.0 - exp(-m.a * (end - s.t));
-        s.color += s.transmittance * absorbed * m.rgb;
+        s.color += s.transmittance * absorbed * m.rgb * (uVolumeShading != 0 ? volumeShade(g, s.rayDir) : 1.0);
         s.transmittance *= 1.0 - absorbed;
       }
       s.t = end;

@@ -1116,7 +1116,37 @@ class ViewerTest : public QObject {
     QCOMPARE(w->findChild<QDoubleSpinBox*>("volumeStep")->value(), 0.025);
     QCOMPARE(step->value(), 0.025);
 
-    // Sessions: the transfer function, the panel's preset, window and scale, the step.
+    // Shading: the switch sets Volume::shading, the frame says so, the image changes, and the
+    // frame quality is measured against the oracle's shaded image (the same scene).
+    auto* shade = w->findChild<QCheckBox*>("hvShade");
+    QVERIFY(shade && !shade->isChecked() && !m.volumeShading());
+    settle(m);
+    const mfr::ImageRGBA8 unshaded = w->view().renderImage(m.renderSize());
+    QCOMPARE(note("volume shading"), std::string("off"));
+    shade->setChecked(true);
+    QVERIFY(m.volumeShading());
+    QVERIFY(m.scene().visibleVolume()->shading);
+    settle(m);
+    QCOMPARE(note("volume shading"), std::string("on"));
+    const mfr::ImageRGBA8 shadedFrame = w->view().renderImage(m.renderSize());
+    qInfo("unshaded vs shaded: RMSE %.5f", mfr::rmse(unshaded, shadedFrame));
+    QVERIFY(mfr::rmse(unshaded, shadedFrame) > 0.002);
+    m.requestFrameQuality();
+    QTRY_VERIFY_WITH_TIMEOUT(m.frameQuality().valid, kTimeoutMs);
+    {
+      mfr::RenderRequest request;
+      request.method = "oracle";
+      request.operation = "volume";
+      request.volumeStep = m.volumeStep();
+      request.width = m.renderSize().width();
+      request.height = m.renderSize().height();
+      const double exact = mfr::rmse(mfr::render(m.scene(), m.camera(), request).image, shadedFrame);
+      qInfo("shaded frame quality RMSE %.6f (recomputed %.6f)", m.frameQuality().rmse, exact);
+      QVERIFY(std::abs(m.frameQuality().rmse - exact) < 1e-9);
+      QVERIFY(exact < 0.002);
+    }
+
+    // Sessions: the transfer function, the panel's preset, window and scale, the step, shading.
     preset->setCurrentIndex(preset->findData(QStringLiteral("bone")));
     windowMax->setValue(1.1);
     opacity->setValue(700);
@@ -1147,6 +1177,8 @@ class ViewerTest : public QObject {
       QCOMPARE(again->findChild<QSlider*>("hvOpacity")->value(), 700);
       QCOMPARE(again->findChild<QDoubleSpinBox*>("hvStep")->value(), 0.025);
       QVERIFY(again->findChild<QCheckBox*>("hvShow")->isChecked());
+      QVERIFY(a.volumeShading());
+      QVERIFY(again->findChild<QCheckBox*>("hvShade")->isChecked());
       QCOMPARE(maxChannelDifference(before, again->view().renderImage(a.renderSize())), 0);
     }
     // The viewer's own session keys ("volume_step", "volumes") restore the step and the function
@@ -1169,6 +1201,7 @@ class ViewerTest : public QObject {
       QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.framesRendered() > 0, kTimeoutMs);
       settle(a);
       QCOMPARE(a.volumeStep(), 0.025);
+      QVERIFY(a.volumeShading());  // the session's "volumes" carry it
       const mfr::TransferFunction restored = a.transferFunction();
       QCOMPARE(restored.points.size(), saved.points.size());
       QCOMPARE(restored.unitDistance, saved.unitDistance);
@@ -1178,6 +1211,7 @@ class ViewerTest : public QObject {
     // As Loaded: the scene's own function, Custom over its own range again (at the default step:
     // the original image exactly).
     stepDefault->click();
+    shade->setChecked(false);
     asLoaded->click();
     {
       const mfr::TransferFunction now = m.transferFunction();

@@ -49,6 +49,21 @@ TEST_F(CliVolume, OracleAndGpuAgreeAndTheStepMatters) {
   EXPECT_EQ(j["notes"]["volume (bytes)"], std::to_string(96 * 96 * 96 * 4 + 256 * 16));
 }
 
+TEST_F(CliVolume, ShadeTurnsOnGradientShading) {
+  const std::string common = "render @volume --view iso --size 96x80";
+  const fs::path plain = dir() / "plain.png", oracle = dir() / "oracle.png", gpu = dir() / "gpu.png",
+                 stats = dir() / "stats.json";
+  ASSERT_EQ(runCli(common + " -m abuffer-sbuffer -o " + plain.string()).exitCode, 0);
+  ASSERT_EQ(runCli(common + " --shade -o " + oracle.string()).exitCode, 0);
+  const CliResult g = runCli(common + " --shade -m abuffer-sbuffer -o " + gpu.string() + " --stats " + stats.string());
+  ASSERT_EQ(g.exitCode, 0) << g.out;
+  EXPECT_LT(rmseOf(oracle, gpu), 0.01);  // edge pixels only
+  EXPECT_GT(rmseOf(plain, gpu), 0.01);   // the medium is lit differently
+  std::ifstream in(stats);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["notes"]["volume shading"], "on") << j.dump();
+}
+
 TEST_F(CliVolume, BenchMeasuresRowsAgainstTheOraclesVolumeImage) {
   const fs::path json = dir() / "bench.json";
   const CliResult r = runCli(
@@ -88,6 +103,7 @@ TEST_F(CliVolume, BadInputIsOneLine) {
   expectCleanFailure("render @volume --op volume --method mboit", "mboit");
   expectCleanFailure("render @sample --op volume", "no visible volume");
   expectCleanFailure("render @sample --op volume --method abuffer-ll", "no visible volume");
+  expectCleanFailure("render @sample --shade", "--shade");
   const fs::path json = dir() / "b.json";
   const CliResult bench = runCli("bench @volume -m abuffer-ll:step=-3 --json " + json.string());
   EXPECT_NE(bench.exitCode, 0);

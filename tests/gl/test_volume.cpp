@@ -71,6 +71,46 @@ TEST(VolumeGpu, EqualsTheOracleWithSurfacesInsideTheVolume) {
   }
 }
 
+// A shaded volume (gradient lighting, the sample's own field has smooth boundaries) on the GPU
+// against the oracle's shaded image; shading must change the image where the medium is.
+TEST(VolumeGpu, ShadedEqualsTheOracle) {
+  context();
+  Scene scene = makeVolumeSampleScene();
+  const Scene unshaded = scene;
+  scene.volumes[0].shading = true;
+  const int w = 128, h = 112;
+  GpuRenderer gpu, plain;
+  gpu.setScene(scene);
+  plain.setScene(unshaded);
+  for (const char* view : {"iso", "front"}) {
+    const Camera camera = scene.view(view);
+    const FragmentLists oracle = castFragments(scene, camera, w, h);
+    RenderRequest req;
+    req.operation = "volume";
+    req.width = w;
+    req.height = h;
+    const ImageRGBA8 expected = compositeVolume(oracle, camera, *scene.visibleVolume(),
+                                                volumeStepOf(req, *scene.visibleVolume()), scene.background);
+    for (const char* method : {"abuffer-ll", "abuffer-sbuffer"}) {
+      SCOPED_TRACE(std::string(view) + " " + method);
+      req.method = method;
+      const RenderOutput out = gpu.render(camera, req);
+      const Comparison c = compareOffEdges(oracle, expected, out.image, scene.background, 2);
+      EXPECT_GT(c.compared, static_cast<std::size_t>(w * h) * 8 / 10);
+      EXPECT_GE(static_cast<double>(c.within) / c.compared, 0.999)
+          << c.compared - c.within << " pixels off by more than 2/255, max " << c.maxDifference;
+      const auto note = std::find_if(out.stats.notes.begin(), out.stats.notes.end(),
+                                     [](const auto& n) { return n.first == "volume shading"; });
+      ASSERT_NE(note, out.stats.notes.end());
+      EXPECT_EQ(note->second, "on");
+      std::size_t changed = 0;
+      test::compareOffEdges(oracle, plain.render(camera, req).image, out.image, 8,
+                            [&](int, int, int diff) { changed += diff > 8; });
+      EXPECT_GT(changed, c.volumeOnly / 2) << "shading left the medium's " << c.volumeOnly << " pixels unchanged";
+    }
+  }
+}
+
 // The medium changes the image: the same scene with "oit" differs from "volume" wherever the
 // volume is, and a scene of the volume alone (no triangles) renders on both renderers alike.
 TEST(VolumeGpu, VolumeAloneAndAutoOperation) {

@@ -209,6 +209,51 @@ TEST(VolumeComposite, MissesTinyStepsAndOpaqueMedia) {
   expectNear(centrePixel(hidden, v, 0.0, bg), glm::vec3(0.3f, 0.6f, 0.9f), 1e-3f);
 }
 
+// Shaded volumes: a medium of one colour whose scalar field is linear — its gradient, and so the
+// shading factor mix(1, ambient + diffuse·|n·v|, w), is the same at every sample of the centre
+// ray — must be the homogeneous closed form with its emission scaled by that factor.
+TEST(VolumeShading, LinearFieldsScaleTheEmissionByTheirLighting) {
+  const glm::vec4 medium(0.2f, 0.6f, 0.9f, 0.3f);
+  const glm::vec3 bg(1.0f, 0.9f, 0.8f);
+  const double unit = 0.25, sigma = -std::log(1.0 - 0.3) / unit, chord = 2.0;
+  const double tr = std::exp(-sigma * chord);
+  const auto expected = [&](double factor) {
+    return glm::vec3(medium) * static_cast<float>(factor * (1.0 - tr)) + bg * static_cast<float>(tr);
+  };
+  const int n = 9;
+  const double h = 2.0 / (n - 1);
+  // w = g/(g + EDGE·range): the gradient per grid cell (h for a unit slope) against the range 2.
+  const double w = h / (h + MFR_VOLUME_SHADE_EDGE * 2.0);
+  const auto shaded = [&](auto field, const glm::dmat4& transform) {
+    Volume v = boxVolume(n, field);
+    v.transform = transform;
+    v.transfer = uniformTransfer(medium, unit, -1.0, 1.0);
+    v.shading = true;
+    return v;
+  };
+  const auto lit = [&](double facing) { return (1.0 - w) + w * (MFR_VOLUME_AMBIENT + MFR_VOLUME_DIFFUSE * facing); };
+  // Gradient across the ray: only the ambient term lights it.
+  expectNear(centrePixel({}, shaded([](double, double y, double) { return y; }, glm::dmat4(1.0)), 0.0, bg),
+             expected(lit(0.0)), 2e-5f);
+  // Gradient along the ray: fully lit, ambient + diffuse = 1, the unshaded image.
+  expectNear(centrePixel({}, shaded([](double, double, double z) { return z; }, glm::dmat4(1.0)), 0.0, bg),
+             expected(1.0), 2e-5f);
+  // A constant field has no gradient: unshaded.
+  expectNear(centrePixel({}, shaded([](double, double, double) { return 0.25; }, glm::dmat4(1.0)), 0.0, bg),
+             expected(1.0), 2e-5f);
+  // Sheared placement y_world = y + z/2 (z unchanged, so the chord is still 2): the field y is
+  // y_world − z_world/2 in the world, gradient (0, 1, −1/2), |n·v| = 0.5/√1.25. Normals must be
+  // carried to the world by the inverse transpose of the placement, not by the inverse.
+  glm::dmat4 shear(1.0);
+  shear[2][1] = 0.5;  // column z, row y
+  expectNear(centrePixel({}, shaded([](double, double y, double) { return y; }, shear), 0.0, bg),
+             expected(lit(0.5 / std::sqrt(1.25))), 2e-5f);
+  // Shading off: the same field is the unshaded closed form.
+  Volume plain = shaded([](double, double y, double) { return y; }, glm::dmat4(1.0));
+  plain.shading = false;
+  expectNear(centrePixel({}, plain, 0.0, bg), expected(1.0), 2e-5f);
+}
+
 TEST(VolumeModel, BoundsStepAndValidation) {
   Volume v = boxVolume(5, [](double x, double, double) { return x; });
   v.transfer = uniformTransfer(glm::vec4(0.5f), 1.0);

@@ -91,6 +91,7 @@ class GpuRenderer {
   struct GpuVolume;
   std::shared_ptr<GpuVolume> volume_;
   double volumeStep_ = 0.0;  // of the prepared request (scene units)
+  bool volumeShading_ = false;  // of the prepared request (its own, else the volume's)
   void uploadVolume(const Scene& scene);
   gl::Buffer csgVisible_;
   std::size_t csgPixels_ = 0;

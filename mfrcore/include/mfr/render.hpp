@@ -4,6 +4,7 @@
 // name is a GPU method from the registry (methods/registry.hpp).
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,8 @@ struct RenderRequest {
   double thickness = 0.0;
   // Operation "volume": ray-march step in scene units; 0 picks the volume's defaultStep().
   double volumeStep = 0.0;
+  // Operation "volume": gradient shading on or off; unset: the volume's own Volume::shading.
+  std::optional<bool> volumeShading;
 };
 
 // The operations render() and GpuRenderer accept, for messages: "auto, oit, hybrid, csg, zthickness, volume".
@@ -40,6 +43,8 @@ double zThicknessOf(const RenderRequest& request, const Bounds& sceneBounds);
 // The step a request asks for (its own, or the volume's default); throws mfr::Error("--step", …)
 // for a negative, infinite or NaN value.
 double volumeStepOf(const RenderRequest& request, const Volume& volume);
+// The volume as a request draws it: a copy (sharing the grid) with the request's shading, if any.
+Volume volumeAsRequested(const RenderRequest& request, const Volume& volume);
 // What a request's operation means for a method (info; nullptr: the oracle) on a scene with or
 // without a visible volume: "auto" is the method's preferredOperation, except that a scene with a
 // volume gets "volume" from every method that prefers "oit" and resolves sorted lists.

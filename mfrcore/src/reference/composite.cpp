@@ -156,6 +156,7 @@ VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int wi
   s.tfLow = static_cast<float>(volume.transfer.low());
   s.tfHigh = static_cast<float>(volume.transfer.high());
   s.table = volume.transfer.table();
+  s.shading = volume.shading;
   return s;
 }
 
@@ -183,6 +184,22 @@ struct VolumeMarcher {
     const int i = std::min(static_cast<int>(u), MFR_VOLUME_TF_SIZE - 2);
     const float f = u - static_cast<float>(i);
     return glm::mix(setup.table[static_cast<std::size_t>(i)], setup.table[static_cast<std::size_t>(i) + 1], f);
+  }
+
+  // The emission factor of a shaded volume at grid point g (shaders/ops/volume.glsl volumeShade).
+  [[nodiscard]] float shade(const glm::vec3& g) const {
+    const glm::vec3 gradient =
+        0.5f * glm::vec3(grid.sample(g + glm::vec3(1.0f, 0.0f, 0.0f)) - grid.sample(g - glm::vec3(1.0f, 0.0f, 0.0f)),
+                         grid.sample(g + glm::vec3(0.0f, 1.0f, 0.0f)) - grid.sample(g - glm::vec3(0.0f, 1.0f, 0.0f)),
+                         grid.sample(g + glm::vec3(0.0f, 0.0f, 1.0f)) - grid.sample(g - glm::vec3(0.0f, 0.0f, 1.0f)));
+    const float perCell = glm::length(gradient);
+    if (!(perCell > 0.0f)) return 1.0f;
+    // ∇ in world units: the transpose of world → grid's linear part applied to ∇ in grid units.
+    const glm::vec3 world = glm::transpose(glm::mat3(setup.worldToGrid)) * gradient;
+    const float facing = std::abs(glm::dot(world, rayDir)) / glm::length(world);
+    const float lit = static_cast<float>(MFR_VOLUME_AMBIENT) + static_cast<float>(MFR_VOLUME_DIFFUSE) * facing;
+    const float w = perCell / (perCell + static_cast<float>(MFR_VOLUME_SHADE_EDGE) * (setup.tfHigh - setup.tfLow));
+    return glm::mix(1.0f, lit, w);
   }
 
   void begin(int glX, int glY) {
@@ -220,10 +237,11 @@ struct VolumeMarcher {
       const float boundary = tEnter + static_cast<float>(next) * step;
       const float end = std::min(boundary, tTo);
       if (end > t) {
-        const glm::vec4 m = transfer(grid.sample(gridStart + gridDir * (0.5f * (t + end))));
+        const glm::vec3 g = gridStart + gridDir * (0.5f * (t + end));
+        const glm::vec4 m = transfer(grid.sample(g));
         if (m.a > 0.0f) {
           const float absorbed = 1.0f - std::exp(-m.a * (end - t));
-          color += transmittance * absorbed * glm::vec3(m);
+          color += transmittance * absorbed * glm::vec3(m) * (setup.shading ? shade(g) : 1.0f);
           transmittance *= 1.0f - absorbed;
         }
         t = end;

@@ -248,6 +248,7 @@ Volume parseVolume(const Reader& r, const json& j, const std::string& where, con
   const glm::dmat4 xf =
       v.contains("transform") ? parseTransform(r, v["transform"], where + ".transform") : glm::dmat4(1.0);
   if (v.contains("visible") && !v["visible"].is_boolean()) r.fail(where + ".visible", "expected true or false");
+  if (v.contains("shading") && !v["shading"].is_boolean()) r.fail(where + ".shading", "expected true or false");
   Volume volume;
   try {
     volume = loadVolume(baseDir / file, progress);  // its errors name the volume file
@@ -259,6 +260,7 @@ Volume parseVolume(const Reader& r, const json& j, const std::string& where, con
   volume.name = r.string(v, "name", where, volume.name);
   volume.transform = xf * volume.transform;
   volume.visible = v.value("visible", true);
+  volume.shading = v.value("shading", false);
   // The defaults are relative to where the volume now is: its world diagonal.
   volume.transfer = defaultTransfer(*volume.grid, volume.bounds());
   if (v.contains("transfer")) volume.transfer = parseTransfer(r, v["transfer"], where + ".transfer", volume);

@@ -36,7 +36,8 @@ ImageRGBA8 compositeZThickness(const FragmentLists& lists, const Camera& camera,
 // its centre on the near plane to the far plane (t in world units); inside the volume's box,
 // interval boundaries lie every `step` from the entry point, cut further at surfaces, and each
 // interval takes the (rgb, σ) of the transfer table at its midpoint's trilinear sample:
-// C += T·(1 - e^(-σ·Δ))·rgb, T ·= e^(-σ·Δ). Marching stops once T < MFR_VOLUME_MIN_TRANSMITTANCE;
+// C += T·(1 - e^(-σ·Δ))·rgb·shade, T ·= e^(-σ·Δ), shade = 1 unless the volume is shaded
+// (MFR_VOLUME_AMBIENT in shaders/common/bindings.h says how). Marching stops once T < MFR_VOLUME_MIN_TRANSMITTANCE;
 // a chord longer than MFR_VOLUME_MAX_STEPS steps gets a longer step.
 struct VolumeRaySetup {
   glm::mat4 invViewProj{1.0f};  // NDC → world (computed in double, rounded to float)
@@ -46,6 +47,7 @@ struct VolumeRaySetup {
   float step = 0.0f;  // world units
   float tfLow = 0.0f, tfHigh = 1.0f;
   std::vector<glm::vec4> table;  // TransferFunction::table()
+  bool shading = false;          // Volume::shading
 };
 // The values both renderers use; step ≤ 0 picks Volume::defaultStep().
 VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int width, int height, double step);

@@ -82,6 +82,9 @@ struct Volume {
   glm::dmat4 transform{1.0};  // object → world
   TransferFunction transfer;
   bool visible = true;
+  // Gradient shading with a headlight (MFR_VOLUME_AMBIENT/DIFFUSE in shaders/common/bindings.h):
+  // boundaries inside the medium read as surfaces. Off: pure emission-absorption.
+  bool shading = false;
 
   // Object → grid coordinates composed with transform: world → grid is inverse(gridToWorld()).
   [[nodiscard]] glm::dmat4 gridToWorld() const;
