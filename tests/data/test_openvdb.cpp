@@ -105,15 +105,8 @@ TEST_F(OpenVdbFiles, SceneOfAVdbFile) {
 
 TEST_F(OpenVdbFiles, BadFilesAreOneLineErrors) {
   const auto expectError = [](const fs::path& path, const std::string& reason) {
-    try {
-      (void)loadVolume(path);
-      ADD_FAILURE() << path << ": loaded, expected '" << reason << "'";
-    } catch (const Error& e) {
-      const std::string what = e.what();
-      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-      EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << what;
-      EXPECT_NE(what.find(reason), std::string::npos) << what;
-    }
+    expectFileError(path, reason,
+                    [&] { return "a volume of " + std::to_string(loadVolume(path).grid->values.size()) + " points"; });
   };
   expectError(write("text.vdb", "not a VDB file at all, just text\n"), "not an OpenVDB file");
   const fs::path good = make("-sphere radius=1 voxel=0.1 -ls2fog", "good.vdb");

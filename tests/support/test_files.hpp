@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <ios>
 #include <optional>
 #include <string>
@@ -102,10 +103,13 @@ class TempDirTest : public ::testing::Test {
 
 // Expects loadModel(path) to throw one mfr::Error whose message is one line that starts with
 // "<path>: " and contains `reason`. Loading, LoadCancelled and any other exception are failures.
-inline void expectLoadError(const std::filesystem::path& path, const std::string& reason) {
+// load() is the loader under test, returning a description of what it loaded (for the message
+// when it should not have); expectLoadError is the case of loadModel.
+inline void expectFileError(const std::filesystem::path& path, const std::string& reason,
+                            const std::function<std::string()>& load) {
   try {
-    const auto objects = mfr::loadModel(path);
-    ADD_FAILURE() << path << ": loaded " << objects.size() << " objects, expected an error about '" << reason << "'";
+    const std::string loaded = load();
+    ADD_FAILURE() << path << ": loaded " << loaded << ", expected an error about '" << reason << "'";
   } catch (const mfr::LoadCancelled&) {
     ADD_FAILURE() << path << ": cancelled";
   } catch (const mfr::Error& e) {
@@ -116,6 +120,10 @@ inline void expectLoadError(const std::filesystem::path& path, const std::string
   } catch (const std::exception& e) {
     ADD_FAILURE() << path << ": non-mfr exception: " << e.what();
   }
+}
+
+inline void expectLoadError(const std::filesystem::path& path, const std::string& reason) {
+  expectFileError(path, reason, [&] { return std::to_string(mfr::loadModel(path).size()) + " objects"; });
 }
 
 struct CliResult {

@@ -32,20 +32,10 @@ class VolumeLoading : public mfr::test::TempDirTest {};
 
 // Expects loadVolume(path) to throw one mfr::Error: one line, starting "<path>: ", containing reason.
 void expectVolumeError(const fs::path& path, const std::string& reason) {
-  try {
-    const mfr::Volume v = mfr::loadVolume(path);
-    ADD_FAILURE() << path << ": loaded a volume of " << v.grid->dims.x << "x" << v.grid->dims.y << "x" << v.grid->dims.z
-                  << ", expected an error about '" << reason << "'";
-  } catch (const mfr::LoadCancelled&) {
-    ADD_FAILURE() << path << ": cancelled";
-  } catch (const mfr::Error& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.find('\n'), std::string::npos) << "not one line: " << what;
-    EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << "does not start with the path: " << what;
-    EXPECT_NE(what.find(reason), std::string::npos) << "expected '" << reason << "' in: " << what;
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << path << ": non-mfr exception: " << e.what();
-  }
+  mfr::test::expectFileError(path, reason, [&] {
+    const glm::ivec3 d = mfr::loadVolume(path).grid->dims;
+    return "a volume of " + std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z);
+  });
 }
 
 std::string errorOf(const std::function<void()>& f) {
