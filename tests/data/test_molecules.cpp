@@ -31,6 +31,7 @@ namespace fs = std::filesystem;
 namespace {
 
 using mfr::test::expectLoadError;
+using mfr::test::readTestFile;
 
 const fs::path kPymolDemo = "/usr/share/pymol/data/demo";
 const fs::path kBiopython = "/usr/share/doc/python-biopython-doc/Tests/PDB";
@@ -38,21 +39,6 @@ const fs::path kBiopython = "/usr/share/doc/python-biopython-doc/Tests/PDB";
 fs::path requireFile(const fs::path& path, const std::string& package) {
   if (!fs::exists(path)) ADD_FAILURE() << "missing " << path << " (from " << package << "; scripts/setup installs it)";
   return path;
-}
-
-std::string readText(const fs::path& path) {
-  if (path.extension() == ".gz") {
-    gzFile gz = gzopen(path.c_str(), "rb");
-    if (gz == nullptr) return {};
-    std::string out;
-    char buf[1 << 16];
-    int n = 0;
-    while ((n = gzread(gz, buf, sizeof buf)) > 0) out.append(buf, static_cast<std::size_t>(n));
-    gzclose(gz);
-    return out;
-  }
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 std::string trim(const std::string& s) {
@@ -308,7 +294,7 @@ using Counts = std::vector<std::pair<std::string, std::size_t>>;
 
 TEST(Molecules, Pdb1tii) {
   const fs::path p = requireFile(kPymolDemo / "1tii.pdb", "Debian package pymol-data");
-  const RefParts ref = readPdb(readText(p));
+  const RefParts ref = readPdb(readTestFile(p));
   // 5684 ATOM/HETATM records (grep -c), no altlocs, chains D–H first in the file, waters with a
   // blank chain ID.
   EXPECT_EQ(counts(ref), (Counts{{"chain D", 740},
@@ -329,7 +315,7 @@ TEST(Molecules, Pdb1tii) {
 
 TEST(Molecules, PdbIl2WithHydrogensAndBlankChain) {
   const fs::path p = requireFile(kPymolDemo / "il2.pdb", "Debian package pymol-data");
-  const RefParts ref = readPdb(readText(p));
+  const RefParts ref = readPdb(readTestFile(p));
   EXPECT_EQ(counts(ref), (Counts{{"chain (blank)", 2084}}));
   const auto objects = mfr::loadModel(p);
   expectParts(objects, ref, 320);
@@ -341,7 +327,7 @@ TEST(Molecules, PdbIl2WithHydrogensAndBlankChain) {
 // An older file: entry ID and line numbers in columns 73–80 where the element and charge are now.
 TEST(Molecules, Pdb1hpvLigandWithoutElementColumns) {
   const fs::path p = requireFile("/usr/share/pymol/data/tut/1hpv.pdb", "Debian package pymol-data");
-  const RefParts ref = readPdb(readText(p));
+  const RefParts ref = readPdb(readTestFile(p));
   EXPECT_EQ(counts(ref), (Counts{{"chain A", 758}, {"chain B", 758}, {"ligands", 35}, {"water", 80}}));
   expectParts(mfr::loadModel(p), ref, 320);
 }
@@ -350,7 +336,7 @@ TEST(Molecules, Pdb1hpvLigandWithoutElementColumns) {
 
 TEST(Molecules, Mmcif4cupLigandsWaterAltlocs) {
   const fs::path p = requireFile(kBiopython / "4CUP.cif.gz", "Debian package python-biopython-doc");
-  const RefParts ref = readMmcif(readText(p));
+  const RefParts ref = readMmcif(readTestFile(p));
   // 1107 _atom_site rows, 13 of them a second alternative location.
   EXPECT_EQ(counts(ref), (Counts{{"chain A", 924}, {"ligands", 24}, {"water", 146}}));
   expectParts(mfr::loadModel(p), ref, 320);
@@ -360,14 +346,14 @@ TEST(Molecules, Mmcif4cupLigandsWaterAltlocs) {
 TEST(Molecules, Mmcif2begFirstOfTenModelsEqualsThePdb) {
   const fs::path cif = requireFile(kBiopython / "2BEG.cif.gz", "Debian package python-biopython-doc");
   const fs::path pdb = requireFile(kBiopython / "2BEG.pdb.gz", "Debian package python-biopython-doc");
-  const RefParts ref = readMmcif(readText(cif));
+  const RefParts ref = readMmcif(readTestFile(cif));
   EXPECT_EQ(counts(ref),
             (Counts{{"chain A", 371}, {"chain B", 371}, {"chain C", 371}, {"chain D", 371}, {"chain E", 371}}));
-  EXPECT_EQ(counts(readPdb(readText(pdb))), counts(ref));
+  EXPECT_EQ(counts(readPdb(readTestFile(pdb))), counts(ref));
   const auto fromCif = mfr::loadModel(cif);
   expectParts(fromCif, ref, 320, " (model 1 of 10)");
   const auto fromPdb = mfr::loadModel(pdb);
-  expectParts(fromPdb, readPdb(readText(pdb)), 320);
+  expectParts(fromPdb, readPdb(readTestFile(pdb)), 320);
   ASSERT_EQ(fromCif.size(), fromPdb.size());
   for (std::size_t i = 0; i < fromCif.size(); ++i) {
     ASSERT_EQ(fromCif[i].mesh->positions.size(), fromPdb[i].mesh->positions.size());
@@ -381,11 +367,11 @@ TEST(Molecules, Mmcif2begFirstOfTenModelsEqualsThePdb) {
 TEST(Molecules, Mmcif1a8oModifiedResiduesStayInTheChain) {
   const fs::path cif = requireFile(kBiopython / "1A8O.cif.gz", "Debian package python-biopython-doc");
   const fs::path pdb = requireFile(kBiopython / "1A8O.pdb.gz", "Debian package python-biopython-doc");
-  const RefParts ref = readMmcif(readText(cif));
+  const RefParts ref = readMmcif(readTestFile(cif));
   EXPECT_EQ(counts(ref), (Counts{{"chain A", 556}, {"water", 88}}));
-  EXPECT_EQ(counts(readPdb(readText(pdb))), counts(ref));
+  EXPECT_EQ(counts(readPdb(readTestFile(pdb))), counts(ref));
   expectParts(mfr::loadModel(cif), ref, 320);
-  expectParts(mfr::loadModel(pdb), readPdb(readText(pdb)), 320);
+  expectParts(mfr::loadModel(pdb), readPdb(readTestFile(pdb)), 320);
 }
 
 // ---- damaged copies ---------------------------------------------------------------------------
@@ -393,7 +379,7 @@ TEST(Molecules, Mmcif1a8oModifiedResiduesStayInTheChain) {
 class DamagedMolecules : public mfr::test::TempDirTest {};
 
 TEST_F(DamagedMolecules, TruncatedCorruptAndEmptied) {
-  const std::string pdb = readText(requireFile(kPymolDemo / "1tii.pdb", "Debian package pymol-data"));
+  const std::string pdb = readTestFile(requireFile(kPymolDemo / "1tii.pdb", "Debian package pymol-data"));
   ASSERT_FALSE(pdb.empty());
   // Cut in the middle of a record halfway through the coordinates.
   const std::size_t middle = pdb.find("\nATOM", (pdb.find("\nATOM") + pdb.rfind("\nATOM")) / 2) + 1 + 35;
@@ -406,7 +392,7 @@ TEST_F(DamagedMolecules, TruncatedCorruptAndEmptied) {
     if (line.rfind("ATOM", 0) != 0 && line.rfind("HETATM", 0) != 0) header += line + "\n";
   expectLoadError(write("1tii-header.pdb", header), "no atoms");
 
-  const std::string cif = readText(requireFile(kBiopython / "4CUP.cif.gz", "Debian package python-biopython-doc"));
+  const std::string cif = readTestFile(requireFile(kBiopython / "4CUP.cif.gz", "Debian package python-biopython-doc"));
   ASSERT_FALSE(cif.empty());
   const std::size_t row = cif.find("\nATOM", (cif.find("\nATOM") + cif.rfind("\nHETATM")) / 2) + 1 + 30;
   expectLoadError(write("4cup-cut.cif", cif.substr(0, row)),

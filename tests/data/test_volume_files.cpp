@@ -41,6 +41,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using mfr::test::readTestFile;
+
 // The fetched test data: $MFR_TESTDATA_DIR, else the source tree's .testdata (scripts/setup).
 fs::path testData() {
   const char* env = std::getenv("MFR_TESTDATA_DIR");
@@ -52,22 +54,6 @@ fs::path cgalImage(const std::string& name) {
   if (!fs::exists(p))
     ADD_FAILURE() << "missing " << p << " (from libcgal-dev's data.tar.gz; scripts/setup extracts it)";
   return p;
-}
-
-std::string readFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-std::string gunzip(const fs::path& p) {
-  gzFile gz = gzopen(p.c_str(), "rb");
-  if (gz == nullptr) return {};
-  std::string out;
-  char buf[1 << 16];
-  int n = 0;
-  while ((n = gzread(gz, buf, sizeof buf)) > 0) out.append(buf, static_cast<std::size_t>(n));
-  gzclose(gz);
-  return out;
 }
 
 // ---- an independent INRIMAGE reader -------------------------------------------------------------
@@ -158,7 +144,7 @@ void expectSameAsIndependentReader(const mfr::Volume& v, const Inrimage& want) {
 
 TEST(VolumeFiles, CgalSkullInrimage) {
   const fs::path p = cgalImage("skull_2.9.inr");
-  const Inrimage want = parseInrimage(readFile(p));
+  const Inrimage want = parseInrimage(readTestFile(p));
   ASSERT_EQ(want.dims[0], 64);
   const mfr::Volume v = mfr::loadVolume(p);
   EXPECT_EQ(v.name, "skull_2.9.inr");
@@ -178,7 +164,7 @@ TEST(VolumeFiles, CgalSkullInrimage) {
 
 TEST(VolumeFiles, CgalLiverGzippedInrimage) {
   const fs::path p = cgalImage("liver.inr.gz");
-  const Inrimage want = parseInrimage(gunzip(p));
+  const Inrimage want = parseInrimage(readTestFile(p));
   ASSERT_EQ(want.dims[0], 438);
   ASSERT_EQ(want.dims[1], 353);
   ASSERT_EQ(want.dims[2], 165);
@@ -208,7 +194,7 @@ TEST(VolumeFiles, LoadSceneOnTheSkull) {
 }
 
 TEST(VolumeFiles, TruncatedCopiesOfTheSkull) {
-  const std::string whole = readFile(cgalImage("skull_2.9.inr"));
+  const std::string whole = readTestFile(cgalImage("skull_2.9.inr"));
   ASSERT_EQ(whole.size(), 256 + 64u * 64 * 64 * 4);
   const mfr::test::TempDir dir;
   const auto write = [&](const std::string& name, const std::string& bytes) { return dir.write(name, bytes); };

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <functional>
 #include <ios>
+#include <iterator>
 #include <optional>
 #include <string>
 #include <system_error>
@@ -124,6 +125,23 @@ inline void expectFileError(const std::filesystem::path& path, const std::string
 
 inline void expectLoadError(const std::filesystem::path& path, const std::string& reason) {
   expectFileError(path, reason, [&] { return std::to_string(mfr::loadModel(path).size()) + " objects"; });
+}
+
+// A whole file, decompressed when its name ends in .gz (zlib's own reader: independent of the
+// loaders' code); empty when it cannot be read.
+inline std::string readTestFile(const std::filesystem::path& path) {
+  if (path.extension() == ".gz") {
+    gzFile gz = gzopen(path.c_str(), "rb");
+    if (gz == nullptr) return {};
+    std::string out;
+    char buf[1 << 16];
+    int n = 0;
+    while ((n = gzread(gz, buf, sizeof buf)) > 0) out.append(buf, static_cast<std::size_t>(n));
+    gzclose(gz);
+    return out;
+  }
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 struct CliResult {
