@@ -19,6 +19,7 @@ void addDataset(CLI::App& app);
 void addTrain(CLI::App& app);
 void addEvaluate(CLI::App& app);
 void addAllocations(CLI::App& app);
+void addProbe(CLI::App& app);
 
 // "WxH" → (w, h); throws mfr::Error naming the option.
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);

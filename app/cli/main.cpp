@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   mfr::cli::addTrain(app);
   mfr::cli::addEvaluate(app);
   mfr::cli::addAllocations(app);
+  mfr::cli::addProbe(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

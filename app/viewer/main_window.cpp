@@ -33,6 +33,7 @@
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
 #include "method_panel.hpp"
+#include "probe_panel.hpp"
 #include "render_view.hpp"
 #include "scene_tree_panel.hpp"
 #include "stats_panel.hpp"
@@ -318,6 +319,15 @@ void MainWindow::buildDocks() {
   method->raise();
   QDockWidget* stats =
       dock(tr("Statistics"), QStringLiteral("statsDock"), new StatsPanel(*model_), Qt::RightDockWidgetArea);
+  auto* probePanel = new ProbePanel(*model_, *view_);
+  QDockWidget* probe = dock(tr("Probe"), QStringLiteral("probeDock"), probePanel, Qt::RightDockWidgetArea);
+  tabifyDockWidget(stats, probe);
+  stats->raise();
+  // A probe brings its dock to the front (Ctrl + click is the only way to start one).
+  connect(view_, &RenderView::probeRequested, probe, [probe] {
+    probe->show();
+    probe->raise();
+  });
   // The image gets most of the window; panels start narrow (users widen them as they like).
   // Deferred until the window has its size, or the layout overrides it.
   QTimer::singleShot(0, this, [this, scene, stats] {

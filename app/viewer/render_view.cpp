@@ -83,6 +83,9 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
   splitHandle_ = new SplitHandle(this);
   splitHandle_->setObjectName(QStringLiteral("splitHandle"));
   splitHandle_->hide();
+  probeMarker_ = new ProbeMarker(this);
+  probeMarker_->setObjectName(QStringLiteral("probeMarker"));
+  probeMarker_->hide();
   connect(splitHandle_, &SplitHandle::dragged, this,
           [this](int x) { model_.setCompareSplit(static_cast<double>(x) / std::max(1, width())); });
 }
@@ -97,6 +100,7 @@ RenderView::~RenderView() {
 }
 
 void RenderView::releaseGl() {
+  probeRenderer_.reset();
   for (auto& r : previewRenderers_) r.reset();  // they share the scene buffers of renderers_
   for (auto& r : renderers_) r.reset();
   for (auto* targets : {&targets_, &reducedTargets_})
@@ -635,10 +639,74 @@ mfr::ImageRGBA8 RenderView::renderImage(QSize size) {
   }
 }
 
+// ---- pixel probe ---------------------------------------------------------------------------
+
+ViewProbe RenderView::probeAt(QPoint point) {
+  if (!model_.hasScene()) throw mfr::Error("probe", "no scene loaded");
+  const double ratio = devicePixelRatioF();
+  const QPoint device(static_cast<int>(std::floor(point.x() * ratio)), static_cast<int>(std::floor(point.y() * ratio)));
+  ViewProbe result;
+  result.point = point;
+  result.side = -1;
+  for (int side = 0; side < model_.paneCount(); ++side)
+    if (paneVisibleRect(side).contains(device)) result.side = side;
+  if (result.side < 0) throw mfr::Error("probe", "the point is not on an image");
+  const QRect pane = paneRect(result.side);
+  result.paneSize = pane.size();
+  result.method = model_.methodOf(result.side);
+  const QPoint pixel = device - pane.topLeft();
+  result.probe = mfr::probePixel(model_.scene(), model_.camera(), pane.width(), pane.height(), pixel.x(), pixel.y());
+
+  const mfr::MethodInfo* info = model_.isCpuMethod(result.method) ? nullptr : model_.methodInfo(result.method);
+  result.methodHasLists = info != nullptr && info->sortedLists;
+  if (!result.methodHasLists) return result;
+  if (!renderers_[0]) throw mfr::Error("OpenGL", "the view has no OpenGL 4.5 context yet");
+  makeCurrent();
+  struct DoneCurrent {
+    RenderView* view;
+    ~DoneCurrent() { view->doneCurrent(); }
+  } done{this};
+  QStringList errors;
+  if (!uploadSceneIfChanged(result.side, errors))
+    throw mfr::Error(model_.scene().name, errors.join("; ").toStdString());
+  try {
+    if (!probeRenderer_) probeRenderer_ = std::make_unique<mfr::GpuRenderer>();
+    probeRenderer_->shareScene(renderer(result.side));
+    // Room for every exact fragment and more, so a method holding extra ones shows them.
+    const int room = static_cast<int>(std::min<std::size_t>(result.probe.fragments.size() * 2 + 64, 1u << 16));
+    const mfr::CapturedLists lists =
+        probeRenderer_->capture(model_.camera(), model_.renderRequest(result.side, pane.size()), room,
+                                mfr::PixelRect{pixel.x(), pixel.y(), 1, 1});
+    const std::uint32_t count = lists.count(pixel.x(), pixel.y());
+    mfr::matchCapture(result.probe,
+                      {lists.pixel(pixel.x(), pixel.y()), std::min<std::size_t>(count, static_cast<std::size_t>(room))},
+                      count);
+  } catch (...) {
+    mfr::gl::discardErrors();
+    throw;
+  }
+  return result;
+}
+
+void RenderView::setProbeMark(std::optional<QPoint> point) {
+  if (!point) {
+    probeMarker_->hide();
+    return;
+  }
+  probeMarker_->setCentre(*point);
+  probeMarker_->show();
+  probeMarker_->raise();
+}
+
 // ---- navigation ----------------------------------------------------------------------------
 
 void RenderView::mousePressEvent(QMouseEvent* event) {
   lastMouse_ = event->position().toPoint();
+  if (event->button() == Qt::LeftButton && (event->modifiers() & Qt::ControlModifier)) {
+    drag_ = Drag::None;  // a probe, not the start of an orbit
+    emit probeRequested(lastMouse_);
+    return;
+  }
   const bool panGesture = event->button() == Qt::MiddleButton ||
                           (event->button() == Qt::LeftButton && (event->modifiers() & Qt::ShiftModifier));
   drag_ = panGesture ? Drag::Pan : event->button() == Qt::LeftButton ? Drag::Orbit : Drag::None;

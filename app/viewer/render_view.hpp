@@ -20,16 +20,29 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "mfr/gpu_renderer.hpp"
 #include "mfr/image.hpp"
+#include "mfr/reference/probe.hpp"
 #include "viewer_model.hpp"
 
 class MapLegend;
 class QTimer;
 class PaneCaption;
+class ProbeMarker;
 class SplitHandle;
+
+// What the pixel probe found under a point of the view (RenderView::probeAt).
+struct ViewProbe {
+  QPoint point;                 // the probed point (logical widget coordinates)
+  int side = 0;                 // the pane showing it
+  QSize paneSize;               // that pane's image size (device pixels)
+  QString method;               // the pane's method
+  bool methodHasLists = false;  // a GPU method keeping sorted lists: probe.captured says what it holds
+  mfr::PixelProbe probe;        // the oracle's exact list at the pane pixel (probe.x, probe.y)
+};
 
 class RenderView final : public QOpenGLWidget {
   Q_OBJECT
@@ -78,10 +91,21 @@ class RenderView final : public QOpenGLWidget {
   [[nodiscard]] QRect paneRect(int side) const;
   [[nodiscard]] QRect paneVisibleRect(int side) const;
 
+  // The pixel probe at `point` (logical widget coordinates): the pane that shows it, the pixel of
+  // that pane's image, the oracle's exact sorted list there and — for a GPU method keeping sorted
+  // lists — which of those fragments the method holds (GpuRenderer::capture of that one pixel by a
+  // renderer of its own that shares the scene, so probing never changes what a method keeps
+  // between frames). Throws mfr::Error (no scene, no GL yet, a point outside the view).
+  ViewProbe probeAt(QPoint point);
+  // Marks the probed point with a small cross (nothing: no mark).
+  void setProbeMark(std::optional<QPoint> point);
+
  signals:
   void glInitialized();
   // The reduction of the frames being drawn changed (f > 1: navigation previews; 1: full frames).
   void frameReductionChanged(int reduction);
+  // Ctrl + left click: the user asks what lies behind this point (logical widget coordinates).
+  void probeRequested(QPoint point);
 
  protected:
   void initializeGL() override;
@@ -131,6 +155,7 @@ class RenderView final : public QOpenGLWidget {
   // a preview never changes what a method keeps between frames (e.g. pool=previous's count) or
   // reallocates the full frame's buffers.
   std::array<std::unique_ptr<mfr::GpuRenderer>, kSides> previewRenderers_;
+  std::unique_ptr<mfr::GpuRenderer> probeRenderer_;  // the pixel probe's captures (shares a pane's scene)
   std::array<quint64, kSides> uploadedRevision_{0, 0};
   std::array<QString, kSides> uploadError_;
   std::array<PaneTarget, kSides> targets_;
@@ -169,4 +194,5 @@ class RenderView final : public QOpenGLWidget {
   std::array<PaneCaption*, kSides> captions_{};
   std::array<MapLegend*, kSides> legends_{};
   SplitHandle* splitHandle_ = nullptr;
+  ProbeMarker* probeMarker_ = nullptr;
 };

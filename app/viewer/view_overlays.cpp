@@ -112,3 +112,28 @@ void SplitHandle::mousePressEvent(QMouseEvent* event) {
 void SplitHandle::mouseMoveEvent(QMouseEvent* event) {
   if (event->buttons() & Qt::LeftButton) emit dragged(mapToParent(event->position().toPoint()).x());
 }
+
+ProbeMarker::ProbeMarker(QWidget* parent) : QWidget(parent) {
+  setAttribute(Qt::WA_TransparentForMouseEvents);
+  setAttribute(Qt::WA_TranslucentBackground);
+  setFixedSize(kSize, kSize);
+}
+
+void ProbeMarker::setCentre(QPoint centre) {
+  move(centre - QPoint(kSize / 2, kSize / 2));
+}
+
+void ProbeMarker::paintEvent(QPaintEvent*) {
+  QPainter p(this);
+  p.setRenderHint(QPainter::Antialiasing);
+  const QPointF c(kSize / 2.0, kSize / 2.0);
+  // Dark under light, so the mark shows on any image.
+  for (const auto& [colour, width] : {std::pair{QColor(0, 0, 0, 200), 3.0}, std::pair{QColor(255, 255, 0), 1.2}}) {
+    p.setPen(QPen(colour, width));
+    p.drawEllipse(c, kSize / 2.0 - 2.0, kSize / 2.0 - 2.0);
+    p.drawLine(QPointF(c.x(), 1.0), QPointF(c.x(), c.y() - 3.0));
+    p.drawLine(QPointF(c.x(), c.y() + 3.0), QPointF(c.x(), kSize - 1.0));
+    p.drawLine(QPointF(1.0, c.y()), QPointF(c.x() - 3.0, c.y()));
+    p.drawLine(QPointF(c.x() + 3.0, c.y()), QPointF(kSize - 1.0, c.y()));
+  }
+}

@@ -52,3 +52,17 @@ class SplitHandle final : public QWidget {
   void mousePressEvent(QMouseEvent* event) override;
   void mouseMoveEvent(QMouseEvent* event) override;
 };
+
+// The pixel probe's mark: a small cross in a ring centred on the probed point. Transparent for the
+// mouse, so navigation and further probes go to the view under it.
+class ProbeMarker final : public QWidget {
+  Q_OBJECT
+
+ public:
+  explicit ProbeMarker(QWidget* parent = nullptr);
+  static constexpr int kSize = 17;
+  void setCentre(QPoint centre);  // in the parent's coordinates
+
+ protected:
+  void paintEvent(QPaintEvent* event) override;
+};

@@ -225,6 +225,22 @@ glm::dvec2 ViewerModel::volumeValueRange() const {
                                                                       : volumeRanges_[static_cast<std::size_t>(i)];
 }
 
+std::vector<std::uint64_t> ViewerModel::volumeHistogram(double low, double high, int bins) const {
+  const int i = volumeIndex();
+  if (i < 0 || bins < 1 || !std::isfinite(low) || !std::isfinite(high) || !(low < high)) return {};
+  const auto& grid = scene_.volumes[static_cast<std::size_t>(i)].grid;
+  if (!grid) return {};
+  std::vector<std::uint64_t> counts(static_cast<std::size_t>(bins), 0);
+  for (const float sample : grid->values) {
+    const double v = sample;
+    // NaN fails both comparisons; infinities fall outside any finite window.
+    if (!(v >= low && v <= high)) continue;
+    const int bin = std::min(static_cast<int>((v - low) / (high - low) * bins), bins - 1);
+    ++counts[static_cast<std::size_t>(bin)];
+  }
+  return counts;
+}
+
 bool ViewerModel::volumeVisible() const {
   const int i = volumeIndex();
   return i >= 0 && scene_.volumes[static_cast<std::size_t>(i)].visible;

@@ -128,14 +128,15 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] QString resolvedOperation(int side, const QString& operation) const;
   [[nodiscard]] QString effectiveOperation() const override { return effectiveOperationOf(0); }
 
-  // The scalar volume (ViewerContext 1.4); the step is shared by both sides. A new scene (setScene)
-  // starts at step 0 (the default).
+  // The scalar volume (ViewerContext 1.4, volumeHistogram 1.5); the step is shared by both sides.
+  // A new scene (setScene) starts at step 0 (the default).
   [[nodiscard]] bool hasVolume() const override { return volumeIndex() >= 0; }
   [[nodiscard]] QString volumeName() const override;
   [[nodiscard]] glm::ivec3 volumeDims() const override;
   [[nodiscard]] glm::dvec3 volumeSpacing() const override;
   [[nodiscard]] mfr::Bounds volumeBounds() const override;
   [[nodiscard]] glm::dvec2 volumeValueRange() const override;
+  [[nodiscard]] std::vector<std::uint64_t> volumeHistogram(double low, double high, int bins) const override;
   [[nodiscard]] bool volumeVisible() const override;
   void setVolumeVisible(bool visible) override;
   [[nodiscard]] bool volumeShading() const override;

@@ -15,6 +15,7 @@
 #include <QVector>
 #include <QtPlugin>
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -136,6 +137,11 @@ class ViewerContext : public QObject {
   [[nodiscard]] virtual mfr::Bounds volumeBounds() const = 0;  // world bounds of the grid's domain
   // Smallest and largest sample (VolumeGrid::range, computed once per scene).
   [[nodiscard]] virtual glm::dvec2 volumeValueRange() const = 0;
+  // 1.5: counts of the volume's finite samples in `bins` equal bins over [low, high] (sample v in
+  // bin floor((v - low) / (high - low) * bins), v = high in the last); samples outside are not
+  // counted. Empty without a volume, for bins < 1, or unless low < high (both finite). Computed
+  // anew on each call (one pass over the grid): callers cache it.
+  [[nodiscard]] virtual std::vector<std::uint64_t> volumeHistogram(double low, double high, int bins) const = 0;
   // Whether it is drawn (Volume::visible); showing it hides any other volume of the scene.
   [[nodiscard]] virtual bool volumeVisible() const = 0;
   virtual void setVolumeVisible(bool visible) = 0;
@@ -199,5 +205,6 @@ class MfrViewerPlugin {
 // 1.3: operation zthickness and its thickness, supportsOperation, per-object opacity.
 // 1.4: the scalar volume (operation volume): presence, dims, bounds, visibility, transfer function
 //      (presets, table), ray-march step, shading, effectiveOperation, volumeChanged.
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.4"
+// 1.5: volumeHistogram (the transfer-function editor's background).
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.5"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -308,20 +308,30 @@ std::vector<std::uint32_t> GpuRenderer::depthComplexity(const Camera& camera, in
   return flipRows(raw, width, height);
 }
 
-CapturedLists GpuRenderer::capture(const Camera& camera, const RenderRequest& request, int maxPerPixel) {
+CapturedLists GpuRenderer::capture(const Camera& camera, const RenderRequest& request, int maxPerPixel,
+                                   const PixelRect& region) {
   Method& method = prepare(request);
   const int w = request.width, h = request.height;
-  const std::size_t pixels = static_cast<std::size_t>(w) * h;
+  PixelRect r = region.empty() ? PixelRect{0, 0, w, h} : region;
+  if (r.x < 0 || r.y < 0 || static_cast<long long>(r.x) + r.width > w || static_cast<long long>(r.y) + r.height > h)
+    throw Error("pixel region", std::to_string(r.width) + "x" + std::to_string(r.height) + " at (" +
+                                    std::to_string(r.x) + ", " + std::to_string(r.y) + ") is not inside the " +
+                                    std::to_string(w) + "x" + std::to_string(h) + " image");
+  if (maxPerPixel < 1) throw Error("capture", "at least one fragment per pixel must be kept");
+  const std::size_t pixels = static_cast<std::size_t>(r.width) * r.height;
   gl::Buffer fragments = gl::createBuffer(pixels * static_cast<std::size_t>(maxPerPixel) * 8);
   gl::Buffer counts = gl::createBuffer(pixels * 4);
   const GLuint zero = 0;
   glClearNamedBufferData(counts.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
   glClearNamedBufferData(fragments.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  // The region in GL window coordinates (rows bottom-up).
+  const glm::ivec2 glOrigin(r.x, h - r.y - r.height);
   Operation dump{"dump", "ops/dump.glsl", [&](const gl::Program& p) {
                    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_DUMP, fragments.id());
                    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_DUMP_COUNT, counts.id());
                    p.set("uDumpMax", static_cast<unsigned>(maxPerPixel));
-                   p.set("uDumpWidth", w);
+                   p.set("uDumpOrigin", glOrigin);
+                   p.set("uDumpSize", glm::ivec2(r.width, r.height));
                  }};
   gl::Texture color = gl::createTexture2D(GL_RGBA8, w, h);
   gl::Framebuffer fbo = gl::createFramebuffer();
@@ -339,8 +349,10 @@ CapturedLists GpuRenderer::capture(const Camera& camera, const RenderRequest& re
   timer.collect();
 
   CapturedLists out;
-  out.width = w;
-  out.height = h;
+  out.x0 = r.x;
+  out.y0 = r.y;
+  out.width = r.width;
+  out.height = r.height;
   out.maxPerPixel = maxPerPixel;
   std::vector<std::uint32_t> rawCounts(pixels);
   std::vector<std::uint32_t> raw(pixels * static_cast<std::size_t>(maxPerPixel) * 2);
@@ -349,10 +361,10 @@ CapturedLists GpuRenderer::capture(const Camera& camera, const RenderRequest& re
   out.counts.resize(pixels);
   out.fragments.resize(pixels * static_cast<std::size_t>(maxPerPixel));
   // GL rows are bottom-up; CapturedLists uses image rows (top-down) like the oracle.
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const std::size_t src = static_cast<std::size_t>(h - 1 - y) * w + x;
-      const std::size_t dst = static_cast<std::size_t>(y) * w + x;
+  for (int y = 0; y < r.height; ++y)
+    for (int x = 0; x < r.width; ++x) {
+      const std::size_t src = static_cast<std::size_t>(r.height - 1 - y) * r.width + x;
+      const std::size_t dst = static_cast<std::size_t>(y) * r.width + x;
       out.counts[dst] = rawCounts[src];
       for (int i = 0; i < maxPerPixel; ++i) {
         const std::size_t s = (src * static_cast<std::size_t>(maxPerPixel) + static_cast<std::size_t>(i)) * 2;

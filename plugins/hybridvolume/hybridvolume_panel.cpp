@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "transfer_function_editor.hpp"
 #include "viewer_plugin.hpp"
 
 namespace {
@@ -59,6 +60,17 @@ mfr::TransferFunction transferFromJson(const QJsonObject& json) {
         {p[0].toDouble(), glm::vec4(glm::dvec4(p[1].toDouble(), p[2].toDouble(), p[3].toDouble(), p[4].toDouble()))});
   }
   return t;
+}
+
+QDoubleSpinBox* unitSpinBox(const char* name, const QString& tip) {
+  auto* box = new QDoubleSpinBox;
+  box->setObjectName(QLatin1String(name));
+  box->setRange(0.0, 1.0);
+  box->setDecimals(3);
+  box->setSingleStep(0.01);
+  box->setKeyboardTracking(false);
+  box->setToolTip(tip);
+  return box;
 }
 
 QString bytesText(double bytes) {
@@ -138,6 +150,38 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
          "volume read as surfaces; homogeneous regions stay unshaded"));
   form->addRow(tr("Shading"), shade_);
 
+  editor_ = new TransferFunctionEditor;
+  editor_->setObjectName(QStringLiteral("hvTransferEditor"));
+  form->addRow(editor_);
+  pointFields_ = new QWidget;
+  auto* pointForm = new QFormLayout(pointFields_);
+  pointForm->setContentsMargins(0, 0, 0, 0);
+  pointValue_ = new QDoubleSpinBox;
+  pointValue_->setObjectName(QStringLiteral("hvPointValue"));
+  pointValue_->setDecimals(6);
+  pointValue_->setRange(-1.0e12, 1.0e12);
+  pointValue_->setKeyboardTracking(false);
+  pointValue_->setToolTip(tr("The selected point's scalar value (the end points stay at the window's ends)"));
+  pointOpacity_ = unitSpinBox("hvPointOpacity", tr("The selected point's opacity: what one unit distance absorbs"));
+  pointOpacity_->setDecimals(4);
+  auto* pointRow = new QHBoxLayout;
+  pointRow->addWidget(pointValue_, 3);
+  pointRow->addWidget(new QLabel(tr("opacity")));
+  pointRow->addWidget(pointOpacity_, 2);
+  pointForm->addRow(tr("Point"), pointRow);
+  pointRed_ = unitSpinBox("hvPointRed", tr("The selected point's red, 0 … 1"));
+  pointGreen_ = unitSpinBox("hvPointGreen", tr("The selected point's green, 0 … 1"));
+  pointBlue_ = unitSpinBox("hvPointBlue", tr("The selected point's blue, 0 … 1"));
+  pointColor_ = new QPushButton;
+  pointColor_->setObjectName(QStringLiteral("hvPointColor"));
+  pointColor_->setToolTip(tr("Choose the selected point's colour"));
+  pointColor_->setFixedWidth(pointColor_->sizeHint().height() * 3 / 2);
+  auto* colorRow = new QHBoxLayout;
+  for (QDoubleSpinBox* box : {pointRed_, pointGreen_, pointBlue_}) colorRow->addWidget(box, 1);
+  colorRow->addWidget(pointColor_);
+  pointForm->addRow(tr("Colour"), colorRow);
+  form->addRow(pointFields_);
+
   preview_ = new QLabel;
   preview_->setObjectName(QStringLiteral("hvPreview"));
   preview_->setMinimumHeight(28);
@@ -192,8 +236,19 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   connect(&context_, &ViewerContext::volumeChanged, this, &HybridVolumePanel::volumeChanged);
   connect(&context_, &ViewerContext::frameRendered, this, &HybridVolumePanel::showInfo);
   connect(preset_, &QComboBox::currentIndexChanged, this, &HybridVolumePanel::applyTransfer);
-  connect(windowMin_, &QDoubleSpinBox::valueChanged, this, &HybridVolumePanel::applyTransfer);
-  connect(windowMax_, &QDoubleSpinBox::valueChanged, this, &HybridVolumePanel::applyTransfer);
+  connect(windowMin_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+    windowLow_ = v;
+    applyTransfer();
+  });
+  connect(windowMax_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+    windowHigh_ = v;
+    applyTransfer();
+  });
+  connect(editor_, &TransferFunctionEditor::edited, this, &HybridVolumePanel::applyEditor);
+  connect(editor_, &TransferFunctionEditor::selectionChanged, this, &HybridVolumePanel::showSelectedPoint);
+  for (QDoubleSpinBox* box : {pointValue_, pointOpacity_, pointRed_, pointGreen_, pointBlue_})
+    connect(box, &QDoubleSpinBox::valueChanged, this, &HybridVolumePanel::editSelectedPoint);
+  connect(pointColor_, &QPushButton::clicked, this, [this] { editor_->editPointColor(editor_->selectedPoint()); });
   connect(opacity_, &QSlider::valueChanged, this, [this] {
     showScaleValue();
     applyTransfer();
@@ -227,6 +282,10 @@ void HybridVolumePanel::volumeChanged() {
   show_->setEnabled(has);
   if (!has) {
     sceneKey_.clear();
+    editor_->setPoints({});
+    editor_->setHistogram({});
+    histogramKey_.clear();
+    showSelectedPoint();
     info_->setText(tr("The scene has no volume: open a .vti, .vtk, .mhd/.mha, .nrrd or .inr file, or @volume."));
     showState();
     return;
@@ -249,7 +308,7 @@ void HybridVolumePanel::volumeChanged() {
     const QSignalBlocker blockShade(shade_);
     shade_->setChecked(context_.volumeShading());
   }
-  showPreview();
+  showFunction();
   showStep();
   showState();
   showInfo();
@@ -264,22 +323,25 @@ void HybridVolumePanel::resetToCurrent() {
     const double span = std::max(std::abs(base_.high() - base_.low()), 1e-12);
     for (QDoubleSpinBox* box : {windowMin_, windowMax_})
       box->setSingleStep(std::pow(10.0, std::floor(std::log10(span)) - 1.0));
-    windowMin_->setValue(base_.low());
-    windowMax_->setValue(base_.high());
+    windowLow_ = base_.low();
+    windowHigh_ = base_.high();
+    windowMin_->setValue(windowLow_);
+    windowMax_->setValue(windowHigh_);
   }
   opacity_->setValue(logPosition(1.0, kMinScale, kMaxScale));
   showScaleValue();
-  showPreview();
+  showFunction();
 }
 
 mfr::TransferFunction HybridVolumePanel::composed() const {
-  const double lo = windowMin_->value(), hi = windowMax_->value();
+  const double lo = windowLow_, hi = windowHigh_;
   const double unit = base_.unitDistance / opacityScale();
   const QString mode = preset_->currentData().toString();
   if (mode != kCustom) return context_.transferPreset(mode, lo, hi, unit);
   mfr::TransferFunction t = base_;
   t.unitDistance = unit;
-  if (base_.points.size() >= 2 && base_.high() > base_.low()) {
+  // Points already spanning the window (the editor's, the loaded ones) stay exactly as they are.
+  if (base_.points.size() >= 2 && base_.high() > base_.low() && (base_.low() != lo || base_.high() != hi)) {
     const double from = base_.low(), span = base_.high() - base_.low();
     for (mfr::TransferPoint& p : t.points) p.value = lo + (p.value - from) / span * (hi - lo);
   }
@@ -289,7 +351,7 @@ mfr::TransferFunction HybridVolumePanel::composed() const {
 void HybridVolumePanel::applyTransfer() {
   if (!context_.hasVolume()) return;
   QString reason;
-  if (!(windowMin_->value() < windowMax_->value())) {
+  if (!(windowLow_ < windowHigh_)) {
     reason = tr("window: the minimum must be below the maximum");
   } else {
     const mfr::TransferFunction t = composed();
@@ -299,7 +361,84 @@ void HybridVolumePanel::applyTransfer() {
   }
   error_->setText(reason);
   error_->setVisible(!reason.isEmpty());
+  showFunction();
+}
+
+void HybridVolumePanel::showFunction() {
   showPreview();
+  showEditor();
+  showSelectedPoint();
+}
+
+void HybridVolumePanel::showEditor() {
+  const mfr::TransferFunction t = context_.transferFunction();
+  editor_->setPoints(t.points);
+  if (t.points.size() < 2 || !(t.high() > t.low())) return;
+  // One pass over the grid: only for another volume or range, not for each edit of the points.
+  const QString key = QStringLiteral("%1|%2|%3").arg(sceneKey_).arg(t.low(), 0, 'g', 17).arg(t.high(), 0, 'g', 17);
+  if (key == histogramKey_) return;
+  histogramKey_ = key;
+  editor_->setHistogram(context_.volumeHistogram(t.low(), t.high(), TransferFunctionEditor::kHistogramBins));
+}
+
+void HybridVolumePanel::showSelectedPoint() {
+  const int index = editor_->selectedPoint();
+  const std::vector<mfr::TransferPoint>& points = editor_->points();
+  const bool has = index >= 0 && index < static_cast<int>(points.size());
+  pointFields_->setEnabled(has);
+  const QSignalBlocker blockValue(pointValue_), blockOpacity(pointOpacity_), blockRed(pointRed_),
+      blockGreen(pointGreen_), blockBlue(pointBlue_);
+  if (!has) {
+    for (QDoubleSpinBox* box : {pointValue_, pointOpacity_, pointRed_, pointGreen_, pointBlue_}) box->setValue(0.0);
+    pointColor_->setStyleSheet(QString());
+    return;
+  }
+  const mfr::TransferPoint& p = points[static_cast<std::size_t>(index)];
+  // The end points' values are the window's.
+  pointValue_->setEnabled(index > 0 && index + 1 < static_cast<int>(points.size()));
+  const double span = points.back().value - points.front().value;
+  pointValue_->setSingleStep(std::pow(10.0, std::floor(std::log10(std::max(span, 1e-12))) - 2.0));
+  pointValue_->setValue(p.value);
+  pointOpacity_->setValue(p.color.a);
+  pointRed_->setValue(p.color.r);
+  pointGreen_->setValue(p.color.g);
+  pointBlue_->setValue(p.color.b);
+  pointColor_->setStyleSheet(
+      QStringLiteral("background-color: %1;").arg(QColor::fromRgbF(p.color.r, p.color.g, p.color.b).name()));
+}
+
+void HybridVolumePanel::editSelectedPoint() {
+  const int index = editor_->selectedPoint();
+  if (index < 0 || index >= static_cast<int>(editor_->points().size())) return;
+  const QObject* from = sender();
+  const mfr::TransferPoint p = editor_->points()[static_cast<std::size_t>(index)];
+  // Only the field the user changed: the others show rounded values and would round the point.
+  if (from == pointValue_ || from == pointOpacity_) {
+    editor_->movePoint(index, from == pointValue_ ? pointValue_->value() : p.value,
+                       from == pointOpacity_ ? pointOpacity_->value() : p.color.a);
+  } else {
+    glm::vec3 rgb(p.color);
+    if (from == pointRed_) rgb.r = static_cast<float>(pointRed_->value());
+    if (from == pointGreen_) rgb.g = static_cast<float>(pointGreen_->value());
+    if (from == pointBlue_) rgb.b = static_cast<float>(pointBlue_->value());
+    editor_->setPointColor(index, rgb);
+  }
+  showSelectedPoint();  // a clamped value shows as applied
+}
+
+void HybridVolumePanel::applyEditor() {
+  if (!context_.hasVolume()) return;
+  // The edited points become Custom's own; their ends are the function's range, the window.
+  base_.points = editor_->points();
+  windowLow_ = base_.low();
+  windowHigh_ = base_.high();
+  {
+    const QSignalBlocker blockPreset(preset_), blockMin(windowMin_), blockMax(windowMax_);
+    preset_->setCurrentIndex(preset_->findData(kCustom));
+    windowMin_->setValue(windowLow_);
+    windowMax_->setValue(windowHigh_);
+  }
+  applyTransfer();
 }
 
 void HybridVolumePanel::showPreview() {
@@ -429,7 +568,7 @@ void HybridVolumePanel::showInfo() {
 QJsonObject HybridVolumePanel::saveSettings() const {
   return {{QStringLiteral("show"), show_->isChecked()},
           {QStringLiteral("preset"), preset_->currentData().toString()},
-          {QStringLiteral("window"), QJsonArray{windowMin_->value(), windowMax_->value()}},
+          {QStringLiteral("window"), QJsonArray{windowLow_, windowHigh_}},
           {QStringLiteral("opacity_scale"), opacityScale()},
           {QStringLiteral("shading"), shade_->isChecked()},
           {QStringLiteral("base"), transferToJson(base_)},
@@ -451,8 +590,10 @@ void HybridVolumePanel::loadSettings(const QJsonObject& settings) {
     preset_->setCurrentIndex(preset >= 0 ? preset : preset_->findData(kCustom));
     const QJsonArray window = settings.value(QStringLiteral("window")).toArray();
     if (window.size() == 2) {
-      windowMin_->setValue(window[0].toDouble());
-      windowMax_->setValue(window[1].toDouble());
+      windowLow_ = window[0].toDouble();
+      windowHigh_ = window[1].toDouble();
+      windowMin_->setValue(windowLow_);
+      windowMax_->setValue(windowHigh_);
     }
     const double scale = settings.value(QStringLiteral("opacity_scale")).toDouble(1.0);
     opacity_->setValue(logPosition(scale, kMinScale, kMaxScale));

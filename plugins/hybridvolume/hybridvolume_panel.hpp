@@ -4,10 +4,18 @@
 //   choosing abuffer-sbuffer when the current method keeps no sorted lists
 //   (ViewerContext::supportsOperation); off, it hides the volume and brings back the method and
 //   operation it replaced.
-// - Transfer function: a preset (mfr::transferPresetNames) or "Custom" (the function as loaded, or
-//   one set elsewhere), mapped onto a window [min, max] of scalar values; an opacity scale on a
-//   logarithmic slider multiplies the extinction (divides the unit distance); "As Loaded" brings
-//   back the scene's own function. A strip previews the 256-entry table the renderers sample.
+// - Transfer function: a preset (mfr::transferPresetNames) or "Custom" (the function as loaded, one
+//   set elsewhere, or the editor's points), mapped onto a window [min, max] of scalar values; an
+//   opacity scale on a logarithmic slider multiplies the extinction (divides the unit distance);
+//   "As Loaded" brings back the scene's own function. A strip previews the 256-entry table the
+//   renderers sample.
+// - The editor (TransferFunctionEditor) shows the function applied, over the window, on a histogram
+//   of the volume, and edits its points; under it the selected point's value, opacity and colour
+//   in spin boxes. An edit switches the preset to Custom with the edited points as its own (their
+//   ends are the window's, so they apply unchanged; a later window stretches them) and applies them
+//   live. The points' opacities are those of the scene's unit distance: the opacity scale stays a
+//   separate factor on the extinction, so editing never moves the scale and the scale never moves
+//   the points.
 // - Step: a logarithmic slider (0.1× … 10× the default), a spin box in scene units and Default,
 //   all on ViewerContext::volumeStep (shared with the method panel's Step row).
 // - An info line: grid size, spacing, value range, and the last frame's step and GPU bytes (its
@@ -21,7 +29,9 @@ class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
+class QPushButton;
 class QSlider;
+class TransferFunctionEditor;
 class ViewerContext;
 
 class HybridVolumePanel final : public QWidget {
@@ -51,7 +61,12 @@ class HybridVolumePanel final : public QWidget {
   [[nodiscard]] mfr::TransferFunction composed() const;
   [[nodiscard]] double opacityScale() const;
   void showScaleValue();
+  void showFunction();  // the preview strip, the editor and its histogram, the point's fields
   void showPreview();
+  void showEditor();
+  void showSelectedPoint();
+  void applyEditor();  // the editor's points as Custom's
+  void editSelectedPoint();
   void showStep();
   void stepFromSlider(int position);
   void showInfo();
@@ -66,6 +81,14 @@ class HybridVolumePanel final : public QWidget {
   QCheckBox* shade_ = nullptr;
   QLabel* opacityValue_ = nullptr;
   QLabel* preview_ = nullptr;
+  TransferFunctionEditor* editor_ = nullptr;
+  QDoubleSpinBox* pointValue_ = nullptr;
+  QDoubleSpinBox* pointOpacity_ = nullptr;
+  QDoubleSpinBox* pointRed_ = nullptr;
+  QDoubleSpinBox* pointGreen_ = nullptr;
+  QDoubleSpinBox* pointBlue_ = nullptr;
+  QPushButton* pointColor_ = nullptr;
+  QWidget* pointFields_ = nullptr;
   QLabel* error_ = nullptr;
   QSlider* stepSlider_ = nullptr;
   QDoubleSpinBox* step_ = nullptr;
@@ -73,6 +96,11 @@ class HybridVolumePanel final : public QWidget {
   QWidget* controls_ = nullptr;
 
   QString sceneKey_;               // the volume the panel was set up for
+  QString histogramKey_;           // the volume and range of the editor's histogram
+  // The window, exact (the spin boxes show it rounded to their decimals): the function's own range
+  // after resetToCurrent, so Custom applies it unchanged and sessions restore it to the bit.
+  double windowLow_ = 0.0;
+  double windowHigh_ = 1.0;
   mfr::TransferFunction base_;     // Custom's points (over their own range) and the unit distance at scale 1
   mfr::TransferFunction applied_;  // what the panel last set (another function: an edit from elsewhere)
   QString previousOperation_;      // replaced by "volume" when the switch went on, else empty

@@ -5,7 +5,8 @@
 QString HybridVolumePlugin::description() const {
   return tr(
       "Volume panel: show the scene's scalar volume between the sorted surfaces (operation volume), with a "
-      "transfer-function preset, window, opacity scale and preview, and the ray-march step.");
+      "transfer-function preset, window, opacity scale, preview and editor (control points over a histogram of "
+      "the values), and the ray-march step.");
 }
 
 QWidget* HybridVolumePlugin::createPanel(ViewerContext& context, QWidget* parent) {

@@ -2,11 +2,13 @@
 // server with Mesa llvmpipe. Each test function is one ctest test (tests/app/CMakeLists.txt).
 #include <QAction>
 #include <QCheckBox>
+#include <QColorDialog>
 #include <QComboBox>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
 #include <QJsonArray>
 #include <QLineEdit>
+#include <QLabel>
 #include <QListWidget>
 #include <QMessageBox>
 #include <QPlainTextEdit>
@@ -32,6 +34,7 @@
 
 #include "camera_navigator.hpp"
 #include "main_window.hpp"
+#include "probe_panel.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/methods/registry.hpp"
@@ -122,6 +125,138 @@ void writeSceneFile(const QString& path, const QString& model, int objects) {
   json += QStringLiteral("{\"name\": \"ball\", \"primitive\": {\"type\": \"sphere\", \"radius\": 0.5}}]}");
   QFile f(path);
   if (f.open(QIODevice::WriteOnly)) f.write(json.toUtf8());
+}
+
+// A small volume scene for the transfer-function editor tests, written into `dir`: blob.vti (20³
+// points, spacing 0.1, a Gaussian blob with values in (0, 1)), a translucent ball beside it, the view
+// "iso", and `transfer` as the volume's transfer function (numbers written to round-trip exactly).
+QString writeBlobScene(const QTemporaryDir& dir, const QString& name, const mfr::TransferFunction& transfer) {
+  const QString vti = dir.filePath(QStringLiteral("blob.vti"));
+  if (!QFile::exists(vti)) {
+    constexpr int n = 20;
+    QString values;
+    for (int k = 0; k < n; ++k)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          const double dx = 0.1 * i - 0.95, dy = 0.1 * j - 0.95, dz = 0.1 * k - 0.95;
+          values += QString::number(std::exp(-(dx * dx + dy * dy + dz * dz) / (2 * 0.35 * 0.35)), 'g', 9) + ' ';
+        }
+    QFile f(vti);
+    if (!f.open(QIODevice::WriteOnly)) return {};
+    f.write(QStringLiteral("<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" "
+                           "byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"0 19 0 19 0 19\" Origin=\"0 0 0\" "
+                           "Spacing=\"0.1 0.1 0.1\">\n<Piece Extent=\"0 19 0 19 0 19\"><PointData><DataArray "
+                           "type=\"Float32\" Name=\"blob\" format=\"ascii\">%1</DataArray></PointData><CellData>"
+                           "</CellData></Piece>\n</ImageData>\n</VTKFile>\n")
+                .arg(values)
+                .toUtf8());
+  }
+  QJsonArray points;
+  for (const mfr::TransferPoint& p : transfer.points)
+    points.append(QJsonArray{p.value, p.color.r, p.color.g, p.color.b, p.color.a});
+  const QJsonObject ball{{"name", "ball"},
+                         {"primitive", QJsonObject{{"type", "sphere"}, {"radius", 0.35}}},
+                         {"color", QJsonArray{0.9, 0.3, 0.2}},
+                         {"opacity", 0.5},
+                         {"transform", QJsonObject{{"translate", QJsonArray{1.5, 1.3, 1.4}}}}};
+  const QJsonObject volume{{"name", "blob"},
+                           {"file", "blob.vti"},
+                           {"transfer", QJsonObject{{"points", points}, {"unit_distance", transfer.unitDistance}}}};
+  const QJsonObject iso{
+      {"name", "iso"}, {"eye", QJsonArray{4.0, 3.0, 5.0}}, {"target", QJsonArray{0.95, 0.95, 0.95}}, {"fit", true}};
+  const QJsonObject scene{
+      {"name", "blob"}, {"objects", QJsonArray{ball}}, {"volumes", QJsonArray{volume}}, {"views", QJsonArray{iso}}};
+  const QString path = dir.filePath(name);
+  QFile f(path);
+  if (!f.open(QIODevice::WriteOnly)) return {};
+  f.write(QJsonDocument(scene).toJson());
+  return path;
+}
+
+// The blob scene's function as loaded: transparent black at 0, opaque warm white at 1.
+mfr::TransferFunction blobTransfer() {
+  mfr::TransferFunction t;
+  t.unitDistance = 0.2;
+  t.points = {{0.0, {0.0f, 0.0f, 0.2f, 0.0f}}, {1.0, {1.0f, 0.9f, 0.6f, 0.8f}}};
+  return t;
+}
+
+// The Volume panel's transfer-function editor, reached through its meta-object (the plugin is not
+// linked into the tests): its value↔pixel mapping and what it shows.
+struct EditorProbe {
+  QWidget* editor = nullptr;
+
+  [[nodiscard]] double call(const char* name, double arg) const {
+    double result = std::nan("");
+    QMetaObject::invokeMethod(editor, name, Qt::DirectConnection, Q_RETURN_ARG(double, result), Q_ARG(double, arg));
+    return result;
+  }
+  [[nodiscard]] double x(double value) const { return call("xForValue", value); }
+  [[nodiscard]] double y(double opacity) const { return call("yForOpacity", opacity); }
+  [[nodiscard]] double value(double x) const { return call("valueForX", x); }
+  [[nodiscard]] double opacity(double y) const { return call("opacityForY", y); }
+  // The pixel nearest (value, opacity).
+  [[nodiscard]] QPoint at(double value, double opacity) const {
+    return {static_cast<int>(std::lround(x(value))), static_cast<int>(std::lround(y(opacity)))};
+  }
+  [[nodiscard]] QPoint at(const mfr::TransferPoint& p) const { return at(p.value, p.color.a); }
+  [[nodiscard]] QRectF plot() const {
+    QRectF r;
+    QMetaObject::invokeMethod(editor, "plotRect", Qt::DirectConnection, Q_RETURN_ARG(QRectF, r));
+    return r;
+  }
+  // One pixel's worth of value (over the function's range) and of opacity.
+  [[nodiscard]] double valuePixel(const mfr::TransferFunction& t) const {
+    return (t.high() - t.low()) / plot().width();
+  }
+  [[nodiscard]] double opacityPixel() const { return 1.0 / plot().height(); }
+  [[nodiscard]] int selected() const {
+    int index = -2;
+    QMetaObject::invokeMethod(editor, "selectedPoint", Qt::DirectConnection, Q_RETURN_ARG(int, index));
+    return index;
+  }
+  [[nodiscard]] QList<quint64> histogram() const {
+    QList<quint64> counts;
+    QMetaObject::invokeMethod(editor, "histogramCounts", Qt::DirectConnection, Q_RETURN_ARG(QList<quint64>, counts));
+    return counts;
+  }
+  void drag(const QPoint& from, const QPoint& to) const {
+    QTest::mousePress(editor, Qt::LeftButton, {}, from);
+    // Through a point halfway, as a hand would: the editor follows every move.
+    QTest::mouseMove(editor, (from + to) / 2);
+    QTest::mouseMove(editor, to);
+    QTest::mouseRelease(editor, Qt::LeftButton, {}, to);
+  }
+};
+
+// Counts of the grid's values in `bins` equal bins over [low, high], computed here as
+// ViewerContext::volumeHistogram documents it (v = high in the last bin, values outside skipped).
+std::vector<std::uint64_t> histogramOf(const mfr::VolumeGrid& grid, double low, double high, int bins) {
+  std::vector<std::uint64_t> counts(static_cast<std::size_t>(bins), 0);
+  const double width = (high - low) / bins;
+  for (const float value : grid.values) {
+    const double v = value;
+    if (v < low || v > high) continue;
+    // By the bin width rather than the documented (v - low) / (high - low) · bins: the tests use
+    // power-of-two widths, where both are exact, so any difference is the viewer's.
+    int b = static_cast<int>(std::floor((v - low) / width));
+    b = std::clamp(b, 0, bins - 1);
+    ++counts[static_cast<std::size_t>(b)];
+  }
+  return counts;
+}
+
+bool samePoints(const mfr::TransferFunction& a, const mfr::TransferFunction& b) {
+  if (a.points.size() != b.points.size() || a.unitDistance != b.unitDistance) return false;
+  for (std::size_t i = 0; i < a.points.size(); ++i)
+    if (a.points[i].value != b.points[i].value || a.points[i].color != b.points[i].color) return false;
+  return true;
+}
+
+bool ascending(const mfr::TransferFunction& t) {
+  for (std::size_t i = 1; i < t.points.size(); ++i)
+    if (!(t.points[i].value > t.points[i - 1].value)) return false;
+  return true;
 }
 
 // Every fraction a loader reports; optionally cancels at report number `cancelAt` (1-based).
@@ -1236,6 +1371,292 @@ class ViewerTest : public QObject {
     QVERIFY(!show->isChecked());
   }
 
+  // The Volume panel's transfer-function editor on a small .vti scene, driven by synthesised mouse
+  // and key events at positions from its own value↔pixel mapping: a click adds a point at the
+  // clicked value and opacity, a drag moves it, a drag past a neighbour stops short of it, the ends
+  // keep their values, removal never leaves fewer than two points, keys and the point's spin boxes
+  // edit it, a double click sets its colour, a preset becomes Custom when edited; the histogram is
+  // the grid's; the edited image differs from the loaded one and equals `mfr render` of a scene
+  // file with the same points.
+  void transferFunctionEditor() {
+    QTemporaryDir dir;
+    const QString scenePath = writeBlobScene(dir, "blob.mfrscene", blobTransfer());
+    QVERIFY(!scenePath.isEmpty());
+    auto w = openWindow(scenePath);
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    QVERIFY2(w->findChild<QDockWidget*>("plugin-hybridvolume"), "hybridvolume plugin not loaded");
+    const QSize size(200, 150);
+    w->view().setFixedSize(size);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), size, kTimeoutMs);
+    m.setMethod("abuffer-ll");
+    m.setOperation("volume");
+    m.setVolumeStep(0.02);
+    m.setCamera(m.scene().view("iso"));
+    auto* preset = w->findChild<QComboBox*>("hvPreset");
+    auto* error = w->findChild<QLabel*>("hvError");
+    auto* pointValue = w->findChild<QDoubleSpinBox*>("hvPointValue");
+    auto* pointOpacity = w->findChild<QDoubleSpinBox*>("hvPointOpacity");
+    auto* pointRed = w->findChild<QDoubleSpinBox*>("hvPointRed");
+    EditorProbe probe{w->findChild<QWidget*>("hvTransferEditor")};
+    QVERIFY(preset && error && pointValue && pointOpacity && pointRed && probe.editor);
+    QTRY_VERIFY_WITH_TIMEOUT(probe.editor->isVisible(), kTimeoutMs);  // the panel comes to the front
+    qInfo("editor %dx%d, plot %.0fx%.0f", probe.editor->width(), probe.editor->height(), probe.plot().width(),
+          probe.plot().height());
+    QVERIFY(probe.plot().width() >= 100 && probe.plot().height() >= 60);
+    const mfr::TransferFunction loaded = m.transferFunction();
+    QVERIFY(samePoints(loaded, blobTransfer()));
+    // A pixel's worth of value and opacity, now (the dock may change the editor's size).
+    const auto dv = [&] { return probe.valuePixel(m.transferFunction()); };
+    const auto da = [&] { return probe.opacityPixel(); };
+    QCOMPARE(probe.x(0.0), probe.plot().left());
+    QCOMPARE(probe.x(1.0), probe.plot().right());
+    settle(m);
+    const mfr::ImageRGBA8 loadedImage = w->view().renderImage(size);
+
+    // The histogram: the viewer's counts are the grid's, outside values skipped, and the editor
+    // shows them over the function's range.
+    const mfr::VolumeGrid& grid = *m.scene().visibleVolume()->grid;
+    const std::vector<std::uint64_t> all = histogramOf(grid, 0.0, 1.0, 128);
+    QVERIFY(m.volumeHistogram(0.0, 1.0, 128) == all);
+    std::uint64_t total = 0;
+    for (const std::uint64_t c : all) total += c;
+    QCOMPARE(total, static_cast<std::uint64_t>(grid.values.size()));  // every value lies in [0, 1]
+    const std::vector<std::uint64_t> middle = histogramOf(grid, 0.25, 0.75, 8);
+    QVERIFY(m.volumeHistogram(0.25, 0.75, 8) == middle);
+    QVERIFY(std::count(middle.begin(), middle.end(), 0u) == 0);
+    QVERIFY(m.volumeHistogram(1.0, 0.0, 8).empty() && m.volumeHistogram(0.0, 1.0, 0).empty());
+    QCOMPARE(probe.histogram(), QList<quint64>(all.begin(), all.end()));
+
+    // A click on empty space adds a point there, interpolating the colour; the ends stay.
+    QTest::mouseClick(probe.editor, Qt::LeftButton, {}, probe.at(0.4, 0.7));
+    mfr::TransferFunction t = m.transferFunction();
+    QCOMPARE(t.points.size(), std::size_t{3});
+    qInfo("click at (0.4, 0.7) added (%.6f, %.6f); a pixel is %.6f in value, %.6f in opacity", t.points[1].value,
+          t.points[1].color.a, dv(), da());
+    QVERIFY(std::abs(t.points[1].value - 0.4) <= dv());
+    QVERIFY(std::abs(t.points[1].color.a - 0.7) <= da());
+    {
+      const double f = t.points[1].value;  // the loaded function is linear over [0, 1]
+      const glm::vec4 expected = glm::mix(loaded.points[0].color, loaded.points[1].color, static_cast<float>(f));
+      for (int c = 0; c < 3; ++c) QVERIFY(std::abs(t.points[1].color[c] - expected[c]) < 1e-6f);
+    }
+    QCOMPARE(t.points.front().value, 0.0);
+    QCOMPARE(t.points.back().value, 1.0);
+    QCOMPARE(t.unitDistance, loaded.unitDistance);
+    QCOMPARE(probe.selected(), 1);
+    QVERIFY(std::abs(pointValue->value() - t.points[1].value) < 1e-6 && pointValue->isEnabled());
+    QVERIFY(std::abs(pointOpacity->value() - t.points[1].color.a) < 1e-4);
+    QVERIFY(!error->isVisibleTo(w.get()));
+    settle(m);
+    const mfr::ImageRGBA8 added = w->view().renderImage(size);
+    qInfo("loaded vs one point added: RMSE %.5f", mfr::rmse(loadedImage, added));
+    QVERIFY(mfr::rmse(loadedImage, added) > 0.002);
+
+    // A drag moves it.
+    probe.drag(probe.at(t.points[1]), probe.at(0.55, 0.3));
+    t = m.transferFunction();
+    QCOMPARE(t.points.size(), std::size_t{3});
+    qInfo("dragged to (%.6f, %.6f)", t.points[1].value, t.points[1].color.a);
+    QVERIFY(std::abs(t.points[1].value - 0.55) <= dv());
+    QVERIFY(std::abs(t.points[1].color.a - 0.3) <= da());
+    // Past a neighbour (and out of the plot): it stops short of it, the values still ascend.
+    QTest::mouseClick(probe.editor, Qt::LeftButton, {}, probe.at(0.8, 0.5));
+    t = m.transferFunction();
+    QCOMPARE(t.points.size(), std::size_t{4});
+    const double neighbour = t.points[2].value;
+    probe.drag(probe.at(t.points[1]), probe.at(1.3, 0.2));
+    t = m.transferFunction();
+    qInfo("dragged past %.6f: now %.9f", neighbour, t.points[1].value);
+    QCOMPARE(t.points.size(), std::size_t{4});
+    QVERIFY(ascending(t));
+    QCOMPARE(t.points[2].value, neighbour);
+    QVERIFY(t.points[1].value > neighbour - dv() && t.points[1].value < neighbour);
+    probe.drag(probe.at(t.points[1]), probe.at(-0.5, 0.25));  // and the other way, past the first
+    t = m.transferFunction();
+    QVERIFY(ascending(t));
+    QVERIFY(t.points[1].value > 0.0 && t.points[1].value < dv());
+    QCOMPARE(t.points.front().value, 0.0);
+    // The ends move only vertically.
+    probe.drag(probe.at(t.points.back()), probe.at(0.6, 0.5));
+    t = m.transferFunction();
+    QCOMPARE(t.points.back().value, 1.0);
+    QVERIFY(std::abs(t.points.back().color.a - 0.5) <= da());
+    QVERIFY(ascending(t));
+
+    // Keys and spin boxes on the selected point.
+    QTest::mouseClick(probe.editor, Qt::LeftButton, {}, probe.at(t.points[2]));
+    QCOMPARE(probe.selected(), 2);
+    const mfr::TransferPoint before = t.points[2];
+    QTest::keyClick(probe.editor, Qt::Key_Right);
+    QTest::keyClick(probe.editor, Qt::Key_Up);
+    t = m.transferFunction();
+    QVERIFY(std::abs(t.points[2].value - (before.value + dv())) < 1e-9);
+    QVERIFY(std::abs(t.points[2].color.a - (before.color.a + da())) < 1e-6);
+    pointValue->setValue(0.7);
+    pointOpacity->setValue(0.65);
+    pointRed->setValue(0.125);
+    t = m.transferFunction();
+    QCOMPARE(t.points[2].value, 0.7);
+    QCOMPARE(t.points[2].color.a, 0.65f);
+    QCOMPARE(t.points[2].color.r, 0.125f);
+    QCOMPARE(t.points[2].color.g, before.color.g);
+    pointValue->setValue(5.0);  // clamped below the last point
+    t = m.transferFunction();
+    QVERIFY(t.points[2].value < 1.0 && ascending(t));
+    QVERIFY(std::abs(pointValue->value() - t.points[2].value) < 1e-6);
+    pointValue->setValue(0.7);
+
+    // A double click: the colour dialog for the point.
+    QTest::mouseDClick(probe.editor, Qt::LeftButton, {}, probe.at(m.transferFunction().points[2]));
+    QTest::mouseRelease(probe.editor, Qt::LeftButton, {}, probe.at(m.transferFunction().points[2]));
+    auto* dialog = probe.editor->findChild<QColorDialog*>("hvPointColorDialog");
+    QVERIFY(dialog);
+    dialog->setCurrentColor(QColor(0, 255, 0));
+    dialog->accept();
+    t = m.transferFunction();
+    QVERIFY(glm::vec3(t.points[2].color) == glm::vec3(0.0f, 1.0f, 0.0f));
+    QCOMPARE(t.points[2].color.a, 0.65f);
+
+    // The edited image is `mfr render`'s of a scene file with the same points.
+    settle(m);
+    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    const mfr::ImageRGBA8 edited = w->view().renderImage(size);
+    QVERIFY(mfr::rmse(added, edited) > 0.002);
+    {
+      const QString cliScene = writeBlobScene(dir, "edited.mfrscene", m.transferFunction());
+      const QString cliPng = dir.filePath("cli.png");
+      QString out;
+      QCOMPARE(runProgram(MFR_CLI,
+                          {"render", cliScene, "-o", cliPng, "--size", "200x150", "--method", "abuffer-ll", "--op",
+                           "volume", "--step", "0.02", "--view", "iso"},
+                          &out),
+               0);
+      const int diff = maxChannelDifference(edited, mfr::readPng(cliPng.toStdString()));
+      qInfo("edited transfer function: viewer vs mfr render max channel difference %d", diff);
+      QCOMPARE(diff, 0);
+    }
+
+    // Removal: right clicks on every point, Delete on the selected one; never fewer than two,
+    // and the ends stay.
+    for (int round = 0; round < 3; ++round) {
+      t = m.transferFunction();
+      for (const mfr::TransferPoint& p : t.points) QTest::mouseClick(probe.editor, Qt::RightButton, {}, probe.at(p));
+    }
+    t = m.transferFunction();
+    QCOMPARE(t.points.size(), std::size_t{2});
+    QCOMPARE(t.points.front().value, 0.0);
+    QCOMPARE(t.points.back().value, 1.0);
+    QVERIFY(!error->isVisibleTo(w.get()));  // no function of fewer points was even tried
+    QTest::mouseClick(probe.editor, Qt::LeftButton, {}, probe.at(0.5, 0.5));
+    QCOMPARE(m.transferFunction().points.size(), std::size_t{3});
+    QTest::keyClick(probe.editor, Qt::Key_Delete);
+    QCOMPARE(m.transferFunction().points.size(), std::size_t{2});
+    for (const mfr::TransferPoint& p : m.transferFunction().points) {
+      QTest::mouseClick(probe.editor, Qt::LeftButton, {}, probe.at(p));
+      QVERIFY(probe.selected() >= 0);
+      QTest::keyClick(probe.editor, Qt::Key_Delete);
+      QTest::keyClick(probe.editor, Qt::Key_Backspace);
+    }
+    QCOMPARE(m.transferFunction().points.size(), std::size_t{2});
+    QVERIFY(!error->isVisibleTo(w.get()));
+
+    // A preset edited becomes Custom with the edit; its other points stay.
+    preset->setCurrentIndex(preset->findData(QStringLiteral("fire")));
+    const mfr::TransferFunction fire = m.transferFunction();
+    QCOMPARE(fire.points.size(), std::size_t{4});
+    QTest::mouseClick(probe.editor, Qt::LeftButton, {}, probe.at(0.5, 0.9));
+    t = m.transferFunction();
+    QCOMPARE(preset->currentData().toString(), QStringLiteral("Custom"));
+    QCOMPARE(t.points.size(), std::size_t{5});
+    QCOMPARE(t.unitDistance, fire.unitDistance);
+    for (std::size_t i = 0, j = 0; i < t.points.size(); ++i) {
+      if (std::abs(t.points[i].value - 0.5) <= dv()) continue;  // the new one
+      QCOMPARE(t.points[i].value, fire.points[j].value);
+      QVERIFY(t.points[i].color == fire.points[j].color);
+      ++j;
+    }
+    // A new window stretches the edited points onto it, and the editor shows them.
+    auto* windowMax = w->findChild<QDoubleSpinBox*>("hvWindowMax");
+    windowMax->setValue(0.5);
+    t = m.transferFunction();
+    QCOMPARE(t.points.size(), std::size_t{5});
+    QCOMPARE(t.high(), 0.5);
+    QVERIFY(ascending(t));
+    QVERIFY(std::abs(probe.x(0.5) - probe.plot().right()) < 1e-9);
+    const std::vector<std::uint64_t> lower = histogramOf(grid, 0.0, 0.5, 128);
+    QCOMPARE(probe.histogram(), QList<quint64>(lower.begin(), lower.end()));
+    // As Loaded: the scene's own function again.
+    w->findChild<QPushButton*>("hvAsLoaded")->click();
+    QVERIFY(samePoints(m.transferFunction(), loaded));
+    QCOMPARE(probe.x(1.0), probe.plot().right());
+  }
+
+  // A session saved after editing points with the mouse (and a window and an opacity scale)
+  // restores the same points and the same image: through the viewer's "volumes" and the panel's
+  // settings together, and through the panel's settings alone.
+  void transferFunctionEditorSession() {
+    QTemporaryDir dir;
+    const QString scenePath = writeBlobScene(dir, "blob.mfrscene", blobTransfer());
+    QVERIFY(!scenePath.isEmpty());
+    const QSize size(200, 150);
+    const QString sessionPath = dir.filePath("edited.mfrsession");
+    mfr::TransferFunction saved;
+    mfr::ImageRGBA8 before;
+    {
+      auto w = openWindow(scenePath);
+      QVERIFY(w);
+      ViewerModel& m = w->model();
+      w->view().setFixedSize(size);
+      QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), size, kTimeoutMs);
+      m.setMethod("abuffer-ll");
+      m.setCamera(m.scene().view("iso"));
+      EditorProbe probe{w->findChild<QWidget*>("hvTransferEditor")};
+      QVERIFY(probe.editor);
+      QTRY_VERIFY_WITH_TIMEOUT(probe.editor->isVisible(), kTimeoutMs);
+      QTest::mouseClick(probe.editor, Qt::LeftButton, {}, probe.at(0.3, 0.05));
+      QTest::mouseClick(probe.editor, Qt::LeftButton, {}, probe.at(0.6, 0.75));
+      probe.drag(probe.at(m.transferFunction().points[1]), probe.at(0.45, 0.15));
+      probe.drag(probe.at(m.transferFunction().points.back()), probe.at(1.0, 0.35));
+      w->findChild<QSlider*>("hvOpacity")->setValue(640);
+      QCOMPARE(m.transferFunction().points.size(), std::size_t{4});
+      QVERIFY(!samePoints(m.transferFunction(), blobTransfer()));
+      settle(m);
+      saved = m.transferFunction();
+      before = w->view().renderImage(size);
+      w->saveSession(sessionPath);
+    }
+    const auto restore = [&](const QString& path) {
+      auto w = openWindow(QString());
+      QVERIFY(w);
+      w->view().setFixedSize(size);
+      w->openSession(path);
+      ViewerModel& m = w->model();
+      QTRY_VERIFY_WITH_TIMEOUT(m.hasScene() && m.framesRendered() > 0, kTimeoutMs);
+      settle(m);
+      const mfr::TransferFunction restored = m.transferFunction();
+      QCOMPARE(restored.points.size(), saved.points.size());
+      QVERIFY(samePoints(restored, saved));
+      QCOMPARE(w->findChild<QComboBox*>("hvPreset")->currentData().toString(), QStringLiteral("Custom"));
+      QCOMPARE(w->findChild<QSlider*>("hvOpacity")->value(), 640);
+      QCOMPARE(maxChannelDifference(before, w->view().renderImage(size)), 0);
+    };
+    restore(sessionPath);
+    if (QTest::currentTestFailed()) return;
+    // The panel's settings alone (no "volumes"): its saved points give the same function.
+    QFile file(sessionPath);
+    QVERIFY(file.open(QIODevice::ReadOnly));
+    QJsonObject json = QJsonDocument::fromJson(file.readAll()).object();
+    QVERIFY(json.contains("volumes"));
+    json.remove("volumes");
+    const QString pluginOnly = dir.filePath("plugin-only.mfrsession");
+    QFile out(pluginOnly);
+    QVERIFY(out.open(QIODevice::WriteOnly));
+    out.write(QJsonDocument(json).toJson());
+    out.close();
+    restore(pluginOnly);
+  }
+
   // The live widget's framebuffer (GpuRenderer::renderTo into QOpenGLWidget's FBO) against the
   // CLI at the widget's size.
   void widgetEqualsCli() {
@@ -1816,6 +2237,86 @@ class ViewerTest : public QObject {
     QCOMPARE(ortho.projection, mfr::Projection::Orthographic);
     const mfr::Camera back = navigation::toggledProjection(ortho);
     QVERIFY(glm::length(back.eye - c.eye) < 1e-9);  // the round trip keeps the framing
+  }
+
+  // The Probe dock: Ctrl + click lists the oracle's exact fragments behind the pixel (parts in
+  // depth order, shares summing to 100 %), which of them the method holds (a k-buffer's k nearest,
+  // an A-buffer's all), follows the method without another click, does not orbit, and clears.
+  void pixelProbe() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    RenderView& view = w->view();
+    view.setFixedSize(200, 150);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(200, 150), kTimeoutMs);
+    QCOMPARE(view.devicePixelRatioF(), 1.0);  // widget points are image pixels here
+    m.setMethod("kplus-array");
+    m.setParams({{"k", "2"}});
+    m.setCamera(m.scene().view("iso"));
+    settle(m);
+    const mfr::FragmentLists oracle = mfr::castFragments(m.scene(), m.camera(), 200, 150);
+    // The deepest unambiguous pixel near the middle.
+    QPoint pixel(-1, -1);
+    for (int y = 50; y < 100; ++y)
+      for (int x = 70; x < 130; ++x)
+        if (!oracle.isAmbiguous(x, y) && (pixel.x() < 0 || oracle.count(x, y) > oracle.count(pixel.x(), pixel.y())))
+          pixel = QPoint(x, y);
+    QVERIFY(pixel.x() >= 0);
+    const auto list = oracle.pixel(pixel.x(), pixel.y());
+    const int n = static_cast<int>(list.size());
+    QVERIFY2(n >= 4, "the probed list must be longer than k");
+
+    auto* table = w->findChild<QTableWidget*>("probeTable");
+    auto* summary = w->findChild<QLabel*>("probeSummary");
+    QVERIFY(table && summary);
+    const glm::dvec3 eyeBefore = m.camera().eye;
+    // A probe of this small view takes milliseconds: a failure should not wait the usual timeout.
+    constexpr int kProbeTimeoutMs = 20000;
+    QTest::mouseClick(&view, Qt::LeftButton, Qt::ControlModifier, pixel);
+    QTRY_COMPARE_WITH_TIMEOUT(table->rowCount(), n + 1, kProbeTimeoutMs);
+    QCOMPARE(m.camera().eye, eyeBefore);  // a probe, not an orbit
+    const auto checkRows = [&](int held) {
+      double share = 0.0;
+      for (int i = 0; i < n; ++i) {
+        const std::uint32_t id = list[static_cast<std::size_t>(i)].objectId;
+        QCOMPARE(table->item(i, ProbePanel::Part)->text(), QString::fromStdString(m.scene().objects[id].name));
+        QCOMPARE(table->item(i, ProbePanel::Held)->text(),
+                 i < held ? QStringLiteral("held") : QStringLiteral("dropped"));
+        if (i > 0)
+          QVERIFY(table->item(i, ProbePanel::EyeDepth)->text().toDouble() >
+                  table->item(i - 1, ProbePanel::EyeDepth)->text().toDouble());
+        share += table->item(i, ProbePanel::Share)->text().remove(QStringLiteral(" %")).toDouble();
+      }
+      QCOMPARE(table->item(n, ProbePanel::Part)->text(), QStringLiteral("background"));
+      share += table->item(n, ProbePanel::Share)->text().remove(QStringLiteral(" %")).toDouble();
+      QVERIFY2(std::abs(share - 100.0) < 0.1 * (n + 1), qPrintable(QString::number(share)));
+    };
+    checkRows(2);
+    QVERIFY2(summary->text().contains(QStringLiteral("kplus-array holds 2 of them")), qPrintable(summary->text()));
+    auto* mark = w->findChild<QWidget*>("probeMarker");
+    QVERIFY(mark && mark->isVisible());
+    QCOMPARE(mark->geometry().center(), pixel);
+
+    // The probe follows the method (after its next full frame), without another click.
+    m.setMethod("abuffer-ll");
+    QTRY_VERIFY2_WITH_TIMEOUT(summary->text().contains(QStringLiteral("abuffer-ll holds %1 of them").arg(n)),
+                              qPrintable(summary->text()), kProbeTimeoutMs);
+    checkRows(n);
+    // A method without lists: the exact list only.
+    m.setMethod("wboit");
+    QTRY_VERIFY2_WITH_TIMEOUT(summary->text().contains(QStringLiteral("wboit keeps no per-pixel lists")),
+                              qPrintable(summary->text()), kProbeTimeoutMs);
+    QCOMPARE(table->item(0, ProbePanel::Held)->text(), QStringLiteral("—"));
+
+    // Empty space: only the background, all of the colour.
+    QTest::mouseClick(&view, Qt::LeftButton, Qt::ControlModifier, QPoint(1, 1));
+    QTRY_COMPARE_WITH_TIMEOUT(table->rowCount(), 1, kProbeTimeoutMs);
+    QCOMPARE(oracle.count(1, 1), 0u);
+    QCOMPARE(table->item(0, ProbePanel::Share)->text(), QStringLiteral("100.0 %"));
+
+    w->findChild<QPushButton*>("probeClear")->click();
+    QCOMPARE(table->rowCount(), 0);
+    QVERIFY(!mark->isVisible());
   }
 };
 

@@ -14,16 +14,23 @@
 
 namespace mfr {
 
-// Per-pixel sorted lists as a GPU method captured them (image coordinates, y = 0 top row).
+// Per-pixel sorted lists as a GPU method captured them, for a rectangle of the image (x0, y0:
+// its top-left pixel; width × height: its size; the whole image unless a region was asked for).
+// Pixels are addressed in image coordinates (y = 0 top row).
 struct CapturedLists {
+  int x0 = 0;
+  int y0 = 0;
   int width = 0;
   int height = 0;
   int maxPerPixel = 0;                // fragments kept per pixel in `fragments`
   std::vector<std::uint32_t> counts;  // fragments the method holds per pixel
   std::vector<Fragment> fragments;    // width*height*maxPerPixel, the first min(count, max) valid
-  [[nodiscard]] std::uint32_t count(int x, int y) const { return counts[static_cast<std::size_t>(y) * width + x]; }
+  [[nodiscard]] std::size_t index(int x, int y) const {
+    return static_cast<std::size_t>(y - y0) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x - x0);
+  }
+  [[nodiscard]] std::uint32_t count(int x, int y) const { return counts[index(x, y)]; }
   [[nodiscard]] const Fragment* pixel(int x, int y) const {
-    return &fragments[(static_cast<std::size_t>(y) * width + x) * static_cast<std::size_t>(maxPerPixel)];
+    return &fragments[index(x, y) * static_cast<std::size_t>(maxPerPixel)];
   }
 };
 
@@ -57,8 +64,11 @@ class GpuRenderer {
   // The method object of the last request (nullptr before one): tests and diagnostics reach a
   // method's own read-backs through it.
   [[nodiscard]] Method* method() const { return method_.get(); }
-  // Captures with the method and resolves with the "dump" operation (tests, diagnostics).
-  CapturedLists capture(const Camera& camera, const RenderRequest& request, int maxPerPixel);
+  // Captures with the method and resolves with the "dump" operation (tests, diagnostics, the
+  // pixel probe): the sorted lists of `region` (image coordinates; empty: the whole image), at most
+  // maxPerPixel fragments each. Throws mfr::Error for a region outside the image or maxPerPixel < 1.
+  CapturedLists capture(const Camera& camera, const RenderRequest& request, int maxPerPixel,
+                        const PixelRect& region = {});
 
  private:
   Method& prepare(const RenderRequest& request);

@@ -133,14 +133,15 @@ double distanceToSegment(const glm::dvec2& p, const glm::dvec2& a, const glm::dv
 
 // Marks every pixel whose centre lies within eps of segment ab. Rows are walked over the
 // segment's extent; in each row only the x range of segment points within eps vertically
-// (widened by eps) can qualify, so long edges cost O(length), not O(bounding box).
-void markSegment(const glm::dvec2& a, const glm::dvec2& b, double eps, int width, int height,
+// (widened by eps) can qualify, so long edges cost O(length), not O(bounding box). Only pixels of
+// `region` (image coordinates, not empty) are marked.
+void markSegment(const glm::dvec2& a, const glm::dvec2& b, double eps, int width, int height, const PixelRect& region,
                  std::vector<std::uint8_t>& flags) {
   const double ymin = std::min(a.y, b.y) - eps;
   const double ymax = std::max(a.y, b.y) + eps;
-  // Window row r has its centre at r + 0.5.
-  const double rowLo = std::max(0.0, std::ceil(ymin - 0.5));
-  const double rowHi = std::min(static_cast<double>(height - 1), std::floor(ymax - 0.5));
+  // Window row r has its centre at r + 0.5; image row y is window row height - 1 - y.
+  const double rowLo = std::max(static_cast<double>(height - region.y - region.height), std::ceil(ymin - 0.5));
+  const double rowHi = std::min(static_cast<double>(height - 1 - region.y), std::floor(ymax - 0.5));
   if (!(rowLo <= rowHi)) return;
   const glm::dvec2 d = b - a;
   for (int row = static_cast<int>(rowLo); row <= static_cast<int>(rowHi); ++row) {
@@ -159,8 +160,9 @@ void markSegment(const glm::dvec2& a, const glm::dvec2& b, double eps, int width
     }
     const double x0 = a.x + t0 * d.x;
     const double x1 = a.x + t1 * d.x;
-    const double xLo = std::max(0.0, std::ceil(std::min(x0, x1) - eps - 0.5));
-    const double xHi = std::min(static_cast<double>(width - 1), std::floor(std::max(x0, x1) + eps - 0.5));
+    const double xLo = std::max(static_cast<double>(region.x), std::ceil(std::min(x0, x1) - eps - 0.5));
+    const double xHi =
+        std::min(static_cast<double>(region.x + region.width - 1), std::floor(std::max(x0, x1) + eps - 0.5));
     if (!(xLo <= xHi)) continue;
     const std::size_t rowBase = static_cast<std::size_t>(height - 1 - row) * width;  // image rows top-down
     for (int col = static_cast<int>(xLo); col <= static_cast<int>(xHi); ++col)
@@ -392,6 +394,17 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     throw Error("image size", std::to_string(width) + "x" + std::to_string(height) + " is not in 1.." +
                                   std::to_string(kMaxImageSize) + " per side");
 
+  PixelRect region = options.region;
+  if (region.empty()) {
+    region = {0, 0, width, height};
+  } else if (region.x < 0 || region.y < 0 || static_cast<long long>(region.x) + region.width > width ||
+             static_cast<long long>(region.y) + region.height > height) {
+    throw Error("pixel region", std::to_string(region.width) + "x" + std::to_string(region.height) + " at (" +
+                                    std::to_string(region.x) + ", " + std::to_string(region.y) +
+                                    ") is not inside the " + std::to_string(width) + "x" + std::to_string(height) +
+                                    " image");
+  }
+
   const glm::dmat4 viewProj =
       camera.projectionMatrix(static_cast<double>(width) / height) * camera.viewMatrix();
   const glm::dmat4 invViewProj = glm::inverse(viewProj);
@@ -437,7 +450,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     const std::vector<glm::dvec2> poly = windowPolygon(triangles[t], viewProj, width, height);
     screenDegenerate[t] = polygonArea(poly) < kMinScreenArea ? 1 : 0;
     for (std::size_t i = 0; i < poly.size(); ++i)
-      markSegment(poly[i], poly[(i + 1) % poly.size()], options.edgeEpsilon, width, height, lists.flags);
+      markSegment(poly[i], poly[(i + 1) % poly.size()], options.edgeEpsilon, width, height, region, lists.flags);
   });
 
   const glm::vec3 viewDir(camera.forward());
@@ -448,7 +461,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   const auto castRow = [&](int y, std::vector<std::uint32_t>& candidates, std::vector<Hit>& hits) {
     std::vector<Fragment>& out = rowFragments[static_cast<std::size_t>(y)];
     const double wy = (height - 1 - y) + 0.5;
-    for (int x = 0; x < width; ++x) {
+    for (int x = region.x; x < region.x + region.width; ++x) {
       const std::size_t pixel = static_cast<std::size_t>(y) * width + x;
       const double ndcX = 2.0 * (x + 0.5) / width - 1.0;
       const double ndcY = 2.0 * wy / height - 1.0;
@@ -497,11 +510,11 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     }
   };
 
-  runParallel(std::min(threadCount, static_cast<unsigned>(height)), static_cast<std::size_t>(height), 1,
-              [&](std::size_t y) {
+  runParallel(std::min(threadCount, static_cast<unsigned>(region.height)), static_cast<std::size_t>(region.height), 1,
+              [&](std::size_t row) {
                 thread_local std::vector<std::uint32_t> candidates;
                 thread_local std::vector<Hit> hits;
-                castRow(static_cast<int>(y), candidates, hits);
+                castRow(region.y + static_cast<int>(row), candidates, hits);
               });
 
   lists.offsets.resize(pixelCount + 1);

@@ -19,6 +19,16 @@ struct Fragment {
   bool frontFacing = false;  // counter-clockwise in window space, like gl_FrontFacing
 };
 
+// A rectangle of pixels in image coordinates (y = 0 is the top row); empty means the whole image.
+struct PixelRect {
+  int x = 0;
+  int y = 0;
+  int width = 0;
+  int height = 0;
+  [[nodiscard]] bool empty() const { return width <= 0 || height <= 0; }
+  [[nodiscard]] bool contains(int px, int py) const { return px >= x && py >= y && px - x < width && py - y < height; }
+};
+
 struct OracleOptions {
   // Screen-space distance (pixels) under which a pixel centre counts as lying on a triangle edge:
   // there rasterisation tie rules and vertex snapping (1/256 px) decide, so tests exclude it.
@@ -26,6 +36,9 @@ struct OracleOptions {
   // Relative depth difference under which two fragments of a pixel count as tied in depth.
   double depthTieEpsilon = 1e-6;
   int threads = 0;  // 0: hardware concurrency
+  // Cast only these pixels (a probe of one pixel, a zoomed-in check); the others get empty lists
+  // and no flags. Empty: the whole image. A rectangle not inside the image throws mfr::Error.
+  PixelRect region;
 };
 
 // Exact fragment lists of one image. Pixel (x, y) uses image coordinates: y = 0 is the top row.

@@ -1,0 +1,186 @@
+// mfr probe: what lies behind one pixel — the oracle's exact sorted list (depth, part, colour,
+// facing, share of the pixel's colour) and, with --method, which of those fragments the GPU method
+// holds and the colour it draws there.
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "mfr/error.hpp"
+#include "mfr/gpu_renderer.hpp"
+#include "mfr/image.hpp"
+#include "mfr/io_util.hpp"
+#include "mfr/reference/probe.hpp"
+#include "mfr/render.hpp"
+
+namespace mfr::cli {
+
+namespace {
+
+std::pair<int, int> parsePixel(const std::string& text) {
+  const auto comma = text.find(',');
+  if (comma != std::string::npos) {
+    const std::optional<double> x = parseNumber(text.substr(0, comma));
+    const std::optional<double> y = parseNumber(text.substr(comma + 1));
+    if (x && y && *x == static_cast<int>(*x) && *y == static_cast<int>(*y))
+      return {static_cast<int>(*x), static_cast<int>(*y)};
+  }
+  throw Error("--pixel " + text, "expected X,Y (whole pixels, 0,0 the top-left)");
+}
+
+std::string rgba(std::uint32_t packed) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%3u %3u %3u %3u", packed & 0xffu, (packed >> 8) & 0xffu, (packed >> 16) & 0xffu,
+                packed >> 24);
+  return text;
+}
+
+nlohmann::ordered_json rgbaJson(std::uint32_t packed) {
+  return {packed & 0xffu, (packed >> 8) & 0xffu, (packed >> 16) & 0xffu, packed >> 24};
+}
+
+int to8(float c) {
+  return static_cast<int>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f));
+}
+
+}  // namespace
+
+void addProbe(CLI::App& app) {
+  struct Options {
+    std::string scene, pixel, size = "512x512", view = "fit", method, json;
+    std::vector<std::string> params;
+    double opacity = -1.0;
+  };
+  auto opt = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "probe", "List what lies behind one pixel: the exact sorted fragments and which of them a method holds");
+  cmd->add_option("scene", opt->scene, "Scene: model file, .mfrscene, or @sample")->required();
+  cmd->add_option("--pixel", opt->pixel, "X,Y in image coordinates (0,0 the top-left pixel)")->required();
+  cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
+  cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
+  cmd->add_option("--method,-m", opt->method, "Also a GPU method: which fragments it holds, the colour it draws");
+  cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
+  cmd->add_option("--json", opt->json, "Also write the probe as JSON");
+  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
+  cmd->callback([opt] {
+    const auto [w, h] = parseSize("--size", opt->size);
+    validateImageSize("--size", w, h);
+    const auto [x, y] = parsePixel(opt->pixel);
+    if (x < 0 || y < 0 || x >= w || y >= h) throw Error("--pixel " + opt->pixel, "outside the " + opt->size + " image");
+    RenderRequest req;
+    req.width = w;
+    req.height = h;
+    for (const std::string& p : opt->params) {
+      const auto eq = p.find('=');
+      if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");
+      req.params[p.substr(0, eq)] = p.substr(eq + 1);
+    }
+    const MethodInfo* info = nullptr;
+    if (!opt->method.empty()) {
+      info = findMethodInfo(opt->method);
+      if (info == nullptr || opt->method == "oracle" || opt->method == "optimal-k")
+        throw Error("--method " + opt->method, "not a GPU method (see mfr info --methods)");
+      req.method = opt->method;
+    } else if (!req.params.empty()) {
+      throw Error("--param", "needs --method");
+    }
+    const Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
+    const Camera camera = scene.view(opt->view);
+    PixelProbe probe = probePixel(scene, camera, w, h, x, y);
+
+    std::optional<glm::u8vec4> methodPixel;
+    if (info != nullptr) {
+      const RenderOutput out = render(scene, camera, req);  // also validates the parameters
+      const std::uint8_t* p = out.image.at(x, y);
+      methodPixel = glm::u8vec4(p[0], p[1], p[2], p[3]);
+      if (info->sortedLists) {
+        GpuRenderer& gpu = headlessRenderer();
+        gpu.setScene(scene);
+        // Room for every fragment the oracle sees and more, so a method holding extra ones shows.
+        const int room = static_cast<int>(std::min<std::size_t>(probe.fragments.size() * 2 + 64, 1u << 16));
+        const CapturedLists lists = gpu.capture(camera, req, room, PixelRect{x, y, 1, 1});
+        const std::uint32_t count = lists.count(x, y);
+        matchCapture(probe, {lists.pixel(x, y), std::min<std::size_t>(count, static_cast<std::size_t>(room))}, count);
+      }
+    }
+
+    std::ostringstream text;
+    text << scene.name << ", view " << opt->view << ", " << w << "x" << h << ", pixel (" << x << ", " << y
+         << "): " << probe.fragments.size() << " fragment" << (probe.fragments.size() == 1 ? "" : "s");
+    if (probe.edge) text << " (on a triangle edge: rasterisation may differ)";
+    if (probe.depthTie) text << " (two at one depth: order undefined)";
+    text << "\n";
+    char line[256];
+    std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7s%s\n", "#", "eye depth", "part", "RGBA",
+                  "faces", "weight", probe.captured ? ("  " + opt->method).c_str() : "");
+    text << line;
+    nlohmann::ordered_json fragments = nlohmann::ordered_json::array();
+    for (std::size_t i = 0; i < probe.fragments.size(); ++i) {
+      const ProbeFragment& f = probe.fragments[i];
+      const std::uint32_t object = f.fragment.objectId;
+      const std::string part = object < scene.objects.size() ? scene.objects[object].name : "?";
+      std::snprintf(line, sizeof line, "%4zu  %12.6g  %-24.24s  %-15s  %-5s  %7.4f%s\n", i + 1, f.eyeDepth,
+                    part.c_str(), rgba(f.fragment.color).c_str(), f.fragment.frontFacing ? "front" : "back", f.weight,
+                    probe.captured ? (f.held ? "  held" : "  -") : "");
+      text << line;
+      nlohmann::ordered_json j;
+      j["depth"] = f.fragment.depth;
+      j["eye_depth"] = f.eyeDepth;
+      j["object"] = object;
+      j["part"] = part;
+      j["rgba"] = rgbaJson(f.fragment.color);
+      j["front_facing"] = f.fragment.frontFacing;
+      j["weight"] = f.weight;
+      if (probe.captured) j["held"] = f.held;
+      fragments.push_back(j);
+    }
+    std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7.4f\n", "", "", "background", "", "",
+                  probe.transmittance);
+    text << line;
+    const glm::ivec3 exact(to8(probe.exactColor.r), to8(probe.exactColor.g), to8(probe.exactColor.b));
+    text << "exact colour (over): " << exact.r << " " << exact.g << " " << exact.b << "\n";
+
+    nlohmann::ordered_json j;
+    j["scene"] = scene.name;
+    j["view"] = opt->view;
+    j["width"] = w;
+    j["height"] = h;
+    j["x"] = x;
+    j["y"] = y;
+    j["edge"] = probe.edge;
+    j["depth_tie"] = probe.depthTie;
+    j["fragments"] = fragments;
+    j["background_weight"] = probe.transmittance;
+    j["exact_rgb"] = {exact.r, exact.g, exact.b};
+    if (methodPixel) {
+      const int diff = std::max(
+          {std::abs(methodPixel->r - exact.r), std::abs(methodPixel->g - exact.g), std::abs(methodPixel->b - exact.b)});
+      text << opt->method << " colour: " << int(methodPixel->r) << " " << int(methodPixel->g) << " "
+           << int(methodPixel->b) << " (largest difference from exact " << diff << "/255)\n";
+      nlohmann::ordered_json m;
+      m["name"] = opt->method;
+      m["params"] = req.params;
+      m["rgb"] = {methodPixel->r, methodPixel->g, methodPixel->b};
+      m["max_difference"] = diff;
+      if (probe.captured) {
+        text << opt->method << " holds " << probe.methodCount << " fragment" << (probe.methodCount == 1 ? "" : "s")
+             << ", " << probe.heldCount() << " of the " << probe.fragments.size() << " exact ones";
+        if (probe.unmatched > 0) text << "; " << probe.unmatched << " at no exact fragment's depth";
+        text << "\n";
+        m["holds"] = probe.methodCount;
+        m["held_exact"] = probe.heldCount();
+        m["unmatched"] = probe.unmatched;
+      } else {
+        text << opt->method << " keeps no per-pixel lists (its image only)\n";
+      }
+      j["method"] = m;
+    }
+    if (!opt->json.empty()) writeFileAtomically(opt->json, j.dump(2) + "\n");
+    std::cout << text.str();
+  });
+}
+
+}  // namespace mfr::cli

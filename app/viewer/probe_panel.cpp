@@ -1,0 +1,158 @@
+#include "probe_panel.hpp"
+
+#include <QHeaderView>
+#include <QLabel>
+#include <QPushButton>
+#include <QTableWidget>
+#include <QTimer>
+#include <QVBoxLayout>
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+
+#include "render_view.hpp"
+#include "viewer_model.hpp"
+
+namespace {
+
+QColor rgbOf(std::uint32_t packed) {
+  return QColor(static_cast<int>(packed & 0xffu), static_cast<int>((packed >> 8) & 0xffu),
+                static_cast<int>((packed >> 16) & 0xffu));
+}
+
+QTableWidgetItem* item(const QString& text, Qt::Alignment align = Qt::AlignLeft | Qt::AlignVCenter) {
+  auto* i = new QTableWidgetItem(text);
+  i->setTextAlignment(align);
+  i->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable);
+  return i;
+}
+
+}  // namespace
+
+ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
+    : QWidget(parent), model_(model), view_(view) {
+  auto* layout = new QVBoxLayout(this);
+  summary_ = new QLabel(tr("Ctrl + click the view to list what lies behind a pixel."), this);
+  summary_->setObjectName(QStringLiteral("probeSummary"));
+  summary_->setWordWrap(true);
+  summary_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  layout->addWidget(summary_);
+  table_ = new QTableWidget(0, ColumnCount, this);
+  table_->setObjectName(QStringLiteral("probeTable"));
+  table_->setHorizontalHeaderLabels(
+      {tr("#"), tr("Eye depth"), tr("Part"), tr("Colour"), tr("α"), tr("Faces"), tr("Share"), tr("Held")});
+  table_->horizontalHeaderItem(Share)->setToolTip(
+      tr("The fragment's share of the pixel's colour: α·Π(1 − α) of the fragments in front of it"));
+  table_->horizontalHeaderItem(Held)->setToolTip(tr("Whether the pane's method holds this fragment"));
+  table_->verticalHeader()->hide();
+  table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  table_->horizontalHeader()->setSectionResizeMode(Part, QHeaderView::Stretch);
+  table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  layout->addWidget(table_, 1);
+  clear_ = new QPushButton(tr("Clear"), this);
+  clear_->setObjectName(QStringLiteral("probeClear"));
+  clear_->setEnabled(false);
+  layout->addWidget(clear_, 0, Qt::AlignRight);
+  connect(clear_, &QPushButton::clicked, this, &ProbePanel::clear);
+
+  connect(&view_, &RenderView::probeRequested, this, &ProbePanel::probe);
+  // Full frames only (navigation previews are not reported): the probe follows the view without
+  // costing every drag step a ray cast.
+  connect(&model_, &ViewerModel::frameRendered, this, [this] {
+    if (point_) QTimer::singleShot(0, this, &ProbePanel::refreshIfChanged);
+  });
+  connect(&model_, &ViewerModel::sceneLoaded, this, &ProbePanel::clear);
+}
+
+void ProbePanel::probe(QPoint point) {
+  point_ = point;
+  clear_->setEnabled(true);
+  // The mark moves only here and in clear(): moving a child of the view exposes the view, which
+  // renders a frame, and a frame must not lead to another one.
+  view_.setProbeMark(point_);
+  refresh();
+}
+
+void ProbePanel::refreshIfChanged() {
+  if (point_ && !(model_.frameKey(probedSide_) == probedKey_)) refresh();
+}
+
+void ProbePanel::clear() {
+  point_.reset();
+  view_.setProbeMark(std::nullopt);
+  table_->setRowCount(0);
+  summary_->setText(tr("Ctrl + click the view to list what lies behind a pixel."));
+  clear_->setEnabled(false);
+}
+
+void ProbePanel::refresh() {
+  if (!point_) return;
+  try {
+    const ViewProbe result = view_.probeAt(*point_);
+    probedSide_ = result.side;
+    show(result);
+  } catch (const std::exception& e) {
+    probedSide_ = 0;
+    table_->setRowCount(0);
+    summary_->setText(tr("Probe: %1").arg(QString::fromUtf8(e.what())));
+  }
+  probedKey_ = model_.frameKey(probedSide_);
+  emit probed();
+}
+
+void ProbePanel::show(const ViewProbe& r) {
+  const mfr::PixelProbe& p = r.probe;
+  const auto n = static_cast<int>(p.fragments.size());
+  QString text = tr("Pixel (%1, %2) of %3×%4%5: %n fragment(s)", nullptr, n)
+                     .arg(p.x)
+                     .arg(p.y)
+                     .arg(r.paneSize.width())
+                     .arg(r.paneSize.height())
+                     .arg(model_.paneCount() > 1 ? (r.side == 0 ? tr(", pane A") : tr(", pane B")) : QString());
+  if (p.edge) text += tr(" — on a triangle edge (rasterisation may differ)");
+  if (p.depthTie) text += tr(" — two at one depth (order undefined)");
+  const auto to8 = [](float c) { return static_cast<int>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f)); };
+  const QColor exact(to8(p.exactColor.r), to8(p.exactColor.g), to8(p.exactColor.b));
+  text += tr(". Exact colour %1.").arg(exact.name());
+  if (p.captured) {
+    text += tr(" %1 holds %2 of them").arg(r.method).arg(p.heldCount());
+    if (p.methodCount != p.heldCount()) text += tr(" (%1 in all)").arg(p.methodCount);
+    text += QStringLiteral(".");
+  } else {
+    text += tr(" %1 keeps no per-pixel lists.").arg(r.method);
+  }
+  summary_->setText(text);
+
+  table_->setRowCount(n + 1);
+  const auto& objects = model_.scene().objects;
+  const Qt::Alignment right = Qt::AlignRight | Qt::AlignVCenter;
+  for (int i = 0; i < n; ++i) {
+    const mfr::ProbeFragment& f = p.fragments[static_cast<std::size_t>(i)];
+    const std::uint32_t id = f.fragment.objectId;
+    const QColor colour = rgbOf(f.fragment.color);
+    table_->setItem(i, Index, item(QString::number(i + 1), right));
+    table_->setItem(i, EyeDepth, item(QString::number(f.eyeDepth, 'g', 6), right));
+    table_->setItem(i, Part,
+                    item(id < objects.size() ? QString::fromStdString(objects[id].name) : QStringLiteral("?")));
+    QTableWidgetItem* swatch = item(colour.name());
+    swatch->setBackground(colour);
+    swatch->setForeground(colour.lightnessF() > 0.5 ? Qt::black : Qt::white);
+    table_->setItem(i, Colour, swatch);
+    table_->setItem(i, Alpha, item(QString::number((f.fragment.color >> 24) / 255.0, 'f', 3), right));
+    table_->setItem(i, Faces, item(f.fragment.frontFacing ? tr("front") : tr("back")));
+    table_->setItem(i, Share, item(QString::number(100.0 * f.weight, 'f', 1) + QStringLiteral(" %"), right));
+    table_->setItem(i, Held, item(!p.captured ? QStringLiteral("—") : f.held ? tr("held") : tr("dropped")));
+    if (p.captured && !f.held)
+      for (int c = 0; c < ColumnCount; ++c)
+        if (c != Colour) table_->item(i, c)->setForeground(palette().color(QPalette::Disabled, QPalette::Text));
+  }
+  const QColor bg(to8(model_.scene().background.r), to8(model_.scene().background.g), to8(model_.scene().background.b));
+  for (int c = 0; c < ColumnCount; ++c) table_->setItem(n, c, item(QString()));
+  table_->item(n, Part)->setText(tr("background"));
+  table_->item(n, Colour)->setText(bg.name());
+  table_->item(n, Colour)->setBackground(bg);
+  table_->item(n, Colour)->setForeground(bg.lightnessF() > 0.5 ? Qt::black : Qt::white);
+  table_->item(n, Share)->setText(QString::number(100.0 * p.transmittance, 'f', 1) + QStringLiteral(" %"));
+  table_->item(n, Share)->setTextAlignment(right);
+}

@@ -1,0 +1,57 @@
+#pragma once
+// The pixel probe: what lies behind one pixel. The oracle's exact sorted list of the pixel, each
+// fragment with its part, its distance from the eye and its share of the "over" result, and —
+// given a GPU method's capture of the same pixel (GpuRenderer::capture with a one-pixel region) —
+// which of those fragments the method holds. `mfr probe` prints it; mfrview's Probe dock shows it.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/reference/oracle.hpp"
+#include "mfr/scene/camera.hpp"
+#include "mfr/scene/scene.hpp"
+
+namespace mfr {
+
+struct ProbeFragment {
+  Fragment fragment;      // as the oracle casts it (window depth, shaded colour, object, facing)
+  double eyeDepth = 0.0;  // distance along the view axis (world units), Camera::depthToEye
+  double weight = 0.0;    // α_i·Π_{j<i}(1 − α_j): the fraction of the pixel's colour it gives
+  bool held = false;      // the method's capture holds it (matchCapture)
+};
+
+struct PixelProbe {
+  int x = 0;  // image coordinates, y = 0 is the top row
+  int y = 0;
+  int width = 0;  // of the image the pixel belongs to
+  int height = 0;
+  bool edge = false;                     // the centre lies on a projected triangle edge: rasterisation may differ
+  bool depthTie = false;                 // two fragments at one depth: their order is undefined
+  std::vector<ProbeFragment> fragments;  // front to back
+  glm::vec3 exactColor{0.0f};            // "over" of every fragment on the background
+  double transmittance = 1.0;            // Π(1 − α): the background's share
+
+  // Set by matchCapture.
+  bool captured = false;
+  std::uint32_t methodCount = 0;          // fragments the method holds at the pixel
+  std::vector<Fragment> methodFragments;  // its sorted list as read back (at most what was kept)
+  std::uint32_t unmatched = 0;            // of methodFragments, those at no oracle fragment's depth
+  [[nodiscard]] std::uint32_t heldCount() const;
+};
+
+// The probe of pixel (x, y) of a width × height image (throws mfr::Error for a pixel outside it,
+// an empty scene or a bad camera, like castFragments). Casts only that pixel.
+PixelProbe probePixel(const Scene& scene, const Camera& camera, int width, int height, int x, int y,
+                      const OracleOptions& options = {});
+
+// Marks the oracle fragments a method holds: each captured fragment is paired with the unpaired
+// oracle fragment nearest in depth within `depthTolerance` (window depth, relative above 1 —
+// the tolerance of the GPU-versus-oracle tests), the closer colour deciding between equal depths.
+// `count` is what the method reports holding (it may exceed fragments.size() when the read-back
+// kept fewer).
+void matchCapture(PixelProbe& probe, std::span<const Fragment> fragments, std::uint32_t count,
+                  double depthTolerance = 1e-5);
+
+}  // namespace mfr

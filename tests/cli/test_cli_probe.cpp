@@ -1,0 +1,113 @@
+// mfr probe end to end: the listed fragments and colours against `mfr render` of the same pixel
+// (the oracle's and the method's own images), the "over" weights summing to one, what k-buffers
+// hold, and bad input refused with one line and no JSON file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mfr/image.hpp"
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using mfr::test::CliResult;
+using mfr::test::runCli;
+
+using CliProbe = mfr::test::CliTest;
+
+constexpr const char* kScene = "@sample --size 64x48 --view iso";
+
+nlohmann::json readJsonFile(const fs::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+TEST_F(CliProbe, FragmentsAndColoursMatchTheRenderedImages) {
+  const fs::path oracle = dir() / "oracle.png", gpu = dir() / "gpu.png";
+  ASSERT_EQ(runCli(std::string("render ") + kScene + " -o " + oracle.string()).exitCode, 0);
+  ASSERT_EQ(runCli(std::string("render ") + kScene + " -m kplus-array -p k=2 -o " + gpu.string()).exitCode, 0);
+  const mfr::ImageRGBA8 exactImage = mfr::readPng(oracle), gpuImage = mfr::readPng(gpu);
+  int probed = 0, deep = 0, tried = 0;
+  // Pixels across the middle of the image until three lie off triangle edges (the sample is dense
+  // in triangles at this size, so many centres are on an edge).
+  std::vector<std::pair<int, int>> pixels;
+  for (int y = 12; y <= 36; y += 6)
+    for (int x = 18; x <= 46; x += 7) pixels.emplace_back(x, y);
+  for (const auto& [x, y] : pixels) {
+    if (probed == 3) break;
+    ++tried;
+    SCOPED_TRACE(std::to_string(x) + "," + std::to_string(y));
+    const fs::path json = dir() / "probe.json";
+    const CliResult r = runCli(std::string("probe ") + kScene + " --pixel " + std::to_string(x) + "," +
+                               std::to_string(y) + " -m kplus-array -p k=2 --json " + json.string());
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    const nlohmann::json j = readJsonFile(json);
+    EXPECT_EQ(j["x"], x);
+    EXPECT_EQ(j["y"], y);
+    const nlohmann::json& fragments = j["fragments"];
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(j["exact_rgb"][c].get<int>(), exactImage.at(x, y)[c]) << c;
+      EXPECT_EQ(j["method"]["rgb"][c].get<int>(), gpuImage.at(x, y)[c]) << c;
+    }
+    double sum = j["background_weight"].get<double>(), previous = 0.0;
+    for (const nlohmann::json& f : fragments) {
+      sum += f["weight"].get<double>();
+      EXPECT_GT(f["eye_depth"].get<double>(), previous);
+      previous = f["eye_depth"].get<double>();
+      EXPECT_FALSE(f["part"].get<std::string>().empty());
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-5);
+    if (j["edge"].get<bool>()) continue;
+    ++probed;
+    const std::size_t n = fragments.size();
+    deep += n > 2 ? 1 : 0;
+    EXPECT_EQ(j["method"]["holds"].get<std::size_t>(), std::min<std::size_t>(n, 2));
+    EXPECT_EQ(j["method"]["unmatched"].get<int>(), 0);
+    for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(fragments[i]["held"].get<bool>(), i < 2) << i;
+    // The text says the same.
+    EXPECT_NE(r.out.find("kplus-array holds " + std::to_string(std::min<std::size_t>(n, 2)) + " fragment"),
+              std::string::npos)
+        << r.out;
+  }
+  EXPECT_EQ(probed, 3) << "of " << tried;
+  EXPECT_GE(deep, 2);
+}
+
+TEST_F(CliProbe, MethodsWithoutListsShowTheirColourOnly) {
+  const CliResult r = runCli(std::string("probe ") + kScene + " --pixel 32,24 -m wboit");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("wboit keeps no per-pixel lists"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("wboit colour:"), std::string::npos) << r.out;
+}
+
+TEST_F(CliProbe, BadInputIsOneLineAndWritesNoJson) {
+  const fs::path json = dir() / "probe.json";
+  const std::pair<std::string, std::string> cases[] = {
+      {"--pixel 64,0", "outside the 64x48 image"},       {"--pixel 3,-1", "outside the 64x48 image"},
+      {"--pixel 1.5,2", "--pixel 1.5,2: expected X,Y"},  {"--pixel banana", "--pixel banana: expected X,Y"},
+      {"--pixel 3,3 -p k=2", "--param: needs --method"}, {"--pixel 3,3 -m oracle", "not a GPU method"},
+      {"--pixel 3,3 -m nonsense", "not a GPU method"},   {"--pixel 3,3 -m kplus-array -p k=0", "k"},
+  };
+  for (const auto& [args, mention] : cases) {
+    SCOPED_TRACE(args);
+    const CliResult r = runCli(std::string("probe ") + kScene + " " + args + " --json " + json.string());
+    EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << "exit " << r.exitCode << ": " << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    EXPECT_EQ(r.out.rfind("mfr: ", 0), 0u) << r.out;
+    EXPECT_NE(r.out.find(mention), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(json));
+  }
+  const CliResult missing = runCli("probe " + (dir() / "nope.stl").string() + " --pixel 1,1");
+  EXPECT_EQ(missing.exitCode, 1) << missing.out;
+  EXPECT_NE(missing.out.find("nope.stl: no such file"), std::string::npos) << missing.out;
+}
+
+}  // namespace
