@@ -31,6 +31,12 @@ Scene loadSceneWithOpacity(const std::string& path, double opacity);
 // or view fails at once; throws mfr::Error for an empty view list.
 std::vector<Scene> loadScenesWithViews(const std::vector<std::string>& paths, double opacity,
                                        const std::vector<std::string>& views);
+// --clip: "xmin,ymin,zmin,xmax,ymax,zmax" (world units) sets scene.clipBox, "none" removes the
+// scene's own; empty text leaves the scene as it is. Throws mfr::Error naming --clip.
+void applyClipOption(Scene& scene, const std::string& text);
+inline constexpr const char* kClipHelp =
+    "Clip box xmin,ymin,zmin,xmax,ymax,zmax in world units: only what lies inside is drawn (surfaces cut "
+    "open, the volume cropped); 'none' removes the scene's own";
 // The whole text as a finite number, or nothing ("1.5" yes; "1.5x", "", "nan", "inf" no).
 std::optional<double> parseNumber(const std::string& text);
 // "name" or "name:key=value:key=value" → request of w×h (a method run with several settings);

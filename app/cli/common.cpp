@@ -179,4 +179,23 @@ std::uint64_t BudgetSpec::byteCount() const {
   return bytes ? bytes : static_cast<std::uint64_t>(std::floor(mib * 1024.0 * 1024.0));
 }
 
+void applyClipOption(Scene& scene, const std::string& text) {
+  if (text.empty()) return;
+  if (text == "none") {
+    scene.clipBox.reset();
+    return;
+  }
+  const std::vector<std::string> items = splitList(text);
+  Bounds box;
+  bool ok = items.size() == 6;
+  for (std::size_t i = 0; ok && i < 6; ++i) {
+    const std::optional<double> v = parseNumber(items[i]);
+    ok = v.has_value();
+    if (ok) (i < 3 ? box.min : box.max)[static_cast<int>(i % 3)] = *v;
+  }
+  if (!ok) throw Error("--clip " + text, "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax (or none)");
+  if (!box.valid()) throw Error("--clip " + text, "min must not exceed max on any axis");
+  scene.clipBox = box;
+}
+
 }  // namespace mfr::cli

@@ -50,7 +50,7 @@ int to8(float c) {
 
 void addProbe(CLI::App& app) {
   struct Options {
-    std::string scene, pixel, size = "512x512", view = "fit", method, json;
+    std::string scene, pixel, size = "512x512", view = "fit", method, json, clip;
     std::vector<std::string> params;
     double opacity = -1.0;
   };
@@ -64,6 +64,7 @@ void addProbe(CLI::App& app) {
   cmd->add_option("--method,-m", opt->method, "Also a GPU method: which fragments it holds, the colour it draws");
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
   cmd->add_option("--json", opt->json, "Also write the probe as JSON");
+  cmd->add_option("--clip", opt->clip, kClipHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
   cmd->callback([opt] {
     const auto [w, h] = parseSize("--size", opt->size);
@@ -87,7 +88,8 @@ void addProbe(CLI::App& app) {
     } else if (!req.params.empty()) {
       throw Error("--param", "needs --method");
     }
-    const Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
+    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
+    applyClipOption(scene, opt->clip);
     const Camera camera = scene.view(opt->view);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);
 

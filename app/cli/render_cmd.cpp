@@ -13,7 +13,7 @@ namespace mfr::cli {
 
 void addRender(CLI::App& app) {
   struct Options {
-    std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats;
+    std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats, clip;
     std::vector<std::string> params;
     double opacity = -1.0;
     double thickness = 0.0;
@@ -39,6 +39,7 @@ void addRender(CLI::App& app) {
   cmd->add_flag("--shade", opt->shade,
                 "Operation volume: shade the volume by its gradient with a headlight (boundaries inside the medium "
                 "read as surfaces)");
+  cmd->add_option("--clip", opt->clip, kClipHelp);
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
@@ -64,7 +65,8 @@ void addRender(CLI::App& app) {
       if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");
       req.params[p.substr(0, eq)] = p.substr(eq + 1);
     }
-    const Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
+    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
+    applyClipOption(scene, opt->clip);
     if (opt->shade) {
       if (scene.volumes.empty()) throw Error("--shade", "scene '" + scene.name + "' has no volume");
       req.volumeShading = true;

@@ -28,6 +28,7 @@
 #include <exception>
 
 #include "camera_navigator.hpp"
+#include "clip_panel.hpp"
 #include "compare_panel.hpp"
 #include "mfr/error.hpp"
 #include "mfr/image.hpp"
@@ -312,6 +313,9 @@ void MainWindow::buildDocks() {
   };
   QDockWidget* scene =
       dock(tr("Scene"), QStringLiteral("sceneDock"), new SceneTreePanel(*model_), Qt::LeftDockWidgetArea);
+  QDockWidget* clip = dock(tr("Clip"), QStringLiteral("clipDock"), new ClipPanel(*model_), Qt::LeftDockWidgetArea);
+  tabifyDockWidget(scene, clip);
+  scene->raise();
   QDockWidget* method =
       dock(tr("Method"), QStringLiteral("methodDock"), new MethodPanel(*model_), Qt::LeftDockWidgetArea);
   compareDock_ = dock(tr("Compare"), QStringLiteral("compareDock"), new ComparePanel(*model_), Qt::LeftDockWidgetArea);

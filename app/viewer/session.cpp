@@ -102,6 +102,8 @@ Session captureSession(const ViewerModel& model) {
   s.operation = model.operation();
   s.thickness = model.zThickness();
   s.volumeStep = model.volumeStep();
+  s.hasClip = true;
+  s.clip = model.clipBox();
   for (const mfr::Volume& v : model.scene().volumes)
     s.volumes.push_back({QString::fromStdString(v.name), v.visible, v.transfer, v.shading});
   s.params = model.allParams();
@@ -131,6 +133,7 @@ void applySession(const Session& session, ViewerModel& model) {
   }
   model.setAllParams(session.params);
   model.setZThickness(session.thickness);
+  if (session.hasClip) model.setClipBox(session.clip);
   if (session.volumes.size() == model.scene().volumes.size())
     for (std::size_t i = 0; i < session.volumes.size(); ++i)
       model.setVolumeStateAt(static_cast<int>(i), session.volumes[i].visible, session.volumes[i].transfer,
@@ -184,13 +187,23 @@ QJsonObject sessionToJson(const Session& s) {
                                {"color", QJsonArray{o.color.r, o.color.g, o.color.b}},
                                {"opacity", o.color.a},
                                {"vertex_colors", o.vertexColors}});
-  return {{"format", "mfrview-session"}, {"version", 1},
-          {"scene", s.scenePath},        {"camera", camera},
-          {"method", s.method},          {"operation", s.operation},
-          {"thickness", s.thickness},    {"volume_step", s.volumeStep},
-          {"volumes", volumes},          {"params", paramsToJson(s.params)},
-          {"objects", objects},          {"compare", compare},
-          {"data_view", dataView},       {"plugins", s.plugins}};
+  return {{"format", "mfrview-session"},
+          {"version", 1},
+          {"scene", s.scenePath},
+          {"camera", camera},
+          {"method", s.method},
+          {"operation", s.operation},
+          {"thickness", s.thickness},
+          {"volume_step", s.volumeStep},
+          {"volumes", volumes},
+          {"params", paramsToJson(s.params)},
+          {"objects", objects},
+          {"compare", compare},
+          {"data_view", dataView},
+          {"plugins", s.plugins},
+          {"clip", s.clip ? QJsonValue(QJsonObject{{"min", QJsonArray{s.clip->min.x, s.clip->min.y, s.clip->min.z}},
+                                                   {"max", QJsonArray{s.clip->max.x, s.clip->max.y, s.clip->max.z}}})
+                          : QJsonValue(QJsonValue::Null)}};
 }
 
 Session sessionFromJson(const QJsonObject& json, const QString& file) {
@@ -226,6 +239,18 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   s.volumeStep = json.value("volume_step").toDouble(0.0);
   if (!std::isfinite(s.volumeStep) || s.volumeStep < 0.0)
     r.fail(QStringLiteral("volume_step"), QStringLiteral("expected a length >= 0 in scene units (0: the default)"));
+  if (json.contains("clip")) {
+    s.hasClip = true;
+    if (!json.value("clip").isNull()) {
+      if (!json.value("clip").isObject()) r.fail(QStringLiteral("clip"), QStringLiteral("expected null or {min, max}"));
+      const QJsonObject clip = json.value("clip").toObject();
+      mfr::Bounds box;
+      box.min = r.vec3(clip, "min", "clip");
+      box.max = r.vec3(clip, "max", "clip");
+      if (!box.valid()) r.fail(QStringLiteral("clip"), QStringLiteral("min must not exceed max on any axis"));
+      s.clip = box;
+    }
+  }
   const QJsonArray volumes = json.value("volumes").toArray();
   for (qsizetype i = 0; i < volumes.size(); ++i) {
     const QJsonObject v = volumes[i].toObject();

@@ -8,6 +8,7 @@
 #include <QString>
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,10 @@ struct Session {
   QString operation;
   double thickness = 0.0;  // operation zthickness, scene units, both sides; 0 = the scene's default
   double volumeStep = 0.0;  // operation volume, scene units, both sides; 0 = the volume's default
+  // The clip box ("clip": null or {min, max}); hasClip false: the session has no "clip" key (written
+  // before it existed), so the scene keeps its own.
+  bool hasClip = false;
+  std::optional<mfr::Bounds> clip;
   struct VolumeState {
     QString name;
     bool visible = true;

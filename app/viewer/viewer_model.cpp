@@ -146,6 +146,20 @@ mfr::RenderRequest ViewerModel::renderRequest(int side, QSize size) const {
   return request;
 }
 
+void ViewerModel::setClipBox(const std::optional<mfr::Bounds>& box) {
+  try {
+    mfr::validateClipBox(box, "clip box");
+  } catch (const mfr::Error&) {
+    return;
+  }
+  const auto same = [](const std::optional<mfr::Bounds>& a, const std::optional<mfr::Bounds>& b) {
+    return a.has_value() == b.has_value() && (!a || (a->min == b->min && a->max == b->max));
+  };
+  if (same(box, scene_.clipBox)) return;
+  scene_.clipBox = box;
+  sceneEdited();
+}
+
 void ViewerModel::setZThickness(double thickness) {
   if (!std::isfinite(thickness) || thickness < 0.0 || thickness == thickness_) return;
   thickness_ = thickness;

@@ -118,6 +118,11 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] bool supportsOperation(const QString& method, const QString& operation) const override;
   // The z-thickness of every pane (RenderRequest::thickness; 0 = the scene's default). A new
   // scene (setScene) starts at 0.
+  // The scene's clip box (mfr::Scene::clipBox; a scene file's "clip" as loaded). Setting it is a
+  // scene edit (sceneChanged): every renderer and the oracle draw only what lies inside. A box with
+  // min > max on an axis, or a non-finite corner, is ignored.
+  [[nodiscard]] const std::optional<mfr::Bounds>& clipBox() const { return scene_.clipBox; }
+  void setClipBox(const std::optional<mfr::Bounds>& box);
   [[nodiscard]] double zThickness() const override { return thickness_; }
   void setZThickness(double thickness) override;
   [[nodiscard]] double zThicknessDefault() const override;

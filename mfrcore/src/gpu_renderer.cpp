@@ -70,6 +70,7 @@ void GpuRenderer::setScene(const Scene& scene) {
   csgMirrored_ = csgMirroredPrimitives(scene);
   sceneName_ = scene.name;
   sceneBounds_ = scene.bounds();
+  clipBox_ = scene.clipBox;
   uploadVolume(scene);
   gl::checkErrors("scene upload");
 }
@@ -82,6 +83,7 @@ void GpuRenderer::shareScene(const GpuRenderer& other) {
   csgMirrored_ = other.csgMirrored_;
   sceneName_ = other.sceneName_;
   sceneBounds_ = other.sceneBounds_;
+  clipBox_ = other.clipBox_;
   volume_ = other.volume_;
 }
 
@@ -111,6 +113,7 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
     if (!kb->tailEnabled()) throw Error("--op hybrid", "needs --param tail=true with method " + request.method);
   }
   if (operation_ == "csg") {
+    if (clipBox_) throw Error("--op csg", kCsgClipRefusal);
     if (csg_.empty())
       throw Error("--op csg", "scene '" + sceneName_ + "' has no CSG tree (a \"csg\" key in an .mfrscene file)");
     if (!method_->info().objectPayload) {
@@ -131,6 +134,11 @@ FrameContext GpuRenderer::frameContext(const Camera& camera, int width, int heig
   frame.viewProj = glm::mat4(camera.projectionMatrix(aspect) * camera.viewMatrix());
   frame.viewDir = glm::vec3(camera.forward());
   frame.payload = operation_ == "csg" ? MFR_PAYLOAD_OBJECT : MFR_PAYLOAD_COLOR;
+  if (clipBox_) {
+    frame.clip = true;
+    frame.clipMin = glm::vec3(clipBox_->min);
+    frame.clipMax = glm::vec3(clipBox_->max);
+  }
   return FrameContext{*scene_,
                       frame,
                       background_,
@@ -154,7 +162,8 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   if (operation_ == "csg") {
     renderCsg(ctx, method);
   } else if (operation_ == "volume") {
-    const VolumeRaySetup setup = volumeRaySetup(volume_->volume, camera, request.width, request.height, volumeStep_);
+    const VolumeRaySetup setup =
+        volumeRaySetup(volume_->volume, camera, request.width, request.height, volumeStep_, clipBox_);
     method.resolve(ctx, Operation{"volume", "ops/volume.glsl", [&](const gl::Program& p) {
                                     p.set("uInvViewProj", setup.invViewProj);
                                     p.set("uViewport", setup.viewport);
@@ -164,6 +173,9 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
                                     p.set("uTfLow", setup.tfLow);
                                     p.set("uTfHigh", setup.tfHigh);
                                     p.set("uVolumeShading", volumeShading_ ? 1 : 0);
+                                    p.set("uClip", setup.clip ? 1 : 0);
+                                    p.set("uClipMin", setup.clipMin);
+                                    p.set("uClipMax", setup.clipMax);
                                     glBindTextureUnit(MFR_TEX_VOLUME, volume_->grid.id());
                                     glBindTextureUnit(MFR_TEX_VOLUME_TF, volume_->transfer.id());
                                   }});

@@ -202,7 +202,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     if (!volume) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");
     const double step = volumeStepOf(request, *volume);
     const Volume drawn = volumeAsRequested(request, *volume);
-    out.image = compositeVolume(lists, camera, drawn, step, scene.background);
+    out.image = compositeVolume(lists, camera, drawn, step, scene.background, scene.clipBox);
     out.stats.notes.emplace_back("volume step", std::to_string(step));
     out.stats.notes.emplace_back("volume shading", drawn.shading ? "on" : "off");
   } else if (operation == "zthickness") {
@@ -210,6 +210,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     out.image = compositeZThickness(lists, camera, thickness, scene.background);
     out.stats.notes.emplace_back("z-thickness", std::to_string(thickness));
   } else if (operation == "csg") {
+    if (scene.clipBox) throw Error("--op csg", kCsgClipRefusal);
     if (scene.csg.empty())
       throw Error("--op csg", "scene '" + scene.name + "' has no CSG tree (a \"csg\" key in an .mfrscene file)");
     out.image = compositeCsg(lists, scene);

@@ -12,6 +12,11 @@ uniform mat4 uModel;
 uniform mat3 uNormalMatrix;
 uniform vec4 uColor;
 uniform int uVertexColors;  // 0: the object's colour replaces the mesh's per-vertex colours
+// Scene::clipBox (world space): distances to its six faces, positive inside. GL clips with them
+// only while GpuScene::draw enables GL_CLIP_DISTANCE0…5 (a scene with a clip box).
+uniform vec3 uClipMin;
+uniform vec3 uClipMax;
+out float gl_ClipDistance[6];
 
 out vec3 vNormal;
 out vec4 vColor;
@@ -23,5 +28,13 @@ invariant gl_Position;
 void main() {
   vNormal = uNormalMatrix * aNormal;
   vColor = uVertexColors != 0 ? uColor * aColor : uColor;
-  gl_Position = uViewProj * (uModel * vec4(aPosition, 1.0));
+  vec4 world = uModel * vec4(aPosition, 1.0);
+  gl_Position = uViewProj * world;
+  vec3 below = world.xyz - uClipMin, above = uClipMax - world.xyz;
+  gl_ClipDistance[0] = below.x;
+  gl_ClipDistance[1] = below.y;
+  gl_ClipDistance[2] = below.z;
+  gl_ClipDistance[3] = above.x;
+  gl_ClipDistance[4] = above.y;
+  gl_ClipDistance[5] = above.z;
 }

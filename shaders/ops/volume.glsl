@@ -19,6 +19,9 @@ uniform float uVolumeStep;   // world units along the ray
 uniform float uTfLow;        // scalar of the first transfer-table entry
 uniform float uTfHigh;       // scalar of the last one
 uniform int uVolumeShading;  // Volume::shading
+uniform int uClip;           // Scene::clipBox: the march stays inside [uClipMin, uClipMax] too (world)
+uniform vec3 uClipMin;
+uniform vec3 uClipMax;
 layout(binding = MFR_TEX_VOLUME) uniform sampler3D uVolume;       // R32F, read with texelFetch
 layout(binding = MFR_TEX_VOLUME_TF) uniform sampler1D uTransfer;  // (rgb, σ), MFR_VOLUME_TF_SIZE
 
@@ -106,6 +109,18 @@ void opBegin(inout OpState s, ivec2 pixel) {
       float tb = (last[a] - s.gridStart[a]) / s.gridDir[a];
       t0 = max(t0, min(ta, tb));
       t1 = min(t1, max(ta, tb));
+    }
+  }
+  if (uClip != 0) {  // slabs of the clip box, in world space
+    for (int a = 0; a < 3; ++a) {
+      if (abs(s.rayDir[a]) < 1e-30) {
+        if (s.rayStart[a] < uClipMin[a] || s.rayStart[a] > uClipMax[a]) t1 = -1.0;
+      } else {
+        float ta = (uClipMin[a] - s.rayStart[a]) / s.rayDir[a];
+        float tb = (uClipMax[a] - s.rayStart[a]) / s.rayDir[a];
+        t0 = max(t0, min(ta, tb));
+        t1 = min(t1, max(ta, tb));
+      }
     }
   }
   s.tEnter = t0;

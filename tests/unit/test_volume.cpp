@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <optional>
 #include <memory>
 
 #include <glm/gtc/packing.hpp>
@@ -72,8 +73,9 @@ Fragment surface(const Camera& c, double z, glm::vec4 color) {
 constexpr int kSize = 33;  // odd: the centre pixel's ray is the z axis
 const int kCentre = kSize / 2;
 
-glm::vec3 centrePixel(std::span<const Fragment> sorted, const Volume& v, double step, glm::vec3 background) {
-  const VolumeRaySetup setup = volumeRaySetup(v, frontCamera(), kSize, kSize, step);
+glm::vec3 centrePixel(std::span<const Fragment> sorted, const Volume& v, double step, glm::vec3 background,
+                      const std::optional<Bounds>& clip = std::nullopt) {
+  const VolumeRaySetup setup = volumeRaySetup(v, frontCamera(), kSize, kSize, step, clip);
   return compositeVolume(sorted, kCentre, kCentre, setup, *v.grid, background);
 }
 
@@ -119,6 +121,35 @@ TEST(VolumeComposite, HomogeneousMediumIsBeerLambert) {
     SCOPED_TRACE(step);
     expectNear(centrePixel({}, v, step, bg), expected, 2e-5f);
   }
+}
+
+// A clip box crops the medium: the chord along z is what lies inside both boxes.
+TEST(VolumeComposite, ClipBoxCropsTheMediumToItsChord) {
+  const glm::vec4 medium(0.2f, 0.6f, 0.9f, 0.3f);
+  Volume v = boxVolume(5, [](double, double, double) { return 0.5; });
+  v.transfer = uniformTransfer(medium, 0.25);
+  const double sigma = -std::log(1.0 - 0.3) / 0.25;
+  const glm::vec3 bg(1.0f, 0.9f, 0.8f);
+  const auto through = [&](double length) {
+    const double tr = std::exp(-sigma * length);
+    return glm::vec3(medium) * static_cast<float>(1.0 - tr) + bg * static_cast<float>(tr);
+  };
+  Bounds box;
+  box.min = {-5.0, -5.0, -0.25};
+  box.max = {5.0, 5.0, 0.5};
+  for (const double step : {0.0, 0.013, 0.7}) {
+    SCOPED_TRACE(step);
+    expectNear(centrePixel({}, v, step, bg, box), through(0.75), 2e-5f);
+    // Reaching past the volume on one side: the volume's own face ends the chord there.
+    box.min.z = -3.0;
+    expectNear(centrePixel({}, v, step, bg, box), through(1.5), 2e-5f);
+    box.min.z = -0.25;
+  }
+  // A box beside the ray: no medium at all.
+  Bounds aside;
+  aside.min = {0.2, -5.0, -5.0};
+  aside.max = {5.0, 5.0, 5.0};
+  expectNear(centrePixel({}, v, 0.0, bg, aside), bg, 1e-6f);
 }
 
 TEST(VolumeComposite, SurfacesInFrontInsideAndBehindTheMediumAtTheirExactDepths) {

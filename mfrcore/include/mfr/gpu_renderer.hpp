@@ -95,6 +95,7 @@ class GpuRenderer {
   std::uint32_t csgMirrored_ = 0;  // csgMirroredPrimitives of the scene
   std::string sceneName_;
   Bounds sceneBounds_;
+  std::optional<Bounds> clipBox_;  // Scene::clipBox
   double thickness_ = 0.0;  // operation "zthickness" of the prepared request (scene units)
   // Operation "volume": the scene's visible volume on the GPU (shared with shareScene; a new
   // scene with the same grid keeps the grid texture and uploads only the transfer table).

@@ -31,6 +31,10 @@ struct RenderRequest {
   std::optional<bool> volumeShading;
 };
 
+// Why operation "csg" refuses a scene with a clip box (GPU and oracle say the same).
+inline constexpr const char* kCsgClipRefusal =
+    "a clip box cuts open the closed solids CSG needs (remove the clip box for this operation)";
+
 // The operations render() and GpuRenderer accept, for messages: "auto, oit, hybrid, csg, zthickness, volume".
 const std::string& operationNames();
 // Throws mfr::Error("--op <name>", …) for a name not in operationNames().

@@ -54,6 +54,15 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
   program.set("uViewProj", frame.viewProj);
   program.set("uViewDir", frame.viewDir);
   program.set("uPayload", frame.payload);
+  program.set("uClipMin", frame.clipMin);
+  program.set("uClipMax", frame.clipMax);
+  // Six planes, enabled only while this draw runs (full-screen passes write no clip distances).
+  for (int i = 0; i < 6; ++i) {
+    if (frame.clip)
+      glEnable(GL_CLIP_DISTANCE0 + static_cast<GLenum>(i));
+    else
+      glDisable(GL_CLIP_DISTANCE0 + static_cast<GLenum>(i));
+  }
   for (const DrawItem& item : items_) {
     const GpuMesh& m = meshes_[item.mesh];
     program.set("uModel", item.model);
@@ -65,6 +74,8 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
     glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
   }
   glBindVertexArray(0);
+  if (frame.clip)
+    for (int i = 0; i < 6; ++i) glDisable(GL_CLIP_DISTANCE0 + static_cast<GLenum>(i));
 }
 
 }  // namespace mfr::gl

@@ -145,7 +145,8 @@ ImageRGBA8 compositeZThickness(const FragmentLists& lists, const Camera& camera,
   return image;
 }
 
-VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int width, int height, double step) {
+VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int width, int height, double step,
+                              const std::optional<Bounds>& clip) {
   VolumeRaySetup s;
   const double aspect = static_cast<double>(width) / height;
   s.invViewProj = glm::mat4(glm::inverse(camera.projectionMatrix(aspect) * camera.viewMatrix()));
@@ -157,6 +158,11 @@ VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int wi
   s.tfHigh = static_cast<float>(volume.transfer.high());
   s.table = volume.transfer.table();
   s.shading = volume.shading;
+  if (clip) {
+    s.clip = true;
+    s.clipMin = glm::vec3(clip->min);
+    s.clipMax = glm::vec3(clip->max);
+  }
   return s;
 }
 
@@ -222,6 +228,17 @@ struct VolumeMarcher {
         t1 = std::min(t1, std::max(ta, tb));
       }
     }
+    if (setup.clip)  // slabs of the clip box, in world space
+      for (int a = 0; a < 3; ++a) {
+        if (std::abs(rayDir[a]) < 1e-30f) {
+          if (rayStart[a] < setup.clipMin[a] || rayStart[a] > setup.clipMax[a]) t1 = -1.0f;
+        } else {
+          const float ta = (setup.clipMin[a] - rayStart[a]) / rayDir[a];
+          const float tb = (setup.clipMax[a] - rayStart[a]) / rayDir[a];
+          t0 = std::max(t0, std::min(ta, tb));
+          t1 = std::min(t1, std::max(ta, tb));
+        }
+      }
     tEnter = t0;
     tExit = std::max(t1, t0);
     step = std::max(setup.step, (tExit - tEnter) / static_cast<float>(MFR_VOLUME_MAX_STEPS));
@@ -270,11 +287,11 @@ glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, co
 }
 
 ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, const Volume& volume, double step,
-                           const glm::vec3& background) {
+                           const glm::vec3& background, const std::optional<Bounds>& clip) {
   volume.validate();
   if (!std::isfinite(step) || step < 0.0)
     throw Error("--step", "must be a positive length in scene units (got " + std::to_string(step) + ")");
-  const VolumeRaySetup setup = volumeRaySetup(volume, camera, lists.width, lists.height, step);
+  const VolumeRaySetup setup = volumeRaySetup(volume, camera, lists.width, lists.height, step, clip);
   ImageRGBA8 image(lists.width, lists.height);
   for (int y = 0; y < lists.height; ++y)
     for (int x = 0; x < lists.width; ++x)

@@ -458,17 +458,45 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   std::vector<std::uint32_t> counts(pixelCount, 0);
   std::vector<std::uint8_t> rayFlags(pixelCount, 0);
 
+  // The ray through window point (wx, wy): origin on the near plane, dir to the far plane.
+  const auto windowRay = [&](double wx, double wy, glm::dvec3& origin, glm::dvec3& dir) {
+    const double ndcX = 2.0 * wx / width - 1.0;
+    const double ndcY = 2.0 * wy / height - 1.0;
+    const glm::dvec4 n4 = invViewProj * glm::dvec4(ndcX, ndcY, -1.0, 1.0);
+    const glm::dvec4 f4 = invViewProj * glm::dvec4(ndcX, ndcY, 1.0, 1.0);
+    origin = glm::dvec3(n4) / n4.w;
+    dir = glm::dvec3(f4) / f4.w - origin;
+  };
+  const std::optional<Bounds>& clipBox = scene.clipBox;
+  // Whether the line where the triangle's plane meets a face of the clip box passes within
+  // edgeEpsilon pixels of the centre whose ray hits that plane at p: each face coordinate's change
+  // per pixel on the plane comes from the rays through the next centres right and up. There GL's
+  // clipping (in float, then snapped) and the exact test may disagree, like at a triangle's edge.
+  const auto nearClipFace = [&](const WorldTriangle& tri, const glm::dvec3& p, double wx, double wy) {
+    const glm::dvec3 normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
+    glm::dvec3 onPlane[2];
+    for (int i = 0; i < 2; ++i) {
+      glm::dvec3 o, d;
+      windowRay(wx + (i == 0 ? 1.0 : 0.0), wy + (i == 1 ? 1.0 : 0.0), o, d);
+      const double facing = glm::dot(normal, d);
+      if (facing == 0.0) return true;  // edge-on: no measure; treat as ambiguous
+      onPlane[i] = o + d * (glm::dot(normal, tri.p[0] - o) / facing);
+    }
+    for (int a = 0; a < 3; ++a) {
+      const double perPixel = std::hypot(onPlane[0][a] - p[a], onPlane[1][a] - p[a]);
+      for (const double face : {clipBox->min[a], clipBox->max[a]})
+        if (std::abs(p[a] - face) <= options.edgeEpsilon * perPixel) return true;
+    }
+    return false;
+  };
+
   const auto castRow = [&](int y, std::vector<std::uint32_t>& candidates, std::vector<Hit>& hits) {
     std::vector<Fragment>& out = rowFragments[static_cast<std::size_t>(y)];
     const double wy = (height - 1 - y) + 0.5;
     for (int x = region.x; x < region.x + region.width; ++x) {
       const std::size_t pixel = static_cast<std::size_t>(y) * width + x;
-      const double ndcX = 2.0 * (x + 0.5) / width - 1.0;
-      const double ndcY = 2.0 * wy / height - 1.0;
-      const glm::dvec4 n4 = invViewProj * glm::dvec4(ndcX, ndcY, -1.0, 1.0);
-      const glm::dvec4 f4 = invViewProj * glm::dvec4(ndcX, ndcY, 1.0, 1.0);
-      const glm::dvec3 origin = glm::dvec3(n4) / n4.w;
-      const glm::dvec3 dir = glm::dvec3(f4) / f4.w - origin;
+      glm::dvec3 origin, dir;
+      windowRay(x + 0.5, wy, origin, dir);
       // The broad phase takes a slightly longer segment; the exact depth test below decides.
       candidates.clear();
       SegmentCandidates collect(origin, dir, -1e-6, 1.0 + 1e-6, cgalTriangles.cbegin(), candidates);
@@ -486,6 +514,10 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
         if (screenDegenerate[index] != 0) {
           rayFlags[pixel] |= FragmentLists::kEdge;
           continue;
+        }
+        if (clipBox) {
+          if (nearClipFace(tri, p, x + 0.5, wy)) rayFlags[pixel] |= FragmentLists::kEdge;
+          if (!insideClipBox(clipBox, p)) continue;
         }
         const glm::dvec3 normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
         Fragment frag;

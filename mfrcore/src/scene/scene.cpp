@@ -77,6 +77,19 @@ void Scene::validate() const {
   if (visibleVolumes > 1)
     throw Error("scene '" + name + "'", std::to_string(visibleVolumes) + " visible volumes: at most one can be drawn");
   validateCsg(*this);
+  validateClipBox(clipBox, "clip box");
+}
+
+void validateClipBox(const std::optional<Bounds>& box, const std::string& what) {
+  if (!box) return;
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(box->min[a]) || !std::isfinite(box->max[a]) || !(box->min[a] <= box->max[a]))
+      throw Error(what, "needs finite corners with min <= max on every axis");
+}
+
+bool insideClipBox(const std::optional<Bounds>& box, const glm::dvec3& p) {
+  return !box || (p.x >= box->min.x && p.y >= box->min.y && p.z >= box->min.z && p.x <= box->max.x &&
+                  p.y <= box->max.y && p.z <= box->max.z);
 }
 
 std::vector<std::string> Scene::viewNames() const {

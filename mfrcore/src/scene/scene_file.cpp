@@ -364,6 +364,15 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
   scene.name = r.string(doc, "name", "top level", std::filesystem::path(name).stem().string());
   if (doc.contains("background")) scene.background = glm::vec3(r.vec3(doc["background"], "background"));
   if (doc.value("sample", false)) scene = makeSampleScene();
+  if (doc.contains("clip")) {
+    const json& clip = r.object(doc["clip"], "clip");
+    if (!clip.contains("min") || !clip.contains("max")) r.fail("clip", "expected \"min\" and \"max\" corners");
+    Bounds box;
+    box.min = r.vec3(clip["min"], "clip.min");
+    box.max = r.vec3(clip["max"], "clip.max");
+    if (!box.valid()) r.fail("clip", "min must not exceed max on any axis");
+    scene.clipBox = box;
+  }
 
   // One equal part of the progress per object and per volume.
   const auto items = [&](const char* key) { return doc.contains(key) && doc[key].is_array() ? doc[key].size() : 0; };

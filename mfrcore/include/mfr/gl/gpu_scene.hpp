@@ -18,6 +18,12 @@ struct FrameUniforms {
   glm::mat4 viewProj{1.0f};
   glm::vec3 viewDir{0.0f, 0.0f, -1.0f};  // headlight direction (camera forward), world space
   int payload = 0;  // what capture passes store in a fragment's colour word: MFR_PAYLOAD_* (bindings.h)
+  // Scene::clipBox: draw() clips every triangle to it with six clip distances (common/scene.vert).
+  // Without a box the faces lie far outside any scene: llvmpipe clips by written distances even
+  // with GL_CLIP_DISTANCEi disabled, so they must be positive either way.
+  bool clip = false;
+  glm::vec3 clipMin{-1e30f};
+  glm::vec3 clipMax{1e30f};
 };
 
 class GpuScene {

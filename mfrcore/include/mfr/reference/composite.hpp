@@ -1,6 +1,7 @@
 #pragma once
 // Exact operations on the oracle's sorted lists.
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -48,14 +49,19 @@ struct VolumeRaySetup {
   float tfLow = 0.0f, tfHigh = 1.0f;
   std::vector<glm::vec4> table;  // TransferFunction::table()
   bool shading = false;          // Volume::shading
+  // Scene::clipBox: the march is limited to the part of the ray inside it too (world space).
+  bool clip = false;
+  glm::vec3 clipMin{0.0f};
+  glm::vec3 clipMax{0.0f};
 };
-// The values both renderers use; step ≤ 0 picks Volume::defaultStep().
-VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int width, int height, double step);
+// The values both renderers use; step ≤ 0 picks Volume::defaultStep(); clip: the scene's clip box.
+VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int width, int height, double step,
+                              const std::optional<Bounds>& clip = std::nullopt);
 // One pixel; (glX, glY) in GL window coordinates (row 0 at the bottom).
 glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, const VolumeRaySetup& setup,
                           const VolumeGrid& grid, const glm::vec3& background);
 ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, const Volume& volume, double step,
-                           const glm::vec3& background);
+                           const glm::vec3& background, const std::optional<Bounds>& clip = std::nullopt);
 
 // Image-space CSG (scene.csg, rule of csgVisibleFragment with the scene's mirrored primitives):
 // each pixel shows its visible fragment's colour as an opaque surface (RGB of the stored colour,

@@ -44,6 +44,11 @@ struct Scene {
   CsgTree csg;  // image-space CSG over some objects (operation "csg"); empty: none
   // Scalar volumes composited with the surfaces by the operation "volume"; at most one visible.
   std::vector<Volume> volumes;
+  // The clip box (world space): only what lies inside it is drawn — surfaces are cut open along its
+  // faces, the volume is cropped — by every method and by the oracle. Unset: nothing is clipped.
+  // bounds() and fit() ignore it, so a view frames the whole scene and the cut shows in place.
+  // (.mfrscene "clip", mfr render --clip, mfrview's Clip box.)
+  std::optional<Bounds> clipBox;
 
   [[nodiscard]] Bounds bounds() const;  // world bounds of visible objects and volumes
   // Radius of the smallest sphere around bounds().center() holding every visible vertex and
@@ -63,5 +68,11 @@ struct Scene {
   [[nodiscard]] Camera view(const std::string& name) const;
   [[nodiscard]] std::vector<std::string> viewNames() const;
 };
+
+// Throws mfr::Error(what, …) for a clip box with a non-finite corner or min > max on an axis.
+void validateClipBox(const std::optional<Bounds>& box, const std::string& what);
+// Whether world point p is drawn under the clip box (always without one); the box's faces count
+// as inside.
+bool insideClipBox(const std::optional<Bounds>& box, const glm::dvec3& p);
 
 }  // namespace mfr
