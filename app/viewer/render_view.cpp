@@ -619,18 +619,19 @@ void RenderView::updateOverlays() {
 
 // ---- export --------------------------------------------------------------------------------
 
+RenderView::CurrentContext RenderView::currentWithScene(int side) {
+  if (!renderers_[0]) throw mfr::Error("OpenGL", "the view has no OpenGL 4.5 context yet");
+  CurrentContext current(*this);
+  QStringList errors;
+  if (!uploadSceneIfChanged(side, errors)) throw mfr::Error(model_.scene().name, errors.join("; ").toStdString());
+  return current;
+}
+
 mfr::ImageRGBA8 RenderView::renderImage(QSize size) {
   if (!model_.hasScene()) throw mfr::Error("export", "no scene loaded");
   const mfr::RenderRequest request = model_.renderRequest(0, size);
   if (model_.isCpuMethod(model_.method())) return mfr::render(model_.scene(), model_.camera(), request).image;
-  if (!renderers_[0]) throw mfr::Error("OpenGL", "the view has no OpenGL 4.5 context yet");
-  makeCurrent();
-  struct DoneCurrent {
-    RenderView* view;
-    ~DoneCurrent() { view->doneCurrent(); }
-  } done{this};
-  QStringList errors;
-  if (!uploadSceneIfChanged(0, errors)) throw mfr::Error(model_.scene().name, errors.join("; ").toStdString());
+  const CurrentContext current = currentWithScene(0);
   try {
     return renderer(0).render(model_.camera(), request).image;
   } catch (...) {
@@ -660,15 +661,7 @@ ViewProbe RenderView::probeAt(QPoint point) {
   const mfr::MethodInfo* info = model_.isCpuMethod(result.method) ? nullptr : model_.methodInfo(result.method);
   result.methodHasLists = info != nullptr && info->sortedLists;
   if (!result.methodHasLists) return result;
-  if (!renderers_[0]) throw mfr::Error("OpenGL", "the view has no OpenGL 4.5 context yet");
-  makeCurrent();
-  struct DoneCurrent {
-    RenderView* view;
-    ~DoneCurrent() { view->doneCurrent(); }
-  } done{this};
-  QStringList errors;
-  if (!uploadSceneIfChanged(result.side, errors))
-    throw mfr::Error(model_.scene().name, errors.join("; ").toStdString());
+  const CurrentContext current = currentWithScene(result.side);
   try {
     if (!probeRenderer_) probeRenderer_ = std::make_unique<mfr::GpuRenderer>();
     probeRenderer_->shareScene(renderer(result.side));

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "mfr/gpu_renderer.hpp"
@@ -125,6 +126,25 @@ class RenderView final : public QOpenGLWidget {
   };
   mfr::GpuRenderer& renderer(int side);
   bool uploadSceneIfChanged(int side, QStringList& errors);
+  // The view's context made current for GL work outside paintGL (export, probe), released when
+  // the guard goes (moved, not copied).
+  class CurrentContext {
+   public:
+    explicit CurrentContext(RenderView& view) : view_(&view) { view.makeCurrent(); }
+    CurrentContext(CurrentContext&& other) noexcept : view_(std::exchange(other.view_, nullptr)) {}
+    CurrentContext(const CurrentContext&) = delete;
+    CurrentContext& operator=(const CurrentContext&) = delete;
+    CurrentContext& operator=(CurrentContext&&) = delete;
+    ~CurrentContext() {
+      if (view_) view_->doneCurrent();
+    }
+
+   private:
+    RenderView* view_;
+  };
+  // The context current and side's scene uploaded; throws mfr::Error without a GL context yet or
+  // when the scene cannot be uploaded (e.g. every object hidden).
+  [[nodiscard]] CurrentContext currentWithScene(int side);
   void paintSingleImage(QStringList& errors);
   void paintPane(int side, QStringList& errors);
   PaneTarget& paneTarget(int side, QSize size) { return targetOf(targets_, side, size); }
