@@ -114,7 +114,13 @@ void ProbePanel::show(const ViewProbe& r) {
   if (p.depthTie) text += tr(" — two at one depth (order undefined)");
   const auto to8 = [](float c) { return static_cast<int>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f)); };
   const QColor exact(to8(p.exactColor.r), to8(p.exactColor.g), to8(p.exactColor.b));
-  text += tr(". Exact colour %1.").arg(exact.name());
+  text += tr(". Exact colour %1").arg(exact.name());
+  if (r.shown) {
+    const int diff = std::max({std::abs(r.shown->red() - exact.red()), std::abs(r.shown->green() - exact.green()),
+                               std::abs(r.shown->blue() - exact.blue())});
+    text += tr(", shown %1 (largest difference %2/255)").arg(r.shown->name()).arg(diff);
+  }
+  text += QStringLiteral(".");
   if (p.captured) {
     text += tr(" %1 holds %2 of them").arg(r.method).arg(p.heldCount());
     if (p.methodCount != p.heldCount()) text += tr(" (%1 in all)").arg(p.methodCount);

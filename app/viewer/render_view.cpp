@@ -657,6 +657,16 @@ ViewProbe RenderView::probeAt(QPoint point) {
   result.method = model_.methodOf(result.side);
   const QPoint pixel = device - pane.topLeft();
   result.probe = mfr::probePixel(model_.scene(), model_.camera(), pane.width(), pane.height(), pixel.x(), pixel.y());
+  const bool showsImage = model_.dataView() == DataView::Image &&
+                          (!model_.compareEnabled() || model_.compareDisplay() == CompareDisplay::Images);
+  if (showsImage && renderers_[0]) {
+    // What the last frame left in the widget's framebuffer (GL rows bottom-up).
+    const CurrentContext current(*this);
+    std::uint8_t rgba[4] = {0, 0, 0, 0};
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, defaultFramebufferObject());
+    glReadPixels(device.x(), pixelSize().height() - 1 - device.y(), 1, 1, GL_RGBA, GL_UNSIGNED_BYTE, rgba);
+    result.shown = QColor(rgba[0], rgba[1], rgba[2]);
+  }
 
   const mfr::MethodInfo* info = model_.isCpuMethod(result.method) ? nullptr : model_.methodInfo(result.method);
   result.methodHasLists = info != nullptr && info->sortedLists;

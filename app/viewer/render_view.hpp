@@ -14,6 +14,7 @@
 // epoxy must come before Qt's OpenGL headers (it replaces the system GL headers).
 #include <epoxy/gl.h>
 
+#include <QColor>
 #include <QOpenGLWidget>
 #include <QPoint>
 
@@ -43,6 +44,9 @@ struct ViewProbe {
   QString method;               // the pane's method
   bool methodHasLists = false;  // a GPU method keeping sorted lists: probe.captured says what it holds
   mfr::PixelProbe probe;        // the oracle's exact list at the pane pixel (probe.x, probe.y)
+  // The colour the view shows at the point (its last frame, read from the framebuffer); unset
+  // while a data view or a heat map replaces the image.
+  std::optional<QColor> shown;
 };
 
 class RenderView final : public QOpenGLWidget {

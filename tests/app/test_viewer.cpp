@@ -2294,6 +2294,12 @@ class ViewerTest : public QObject {
     };
     checkRows(2);
     QVERIFY2(summary->text().contains(QStringLiteral("kplus-array holds 2 of them")), qPrintable(summary->text()));
+    // The shown colour is the method's image at the pixel (its `mfr render` path).
+    const mfr::ImageRGBA8 image = view.renderImage(QSize(200, 150));
+    const std::uint8_t* at = image.at(pixel.x(), pixel.y());
+    const QString shown = QColor(at[0], at[1], at[2]).name();
+    QVERIFY2(summary->text().contains(QStringLiteral("shown %1").arg(shown)),
+             qPrintable(summary->text() + " / " + shown));
     auto* mark = w->findChild<QWidget*>("probeMarker");
     QVERIFY(mark && mark->isVisible());
     QCOMPARE(mark->geometry().center(), pixel);
@@ -2303,6 +2309,15 @@ class ViewerTest : public QObject {
     QTRY_VERIFY2_WITH_TIMEOUT(summary->text().contains(QStringLiteral("abuffer-ll holds %1 of them").arg(n)),
                               qPrintable(summary->text()), kProbeTimeoutMs);
     checkRows(n);
+    {  // An exact method: what the view shows there is its image, the exact colour up to edges.
+      const mfr::ImageRGBA8 exactImage = view.renderImage(QSize(200, 150));
+      const std::uint8_t* px = exactImage.at(pixel.x(), pixel.y());
+      const std::uint8_t* mirrored = exactImage.at(pixel.x(), 149 - pixel.y());
+      QVERIFY(std::memcmp(px, mirrored, 3) != 0);  // a read from the wrong row would show
+      const QString shownExact = QColor(px[0], px[1], px[2]).name();
+      QVERIFY2(summary->text().contains(QStringLiteral("shown %1").arg(shownExact)),
+               qPrintable(summary->text() + " / " + shownExact));
+    }
     // A method without lists: the exact list only.
     m.setMethod("wboit");
     QTRY_VERIFY2_WITH_TIMEOUT(summary->text().contains(QStringLiteral("wboit keeps no per-pixel lists")),
