@@ -10,6 +10,7 @@
 #include "mfr/reference/composite.hpp"
 #include "methods/kbuffer_common.hpp"
 #include "methods/method_util.hpp"
+#include "reference/pixel_region.hpp"
 
 namespace mfr {
 
@@ -324,11 +325,7 @@ CapturedLists GpuRenderer::capture(const Camera& camera, const RenderRequest& re
                                    const PixelRect& region) {
   Method& method = prepare(request);
   const int w = request.width, h = request.height;
-  PixelRect r = region.empty() ? PixelRect{0, 0, w, h} : region;
-  if (r.x < 0 || r.y < 0 || static_cast<long long>(r.x) + r.width > w || static_cast<long long>(r.y) + r.height > h)
-    throw Error("pixel region", std::to_string(r.width) + "x" + std::to_string(r.height) + " at (" +
-                                    std::to_string(r.x) + ", " + std::to_string(r.y) + ") is not inside the " +
-                                    std::to_string(w) + "x" + std::to_string(h) + " image");
+  const PixelRect r = regionInImage(region, w, h);
   if (maxPerPixel < 1) throw Error("capture", "at least one fragment per pixel must be kept");
   const std::size_t pixels = static_cast<std::size_t>(r.width) * r.height;
   gl::Buffer fragments = gl::createBuffer(pixels * static_cast<std::size_t>(maxPerPixel) * 8);

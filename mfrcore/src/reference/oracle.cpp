@@ -19,6 +19,8 @@
 // less than depthTieEpsilon·max(1e-30, |depth|).
 #include "mfr/reference/oracle.hpp"
 
+#include "reference/pixel_region.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -394,16 +396,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     throw Error("image size", std::to_string(width) + "x" + std::to_string(height) + " is not in 1.." +
                                   std::to_string(kMaxImageSize) + " per side");
 
-  PixelRect region = options.region;
-  if (region.empty()) {
-    region = {0, 0, width, height};
-  } else if (region.x < 0 || region.y < 0 || static_cast<long long>(region.x) + region.width > width ||
-             static_cast<long long>(region.y) + region.height > height) {
-    throw Error("pixel region", std::to_string(region.width) + "x" + std::to_string(region.height) + " at (" +
-                                    std::to_string(region.x) + ", " + std::to_string(region.y) +
-                                    ") is not inside the " + std::to_string(width) + "x" + std::to_string(height) +
-                                    " image");
-  }
+  const PixelRect region = regionInImage(options.region, width, height);
 
   const glm::dmat4 viewProj =
       camera.projectionMatrix(static_cast<double>(width) / height) * camera.viewMatrix();
