@@ -37,6 +37,17 @@ void applyClipOption(Scene& scene, const std::string& text);
 inline constexpr const char* kClipHelp =
     "Clip box xmin,ymin,zmin,xmax,ymax,zmax in world units: only what lies inside is drawn (surfaces cut "
     "open, the volume cropped); 'none' removes the scene's own";
+// --section: "AXIS=VALUE" (AXIS one of x y z -x -y -z: the plane AXIS = VALUE, keeping the side the
+// axis points to; "-z=0.5" keeps z <= 0.5) or "px,py,pz,nx,ny,nz" (a point and the normal of the kept
+// side), each optionally followed by ":nocaps"; "none" removes the scene's own; empty text leaves the
+// scene as it is. Then the scene is cut by its section (the option's or the scene file's; once, so that
+// every renderer gets the cut scene), with a one-line note on stderr naming cut parts left without a
+// cap because they are not closed. Throws mfr::Error naming --section.
+void applySectionOption(Scene& scene, const std::string& text);
+inline constexpr const char* kSectionHelp =
+    "Section plane: AXIS=VALUE (x, y, z, -x, -y, -z; keeps the side the axis points to) or "
+    "px,py,pz,nx,ny,nz (point, normal of the kept side), optionally :nocaps; closed surfaces get caps; "
+    "'none' removes the scene's own";
 // The whole text as a finite number, or nothing ("1.5" yes; "1.5x", "", "nan", "inf" no).
 std::optional<double> parseNumber(const std::string& text);
 // "name" or "name:key=value:key=value" → request of w×h (a method run with several settings);

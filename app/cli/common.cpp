@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <iostream>
 #include <sstream>
 
 #include "commands.hpp"
@@ -8,6 +9,7 @@
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/render.hpp"
+#include "mfr/scene/section.hpp"
 
 namespace mfr::cli {
 
@@ -196,6 +198,66 @@ void applyClipOption(Scene& scene, const std::string& text) {
   if (!ok) throw Error("--clip " + text, "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax (or none)");
   if (!box.valid()) throw Error("--clip " + text, "min must not exceed max on any axis");
   scene.clipBox = box;
+}
+
+namespace {
+
+void cutBySection(Scene& scene) {
+  if (!scene.section || scene.sectionCut) return;
+  SectionReport report;
+  scene = sectionedScene(scene, &report);
+  if (report.open.empty()) return;
+  std::string names;
+  for (std::size_t i = 0; i < report.open.size() && i < 5; ++i) names += (i ? ", " : "") + report.open[i];
+  if (report.open.size() > 5) names += ", …";
+  std::cerr << "note: section: " << report.open.size() << " of " << report.cut
+            << " cut parts have no cap (not closed surfaces): " << names << "\n";
+}
+
+}  // namespace
+
+void applySectionOption(Scene& scene, const std::string& text) {
+  if (text == "none") {
+    scene.section.reset();
+    return;
+  }
+  if (text.empty()) {
+    cutBySection(scene);
+    return;
+  }
+  const std::string what = "--section " + text;
+  std::string plane = text;
+  SectionPlane section;
+  if (const std::size_t colon = text.find(':'); colon != std::string::npos) {
+    if (text.substr(colon + 1) != "nocaps") throw Error(what, "the only suffix is :nocaps");
+    section.caps = false;
+    plane = text.substr(0, colon);
+  }
+  if (const std::size_t eq = plane.find('='); eq != std::string::npos) {
+    const std::string axis = plane.substr(0, eq);
+    static const char* const kAxes[] = {"x", "y", "z", "-x", "-y", "-z"};
+    int index = -1;
+    for (int a = 0; a < 6; ++a)
+      if (axis == kAxes[a]) index = a;
+    const std::optional<double> value = parseNumber(plane.substr(eq + 1));
+    if (index < 0 || !value) throw Error(what, "expected AXIS=VALUE with AXIS one of x, y, z, -x, -y, -z and a number");
+    section.normal = glm::dvec3(0.0);
+    section.normal[index % 3] = index < 3 ? 1.0 : -1.0;
+    section.point = glm::dvec3(0.0);
+    section.point[index % 3] = *value;
+  } else {
+    const std::vector<std::string> items = splitList(plane);
+    bool ok = items.size() == 6;
+    for (std::size_t i = 0; ok && i < 6; ++i) {
+      const std::optional<double> v = parseNumber(items[i]);
+      ok = v.has_value();
+      if (ok) (i < 3 ? section.point : section.normal)[static_cast<int>(i % 3)] = *v;
+    }
+    if (!ok) throw Error(what, "expected AXIS=VALUE or six numbers px,py,pz,nx,ny,nz (or none)");
+    if (!(glm::length(section.normal) > 0.0)) throw Error(what, "the normal must not be zero");
+  }
+  scene.section = section;
+  cutBySection(scene);
 }
 
 }  // namespace mfr::cli

@@ -50,7 +50,7 @@ int to8(float c) {
 
 void addProbe(CLI::App& app) {
   struct Options {
-    std::string scene, pixel, size = "512x512", view = "fit", method, json, clip;
+    std::string scene, pixel, size = "512x512", view = "fit", method, json, clip, section;
     std::vector<std::string> params;
     double opacity = -1.0;
   };
@@ -65,6 +65,7 @@ void addProbe(CLI::App& app) {
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
   cmd->add_option("--json", opt->json, "Also write the probe as JSON");
   cmd->add_option("--clip", opt->clip, kClipHelp);
+  cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
   cmd->callback([opt] {
     const auto [w, h] = parseSize("--size", opt->size);
@@ -90,6 +91,7 @@ void addProbe(CLI::App& app) {
     }
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
     applyClipOption(scene, opt->clip);
+    applySectionOption(scene, opt->section);
     const Camera camera = scene.view(opt->view);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);
 

@@ -13,7 +13,7 @@ namespace mfr::cli {
 
 void addRender(CLI::App& app) {
   struct Options {
-    std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats, clip;
+    std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats, clip, section;
     std::vector<std::string> params;
     double opacity = -1.0;
     double thickness = 0.0;
@@ -40,6 +40,7 @@ void addRender(CLI::App& app) {
                 "Operation volume: shade the volume by its gradient with a headlight (boundaries inside the medium "
                 "read as surfaces)");
   cmd->add_option("--clip", opt->clip, kClipHelp);
+  cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
@@ -67,6 +68,7 @@ void addRender(CLI::App& app) {
     }
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
     applyClipOption(scene, opt->clip);
+    applySectionOption(scene, opt->section);
     if (opt->shade) {
       if (scene.volumes.empty()) throw Error("--shade", "scene '" + scene.name + "' has no volume");
       req.volumeShading = true;

@@ -1,6 +1,7 @@
 #include "clip_panel.hpp"
 
 #include <QCheckBox>
+#include <QComboBox>
 #include <QGridLayout>
 #include <QLabel>
 #include <QPushButton>
@@ -48,7 +49,53 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
   reset_ = new QPushButton(tr("Reset"), this);
   reset_->setObjectName(QStringLiteral("clipReset"));
   layout->addWidget(reset_, 0, Qt::AlignRight);
+
+  sectionEnabled_ = new QCheckBox(tr("Section plane"), this);
+  sectionEnabled_->setObjectName(QStringLiteral("sectionEnabled"));
+  sectionEnabled_->setToolTip(
+      tr("Cut the scene with a plane: what lies on the far side is removed, closed parts are capped"));
+  layout->addWidget(sectionEnabled_);
+  auto* section = new QGridLayout;
+  sectionAxis_ = new QComboBox(this);
+  sectionAxis_->setObjectName(QStringLiteral("sectionAxis"));
+  sectionAxis_->addItems({QStringLiteral("X"), QStringLiteral("Y"), QStringLiteral("Z")});
+  sectionFlip_ = new QCheckBox(tr("Flip"), this);
+  sectionFlip_->setObjectName(QStringLiteral("sectionFlip"));
+  sectionFlip_->setToolTip(tr("Keep the other side of the plane"));
+  sectionCaps_ = new QCheckBox(tr("Caps"), this);
+  sectionCaps_->setObjectName(QStringLiteral("sectionCaps"));
+  sectionCaps_->setToolTip(tr("Close every cut closed part with its cross-section"));
+  sectionCaps_->setChecked(true);
+  sectionOffset_ = new QSlider(Qt::Horizontal, this);
+  sectionOffset_->setObjectName(QStringLiteral("sectionOffset"));
+  sectionOffset_->setRange(0, kSteps);
+  sectionOffset_->setValue(kSteps / 2);
+  sectionValue_ = new QLabel(this);
+  sectionValue_->setObjectName(QStringLiteral("sectionValue"));
+  // Narrow, like the box's rows: the dock shares the left side with the scene tree.
+  section->addWidget(sectionAxis_, 0, 0);
+  section->addWidget(sectionFlip_, 0, 1);
+  section->addWidget(sectionCaps_, 0, 2);
+  section->addWidget(sectionOffset_, 1, 0, 1, 2);
+  section->addWidget(sectionValue_, 1, 2);
+  sectionAlign_ = new QPushButton(tr("Align to view"), this);
+  sectionAlign_->setObjectName(QStringLiteral("sectionAlign"));
+  sectionAlign_->setToolTip(
+      tr("The plane through the view's target, facing away from the eye: the near half is cut away"));
+  section->addWidget(sectionAlign_, 2, 0, 1, 3, Qt::AlignRight);
+  section->setColumnStretch(0, 1);
+  layout->addLayout(section);
   layout->addStretch(1);
+  connect(sectionEnabled_, &QCheckBox::toggled, this, [this] { apply(); });
+  connect(sectionAxis_, &QComboBox::currentIndexChanged, this, [this] { apply(); });
+  connect(sectionFlip_, &QCheckBox::toggled, this, [this] { apply(); });
+  connect(sectionCaps_, &QCheckBox::toggled, this, [this] { apply(); });
+  connect(sectionOffset_, &QSlider::valueChanged, this, [this] { apply(); });
+  connect(sectionAlign_, &QPushButton::clicked, this, [this] {
+    const mfr::Camera& camera = model_.camera();
+    model_.setSection(mfr::SectionPlane{camera.target, camera.forward(), sectionCaps_->isChecked()});
+    showModel();
+  });
 
   connect(enabled_, &QCheckBox::toggled, this, [this] { apply(); });
   connect(reset_, &QPushButton::clicked, this, [this] {
@@ -61,7 +108,7 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
     apply();
   });
   connect(&model_, &ViewerModel::sceneChanged, this, &ClipPanel::showModel);
-  showModel();
+  showModel();  // an unchanged model emits nothing: the controls still follow the switches
 }
 
 mfr::Bounds ClipPanel::boxFromPositions(const mfr::Bounds& bounds, const std::array<int, 3>& low,
@@ -73,6 +120,31 @@ mfr::Bounds ClipPanel::boxFromPositions(const mfr::Bounds& bounds, const std::ar
     box.max[a] = bounds.min[a] + extent * high[static_cast<std::size_t>(a)] / kSteps;
   }
   return box;
+}
+
+namespace {
+
+// The bounds' extent along unit n: the lowest and highest dot(n, corner).
+std::pair<double, double> extentAlong(const mfr::Bounds& b, const glm::dvec3& n) {
+  double lo = 1e300, hi = -1e300;
+  for (int c = 0; c < 8; ++c) {
+    const glm::dvec3 corner((c & 1) ? b.max.x : b.min.x, (c & 2) ? b.max.y : b.min.y, (c & 4) ? b.max.z : b.min.z);
+    lo = std::min(lo, glm::dot(n, corner));
+    hi = std::max(hi, glm::dot(n, corner));
+  }
+  return {lo, hi};
+}
+
+}  // namespace
+
+mfr::SectionPlane ClipPanel::sectionFromPosition(const mfr::Bounds& bounds, const glm::dvec3& axis, int position,
+                                                 bool flip, bool caps) {
+  const auto [lo, hi] = extentAlong(bounds, axis);
+  mfr::SectionPlane plane;
+  plane.point = axis * (lo + (hi - lo) * position / kSteps);
+  plane.normal = flip ? -axis : axis;
+  plane.caps = caps;
+  return plane;
 }
 
 void ClipPanel::showModel() {
@@ -98,21 +170,68 @@ void ClipPanel::showModel() {
                              : QStringLiteral("—"));
   }
   reset_->setEnabled(usable && clip.has_value());
+
+  // The section: which axis (or the file's own normal), which side, where along it.
+  const std::optional<mfr::SectionPlane>& section = model_.section();
+  sectionEnabled_->setEnabled(usable);
+  sectionAlign_->setEnabled(usable);
+  sectionEnabled_->setChecked(section.has_value());
+  if (section) {
+    const glm::dvec3 n = glm::normalize(section->normal);
+    int axis = -1;
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(std::abs(n[a]) - 1.0) < 1e-12) axis = a;
+    glm::dvec3 base = n;
+    bool flip = false;
+    if (axis >= 0) {
+      flip = n[axis] < 0.0;
+      base = glm::dvec3(0.0);
+      base[axis] = 1.0;
+      if (sectionAxis_->count() > 3) sectionAxis_->removeItem(3);
+      sectionAxis_->setCurrentIndex(axis);
+    } else {
+      customNormal_ = n;
+      if (sectionAxis_->count() == 3) sectionAxis_->addItem(tr("Custom"));
+      sectionAxis_->setCurrentIndex(3);
+    }
+    sectionFlip_->setChecked(flip);
+    sectionCaps_->setChecked(section->caps);
+    const auto [lo, hi] = extentAlong(bounds, base);
+    const double at = glm::dot(base, section->point);
+    sectionOffset_->setValue(
+        hi > lo ? std::clamp(static_cast<int>(std::lround((at - lo) / (hi - lo) * kSteps)), 0, kSteps) : kSteps / 2);
+    sectionValue_->setText(QStringLiteral("%1").arg(at, 0, 'g', 5));
+  } else {
+    sectionValue_->setText(QStringLiteral("—"));
+  }
+  for (QWidget* w : std::initializer_list<QWidget*>{sectionAxis_, sectionFlip_, sectionCaps_, sectionOffset_})
+    w->setEnabled(usable && section.has_value());
   showing_ = false;
 }
 
 void ClipPanel::apply() {
   if (showing_) return;
-  if (!enabled_->isChecked()) {
+  if (enabled_->isChecked()) {
+    std::array<int, 3> low{}, high{};
+    for (int a = 0; a < 3; ++a) {
+      low[static_cast<std::size_t>(a)] = low_[a]->value();
+      high[static_cast<std::size_t>(a)] = high_[a]->value();
+    }
+    model_.setClipBox(boxFromPositions(model_.scene().bounds(), low, high));
+  } else {
     model_.setClipBox(std::nullopt);
-    showModel();  // an unchanged model emits nothing: the controls still follow the switch
-    return;
   }
-  std::array<int, 3> low{}, high{};
-  for (int a = 0; a < 3; ++a) {
-    low[static_cast<std::size_t>(a)] = low_[a]->value();
-    high[static_cast<std::size_t>(a)] = high_[a]->value();
+  if (sectionEnabled_->isChecked()) {
+    const int index = sectionAxis_->currentIndex();
+    glm::dvec3 axis = customNormal_;
+    if (index >= 0 && index < 3) {
+      axis = glm::dvec3(0.0);
+      axis[index] = 1.0;
+    }
+    model_.setSection(sectionFromPosition(model_.scene().bounds(), axis, sectionOffset_->value(),
+                                          sectionFlip_->isChecked(), sectionCaps_->isChecked()));
+  } else {
+    model_.setSection(std::nullopt);
   }
-  model_.setClipBox(boxFromPositions(model_.scene().bounds(), low, high));
-  showModel();
+  showModel();  // an unchanged model emits nothing: the controls still follow the switches
 }

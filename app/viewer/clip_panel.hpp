@@ -5,14 +5,20 @@
 // box's faces as fractions of the scene's bounds (as loaded, unclipped), with the world values
 // beside them; Reset gives back the whole bounds. A scene file's own "clip" shows as loaded, and
 // sessions save the box.
+// Below it, the section plane (mfr::Scene::section): perpendicular to X, Y or Z (or a scene file's
+// own normal, "Custom"), moved by a slider across the scene's extent along that normal, keeping the
+// side the normal points to unless flipped; closed parts are capped unless Caps is off. "Align to
+// view" puts it through the view's target, facing away from the eye (the near half is cut away).
 #include <QWidget>
 
 #include <array>
 #include <optional>
 
 #include "mfr/scene/mesh.hpp"
+#include "mfr/scene/scene.hpp"
 
 class QCheckBox;
+class QComboBox;
 class QLabel;
 class QPushButton;
 class QSlider;
@@ -28,6 +34,10 @@ class ClipPanel final : public QWidget {
   // The box the sliders give over bounds (position p ↦ min + p/kSteps · extent on each axis).
   [[nodiscard]] static mfr::Bounds boxFromPositions(const mfr::Bounds& bounds, const std::array<int, 3>& low,
                                                     const std::array<int, 3>& high);
+  // The plane perpendicular to unit `axis` at slider `position` of the bounds' extent along it,
+  // keeping the side `axis` points to (the other with `flip`).
+  [[nodiscard]] static mfr::SectionPlane sectionFromPosition(const mfr::Bounds& bounds, const glm::dvec3& axis,
+                                                             int position, bool flip, bool caps);
 
  private:
   void showModel();  // controls from the model's clip box
@@ -39,5 +49,13 @@ class ClipPanel final : public QWidget {
   std::array<QSlider*, 3> high_{};
   std::array<QLabel*, 3> values_{};
   QPushButton* reset_ = nullptr;
+  QCheckBox* sectionEnabled_ = nullptr;
+  QComboBox* sectionAxis_ = nullptr;  // X, Y, Z, and "Custom" while a file's own normal is shown
+  QSlider* sectionOffset_ = nullptr;
+  QCheckBox* sectionFlip_ = nullptr;
+  QCheckBox* sectionCaps_ = nullptr;
+  QLabel* sectionValue_ = nullptr;
+  QPushButton* sectionAlign_ = nullptr;
+  glm::dvec3 customNormal_{0.0, 0.0, 1.0};  // unit; the "Custom" entry's axis
   bool showing_ = false;  // controls being set from the model: no apply()
 };

@@ -17,6 +17,7 @@
 #include <QMimeData>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QScrollArea>
 #include <QSettings>
 #include <QStatusBar>
 #include <QTableWidget>
@@ -313,7 +314,13 @@ void MainWindow::buildDocks() {
   };
   QDockWidget* scene =
       dock(tr("Scene"), QStringLiteral("sceneDock"), new SceneTreePanel(*model_), Qt::LeftDockWidgetArea);
-  QDockWidget* clip = dock(tr("Clip"), QStringLiteral("clipDock"), new ClipPanel(*model_), Qt::LeftDockWidgetArea);
+  // Scrolled: the box's and the section's controls are taller than the scene tree they share the
+  // left side with, and would otherwise set the window's minimum height.
+  auto* clipScroll = new QScrollArea;
+  clipScroll->setWidgetResizable(true);
+  clipScroll->setFrameShape(QFrame::NoFrame);
+  clipScroll->setWidget(new ClipPanel(*model_));
+  QDockWidget* clip = dock(tr("Clip"), QStringLiteral("clipDock"), clipScroll, Qt::LeftDockWidgetArea);
   tabifyDockWidget(scene, clip);
   scene->raise();
   QDockWidget* method =

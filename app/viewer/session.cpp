@@ -104,6 +104,8 @@ Session captureSession(const ViewerModel& model) {
   s.volumeStep = model.volumeStep();
   s.hasClip = true;
   s.clip = model.clipBox();
+  s.hasSection = true;
+  s.section = model.section();
   for (const mfr::Volume& v : model.scene().volumes)
     s.volumes.push_back({QString::fromStdString(v.name), v.visible, v.transfer, v.shading});
   s.params = model.allParams();
@@ -134,6 +136,7 @@ void applySession(const Session& session, ViewerModel& model) {
   model.setAllParams(session.params);
   model.setZThickness(session.thickness);
   if (session.hasClip) model.setClipBox(session.clip);
+  if (session.hasSection) model.setSection(session.section);
   if (session.volumes.size() == model.scene().volumes.size())
     for (std::size_t i = 0; i < session.volumes.size(); ++i)
       model.setVolumeStateAt(static_cast<int>(i), session.volumes[i].visible, session.volumes[i].transfer,
@@ -187,23 +190,29 @@ QJsonObject sessionToJson(const Session& s) {
                                {"color", QJsonArray{o.color.r, o.color.g, o.color.b}},
                                {"opacity", o.color.a},
                                {"vertex_colors", o.vertexColors}});
-  return {{"format", "mfrview-session"},
-          {"version", 1},
-          {"scene", s.scenePath},
-          {"camera", camera},
-          {"method", s.method},
-          {"operation", s.operation},
-          {"thickness", s.thickness},
-          {"volume_step", s.volumeStep},
-          {"volumes", volumes},
-          {"params", paramsToJson(s.params)},
-          {"objects", objects},
-          {"compare", compare},
-          {"data_view", dataView},
-          {"plugins", s.plugins},
-          {"clip", s.clip ? QJsonValue(QJsonObject{{"min", QJsonArray{s.clip->min.x, s.clip->min.y, s.clip->min.z}},
-                                                   {"max", QJsonArray{s.clip->max.x, s.clip->max.y, s.clip->max.z}}})
-                          : QJsonValue(QJsonValue::Null)}};
+  return {
+      {"format", "mfrview-session"},
+      {"version", 1},
+      {"scene", s.scenePath},
+      {"camera", camera},
+      {"method", s.method},
+      {"operation", s.operation},
+      {"thickness", s.thickness},
+      {"volume_step", s.volumeStep},
+      {"volumes", volumes},
+      {"params", paramsToJson(s.params)},
+      {"objects", objects},
+      {"compare", compare},
+      {"data_view", dataView},
+      {"plugins", s.plugins},
+      {"clip", s.clip ? QJsonValue(QJsonObject{{"min", QJsonArray{s.clip->min.x, s.clip->min.y, s.clip->min.z}},
+                                               {"max", QJsonArray{s.clip->max.x, s.clip->max.y, s.clip->max.z}}})
+                      : QJsonValue(QJsonValue::Null)},
+      {"section", s.section ? QJsonValue(QJsonObject{
+                                  {"point", QJsonArray{s.section->point.x, s.section->point.y, s.section->point.z}},
+                                  {"normal", QJsonArray{s.section->normal.x, s.section->normal.y, s.section->normal.z}},
+                                  {"caps", s.section->caps}})
+                            : QJsonValue(QJsonValue::Null)}};
 }
 
 Session sessionFromJson(const QJsonObject& json, const QString& file) {
@@ -249,6 +258,23 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
       box.max = r.vec3(clip, "max", "clip");
       if (!box.valid()) r.fail(QStringLiteral("clip"), QStringLiteral("min must not exceed max on any axis"));
       s.clip = box;
+    }
+  }
+  if (json.contains("section")) {
+    s.hasSection = true;
+    if (!json.value("section").isNull()) {
+      if (!json.value("section").isObject())
+        r.fail(QStringLiteral("section"), QStringLiteral("expected null or {point, normal, caps}"));
+      const QJsonObject section = json.value("section").toObject();
+      mfr::SectionPlane plane;
+      plane.point = r.vec3(section, "point", "section");
+      plane.normal = r.vec3(section, "normal", "section");
+      if (!(glm::length(plane.normal) > 0.0))
+        r.fail(QStringLiteral("section"), QStringLiteral("the normal must not be zero"));
+      if (section.contains("caps") && !section.value("caps").isBool())
+        r.fail(QStringLiteral("section"), QStringLiteral("caps: expected true or false"));
+      plane.caps = section.value("caps").toBool(true);
+      s.section = plane;
     }
   }
   const QJsonArray volumes = json.value("volumes").toArray();

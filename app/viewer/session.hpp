@@ -32,6 +32,10 @@ struct Session {
   // before it existed), so the scene keeps its own.
   bool hasClip = false;
   std::optional<mfr::Bounds> clip;
+  // The section plane ("section": null or {point, normal, caps}); hasSection false: no "section" key
+  // (an older session), so the scene keeps its own.
+  bool hasSection = false;
+  std::optional<mfr::SectionPlane> section;
   struct VolumeState {
     QString name;
     bool visible = true;

@@ -160,6 +160,17 @@ void ViewerModel::setClipBox(const std::optional<mfr::Bounds>& box) {
   sceneEdited();
 }
 
+void ViewerModel::setSection(const std::optional<mfr::SectionPlane>& section) {
+  try {
+    mfr::validateSectionPlane(section, "section plane");
+  } catch (const mfr::Error&) {
+    return;
+  }
+  if (section == scene_.section) return;
+  scene_.section = section;
+  sceneEdited();
+}
+
 void ViewerModel::setZThickness(double thickness) {
   if (!std::isfinite(thickness) || thickness < 0.0 || thickness == thickness_) return;
   thickness_ = thickness;

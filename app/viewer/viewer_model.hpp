@@ -123,6 +123,11 @@ class ViewerModel final : public ViewerContext {
   // min > max on an axis, or a non-finite corner, is ignored.
   [[nodiscard]] const std::optional<mfr::Bounds>& clipBox() const { return scene_.clipBox; }
   void setClipBox(const std::optional<mfr::Bounds>& box);
+  // The scene's section plane (mfr::Scene::section; a scene file's "section" as loaded). Setting it is
+  // a scene edit: the renderers and the oracle draw the scene cut by it (closed parts capped). A
+  // plane with a zero or non-finite normal or point is ignored.
+  [[nodiscard]] const std::optional<mfr::SectionPlane>& section() const { return scene_.section; }
+  void setSection(const std::optional<mfr::SectionPlane>& section);
   [[nodiscard]] double zThickness() const override { return thickness_; }
   void setZThickness(double thickness) override;
   [[nodiscard]] double zThicknessDefault() const override;

@@ -8,6 +8,7 @@
 #include "mfr/gl/context.hpp"
 #include "mfr/methods/registry.hpp"
 #include "mfr/reference/composite.hpp"
+#include "mfr/scene/section.hpp"
 #include "methods/kbuffer_common.hpp"
 #include "methods/method_util.hpp"
 #include "reference/pixel_region.hpp"
@@ -63,8 +64,10 @@ void GpuRenderer::uploadVolume(const Scene& scene) {
 
 GpuRenderer::GpuRenderer(bool finishTiming) : finishTiming_(finishTiming) {}
 
-void GpuRenderer::setScene(const Scene& scene) {
-  scene.validate();
+void GpuRenderer::setScene(const Scene& original) {
+  original.validate();
+  // A section plane is applied as geometry (cut surfaces, caps); the volume keeps the plane.
+  const Scene scene = sectionedScene(original);
   scene_ = std::make_shared<const gl::GpuScene>(scene);
   background_ = scene.background;
   csg_ = scene.csg;
@@ -72,6 +75,7 @@ void GpuRenderer::setScene(const Scene& scene) {
   sceneName_ = scene.name;
   sceneBounds_ = scene.bounds();
   clipBox_ = scene.clipBox;
+  section_ = scene.section;
   uploadVolume(scene);
   gl::checkErrors("scene upload");
 }
@@ -85,6 +89,7 @@ void GpuRenderer::shareScene(const GpuRenderer& other) {
   sceneName_ = other.sceneName_;
   sceneBounds_ = other.sceneBounds_;
   clipBox_ = other.clipBox_;
+  section_ = other.section_;
   volume_ = other.volume_;
 }
 
@@ -164,7 +169,7 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
     renderCsg(ctx, method);
   } else if (operation_ == "volume") {
     const VolumeRaySetup setup =
-        volumeRaySetup(volume_->volume, camera, request.width, request.height, volumeStep_, clipBox_);
+        volumeRaySetup(volume_->volume, camera, request.width, request.height, volumeStep_, clipBox_, section_);
     method.resolve(ctx, Operation{"volume", "ops/volume.glsl", [&](const gl::Program& p) {
                                     p.set("uInvViewProj", setup.invViewProj);
                                     p.set("uViewport", setup.viewport);
@@ -177,6 +182,8 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
                                     p.set("uClip", setup.clip ? 1 : 0);
                                     p.set("uClipMin", setup.clipMin);
                                     p.set("uClipMax", setup.clipMax);
+                                    p.set("uSection", setup.section ? 1 : 0);
+                                    p.set("uSectionPlane", setup.sectionPlane);
                                     glBindTextureUnit(MFR_TEX_VOLUME, volume_->grid.id());
                                     glBindTextureUnit(MFR_TEX_VOLUME_TF, volume_->transfer.id());
                                   }});

@@ -202,7 +202,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     if (!volume) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");
     const double step = volumeStepOf(request, *volume);
     const Volume drawn = volumeAsRequested(request, *volume);
-    out.image = compositeVolume(lists, camera, drawn, step, scene.background, scene.clipBox);
+    out.image = compositeVolume(lists, camera, drawn, step, scene.background, scene.clipBox, scene.section);
     out.stats.notes.emplace_back("volume step", std::to_string(step));
     out.stats.notes.emplace_back("volume shading", drawn.shading ? "on" : "off");
   } else if (operation == "zthickness") {

@@ -22,6 +22,8 @@ uniform int uVolumeShading;  // Volume::shading
 uniform int uClip;           // Scene::clipBox: the march stays inside [uClipMin, uClipMax] too (world)
 uniform vec3 uClipMin;
 uniform vec3 uClipMax;
+uniform int uSection;         // Scene::section: the march stays where dot(plane.xyz, p) + plane.w >= 0 (world)
+uniform vec4 uSectionPlane;
 layout(binding = MFR_TEX_VOLUME) uniform sampler3D uVolume;       // R32F, read with texelFetch
 layout(binding = MFR_TEX_VOLUME_TF) uniform sampler1D uTransfer;  // (rgb, σ), MFR_VOLUME_TF_SIZE
 
@@ -121,6 +123,16 @@ void opBegin(inout OpState s, ivec2 pixel) {
         t0 = max(t0, min(ta, tb));
         t1 = min(t1, max(ta, tb));
       }
+    }
+  }
+  if (uSection != 0) {  // the kept half-space of the section plane
+    float s0 = dot(uSectionPlane.xyz, s.rayStart) + uSectionPlane.w, ds = dot(uSectionPlane.xyz, s.rayDir);
+    if (abs(ds) < 1e-30) {
+      if (s0 < 0.0) t1 = -1.0;
+    } else if (ds > 0.0) {
+      t0 = max(t0, -s0 / ds);
+    } else {
+      t1 = min(t1, -s0 / ds);
     }
   }
   s.tEnter = t0;

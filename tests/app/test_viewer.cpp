@@ -2408,6 +2408,92 @@ class ViewerTest : public QObject {
     settle(m);
     QCOMPARE(maxChannelDifference(w->view().renderImage(QSize(200, 150)), cut), 0);
   }
+
+  void sectionPlane() {
+    QTemporaryDir dir;
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(200, 150);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(200, 150), kTimeoutMs);
+    m.setMethod("abuffer-ll");
+    m.setCamera(m.scene().view("iso"));
+    settle(m);
+    const mfr::ImageRGBA8 whole = w->view().renderImage(QSize(200, 150));
+    auto* enabled = w->findChild<QCheckBox*>("sectionEnabled");
+    auto* axis = w->findChild<QComboBox*>("sectionAxis");
+    auto* offset = w->findChild<QSlider*>("sectionOffset");
+    auto* flip = w->findChild<QCheckBox*>("sectionFlip");
+    auto* caps = w->findChild<QCheckBox*>("sectionCaps");
+    QVERIFY(enabled && axis && offset && flip && caps);
+    QVERIFY(!m.section());
+    QVERIFY(!offset->isEnabled());
+    enabled->setChecked(true);
+    QVERIFY(m.section().has_value());
+    axis->setCurrentIndex(0);
+    offset->setValue(400);
+    flip->setChecked(true);
+    const mfr::Bounds b = m.scene().bounds();
+    QVERIFY(m.section().has_value());
+    const mfr::SectionPlane plane = *m.section();
+    QCOMPARE(plane.normal, glm::dvec3(-1.0, 0.0, 0.0));
+    QCOMPARE(plane.point.x, b.min.x + (b.max.x - b.min.x) * 400 / 1000);
+    QVERIFY(plane.caps);
+    settle(m);
+    const mfr::ImageRGBA8 cut = w->view().renderImage(QSize(200, 150));
+    QVERIFY(maxChannelDifference(cut, whole) > 50);
+    // Caps change the picture: the cut parts are closed again.
+    caps->setChecked(false);
+    QVERIFY(!m.section()->caps);
+    settle(m);
+    QVERIFY(maxChannelDifference(w->view().renderImage(QSize(200, 150)), cut) > 20);
+    caps->setChecked(true);
+    // The same plane through the command line: the same pixels.
+    const QString planeText = QString::asprintf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g", plane.point.x, plane.point.y,
+                                                plane.point.z, plane.normal.x, plane.normal.y, plane.normal.z);
+    const QString cliPng = dir.filePath("cli.png");
+    QString out;
+    QCOMPARE(runProgram(MFR_CLI,
+                        {"render", "@sample", "--size", "200x150", "--view", "iso", "-m", "abuffer-ll", "--section",
+                         planeText, "-o", cliPng},
+                        &out),
+             0);
+    settle(m);
+    const int diff = maxChannelDifference(mfr::readPng(cliPng.toStdString()), cut);
+    qInfo("section %s: viewer vs mfr render max channel difference %d", qPrintable(planeText), diff);
+    QCOMPARE(diff, 0);
+
+    // Sessions keep the plane; a file's own oblique normal shows as "Custom".
+    const QString sessionPath = dir.filePath("section.mfrsession");
+    writeSessionFile(sessionPath, captureSession(m));
+    enabled->setChecked(false);
+    QVERIFY(!m.section());
+    settle(m);
+    QCOMPARE(maxChannelDifference(w->view().renderImage(QSize(200, 150)), whole), 0);
+    applySession(readSessionFile(sessionPath), m);
+    QVERIFY(m.section().has_value());
+    QCOMPARE(*m.section(), plane);
+    QVERIFY(enabled->isChecked() && flip->isChecked());
+    QCOMPARE(offset->value(), 400);
+    settle(m);
+    QCOMPARE(maxChannelDifference(w->view().renderImage(QSize(200, 150)), cut), 0);
+    m.setSection(mfr::SectionPlane{b.center(), {1.0, 1.0, 0.0}, true});
+    QCOMPARE(axis->currentText(), QStringLiteral("Custom"));
+    QCOMPARE(offset->value(), 500);
+    offset->setValue(600);
+    QVERIFY(m.section()->normal.x > 0.7 && m.section()->normal.y > 0.7);
+    // Align to view: through the target, facing away from the eye; the near half is gone.
+    enabled->setChecked(false);
+    auto* align = w->findChild<QPushButton*>("sectionAlign");
+    QVERIFY(align);
+    align->click();
+    QVERIFY(m.section().has_value() && enabled->isChecked());
+    QCOMPARE(axis->currentText(), QStringLiteral("Custom"));
+    QCOMPARE(m.section()->point, m.camera().target);
+    QVERIFY(glm::length(m.section()->normal - m.camera().forward()) < 1e-12);
+    settle(m);
+    QVERIFY(maxChannelDifference(w->view().renderImage(QSize(200, 150)), whole) > 50);
+  }
 };
 
 QTEST_MAIN(ViewerTest)

@@ -96,6 +96,7 @@ class GpuRenderer {
   std::string sceneName_;
   Bounds sceneBounds_;
   std::optional<Bounds> clipBox_;  // Scene::clipBox
+  std::optional<SectionPlane> section_;  // Scene::section (the surfaces come cut; the volume march is cropped)
   double thickness_ = 0.0;  // operation "zthickness" of the prepared request (scene units)
   // Operation "volume": the scene's visible volume on the GPU (shared with shareScene; a new
   // scene with the same grid keeps the grid texture and uploads only the transfer table).

@@ -12,6 +12,7 @@
 
 #include "common/bindings.h"
 #include "mfr/error.hpp"
+#include "mfr/scene/section.hpp"
 
 namespace mfr {
 
@@ -146,7 +147,7 @@ ImageRGBA8 compositeZThickness(const FragmentLists& lists, const Camera& camera,
 }
 
 VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int width, int height, double step,
-                              const std::optional<Bounds>& clip) {
+                              const std::optional<Bounds>& clip, const std::optional<SectionPlane>& section) {
   VolumeRaySetup s;
   const double aspect = static_cast<double>(width) / height;
   s.invViewProj = glm::mat4(glm::inverse(camera.projectionMatrix(aspect) * camera.viewMatrix()));
@@ -162,6 +163,10 @@ VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int wi
     s.clip = true;
     s.clipMin = glm::vec3(clip->min);
     s.clipMax = glm::vec3(clip->max);
+  }
+  if (section) {
+    s.section = true;
+    s.sectionPlane = glm::vec4(sectionPlaneEquation(*section));
   }
   return s;
 }
@@ -239,6 +244,17 @@ struct VolumeMarcher {
           t1 = std::min(t1, std::max(ta, tb));
         }
       }
+    if (setup.section) {  // the kept half-space of the section plane
+      const glm::vec3 n(setup.sectionPlane);
+      const float s0 = glm::dot(n, rayStart) + setup.sectionPlane.w, ds = glm::dot(n, rayDir);
+      if (std::abs(ds) < 1e-30f) {
+        if (s0 < 0.0f) t1 = -1.0f;
+      } else if (ds > 0.0f) {
+        t0 = std::max(t0, -s0 / ds);
+      } else {
+        t1 = std::min(t1, -s0 / ds);
+      }
+    }
     tEnter = t0;
     tExit = std::max(t1, t0);
     step = std::max(setup.step, (tExit - tEnter) / static_cast<float>(MFR_VOLUME_MAX_STEPS));
@@ -287,11 +303,12 @@ glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, co
 }
 
 ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, const Volume& volume, double step,
-                           const glm::vec3& background, const std::optional<Bounds>& clip) {
+                           const glm::vec3& background, const std::optional<Bounds>& clip,
+                           const std::optional<SectionPlane>& section) {
   volume.validate();
   if (!std::isfinite(step) || step < 0.0)
     throw Error("--step", "must be a positive length in scene units (got " + std::to_string(step) + ")");
-  const VolumeRaySetup setup = volumeRaySetup(volume, camera, lists.width, lists.height, step, clip);
+  const VolumeRaySetup setup = volumeRaySetup(volume, camera, lists.width, lists.height, step, clip, section);
   ImageRGBA8 image(lists.width, lists.height);
   for (int y = 0; y < lists.height; ++y)
     for (int x = 0; x < lists.width; ++x)

@@ -40,6 +40,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "mfr/error.hpp"
+#include "mfr/scene/section.hpp"
 
 namespace mfr::shading {
 using namespace glm;
@@ -392,6 +393,8 @@ std::shared_ptr<const PreparedGeometry> preparedGeometry(const Scene& scene) {
 
 FragmentLists castFragments(const Scene& scene, const Camera& camera, int width, int height,
                             const OracleOptions& options) {
+  // A section plane is applied as geometry, as the GPU renderer does (scene/section.hpp).
+  if (scene.section && !scene.sectionCut) return castFragments(sectionedScene(scene), camera, width, height, options);
   if (width <= 0 || height <= 0 || width > kMaxImageSize || height > kMaxImageSize)
     throw Error("image size", std::to_string(width) + "x" + std::to_string(height) + " is not in 1.." +
                                   std::to_string(kMaxImageSize) + " per side");

@@ -78,6 +78,16 @@ void Scene::validate() const {
     throw Error("scene '" + name + "'", std::to_string(visibleVolumes) + " visible volumes: at most one can be drawn");
   validateCsg(*this);
   validateClipBox(clipBox, "clip box");
+  validateSectionPlane(section, "section plane");
+}
+
+void validateSectionPlane(const std::optional<SectionPlane>& plane, const std::string& what) {
+  if (!plane) return;
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(plane->point[a]) || !std::isfinite(plane->normal[a]))
+      throw Error(what, "needs a finite point and normal");
+  const double length = glm::length(plane->normal);
+  if (!(length > 1e-12) || !std::isfinite(length)) throw Error(what, "needs a non-zero normal");
 }
 
 void validateClipBox(const std::optional<Bounds>& box, const std::string& what) {

@@ -373,6 +373,20 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     if (!box.valid()) r.fail("clip", "min must not exceed max on any axis");
     scene.clipBox = box;
   }
+  if (doc.contains("section")) {
+    const json& section = r.object(doc["section"], "section");
+    if (!section.contains("point") || !section.contains("normal"))
+      r.fail("section", "expected \"point\" and \"normal\"");
+    SectionPlane plane;
+    plane.point = r.vec3(section["point"], "section.point");
+    plane.normal = r.vec3(section["normal"], "section.normal");
+    if (!(glm::length(plane.normal) > 0.0)) r.fail("section.normal", "must not be zero");
+    if (section.contains("caps")) {
+      if (!section["caps"].is_boolean()) r.fail("section.caps", "expected true or false");
+      plane.caps = section["caps"].get<bool>();
+    }
+    scene.section = plane;
+  }
 
   // One equal part of the progress per object and per volume.
   const auto items = [&](const char* key) { return doc.contains(key) && doc[key].is_array() ? doc[key].size() : 0; };

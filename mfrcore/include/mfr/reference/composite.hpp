@@ -9,6 +9,7 @@
 #include "mfr/image.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "mfr/scene/csg.hpp"
+#include "mfr/scene/scene.hpp"
 #include "mfr/scene/volume.hpp"
 
 namespace mfr {
@@ -53,15 +54,21 @@ struct VolumeRaySetup {
   bool clip = false;
   glm::vec3 clipMin{0.0f};
   glm::vec3 clipMax{0.0f};
+  // Scene::section: the march is limited to dot(plane.xyz, p) + plane.w >= 0 too (world space).
+  bool section = false;
+  glm::vec4 sectionPlane{0.0f};
 };
-// The values both renderers use; step ≤ 0 picks Volume::defaultStep(); clip: the scene's clip box.
+// The values both renderers use; step ≤ 0 picks Volume::defaultStep(); clip: the scene's clip box;
+// section: its section plane.
 VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int width, int height, double step,
-                              const std::optional<Bounds>& clip = std::nullopt);
+                              const std::optional<Bounds>& clip = std::nullopt,
+                              const std::optional<SectionPlane>& section = std::nullopt);
 // One pixel; (glX, glY) in GL window coordinates (row 0 at the bottom).
 glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, const VolumeRaySetup& setup,
                           const VolumeGrid& grid, const glm::vec3& background);
 ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, const Volume& volume, double step,
-                           const glm::vec3& background, const std::optional<Bounds>& clip = std::nullopt);
+                           const glm::vec3& background, const std::optional<Bounds>& clip = std::nullopt,
+                           const std::optional<SectionPlane>& section = std::nullopt);
 
 // Image-space CSG (scene.csg, rule of csgVisibleFragment with the scene's mirrored primitives):
 // each pixel shows its visible fragment's colour as an opaque surface (RGB of the stored colour,

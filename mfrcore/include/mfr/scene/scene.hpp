@@ -31,6 +31,17 @@ struct Object {
   bool visible = true;
 };
 
+// A section plane (world space): what lies on the side its normal points to is kept, the rest is
+// cut away. With caps, every closed surface it cuts is closed again by the cross-section, so solids
+// look solid (the CAD section view); open surfaces are only cut. (.mfrscene "section",
+// mfr render --section, mfrview's Clip dock; scene/section.hpp does the cutting.)
+struct SectionPlane {
+  glm::dvec3 point{0.0};
+  glm::dvec3 normal{0.0, 0.0, 1.0};  // need not be unit length; never zero
+  bool caps = true;
+  bool operator==(const SectionPlane&) const = default;
+};
+
 struct NamedView {
   std::string name;
   Camera camera;
@@ -49,6 +60,11 @@ struct Scene {
   // bounds() and fit() ignore it, so a view frames the whole scene and the cut shows in place.
   // (.mfrscene "clip", mfr render --clip, mfrview's Clip box.)
   std::optional<Bounds> clipBox;
+  // The section plane: both renderers draw sectionedScene(*this) (scene/section.hpp) — surfaces cut
+  // and capped as geometry, the volume cropped to the kept side. Unset: no section. bounds() and
+  // fit() ignore it, like the clip box.
+  std::optional<SectionPlane> section;
+  bool sectionCut = false;  // the meshes are sectionedScene's: already cut by `section`
 
   [[nodiscard]] Bounds bounds() const;  // world bounds of visible objects and volumes
   // Radius of the smallest sphere around bounds().center() holding every visible vertex and
@@ -71,6 +87,8 @@ struct Scene {
 
 // Throws mfr::Error(what, …) for a clip box with a non-finite corner or min > max on an axis.
 void validateClipBox(const std::optional<Bounds>& box, const std::string& what);
+// Throws mfr::Error(what, …) for a section plane with a non-finite point or normal or a zero normal.
+void validateSectionPlane(const std::optional<SectionPlane>& plane, const std::string& what);
 // Whether world point p is drawn under the clip box (always without one); the box's faces count
 // as inside.
 bool insideClipBox(const std::optional<Bounds>& box, const glm::dvec3& p);

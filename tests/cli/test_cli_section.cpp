@@ -1,0 +1,76 @@
+// --section end to end: the GPU image equals the oracle's under the same plane, the plane and its
+// caps change the image, the axis form equals the point-normal form, a scene file's "section" is
+// honoured and "none" removes it, open parts are named in a note, and bad planes are one line.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "mfr/image.hpp"
+#include "mfr/reference/metrics.hpp"
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using mfr::test::CliResult;
+using mfr::test::runCli;
+
+using CliSection = mfr::test::CliTest;
+
+TEST_F(CliSection, GpuEqualsOracleAndThePlaneCuts) {
+  const fs::path oracle = dir() / "o.png", gpu = dir() / "g.png", whole = dir() / "w.png", open = dir() / "n.png",
+                 pointNormal = dir() / "p.png";
+  const std::string common = "render @sample --size 64x48 --view iso ";
+  ASSERT_EQ(runCli(common + "--section -x=0.1 -o " + oracle.string()).exitCode, 0);
+  const CliResult r = runCli(common + "--section -x=0.1 -m abuffer-ll -o " + gpu.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  ASSERT_EQ(runCli(common + "-m abuffer-ll -o " + whole.string()).exitCode, 0);
+  ASSERT_EQ(runCli(common + "--section -x=0.1:nocaps -m abuffer-ll -o " + open.string()).exitCode, 0);
+  ASSERT_EQ(runCli(common + "--section 0.1,7,-3,-2,0,0 -m abuffer-ll -o " + pointNormal.string()).exitCode, 0);
+  const mfr::ImageRGBA8 o = mfr::readPng(oracle), g = mfr::readPng(gpu), w = mfr::readPng(whole);
+  EXPECT_LT(mfr::rmse(o, g), 0.02);                         // edge pixels may differ; everything else is exact
+  EXPECT_GT(mfr::rmse(w, g), 0.05);                         // the plane removes much of the sample
+  EXPECT_GT(mfr::rmse(mfr::readPng(open), g), 0.005);       // caps are drawn
+  EXPECT_EQ(mfr::rmse(mfr::readPng(pointNormal), g), 0.0);  // x <= 0.1 either way
+  // Right of x = 0.1 nothing is drawn: the right columns are background.
+  EXPECT_EQ(g.at(61, 24)[0], 255);
+  EXPECT_EQ(g.at(61, 24)[1], 255);
+}
+
+TEST_F(CliSection, SceneFileSectionNoneAndOpenParts) {
+  const fs::path scene =
+      write("s.mfrscene", R"({"sample": true, "section": {"point": [0.1, 0, 0], "normal": [-1, 0, 0]}})");
+  const fs::path fromFile = dir() / "f.png", fromOption = dir() / "o.png", none = dir() / "n.png",
+                 plain = dir() / "p.png";
+  ASSERT_EQ(runCli("render " + scene.string() + " --size 48x40 -m abuffer-ll -o " + fromFile.string()).exitCode, 0);
+  ASSERT_EQ(runCli("render @sample --size 48x40 -m abuffer-ll --section -x=0.1 -o " + fromOption.string()).exitCode, 0);
+  ASSERT_EQ(
+      runCli("render " + scene.string() + " --size 48x40 -m abuffer-ll --section none -o " + none.string()).exitCode,
+      0);
+  ASSERT_EQ(runCli("render @sample --size 48x40 -m abuffer-ll -o " + plain.string()).exitCode, 0);
+  EXPECT_EQ(mfr::rmse(mfr::readPng(fromFile), mfr::readPng(fromOption)), 0.0);
+  EXPECT_EQ(mfr::rmse(mfr::readPng(none), mfr::readPng(plain)), 0.0);
+  EXPECT_GT(mfr::rmse(mfr::readPng(fromFile), mfr::readPng(plain)), 0.05);
+  // A one-sided plane is not a solid: cut, not capped, and named.
+  const fs::path sheet = write("sheet.mfrscene", R"({"objects": [{"name": "sheet", "primitive": {"type": "plane"}},
+      {"name": "block", "primitive": {"type": "box"}}]})");
+  const CliResult r =
+      runCli("render " + sheet.string() + " --size 32x32 --section x=0 -o " + (dir() / "s.png").string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("note: section: 1 of 2 cut parts have no cap (not closed surfaces): sheet"), std::string::npos)
+      << r.out;
+}
+
+TEST_F(CliSection, BadPlanesAreRefused) {
+  expectCleanFailure("render @sample --size 16x16 --section 1,2,3",
+                     "--section 1,2,3: expected AXIS=VALUE or six numbers");
+  expectCleanFailure("render @sample --size 16x16 --section w=1", "expected AXIS=VALUE with AXIS one of");
+  expectCleanFailure("render @sample --size 16x16 --section x=nan", "expected AXIS=VALUE");
+  expectCleanFailure("render @sample --size 16x16 --section 0,0,0,0,0,0", "the normal must not be zero");
+  expectCleanFailure("render @sample --size 16x16 --section x=0:caps", "the only suffix is :nocaps");
+  expectCleanFailure("render @sample --size 16x16 --section x=100", "section plane: cuts away every visible surface");
+}
+
+}  // namespace

@@ -1,0 +1,333 @@
+// Section planes (scene/section.hpp): cut meshes checked against closed-form geometry — the volume
+// and cap area of a cut box and sphere, closedness and outward orientation of what is left (also
+// under mirrored, scaled and rotated transforms) — and the oracle's view of a capped box against
+// the box that is already that shape. Plus the .mfrscene "section" key and its errors.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
+#include "mfr/reference/oracle.hpp"
+#include "mfr/scene/primitives.hpp"
+#include "mfr/scene/section.hpp"
+#include "test_files.hpp"
+
+namespace mfr {
+namespace {
+
+// Signed volume by the divergence theorem: positive for a closed, outward-wound surface.
+double signedVolume(const Mesh& m, const glm::dmat4& transform = glm::dmat4(1.0)) {
+  double v = 0.0;
+  for (std::size_t t = 0; t < m.triangleCount(); ++t) {
+    glm::dvec3 p[3];
+    for (int k = 0; k < 3; ++k)
+      p[k] = glm::dvec3(transform * glm::dvec4(glm::dvec3(m.positions[m.indices[3 * t + k]]), 1.0));
+    v += glm::dot(p[0], glm::cross(p[1], p[2])) / 6.0;
+  }
+  return v;
+}
+
+// Closed and consistently wound, geometrically: the triangles' vector areas Σ ½ (b − a) × (c − a)
+// cancel (to 1e-6 of their total area). A cap's triangulation may leave out cut-line points that
+// lie on a straight stretch (T-junctions), which an edge count would call open; this does not.
+bool closedAndConsistent(const Mesh& m) {
+  glm::dvec3 sum(0.0);
+  double total = 0.0;
+  for (std::size_t t = 0; t < m.triangleCount(); ++t) {
+    const glm::dvec3 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]),
+        c(m.positions[m.indices[3 * t + 2]]);
+    const glm::dvec3 area = 0.5 * glm::cross(b - a, c - a);
+    sum += area;
+    total += glm::length(area);
+  }
+  return total > 0.0 && glm::length(sum) <= 1e-6 * total;
+}
+
+double capArea(const SectionedMesh& cut) {
+  double area = 0.0;
+  const Mesh& m = cut.mesh;
+  for (std::size_t t = m.triangleCount() - cut.capTriangles; t < m.triangleCount(); ++t) {
+    const glm::dvec3 a(m.positions[m.indices[3 * t]]), b(m.positions[m.indices[3 * t + 1]]),
+        c(m.positions[m.indices[3 * t + 2]]);
+    area += 0.5 * glm::length(glm::cross(b - a, c - a));
+  }
+  return area;
+}
+
+TEST(Section, BoxCutInHalfIsAClosedHalfBoxWithAUnitCap) {
+  const Mesh box = makeBox({1.0, 1.0, 1.0});
+  ASSERT_NEAR(signedVolume(box), 1.0, 1e-6);
+  // Keep z >= 0.2: dot((0,0,1), p) - 0.2 >= 0.
+  const SectionedMesh cut = sectionMesh(box, {0.0, 0.0, 1.0, -0.2}, true);
+  ASSERT_EQ(cut.outcome, SectionOutcome::kCapped);
+  EXPECT_TRUE(cut.closed);
+  EXPECT_GT(cut.capTriangles, 0u);
+  EXPECT_NEAR(signedVolume(cut.mesh), 0.3, 1e-6);
+  EXPECT_NEAR(capArea(cut), 1.0, 1e-6);
+  EXPECT_TRUE(closedAndConsistent(cut.mesh));
+  for (const glm::vec3& p : cut.mesh.positions) EXPECT_GE(p.z, 0.2f - 1e-6f);
+  ASSERT_EQ(cut.mesh.normals.size(), cut.mesh.positions.size());
+  const std::size_t capStart = cut.mesh.positions.size() - 3 * cut.capTriangles;
+  for (std::size_t i = capStart; i < cut.mesh.positions.size(); ++i) {
+    EXPECT_NEAR(cut.mesh.positions[i].z, 0.2f, 1e-6f);
+    EXPECT_EQ(cut.mesh.normals[i], glm::vec3(0.0f, 0.0f, -1.0f));
+  }
+  // The other side: the complement, same cap area.
+  const SectionedMesh other = sectionMesh(box, {0.0, 0.0, -1.0, 0.2}, true);
+  ASSERT_EQ(other.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(signedVolume(other.mesh), 0.7, 1e-6);
+  EXPECT_NEAR(capArea(other), 1.0, 1e-6);
+  // Without caps: open, the same surface minus the cap.
+  const SectionedMesh open = sectionMesh(box, {0.0, 0.0, 1.0, -0.2}, false);
+  ASSERT_EQ(open.outcome, SectionOutcome::kCut);
+  EXPECT_EQ(open.capTriangles, 0u);
+  EXPECT_FALSE(closedAndConsistent(open.mesh));
+}
+
+TEST(Section, ObliqueCutOfASphereMatchesTheSphericalCap) {
+  // Fine enough that the polyhedron is within 0.2 % of the sphere's volume.
+  const double r = 1.5;
+  const Mesh sphere = makeSphere(r, 192, 96);
+  const double full = signedVolume(sphere);
+  ASSERT_NEAR(full, 4.0 / 3.0 * std::numbers::pi * r * r * r, 2e-3 * full);
+  const glm::dvec3 n = glm::normalize(glm::dvec3(1.0, -2.0, 0.5));
+  const double d = 0.6;  // kept: dot(n, p) >= d, a cap of height r - d
+  const SectionedMesh cut = sectionMesh(sphere, glm::dvec4(n, -d), true);
+  ASSERT_EQ(cut.outcome, SectionOutcome::kCapped);
+  EXPECT_TRUE(closedAndConsistent(cut.mesh));
+  const double h = r - d;
+  const double expectedVolume = std::numbers::pi * h * h * (3.0 * r - h) / 3.0;
+  EXPECT_NEAR(signedVolume(cut.mesh) / (full / (4.0 / 3.0 * std::numbers::pi * r * r * r)), expectedVolume,
+              2e-3 * expectedVolume);
+  const double expectedDisc = std::numbers::pi * (r * r - d * d);
+  EXPECT_NEAR(capArea(cut), expectedDisc, 5e-3 * expectedDisc);
+  for (const glm::vec3& p : cut.mesh.positions) EXPECT_GE(glm::dot(n, glm::dvec3(p)), d - 1e-5);
+}
+
+TEST(Section, OpenSurfacesAreCutWithoutCapsAndWholeMeshesAreKeptOrRemoved) {
+  const Mesh plane = makePlane(2.0, 2.0);  // z = 0, one-sided: not closed
+  const SectionedMesh cut = sectionMesh(plane, {1.0, 0.0, 0.0, -0.5}, true);
+  ASSERT_EQ(cut.outcome, SectionOutcome::kCut);
+  EXPECT_FALSE(cut.closed);
+  EXPECT_EQ(cut.capTriangles, 0u);
+  double area = 0.0;
+  for (std::size_t t = 0; t < cut.mesh.triangleCount(); ++t) {
+    const glm::dvec3 a(cut.mesh.positions[cut.mesh.indices[3 * t]]), b(cut.mesh.positions[cut.mesh.indices[3 * t + 1]]),
+        c(cut.mesh.positions[cut.mesh.indices[3 * t + 2]]);
+    const glm::dvec3 normal = glm::cross(b - a, c - a);
+    EXPECT_GT(normal.z, 0.0);  // winding kept
+    area += 0.5 * glm::length(normal);
+  }
+  EXPECT_NEAR(area, 0.5 * 2.0, 1e-6);  // x in [0.5, 1] of [-1, 1] × [-1, 1]
+  EXPECT_EQ(sectionMesh(plane, {1.0, 0.0, 0.0, 5.0}, true).outcome, SectionOutcome::kKept);
+  EXPECT_EQ(sectionMesh(plane, {1.0, 0.0, 0.0, -5.0}, true).outcome, SectionOutcome::kRemoved);
+}
+
+// Where the plane cuts it decides: a box without its +x face is open there — a cut through that
+// face gets no cap — while a cut that misses the hole is capped as usual. A triangle doubled across
+// the plane (scans and tessellations have them) counts once.
+TEST(Section, OnlyTheCutLineMustBeClosed) {
+  const Mesh box = makeBox({1.0, 1.0, 1.0});
+  Mesh holed = box;
+  holed.indices.clear();
+  for (std::size_t t = 0; t < box.triangleCount(); ++t) {
+    bool plusX = true;
+    for (int k = 0; k < 3; ++k) plusX = plusX && box.positions[box.indices[3 * t + k]].x > 0.4f;
+    if (!plusX)
+      for (int k = 0; k < 3; ++k) holed.indices.push_back(box.indices[3 * t + k]);
+  }
+  ASSERT_EQ(holed.triangleCount(), box.triangleCount() - 2);
+  const SectionedMesh throughHole = sectionMesh(holed, {0.0, 0.0, 1.0, -0.1}, true);  // z = 0.1 crosses +x
+  EXPECT_FALSE(throughHole.closed);
+  EXPECT_EQ(throughHole.outcome, SectionOutcome::kCut);
+  EXPECT_EQ(throughHole.capTriangles, 0u);
+  const SectionedMesh besideHole = sectionMesh(holed, {-1.0, 0.0, 0.0, 0.1}, true);  // keeps x <= 0.1
+  EXPECT_TRUE(besideHole.closed);
+  ASSERT_EQ(besideHole.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(besideHole), 1.0, 1e-6);
+
+  Mesh doubled = box;
+  for (std::size_t t = 0; t < box.triangleCount(); ++t) {
+    float lo = 1.0f, hi = -1.0f;
+    for (int k = 0; k < 3; ++k) {
+      lo = std::min(lo, box.positions[box.indices[3 * t + k]].z);
+      hi = std::max(hi, box.positions[box.indices[3 * t + k]].z);
+    }
+    if (lo < 0.0f && hi > 0.0f)  // a side triangle the plane z = 0 crosses
+      for (int k = 0; k < 3; ++k) doubled.indices.push_back(box.indices[3 * t + k]);
+  }
+  ASSERT_GT(doubled.triangleCount(), box.triangleCount());
+  const SectionedMesh cut = sectionMesh(doubled, {0.0, 0.0, 1.0, 0.0}, true);
+  ASSERT_EQ(cut.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(cut), 1.0, 1e-6);
+}
+
+TEST(Section, VertexColoursAreInterpolatedOntoTheCutAndTheCap) {
+  Mesh box = makeBox({2.0, 2.0, 2.0});
+  box.colors.resize(box.positions.size());
+  for (std::size_t i = 0; i < box.positions.size(); ++i)  // red at x = -1 to green at x = +1
+    box.colors[i] = {0.5f - 0.5f * box.positions[i].x, 0.5f + 0.5f * box.positions[i].x, 0.0f, 1.0f};
+  const SectionedMesh cut = sectionMesh(box, {0.0, 1.0, 0.0, 0.0}, true);  // keep y >= 0
+  ASSERT_EQ(cut.outcome, SectionOutcome::kCapped);
+  ASSERT_EQ(cut.mesh.colors.size(), cut.mesh.positions.size());
+  for (std::size_t i = 0; i < cut.mesh.positions.size(); ++i) {
+    const float x = cut.mesh.positions[i].x;
+    EXPECT_NEAR(cut.mesh.colors[i].r, 0.5f - 0.5f * x, 1e-5f);
+    EXPECT_NEAR(cut.mesh.colors[i].g, 0.5f + 0.5f * x, 1e-5f);
+  }
+}
+
+Object object(const std::string& name, const Mesh& mesh, const glm::dmat4& transform) {
+  Object o;
+  o.name = name;
+  o.mesh = std::make_shared<const Mesh>(mesh);
+  o.transform = transform;
+  return o;
+}
+
+TEST(Section, SceneObjectsAreCutInWorldSpaceWhateverTheirTransform) {
+  Scene scene;
+  scene.name = "parts";
+  const glm::dmat4 rotated = glm::rotate(glm::translate(glm::dmat4(1.0), {0.3, -0.2, 0.1}), 0.7, {1.0, 1.0, 0.0});
+  const glm::dmat4 mirrored = glm::scale(glm::translate(glm::dmat4(1.0), {0.0, 0.5, 0.0}), {-1.0, 2.0, 0.5});
+  scene.objects.push_back(object("rotated", makeBox({1.0, 1.0, 1.0}), rotated));
+  scene.objects.push_back(object("mirrored", makeSphere(0.8, 96, 48), mirrored));
+  scene.objects.push_back(object("far", makeBox({1.0, 1.0, 1.0}), glm::translate(glm::dmat4(1.0), {0.0, 0.0, 10.0})));
+  scene.objects.push_back(
+      object("behind", makeBox({1.0, 1.0, 1.0}), glm::translate(glm::dmat4(1.0), {0.0, 0.0, -10.0})));
+  SectionPlane plane;
+  plane.point = {0.1, 0.2, 0.05};
+  plane.normal = {0.0, 0.0, 3.0};  // not unit length: keep z >= 0.05
+  scene.section = plane;
+  SectionReport report;
+  const Scene cut = sectionedScene(scene, &report);
+  EXPECT_TRUE(cut.sectionCut);
+  EXPECT_EQ(report.cut, 2u);
+  EXPECT_EQ(report.capped, 2u);
+  EXPECT_EQ(report.removed, 1u);
+  EXPECT_TRUE(report.open.empty());
+  EXPECT_TRUE(cut.objects[0].visible && cut.objects[1].visible && cut.objects[2].visible);
+  EXPECT_FALSE(cut.objects[3].visible);
+  EXPECT_EQ(cut.objects[2].mesh, scene.objects[2].mesh);  // untouched: shared, not copied
+  for (int o = 0; o < 2; ++o) {
+    SCOPED_TRACE(cut.objects[o].name);
+    const Object& part = cut.objects[o];
+    EXPECT_TRUE(closedAndConsistent(*part.mesh));
+    for (const glm::vec3& p : part.mesh->positions)
+      EXPECT_GE((part.transform * glm::dvec4(glm::dvec3(p), 1.0)).z, 0.05 - 1e-5);
+    // Outward in world space: positive volume, times the transform's orientation.
+    const double sign = glm::determinant(glm::dmat3(part.transform)) > 0.0 ? 1.0 : -1.0;
+    EXPECT_GT(sign * signedVolume(*part.mesh, part.transform), 0.0);
+    // Cap normals, through the normal matrix, face the cut-away side: world -z.
+    const glm::dmat3 normalMatrix = glm::transpose(glm::inverse(glm::dmat3(part.transform)));
+    const glm::vec3 capNormal = part.mesh->normals.back();
+    EXPECT_NEAR(glm::dot(glm::normalize(normalMatrix * glm::dvec3(capNormal)), glm::dvec3(0.0, 0.0, -1.0)), 1.0, 1e-6);
+  }
+  // The sphere's world volume: an ellipsoid (semi-axes 0.8, 1.6, 0.4, centre z = 0) above z = 0.05.
+  const double c = 0.4, zc = 0.05 / c;  // in the unit-sphere frame of the z axis
+  const double expected = std::numbers::pi * 0.8 * 1.6 * c * (2.0 / 3.0 - zc + zc * zc * zc / 3.0);
+  EXPECT_NEAR(-signedVolume(*cut.objects[1].mesh, cut.objects[1].transform), expected, 5e-3 * expected);
+  // Applied once: a cut scene is not cut again.
+  EXPECT_EQ(sectionedScene(cut).objects[0].mesh, cut.objects[0].mesh);
+  // Nothing left.
+  scene.section->point = {0.0, 0.0, 100.0};
+  EXPECT_THROW((void)sectionedScene(scene), Error);
+  scene.section->normal = {0.0, 0.0, 0.0};
+  EXPECT_THROW(scene.validate(), Error);
+}
+
+TEST(Section, OpenPartsAreReportedAndCapsCanBeTurnedOff) {
+  Scene scene;
+  scene.name = "mixed";
+  scene.objects.push_back(object("sheet", makePlane(2.0, 2.0), glm::dmat4(1.0)));
+  scene.objects.push_back(object("block", makeBox({1.0, 1.0, 1.0}), glm::dmat4(1.0)));
+  scene.section = SectionPlane{{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}, true};
+  SectionReport report;
+  (void)sectionedScene(scene, &report);
+  EXPECT_EQ(report.cut, 2u);
+  EXPECT_EQ(report.capped, 1u);
+  ASSERT_EQ(report.open.size(), 1u);
+  EXPECT_EQ(report.open[0], "sheet");
+  scene.section->caps = false;
+  const Scene uncapped = sectionedScene(scene, &report);
+  EXPECT_EQ(report.capped, 0u);
+  EXPECT_TRUE(report.open.empty());
+  EXPECT_FALSE(closedAndConsistent(*uncapped.objects[1].mesh));
+}
+
+// The oracle's view of a unit box cut at z = 0 (keeping z <= 0) is the view of the box that has that
+// shape from the start, [-0.5, 0.5]² × [-0.5, 0]: the cap is the top face, same depth, same normal,
+// same colour.
+TEST(Section, TheOracleSeesACappedBoxAsTheBoxOfThatShape) {
+  Camera camera;
+  camera.eye = {0.6, 0.9, 3.0};
+  camera.target = {0.0, 0.0, -0.2};
+  const int w = 64, h = 48;
+  Scene cut;
+  cut.name = "cut";
+  cut.objects.push_back(object("box", makeBox({1.0, 1.0, 1.0}), glm::dmat4(1.0)));
+  cut.section = SectionPlane{{0.0, 0.0, 0.0}, {0.0, 0.0, -1.0}, true};
+  Scene half;
+  half.name = "half";
+  half.objects.push_back(object("box", makeBox({1.0, 1.0, 0.5}), glm::translate(glm::dmat4(1.0), {0.0, 0.0, -0.25})));
+  const FragmentLists a = castFragments(cut, camera, w, h);
+  const FragmentLists b = castFragments(half, camera, w, h);
+  std::size_t compared = 0, withFragments = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (a.isAmbiguous(x, y) || b.isAmbiguous(x, y)) continue;
+      ++compared;
+      const auto la = a.pixel(x, y), lb = b.pixel(x, y);
+      ASSERT_EQ(la.size(), lb.size()) << x << "," << y;
+      withFragments += la.empty() ? 0 : 1;
+      for (std::size_t i = 0; i < la.size(); ++i) {
+        EXPECT_NEAR(la[i].depth, lb[i].depth, 1e-6f) << x << "," << y;
+        EXPECT_EQ(la[i].color, lb[i].color) << x << "," << y;
+      }
+    }
+  EXPECT_GT(compared, static_cast<std::size_t>(w * h * 3 / 4));
+  EXPECT_GT(withFragments, static_cast<std::size_t>(w * h / 8));
+}
+
+using SceneFileSection = test::TempDirTest;
+
+TEST_F(SceneFileSection, SectionKeyAndItsErrors) {
+  const std::string objects = R"("objects": [{"primitive": {"type": "box"}}])";
+  const Scene scene = loadScene(write(
+      "s.mfrscene", "{" + objects + R"(, "section": {"point": [0, 0.1, 0], "normal": [0, -1, 0], "caps": false}})"));
+  ASSERT_TRUE(scene.section.has_value());
+  EXPECT_EQ(scene.section->point, glm::dvec3(0, 0.1, 0));
+  EXPECT_EQ(scene.section->normal, glm::dvec3(0, -1, 0));
+  EXPECT_FALSE(scene.section->caps);
+  EXPECT_TRUE(
+      loadScene(write("d.mfrscene", "{" + objects + R"(, "section": {"point": [0, 0, 0], "normal": [1, 0, 0]}})"))
+          .section->caps);
+  EXPECT_FALSE(loadScene(write("n.mfrscene", "{" + objects + "}")).section.has_value());
+  const std::pair<std::string, std::string> bad[] = {
+      {R"("section": [1, 2])", "section: expected an object"},
+      {R"("section": {"point": [0, 0, 0]})", "section: expected \"point\" and \"normal\""},
+      {R"("section": {"point": [0, 0], "normal": [1, 0, 0]})", "section.point: expected an array of 3 numbers"},
+      {R"("section": {"point": [0, 0, 0], "normal": [0, 0, 0]})", "section.normal: must not be zero"},
+      {R"("section": {"point": [0, 0, 0], "normal": [0, 0, 1], "caps": 1})", "section.caps: expected true or false"},
+  };
+  for (const auto& [json, mention] : bad) {
+    SCOPED_TRACE(json);
+    try {
+      (void)loadScene(write("bad.mfrscene", "{" + objects + ", " + json + "}"));
+      ADD_FAILURE() << "accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.mfrscene"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(mention), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mfr
