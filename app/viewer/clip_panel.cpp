@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mfr/error.hpp"
+#include "mfr/scene/section.hpp"
 #include "viewer_model.hpp"
 
 ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), model_(model) {
@@ -83,6 +85,10 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
   sectionAlign_->setToolTip(
       tr("The plane through the view's target, facing away from the eye: the near half is cut away"));
   section->addWidget(sectionAlign_, 2, 0, 1, 3, Qt::AlignRight);
+  sectionReport_ = new QLabel(this);
+  sectionReport_->setObjectName(QStringLiteral("sectionReport"));
+  sectionReport_->setWordWrap(true);
+  section->addWidget(sectionReport_, 3, 0, 1, 3);
   section->setColumnStretch(0, 1);
   layout->addLayout(section);
   layout->addStretch(1);
@@ -201,8 +207,29 @@ void ClipPanel::showModel() {
     sectionOffset_->setValue(
         hi > lo ? std::clamp(static_cast<int>(std::lround((at - lo) / (hi - lo) * kSteps)), 0, kSteps) : kSteps / 2);
     sectionValue_->setText(QStringLiteral("%1").arg(at, 0, 'g', 5));
+    // The same cut the renderers make (a few milliseconds for 10⁵ triangles).
+    try {
+      mfr::SectionReport report;
+      (void)mfr::sectionedScene(model_.scene(), &report);
+      QString text = (report.cut == 1 ? tr("1 part cut") : tr("%1 parts cut").arg(report.cut));
+      QString names;
+      if (section->caps) {
+        text += tr(", %1 capped").arg(report.capped);
+        if (!report.open.empty()) {
+          text += tr("; %1 open along the cut, without a cap").arg(report.open.size());
+          for (const std::string& name : report.open) names += QString::fromStdString(name) + QLatin1Char('\n');
+        }
+      }
+      sectionReport_->setText(text);
+      sectionReport_->setToolTip(names.trimmed());
+    } catch (const mfr::Error& e) {
+      sectionReport_->setText(QString::fromUtf8(e.what()));
+      sectionReport_->setToolTip({});
+    }
   } else {
     sectionValue_->setText(QStringLiteral("—"));
+    sectionReport_->clear();
+    sectionReport_->setToolTip({});
   }
   for (QWidget* w : std::initializer_list<QWidget*>{sectionAxis_, sectionFlip_, sectionCaps_, sectionOffset_})
     w->setEnabled(usable && section.has_value());

@@ -9,6 +9,7 @@
 // own normal, "Custom"), moved by a slider across the scene's extent along that normal, keeping the
 // side the normal points to unless flipped; closed parts are capped unless Caps is off. "Align to
 // view" puts it through the view's target, facing away from the eye (the near half is cut away).
+// A line below says how many cut parts got a cap and names those that did not (open along the cut).
 #include <QWidget>
 
 #include <array>
@@ -56,6 +57,7 @@ class ClipPanel final : public QWidget {
   QCheckBox* sectionCaps_ = nullptr;
   QLabel* sectionValue_ = nullptr;
   QPushButton* sectionAlign_ = nullptr;
+  QLabel* sectionReport_ = nullptr;         // how many cut parts are capped; the others' names in its tooltip
   glm::dvec3 customNormal_{0.0, 0.0, 1.0};  // unit; the "Custom" entry's axis
   bool showing_ = false;  // controls being set from the model: no apply()
 };

@@ -36,6 +36,7 @@
 #include "main_window.hpp"
 #include "probe_panel.hpp"
 #include "session.hpp"
+#include "mfr/scene/section.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/methods/registry.hpp"
@@ -2437,6 +2438,17 @@ class ViewerTest : public QObject {
     QVERIFY(m.section().has_value());
     const mfr::SectionPlane plane = *m.section();
     QCOMPARE(plane.normal, glm::dvec3(-1.0, 0.0, 0.0));
+    // The report line counts what sectionedScene does.
+    mfr::SectionReport report;
+    (void)mfr::sectionedScene(m.scene(), &report);
+    QVERIFY(report.cut > 0);
+    auto* reportLabel = w->findChild<QLabel*>("sectionReport");
+    QVERIFY(reportLabel);
+    QVERIFY2(reportLabel->text().startsWith(QStringLiteral("%1 part").arg(report.cut)),
+             qPrintable(reportLabel->text()));
+    QVERIFY2(reportLabel->text().contains(QStringLiteral("%1 capped").arg(report.capped)),
+             qPrintable(reportLabel->text()));
+    QCOMPARE(reportLabel->toolTip().isEmpty(), report.open.empty());
     QCOMPARE(plane.point.x, b.min.x + (b.max.x - b.min.x) * 400 / 1000);
     QVERIFY(plane.caps);
     settle(m);
