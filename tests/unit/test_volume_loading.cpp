@@ -234,6 +234,42 @@ TEST_F(VolumeLoading, NrrdRawGzipAndDetachedHeader) {
   expectField(mfr::loadVolume(write("packed.nrrd", std::string(kNrrdHeader) + "encoding: gzip\n\n" + gz)), {10, 3, 2});
 }
 
+// "space directions" and "space origin": grid point (i, j, k) lies at origin + i·d0 + j·d1 + k·d2
+// (the NRRD format's definition) — here the axes are permuted, scaled, flipped and sheared.
+// vtkNrrdReader alone keeps only the vectors' lengths.
+TEST_F(VolumeLoading, NrrdSpaceDirectionsOrientTheGrid) {
+  const glm::dvec3 d[3] = {{0.0, 2.0, 0.0}, {-3.0, 0.0, 0.5}, {0.0, 0.25, 1.0}};
+  const glm::dvec3 origin(10.0, -20.0, 30.0);
+  const std::string header =
+      "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3 2\nspace: left-posterior-superior\n"
+      "space directions: (0,2,0) ( -3, 0 ,0.5 ) (0,0.25,1)\nspace origin: (10,-20,30)\nendian: little\n"
+      "encoding: raw\n\n";
+  const mfr::Volume v = mfr::loadVolume(write("oriented.nrrd", header + nrrdRaw()));
+  expectField(v, {10, 3, 2});
+  const glm::dmat4 toWorld = v.gridToWorld();
+  for (const glm::ivec3 ijk : {glm::ivec3(0, 0, 0), glm::ivec3(9, 0, 0), glm::ivec3(0, 2, 0), glm::ivec3(0, 0, 1),
+                               glm::ivec3(9, 2, 1), glm::ivec3(4, 1, 1)}) {
+    const glm::dvec3 want = origin + double(ijk.x) * d[0] + double(ijk.y) * d[1] + double(ijk.z) * d[2];
+    const glm::dvec3 got(toWorld * glm::dvec4(glm::dvec3(ijk), 1.0));
+    EXPECT_LT(glm::length(got - want), 1e-9) << ijk.x << "," << ijk.y << "," << ijk.z;
+  }
+  // Without directions the same file is axis-aligned from the origin (spacings only).
+  const mfr::Volume plain =
+      mfr::loadVolume(write("plain.nrrd", std::string(kNrrdHeader) + "encoding: raw\n\n" + nrrdRaw()));
+  EXPECT_EQ(plain.transform, glm::dmat4(1.0));
+  // Directions that flatten the grid, or that are not vectors, are refused with one line.
+  expectVolumeError(write("flat.nrrd",
+                          "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3 2\n"
+                          "space directions: (1,0,0) (2,0,0) (0,0,1)\nencoding: raw\n\n" +
+                              nrrdRaw()),
+                    "not independent");
+  expectVolumeError(write("bad.nrrd",
+                          "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3 2\n"
+                          "space directions: (1,0) (0,1,0) (0,0,1)\nencoding: raw\n\n" +
+                              nrrdRaw()),
+                    "must be vectors (x,y,z) or none");
+}
+
 TEST_F(VolumeLoading, DefaultTransferIsGrayscaleOverTheDataRange) {
   const mfr::Volume v = mfr::loadVolume(write("cube.vti", cubeVti()));
   const mfr::TransferFunction want = mfr::transferPreset("grayscale", 0.0, 26.0, std::sqrt(12.0) / 50.0);

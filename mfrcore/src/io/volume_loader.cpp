@@ -228,7 +228,46 @@ class CerrCapture {
 // and ASCII data is read without checking the stream (a short file gives garbage). This looks at
 // the header as vtkNrrdReader will see it — the first 4 MiB up to a NUL byte, cut after the first
 // blank line — and refuses those cases before the reader runs.
-void checkNrrdHeader(const fs::path& path, const std::string& name) {
+//
+// It also returns the orientation, which vtkNrrdReader (VTK 9.1) reads only in part: of "space
+// directions" it keeps each vector's length as the spacing and drops its direction. Axis a of the
+// grid steps by directions[a] in the file's space from "space origin" (the NRRD format's definition).
+struct NrrdOrientation {
+  std::optional<std::array<glm::dvec3, 3>> directions;  // three spatial axes, none "none"
+  std::vector<long> sizes;
+};
+
+// The value of "space directions": one entry per axis, "(x,y,z)" (spaces allowed inside) or
+// "none" (a non-spatial axis, nothing here). Throws mfr::Error(name, …) for anything else.
+std::vector<std::optional<glm::dvec3>> nrrdDirections(const std::string& text, const std::string& name) {
+  std::vector<std::optional<glm::dvec3>> out;
+  const auto fail = [&] {
+    throw Error(name, "NRRD 'space directions' must be vectors (x,y,z) or none, one per axis (got '" + text + "')");
+  };
+  std::size_t p = 0;
+  while (true) {
+    p = text.find_first_not_of(" \t", p);
+    if (p == std::string::npos) break;
+    if (text.compare(p, 4, "none") == 0) {
+      out.emplace_back(std::nullopt);
+      p += 4;
+      continue;
+    }
+    const std::size_t close = text.find(')', p);
+    if (text[p] != '(' || close == std::string::npos) fail();
+    std::istringstream in(text.substr(p + 1, close - p - 1));
+    glm::dvec3 v;
+    char c1 = 0, c2 = 0;
+    if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',' || !(in >> std::ws).eof()) fail();
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) fail();
+    out.emplace_back(v);
+    p = close + 1;
+  }
+  return out;
+}
+
+NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
+  NrrdOrientation orientation;
   std::ifstream in(path, std::ios::binary);
   std::string text(0x400000 - 1, '\0');
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
@@ -269,10 +308,21 @@ void checkNrrdHeader(const fs::path& path, const std::string& name) {
       if (static_cast<long>(tokens.size()) != dimension)
         throw Error(name, "NRRD 'sizes' has " + std::to_string(tokens.size()) + " values for dimension " +
                               std::to_string(dimension));
-      for (const std::string& t : tokens)
+      for (const std::string& t : tokens) {
         if (t.find_first_not_of("0123456789") != std::string::npos || std::atol(t.c_str()) < 1)
           throw Error(name, "NRRD 'sizes' must be positive integers (got '" + t + "')");
+        orientation.sizes.push_back(std::atol(t.c_str()));
+      }
       sizes = true;
+    } else if (field == "space directions") {
+      const std::vector<std::optional<glm::dvec3>> vectors = nrrdDirections(line.substr(colon + 2), name);
+      // Three spatial axes (a 4D file's "none" axis holds components: VTK's business).
+      if (vectors.size() == 3 && vectors[0] && vectors[1] && vectors[2]) {
+        const glm::dmat3 m(*vectors[0], *vectors[1], *vectors[2]);
+        if (!(std::abs(glm::determinant(m)) > 0.0))
+          throw Error(name, "NRRD 'space directions' are not independent (the grid would be flat)");
+        orientation.directions = std::array<glm::dvec3, 3>{*vectors[0], *vectors[1], *vectors[2]};
+      }
     } else if (field == "encoding") {
       const std::string encoding = tokens.empty() ? std::string() : lower(tokens[0]);
       if (encoding == "ascii" || encoding == "txt" || encoding == "text")
@@ -284,6 +334,7 @@ void checkNrrdHeader(const fs::path& path, const std::string& name) {
     }
   }
   if (!sizes) throw Error(name, "NRRD header has no 'sizes'");
+  return orientation;
 }
 
 // The sample array: the point data's active scalars, else its first numeric array.
@@ -318,7 +369,8 @@ void checkDims(const std::array<std::int64_t, 3>& d, const std::string& name) {
 Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::string& name,
                          const LoadProgress& progress) {
   const std::string label = formatLabel(format);
-  if (format == VolumeFormat::Nrrd) checkNrrdHeader(path, name);
+  NrrdOrientation nrrd;
+  if (format == VolumeFormat::Nrrd) nrrd = checkNrrdHeader(path, name);
   VtkMessages messages;  // before the reader: VTK's output window goes quiet
   std::optional<CerrCapture> metaIo;
   if (format == VolumeFormat::MetaImage) metaIo.emplace();
@@ -403,6 +455,14 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   start[0] = extent[0];
   start[1] = extent[2];
   start[2] = extent[4];
+  // NRRD: the directions VTK dropped (it may also misread their lengths: "( -3, 0, 0.5 )" with
+  // spaces gives a spacing of 0). Only when VTK read the grid as the header's three axes (it takes a
+  // first axis of 9 or fewer samples for vector components, and then they do not apply).
+  const bool nrrdOriented = nrrd.directions && nrrd.sizes.size() == 3 && nrrd.sizes[0] == gridDims.x &&
+                            nrrd.sizes[1] == gridDims.y && nrrd.sizes[2] == gridDims.z && extent[0] == 0 &&
+                            extent[2] == 0 && extent[4] == 0;
+  if (nrrdOriented)
+    for (int a = 0; a < 3; ++a) s[a] = glm::length((*nrrd.directions)[static_cast<std::size_t>(a)]);
   glm::dvec3 spacing, first;
   glm::dmat3 axes = direction;
   for (int a = 0; a < 3; ++a) {
@@ -417,6 +477,8 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   volume.grid = std::move(grid);
   volume.origin = glm::dvec3(o[0], o[1], o[2]) + direction * first;
   volume.spacing = spacing;
+  if (nrrdOriented)
+    for (int a = 0; a < 3; ++a) axes[a] = (*nrrd.directions)[static_cast<std::size_t>(a)] / spacing[a];
   if (axes != glm::dmat3(1.0))
     volume.transform = glm::translate(glm::dmat4(1.0), volume.origin) * glm::dmat4(axes) *
                        glm::translate(glm::dmat4(1.0), -volume.origin);
