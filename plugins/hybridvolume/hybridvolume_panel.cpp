@@ -327,6 +327,13 @@ void HybridVolumePanel::resetToCurrent() {
     windowHigh_ = base_.high();
     windowMin_->setValue(windowLow_);
     windowMax_->setValue(windowHigh_);
+    // A function that is a preset over its own range — a scene file's {"preset", "range"}, an
+    // InVesalius project's "bone" over its saved window — shows as that preset, not as Custom.
+    for (const QString& name : context_.transferPresetNames())
+      if (sameTransfer(context_.transferPreset(name, windowLow_, windowHigh_, base_.unitDistance), base_)) {
+        preset_->setCurrentIndex(preset_->findData(name));
+        break;
+      }
   }
   opacity_->setValue(logPosition(1.0, kMinScale, kMaxScale));
   showScaleValue();

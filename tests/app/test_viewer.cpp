@@ -2410,6 +2410,31 @@ class ViewerTest : public QObject {
     QCOMPARE(maxChannelDifference(w->view().renderImage(QSize(200, 150)), cut), 0);
   }
 
+  // A scene's function that is a preset over its range (written out point by point here, as an
+  // InVesalius project's "bone" over its window arrives) shows as that preset with that window;
+  // the blob's own two-point function stays Custom.
+  void volumePanelNamesAPresetFunction() {
+    QTemporaryDir dir;
+    auto w = openWindow(QString());
+    QVERIFY(w);
+    const mfr::TransferFunction fire = mfr::transferPreset("fire", 0.125, 0.875, 0.2);
+    w->openScene(writeBlobScene(dir, "fire.mfrscene", fire));
+    ViewerModel& m = w->model();
+    QTRY_VERIFY_WITH_TIMEOUT(m.hasScene() && m.framesRendered() > 0, kTimeoutMs);
+    settle(m);
+    auto* preset = w->findChild<QComboBox*>("hvPreset");
+    QVERIFY(preset);
+    QCOMPARE(preset->currentData().toString(), QStringLiteral("fire"));
+    QCOMPARE(w->findChild<QDoubleSpinBox*>("hvWindowMin")->value(), 0.125);
+    QCOMPARE(w->findChild<QDoubleSpinBox*>("hvWindowMax")->value(), 0.875);
+    QCOMPARE(m.transferFunction().points.size(), fire.points.size());  // nothing re-applied
+    w->openScene(writeBlobScene(dir, "blob.mfrscene", blobTransfer()));
+    QTRY_VERIFY_WITH_TIMEOUT(m.hasScene() && m.framesRendered() > 0 && m.transferFunction().points.size() == 2,
+                             kTimeoutMs);
+    settle(m);
+    QCOMPARE(preset->currentData().toString(), QStringLiteral("Custom"));
+  }
+
   void sectionPlane() {
     QTemporaryDir dir;
     auto w = openWindow();

@@ -16,6 +16,7 @@
 #include "mfr/io/load.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "mfr/scene/primitives.hpp"
+#include "mfr/scene/sample.hpp"
 #include "mfr/scene/section.hpp"
 #include "test_files.hpp"
 
@@ -35,8 +36,8 @@ double signedVolume(const Mesh& m, const glm::dmat4& transform = glm::dmat4(1.0)
 }
 
 // Closed and consistently wound, geometrically: the triangles' vector areas Σ ½ (b − a) × (c − a)
-// cancel (to 1e-6 of their total area). A cap's triangulation may leave out cut-line points that
-// lie on a straight stretch (T-junctions), which an edge count would call open; this does not.
+// cancel (to 1e-6 of their total area). The topological test (every edge shared by exactly two
+// triangles) is CSG's own validateCsg, used below.
 bool closedAndConsistent(const Mesh& m) {
   glm::dvec3 sum(0.0);
   double total = 0.0;
@@ -169,6 +170,32 @@ TEST(Section, OnlyTheCutLineMustBeClosed) {
   EXPECT_NEAR(capArea(cut), 1.0, 1e-6);
 }
 
+// A box whose +x face is moved out by `gap` (its edges no longer meet the neighbouring faces'):
+// a gap far below 1e-4 of the size is joined and capped, a visible one is not.
+TEST(Section, TinyGapsAlongTheCutAreJoined) {
+  for (const double gap : {2e-6, 1e-2}) {
+    SCOPED_TRACE(gap);
+    Mesh box = makeBox({1.0, 1.0, 1.0});
+    std::vector<bool> onPlusX(box.positions.size(), false);
+    for (std::size_t t = 0; t < box.triangleCount(); ++t) {
+      bool all = true;
+      for (int k = 0; k < 3; ++k) all = all && box.normals[box.indices[3 * t + k]].x > 0.5f;
+      for (int k = 0; k < 3 && all; ++k) onPlusX[box.indices[3 * t + k]] = true;
+    }
+    for (std::size_t i = 0; i < box.positions.size(); ++i)
+      if (onPlusX[i]) box.positions[i].x += static_cast<float>(gap);
+    const SectionedMesh cut = sectionMesh(box, {0.0, 0.0, 1.0, -0.1}, true);
+    if (gap < 1e-4) {
+      EXPECT_TRUE(cut.closed);
+      ASSERT_EQ(cut.outcome, SectionOutcome::kCapped);
+      EXPECT_NEAR(capArea(cut), 1.0, 1e-4);
+    } else {
+      EXPECT_FALSE(cut.closed);
+      EXPECT_EQ(cut.outcome, SectionOutcome::kCut);
+    }
+  }
+}
+
 TEST(Section, VertexColoursAreInterpolatedOntoTheCutAndTheCap) {
   Mesh box = makeBox({2.0, 2.0, 2.0});
   box.colors.resize(box.positions.size());
@@ -241,6 +268,35 @@ TEST(Section, SceneObjectsAreCutInWorldSpaceWhateverTheirTransform) {
   EXPECT_THROW((void)sectionedScene(scene), Error);
   scene.section->normal = {0.0, 0.0, 0.0};
   EXPECT_THROW(scene.validate(), Error);
+}
+
+// The CSG sample's drills are cylinders turned by 90°: vertices that should lie on y = 0 lie at
+// ±1e-17. They count as on the plane, so every part is capped and stays a solid.
+TEST(Section, VerticesWithinRoundingOfThePlaneAreOnIt) {
+  Scene scene = makeCsgSampleScene();
+  scene.section = SectionPlane{{0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, true};
+  SectionReport report;
+  const Scene cut = sectionedScene(scene, &report);
+  EXPECT_EQ(report.cut, scene.objects.size());
+  EXPECT_EQ(report.capped, report.cut);
+  EXPECT_TRUE(report.open.empty()) << report.open.front();
+  for (const Object& o : cut.objects) EXPECT_TRUE(closedAndConsistent(*o.mesh)) << o.name;
+  EXPECT_NO_THROW(validateCsg(cut));
+}
+
+// CSG's own closedness test is topological (every edge shared by exactly two triangles once
+// coincident vertices merge): the caps keep every point of the cut line, so the cut solids pass it,
+// on an oblique plane too.
+TEST(Section, CutSolidsAreWatertightForCsg) {
+  for (const glm::dvec3 normal : {glm::dvec3(0.3, -1.0, 0.6), glm::dvec3(1.0, 0.2, -0.1), glm::dvec3(0.0, 0.0, 1.0)}) {
+    SCOPED_TRACE(normal.x);
+    Scene scene = makeCsgSampleScene();
+    scene.section = SectionPlane{{0.05, 0.1, -0.02}, normal, true};
+    SectionReport report;
+    const Scene cut = sectionedScene(scene, &report);
+    EXPECT_EQ(report.capped, report.cut);
+    EXPECT_NO_THROW(validateCsg(cut));
+  }
 }
 
 TEST(Section, OpenPartsAreReportedAndCapsCanBeTurnedOff) {

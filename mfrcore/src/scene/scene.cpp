@@ -87,7 +87,7 @@ void validateSectionPlane(const std::optional<SectionPlane>& plane, const std::s
     if (!std::isfinite(plane->point[a]) || !std::isfinite(plane->normal[a]))
       throw Error(what, "needs a finite point and normal");
   const double length = glm::length(plane->normal);
-  if (!(length > 1e-12) || !std::isfinite(length)) throw Error(what, "needs a non-zero normal");
+  if (!(length > 1e-12) || !std::isfinite(length)) throw Error(what, "needs a non-zero normal of finite length");
 }
 
 void validateClipBox(const std::optional<Bounds>& box, const std::string& what) {

@@ -5,114 +5,191 @@
 #include <cstdint>
 #include <limits>
 #include <map>
-#include <ranges>
 #include <tuple>
 #include <unordered_map>
 #include <utility>
 
-#include <vtkCellArray.h>
-#include <vtkContourTriangulator.h>
-#include <vtkNew.h>
-#include <vtkPoints.h>
-#include <vtkPolyData.h>
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
 #include "mfr/error.hpp"
 
 namespace mfr {
 namespace {
 
-constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-// Cut-line endpoints closer than this fraction of a mesh's bounding-box diagonal are one point.
-// Measured on the 2CylinderEngine's parts (glTF, split per face): their cut lines have gaps of
-// 1e-6 to 7e-5 of the diagonal; at 1e-4, 19 of the 24 parts cut by z = 0 close (13 at 1e-6) and
-// all 7 cut by x = 0 (5), 1e-3 adds only 2 of the 51 cut by y = 0.
+constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
+constexpr std::size_t kNoPoint = std::numeric_limits<std::size_t>::max();
+// A chain of the cut line that ends this close (a fraction of the mesh's bounding-box diagonal) to
+// where another starts is joined to it. Measured on the 2CylinderEngine's parts (glTF, split per
+// face): their cut lines have gaps of 1e-6 to 7e-5 of the diagonal; at 1e-4, 19 of the 24 parts
+// cut by z = 0 close (13 at 1e-6), all 7 cut by x = 0 (5) and 38 of the 51 cut by y = 0 (36);
+// 1e-3 adds only 2 of those 51.
 constexpr double kCapWeld = 1e-4;
+
+// Faces of the cap's triangulation: how many constrained edges (cut-line segments) separate them
+// from the outside; odd is inside the section.
+struct CapFace {
+  int nesting = -1;
+};
+using CapKernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using CapTds =
+    CGAL::Triangulation_data_structure_2<CGAL::Triangulation_vertex_base_with_info_2<std::size_t, CapKernel>,
+                                         CGAL::Constrained_triangulation_face_base_2<
+                                             CapKernel, CGAL::Triangulation_face_base_with_info_2<CapFace, CapKernel>>>;
+// Crossing segments (a self-intersecting cut line) throw instead of inventing points.
+using CapTriangulation =
+    CGAL::Constrained_Delaunay_triangulation_2<CapKernel, CapTds, CGAL::No_constraint_intersection_tag>;
+
+// Breadth-first from the infinite face: each region bounded by constrained edges gets one more
+// than the region it was reached from.
+void markNesting(CapTriangulation& cdt) {
+  for (const CapTriangulation::Face_handle f : cdt.all_face_handles()) f->info().nesting = -1;
+  std::vector<CapTriangulation::Edge> border;
+  const auto flood = [&](CapTriangulation::Face_handle start, int nesting) {
+    std::vector<CapTriangulation::Face_handle> queue{start};
+    while (!queue.empty()) {
+      const CapTriangulation::Face_handle f = queue.back();
+      queue.pop_back();
+      if (f->info().nesting != -1) continue;
+      f->info().nesting = nesting;
+      for (int i = 0; i < 3; ++i) {
+        const CapTriangulation::Face_handle next = f->neighbor(i);
+        if (next->info().nesting != -1) continue;
+        if (cdt.is_constrained({f, i}))
+          border.emplace_back(f, i);
+        else
+          queue.push_back(next);
+      }
+    }
+  };
+  flood(cdt.infinite_face(), 0);
+  while (!border.empty()) {
+    const CapTriangulation::Edge e = border.back();
+    border.pop_back();
+    const CapTriangulation::Face_handle next = e.first->neighbor(e.second);
+    if (next->info().nesting == -1) flood(next, e.first->info().nesting + 1);
+  }
+}
 
 // The cap of one cut mesh, from its cut line: the segments exit → entry (indices into the cut mesh
 // `m`) where its triangles cross the plane, in the surface's winding.
 //
-// Endpoints closer than kCapWeld of the mesh's size are merged (a CAD face's edge nodes, evaluated
-// on each of its surfaces, differ by rounding); a segment repeated (a doubled triangle) counts once and
-// a segment with its reverse (a two-sided sheet) cancels. The rest must form closed loops — every
-// point entered as often as left — or the surface is open where the plane cuts it and gets no cap.
-// vtkContourTriangulator fills the loops (outer boundaries and holes by their winding), and the cap
-// is kept only if its area equals the area the loops enclose, to 0.1 %: a failed triangulation is
+// Points at the same position are one; a segment repeated (a doubled triangle) counts once and a
+// segment with its reverse (a two-sided sheet) cancels; a chain that ends within kCapWeld of the
+// mesh's size of where another starts is joined to it (a CAD face's edge nodes, evaluated on each
+// of its surfaces, differ by rounding). The rest must form closed loops — every point entered as
+// often as left — or the surface is open where the plane cuts it and gets no cap.
+// CGAL's constrained Delaunay triangulation fills the loops (inside: an odd number of loops around),
+// keeping every cut point as a vertex, so the cap meets the cut surface edge to edge (watertight).
+// The cap is kept only if its area equals the area the loops enclose, to 0.1 %: a failed fill is
 // dropped, never drawn. Returns whether the loops closed; `cap` gets the triangles (normal
 // `outward`, counter-clockwise seen from that side; vertex colours from the cut when withColors).
 bool buildCap(const Mesh& m, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& cutLine,
               const glm::dvec3& outward, double weldDistance, bool withColors, Mesh& cap) {
-  // Weld: one id per grid cell of size weldDistance, looking at the neighbouring cells too.
-  using Cell = std::tuple<long long, long long, long long>;
-  std::map<Cell, std::vector<vtkIdType>> grid;
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  std::vector<std::uint32_t> source;  // cut-mesh vertex of each welded point
-  std::unordered_map<std::uint32_t, vtkIdType> idOf;
-  const auto weld = [&](std::uint32_t v) {
-    if (const auto it = idOf.find(v); it != idOf.end()) return it->second;
-    const glm::dvec3 p(m.positions[v]);
-    const Cell c{std::llround(p.x / weldDistance), std::llround(p.y / weldDistance), std::llround(p.z / weldDistance)};
-    vtkIdType id = -1;
-    for (long long dx = -1; dx <= 1 && id < 0; ++dx)
-      for (long long dy = -1; dy <= 1 && id < 0; ++dy)
-        for (long long dz = -1; dz <= 1 && id < 0; ++dz) {
-          const auto near = grid.find({std::get<0>(c) + dx, std::get<1>(c) + dy, std::get<2>(c) + dz});
-          if (near == grid.end()) continue;
-          for (const vtkIdType q : near->second)
-            if (glm::distance(p, glm::dvec3(m.positions[source[static_cast<std::size_t>(q)]])) <= weldDistance) {
-              id = q;
-              break;
-            }
-        }
-    if (id < 0) {
-      id = points->InsertNextPoint(p.x, p.y, p.z);
-      source.push_back(v);
-      grid[c].push_back(id);
-    }
-    idOf.emplace(v, id);
-    return id;
+  // Points: cut vertices at the same position are one (a mesh split per face cuts each face's copy
+  // of an edge to the same bits).
+  std::map<std::tuple<float, float, float>, std::size_t> idAt;
+  std::vector<std::uint32_t> source;  // cut-mesh vertex of each point
+  const auto position = [&](std::size_t id) { return glm::dvec3(m.positions[source[id]]); };
+  const auto pointOf = [&](std::uint32_t v) {
+    const glm::vec3& p = m.positions[v];
+    const auto [it, inserted] = idAt.try_emplace({p.x, p.y, p.z}, source.size());
+    if (inserted) source.push_back(v);
+    return it->second;
   };
-  std::map<std::pair<vtkIdType, vtkIdType>, int> segments;  // directed, counted once
-  for (const auto& [a, b] : cutLine) {
-    const vtkIdType i = weld(a), j = weld(b);
-    if (i != j) segments[{i, j}] = 1;
+  std::vector<std::pair<std::size_t, std::size_t>> raw;
+  raw.reserve(cutLine.size());
+  for (const auto& [a, b] : cutLine) raw.emplace_back(pointOf(a), pointOf(b));
+
+  // Segments between distinct points, counted once; a segment and its reverse cancel.
+  std::vector<std::size_t> root(source.size());
+  for (std::size_t i = 0; i < root.size(); ++i) root[i] = i;
+  const auto find = [&](std::size_t i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  };
+  std::map<std::pair<std::size_t, std::size_t>, bool> segments;
+  std::vector<int> balance;
+  const auto collect = [&] {
+    segments.clear();
+    for (const auto& [a, b] : raw)
+      if (const std::size_t i = find(a), j = find(b); i != j) segments[{i, j}] = true;
+    for (auto& [segment, keep] : segments)
+      if (segments.contains({segment.second, segment.first})) keep = false;
+    balance.assign(source.size(), 0);
+    for (const auto& [segment, keep] : segments)
+      if (keep) {
+        ++balance[segment.first];
+        --balance[segment.second];
+      }
+  };
+  collect();
+  // Gaps: where a chain ends (more entered than left) and another starts (more left than entered)
+  // within weldDistance, the two are one point — the nearest pairs first. Points that close
+  // already are never moved, so a fine tessellation keeps every cut point.
+  std::vector<std::tuple<double, std::size_t, std::size_t>> gaps;
+  for (std::size_t e = 0; e < balance.size(); ++e)
+    if (balance[e] < 0)
+      for (std::size_t b = 0; b < balance.size(); ++b)
+        if (balance[b] > 0)
+          if (const double d = glm::distance(position(e), position(b)); d <= weldDistance) gaps.emplace_back(d, e, b);
+  if (!gaps.empty()) {
+    std::sort(gaps.begin(), gaps.end());
+    std::vector<int> open = balance;
+    for (const auto& [d, e, b] : gaps) {
+      if (open[e] >= 0 || open[b] <= 0 || find(e) == find(b)) continue;
+      ++open[e];
+      --open[b];
+      root[find(b)] = find(e);
+    }
+    collect();
   }
-  for (auto& [segment, keep] : segments)  // a segment and its reverse cancel
-    if (const auto back = segments.find({segment.second, segment.first}); back != segments.end()) keep = 0;
-  std::vector<int> balance(static_cast<std::size_t>(points->GetNumberOfPoints()), 0);
-  vtkNew<vtkCellArray> lines;
-  glm::dvec3 centre(0.0);
-  for (const vtkIdType id : std::views::iota(vtkIdType{0}, points->GetNumberOfPoints()))
-    centre += glm::dvec3(m.positions[source[static_cast<std::size_t>(id)]]);
-  centre /= std::max<double>(1.0, static_cast<double>(points->GetNumberOfPoints()));
-  double enclosed = 0.0;  // about `centre`, along -outward (the cut line's own winding)
-  for (const auto& [segment, keep] : segments) {
-    if (!keep) continue;
-    ++balance[static_cast<std::size_t>(segment.first)];
-    --balance[static_cast<std::size_t>(segment.second)];
-    const vtkIdType ids[2] = {segment.first, segment.second};
-    lines->InsertNextCell(2, ids);
-    const glm::dvec3 a = glm::dvec3(m.positions[source[static_cast<std::size_t>(segment.first)]]) - centre;
-    const glm::dvec3 b = glm::dvec3(m.positions[source[static_cast<std::size_t>(segment.second)]]) - centre;
-    enclosed -= 0.5 * glm::dot(glm::cross(a, b), outward);
-  }
-  if (lines->GetNumberOfCells() < 3) return false;
+  std::size_t kept = 0;
+  for (const auto& [segment, keep] : segments) kept += keep ? 1 : 0;
+  if (kept < 3) return false;
   if (std::any_of(balance.begin(), balance.end(), [](int b) { return b != 0; })) return false;
 
-  vtkNew<vtkPolyData> contours;
-  contours->SetPoints(points);
-  contours->SetLines(lines);
-  vtkNew<vtkCellArray> triangles;
-  const double normal[3] = {-outward.x, -outward.y, -outward.z};
-  (void)vtkContourTriangulator::TriangulateContours(contours, 0, lines->GetNumberOfCells(), triangles, normal);
+  // The plane's own 2D frame, about the cut line's centre.
+  glm::dvec3 centre(0.0);
+  for (std::size_t id = 0; id < source.size(); ++id) centre += position(id);
+  centre /= static_cast<double>(source.size());
+  const glm::dvec3 u = glm::normalize(glm::abs(outward.x) < 0.9 ? glm::cross(outward, glm::dvec3(1.0, 0.0, 0.0))
+                                                                : glm::cross(outward, glm::dvec3(0.0, 1.0, 0.0)));
+  const glm::dvec3 v = glm::cross(outward, u);
+  CapTriangulation cdt;
+  std::vector<CapTriangulation::Vertex_handle> handle(source.size());
+  double enclosed = 0.0;  // about `centre`, along -outward (the cut line's own winding)
+  try {
+    for (std::size_t id = 0; id < source.size(); ++id) {
+      if (find(id) != id) continue;  // merged into its root
+      const glm::dvec3 p = position(id) - centre;
+      handle[id] = cdt.insert(CapKernel::Point_2(glm::dot(p, u), glm::dot(p, v)));
+      handle[id]->info() = id;
+    }
+    for (const auto& [segment, keep] : segments) {
+      if (!keep) continue;
+      if (handle[segment.first] == handle[segment.second]) return true;  // two points in one: no cap
+      cdt.insert_constraint(handle[segment.first], handle[segment.second]);
+      enclosed -=
+          0.5 * glm::dot(glm::cross(position(segment.first) - centre, position(segment.second) - centre), outward);
+    }
+  } catch (const CapTriangulation::Intersection_of_constraints_exception&) {
+    return true;  // the cut line crosses itself: closed, but no cap
+  }
+  markNesting(cdt);
+
   Mesh filled;
   double area = 0.0;
-  const vtkIdType* ids = nullptr;
-  vtkIdType count = 0;
-  for (triangles->InitTraversal(); triangles->GetNextCell(count, ids);) {
-    if (count != 3) continue;
+  for (const CapTriangulation::Face_handle f : cdt.finite_face_handles()) {
+    if (f->info().nesting % 2 != 1) continue;
+    std::size_t ids[3];
     glm::dvec3 p[3];
-    for (int k = 0; k < 3; ++k) p[k] = glm::dvec3(m.positions[source[static_cast<std::size_t>(ids[k])]]);
+    for (int k = 0; k < 3; ++k) {
+      ids[k] = f->vertex(k)->info();
+      p[k] = position(ids[k]);
+    }
     const double facing = glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), outward);
     if (facing == 0.0) continue;
     area += 0.5 * std::abs(facing);
@@ -121,7 +198,7 @@ bool buildCap(const Mesh& m, const std::vector<std::pair<std::uint32_t, std::uin
       filled.indices.push_back(static_cast<std::uint32_t>(filled.positions.size()));
       filled.positions.emplace_back(p[k]);
       filled.normals.emplace_back(outward);
-      if (withColors) filled.colors.push_back(m.colors[source[static_cast<std::size_t>(ids[k])]]);
+      if (withColors) filled.colors.push_back(m.colors[source[ids[k]]]);
     }
   }
   if (area > 0.0 && std::abs(area - enclosed) <= 1e-3 * area) cap = std::move(filled);
@@ -139,8 +216,16 @@ glm::dvec4 sectionPlaneEquation(const SectionPlane& plane) {
 SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) {
   SectionedMesh out;
   const glm::dvec3 n(plane);
+  // Signed distances; those within 1e-9 of the mesh's size are on the plane. A part turned by 90°
+  // has vertices at 1e-17 instead of 0 (cos 90° in double), on either side: cutting the edges
+  // between them would put cut points anywhere along edges that lie in the plane.
+  const Bounds box = mesh.bounds();
+  const double onPlane = 1e-9 * glm::length(box.max - box.min) * glm::length(n);
   std::vector<double> s(mesh.positions.size());
-  for (std::size_t i = 0; i < s.size(); ++i) s[i] = glm::dot(n, glm::dvec3(mesh.positions[i])) + plane.w;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    s[i] = glm::dot(n, glm::dvec3(mesh.positions[i])) + plane.w;
+    if (std::abs(s[i]) <= onPlane) s[i] = 0.0;
+  }
   bool anyKept = false, anyRemoved = false;
   for (const std::uint32_t i : mesh.indices) (s[i] >= 0.0 ? anyKept : anyRemoved) = true;
   if (!anyRemoved) return out;
@@ -151,9 +236,9 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
 
   Mesh& m = out.mesh;
   const bool hasNormals = !mesh.normals.empty(), hasColors = !mesh.colors.empty();
-  std::vector<std::uint32_t> keptIndex(mesh.positions.size(), kNone);
+  std::vector<std::uint32_t> keptIndex(mesh.positions.size(), kNoVertex);
   const auto keep = [&](std::uint32_t i) {
-    if (keptIndex[i] == kNone) {
+    if (keptIndex[i] == kNoVertex) {
       keptIndex[i] = static_cast<std::uint32_t>(m.positions.size());
       m.positions.push_back(mesh.positions[i]);
       if (hasNormals) m.normals.push_back(mesh.normals[i]);
@@ -187,7 +272,7 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
     // The kept part, in the triangle's winding: 3 or 4 corners (one cut edge pair).
     std::uint32_t polygon[4];
     int corners = 0;
-    std::uint32_t exit = kNone, entry = kNone;  // where the winding leaves and re-enters the kept side
+    std::uint32_t exit = kNoVertex, entry = kNoVertex;  // where the winding leaves and re-enters the kept side
     for (int k = 0; k < 3; ++k) {
       const int next = (k + 1) % 3;
       if (kept[k]) polygon[corners++] = keep(v[k]);
@@ -196,7 +281,7 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
         (kept[k] ? exit : entry) = polygon[corners++];
       }
     }
-    if (exit != kNone && entry != kNone && exit != entry) cutLine.emplace_back(exit, entry);
+    if (exit != kNoVertex && entry != kNoVertex && exit != entry) cutLine.emplace_back(exit, entry);
     for (int k = 1; k + 1 < corners; ++k) {
       if (polygon[0] == polygon[k] || polygon[k] == polygon[k + 1] || polygon[0] == polygon[k + 1]) continue;
       m.indices.insert(m.indices.end(), {polygon[0], polygon[k], polygon[k + 1]});
@@ -204,7 +289,6 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
   }
   out.outcome = SectionOutcome::kCut;
   if (caps && !m.indices.empty()) {
-    const Bounds box = mesh.bounds();
     const double weldDistance = std::max(kCapWeld * glm::length(box.max - box.min), 1e-30);
     Mesh cap;
     out.closed = buildCap(m, cutLine, -glm::normalize(n), weldDistance, hasColors, cap);

@@ -2,7 +2,7 @@
 // Section views: a scene cut by its section plane (Scene::section), as geometry. Surfaces are
 // clipped triangle by triangle (winding, normals and colours kept, cut edges shared between the
 // triangles that share an edge); the cross-section of every closed surface is triangulated by VTK's
-// vtkContourTriangulator into a cap with the plane's normal, so a cut solid stays a closed, outward
+// CGAL's constrained Delaunay triangulation into a cap with the plane's normal, so a cut solid stays a closed, outward
 // oriented solid (CSG and the solid-aware operations still see solids).
 #include <cstddef>
 #include <string>
@@ -31,9 +31,9 @@ struct SectionedMesh {
 };
 
 // Cuts `mesh` by the plane dot(plane.xyz, p) + plane.w >= 0 (kept side, object space). With `caps`,
-// the cut line — the segments where triangles cross the plane, endpoints within 1e-4 of the
-// bounding box's diagonal merged, repeats counted once, a segment and its reverse cancelled — must
-// form closed loops (the surface is closed where the plane cuts it; holes elsewhere do not matter);
+// the cut line — the segments where triangles cross the plane, repeats counted once, a segment and
+// its reverse cancelled, chains ending within 1e-4 of the bounding box's diagonal of another's start
+// joined — must form closed loops (the surface is closed where the plane cuts it; holes elsewhere do not matter);
 // the loops are filled, and the cap is kept only if its area equals the area they enclose (0.1 %):
 // a failed triangulation is dropped, never drawn. Caps get the normal -plane.xyz (outward) and, when
 // the mesh has vertex colours, the colours of the cut.
