@@ -63,6 +63,22 @@ TEST_F(CliSection, SceneFileSectionNoneAndOpenParts) {
       << r.out;
 }
 
+// The CSG sample cut obliquely: the cut solids stay closed, so CSG runs on them, on the GPU as in
+// the oracle, and the cut shows.
+TEST_F(CliSection, CsgRunsOnCutSolids) {
+  const fs::path oracle = dir() / "o.png", gpu = dir() / "g.png", whole = dir() / "w.png";
+  const std::string common = "render @csg --op csg --size 64x48 --view iso ";
+  const std::string plane = "--section 0,0,0,0.3,-1,0.6 ";
+  const CliResult r = runCli(common + plane + "-m abuffer-ll -o " + gpu.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;  // every part capped
+  ASSERT_EQ(runCli(common + plane + "-o " + oracle.string()).exitCode, 0);
+  ASSERT_EQ(runCli(common + "-m abuffer-ll -o " + whole.string()).exitCode, 0);
+  const mfr::ImageRGBA8 o = mfr::readPng(oracle), g = mfr::readPng(gpu), w = mfr::readPng(whole);
+  EXPECT_LT(mfr::rmse(o, g), 0.03);
+  EXPECT_GT(mfr::rmse(w, g), 0.05);
+}
+
 TEST_F(CliSection, BadPlanesAreRefused) {
   expectCleanFailure("render @sample --size 16x16 --section 1,2,3",
                      "--section 1,2,3: expected AXIS=VALUE or six numbers");
