@@ -11,8 +11,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "mfr/error.hpp"
-#include "mfr/scene/section.hpp"
 #include "viewer_model.hpp"
 
 ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), model_(model) {
@@ -207,10 +205,12 @@ void ClipPanel::showModel() {
     sectionOffset_->setValue(
         hi > lo ? std::clamp(static_cast<int>(std::lround((at - lo) / (hi - lo) * kSteps)), 0, kSteps) : kSteps / 2);
     sectionValue_->setText(QStringLiteral("%1").arg(at, 0, 'g', 5));
-    // The same cut the renderers make (a few milliseconds for 10⁵ triangles).
-    try {
-      mfr::SectionReport report;
-      (void)mfr::sectionedScene(model_.scene(), &report);
+    // The cut the renderers draw (made once per edit by the model).
+    if (!model_.sectionError().isEmpty()) {
+      sectionReport_->setText(model_.sectionError());
+      sectionReport_->setToolTip({});
+    } else {
+      const mfr::SectionReport& report = model_.sectionReport();
       QString text = (report.cut == 1 ? tr("1 part cut") : tr("%1 parts cut").arg(report.cut));
       QString names;
       if (section->caps) {
@@ -222,9 +222,6 @@ void ClipPanel::showModel() {
       }
       sectionReport_->setText(text);
       sectionReport_->setToolTip(names.trimmed());
-    } catch (const mfr::Error& e) {
-      sectionReport_->setText(QString::fromUtf8(e.what()));
-      sectionReport_->setToolTip({});
     }
   } else {
     sectionValue_->setText(QStringLiteral("—"));

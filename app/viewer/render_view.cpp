@@ -167,7 +167,7 @@ bool RenderView::uploadSceneIfChanged(int side, QStringList& errors) {
     uploadedRevision_[i] = model_.sceneRevision();
     uploadError_[i].clear();
     try {
-      r.setScene(model_.scene());
+      r.setScene(model_.drawnScene());
     } catch (const std::exception& e) {
       uploadError_[i] = QString::fromUtf8(e.what());  // e.g. every object hidden
       mfr::gl::discardErrors();
@@ -630,7 +630,7 @@ RenderView::CurrentContext RenderView::currentWithScene(int side) {
 mfr::ImageRGBA8 RenderView::renderImage(QSize size) {
   if (!model_.hasScene()) throw mfr::Error("export", "no scene loaded");
   const mfr::RenderRequest request = model_.renderRequest(0, size);
-  if (model_.isCpuMethod(model_.method())) return mfr::render(model_.scene(), model_.camera(), request).image;
+  if (model_.isCpuMethod(model_.method())) return mfr::render(model_.drawnScene(), model_.camera(), request).image;
   const CurrentContext current = currentWithScene(0);
   try {
     return renderer(0).render(model_.camera(), request).image;
@@ -656,7 +656,8 @@ ViewProbe RenderView::probeAt(QPoint point) {
   result.paneSize = pane.size();
   result.method = model_.methodOf(result.side);
   const QPoint pixel = device - pane.topLeft();
-  result.probe = mfr::probePixel(model_.scene(), model_.camera(), pane.width(), pane.height(), pixel.x(), pixel.y());
+  result.probe =
+      mfr::probePixel(model_.drawnScene(), model_.camera(), pane.width(), pane.height(), pixel.x(), pixel.y());
   const bool showsImage = model_.dataView() == DataView::Image &&
                           (!model_.compareEnabled() || model_.compareDisplay() == CompareDisplay::Images);
   if (showsImage && renderers_[0]) {

@@ -529,6 +529,7 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
   hasScene_ = true;
   ++sceneRevision_;
   updateSceneGeometry();
+  updateDrawnScene();
   // The z-thickness is a length in the old scene's units: the new one starts at its own default.
   if (thickness_ != 0.0) {
     thickness_ = 0.0;
@@ -557,7 +558,20 @@ void ViewerModel::updateSceneGeometry() {
 
 void ViewerModel::sceneEdited() {
   ++sceneRevision_;
+  updateDrawnScene();
   emit sceneChanged();
+}
+
+void ViewerModel::updateDrawnScene() {
+  drawn_ = {};
+  sectionReport_ = {};
+  sectionError_.clear();
+  if (!scene_.section) return;
+  try {
+    drawn_ = mfr::sectionedScene(scene_, &sectionReport_);
+  } catch (const std::exception& e) {
+    sectionError_ = QString::fromUtf8(e.what());
+  }
 }
 
 QStringList ViewerModel::objectNames() const {
@@ -762,7 +776,7 @@ void ViewerModel::startCpuJob() {
   cpuRunning_ = true;
   runInBackground<std::shared_ptr<const CpuImage>>(
       this,
-      [scene = scene_, camera = camera_, wish = *next]() -> std::shared_ptr<const CpuImage> {
+      [scene = drawnScene(), camera = camera_, wish = *next]() -> std::shared_ptr<const CpuImage> {
         auto result = std::make_shared<CpuImage>();
         result->key = wish.key;
         try {

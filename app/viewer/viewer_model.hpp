@@ -19,6 +19,7 @@
 #include <optional>
 #include <string>
 
+#include "mfr/scene/section.hpp"
 #include "mfr/image.hpp"
 #include "mfr/reference/metrics.hpp"
 #include "mfr/render.hpp"
@@ -184,6 +185,14 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] bool lastCancelStoppedLoader() const { return lastCancelStoppedLoader_; }
   void setScene(mfr::Scene scene, const QString& path);
   [[nodiscard]] const mfr::Scene& scene() const { return scene_; }
+  // What the renderers draw: scene() cut by its section plane (mfr::sectionedScene, made once per
+  // scene edit, not by each renderer), or scene() itself without one. When the cut fails (it leaves
+  // nothing visible) this is scene() uncut and sectionError() says why; renderers then report it.
+  [[nodiscard]] const mfr::Scene& drawnScene() const {
+    return scene_.section && sectionError_.isEmpty() ? drawn_ : scene_;
+  }
+  [[nodiscard]] const mfr::SectionReport& sectionReport() const { return sectionReport_; }
+  [[nodiscard]] const QString& sectionError() const { return sectionError_; }
   [[nodiscard]] const QString& scenePath() const { return scenePath_; }
   [[nodiscard]] quint64 sceneRevision() const { return sceneRevision_; }
   void setObjectVisible(int index, bool visible);
@@ -280,6 +289,7 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] bool metricsWanted(int side) const;
   void sceneEdited();
   void updateSceneGeometry();
+  void updateDrawnScene();  // drawn_ and the section report from scene_
   void startCpuJob();
   void updateMetrics();
   void startMetrics(int side, const mfr::ImageRGBA8& reference);
@@ -287,6 +297,9 @@ class ViewerModel final : public ViewerContext {
   void volumeEdited();
 
   mfr::Scene scene_;
+  mfr::Scene drawn_;  // scene_ cut by its section (drawnScene())
+  mfr::SectionReport sectionReport_;
+  QString sectionError_;
   std::vector<mfr::Material> loadedMaterials_;  // of scene_'s objects as loaded, for resetObjectColor
   bool hasScene_ = false;
   QString scenePath_;

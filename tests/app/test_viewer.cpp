@@ -2499,6 +2499,17 @@ class ViewerTest : public QObject {
     const int diff = maxChannelDifference(mfr::readPng(cliPng.toStdString()), cut);
     qInfo("section %s: viewer vs mfr render max channel difference %d", qPrintable(planeText), diff);
     QCOMPARE(diff, 0);
+    // The exact reference (a CPU image from the model's cut scene) too.
+    const QString oraclePng = dir.filePath("oracle.png");
+    QCOMPARE(
+        runProgram(MFR_CLI,
+                   {"render", "@sample", "--size", "200x150", "--view", "iso", "--section", planeText, "-o", oraclePng},
+                   &out),
+        0);
+    m.setMethod("oracle");
+    settle(m);
+    QCOMPARE(maxChannelDifference(mfr::readPng(oraclePng.toStdString()), w->view().renderImage(QSize(200, 150))), 0);
+    m.setMethod("abuffer-ll");
 
     // Sessions keep the plane; a file's own oblique normal shows as "Custom".
     const QString sessionPath = dir.filePath("section.mfrsession");
