@@ -18,6 +18,22 @@ inline int rgbDifference(const ImageRGBA8& a, const ImageRGBA8& b, int x, int y)
   return diff;
 }
 
+// The largest rgbDifference over the whole image.
+inline int maxRgbDifference(const ImageRGBA8& a, const ImageRGBA8& b) {
+  int diff = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) diff = std::max(diff, rgbDifference(a, b, x, y));
+  return diff;
+}
+
+// How many pixels differ by more than `threshold` in some RGB channel (an edit is not a no-op).
+inline std::size_t pixelsDifferingBy(const ImageRGBA8& a, const ImageRGBA8& b, int threshold) {
+  std::size_t n = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) n += rgbDifference(a, b, x, y) > threshold ? 1 : 0;
+  return n;
+}
+
 struct OffEdgeComparison {
   std::size_t compared = 0;  // pixels off the edges
   std::size_t within = 0;    // of those, within the tolerance
