@@ -25,9 +25,10 @@ Frame frameOf(const mfr::Camera& c) {
   return f;
 }
 
-// World units per pixel on the plane through the target, perpendicular to the view direction.
+// World units per pixel on the plane through the target, perpendicular to the view direction (the
+// field of view spans the view's shorter side, mfr::Camera).
 double worldPerPixel(const mfr::Camera& c, const Frame& f, QSize view) {
-  const double height = std::max(1, view.height());
+  const double height = std::max(1, std::min(view.width(), view.height()));
   if (c.projection == mfr::Projection::Orthographic) return c.orthoHeight / height;
   return 2.0 * f.distance * std::tan(glm::radians(c.fovyDegrees) * 0.5) / height;
 }

@@ -194,6 +194,46 @@ TEST(CompositeOver, HandBuiltListsAndBackground) {
   EXPECT_FLOAT_EQ(red.b, 0.0f);
 }
 
+// The field of view spans the image's shorter side: landscape and square images keep glm's
+// vertical field of view exactly; a portrait image of a fitted view still holds the whole bounding
+// sphere (every point of it projects inside the image), where a vertical field of view would cut
+// its sides off; orthographic alike.
+TEST(CameraProjection, FieldOfViewSpansTheShorterSide) {
+  Camera c;
+  c.eye = {1.0, 2.0, 6.0};
+  c.fovyDegrees = 40.0;
+  for (const double aspect : {1.0, 1.5}) {
+    const glm::dmat4 want = glm::perspective(glm::radians(40.0), aspect, c.nearPlane, c.farPlane);
+    const glm::dmat4 got = c.projectionMatrix(aspect);
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j) EXPECT_DOUBLE_EQ(got[i][j], want[i][j]);
+  }
+  Bounds b;
+  b.extend(glm::dvec3(-3.0, -0.4, -0.5));
+  b.extend(glm::dvec3(3.0, 0.4, 0.5));  // long in x, like an engine
+  for (const Projection projection : {Projection::Perspective, Projection::Orthographic}) {
+    Camera base;
+    base.projection = projection;
+    const Camera fitted = base.fittedTo(b);
+    const double r = b.radius();
+    for (const double aspect : {1.0, 0.5, 0.25}) {
+      SCOPED_TRACE(aspect);
+      const glm::dmat4 m = fitted.projectionMatrix(aspect) * fitted.viewMatrix();
+      double reach = 0.0;  // the largest |NDC x| or |NDC y| over the sphere's outline points
+      for (int i = 0; i < 64; ++i) {
+        const double t = 2.0 * 3.14159265358979 * i / 64;
+        for (const glm::dvec3 d :
+             {glm::dvec3(std::cos(t), std::sin(t), 0.0), glm::dvec3(std::cos(t), 0.0, std::sin(t))}) {
+          const glm::dvec4 p = m * glm::dvec4(b.center() + r * d, 1.0);
+          reach = std::max({reach, std::abs(p.x / p.w), std::abs(p.y / p.w)});
+        }
+      }
+      EXPECT_LT(reach, 1.0);
+      EXPECT_GT(reach, 0.8);  // and the sphere still fills the shorter side
+    }
+  }
+}
+
 TEST(OracleDepth, PerspectivePlanesGiveProjectionFormulaDepth) {
   // Planes perpendicular to the view at eye distances 10 and 13, large enough to fill the view
   // (half-width 10·tan 20°·1.5 = 5.5 and 7.1).

@@ -10,12 +10,16 @@ namespace mfr {
 glm::dmat4 Camera::viewMatrix() const { return glm::lookAt(eye, target, up); }
 
 glm::dmat4 Camera::projectionMatrix(double aspect) const {
+  // The field of view (orthoHeight) spans the image's shorter side: a portrait image shows as much
+  // across as a landscape one shows top to bottom, so what fits one fits the other.
+  const double shorter = std::min(aspect, 1.0);
   if (projection == Projection::Orthographic) {
-    const double h = 0.5 * orthoHeight;
+    const double h = 0.5 * orthoHeight / shorter;
     const double w = h * aspect;
     return glm::ortho(-w, w, -h, h, nearPlane, farPlane);
   }
-  return glm::perspective(glm::radians(fovyDegrees), aspect, nearPlane, farPlane);
+  const double fovy = 2.0 * std::atan(std::tan(0.5 * glm::radians(fovyDegrees)) / shorter);
+  return glm::perspective(fovy, aspect, nearPlane, farPlane);
 }
 
 glm::dvec4 Camera::depthToEye() const {

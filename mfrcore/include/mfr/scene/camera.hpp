@@ -15,8 +15,10 @@ struct Camera {
   glm::dvec3 target{0.0};
   glm::dvec3 up{0.0, 1.0, 0.0};
   Projection projection = Projection::Perspective;
+  // Both span the image's shorter side (its height when it is landscape or square, its width when
+  // it is portrait), so the fit-all view frames the scene whatever the image's shape.
   double fovyDegrees = 40.0;   // perspective
-  double orthoHeight = 2.0;    // orthographic: world height of the view
+  double orthoHeight = 2.0;    // orthographic: world extent of the view
   double nearPlane = 0.1;
   double farPlane = 100.0;
 
