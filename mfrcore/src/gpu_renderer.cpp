@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <optional>
 
 #include "common/bindings.h"
 #include "mfr/error.hpp"
@@ -66,8 +67,11 @@ GpuRenderer::GpuRenderer(bool finishTiming) : finishTiming_(finishTiming) {}
 
 void GpuRenderer::setScene(const Scene& original) {
   original.validate();
-  // A section plane is applied as geometry (cut surfaces, caps); the volume keeps the plane.
-  const Scene scene = sectionedScene(original);
+  // A section plane is applied as geometry (cut surfaces, caps); the volume keeps the plane. Without
+  // one (or already cut) the scene is used as it is, not copied.
+  std::optional<Scene> cut;
+  if (original.section && !original.sectionCut) cut = sectionedScene(original);
+  const Scene& scene = cut ? *cut : original;
   scene_ = std::make_shared<const gl::GpuScene>(scene);
   background_ = scene.background;
   csg_ = scene.csg;
