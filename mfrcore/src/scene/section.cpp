@@ -20,13 +20,14 @@ namespace mfr {
 namespace {
 
 constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
-constexpr std::size_t kNoPoint = std::numeric_limits<std::size_t>::max();
 // A chain of the cut line that ends this close (a fraction of the mesh's bounding-box diagonal) to
 // where another starts is joined to it. Measured on the 2CylinderEngine's parts (glTF, split per
-// face): their cut lines have gaps of 1e-6 to 7e-5 of the diagonal; at 1e-4, 19 of the 24 parts
-// cut by z = 0 close (13 at 1e-6), all 7 cut by x = 0 (5) and 38 of the 51 cut by y = 0 (36);
-// 1e-3 adds only 2 of those 51.
-constexpr double kCapWeld = 1e-4;
+// face): their cut lines have gaps of 1e-6 to 7e-5 of the diagonal, and its two rods are split in
+// two primitives with gaps of 2.6e-4 between them. Parts capped at 1e-6 / 1e-4 / 1e-3, with solids
+// split over parts capped jointly (capJointly): z = 0 13 / 23 / 23 of 24, x = 0 5 / 7 / 7 of 7,
+// y = 0 36 / 42 / 48 of 51 (each alone: 19 of 24, 7 of 7, 38 of 51 at 1e-4). Only open ends are
+// joined, never points that close already, and the cap's area check stays the last word.
+constexpr double kCapWeld = 1e-3;
 
 // Faces of the cap's triangulation: how many constrained edges (cut-line segments) separate them
 // from the outside; odd is inside the section.
@@ -73,114 +74,119 @@ void markNesting(CapTriangulation& cdt) {
   }
 }
 
-// The cap of one cut mesh, from its cut line: the segments exit → entry (indices into the cut mesh
-// `m`) where its triangles cross the plane, in the surface's winding.
+// A cut line welded into loops: the segments exit → entry (vertex indices into `positions`) where
+// a surface's triangles cross the plane, in the surface's winding.
 //
 // Points at the same position are one; a segment repeated (a doubled triangle) counts once and a
-// segment with its reverse (a two-sided sheet) cancels; a chain that ends within kCapWeld of the
-// mesh's size of where another starts is joined to it (a CAD face's edge nodes, evaluated on each
-// of its surfaces, differ by rounding). The rest must form closed loops — every point entered as
-// often as left — or the surface is open where the plane cuts it and gets no cap.
-// CGAL's constrained Delaunay triangulation fills the loops (inside: an odd number of loops around),
-// keeping every cut point as a vertex, so the cap meets the cut surface edge to edge (watertight).
-// The cap is kept only if its area equals the area the loops enclose, to 0.1 %: a failed fill is
-// dropped, never drawn. Returns whether the loops closed; `cap` gets the triangles (normal
-// `outward`, counter-clockwise seen from that side; vertex colours from the cut when withColors).
-bool buildCap(const Mesh& m, const std::vector<std::pair<std::uint32_t, std::uint32_t>>& cutLine,
-              const glm::dvec3& outward, double weldDistance, bool withColors, Mesh& cap) {
-  // Points: cut vertices at the same position are one (a mesh split per face cuts each face's copy
-  // of an edge to the same bits).
+// segment with its reverse (a two-sided sheet) cancels; a chain that ends within `weldDistance` of
+// where another starts is joined to it (a CAD face's edge nodes, evaluated on each of its surfaces,
+// differ by rounding), the nearest pairs first. Points that close already are never moved, so a
+// fine tessellation keeps every cut point.
+struct WeldedCutLine {
+  std::vector<std::uint32_t> source;                          // the vertex of each point
+  std::vector<std::size_t> root;                              // union-find over points: a joined point's representative
+  std::vector<std::pair<std::size_t, std::size_t>> segments;  // between representatives, kept ones
+  std::vector<int> balance;  // per point: segments leaving minus entering; all 0 when the loops close
+
+  std::size_t find(std::size_t i) {
+    while (root[i] != i) i = root[i] = root[root[i]];
+    return i;
+  }
+  bool closed() const {
+    return segments.size() >= 3 && std::all_of(balance.begin(), balance.end(), [](int b) { return b == 0; });
+  }
+};
+
+WeldedCutLine weldCutLine(const std::vector<glm::vec3>& positions,
+                          const std::vector<std::pair<std::uint32_t, std::uint32_t>>& cutLine, double weldDistance) {
+  WeldedCutLine w;
   std::map<std::tuple<float, float, float>, std::size_t> idAt;
-  std::vector<std::uint32_t> source;  // cut-mesh vertex of each point
-  const auto position = [&](std::size_t id) { return glm::dvec3(m.positions[source[id]]); };
   const auto pointOf = [&](std::uint32_t v) {
-    const glm::vec3& p = m.positions[v];
-    const auto [it, inserted] = idAt.try_emplace({p.x, p.y, p.z}, source.size());
-    if (inserted) source.push_back(v);
+    const glm::vec3& p = positions[v];
+    const auto [it, inserted] = idAt.try_emplace({p.x, p.y, p.z}, w.source.size());
+    if (inserted) w.source.push_back(v);
     return it->second;
   };
   std::vector<std::pair<std::size_t, std::size_t>> raw;
   raw.reserve(cutLine.size());
   for (const auto& [a, b] : cutLine) raw.emplace_back(pointOf(a), pointOf(b));
+  const auto position = [&](std::size_t id) { return glm::dvec3(positions[w.source[id]]); };
 
-  // Segments between distinct points, counted once; a segment and its reverse cancel.
-  std::vector<std::size_t> root(source.size());
-  for (std::size_t i = 0; i < root.size(); ++i) root[i] = i;
-  const auto find = [&](std::size_t i) {
-    while (root[i] != i) i = root[i] = root[root[i]];
-    return i;
-  };
-  std::map<std::pair<std::size_t, std::size_t>, bool> segments;
-  std::vector<int> balance;
+  w.root.resize(w.source.size());
+  for (std::size_t i = 0; i < w.root.size(); ++i) w.root[i] = i;
   const auto collect = [&] {
-    segments.clear();
+    std::map<std::pair<std::size_t, std::size_t>, bool> segments;
     for (const auto& [a, b] : raw)
-      if (const std::size_t i = find(a), j = find(b); i != j) segments[{i, j}] = true;
+      if (const std::size_t i = w.find(a), j = w.find(b); i != j) segments[{i, j}] = true;
     for (auto& [segment, keep] : segments)
       if (segments.contains({segment.second, segment.first})) keep = false;
-    balance.assign(source.size(), 0);
+    w.segments.clear();
+    w.balance.assign(w.source.size(), 0);
     for (const auto& [segment, keep] : segments)
       if (keep) {
-        ++balance[segment.first];
-        --balance[segment.second];
+        w.segments.push_back(segment);
+        ++w.balance[segment.first];
+        --w.balance[segment.second];
       }
   };
   collect();
-  // Gaps: where a chain ends (more entered than left) and another starts (more left than entered)
-  // within weldDistance, the two are one point — the nearest pairs first. Points that close
-  // already are never moved, so a fine tessellation keeps every cut point.
   std::vector<std::tuple<double, std::size_t, std::size_t>> gaps;
-  for (std::size_t e = 0; e < balance.size(); ++e)
-    if (balance[e] < 0)
-      for (std::size_t b = 0; b < balance.size(); ++b)
-        if (balance[b] > 0)
+  for (std::size_t e = 0; e < w.balance.size(); ++e)
+    if (w.balance[e] < 0)
+      for (std::size_t b = 0; b < w.balance.size(); ++b)
+        if (w.balance[b] > 0)
           if (const double d = glm::distance(position(e), position(b)); d <= weldDistance) gaps.emplace_back(d, e, b);
   if (!gaps.empty()) {
     std::sort(gaps.begin(), gaps.end());
-    std::vector<int> open = balance;
+    std::vector<int> open = w.balance;
     for (const auto& [d, e, b] : gaps) {
-      if (open[e] >= 0 || open[b] <= 0 || find(e) == find(b)) continue;
+      if (open[e] >= 0 || open[b] <= 0 || w.find(e) == w.find(b)) continue;
       ++open[e];
       --open[b];
-      root[find(b)] = find(e);
+      w.root[w.find(b)] = w.find(e);
     }
     collect();
   }
-  std::size_t kept = 0;
-  for (const auto& [segment, keep] : segments) kept += keep ? 1 : 0;
-  if (kept < 3) return false;
-  if (std::any_of(balance.begin(), balance.end(), [](int b) { return b != 0; })) return false;
+  return w;
+}
 
+// The cap of a closed cut line: CGAL's constrained Delaunay triangulation fills the loops (inside:
+// an odd number of loops around), keeping every cut point as a vertex, so the cap meets the cut
+// surface edge to edge (watertight). The cap is kept only if its area equals the area the loops
+// enclose, to 0.1 %: a failed fill is dropped, never drawn. `corners` gets the cap's triangles as
+// vertex indices into `positions`, counter-clockwise seen from `outward`; empty when there is no cap.
+void fillCap(const std::vector<glm::vec3>& positions, const WeldedCutLine& line, const glm::dvec3& outward,
+             std::vector<std::uint32_t>& corners) {
+  corners.clear();
+  const auto position = [&](std::size_t id) { return glm::dvec3(positions[line.source[id]]); };
   // The plane's own 2D frame, about the cut line's centre.
   glm::dvec3 centre(0.0);
-  for (std::size_t id = 0; id < source.size(); ++id) centre += position(id);
-  centre /= static_cast<double>(source.size());
+  for (std::size_t id = 0; id < line.source.size(); ++id) centre += position(id);
+  centre /= static_cast<double>(line.source.size());
   const glm::dvec3 u = glm::normalize(glm::abs(outward.x) < 0.9 ? glm::cross(outward, glm::dvec3(1.0, 0.0, 0.0))
                                                                 : glm::cross(outward, glm::dvec3(0.0, 1.0, 0.0)));
   const glm::dvec3 v = glm::cross(outward, u);
   CapTriangulation cdt;
-  std::vector<CapTriangulation::Vertex_handle> handle(source.size());
+  std::vector<CapTriangulation::Vertex_handle> handle(line.source.size());
   double enclosed = 0.0;  // about `centre`, along -outward (the cut line's own winding)
   try {
-    for (std::size_t id = 0; id < source.size(); ++id) {
-      if (find(id) != id) continue;  // merged into its root
+    for (std::size_t id = 0; id < line.source.size(); ++id) {
+      if (line.root[id] != id) continue;  // joined to its representative
       const glm::dvec3 p = position(id) - centre;
       handle[id] = cdt.insert(CapKernel::Point_2(glm::dot(p, u), glm::dot(p, v)));
       handle[id]->info() = id;
     }
-    for (const auto& [segment, keep] : segments) {
-      if (!keep) continue;
-      if (handle[segment.first] == handle[segment.second]) return true;  // two points in one: no cap
-      cdt.insert_constraint(handle[segment.first], handle[segment.second]);
-      enclosed -=
-          0.5 * glm::dot(glm::cross(position(segment.first) - centre, position(segment.second) - centre), outward);
+    for (const auto& [a, b] : line.segments) {
+      if (handle[a] == handle[b]) return;  // two points in one: no cap
+      cdt.insert_constraint(handle[a], handle[b]);
+      enclosed -= 0.5 * glm::dot(glm::cross(position(a) - centre, position(b) - centre), outward);
     }
   } catch (const CapTriangulation::Intersection_of_constraints_exception&) {
-    return true;  // the cut line crosses itself: closed, but no cap
+    return;  // the cut line crosses itself: closed, but no cap
   }
   markNesting(cdt);
 
-  Mesh filled;
+  std::vector<std::uint32_t> filled;
   double area = 0.0;
   for (const CapTriangulation::Face_handle f : cdt.finite_face_handles()) {
     if (f->info().nesting % 2 != 1) continue;
@@ -194,15 +200,9 @@ bool buildCap(const Mesh& m, const std::vector<std::pair<std::uint32_t, std::uin
     if (facing == 0.0) continue;
     area += 0.5 * std::abs(facing);
     const int order[3] = {0, facing > 0.0 ? 1 : 2, facing > 0.0 ? 2 : 1};
-    for (const int k : order) {
-      filled.indices.push_back(static_cast<std::uint32_t>(filled.positions.size()));
-      filled.positions.emplace_back(p[k]);
-      filled.normals.emplace_back(outward);
-      if (withColors) filled.colors.push_back(m.colors[source[ids[k]]]);
-    }
+    for (const int k : order) filled.push_back(line.source[ids[k]]);
   }
-  if (area > 0.0 && std::abs(area - enclosed) <= 1e-3 * area) cap = std::move(filled);
-  return true;
+  if (area > 0.0 && std::abs(area - enclosed) <= 1e-3 * area) corners = std::move(filled);
 }
 
 }  // namespace
@@ -220,18 +220,37 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
   // has vertices at 1e-17 instead of 0 (cos 90° in double), on either side: cutting the edges
   // between them would put cut points anywhere along edges that lie in the plane.
   const Bounds box = mesh.bounds();
-  const double onPlane = 1e-9 * glm::length(box.max - box.min) * glm::length(n);
+  const double size = glm::length(box.max - box.min) * glm::length(n);
+  const double onPlane = 1e-9 * size;
   std::vector<double> s(mesh.positions.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    s[i] = glm::dot(n, glm::dvec3(mesh.positions[i])) + plane.w;
-    if (std::abs(s[i]) <= onPlane) s[i] = 0.0;
+  for (std::size_t i = 0; i < s.size(); ++i) s[i] = glm::dot(n, glm::dvec3(mesh.positions[i])) + plane.w;
+  bool anyKept = false, anyRemoved = false, anyOn = false;
+  for (const std::uint32_t i : mesh.indices) {
+    anyKept = anyKept || s[i] > onPlane;
+    anyRemoved = anyRemoved || s[i] < -onPlane;
+    anyOn = anyOn || std::abs(s[i]) <= onPlane;
   }
-  bool anyKept = false, anyRemoved = false;
-  for (const std::uint32_t i : mesh.indices) (s[i] >= 0.0 ? anyKept : anyRemoved) = true;
+  // Touching the plane from one side is not being cut; a sheet lying in it is kept.
   if (!anyRemoved) return out;
   if (!anyKept) {
     out.outcome = SectionOutcome::kRemoved;
     return out;
+  }
+  // A part cut through with vertices on the plane — a face or an edge lying in it, common in CAD
+  // parts cut at a round coordinate — is cut a millionth of its size further in instead, where no
+  // vertex is: every cut edge then crosses the plane, and the cut line is made of crossings only.
+  // (Edges lying in the plane would have to be matched against the faces beside them to close the
+  // cut line.) If every tried offset meets a vertex, the vertices on the plane count as kept.
+  double shift = 0.0;
+  if (anyOn)
+    for (double tryShift = 1e-6 * size; tryShift < 1e-5 * size && shift == 0.0; tryShift *= 1.37) {
+      bool clear = true;
+      for (const std::uint32_t i : mesh.indices) clear = clear && std::abs(s[i] - tryShift) > onPlane;
+      if (clear) shift = tryShift;
+    }
+  for (double& d : s) {
+    d -= shift;
+    if (std::abs(d) <= onPlane) d = 0.0;
   }
 
   Mesh& m = out.mesh;
@@ -290,21 +309,145 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
   out.outcome = SectionOutcome::kCut;
   if (caps && !m.indices.empty()) {
     const double weldDistance = std::max(kCapWeld * glm::length(box.max - box.min), 1e-30);
-    Mesh cap;
-    out.closed = buildCap(m, cutLine, -glm::normalize(n), weldDistance, hasColors, cap);
-    if (!cap.indices.empty()) {
-      out.capTriangles = cap.triangleCount();
-      const auto base = static_cast<std::uint32_t>(m.positions.size());
-      m.positions.insert(m.positions.end(), cap.positions.begin(), cap.positions.end());
-      if (hasNormals) m.normals.insert(m.normals.end(), cap.normals.begin(), cap.normals.end());
-      if (hasColors) m.colors.insert(m.colors.end(), cap.colors.begin(), cap.colors.end());
-      for (const std::uint32_t i : cap.indices) m.indices.push_back(base + i);
+    WeldedCutLine line = weldCutLine(m.positions, cutLine, weldDistance);
+    out.closed = line.closed();
+    std::vector<std::uint32_t> corners;
+    if (out.closed) fillCap(m.positions, line, -glm::normalize(n), corners);
+    if (!corners.empty()) {
+      out.capTriangles = corners.size() / 3;
+      const glm::vec3 outward(-glm::normalize(n));
+      for (const std::uint32_t c : corners) {
+        const glm::vec3 position = m.positions[c];
+        m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
+        m.positions.push_back(position);
+        if (hasNormals) m.normals.push_back(outward);
+        if (hasColors) {
+          const glm::vec4 colour = m.colors[c];
+          m.colors.push_back(colour);
+        }
+      }
       out.outcome = SectionOutcome::kCapped;
+    } else {
+      out.cutLine = std::move(cutLine);
     }
   }
   if (!hasNormals) m.computeSmoothNormals();
   return out;
 }
+
+namespace {
+
+// A part cut without a cap though caps were asked for, waiting for capJointly.
+struct OpenCut {
+  std::size_t object = 0;
+  SectionedMesh cut;
+  std::vector<glm::dvec3> world;  // the cut mesh's vertices in world space
+  double diagonal = 0.0;          // of their bounding box
+  bool mirrored = false;          // the transform turns its winding inside out
+};
+
+// Caps solids that are split over several parts: a glTF mesh with one primitive per material, or
+// a CAD body exported face by face, is open part by part but closed as a whole. Parts whose cut
+// lines end where another's start (within kCapWeld of the larger part's size) are grouped; a group
+// whose joint cut line closes gets one cap, on the part with the most of that line (its colour;
+// vertex colours from each part's cut, white where a part has none, so the owner's material shows).
+// Returns, per entry of `open`, whether it was capped jointly.
+std::vector<bool> capJointly(std::vector<Object>& objects, std::vector<OpenCut>& open, const glm::dvec3& outward) {
+  std::vector<bool> capped(open.size(), false);
+  // The open ends of each part's own cut line, in world space.
+  struct End {
+    glm::dvec3 position;
+    std::size_t part;
+    bool entering;  // more segments enter than leave
+  };
+  std::vector<End> ends;
+  for (std::size_t i = 0; i < open.size(); ++i) {
+    const OpenCut& part = open[i];
+    std::vector<glm::vec3> positions(part.world.begin(), part.world.end());
+    WeldedCutLine line = weldCutLine(positions, part.cut.cutLine, kCapWeld * part.diagonal);
+    for (std::size_t p = 0; p < line.balance.size(); ++p)
+      if (line.balance[p] != 0) ends.push_back({part.world[line.source[p]], i, (line.balance[p] < 0) != part.mirrored});
+  }
+  std::vector<std::size_t> group(open.size());
+  for (std::size_t i = 0; i < group.size(); ++i) group[i] = i;
+  const auto find = [&](std::size_t i) {
+    while (group[i] != i) i = group[i] = group[group[i]];
+    return i;
+  };
+  double widest = 0.0;
+  for (const OpenCut& part : open) widest = std::max(widest, kCapWeld * part.diagonal);
+  std::sort(ends.begin(), ends.end(), [](const End& a, const End& b) { return a.position.x < b.position.x; });
+  for (std::size_t a = 0; a < ends.size(); ++a)
+    for (std::size_t b = a + 1; b < ends.size() && ends[b].position.x - ends[a].position.x <= widest; ++b) {
+      const End &e = ends[a], &f = ends[b];
+      if (e.part == f.part || e.entering == f.entering) continue;
+      const double weld = kCapWeld * std::max(open[e.part].diagonal, open[f.part].diagonal);
+      if (glm::distance(e.position, f.position) <= weld) group[find(e.part)] = find(f.part);
+    }
+
+  std::map<std::size_t, std::vector<std::size_t>> members;
+  for (std::size_t i = 0; i < open.size(); ++i) members[find(i)].push_back(i);
+  for (const auto& [root, parts] : members) {
+    if (parts.size() < 2) continue;
+    // The group's cut lines as one, in world space; where each point came from.
+    std::vector<glm::vec3> positions;
+    std::vector<std::pair<std::size_t, std::uint32_t>> from;  // (part, vertex of its cut mesh)
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> cutLine;
+    std::vector<std::size_t> share(parts.size(), 0);
+    Bounds box;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      const OpenCut& part = open[parts[k]];
+      std::unordered_map<std::uint32_t, std::uint32_t> index;
+      const auto pointOf = [&](std::uint32_t v) {
+        const auto [it, inserted] = index.try_emplace(v, static_cast<std::uint32_t>(positions.size()));
+        if (inserted) {
+          positions.emplace_back(part.world[v]);
+          box.extend(part.world[v]);
+          from.emplace_back(parts[k], v);
+        }
+        return it->second;
+      };
+      // In world space a mirrored part's winding, and so its cut line, runs the other way.
+      for (const auto& [a, b] : part.cut.cutLine)
+        cutLine.push_back(part.mirrored ? std::pair(pointOf(b), pointOf(a)) : std::pair(pointOf(a), pointOf(b)));
+      share[k] = part.cut.cutLine.size();
+    }
+    const WeldedCutLine line = weldCutLine(positions, cutLine, kCapWeld * glm::length(box.max - box.min));
+    if (!line.closed()) continue;
+    std::vector<std::uint32_t> corners;
+    fillCap(positions, line, outward, corners);
+    if (corners.empty()) continue;
+
+    // The cap goes to the owner, in its object space.
+    const std::size_t owner =
+        parts[static_cast<std::size_t>(std::max_element(share.begin(), share.end()) - share.begin())];
+    Mesh& m = open[owner].cut.mesh;
+    const glm::dmat4& transform = objects[open[owner].object].transform;
+    const glm::dmat4 toOwner = glm::inverse(transform);
+    const glm::vec3 normal(glm::normalize(glm::transpose(glm::dmat3(transform)) * outward));
+    const bool mirrored = glm::determinant(glm::dmat3(transform)) < 0.0;
+    for (std::size_t c = 0; c < corners.size(); c += 3) {
+      const std::uint32_t triangle[3] = {corners[c], corners[c + (mirrored ? 2 : 1)], corners[c + (mirrored ? 1 : 2)]};
+      for (const std::uint32_t corner : triangle) {
+        const auto [part, v] = from[corner];
+        const Mesh& source = open[part].cut.mesh;
+        const glm::vec3 position =
+            part == owner ? source.positions[v] : glm::vec3(toOwner * glm::dvec4(open[part].world[v], 1.0));
+        const glm::vec4 colour = source.colors.empty() ? glm::vec4(1.0f) : source.colors[v];
+        m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
+        m.positions.push_back(position);
+        if (!m.normals.empty()) m.normals.push_back(normal);
+        if (!m.colors.empty()) m.colors.push_back(colour);
+      }
+    }
+    open[owner].cut.capTriangles = corners.size() / 3;
+    open[owner].cut.outcome = SectionOutcome::kCapped;
+    for (const std::size_t part : parts) capped[part] = true;
+  }
+  return capped;
+}
+
+}  // namespace
 
 Scene sectionedScene(const Scene& scene, SectionReport* report) {
   if (!scene.section || scene.sectionCut) return scene;
@@ -313,7 +456,9 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
   Scene out = scene;
   out.sectionCut = true;
   SectionReport local;
-  for (Object& object : out.objects) {
+  std::vector<OpenCut> open;
+  for (std::size_t i = 0; i < out.objects.size(); ++i) {
+    Object& object = out.objects[i];
     if (!object.visible || !object.mesh || object.mesh->triangleCount() == 0) continue;
     // World p = A·q + t: dot(n, A·q + t) + w = dot(Aᵀn, q) + dot(n, t) + w.
     const glm::dmat3 a(object.transform);
@@ -332,10 +477,32 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
       case SectionOutcome::kCapped:
         ++local.cut;
         if (cut.outcome == SectionOutcome::kCapped) ++local.capped;
+        if (scene.section->caps && cut.outcome == SectionOutcome::kCut && !cut.cutLine.empty()) {
+          OpenCut part{i, std::move(cut), {}, 0.0};
+          Bounds box;
+          part.world.reserve(part.cut.mesh.positions.size());
+          for (const glm::vec3& p : part.cut.mesh.positions) {
+            part.world.emplace_back(object.transform * glm::dvec4(glm::dvec3(p), 1.0));
+            box.extend(part.world.back());
+          }
+          part.diagonal = glm::length(box.max - box.min);
+          part.mirrored = glm::determinant(a) < 0.0;
+          open.push_back(std::move(part));
+          break;
+        }
         if (scene.section->caps && cut.outcome == SectionOutcome::kCut) local.open.push_back(object.name);
         object.mesh = std::make_shared<const Mesh>(std::move(cut.mesh));
         break;
     }
+  }
+  const std::vector<bool> joint = capJointly(out.objects, open, -glm::normalize(n));
+  for (std::size_t k = 0; k < open.size(); ++k) {
+    Object& object = out.objects[open[k].object];
+    if (joint[k])
+      ++local.capped;
+    else
+      local.open.push_back(object.name);
+    object.mesh = std::make_shared<const Mesh>(std::move(open[k].cut.mesh));
   }
   if (out.triangleCount() == 0 && !out.visibleVolume())
     throw Error("section plane", "cuts away every visible surface of scene '" + scene.name + "'");

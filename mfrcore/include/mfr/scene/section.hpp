@@ -1,11 +1,12 @@
 #pragma once
 // Section views: a scene cut by its section plane (Scene::section), as geometry. Surfaces are
 // clipped triangle by triangle (winding, normals and colours kept, cut edges shared between the
-// triangles that share an edge); the cross-section of every closed surface is triangulated by VTK's
-// CGAL's constrained Delaunay triangulation into a cap with the plane's normal, so a cut solid stays a closed, outward
-// oriented solid (CSG and the solid-aware operations still see solids).
+// triangles that share an edge); the cross-section of every closed surface is triangulated by
+// CGAL's constrained Delaunay triangulation into a cap with the plane's normal, so a cut solid stays
+// a closed, outward-oriented solid (CSG and the solid-aware operations still see solids).
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -28,28 +29,37 @@ struct SectionedMesh {
   SectionOutcome outcome = SectionOutcome::kKept;
   std::size_t capTriangles = 0;  // the last capTriangles triangles of mesh are the cap
   bool closed = false;           // the cut line formed closed loops (tested only when caps were asked for)
+  // When caps were asked for and none was made: the cut line, segments exit → entry (indices into
+  // mesh) in the surface's winding. sectionedScene joins those of objects that are one solid together.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> cutLine;
 };
 
-// Cuts `mesh` by the plane dot(plane.xyz, p) + plane.w >= 0 (kept side, object space). With `caps`,
-// the cut line — the segments where triangles cross the plane, repeats counted once, a segment and
-// its reverse cancelled, chains ending within 1e-4 of the bounding box's diagonal of another's start
-// joined — must form closed loops (the surface is closed where the plane cuts it; holes elsewhere do not matter);
-// the loops are filled, and the cap is kept only if its area equals the area they enclose (0.1 %):
-// a failed triangulation is dropped, never drawn. Caps get the normal -plane.xyz (outward) and, when
-// the mesh has vertex colours, the colours of the cut.
+// Cuts `mesh` by the plane dot(plane.xyz, p) + plane.w >= 0 (kept side, object space). A mesh
+// that only touches the plane (vertices within 1e-9 of its size of it, none beyond) is kept or
+// removed whole; one cut through with vertices on the plane is cut 1e-6 of its size further in,
+// where no vertex is, so faces lying in the plane never enter the cut line. With `caps`, the cut
+// line — the segments where triangles cross the plane, repeats counted once, a segment and its
+// reverse cancelled, chains ending within 1e-3 of the bounding box's diagonal of another's start
+// joined — must form closed loops (the surface is closed where the plane cuts it; holes elsewhere do
+// not matter); the loops are filled, and the cap is kept only if its area equals the area they
+// enclose (0.1 %): a failed triangulation is dropped, never drawn. Caps get the normal -plane.xyz
+// (outward) and, when the mesh has vertex colours, the colours of the cut.
 SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps);
 
 struct SectionReport {
   std::size_t cut = 0;     // objects cut (capped or not)
-  std::size_t capped = 0;  // of those, capped
+  std::size_t capped = 0;  // of those, capped (alone or together with the other parts of their solid)
   std::size_t removed = 0;
   std::vector<std::string> open;  // names of objects cut without a cap though caps were asked for
 };
 
 // The scene with its section applied to the surfaces: cut objects get new meshes, objects entirely
-// on the cut-away side become invisible, and sectionCut is set (the section itself stays: the
-// renderers crop the volume's march with it). A scene without a section, or already cut, is returned
-// unchanged. Throws mfr::Error("section plane", …) when nothing visible is left.
+// on the cut-away side become invisible, and sectionCut is set. Objects that are open along the cut
+// but whose cut lines join into closed loops together (one solid split over several parts: a glTF
+// mesh with a primitive per material) get one cap, on the part with the most of the joint cut line;
+// both then count as capped. The section itself stays: the renderers crop the volume's march with
+// it. A scene without a section, or already cut, is returned unchanged. Throws mfr::Error("section plane", …) when
+// nothing visible is left.
 Scene sectionedScene(const Scene& scene, SectionReport* report = nullptr);
 
 // The plane of a section as (n, d), n unit length, kept where dot(n, p) + d >= 0 (world space).
