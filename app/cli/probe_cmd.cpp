@@ -50,7 +50,7 @@ int to8(float c) {
 
 void addProbe(CLI::App& app) {
   struct Options {
-    std::string scene, pixel, size = "512x512", view = "fit", method, json, clip, section;
+    std::string scene, pixel, size = "512x512", view = "fit", method, op = "auto", json, clip, section;
     std::vector<std::string> params;
     double opacity = -1.0;
   };
@@ -63,6 +63,10 @@ void addProbe(CLI::App& app) {
   cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
   cmd->add_option("--method,-m", opt->method, "Also a GPU method: which fragments it holds, the colour it draws");
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
+  cmd->add_option("--op", opt->op,
+                  "The method's operation, as for render (auto: hybrid for fkb, vkb, dkb, else oit). With hybrid, "
+                  "each fragment's share under the method's split: the held ones the core, the rest the tail")
+      ->capture_default_str();
   cmd->add_option("--json", opt->json, "Also write the probe as JSON");
   cmd->add_option("--clip", opt->clip, kClipHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
@@ -86,6 +90,8 @@ void addProbe(CLI::App& app) {
       if (info == nullptr || opt->method == "oracle" || opt->method == "optimal-k")
         throw Error("--method " + opt->method, "not a GPU method (see mfr info --methods)");
       req.method = opt->method;
+      validateOperation(opt->op);
+      req.operation = opt->op;
     } else if (!req.params.empty()) {
       throw Error("--param", "needs --method");
     }
@@ -108,6 +114,8 @@ void addProbe(CLI::App& app) {
         const CapturedLists lists = gpu.capture(camera, req, room, PixelRect{x, y, 1, 1});
         const std::uint32_t count = lists.count(x, y);
         matchCapture(probe, {lists.pixel(x, y), std::min<std::size_t>(count, static_cast<std::size_t>(room))}, count);
+        if (effectiveOperation(req.operation, info, scene.visibleVolume() != nullptr) == "hybrid")
+          splitHybrid(probe, scene.background);
       }
     }
 
@@ -118,17 +126,27 @@ void addProbe(CLI::App& app) {
     if (probe.depthTie) text << " (two at one depth: order undefined)";
     text << "\n";
     char line[256];
+    // The method's column, as wide as its name; with hybrid, each fragment's share and role.
+    const int methodWidth = static_cast<int>(std::max<std::size_t>(opt->method.size(), 4));
+    const auto methodColumns = [&](const char* held, const std::string& hybrid) {
+      if (!probe.captured) return std::string();
+      char columns[128];
+      std::snprintf(columns, sizeof columns, "  %-*s%s", methodWidth, held, hybrid.c_str());
+      return std::string(columns);
+    };
     std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7s%s\n", "#", "eye depth", "part", "RGBA",
-                  "faces", "weight", probe.captured ? ("  " + opt->method).c_str() : "");
+                  "faces", "weight", methodColumns(opt->method.c_str(), probe.hybrid ? "   hybrid" : "").c_str());
     text << line;
     nlohmann::ordered_json fragments = nlohmann::ordered_json::array();
     for (std::size_t i = 0; i < probe.fragments.size(); ++i) {
       const ProbeFragment& f = probe.fragments[i];
       const std::uint32_t object = f.fragment.objectId;
       const std::string part = object < scene.objects.size() ? scene.objects[object].name : "?";
+      char share[32] = "";
+      if (probe.hybrid) std::snprintf(share, sizeof share, "  %7.4f %s", f.hybridWeight, f.held ? "core" : "tail");
       std::snprintf(line, sizeof line, "%4zu  %12.6g  %-24.24s  %-15s  %-5s  %7.4f%s\n", i + 1, f.eyeDepth,
                     part.c_str(), rgba(f.fragment.color).c_str(), f.fragment.frontFacing ? "front" : "back", f.weight,
-                    probe.captured ? (f.held ? "  held" : "  -") : "");
+                    methodColumns(f.held ? "held" : "-", share).c_str());
       text << line;
       nlohmann::ordered_json j;
       j["depth"] = f.fragment.depth;
@@ -139,11 +157,17 @@ void addProbe(CLI::App& app) {
       j["front_facing"] = f.fragment.frontFacing;
       j["weight"] = f.weight;
       if (probe.captured) j["held"] = f.held;
+      if (probe.hybrid) j["hybrid_weight"] = f.hybridWeight;
       fragments.push_back(j);
     }
-    std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7.4f\n", "", "", "background", "", "",
+    std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7.4f", "", "", "background", "", "",
                   probe.transmittance);
     text << line;
+    if (probe.hybrid) {
+      std::snprintf(line, sizeof line, "  %7.4f", probe.hybridBackground);
+      text << methodColumns("", line);
+    }
+    text << "\n";
     const glm::ivec3 exact(to8(probe.exactColor.r), to8(probe.exactColor.g), to8(probe.exactColor.b));
     text << "exact colour (over): " << exact.r << " " << exact.g << " " << exact.b << "\n";
 
@@ -177,6 +201,20 @@ void addProbe(CLI::App& app) {
         m["holds"] = probe.methodCount;
         m["held_exact"] = probe.heldCount();
         m["unmatched"] = probe.unmatched;
+        if (probe.hybrid) {
+          const glm::ivec3 hybrid(to8(probe.hybridColor.r), to8(probe.hybridColor.g), to8(probe.hybridColor.b));
+          const glm::ivec3 fromExact = glm::abs(hybrid - exact),
+                           fromMethod = glm::abs(hybrid - glm::ivec3(*methodPixel));
+          const std::size_t tail = probe.fragments.size() - probe.heldCount();
+          text << "hybrid colour (core: the " << probe.heldCount() << " held, tail: the other " << tail
+               << " by weighted average): " << hybrid.r << " " << hybrid.g << " " << hybrid.b
+               << " (largest difference from exact " << std::max({fromExact.r, fromExact.g, fromExact.b})
+               << "/255, from " << opt->method << "'s " << std::max({fromMethod.r, fromMethod.g, fromMethod.b})
+               << "/255)\n";
+          m["operation"] = "hybrid";
+          m["hybrid_rgb"] = {hybrid.r, hybrid.g, hybrid.b};
+          m["hybrid_background_weight"] = probe.hybridBackground;
+        }
       } else {
         text << opt->method << " keeps no per-pixel lists (its image only)\n";
       }

@@ -40,11 +40,17 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
   layout->addWidget(summary_);
   table_ = new QTableWidget(0, ColumnCount, this);
   table_->setObjectName(QStringLiteral("probeTable"));
-  table_->setHorizontalHeaderLabels(
-      {tr("#"), tr("Eye depth"), tr("Part"), tr("Colour"), tr("α"), tr("Faces"), tr("Share"), tr("Held")});
+  table_->setHorizontalHeaderLabels({tr("#"), tr("Eye depth"), tr("Part"), tr("Colour"), tr("α"), tr("Faces"),
+                                     tr("Share"), tr("Held"), tr("Hybrid")});
   table_->horizontalHeaderItem(Share)->setToolTip(
       tr("The fragment's share of the pixel's colour: α·Π(1 − α) of the fragments in front of it"));
-  table_->horizontalHeaderItem(Held)->setToolTip(tr("Whether the pane's method holds this fragment"));
+  table_->horizontalHeaderItem(Held)->setToolTip(
+      tr("Whether the pane's method holds this fragment (with the operation hybrid: in its core, or left to the "
+         "tail)"));
+  table_->horizontalHeaderItem(HybridShare)
+      ->setToolTip(tr("With the operation hybrid (the budget methods): the fragment's share of the colour the method "
+                      "draws — the core composited exactly, the tail by its weighted average"));
+  table_->setColumnHidden(HybridShare, true);
   table_->verticalHeader()->hide();
   table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   table_->horizontalHeader()->setSectionResizeMode(Part, QHeaderView::Stretch);
@@ -125,6 +131,17 @@ void ProbePanel::show(const ViewProbe& r) {
     text += tr(" %1 holds %2 of them").arg(r.method).arg(p.heldCount());
     if (p.methodCount != p.heldCount()) text += tr(" (%1 in all)").arg(p.methodCount);
     text += QStringLiteral(".");
+    if (p.hybrid) {
+      // What the method's split costs here: its core exact, its tail averaged.
+      const QColor hybrid(to8(p.hybridColor.r), to8(p.hybridColor.g), to8(p.hybridColor.b));
+      const int cost = std::max({std::abs(hybrid.red() - exact.red()), std::abs(hybrid.green() - exact.green()),
+                                 std::abs(hybrid.blue() - exact.blue())});
+      text += tr(" Hybrid colour %1 (core %2, tail %3; largest difference from exact %4/255).")
+                  .arg(hybrid.name())
+                  .arg(p.heldCount())
+                  .arg(n - static_cast<int>(p.heldCount()))
+                  .arg(cost);
+    }
   } else {
     text += tr(" %1 keeps no per-pixel lists.").arg(r.method);
   }
@@ -148,8 +165,14 @@ void ProbePanel::show(const ViewProbe& r) {
     table_->setItem(i, Alpha, item(QString::number((f.fragment.color >> 24) / 255.0, 'f', 3), right));
     table_->setItem(i, Faces, item(f.fragment.frontFacing ? tr("front") : tr("back")));
     table_->setItem(i, Share, item(QString::number(100.0 * f.weight, 'f', 1) + QStringLiteral(" %"), right));
-    table_->setItem(i, Held, item(!p.captured ? QStringLiteral("—") : f.held ? tr("held") : tr("dropped")));
-    if (p.captured && !f.held)
+    table_->setItem(i, Held,
+                    item(!p.captured ? QStringLiteral("—")
+                         : p.hybrid  ? (f.held ? tr("core") : tr("tail"))
+                                     : (f.held ? tr("held") : tr("dropped"))));
+    table_->setItem(
+        i, HybridShare,
+        item(p.hybrid ? QString::number(100.0 * f.hybridWeight, 'f', 1) + QStringLiteral(" %") : QString(), right));
+    if (p.captured && !f.held && !p.hybrid)  // dropped; a tail fragment still counts
       for (int c = 0; c < ColumnCount; ++c)
         if (c != Colour) table_->item(i, c)->setForeground(palette().color(QPalette::Disabled, QPalette::Text));
   }
@@ -161,4 +184,9 @@ void ProbePanel::show(const ViewProbe& r) {
   table_->item(n, Colour)->setForeground(bg.lightnessF() > 0.5 ? Qt::black : Qt::white);
   table_->item(n, Share)->setText(QString::number(100.0 * p.transmittance, 'f', 1) + QStringLiteral(" %"));
   table_->item(n, Share)->setTextAlignment(right);
+  if (p.hybrid) {
+    table_->item(n, HybridShare)->setText(QString::number(100.0 * p.hybridBackground, 'f', 1) + QStringLiteral(" %"));
+    table_->item(n, HybridShare)->setTextAlignment(right);
+  }
+  table_->setColumnHidden(HybridShare, !p.hybrid);
 }

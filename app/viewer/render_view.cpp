@@ -685,6 +685,8 @@ ViewProbe RenderView::probeAt(QPoint point) {
     mfr::matchCapture(result.probe,
                       {lists.pixel(pixel.x(), pixel.y()), std::min<std::size_t>(count, static_cast<std::size_t>(room))},
                       count);
+    if (model_.effectiveOperationOf(result.side) == QLatin1String("hybrid"))
+      mfr::splitHybrid(result.probe, model_.drawnScene().background);
   } catch (...) {
     mfr::gl::discardErrors();
     throw;

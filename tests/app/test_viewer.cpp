@@ -14,6 +14,7 @@
 #include <QPlainTextEdit>
 #include <QProcess>
 #include <QProgressBar>
+#include <QRegularExpression>
 #include <QPushButton>
 #include <QSignalSpy>
 #include <QSlider>
@@ -2295,6 +2296,7 @@ class ViewerTest : public QObject {
     };
     checkRows(2);
     QVERIFY2(summary->text().contains(QStringLiteral("kplus-array holds 2 of them")), qPrintable(summary->text()));
+    QVERIFY(table->isColumnHidden(ProbePanel::HybridShare));  // "oit": no split to show
     // The shown colour is the method's image at the pixel (its `mfr render` path).
     const mfr::ImageRGBA8 image = view.renderImage(QSize(200, 150));
     const std::uint8_t* at = image.at(pixel.x(), pixel.y());
@@ -2319,6 +2321,34 @@ class ViewerTest : public QObject {
       QVERIFY2(summary->text().contains(QStringLiteral("shown %1").arg(shownExact)),
                qPrintable(summary->text() + " / " + shownExact));
     }
+    // A budget method resolves with hybrid: its core and tail, each fragment's share of the colour it
+    // draws (summing to 100 %), and that colour — the one the view shows, to 8-bit rounding.
+    m.setMethod("dkb");
+    m.setParams({{"budget_mib", "1.5"}});
+    QTRY_VERIFY2_WITH_TIMEOUT(summary->text().contains(QStringLiteral("Hybrid colour")), qPrintable(summary->text()),
+                              kProbeTimeoutMs);
+    QVERIFY(!table->isColumnHidden(ProbePanel::HybridShare));
+    {
+      double share = 0.0;
+      int core = 0;
+      for (int i = 0; i <= n; ++i)
+        share += table->item(i, ProbePanel::HybridShare)->text().remove(QStringLiteral(" %")).toDouble();
+      for (int i = 0; i < n; ++i) {
+        const QString role = table->item(i, ProbePanel::Held)->text();
+        QVERIFY2(role == QStringLiteral("core") || role == QStringLiteral("tail"), qPrintable(role));
+        core += role == QStringLiteral("core") ? 1 : 0;
+      }
+      QVERIFY2(std::abs(share - 100.0) < 0.1 * (n + 1), qPrintable(QString::number(share)));
+      QVERIFY2(core >= 1 && core < n, qPrintable(QStringLiteral("core %1 of %2: ").arg(core).arg(n) + summary->text()));
+      const QRegularExpression colours(QStringLiteral("shown (#[0-9a-f]{6}).*Hybrid colour (#[0-9a-f]{6})"));
+      const QRegularExpressionMatch match = colours.match(summary->text());
+      QVERIFY2(match.hasMatch(), qPrintable(summary->text()));
+      const QColor drawn(match.captured(1)), hybrid(match.captured(2));
+      QVERIFY2(std::abs(drawn.red() - hybrid.red()) <= 2 && std::abs(drawn.green() - hybrid.green()) <= 2 &&
+                   std::abs(drawn.blue() - hybrid.blue()) <= 2,
+               qPrintable(summary->text()));
+    }
+
     // A method without lists: the exact list only.
     m.setMethod("wboit");
     QTRY_VERIFY2_WITH_TIMEOUT(summary->text().contains(QStringLiteral("wboit keeps no per-pixel lists")),

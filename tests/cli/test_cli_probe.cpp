@@ -1,6 +1,7 @@
 // mfr probe end to end: the listed fragments and colours against `mfr render` of the same pixel
 // (the oracle's and the method's own images), the "over" weights summing to one, what k-buffers
-// hold, and bad input refused with one line and no JSON file.
+// hold, the hybrid shares of a budget method against its own image, and bad input refused with one
+// line and no JSON file.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -88,13 +89,51 @@ TEST_F(CliProbe, MethodsWithoutListsShowTheirColourOnly) {
   EXPECT_NE(r.out.find("wboit colour:"), std::string::npos) << r.out;
 }
 
+// dkb resolves with the operation hybrid (its "auto"): the probe lists each fragment's share under
+// dkb's split, and the colour that split gives is the colour `mfr render -m dkb` draws there.
+TEST_F(CliProbe, BudgetMethodsShowTheirHybridSplit) {
+  const std::string budget = " -m dkb -p budget_mib=0.15";
+  const fs::path image = dir() / "dkb.png";
+  ASSERT_EQ(runCli(std::string("render ") + kScene + budget + " -o " + image.string()).exitCode, 0);
+  const mfr::ImageRGBA8 drawn = mfr::readPng(image);
+  int tails = 0;
+  for (const auto& [x, y] : {std::pair{32, 24}, std::pair{25, 18}, std::pair{39, 30}}) {
+    SCOPED_TRACE(std::to_string(x) + "," + std::to_string(y));
+    const fs::path json = dir() / "probe.json";
+    const CliResult r = runCli(std::string("probe ") + kScene + " --pixel " + std::to_string(x) + "," +
+                               std::to_string(y) + budget + " --json " + json.string());
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    const nlohmann::json j = readJsonFile(json);
+    ASSERT_EQ(j["method"]["operation"], "hybrid");
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(j["method"]["hybrid_rgb"][c].get<int>(), drawn.at(x, y)[c], 2) << c;
+    double sum = j["method"]["hybrid_background_weight"].get<double>();
+    std::size_t held = 0;
+    for (const nlohmann::json& f : j["fragments"]) {
+      sum += f["hybrid_weight"].get<double>();
+      held += f["held"].get<bool>() ? 1 : 0;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-5);
+    tails += held < j["fragments"].size() ? 1 : 0;
+    EXPECT_NE(r.out.find("hybrid colour (core: the " + std::to_string(held) + " held"), std::string::npos) << r.out;
+  }
+  EXPECT_GE(tails, 2);  // the budget leaves tails at these pixels
+  // With --op oit the same method composites its core only: no split is listed.
+  const fs::path json = dir() / "oit.json";
+  const CliResult oit =
+      runCli(std::string("probe ") + kScene + " --pixel 32,24" + budget + " --op oit --json " + json.string());
+  ASSERT_EQ(oit.exitCode, 0) << oit.out;
+  EXPECT_FALSE(readJsonFile(json)["method"].contains("hybrid_rgb"));
+  EXPECT_EQ(oit.out.find("hybrid colour"), std::string::npos) << oit.out;
+}
+
 TEST_F(CliProbe, BadInputIsOneLineAndWritesNoJson) {
   const fs::path json = dir() / "probe.json";
   const std::pair<std::string, std::string> cases[] = {
-      {"--pixel 64,0", "outside the 64x48 image"},       {"--pixel 3,-1", "outside the 64x48 image"},
-      {"--pixel 1.5,2", "--pixel 1.5,2: expected X,Y"},  {"--pixel banana", "--pixel banana: expected X,Y"},
-      {"--pixel 3,3 -p k=2", "--param: needs --method"}, {"--pixel 3,3 -m oracle", "not a GPU method"},
-      {"--pixel 3,3 -m nonsense", "not a GPU method"},   {"--pixel 3,3 -m kplus-array -p k=0", "k"},
+      {"--pixel 64,0", "outside the 64x48 image"},           {"--pixel 3,-1", "outside the 64x48 image"},
+      {"--pixel 1.5,2", "--pixel 1.5,2: expected X,Y"},      {"--pixel banana", "--pixel banana: expected X,Y"},
+      {"--pixel 3,3 -p k=2", "--param: needs --method"},     {"--pixel 3,3 -m oracle", "not a GPU method"},
+      {"--pixel 3,3 -m nonsense", "not a GPU method"},       {"--pixel 3,3 -m kplus-array -p k=0", "k"},
+      {"--pixel 3,3 -m dkb --op nonsense", "--op nonsense"},
   };
   for (const auto& [args, mention] : cases) {
     SCOPED_TRACE(args);

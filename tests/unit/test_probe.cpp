@@ -1,17 +1,21 @@
 // The pixel probe (mfr probe, mfrview's Probe dock) and the oracle's pixel regions it rests on:
 // eye distances and "over" weights against hand-worked geometry and the "over" formula; a region's
-// lists against the whole image's; the pairing of a method's fragments with the exact ones.
+// lists against the whole image's; the pairing of a method's fragments with the exact ones; the
+// shares under a method's core/tail split against the hybrid formula and compositeHybrid.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "../support/fragments.hpp"
 #include "mfr/error.hpp"
 #include "mfr/reference/composite.hpp"
+#include "mfr/reference/hybrid.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "mfr/reference/probe.hpp"
 #include "mfr/scene/primitives.hpp"
@@ -171,6 +175,64 @@ TEST(PixelProbe, MatchCapturePairsByDepthAndCountsStrangers) {
   EXPECT_EQ(probe.heldCount(), 1u);
   EXPECT_TRUE(probe.fragments[3].held);
   EXPECT_EQ(probe.unmatched, 1u);
+}
+
+PixelProbe probeOf(std::initializer_list<Fragment> fragments, std::initializer_list<bool> held) {
+  PixelProbe probe;
+  auto h = held.begin();
+  for (const Fragment& f : fragments) {
+    ProbeFragment p;
+    p.fragment = f;
+    p.held = *h++;
+    probe.fragments.push_back(p);
+  }
+  probe.captured = true;
+  return probe;
+}
+
+// The paper's formula written out: core (the held fragments, wherever they are in the list) by
+// "over", the tail by α-weighted average with τ_tail = (1 − α_avg)^t, then the background.
+TEST(PixelProbe, HybridSplitFollowsTheFormula) {
+  const glm::vec3 background(0.2f, 0.4f, 0.6f);
+  PixelProbe probe = probeOf(
+      {frag(0.1f, 255, 0, 0, 102), frag(0.2f, 0, 255, 0, 51), frag(0.3f, 0, 0, 255, 153), frag(0.4f, 255, 255, 0, 204)},
+      {true, false, true, false});
+  splitHybrid(probe, background);
+  ASSERT_TRUE(probe.hybrid);
+  const double a0 = 102 / 255.0, a1 = 51 / 255.0, a2 = 153 / 255.0, a3 = 204 / 255.0;
+  const double coreT = (1 - a0) * (1 - a2);
+  const double tailA = 1 - std::pow(1 - (a1 + a3) / 2, 2.0);
+  const double w[4] = {a0, coreT * a1 / (a1 + a3) * tailA, (1 - a0) * a2, coreT * a3 / (a1 + a3) * tailA};
+  double sum = probe.hybridBackground;
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(probe.fragments[i].hybridWeight, w[i], 1e-6) << i;
+    sum += probe.fragments[i].hybridWeight;
+  }
+  EXPECT_NEAR(probe.hybridBackground, coreT * (1 - tailA), 1e-6);
+  EXPECT_NEAR(sum, 1.0, 1e-9);
+  const glm::dvec3 expected = w[0] * glm::dvec3(1, 0, 0) + w[1] * glm::dvec3(0, 1, 0) + w[2] * glm::dvec3(0, 0, 1) +
+                              w[3] * glm::dvec3(1, 1, 0) + coreT * (1 - tailA) * glm::dvec3(background);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(probe.hybridColor[c], expected[c], 1e-6) << c;
+
+  // Held = the nearest k: the colour is compositeHybrid's for that k, for every k; all held is "over".
+  const std::vector<Fragment> sorted = {frag(0.1f, 200, 10, 30, 90), frag(0.2f, 20, 220, 40, 160),
+                                        frag(0.3f, 60, 70, 250, 30), frag(0.5f, 5, 5, 5, 255)};
+  for (std::uint32_t k = 0; k <= 4; ++k) {
+    SCOPED_TRACE(k);
+    PixelProbe prefix = probeOf({sorted[0], sorted[1], sorted[2], sorted[3]}, {k > 0, k > 1, k > 2, k > 3});
+    double over = 1.0;
+    for (std::size_t i = 0; i < 4; ++i) {
+      prefix.fragments[i].weight = over * (glm::unpackUnorm4x8(sorted[i].color).a);
+      over *= 1.0 - glm::unpackUnorm4x8(sorted[i].color).a;
+    }
+    splitHybrid(prefix, background);
+    const glm::vec3 reference = compositeHybrid(sorted, k, background);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(prefix.hybridColor[c], reference[c], 1e-6) << c;
+    if (k >= 3) {  // a one-fragment tail composites exactly
+      for (std::size_t i = 0; i < 4; ++i)
+        EXPECT_NEAR(prefix.fragments[i].hybridWeight, prefix.fragments[i].weight, 1e-6);
+    }
+  }
 }
 
 }  // namespace

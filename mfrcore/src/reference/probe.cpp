@@ -2,8 +2,10 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "mfr/reference/composite.hpp"
+#include "mfr/reference/hybrid.hpp"
 
 namespace mfr {
 
@@ -74,6 +76,36 @@ void matchCapture(PixelProbe& probe, std::span<const Fragment> fragments, std::u
     else
       ++probe.unmatched;
   }
+}
+
+void splitHybrid(PixelProbe& probe, glm::vec3 background) {
+  probe.hybrid = true;
+  std::vector<Fragment> tail;
+  for (const ProbeFragment& f : probe.fragments)
+    if (!f.held) tail.push_back(f.fragment);
+  // The tail's colour and opacity from the exact 8-bit sums, as the GPU's tail hook and
+  // compositeHybrid have them.
+  const HybridTailSums sums = hybridTailSums(tail, 0);
+  const HybridTail tailPart = hybridTail(sums);
+  glm::dvec3 colour(0.0);
+  double transmittance = 1.0;  // τ_core
+  for (ProbeFragment& f : probe.fragments) {
+    if (!f.held) continue;
+    const glm::dvec4 c(glm::unpackUnorm4x8(f.fragment.color));
+    f.hybridWeight = transmittance * c.a;
+    colour += f.hybridWeight * glm::dvec3(c);
+    transmittance *= 1.0 - c.a;
+  }
+  for (ProbeFragment& f : probe.fragments) {
+    if (f.held) continue;
+    const std::uint64_t alpha = (f.fragment.color >> 24) & 0xffu;  // the sums' units: 1/255
+    f.hybridWeight =
+        sums.alpha == 0 ? 0.0
+                        : transmittance * static_cast<double>(alpha) / static_cast<double>(sums.alpha) * tailPart.alpha;
+  }
+  colour += transmittance * glm::dvec3(tailPart.color);
+  probe.hybridBackground = transmittance * (1.0 - tailPart.alpha);
+  probe.hybridColor = glm::vec3(colour + probe.hybridBackground * glm::dvec3(background));
 }
 
 }  // namespace mfr

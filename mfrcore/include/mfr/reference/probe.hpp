@@ -20,6 +20,7 @@ struct ProbeFragment {
   double eyeDepth = 0.0;  // distance along the view axis (world units), Camera::depthToEye
   double weight = 0.0;    // α_i·Π_{j<i}(1 − α_j): the fraction of the pixel's colour it gives
   bool held = false;      // the method's capture holds it (matchCapture)
+  double hybridWeight = 0.0;  // its share of the hybrid colour under the method's core/tail split (splitHybrid)
 };
 
 struct PixelProbe {
@@ -39,6 +40,11 @@ struct PixelProbe {
   std::vector<Fragment> methodFragments;  // its sorted list as read back (at most what was kept)
   std::uint32_t unmatched = 0;            // of methodFragments, those at no oracle fragment's depth
   [[nodiscard]] std::uint32_t heldCount() const;
+
+  // Set by splitHybrid.
+  bool hybrid = false;
+  glm::vec3 hybridColor{0.0f};    // core by "over", tail by its weighted average, on the background
+  double hybridBackground = 0.0;  // the background's share: τ_core·τ_tail
 };
 
 // The probe of pixel (x, y) of a width × height image (throws mfr::Error for a pixel outside it,
@@ -53,5 +59,14 @@ PixelProbe probePixel(const Scene& scene, const Camera& camera, int width, int h
 // kept fewer).
 void matchCapture(PixelProbe& probe, std::span<const Fragment> fragments, std::uint32_t count,
                   double depthTolerance = 1e-5);
+
+// Hybrid transparency with the method's own split (after matchCapture; reference/hybrid.hpp): the
+// fragments it holds are the core, composited by "over" in depth order; the others are the tail,
+// replaced behind the core by their α-weighted average with transmittance (1 − α_avg)^t. Sets each
+// fragment's hybridWeight — a core fragment's α·Π(1 − α) over the core in front of it, a tail
+// fragment's τ_core·(α_i / Σα_tail)·(1 − τ_tail) — the background's share and the colour: what a
+// method resolving with the operation "hybrid" (the budget methods, a k-buffer with its tail) draws
+// at the pixel, and so what the budget costs there against exactColor.
+void splitHybrid(PixelProbe& probe, glm::vec3 background);
 
 }  // namespace mfr
