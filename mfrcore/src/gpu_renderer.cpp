@@ -72,7 +72,9 @@ void GpuRenderer::setScene(const Scene& original) {
   std::optional<Scene> cut;
   if (original.section && !original.sectionCut) cut = sectionedScene(original);
   const Scene& scene = cut ? *cut : original;
-  scene_ = std::make_shared<const gl::GpuScene>(scene);
+  // Meshes the previous upload holds are shared, not uploaded again (an edit of colours, visibility,
+  // the clip box, or a section that leaves parts uncut).
+  scene_ = std::make_shared<const gl::GpuScene>(scene, scene_.get());
   background_ = scene.background;
   csg_ = scene.csg;
   csgMirrored_ = csgMirroredPrimitives(scene);

@@ -11,36 +11,46 @@ struct Vertex {
 };
 }  // namespace
 
-GpuScene::GpuScene(const Scene& scene) {
+GpuScene::GpuScene(const Scene& scene, const GpuScene* previous) {
+  std::map<const Mesh*, std::shared_ptr<const GpuMesh>> before;
+  if (previous)
+    for (const std::shared_ptr<const GpuMesh>& g : previous->meshes_) before.emplace(g->source.get(), g);
   std::map<const Mesh*, std::size_t> uploaded;
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
     if (!o.visible || !o.mesh || o.mesh->triangleCount() == 0) continue;
     auto [it, isNew] = uploaded.try_emplace(o.mesh.get(), meshes_.size());
     if (isNew) {
-      const Mesh& m = *o.mesh;
-      std::vector<Vertex> v(m.positions.size());
-      for (std::size_t k = 0; k < v.size(); ++k)
-        v[k] = {m.positions[k], m.normals.empty() ? glm::vec3(0, 0, 1) : m.normals[k],
-                m.colors.empty() ? glm::vec4(1.0f) : m.colors[k]};
-      GpuMesh g;
-      g.vertices = createBuffer(v.size() * sizeof(Vertex), v.data(), 0);
-      g.indices = createBuffer(m.indices.size() * sizeof(std::uint32_t), m.indices.data(), 0);
-      g.indexCount = static_cast<GLsizei>(m.indices.size());
-      g.vao = createVertexArray();
-      const GLuint vao = g.vao.id();
-      glVertexArrayVertexBuffer(vao, 0, g.vertices.id(), 0, sizeof(Vertex));
-      glVertexArrayElementBuffer(vao, g.indices.id());
-      const auto attrib = [&](GLuint loc, GLint n, std::size_t offset) {
-        glEnableVertexArrayAttrib(vao, loc);
-        glVertexArrayAttribFormat(vao, loc, n, GL_FLOAT, GL_FALSE, static_cast<GLuint>(offset));
-        glVertexArrayAttribBinding(vao, loc, 0);
-      };
-      attrib(MFR_ATTR_POSITION, 3, offsetof(Vertex, position));
-      attrib(MFR_ATTR_NORMAL, 3, offsetof(Vertex, normal));
-      attrib(MFR_ATTR_COLOR, 4, offsetof(Vertex, color));
-      bytes_ += v.size() * sizeof(Vertex) + m.indices.size() * sizeof(std::uint32_t);
-      meshes_.push_back(std::move(g));
+      if (const auto shared = before.find(o.mesh.get()); shared != before.end()) {
+        meshes_.push_back(shared->second);
+      } else {
+        const Mesh& m = *o.mesh;
+        std::vector<Vertex> v(m.positions.size());
+        for (std::size_t k = 0; k < v.size(); ++k)
+          v[k] = {m.positions[k], m.normals.empty() ? glm::vec3(0, 0, 1) : m.normals[k],
+                  m.colors.empty() ? glm::vec4(1.0f) : m.colors[k]};
+        auto g = std::make_shared<GpuMesh>();
+        g->source = o.mesh;
+        g->vertices = createBuffer(v.size() * sizeof(Vertex), v.data(), 0);
+        g->indices = createBuffer(m.indices.size() * sizeof(std::uint32_t), m.indices.data(), 0);
+        g->indexCount = static_cast<GLsizei>(m.indices.size());
+        g->vao = createVertexArray();
+        const GLuint vao = g->vao.id();
+        glVertexArrayVertexBuffer(vao, 0, g->vertices.id(), 0, sizeof(Vertex));
+        glVertexArrayElementBuffer(vao, g->indices.id());
+        const auto attrib = [&](GLuint loc, GLint n, std::size_t offset) {
+          glEnableVertexArrayAttrib(vao, loc);
+          glVertexArrayAttribFormat(vao, loc, n, GL_FLOAT, GL_FALSE, static_cast<GLuint>(offset));
+          glVertexArrayAttribBinding(vao, loc, 0);
+        };
+        attrib(MFR_ATTR_POSITION, 3, offsetof(Vertex, position));
+        attrib(MFR_ATTR_NORMAL, 3, offsetof(Vertex, normal));
+        attrib(MFR_ATTR_COLOR, 4, offsetof(Vertex, color));
+        g->bytes = v.size() * sizeof(Vertex) + m.indices.size() * sizeof(std::uint32_t);
+        uploaded_ += g->bytes;
+        meshes_.push_back(std::move(g));
+      }
+      bytes_ += meshes_.back()->bytes;
     }
     const glm::mat4 model(o.transform);
     items_.push_back({it->second, model, glm::mat3(glm::transpose(glm::inverse(o.transform))), o.material.color,
@@ -64,7 +74,7 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
       glDisable(GL_CLIP_DISTANCE0 + static_cast<GLenum>(i));
   }
   for (const DrawItem& item : items_) {
-    const GpuMesh& m = meshes_[item.mesh];
+    const GpuMesh& m = *meshes_[item.mesh];
     program.set("uModel", item.model);
     program.set("uNormalMatrix", item.normalMatrix);
     program.set("uColor", item.color);

@@ -4,6 +4,7 @@
 // shaders/common/scene.vert (uModel, uNormalMatrix, uColor, uVertexColors, uObjectId) plus the
 // per-frame uViewProj and uViewDir.
 #include <map>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -28,18 +29,24 @@ struct FrameUniforms {
 
 class GpuScene {
  public:
-  explicit GpuScene(const Scene& scene);
+  // `previous`: a scene uploaded before in the same context. Meshes it holds that this scene still
+  // draws (the same Mesh objects: an edit of colours, visibility, transforms, the clip box or a
+  // section that leaves a part uncut keeps them) are shared with it, not uploaded again.
+  explicit GpuScene(const Scene& scene, const GpuScene* previous = nullptr);
   // Draws every visible object with program (already configured by the caller: state, buffers).
   void draw(const Program& program, const FrameUniforms& frame) const;
   [[nodiscard]] std::size_t triangleCount() const { return triangles_; }
-  [[nodiscard]] std::size_t bytes() const { return bytes_; }
+  [[nodiscard]] std::size_t bytes() const { return bytes_; }             // of every mesh it draws, shared or not
+  [[nodiscard]] std::size_t uploadedBytes() const { return uploaded_; }  // of the meshes it uploaded itself
 
  private:
   struct GpuMesh {
+    std::shared_ptr<const Mesh> source;  // kept alive, so that its address names it while shared
     VertexArray vao;
     Buffer vertices;
     Buffer indices;
     GLsizei indexCount = 0;
+    std::size_t bytes = 0;
   };
   struct DrawItem {
     std::size_t mesh;
@@ -49,10 +56,11 @@ class GpuScene {
     bool vertexColors;
     std::uint32_t objectId;
   };
-  std::vector<GpuMesh> meshes_;
+  std::vector<std::shared_ptr<const GpuMesh>> meshes_;
   std::vector<DrawItem> items_;
   std::size_t triangles_ = 0;
   std::size_t bytes_ = 0;
+  std::size_t uploaded_ = 0;
 };
 
 }  // namespace mfr::gl
