@@ -2,9 +2,11 @@
 // libopenvdb-tools; no real .vdb file is packaged): spheres as level sets and as fog volumes, off
 // the origin and with anisotropic placement, loaded by loadVolume and checked against the sphere
 // itself — where the signed distance crosses zero and the fog crosses one half, along each axis —
-// and against vdb_print's report of the same file; bad files end in one error naming the file.
+// and against vdb_print's report of the same file; a vector grid as its magnitude against
+// vdb_tool's -length; bad files end in one error naming the file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <regex>
@@ -103,12 +105,32 @@ TEST_F(OpenVdbFiles, SceneOfAVdbFile) {
   EXPECT_NEAR(scene.volumes[0].defaultStep(), 0.025, 1e-6);
 }
 
+// A vector grid (the gradient of a fog sphere, made by vdb_tool -grad) is read as its magnitude:
+// voxel for voxel what vdb_tool's own -length makes of it, on the same grid and placement.
+TEST_F(OpenVdbFiles, VectorGridsAreReadAsTheirMagnitude) {
+  const fs::path gradient = make("-sphere radius=1 voxel=0.1 -ls2fog -grad", "grad.vdb");
+  const fs::path length = make("-read '" + gradient.string() + "' -length", "length.vdb");
+  const Volume v = loadVolume(gradient), reference = loadVolume(length);
+  ASSERT_EQ(v.grid->dims, reference.grid->dims);
+  EXPECT_EQ(v.origin, reference.origin);
+  EXPECT_EQ(v.gridToWorld(), reference.gridToWorld());
+  float largest = 0.0f;
+  for (std::size_t i = 0; i < v.grid->values.size(); ++i) {
+    EXPECT_NEAR(v.grid->values[i], reference.grid->values[i], 1e-5f * std::max(1.0f, reference.grid->values[i])) << i;
+    largest = std::max(largest, reference.grid->values[i]);
+  }
+  EXPECT_GT(largest, 1.0f);  // the fog rises from 0 to 1 over a few voxels of 0.1: a gradient of several per unit
+}
+
 TEST_F(OpenVdbFiles, BadFilesAreOneLineErrors) {
   const auto expectError = [](const fs::path& path, const std::string& reason) {
     expectFileError(path, reason,
                     [&] { return "a volume of " + std::to_string(loadVolume(path).grid->values.size()) + " points"; });
   };
   expectError(write("text.vdb", "not a VDB file at all, just text\n"), "not an OpenVDB file");
+  // A point data grid is not a volume.
+  expectError(make("-sphere radius=1 voxel=0.1 -ls2mesh -points2vdb", "points.vdb"),
+              "no float, double or vector grid in the file (it has points2vdb_ls2mesh_sphere (ptdataidx32))");
   const fs::path good = make("-sphere radius=1 voxel=0.1 -ls2fog", "good.vdb");
   const std::string bytes = readFile(good);
   for (std::size_t cut = 8; cut < bytes.size(); cut += std::max<std::size_t>(1, bytes.size() / 30)) {

@@ -29,6 +29,20 @@ bool scalar(const openvdb::GridBase& g) {
   return g.isType<openvdb::FloatGrid>() || g.isType<openvdb::DoubleGrid>();
 }
 
+// Vector grids (velocity, gradient, closest point) are read as their magnitude.
+bool vectorValued(const openvdb::GridBase& g) {
+  return g.isType<openvdb::Vec3SGrid>() || g.isType<openvdb::Vec3DGrid>();
+}
+
+template <typename T>
+float valueOf(const T& v) {
+  return static_cast<float>(v);
+}
+template <typename T>
+float valueOf(const openvdb::math::Vec3<T>& v) {
+  return static_cast<float>(v.length());
+}
+
 template <typename GridT>
 void copyDense(const GridT& grid, const openvdb::CoordBBox& box, std::vector<float>& out,
                const LoadProgress& progress) {
@@ -38,8 +52,7 @@ void copyDense(const GridT& grid, const openvdb::CoordBBox& box, std::vector<flo
   std::size_t n = 0;
   for (int k = box.min().z(); k <= box.max().z(); ++k) {
     for (int j = box.min().y(); j <= box.max().y(); ++j)
-      for (int i = box.min().x(); i <= box.max().x(); ++i)
-        out[n++] = static_cast<float>(acc.getValue(openvdb::Coord(i, j, k)));
+      for (int i = box.min().x(); i <= box.max().x(); ++i) out[n++] = valueOf(acc.getValue(openvdb::Coord(i, j, k)));
     progress.step(0.5 + 0.45 * static_cast<double>(n) / static_cast<double>(out.size()));
   }
 }
@@ -54,18 +67,21 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const LoadProg
   openvdb::io::File file(path.string());
   file.open(false);  // no delayed loading: the file is read now, not when voxels are touched
   const openvdb::GridPtrVecPtr headers = file.readAllGridMetadata();
+  // The grid read: "density" if the file has that scalar grid, else its first scalar grid, else the
+  // magnitude of its first vector grid.
   std::string chosen, list;
-  bool found = false;
+  int rank = 0;  // of the chosen grid: 3 density, 2 scalar, 1 vector, 0 none
   for (const openvdb::GridBase::Ptr& g : *headers) {
     list += (list.empty() ? "" : ", ") + g->getName() + " (" + g->valueType() + ")";
-    if (!scalar(*g)) continue;
-    if (!found || g->getName() == "density") chosen = g->getName();
-    found = true;
-    if (g->getName() == "density") break;
+    const int r = scalar(*g) ? (g->getName() == "density" ? 3 : 2) : vectorValued(*g) ? 1 : 0;
+    if (r > rank) {
+      rank = r;
+      chosen = g->getName();
+    }
   }
-  if (!found)
-    throw Error(name,
-                "no float or double grid in the file" + (list.empty() ? std::string() : " (it has " + list + ")"));
+  if (rank == 0)
+    throw Error(name, "no float, double or vector grid in the file" +
+                          (list.empty() ? std::string() : " (it has " + list + ")"));
   progress.step(0.1);
   const openvdb::GridBase::Ptr base = file.readGrid(chosen);
   file.close();
@@ -83,8 +99,12 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const LoadProg
   grid->dims = glm::ivec3(d.x(), d.y(), d.z());
   if (base->isType<openvdb::FloatGrid>())
     copyDense(*openvdb::gridConstPtrCast<openvdb::FloatGrid>(base), box, grid->values, progress);
-  else
+  else if (base->isType<openvdb::DoubleGrid>())
     copyDense(*openvdb::gridConstPtrCast<openvdb::DoubleGrid>(base), box, grid->values, progress);
+  else if (base->isType<openvdb::Vec3SGrid>())
+    copyDense(*openvdb::gridConstPtrCast<openvdb::Vec3SGrid>(base), box, grid->values, progress);
+  else
+    copyDense(*openvdb::gridConstPtrCast<openvdb::Vec3DGrid>(base), box, grid->values, progress);
 
   Volume volume;
   volume.name = chosen.empty() ? path.filename().string() : chosen;
