@@ -90,11 +90,11 @@ void addProbe(CLI::App& app) {
       if (info == nullptr || opt->method == "oracle" || opt->method == "optimal-k")
         throw Error("--method " + opt->method, "not a GPU method (see mfr info --methods)");
       req.method = opt->method;
-      validateOperation(opt->op);
-      req.operation = opt->op;
     } else if (!req.params.empty()) {
       throw Error("--param", "needs --method");
     }
+    validateOperation(opt->op);
+    req.operation = opt->op;
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
@@ -118,6 +118,9 @@ void addProbe(CLI::App& app) {
           splitHybrid(probe, scene.background);
       }
     }
+    // The operation "volume" (a volume scene's own, with or without a method): surfaces and medium.
+    if (effectiveOperation(req.operation, info, scene.visibleVolume() != nullptr) == "volume")
+      splitVolume(probe, scene, camera, req);
 
     std::ostringstream text;
     text << scene.name << ", view " << opt->view << ", " << w << "x" << h << ", pixel (" << x << ", " << y
@@ -126,27 +129,45 @@ void addProbe(CLI::App& app) {
     if (probe.depthTie) text << " (two at one depth: order undefined)";
     text << "\n";
     char line[256];
-    // The method's column, as wide as its name; with hybrid, each fragment's share and role.
+    // The method's column, as wide as its name; then, with hybrid, each fragment's share and role
+    // under the method's split, or with volume, its share of the colour through the medium.
     const int methodWidth = static_cast<int>(std::max<std::size_t>(opt->method.size(), 4));
-    const auto methodColumns = [&](const char* held, const std::string& hybrid) {
+    const auto methodColumn = [&](const char* held) {
       if (!probe.captured) return std::string();
-      char columns[128];
-      std::snprintf(columns, sizeof columns, "  %-*s%s", methodWidth, held, hybrid.c_str());
-      return std::string(columns);
+      char column[64];
+      std::snprintf(column, sizeof column, "  %-*s", methodWidth, held);
+      return std::string(column);
     };
-    std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7s%s\n", "#", "eye depth", "part", "RGBA",
-                  "faces", "weight", methodColumns(opt->method.c_str(), probe.hybrid ? "   hybrid" : "").c_str());
+    std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7s%s%s\n", "#", "eye depth", "part", "RGBA",
+                  "faces", "weight", methodColumn(opt->method.c_str()).c_str(),
+                  probe.hybrid   ? "   hybrid"
+                  : probe.volume ? "   volume"
+                                 : "");
     text << line;
-    nlohmann::ordered_json fragments = nlohmann::ordered_json::array();
+    nlohmann::ordered_json fragments = nlohmann::ordered_json::array(), medium = nlohmann::ordered_json::array();
+    // A stretch of the volume's medium that adds to the pixel: its mean colour and share.
+    const auto mediumRow = [&](std::size_t before) {
+      const ProbeMedium& m = probe.medium[before];
+      if (m.weight < 5e-5) return;
+      const glm::vec3 mean = m.color / static_cast<float>(m.weight);
+      char rgb[32];
+      std::snprintf(rgb, sizeof rgb, "%3d %3d %3d", to8(mean.r), to8(mean.g), to8(mean.b));
+      std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7s%s  %7.4f\n", "", "", "(medium)", rgb, "", "",
+                    methodColumn("").c_str(), m.weight);
+      text << line;
+      medium.push_back({{"before", before}, {"rgb", {m.color.r, m.color.g, m.color.b}}, {"weight", m.weight}});
+    };
     for (std::size_t i = 0; i < probe.fragments.size(); ++i) {
       const ProbeFragment& f = probe.fragments[i];
       const std::uint32_t object = f.fragment.objectId;
       const std::string part = object < scene.objects.size() ? scene.objects[object].name : "?";
+      if (probe.volume) mediumRow(i);
       char share[32] = "";
       if (probe.hybrid) std::snprintf(share, sizeof share, "  %7.4f %s", f.hybridWeight, f.held ? "core" : "tail");
-      std::snprintf(line, sizeof line, "%4zu  %12.6g  %-24.24s  %-15s  %-5s  %7.4f%s\n", i + 1, f.eyeDepth,
+      if (probe.volume) std::snprintf(share, sizeof share, "  %7.4f", f.volumeWeight);
+      std::snprintf(line, sizeof line, "%4zu  %12.6g  %-24.24s  %-15s  %-5s  %7.4f%s%s\n", i + 1, f.eyeDepth,
                     part.c_str(), rgba(f.fragment.color).c_str(), f.fragment.frontFacing ? "front" : "back", f.weight,
-                    methodColumns(f.held ? "held" : "-", share).c_str());
+                    methodColumn(f.held ? "held" : "-").c_str(), share);
       text << line;
       nlohmann::ordered_json j;
       j["depth"] = f.fragment.depth;
@@ -158,18 +179,29 @@ void addProbe(CLI::App& app) {
       j["weight"] = f.weight;
       if (probe.captured) j["held"] = f.held;
       if (probe.hybrid) j["hybrid_weight"] = f.hybridWeight;
+      if (probe.volume) j["volume_weight"] = f.volumeWeight;
       fragments.push_back(j);
     }
-    std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7.4f", "", "", "background", "", "",
-                  probe.transmittance);
+    if (probe.volume) mediumRow(probe.fragments.size());
+    std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7.4f%s", "", "", "background", "", "",
+                  probe.transmittance, methodColumn("").c_str());
     text << line;
-    if (probe.hybrid) {
-      std::snprintf(line, sizeof line, "  %7.4f", probe.hybridBackground);
-      text << methodColumns("", line);
+    if (probe.hybrid || probe.volume) {
+      std::snprintf(line, sizeof line, "  %7.4f", probe.hybrid ? probe.hybridBackground : probe.volumeBackground);
+      text << line;
     }
     text << "\n";
     const glm::ivec3 exact(to8(probe.exactColor.r), to8(probe.exactColor.g), to8(probe.exactColor.b));
     text << "exact colour (over): " << exact.r << " " << exact.g << " " << exact.b << "\n";
+    // Under "volume" the exact colour is the surfaces' and the medium's together.
+    const glm::ivec3 reference =
+        probe.volume ? glm::ivec3(to8(probe.volumeColor.r), to8(probe.volumeColor.g), to8(probe.volumeColor.b)) : exact;
+    if (probe.volume) {
+      double mediumShare = 0.0;
+      for (const ProbeMedium& m : probe.medium) mediumShare += m.weight;
+      text << "exact colour (volume: surfaces and medium): " << reference.r << " " << reference.g << " " << reference.b
+           << " (the medium's share " << std::lround(100.0 * mediumShare) << " %)\n";
+    }
 
     nlohmann::ordered_json j;
     j["scene"] = scene.name;
@@ -183,9 +215,15 @@ void addProbe(CLI::App& app) {
     j["fragments"] = fragments;
     j["background_weight"] = probe.transmittance;
     j["exact_rgb"] = {exact.r, exact.g, exact.b};
+    if (probe.volume) {
+      j["operation"] = "volume";
+      j["medium"] = medium;
+      j["volume_rgb"] = {reference.r, reference.g, reference.b};
+      j["volume_background_weight"] = probe.volumeBackground;
+    }
     if (methodPixel) {
-      const int diff = std::max(
-          {std::abs(methodPixel->r - exact.r), std::abs(methodPixel->g - exact.g), std::abs(methodPixel->b - exact.b)});
+      const int diff = std::max({std::abs(methodPixel->r - reference.r), std::abs(methodPixel->g - reference.g),
+                                 std::abs(methodPixel->b - reference.b)});
       text << opt->method << " colour: " << int(methodPixel->r) << " " << int(methodPixel->g) << " "
            << int(methodPixel->b) << " (largest difference from exact " << diff << "/255)\n";
       nlohmann::ordered_json m;

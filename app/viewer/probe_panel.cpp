@@ -41,7 +41,7 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
   table_ = new QTableWidget(0, ColumnCount, this);
   table_->setObjectName(QStringLiteral("probeTable"));
   table_->setHorizontalHeaderLabels({tr("#"), tr("Eye depth"), tr("Part"), tr("Colour"), tr("α"), tr("Faces"),
-                                     tr("Share"), tr("Held"), tr("Hybrid")});
+                                     tr("Share"), tr("Held"), tr("Hybrid"), tr("Volume")});
   table_->horizontalHeaderItem(Share)->setToolTip(
       tr("The fragment's share of the pixel's colour: α·Π(1 − α) of the fragments in front of it"));
   table_->horizontalHeaderItem(Held)->setToolTip(
@@ -51,6 +51,10 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
       ->setToolTip(tr("With the operation hybrid (the budget methods): the fragment's share of the colour the method "
                       "draws — the core composited exactly, the tail by its weighted average"));
   table_->setColumnHidden(HybridShare, true);
+  table_->horizontalHeaderItem(VolumeShare)
+      ->setToolTip(tr("With the operation volume: the surface's share of the pixel's colour through the medium in "
+                      "front of it (the summary gives the medium's share)"));
+  table_->setColumnHidden(VolumeShare, true);
   table_->verticalHeader()->hide();
   table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   table_->horizontalHeader()->setSectionResizeMode(Part, QHeaderView::Stretch);
@@ -121,9 +125,19 @@ void ProbePanel::show(const ViewProbe& r) {
   const auto to8 = [](float c) { return static_cast<int>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f)); };
   const QColor exact(to8(p.exactColor.r), to8(p.exactColor.g), to8(p.exactColor.b));
   text += tr(". Exact colour %1").arg(exact.name());
+  // Under "volume" the exact colour is the surfaces' and the medium's together.
+  const QColor reference = p.volume ? QColor(to8(p.volumeColor.r), to8(p.volumeColor.g), to8(p.volumeColor.b)) : exact;
+  if (p.volume) {
+    double medium = 0.0;
+    for (const mfr::ProbeMedium& m : p.medium) medium += m.weight;
+    text += tr(" (surfaces only), %1 with the volume (the medium's share %2 %)")
+                .arg(reference.name())
+                .arg(QString::number(100.0 * medium, 'f', 1));
+  }
   if (r.shown) {
-    const int diff = std::max({std::abs(r.shown->red() - exact.red()), std::abs(r.shown->green() - exact.green()),
-                               std::abs(r.shown->blue() - exact.blue())});
+    const int diff =
+        std::max({std::abs(r.shown->red() - reference.red()), std::abs(r.shown->green() - reference.green()),
+                  std::abs(r.shown->blue() - reference.blue())});
     text += tr(", shown %1 (largest difference %2/255)").arg(r.shown->name()).arg(diff);
   }
   text += QStringLiteral(".");
@@ -172,6 +186,9 @@ void ProbePanel::show(const ViewProbe& r) {
     table_->setItem(
         i, HybridShare,
         item(p.hybrid ? QString::number(100.0 * f.hybridWeight, 'f', 1) + QStringLiteral(" %") : QString(), right));
+    table_->setItem(
+        i, VolumeShare,
+        item(p.volume ? QString::number(100.0 * f.volumeWeight, 'f', 1) + QStringLiteral(" %") : QString(), right));
     if (p.captured && !f.held && !p.hybrid)  // dropped; a tail fragment still counts
       for (int c = 0; c < ColumnCount; ++c)
         if (c != Colour) table_->item(i, c)->setForeground(palette().color(QPalette::Disabled, QPalette::Text));
@@ -189,4 +206,9 @@ void ProbePanel::show(const ViewProbe& r) {
     table_->item(n, HybridShare)->setTextAlignment(right);
   }
   table_->setColumnHidden(HybridShare, !p.hybrid);
+  if (p.volume) {
+    table_->item(n, VolumeShare)->setText(QString::number(100.0 * p.volumeBackground, 'f', 1) + QStringLiteral(" %"));
+    table_->item(n, VolumeShare)->setTextAlignment(right);
+  }
+  table_->setColumnHidden(VolumeShare, !p.volume);
 }

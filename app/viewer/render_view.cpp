@@ -669,6 +669,11 @@ ViewProbe RenderView::probeAt(QPoint point) {
     result.shown = QColor(rgba[0], rgba[1], rgba[2]);
   }
 
+  // The operation "volume": surfaces and the medium before, between and behind them.
+  if (model_.effectiveOperationOf(result.side) == QLatin1String("volume"))
+    mfr::splitVolume(result.probe, model_.drawnScene(), model_.camera(),
+                     model_.renderRequest(result.side, pane.size()));
+
   const mfr::MethodInfo* info = model_.isCpuMethod(result.method) ? nullptr : model_.methodInfo(result.method);
   result.methodHasLists = info != nullptr && info->sortedLists;
   if (!result.methodHasLists) return result;

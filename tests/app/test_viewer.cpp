@@ -1104,6 +1104,46 @@ class ViewerTest : public QObject {
     QVERIFY(!m.supportsOperation(QStringLiteral("no-such-method"), QStringLiteral("volume")));
   }
 
+  // The probe on @volume (operation auto → volume): the Volume column gives each surface's share
+  // through the medium, the summary the colour with the medium and the medium's share, which add
+  // up to 100 % with the column; that colour is the oracle's volume image at the pixel.
+  void volumeProbe() {
+    auto w = openWindow(QStringLiteral("@volume"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    RenderView& view = w->view();
+    view.setFixedSize(96, 64);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(96, 64), kTimeoutMs);
+    m.setMethod(QStringLiteral("abuffer-ll"));
+    settle(m);
+    auto* table = w->findChild<QTableWidget*>("probeTable");
+    auto* summary = w->findChild<QLabel*>("probeSummary");
+    QVERIFY(table && summary);
+    const QPoint pixel(48, 32);
+    QTest::mouseClick(&view, Qt::LeftButton, Qt::ControlModifier, pixel);
+    QTRY_VERIFY2_WITH_TIMEOUT(summary->text().contains(QStringLiteral("with the volume")), qPrintable(summary->text()),
+                              20000);
+    QVERIFY(!table->isColumnHidden(ProbePanel::VolumeShare));
+    QVERIFY(table->isColumnHidden(ProbePanel::HybridShare));
+    const QRegularExpression share(
+        QStringLiteral("(#[0-9a-f]{6}) with the volume \\(the medium's share ([0-9.]+) %\\)"));
+    const QRegularExpressionMatch match = share.match(summary->text());
+    QVERIFY2(match.hasMatch(), qPrintable(summary->text()));
+    double total = match.captured(2).toDouble();
+    QVERIFY2(total > 10.0, qPrintable(summary->text()));  // the ray crosses the medium
+    for (int i = 0; i < table->rowCount(); ++i)
+      total += table->item(i, ProbePanel::VolumeShare)->text().remove(QStringLiteral(" %")).toDouble();
+    QVERIFY2(std::abs(total - 100.0) < 0.1 * table->rowCount() + 0.1, qPrintable(QString::number(total)));
+    mfr::RenderRequest oracle;
+    oracle.method = "oracle";
+    oracle.operation = "volume";
+    oracle.width = 96;
+    oracle.height = 64;
+    const mfr::ImageRGBA8 exact = mfr::render(m.scene(), m.camera(), oracle).image;
+    const std::uint8_t* at = exact.at(pixel.x(), pixel.y());
+    QCOMPARE(match.captured(1), QColor(at[0], at[1], at[2]).name());
+  }
+
   // The Volume plugin on @volume: the show switch (abuffer-sbuffer for a method without sorted
   // lists, and back), presets, window and opacity scale changing the transfer function and the
   // image, the preview, the step controls and the info line from the frame's notes, refusals of

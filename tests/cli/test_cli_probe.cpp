@@ -1,9 +1,10 @@
 // mfr probe end to end: the listed fragments and colours against `mfr render` of the same pixel
 // (the oracle's and the method's own images), the "over" weights summing to one, what k-buffers
-// hold, the hybrid shares of a budget method against its own image, and bad input refused with one
-// line and no JSON file.
+// hold, the hybrid shares of a budget method against its own image, the medium of a volume scene
+// against the oracle's volume image, and bad input refused with one line and no JSON file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -124,6 +125,43 @@ TEST_F(CliProbe, BudgetMethodsShowTheirHybridSplit) {
   ASSERT_EQ(oit.exitCode, 0) << oit.out;
   EXPECT_FALSE(readJsonFile(json)["method"].contains("hybrid_rgb"));
   EXPECT_EQ(oit.out.find("hybrid colour"), std::string::npos) << oit.out;
+}
+
+// A volume scene resolves with the operation volume: the probe adds each surface's share through
+// the medium and the medium's own, summing to one with the background's, and the colour they make
+// is the oracle's volume image at the pixel; a GPU method draws it within the volume tests' 3/255.
+TEST_F(CliProbe, VolumeScenesShowTheMediumBetweenTheSurfaces) {
+  const std::string scene = "@volume --size 64x48";
+  const fs::path oracle = dir() / "oracle.png", gpu = dir() / "gpu.png";
+  ASSERT_EQ(runCli("render " + scene + " -o " + oracle.string()).exitCode, 0);
+  ASSERT_EQ(runCli("render " + scene + " -m abuffer-ll -o " + gpu.string()).exitCode, 0);
+  const mfr::ImageRGBA8 exactImage = mfr::readPng(oracle), gpuImage = mfr::readPng(gpu);
+  double mediumSeen = 0.0;
+  for (const auto& [x, y] : {std::pair{32, 24}, std::pair{20, 30}, std::pair{44, 15}}) {
+    SCOPED_TRACE(std::to_string(x) + "," + std::to_string(y));
+    for (const std::string method : {"", " -m abuffer-ll"}) {
+      const fs::path json = dir() / "probe.json";
+      const CliResult r = runCli("probe " + scene + " --pixel " + std::to_string(x) + "," + std::to_string(y) + method +
+                                 " --json " + json.string());
+      ASSERT_EQ(r.exitCode, 0) << r.out;
+      const nlohmann::json j = readJsonFile(json);
+      ASSERT_EQ(j["operation"], "volume");
+      double sum = j["volume_background_weight"].get<double>(), medium = 0.0;
+      for (const nlohmann::json& f : j["fragments"]) sum += f["volume_weight"].get<double>();
+      for (const nlohmann::json& m : j["medium"]) medium += m["weight"].get<double>();
+      EXPECT_NEAR(sum + medium, 1.0, 1e-4);
+      mediumSeen = std::max(mediumSeen, medium);
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(j["volume_rgb"][c].get<int>(), exactImage.at(x, y)[c]) << c;
+        if (!method.empty()) {
+          EXPECT_EQ(j["method"]["rgb"][c].get<int>(), gpuImage.at(x, y)[c]) << c;
+          EXPECT_NEAR(j["method"]["rgb"][c].get<int>(), exactImage.at(x, y)[c], 3) << c;
+        }
+      }
+      EXPECT_NE(r.out.find("exact colour (volume: surfaces and medium)"), std::string::npos) << r.out;
+    }
+  }
+  EXPECT_GT(mediumSeen, 0.3);  // the rays cross the medium
 }
 
 TEST_F(CliProbe, BadInputIsOneLineAndWritesNoJson) {

@@ -178,6 +178,43 @@ TEST(VolumeComposite, SurfacesInFrontInsideAndBehindTheMediumAtTheirExactDepths)
   }
 }
 
+// The same pixel taken apart for the probe: each surface's and each stretch of medium's share,
+// against the closed form above — and the colour, against compositeVolume.
+TEST(VolumeComposite, BreakdownGivesEachSurfaceAndStretchItsShare) {
+  const glm::vec4 medium(0.9f, 0.3f, 0.1f, 0.4f);
+  Volume v = boxVolume(4, [](double, double, double) { return 0.2; });
+  v.transfer = uniformTransfer(medium, 1.0);
+  const double sigma = -std::log(1.0 - 0.4);
+  const glm::vec3 bg(0.2f, 0.3f, 0.4f);
+  const Camera cam = frontCamera();
+  const glm::vec4 front(0.1f, 0.8f, 0.2f, 0.5f), inside(0.2f, 0.2f, 1.0f, 0.6f), behind(1.0f, 1.0f, 1.0f, 0.7f);
+  const double fa = glm::unpackUnorm4x8(glm::packUnorm4x8(front)).a,
+               sa = glm::unpackUnorm4x8(glm::packUnorm4x8(inside)).a,
+               ba = glm::unpackUnorm4x8(glm::packUnorm4x8(behind)).a;
+  const std::vector<Fragment> sorted{surface(cam, 1.7, front), surface(cam, 0.3, inside), surface(cam, -2.0, behind)};
+  const double t1 = std::exp(-sigma * 0.7), t2 = std::exp(-sigma * 1.3);
+  const double mediumWeight[4] = {0.0, (1 - fa) * (1 - t1), (1 - fa) * t1 * (1 - sa) * (1 - t2), 0.0};
+  const double surfaceWeight[3] = {fa, (1 - fa) * t1 * sa, (1 - fa) * t1 * (1 - sa) * t2 * ba};
+  const VolumeRaySetup setup = volumeRaySetup(v, cam, kSize, kSize, 0.05);
+  const VolumeBreakdown b = compositeVolumeBreakdown(sorted, kCentre, kCentre, setup, *v.grid, bg);
+  ASSERT_EQ(b.surfaceWeight.size(), 3u);
+  ASSERT_EQ(b.mediumWeight.size(), 4u);
+  double sum = b.backgroundWeight;
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(b.surfaceWeight[i], surfaceWeight[i], 2e-5) << i;
+    sum += b.surfaceWeight[i];
+  }
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(b.mediumWeight[i], mediumWeight[i], 2e-5) << i;
+    expectNear(b.mediumColor[i], glm::vec3(medium) * static_cast<float>(mediumWeight[i]), 2e-5f);
+    sum += b.mediumWeight[i];
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-5);
+  EXPECT_NEAR(b.backgroundWeight, (1 - fa) * t1 * (1 - sa) * t2 * (1 - ba), 2e-5);
+  const glm::vec3 whole = compositeVolume(sorted, kCentre, kCentre, setup, *v.grid, bg);
+  expectNear(b.color, whole, 0.0f);
+}
+
 // σ linear in z: the midpoint rule integrates it exactly whatever the step, so the colour of a
 // white medium over black is 1 - e^(-τ) with τ the closed-form integral.
 TEST(VolumeComposite, LinearMediumHasTheClosedFormOpticalDepth) {

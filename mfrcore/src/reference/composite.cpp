@@ -283,11 +283,19 @@ struct VolumeMarcher {
     }
   }
 
-  void fragment(const Fragment& f) {
-    march(glm::dot(unproject(2.0f * f.depth - 1.0f) - rayStart, rayDir));
-    const glm::vec4 c = glm::unpackUnorm4x8(f.color);
+  // The ray parameter of a fragment's surface.
+  [[nodiscard]] float tDepth(const Fragment& f) const {
+    return glm::dot(unproject(2.0f * f.depth - 1.0f) - rayStart, rayDir);
+  }
+
+  void surface(const glm::vec4& c) {
     color += transmittance * c.a * glm::vec3(c);
     transmittance *= 1.0f - c.a;
+  }
+
+  void fragment(const Fragment& f) {
+    march(tDepth(f));
+    surface(glm::unpackUnorm4x8(f.color));
   }
 };
 
@@ -300,6 +308,32 @@ glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, co
   for (const Fragment& f : sorted) m.fragment(f);
   m.march(m.tExit);
   return m.color + m.transmittance * background;
+}
+
+VolumeBreakdown compositeVolumeBreakdown(std::span<const Fragment> sorted, int glX, int glY,
+                                         const VolumeRaySetup& setup, const VolumeGrid& grid,
+                                         const glm::vec3& background) {
+  VolumeMarcher m{setup, grid};
+  m.begin(glX, glY);
+  VolumeBreakdown out;
+  // The same steps as compositeVolume, with the medium marched apart from each surface.
+  const auto medium = [&](float tTo) {
+    const glm::vec3 before = m.color;
+    const float in = m.transmittance;
+    m.march(tTo);
+    out.mediumColor.push_back(m.color - before);
+    out.mediumWeight.push_back(in - m.transmittance);
+  };
+  for (const Fragment& f : sorted) {
+    medium(m.tDepth(f));
+    const glm::vec4 c = glm::unpackUnorm4x8(f.color);
+    out.surfaceWeight.push_back(m.transmittance * c.a);
+    m.surface(c);
+  }
+  medium(m.tExit);
+  out.backgroundWeight = m.transmittance;
+  out.color = m.color + m.transmittance * background;
+  return out;
 }
 
 ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, const Volume& volume, double step,

@@ -5,7 +5,9 @@
 #include <vector>
 
 #include "mfr/reference/composite.hpp"
+#include "mfr/error.hpp"
 #include "mfr/reference/hybrid.hpp"
+#include "mfr/render.hpp"
 
 namespace mfr {
 
@@ -106,6 +108,24 @@ void splitHybrid(PixelProbe& probe, glm::vec3 background) {
   colour += transmittance * glm::dvec3(tailPart.color);
   probe.hybridBackground = transmittance * (1.0 - tailPart.alpha);
   probe.hybridColor = glm::vec3(colour + probe.hybridBackground * glm::dvec3(background));
+}
+
+void splitVolume(PixelProbe& probe, const Scene& scene, const Camera& camera, const RenderRequest& request) {
+  const Volume* volume = scene.visibleVolume();
+  if (!volume) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");
+  const Volume drawn = volumeAsRequested(request, *volume);
+  const VolumeRaySetup setup = volumeRaySetup(drawn, camera, probe.width, probe.height, volumeStepOf(request, *volume),
+                                              scene.clipBox, scene.section);
+  std::vector<Fragment> sorted;
+  for (const ProbeFragment& f : probe.fragments) sorted.push_back(f.fragment);
+  const VolumeBreakdown b =
+      compositeVolumeBreakdown(sorted, probe.x, probe.height - 1 - probe.y, setup, *drawn.grid, scene.background);
+  probe.volume = true;
+  for (std::size_t i = 0; i < probe.fragments.size(); ++i) probe.fragments[i].volumeWeight = b.surfaceWeight[i];
+  probe.medium.clear();
+  for (std::size_t i = 0; i < b.mediumColor.size(); ++i) probe.medium.push_back({b.mediumColor[i], b.mediumWeight[i]});
+  probe.volumeColor = b.color;
+  probe.volumeBackground = b.backgroundWeight;
 }
 
 }  // namespace mfr

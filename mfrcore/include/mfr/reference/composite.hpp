@@ -66,6 +66,20 @@ VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int wi
 // One pixel; (glX, glY) in GL window coordinates (row 0 at the bottom).
 glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, const VolumeRaySetup& setup,
                           const VolumeGrid& grid, const glm::vec3& background);
+// The same pixel taken apart (the probe): each surface's share of the colour, α·T with T the
+// transmittance in front of it through surfaces and medium, and for the stretch of medium in front
+// of each surface and behind the last (n + 1 stretches) the colour it adds and its share,
+// T_in·(1 − its own transmittance). The shares and the background's add up to 1.
+struct VolumeBreakdown {
+  std::vector<float> surfaceWeight;    // per fragment
+  std::vector<glm::vec3> mediumColor;  // n + 1: added to the pixel (already weighted)
+  std::vector<float> mediumWeight;     // n + 1
+  glm::vec3 color{0.0f};               // = compositeVolume
+  float backgroundWeight = 1.0f;
+};
+VolumeBreakdown compositeVolumeBreakdown(std::span<const Fragment> sorted, int glX, int glY,
+                                         const VolumeRaySetup& setup, const VolumeGrid& grid,
+                                         const glm::vec3& background);
 ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, const Volume& volume, double step,
                            const glm::vec3& background, const std::optional<Bounds>& clip = std::nullopt,
                            const std::optional<SectionPlane>& section = std::nullopt);

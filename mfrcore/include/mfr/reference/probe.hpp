@@ -15,12 +15,21 @@
 
 namespace mfr {
 
+struct RenderRequest;
+
 struct ProbeFragment {
   Fragment fragment;      // as the oracle casts it (window depth, shaded colour, object, facing)
   double eyeDepth = 0.0;  // distance along the view axis (world units), Camera::depthToEye
   double weight = 0.0;    // α_i·Π_{j<i}(1 − α_j): the fraction of the pixel's colour it gives
   bool held = false;      // the method's capture holds it (matchCapture)
   double hybridWeight = 0.0;  // its share of the hybrid colour under the method's core/tail split (splitHybrid)
+  double volumeWeight = 0.0;  // its share of the "volume" colour: α·T through surfaces and medium (splitVolume)
+};
+
+// A stretch of the volume's medium along the pixel's ray (splitVolume).
+struct ProbeMedium {
+  glm::vec3 color{0.0f};  // what it adds to the pixel's colour
+  double weight = 0.0;    // its share of the colour: the light reaching it times what it absorbs
 };
 
 struct PixelProbe {
@@ -45,6 +54,12 @@ struct PixelProbe {
   bool hybrid = false;
   glm::vec3 hybridColor{0.0f};    // core by "over", tail by its weighted average, on the background
   double hybridBackground = 0.0;  // the background's share: τ_core·τ_tail
+
+  // Set by splitVolume.
+  bool volume = false;
+  std::vector<ProbeMedium> medium;  // fragments.size() + 1: in front of fragment i; the last behind them all
+  glm::vec3 volumeColor{0.0f};      // the exact colour under the operation "volume"
+  double volumeBackground = 0.0;
 };
 
 // The probe of pixel (x, y) of a width × height image (throws mfr::Error for a pixel outside it,
@@ -68,5 +83,11 @@ void matchCapture(PixelProbe& probe, std::span<const Fragment> fragments, std::u
 // method resolving with the operation "hybrid" (the budget methods, a k-buffer with its tail) draws
 // at the pixel, and so what the budget costs there against exactColor.
 void splitHybrid(PixelProbe& probe, glm::vec3 background);
+
+// The operation "volume" at the probed pixel (reference/composite.hpp compositeVolumeBreakdown, on
+// the probe's exact list): each surface's share and the medium's before, between and behind them,
+// and the exact colour — the scene's visible volume as `request` draws it (step, shading), cropped
+// by the scene's clip box and section. Throws mfr::Error when the scene has no visible volume.
+void splitVolume(PixelProbe& probe, const Scene& scene, const Camera& camera, const RenderRequest& request);
 
 }  // namespace mfr
