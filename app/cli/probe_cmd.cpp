@@ -100,6 +100,8 @@ void addProbe(CLI::App& app) {
     applySectionOption(scene, opt->section);
     const Camera camera = scene.view(opt->view);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);
+    // What the method (or, without one, the oracle) does with the lists: hybrid and volume are taken apart.
+    const std::string operation = effectiveOperation(req.operation, info, scene.visibleVolume() != nullptr);
 
     std::optional<glm::u8vec4> methodPixel;
     if (info != nullptr) {
@@ -114,13 +116,11 @@ void addProbe(CLI::App& app) {
         const CapturedLists lists = gpu.capture(camera, req, room, PixelRect{x, y, 1, 1});
         const std::uint32_t count = lists.count(x, y);
         matchCapture(probe, {lists.pixel(x, y), std::min<std::size_t>(count, static_cast<std::size_t>(room))}, count);
-        if (effectiveOperation(req.operation, info, scene.visibleVolume() != nullptr) == "hybrid")
-          splitHybrid(probe, scene.background);
+        if (operation == "hybrid") splitHybrid(probe, scene.background);
       }
     }
     // The operation "volume" (a volume scene's own, with or without a method): surfaces and medium.
-    if (effectiveOperation(req.operation, info, scene.visibleVolume() != nullptr) == "volume")
-      splitVolume(probe, scene, camera, req);
+    if (operation == "volume") splitVolume(probe, scene, camera, req);
 
     std::ostringstream text;
     text << scene.name << ", view " << opt->view << ", " << w << "x" << h << ", pixel (" << x << ", " << y
