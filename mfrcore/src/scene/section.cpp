@@ -329,6 +329,8 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
       out.outcome = SectionOutcome::kCapped;
     } else {
       out.cutLine = std::move(cutLine);
+      for (std::size_t p = 0; p < line.balance.size(); ++p)
+        if (line.balance[p] != 0) out.openEnds.emplace_back(line.source[p], line.balance[p] < 0);
     }
   }
   if (!hasNormals) m.computeSmoothNormals();
@@ -363,10 +365,8 @@ std::vector<bool> capJointly(std::vector<Object>& objects, std::vector<OpenCut>&
   std::vector<End> ends;
   for (std::size_t i = 0; i < open.size(); ++i) {
     const OpenCut& part = open[i];
-    std::vector<glm::vec3> positions(part.world.begin(), part.world.end());
-    WeldedCutLine line = weldCutLine(positions, part.cut.cutLine, kCapWeld * part.diagonal);
-    for (std::size_t p = 0; p < line.balance.size(); ++p)
-      if (line.balance[p] != 0) ends.push_back({part.world[line.source[p]], i, (line.balance[p] < 0) != part.mirrored});
+    for (const auto& [vertex, entering] : part.cut.openEnds)
+      ends.push_back({part.world[vertex], i, entering != part.mirrored});
   }
   std::vector<std::size_t> group(open.size());
   for (std::size_t i = 0; i < group.size(); ++i) group[i] = i;

@@ -32,6 +32,9 @@ struct SectionedMesh {
   // When caps were asked for and none was made: the cut line, segments exit → entry (indices into
   // mesh) in the surface's winding. sectionedScene joins those of objects that are one solid together.
   std::vector<std::pair<std::uint32_t, std::uint32_t>> cutLine;
+  // With cutLine: where its chains end after welding (a vertex of mesh, and whether more segments
+  // enter it than leave), so that sectionedScene can join them to other parts' without welding again.
+  std::vector<std::pair<std::uint32_t, bool>> openEnds;
 };
 
 // Cuts `mesh` by the plane dot(plane.xyz, p) + plane.w >= 0 (kept side, object space). A mesh
