@@ -187,13 +187,13 @@ void addBench(CLI::App& app) {
       if (!opt->noQuality) {
         // The reference of the operation the row ran ("auto": the method's own).
         const MethodInfo* rowInfo = findMethodInfo(req.method);
-        const std::string op = effectiveOperation(req.operation, rowInfo, scene.visibleVolume() != nullptr);
+        const std::string op = effectiveOperation(req.operation, rowInfo, scene.hasVisibleVolume());
         const ImageRGBA8 exact =
             op == "csg" ? csgReference
             : op == "zthickness"
                 ? compositeZThickness(lists, camera, zThicknessOf(req, scene.bounds()), scene.background)
-            : op == "volume" ? compositeVolume(lists, camera, volumeAsRequested(req, *scene.visibleVolume()),
-                                               volumeStepOf(req, *scene.visibleVolume()), scene.background,
+            : op == "volume" ? compositeVolume(lists, camera, volumesAsRequested(req, scene),
+                                               volumeStepOf(req, scene.visibleVolumes()), scene.background,
                                                scene.clipBox, scene.section)
                              : reference;
         const double e = rmse(exact, last.image);

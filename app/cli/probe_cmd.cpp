@@ -101,7 +101,7 @@ void addProbe(CLI::App& app) {
     const Camera camera = scene.view(opt->view);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);
     // What the method (or, without one, the oracle) does with the lists: hybrid and volume are taken apart.
-    const std::string operation = effectiveOperation(req.operation, info, scene.visibleVolume() != nullptr);
+    const std::string operation = effectiveOperation(req.operation, info, scene.hasVisibleVolume());
 
     std::optional<glm::u8vec4> methodPixel;
     if (info != nullptr) {
@@ -155,7 +155,22 @@ void addProbe(CLI::App& app) {
       std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7s%s  %7.4f\n", "", "", "(medium)", rgb, "", "",
                     methodColumn("").c_str(), m.weight);
       text << line;
-      medium.push_back({{"before", before}, {"rgb", {m.color.r, m.color.g, m.color.b}}, {"weight", m.weight}});
+      nlohmann::ordered_json row = {
+          {"before", before}, {"rgb", {m.color.r, m.color.g, m.color.b}}, {"weight", m.weight}};
+      if (probe.volumeNames.size() > 1) {
+        // Several volumes: each one's part of the stretch's share (their media mix where they overlap).
+        nlohmann::ordered_json byVolume = nlohmann::ordered_json::object();
+        for (std::size_t v = 0; v < probe.volumeNames.size(); ++v) {
+          byVolume[probe.volumeNames[v]] = m.weightByVolume[v];
+          if (m.weightByVolume[v] < 5e-5) continue;
+          const std::string label = "(medium) " + probe.volumeNames[v];
+          std::snprintf(line, sizeof line, "%4s  %12s    %-22.22s  %-15s  %-5s  %7s%s  %7.4f\n", "", "", label.c_str(),
+                        "", "", "", methodColumn("").c_str(), m.weightByVolume[v]);
+          text << line;
+        }
+        row["weight_by_volume"] = byVolume;
+      }
+      medium.push_back(row);
     };
     for (std::size_t i = 0; i < probe.fragments.size(); ++i) {
       const ProbeFragment& f = probe.fragments[i];
@@ -198,9 +213,18 @@ void addProbe(CLI::App& app) {
         probe.volume ? glm::ivec3(to8(probe.volumeColor.r), to8(probe.volumeColor.g), to8(probe.volumeColor.b)) : exact;
     if (probe.volume) {
       double mediumShare = 0.0;
-      for (const ProbeMedium& m : probe.medium) mediumShare += m.weight;
+      std::vector<double> shareByVolume(probe.volumeNames.size(), 0.0);
+      for (const ProbeMedium& m : probe.medium) {
+        mediumShare += m.weight;
+        for (std::size_t v = 0; v < shareByVolume.size(); ++v) shareByVolume[v] += m.weightByVolume[v];
+      }
       text << "exact colour (volume: surfaces and medium): " << reference.r << " " << reference.g << " " << reference.b
-           << " (the medium's share " << std::lround(100.0 * mediumShare) << " %)\n";
+           << " (the medium's share " << std::lround(100.0 * mediumShare) << " %";
+      if (shareByVolume.size() > 1)
+        for (std::size_t v = 0; v < shareByVolume.size(); ++v)
+          text << (v == 0 ? ": " : ", ") << probe.volumeNames[v] << " " << std::lround(100.0 * shareByVolume[v])
+               << " %";
+      text << ")\n";
     }
 
     nlohmann::ordered_json j;
@@ -217,6 +241,7 @@ void addProbe(CLI::App& app) {
     j["exact_rgb"] = {exact.r, exact.g, exact.b};
     if (probe.volume) {
       j["operation"] = "volume";
+      j["volumes"] = probe.volumeNames;
       j["medium"] = medium;
       j["volume_rgb"] = {reference.r, reference.g, reference.b};
       j["volume_background_weight"] = probe.volumeBackground;

@@ -124,7 +124,7 @@ void SceneTreePanel::rebuild() {
     item->setTextAlignment(kTriangles, Qt::AlignRight | Qt::AlignVCenter);
     items.push_back(item);
   }
-  // The scene's volumes (operation volume): name, grid size, visibility (at most one shows).
+  // The scene's volumes (operation volume): name, grid size, visibility (at most 4 show).
   const auto& volumes = model_.scene().volumes;
   for (std::size_t v = 0; v < volumes.size(); ++v) {
     const mfr::Volume& volume = volumes[v];
@@ -137,7 +137,8 @@ void SceneTreePanel::rebuild() {
     item->setCheckState(kName, volume.visible ? Qt::Checked : Qt::Unchecked);
     const glm::ivec3 d = volume.grid ? volume.grid->dims : glm::ivec3(0);
     item->setText(kColour, QStringLiteral("%1×%2×%3").arg(d.x).arg(d.y).arg(d.z));
-    item->setToolTip(kName, tr("Drawn by the operation volume; checking it hides the scene's other volumes"));
+    item->setToolTip(kName, tr("Drawn by the operation volume, mixed with the scene's other visible volumes where they "
+                               "overlap (at most 4 at once)"));
     items.push_back(item);
   }
   tree_->addTopLevelItems(items);

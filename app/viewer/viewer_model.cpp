@@ -210,16 +210,37 @@ QString ViewerModel::resolvedOperation(int side, const QString& operation) const
   const QString method = methodOf(side);
   return QString::fromStdString(
       mfr::effectiveOperation(operation.toStdString(), method == QLatin1String("oracle") ? nullptr : methodInfo(method),
-                              scene_.visibleVolume() != nullptr));
+                              scene_.hasVisibleVolume()));
 }
 
 // ---- volume --------------------------------------------------------------------------------
 
 int ViewerModel::volumeIndex() const {
   if (!hasScene_ || scene_.volumes.empty()) return -1;
-  for (std::size_t i = 0; i < scene_.volumes.size(); ++i)
-    if (scene_.volumes[i].visible) return static_cast<int>(i);
-  return 0;
+  return std::clamp(currentVolume_, 0, static_cast<int>(scene_.volumes.size()) - 1);
+}
+
+int ViewerModel::volumeCount() const {
+  return hasScene_ ? static_cast<int>(scene_.volumes.size()) : 0;
+}
+
+int ViewerModel::visibleVolumeCount() const {
+  return hasScene_ ? static_cast<int>(std::count_if(scene_.volumes.begin(), scene_.volumes.end(),
+                                                    [](const mfr::Volume& v) { return v.visible; }))
+                   : 0;
+}
+
+QStringList ViewerModel::volumeNames() const {
+  QStringList names;
+  if (hasScene_)
+    for (const mfr::Volume& v : scene_.volumes) names << QString::fromStdString(v.name);
+  return names;
+}
+
+void ViewerModel::setCurrentVolume(int index) {
+  if (!hasScene_ || index < 0 || index >= static_cast<int>(scene_.volumes.size()) || index == currentVolume_) return;
+  currentVolume_ = index;
+  emit volumeChanged();  // the panel now shows this volume; nothing is drawn differently
 }
 
 QString ViewerModel::volumeName() const {
@@ -275,16 +296,24 @@ void ViewerModel::setVolumeVisible(bool visible) {
   setVolumeVisibleAt(volumeIndex(), visible);
 }
 
+void ViewerModel::showVolume(int index, bool visible) {
+  auto& volumes = scene_.volumes;
+  volumes[static_cast<std::size_t>(index)].visible = visible;
+  if (!visible) return;
+  // At most Scene::kMaxVisibleVolumes are drawn at once: showing one more hides the first other.
+  std::size_t shown = 0;
+  for (const mfr::Volume& v : volumes) shown += v.visible ? 1 : 0;
+  for (std::size_t i = 0; i < volumes.size() && shown > mfr::Scene::kMaxVisibleVolumes; ++i)
+    if (static_cast<int>(i) != index && volumes[i].visible) {
+      volumes[i].visible = false;
+      --shown;
+    }
+}
+
 void ViewerModel::setVolumeVisibleAt(int index, bool visible) {
   if (index < 0 || index >= static_cast<int>(scene_.volumes.size())) return;
-  bool changed = false;
-  for (std::size_t i = 0; i < scene_.volumes.size(); ++i) {
-    const bool want = static_cast<int>(i) == index ? visible : (visible ? false : scene_.volumes[i].visible);
-    if (scene_.volumes[i].visible == want) continue;
-    scene_.volumes[i].visible = want;
-    changed = true;
-  }
-  if (!changed) return;
+  if (scene_.volumes[static_cast<std::size_t>(index)].visible == visible) return;
+  showVolume(index, visible);
   updateSceneGeometry();
   volumeEdited();
 }
@@ -310,10 +339,7 @@ void ViewerModel::setVolumeStateAt(int index, bool visible, const mfr::TransferF
   } catch (const std::exception&) {
     // keeps the loaded one
   }
-  scene_.volumes[static_cast<std::size_t>(index)].visible = visible;
-  if (visible)
-    for (std::size_t i = 0; i < scene_.volumes.size(); ++i)
-      if (static_cast<int>(i) != index) scene_.volumes[i].visible = false;
+  showVolume(index, visible);
   updateSceneGeometry();
   volumeEdited();
 }
@@ -389,7 +415,12 @@ void ViewerModel::setVolumeStep(double step) {
 
 double ViewerModel::volumeStepDefault() const {
   const int i = volumeIndex();
-  return i < 0 ? 0.0 : scene_.volumes[static_cast<std::size_t>(i)].defaultStep();
+  if (i < 0) return 0.0;
+  // What the renderers use: the smallest default step of the volumes drawn (volumeStepOf).
+  double step = 0.0;
+  for (const mfr::Volume& v : scene_.volumes)
+    if (v.visible) step = step == 0.0 ? v.defaultStep() : std::min(step, v.defaultStep());
+  return step > 0.0 ? step : scene_.volumes[static_cast<std::size_t>(i)].defaultStep();
 }
 
 void ViewerModel::volumeEdited() {
@@ -537,6 +568,12 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
   }
   // So is the volume step; the loaded transfer functions are what "As Loaded" brings back.
   volumeStep_ = 0.0;
+  currentVolume_ = 0;
+  for (std::size_t i = 0; i < scene_.volumes.size(); ++i)
+    if (scene_.volumes[i].visible) {
+      currentVolume_ = static_cast<int>(i);
+      break;
+    }
   loadedTransfers_.clear();
   volumeRanges_.clear();
   for (const mfr::Volume& v : scene_.volumes) {
@@ -710,7 +747,7 @@ ImageKey ViewerModel::imageKey(const mfr::RenderRequest& request) const {
     text += ";thickness=" + QString::number(request.thickness, 'g', 17).toStdString();
   // The step matters to images of the operation volume, "auto" included where it resolves to it.
   const mfr::MethodInfo* info = request.method == "oracle" ? nullptr : mfr::findMethodInfo(request.method);
-  if (mfr::effectiveOperation(request.operation, info, scene_.visibleVolume() != nullptr) == "volume")
+  if (mfr::effectiveOperation(request.operation, info, scene_.hasVisibleVolume()) == "volume")
     text += ";step=" + QString::number(request.volumeStep, 'g', 17).toStdString();
   return {sceneRevision_, viewRevision_, QSize(request.width, request.height), text};
 }

@@ -162,11 +162,19 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] double volumeStep() const override { return volumeStep_; }
   void setVolumeStep(double step) override;
   [[nodiscard]] double volumeStepDefault() const override;
-  // Every volume of the scene by index (the scene tree, sessions): showing one hides the others.
+  // 1.6: the scene's volumes, and which one "the volume" of the getters and setters above is.
+  [[nodiscard]] int volumeCount() const override;
+  [[nodiscard]] int visibleVolumeCount() const override;
+  [[nodiscard]] QStringList volumeNames() const override;
+  [[nodiscard]] int currentVolume() const override { return volumeIndex(); }
+  void setCurrentVolume(int index) override;
+  // Every volume of the scene by index (the scene tree, sessions); showing one more than
+  // Scene::kMaxVisibleVolumes hides the first other visible one.
   void setVolumeVisibleAt(int index, bool visible);
   // A session's volume state: visibility and transfer function (an invalid one is ignored).
   void setVolumeStateAt(int index, bool visible, const mfr::TransferFunction& transfer, bool shading);
-  // The index of "the volume": the visible one, else the first; -1 without volumes.
+  // The index of "the volume" (setCurrentVolume; a new scene starts at its first visible volume,
+  // else its first); -1 without volumes.
   [[nodiscard]] int volumeIndex() const;
 
   [[nodiscard]] const ParamsByMethod& allParams() const { return allParamsOf(0); }
@@ -316,6 +324,8 @@ class ViewerModel final : public ViewerContext {
   std::array<ParamsByMethod, kSides> params_;
   double thickness_ = 0.0;  // operation zthickness, scene units; 0 = mfr::zThicknessDefault
   double volumeStep_ = 0.0;                             // operation volume, scene units; 0 = the volume's defaultStep()
+  int currentVolume_ = 0;                               // volumeIndex() of the scene's volumes
+  void showVolume(int index, bool visible);             // keeps at most kMaxVisibleVolumes shown
   std::vector<mfr::TransferFunction> loadedTransfers_;  // of scene_'s volumes as loaded
   std::vector<glm::dvec2> volumeRanges_;                // of scene_'s volumes' grids
 

@@ -125,9 +125,10 @@ class ViewerContext : public QObject {
   [[nodiscard]] virtual double loadedObjectOpacity(int objectId) const = 0;
 
   // ---- Scalar volume, operation "volume" (1.4) ----
-  // "The volume" is the scene's visible volume, or its first one while every volume is hidden
-  // (a scene shows at most one). Without a volume the getters read empty values and the setters
-  // do nothing (setTransferFunction returns a reason).
+  // "The volume" is the current one of the scene's volumes (1.6: currentVolume; a new scene starts
+  // at its first visible volume, else its first). Up to mfr::Scene::kMaxVisibleVolumes are drawn at
+  // once, their media mixed where they overlap. Without a volume the getters read empty values and
+  // the setters do nothing (setTransferFunction returns a reason).
   // The operation the main view runs now: operation() with "auto" resolved.
   [[nodiscard]] virtual QString effectiveOperation() const = 0;
   [[nodiscard]] virtual bool hasVolume() const = 0;
@@ -142,7 +143,8 @@ class ViewerContext : public QObject {
   // counted. Empty without a volume, for bins < 1, or unless low < high (both finite). Computed
   // anew on each call (one pass over the grid): callers cache it.
   [[nodiscard]] virtual std::vector<std::uint64_t> volumeHistogram(double low, double high, int bins) const = 0;
-  // Whether it is drawn (Volume::visible); showing it hides any other volume of the scene.
+  // Whether it is drawn (Volume::visible); showing it while kMaxVisibleVolumes others are shown
+  // hides the first of them.
   [[nodiscard]] virtual bool volumeVisible() const = 0;
   virtual void setVolumeVisible(bool visible) = 0;
   // Gradient shading with a headlight (Volume::shading): boundaries inside the medium read as
@@ -169,8 +171,17 @@ class ViewerContext : public QObject {
   // volumeStepDefault()). A new scene starts at 0; a negative, infinite or NaN value is ignored.
   [[nodiscard]] virtual double volumeStep() const = 0;
   virtual void setVolumeStep(double step) = 0;
-  // Volume::defaultStep(): half the smallest world distance between grid points (0 without a volume).
+  // Volume::defaultStep(): half the smallest world distance between grid points, the smallest over
+  // the volumes drawn (the current volume's while none is; 0 without a volume).
   [[nodiscard]] virtual double volumeStepDefault() const = 0;
+  // 1.6: the scene's volumes (names in scene order) and the current one, whose state the getters
+  // and setters above read and edit. setCurrentVolume ignores an index out of range and emits
+  // volumeChanged; it draws nothing differently.
+  [[nodiscard]] virtual int volumeCount() const = 0;
+  [[nodiscard]] virtual int visibleVolumeCount() const = 0;  // of them, those drawn
+  [[nodiscard]] virtual QStringList volumeNames() const = 0;
+  [[nodiscard]] virtual int currentVolume() const = 0;
+  virtual void setCurrentVolume(int index) = 0;
 
  signals:
   void sceneChanged();  // a new scene, or an object edited
@@ -184,7 +195,8 @@ class ViewerContext : public QObject {
   void dataViewChanged();
   void operationChanged(const QString& operation);
   void zThicknessChanged(double thickness);  // zThickness(), 0 = the default
-  void volumeChanged();                      // 1.4: a new scene, or the volume's visibility, transfer function or step
+  void
+  volumeChanged();  // 1.4: a new scene, or a volume's visibility, transfer function or step; 1.6: the current volume
 };
 
 class MfrViewerPlugin {
@@ -206,5 +218,7 @@ class MfrViewerPlugin {
 // 1.4: the scalar volume (operation volume): presence, dims, bounds, visibility, transfer function
 //      (presets, table), ray-march step, shading, effectiveOperation, volumeChanged.
 // 1.5: volumeHistogram (the transfer-function editor's background).
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.5"
+// 1.6: several volumes drawn at once: volumeCount, visibleVolumeCount, volumeNames, currentVolume,
+//      setCurrentVolume.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.6"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

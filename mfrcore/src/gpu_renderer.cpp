@@ -39,28 +39,38 @@ struct GpuRenderer::GpuVolume {
 
 GpuRenderer::~GpuRenderer() = default;
 
-void GpuRenderer::uploadVolume(const Scene& scene) {
-  const Volume* v = scene.visibleVolume();
-  if (!v) {
-    volume_.reset();
-    return;
+void GpuRenderer::uploadVolumes(const Scene& scene) {
+  const std::vector<Volume> visible = scene.visibleVolumes();
+  std::vector<std::shared_ptr<GpuVolume>> previous = std::move(volumes_);
+  volumes_.clear();
+  // Grids the previous upload holds keep their textures; the others are freed before new ones are
+  // allocated.
+  std::vector<gl::Texture> kept(visible.size());
+  for (std::size_t i = 0; i < visible.size(); ++i)
+    for (auto& old : previous)
+      if (old && old->grid.id() != 0 && old->volume.grid == visible[i].grid) {
+        kept[i] = std::move(old->grid);
+        break;
+      }
+  previous.clear();
+  for (std::size_t i = 0; i < visible.size(); ++i) {
+    const Volume& v = visible[i];
+    auto gpu = std::make_shared<GpuVolume>();
+    gpu->volume = v;
+    const glm::ivec3 d = v.grid->dims;
+    if (kept[i].id() != 0) {
+      gpu->grid = std::move(kept[i]);  // same samples: keep the texture
+    } else {
+      gpu->grid = gl::createTexture3D(GL_R32F, d.x, d.y, d.z);
+      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+      glTextureSubImage3D(gpu->grid.id(), 0, 0, 0, 0, d.x, d.y, d.z, GL_RED, GL_FLOAT, v.grid->values.data());
+    }
+    const std::vector<glm::vec4> table = v.transfer.table();
+    gpu->transfer = gl::createTexture1D(GL_RGBA32F, MFR_VOLUME_TF_SIZE);
+    glTextureSubImage1D(gpu->transfer.id(), 0, 0, MFR_VOLUME_TF_SIZE, GL_RGBA, GL_FLOAT, table.data());
+    gpu->bytes = v.grid->values.size() * sizeof(float) + table.size() * sizeof(glm::vec4);
+    volumes_.push_back(std::move(gpu));
   }
-  auto gpu = std::make_shared<GpuVolume>();
-  gpu->volume = *v;
-  const glm::ivec3 d = v->grid->dims;
-  if (volume_ && volume_->volume.grid == v->grid) {
-    gpu->grid = std::move(volume_->grid);  // same samples: keep the texture
-  } else {
-    volume_.reset();  // free the old grid before allocating the new one
-    gpu->grid = gl::createTexture3D(GL_R32F, d.x, d.y, d.z);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-    glTextureSubImage3D(gpu->grid.id(), 0, 0, 0, 0, d.x, d.y, d.z, GL_RED, GL_FLOAT, v->grid->values.data());
-  }
-  const std::vector<glm::vec4> table = v->transfer.table();
-  gpu->transfer = gl::createTexture1D(GL_RGBA32F, MFR_VOLUME_TF_SIZE);
-  glTextureSubImage1D(gpu->transfer.id(), 0, 0, MFR_VOLUME_TF_SIZE, GL_RGBA, GL_FLOAT, table.data());
-  gpu->bytes = v->grid->values.size() * sizeof(float) + table.size() * sizeof(glm::vec4);
-  volume_ = std::move(gpu);
 }
 
 GpuRenderer::GpuRenderer(bool finishTiming) : finishTiming_(finishTiming) {}
@@ -82,7 +92,7 @@ void GpuRenderer::setScene(const Scene& original) {
   sceneBounds_ = scene.bounds();
   clipBox_ = scene.clipBox;
   section_ = scene.section;
-  uploadVolume(scene);
+  uploadVolumes(scene);
   gl::checkErrors("scene upload");
 }
 
@@ -96,7 +106,7 @@ void GpuRenderer::shareScene(const GpuRenderer& other) {
   sceneBounds_ = other.sceneBounds_;
   clipBox_ = other.clipBox_;
   section_ = other.section_;
-  volume_ = other.volume_;
+  volumes_ = other.volumes_;
 }
 
 Method& GpuRenderer::prepare(const RenderRequest& request) {
@@ -107,12 +117,13 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
     method_ = createMethod(request.method);
     methodName_ = request.method;
   }
-  operation_ = effectiveOperation(request.operation, &method_->info(), volume_ != nullptr);
+  operation_ = effectiveOperation(request.operation, &method_->info(), !volumes_.empty());
   thickness_ = zThicknessOf(request, sceneBounds_);
   if (operation_ == "volume") {
-    if (!volume_) throw Error("--op volume", "scene '" + sceneName_ + "' has no visible volume");
-    volumeStep_ = volumeStepOf(request, volume_->volume);
-    volumeShading_ = request.volumeShading.value_or(volume_->volume.shading);
+    if (volumes_.empty()) throw Error("--op volume", "scene '" + sceneName_ + "' has no visible volume");
+    drawnVolumes_.clear();
+    for (const auto& v : volumes_) drawnVolumes_.push_back(volumeAsRequested(request, v->volume));
+    volumeStep_ = volumeStepOf(request, drawnVolumes_);
   }
   const Params params(method_->info().params, request.params, request.method);
   method_->configure(request.width, request.height, params);
@@ -175,23 +186,30 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
     renderCsg(ctx, method);
   } else if (operation_ == "volume") {
     const VolumeRaySetup setup =
-        volumeRaySetup(volume_->volume, camera, request.width, request.height, volumeStep_, clipBox_, section_);
+        volumeRaySetup(drawnVolumes_, camera, request.width, request.height, volumeStep_, clipBox_, section_);
     method.resolve(ctx, Operation{"volume", "ops/volume.glsl", [&](const gl::Program& p) {
                                     p.set("uInvViewProj", setup.invViewProj);
                                     p.set("uViewport", setup.viewport);
-                                    p.set("uWorldToGrid", setup.worldToGrid);
-                                    p.set("uGridDims", setup.dims);
                                     p.set("uVolumeStep", setup.step);
-                                    p.set("uTfLow", setup.tfLow);
-                                    p.set("uTfHigh", setup.tfHigh);
-                                    p.set("uVolumeShading", volumeShading_ ? 1 : 0);
+                                    p.set("uVolumeCount", static_cast<int>(setup.media.size()));
+                                    for (std::size_t i = 0; i < setup.media.size(); ++i) {
+                                      const VolumeMedium& m = setup.media[i];
+                                      const std::string at = "[" + std::to_string(i) + "]";
+                                      p.set(("uWorldToGrid" + at).c_str(), m.worldToGrid);
+                                      p.set(("uGridDims" + at).c_str(), m.dims);
+                                      p.set(("uTfLow" + at).c_str(), m.tfLow);
+                                      p.set(("uTfHigh" + at).c_str(), m.tfHigh);
+                                      p.set(("uVolumeShading" + at).c_str(), m.shading ? 1 : 0);
+                                      glBindTextureUnit(MFR_TEX_VOLUME + static_cast<GLuint>(i),
+                                                        volumes_[i]->grid.id());
+                                      glBindTextureUnit(MFR_TEX_VOLUME_TF + static_cast<GLuint>(i),
+                                                        volumes_[i]->transfer.id());
+                                    }
                                     p.set("uClip", setup.clip ? 1 : 0);
                                     p.set("uClipMin", setup.clipMin);
                                     p.set("uClipMax", setup.clipMax);
                                     p.set("uSection", setup.section ? 1 : 0);
                                     p.set("uSectionPlane", setup.sectionPlane);
-                                    glBindTextureUnit(MFR_TEX_VOLUME, volume_->grid.id());
-                                    glBindTextureUnit(MFR_TEX_VOLUME_TF, volume_->transfer.id());
                                   }});
   } else if (operation_ == "zthickness") {
     method.resolve(ctx, Operation{"zthickness", "ops/zthickness.glsl", [&](const gl::Program& p) {
@@ -214,9 +232,12 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   if (operation_ == "zthickness") stats.notes.emplace_back("z-thickness", std::to_string(thickness_));
   if (operation_ == "volume") {
     stats.notes.emplace_back("volume step", std::to_string(volumeStep_));
-    stats.notes.emplace_back("volume (bytes)", std::to_string(volume_->bytes));
-    stats.notes.emplace_back("volume shading", volumeShading_ ? "on" : "off");
-  } else if (volume_) {
+    std::size_t bytes = 0;
+    for (const auto& v : volumes_) bytes += v->bytes;
+    stats.notes.emplace_back("volumes", std::to_string(volumes_.size()));
+    stats.notes.emplace_back("volume (bytes)", std::to_string(bytes));
+    stats.notes.emplace_back("volume shading", volumeShadingNote(drawnVolumes_));
+  } else if (!volumes_.empty()) {
     stats.notes.emplace_back("volume", "not drawn (operation " + operation_ + ")");
   }
   lastWidth_ = request.width;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -54,10 +55,25 @@ Volume volumeAsRequested(const RenderRequest& request, const Volume& volume) {
   return v;
 }
 
-double volumeStepOf(const RenderRequest& request, const Volume& volume) {
+std::string volumeShadingNote(std::span<const Volume> volumes) {
+  std::size_t on = 0;
+  for (const Volume& v : volumes) on += v.shading ? 1 : 0;
+  return on == 0 ? "off" : on == volumes.size() ? "on" : std::to_string(on) + " of " + std::to_string(volumes.size());
+}
+
+std::vector<Volume> volumesAsRequested(const RenderRequest& request, const Scene& scene) {
+  std::vector<Volume> volumes = scene.visibleVolumes();
+  for (Volume& v : volumes) v = volumeAsRequested(request, v);
+  return volumes;
+}
+
+double volumeStepOf(const RenderRequest& request, std::span<const Volume> volumes) {
   if (!std::isfinite(request.volumeStep) || request.volumeStep < 0.0)
     throw Error("--step", "must be a positive length in scene units (got " + std::to_string(request.volumeStep) + ")");
-  return request.volumeStep > 0.0 ? request.volumeStep : volume.defaultStep();
+  if (request.volumeStep > 0.0) return request.volumeStep;
+  double step = std::numeric_limits<double>::infinity();
+  for (const Volume& v : volumes) step = std::min(step, v.defaultStep());
+  return std::isfinite(step) ? step : 0.0;
 }
 
 std::string effectiveOperation(const std::string& operation, const MethodInfo* info, bool sceneHasVolume) {
@@ -184,7 +200,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     return out;
   }
   RenderOutput out;
-  const std::string operation = effectiveOperation(request.operation, nullptr, scene.visibleVolume() != nullptr);
+  const std::string operation = effectiveOperation(request.operation, nullptr, scene.hasVisibleVolume());
   const FragmentLists lists = castFragments(scene, camera, request.width, request.height);
   if (operation == "hybrid") {
     // The exact hybrid image for a uniform core size: --method oracle --op hybrid -p k=N.
@@ -198,13 +214,13 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     }
     out.image = compositeHybrid(lists, static_cast<std::uint32_t>(value), scene.background);
   } else if (operation == "volume") {
-    const Volume* volume = scene.visibleVolume();
-    if (!volume) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");
-    const double step = volumeStepOf(request, *volume);
-    const Volume drawn = volumeAsRequested(request, *volume);
+    const std::vector<Volume> drawn = volumesAsRequested(request, scene);
+    if (drawn.empty()) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");
+    const double step = volumeStepOf(request, drawn);
     out.image = compositeVolume(lists, camera, drawn, step, scene.background, scene.clipBox, scene.section);
     out.stats.notes.emplace_back("volume step", std::to_string(step));
-    out.stats.notes.emplace_back("volume shading", drawn.shading ? "on" : "off");
+    out.stats.notes.emplace_back("volumes", std::to_string(drawn.size()));
+    out.stats.notes.emplace_back("volume shading", volumeShadingNote(drawn));
   } else if (operation == "zthickness") {
     const double thickness = zThicknessOf(request, scene.bounds());
     out.image = compositeZThickness(lists, camera, thickness, scene.background);
@@ -217,7 +233,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
   } else {
     out.image = compositeOver(lists, scene.background);
   }
-  if (operation != "volume" && scene.visibleVolume())
+  if (operation != "volume" && scene.hasVisibleVolume())
     out.stats.notes.emplace_back("volume", "not drawn (operation " + operation + ")");
   out.stats.method = "oracle";
   out.stats.operation = operation;

@@ -85,6 +85,20 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   setObjectName(QStringLiteral("hybridVolumePanel"));
   auto* layout = new QVBoxLayout(this);
 
+  // A scene with several volumes: which one the controls below show and edit.
+  volumeChoice_ = new QComboBox;
+  volumeChoice_->setObjectName(QStringLiteral("hvVolume"));
+  volumeChoice_->setToolTip(
+      tr("The volume these controls show and edit. Up to four volumes are drawn at once; where they "
+         "overlap their media mix (extinctions add, colours weighted by extinction)."));
+  volumeRow_ = new QWidget;
+  auto* volumeRow = new QHBoxLayout(volumeRow_);
+  volumeRow->setContentsMargins(0, 0, 0, 0);
+  volumeRow->addWidget(new QLabel(tr("Volume")));
+  volumeRow->addWidget(volumeChoice_, 1);
+  layout->addWidget(volumeRow_);
+  volumeRow_->hide();
+
   show_ = new QCheckBox(tr("Show volume"));
   show_->setObjectName(QStringLiteral("hvShow"));
   show_->setToolTip(
@@ -230,6 +244,9 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   layout->addStretch();
 
   connect(show_, &QCheckBox::toggled, this, &HybridVolumePanel::setShow);
+  connect(volumeChoice_, &QComboBox::currentIndexChanged, this, [this](int index) {
+    if (index >= 0) context_.setCurrentVolume(index);
+  });
   connect(shade_, &QCheckBox::toggled, this, [this](bool on) { context_.setVolumeShading(on); });
   connect(&context_, &ViewerContext::operationChanged, this, &HybridVolumePanel::showState);
   connect(&context_, &ViewerContext::methodChanged, this, &HybridVolumePanel::showState);
@@ -276,7 +293,21 @@ void HybridVolumePanel::showScaleValue() {
 
 // ---- the volume and its transfer function ---------------------------------------------------
 
+void HybridVolumePanel::showVolumeChoice() {
+  const QSignalBlocker block(volumeChoice_);
+  const QStringList names = context_.hasScene() ? context_.volumeNames() : QStringList();
+  QStringList shown;
+  for (int i = 0; i < volumeChoice_->count(); ++i) shown << volumeChoice_->itemText(i);
+  if (shown != names) {
+    volumeChoice_->clear();
+    volumeChoice_->addItems(names);
+  }
+  volumeChoice_->setCurrentIndex(context_.hasScene() ? context_.currentVolume() : -1);
+  volumeRow_->setVisible(names.size() > 1);
+}
+
 void HybridVolumePanel::volumeChanged() {
+  showVolumeChoice();
   const bool has = context_.hasScene() && context_.hasVolume();
   controls_->setEnabled(has);
   show_->setEnabled(has);
@@ -483,13 +514,18 @@ void HybridVolumePanel::setShow(bool on) {
     return;
   }
   if (!on) {
+    context_.setVolumeVisible(false);
+    // Other volumes still drawn keep the operation volume.
+    if (context_.visibleVolumeCount() > 0) {
+      showState();
+      return;
+    }
     if (!previousMethod_.isEmpty() && context_.method() == QLatin1String(kVolumeMethod))
       context_.setMethod(previousMethod_);
     if (context_.operation() == kVolume)
       context_.setOperation(previousOperation_.isEmpty() ? QStringLiteral("auto") : previousOperation_);
     previousMethod_.clear();
     previousOperation_.clear();
-    context_.setVolumeVisible(false);
     showState();
     return;
   }
@@ -573,7 +609,8 @@ void HybridVolumePanel::showInfo() {
 // ---- settings -------------------------------------------------------------------------------
 
 QJsonObject HybridVolumePanel::saveSettings() const {
-  return {{QStringLiteral("show"), show_->isChecked()},
+  return {{QStringLiteral("volume"), context_.currentVolume()},
+          {QStringLiteral("show"), show_->isChecked()},
           {QStringLiteral("preset"), preset_->currentData().toString()},
           {QStringLiteral("window"), QJsonArray{windowLow_, windowHigh_}},
           {QStringLiteral("opacity_scale"), opacityScale()},
@@ -586,6 +623,8 @@ QJsonObject HybridVolumePanel::saveSettings() const {
 
 void HybridVolumePanel::loadSettings(const QJsonObject& settings) {
   if (!context_.hasScene() || !context_.hasVolume()) return;
+  // The volume the panel showed (absent in sessions of one volume): its controls get the settings.
+  context_.setCurrentVolume(settings.value(QStringLiteral("volume")).toInt(context_.currentVolume()));
   volumeChanged();  // this scene's volume (sessions load settings after their own state)
   previousOperation_ = settings.value(QStringLiteral("previous_operation")).toString();
   previousMethod_ = settings.value(QStringLiteral("previous_method")).toString();

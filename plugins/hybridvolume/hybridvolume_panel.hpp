@@ -1,5 +1,7 @@
 #pragma once
 // The Volume panel (plugin "hybridvolume").
+// - Volume (only for a scene with several): which volume the controls show and edit
+//   (ViewerContext::setCurrentVolume); up to four are drawn at once, their media mixed.
 // - "Show volume": shows the scene's volume and switches the main view to the operation volume,
 //   choosing abuffer-sbuffer when the current method keeps no sorted lists
 //   (ViewerContext::supportsOperation); off, it hides the volume and brings back the method and
@@ -54,6 +56,7 @@ class HybridVolumePanel final : public QWidget {
 
  private:
   void volumeChanged();
+  void showVolumeChoice();
   void resetToCurrent();  // Custom, based on the context's function, its own window, scale 1
   void setShow(bool on);
   void showState();
@@ -72,6 +75,8 @@ class HybridVolumePanel final : public QWidget {
   void showInfo();
 
   ViewerContext& context_;
+  QComboBox* volumeChoice_ = nullptr;
+  QWidget* volumeRow_ = nullptr;
   QCheckBox* show_ = nullptr;
   QLabel* note_ = nullptr;
   QComboBox* preset_ = nullptr;

@@ -39,8 +39,10 @@
 #define MFR_TEX_AUX0 1
 #define MFR_TEX_AUX1 2
 #define MFR_TEX_AUX2 3
-#define MFR_TEX_VOLUME 4     // operation "volume": the scalar grid (R32F, texelFetch)
-#define MFR_TEX_VOLUME_TF 5  // operation "volume": the transfer-function table (RGBA32F, 1D)
+// Operation "volume": volume i's scalar grid (R32F, texelFetch) on unit MFR_TEX_VOLUME + i and its
+// transfer-function table (RGBA32F, 1D) on MFR_TEX_VOLUME_TF + i, i < MFR_MAX_VOLUMES.
+#define MFR_TEX_VOLUME 4
+#define MFR_TEX_VOLUME_TF 8
 
 // Invalid index / end of a linked list
 #define MFR_NIL 0xFFFFFFFFu
@@ -81,6 +83,9 @@
 // steps through the volume (a longer chord gets a longer step), and marching stops once the
 // transmittance is below MFR_VOLUME_MIN_TRANSMITTANCE (what is left changes no 8-bit value).
 #define MFR_VOLUME_TF_SIZE 256
+// At most this many volumes are drawn at once; where they overlap, their media mix (extinctions
+// add, emission weighted by extinction: Kainz et al. 2009's multiple volumes).
+#define MFR_MAX_VOLUMES 4
 #define MFR_VOLUME_MAX_STEPS 4096
 #define MFR_VOLUME_MIN_TRANSMITTANCE (1.0 / 4096.0)
 #define MFR_VOLUME_MAX_ALPHA (1.0 - 1.0 / 1024.0)

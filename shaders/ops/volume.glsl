@@ -1,4 +1,4 @@
-// Operation "volume": a scalar volume composited exactly with each pixel's sorted surface fragments
+// Operation "volume": scalar volumes composited exactly with each pixel's sorted surface fragments
 // — the hybrid volume/polygon rendering of Kainz, Grabner, Bornik, Hauswiesner, Muehl, Schmalstieg,
 // "Ray Casting of Multiple Volumetric Datasets with Polyhedral Boundaries on Manycore GPUs", ACM
 // TOG 28(5) (SIGGRAPH Asia) 2009: the fragments sorted along the ray split it into intervals, the
@@ -6,26 +6,33 @@
 // 1995) is ray-marched over each interval, and each surface is composited with "over" at its exact
 // depth — not at the nearest sample — so surfaces inside the medium are hidden by just the medium
 // in front of them. Steps lie on a grid of uVolumeStep from the ray's entry into the volume's box;
-// an interval cut by a surface is integrated in two parts, each with its midpoint's sample. A
-// shaded volume scales each sample's emission by its gradient lighting (volumeShade).
+// an interval cut by a surface is integrated in two parts, each with its midpoint's sample. Up to
+// MFR_MAX_VOLUMES volumes are marched together (the paper's multiple volumes), the intervals also
+// cut where the ray enters or leaves a box; where boxes overlap, the media mix as emission-absorption
+// media do (Max 1995): extinctions add, and the emitted colour is weighted by extinction. A shaded volume scales each sample's emission by its
+// gradient lighting (volumeShade).
 // Same definition and float arithmetic as the oracle's compositeVolume
 // (mfrcore/src/reference/composite.cpp).
 uniform vec3 uBackground;
 uniform mat4 uInvViewProj;   // NDC → world
 uniform vec2 uViewport;      // width, height of the resolve
-uniform mat4 uWorldToGrid;   // world → grid coordinates (point (i,j,k) at (i,j,k))
-uniform ivec3 uGridDims;
 uniform float uVolumeStep;   // world units along the ray
-uniform float uTfLow;        // scalar of the first transfer-table entry
-uniform float uTfHigh;       // scalar of the last one
-uniform int uVolumeShading;  // Volume::shading
+uniform int uVolumeCount;    // volumes drawn, 1 … MFR_MAX_VOLUMES
+uniform mat4 uWorldToGrid[MFR_MAX_VOLUMES];  // world → grid coordinates (point (i,j,k) at (i,j,k))
+uniform ivec3 uGridDims[MFR_MAX_VOLUMES];
+uniform float uTfLow[MFR_MAX_VOLUMES];       // scalar of the first transfer-table entry
+uniform float uTfHigh[MFR_MAX_VOLUMES];      // scalar of the last one
+uniform int uVolumeShading[MFR_MAX_VOLUMES]; // Volume::shading
 uniform int uClip;           // Scene::clipBox: the march stays inside [uClipMin, uClipMax] too (world)
 uniform vec3 uClipMin;
 uniform vec3 uClipMax;
 uniform int uSection;         // Scene::section: the march stays where dot(plane.xyz, p) + plane.w >= 0 (world)
 uniform vec4 uSectionPlane;
-layout(binding = MFR_TEX_VOLUME) uniform sampler3D uVolume;       // R32F, read with texelFetch
-layout(binding = MFR_TEX_VOLUME_TF) uniform sampler1D uTransfer;  // (rgb, σ), MFR_VOLUME_TF_SIZE
+// Volume i on units MFR_TEX_VOLUME + i (R32F, read with texelFetch) and MFR_TEX_VOLUME_TF + i
+// ((rgb, σ), MFR_VOLUME_TF_SIZE entries); indexed only by loop counters bounded by a uniform, so
+// dynamically uniform as GLSL 4.50 requires.
+layout(binding = MFR_TEX_VOLUME) uniform sampler3D uVolume[MFR_MAX_VOLUMES];
+layout(binding = MFR_TEX_VOLUME_TF) uniform sampler1D uTransfer[MFR_MAX_VOLUMES];
 
 struct OpState {
   vec3 color;
@@ -33,27 +40,30 @@ struct OpState {
   vec3 rayStart;  // world point of the pixel's centre on the near plane
   vec3 rayDir;    // unit
   vec2 ndc;
-  vec3 gridStart;  // the ray in grid coordinates: gridStart + t·gridDir, t in world units
-  vec3 gridDir;
-  float tEnter, tExit, step;  // the part of the ray inside the box, and the step used
+  vec3 gridStart[MFR_MAX_VOLUMES];  // the ray in volume i's grid coordinates: gridStart + t·gridDir
+  vec3 gridDir[MFR_MAX_VOLUMES];
+  float enter[MFR_MAX_VOLUMES];     // volume i's part of the ray (empty: enter == exit)
+  float exit[MFR_MAX_VOLUMES];
+  float tEnter, tExit, step;  // from the first entry into a box to the last exit, and the step used
   float t;                    // integrated up to
   int next;                   // index of the next step boundary tEnter + next·step
 };
 
 // Trilinear interpolation, clamped to the grid (VolumeGrid::sample).
-float volumeSample(vec3 g) {
-  vec3 last = vec3(uGridDims - 1);
+float volumeSample(int v, vec3 g) {
+  ivec3 dims = uGridDims[v];
+  vec3 last = vec3(dims - 1);
   vec3 c = clamp(g, vec3(0.0), last);
-  ivec3 i0 = min(ivec3(floor(c)), uGridDims - 2);
+  ivec3 i0 = min(ivec3(floor(c)), dims - 2);
   vec3 f = c - vec3(i0);
-  float v000 = texelFetch(uVolume, i0, 0).r;
-  float v100 = texelFetch(uVolume, i0 + ivec3(1, 0, 0), 0).r;
-  float v010 = texelFetch(uVolume, i0 + ivec3(0, 1, 0), 0).r;
-  float v110 = texelFetch(uVolume, i0 + ivec3(1, 1, 0), 0).r;
-  float v001 = texelFetch(uVolume, i0 + ivec3(0, 0, 1), 0).r;
-  float v101 = texelFetch(uVolume, i0 + ivec3(1, 0, 1), 0).r;
-  float v011 = texelFetch(uVolume, i0 + ivec3(0, 1, 1), 0).r;
-  float v111 = texelFetch(uVolume, i0 + ivec3(1, 1, 1), 0).r;
+  float v000 = texelFetch(uVolume[v], i0, 0).r;
+  float v100 = texelFetch(uVolume[v], i0 + ivec3(1, 0, 0), 0).r;
+  float v010 = texelFetch(uVolume[v], i0 + ivec3(0, 1, 0), 0).r;
+  float v110 = texelFetch(uVolume[v], i0 + ivec3(1, 1, 0), 0).r;
+  float v001 = texelFetch(uVolume[v], i0 + ivec3(0, 0, 1), 0).r;
+  float v101 = texelFetch(uVolume[v], i0 + ivec3(1, 0, 1), 0).r;
+  float v011 = texelFetch(uVolume[v], i0 + ivec3(0, 1, 1), 0).r;
+  float v111 = texelFetch(uVolume[v], i0 + ivec3(1, 1, 1), 0).r;
   float x00 = mix(v000, v100, f.x);
   float x10 = mix(v010, v110, f.x);
   float x01 = mix(v001, v101, f.x);
@@ -61,27 +71,28 @@ float volumeSample(vec3 g) {
   return mix(mix(x00, x10, f.y), mix(x01, x11, f.y), f.z);
 }
 
-// (rgb, σ) of a scalar: the table interpolated linearly (TransferFunction::table).
-vec4 volumeTransfer(float v) {
-  float u = clamp((v - uTfLow) / (uTfHigh - uTfLow), 0.0, 1.0) * float(MFR_VOLUME_TF_SIZE - 1);
+// (rgb, σ) of a scalar: volume v's table interpolated linearly (TransferFunction::table).
+vec4 volumeTransfer(int v, float value) {
+  float u = clamp((value - uTfLow[v]) / (uTfHigh[v] - uTfLow[v]), 0.0, 1.0) * float(MFR_VOLUME_TF_SIZE - 1);
   int i = min(int(u), MFR_VOLUME_TF_SIZE - 2);
   float f = u - float(i);
-  return mix(texelFetch(uTransfer, i, 0), texelFetch(uTransfer, i + 1, 0), f);
+  return mix(texelFetch(uTransfer[v], i, 0), texelFetch(uTransfer[v], i + 1, 0), f);
 }
 
 // The emission factor of a shaded volume at grid point g (MFR_VOLUME_AMBIENT in common/bindings.h;
 // Levoy 1988): headlight diffuse on the normalised world gradient, faded out where the gradient
 // is small against the transfer function's range.
-float volumeShade(vec3 g, vec3 rayDir) {
-  vec3 gradient = 0.5 * vec3(volumeSample(g + vec3(1.0, 0.0, 0.0)) - volumeSample(g - vec3(1.0, 0.0, 0.0)),
-                             volumeSample(g + vec3(0.0, 1.0, 0.0)) - volumeSample(g - vec3(0.0, 1.0, 0.0)),
-                             volumeSample(g + vec3(0.0, 0.0, 1.0)) - volumeSample(g - vec3(0.0, 0.0, 1.0)));
+float volumeShade(int v, vec3 g, vec3 rayDir) {
+  vec3 gradient =
+      0.5 * vec3(volumeSample(v, g + vec3(1.0, 0.0, 0.0)) - volumeSample(v, g - vec3(1.0, 0.0, 0.0)),
+                 volumeSample(v, g + vec3(0.0, 1.0, 0.0)) - volumeSample(v, g - vec3(0.0, 1.0, 0.0)),
+                 volumeSample(v, g + vec3(0.0, 0.0, 1.0)) - volumeSample(v, g - vec3(0.0, 0.0, 1.0)));
   float perCell = length(gradient);
   if (!(perCell > 0.0)) return 1.0;
-  vec3 world = transpose(mat3(uWorldToGrid)) * gradient;
+  vec3 world = transpose(mat3(uWorldToGrid[v])) * gradient;
   float facing = abs(dot(world, rayDir)) / length(world);
   float lit = float(MFR_VOLUME_AMBIENT) + float(MFR_VOLUME_DIFFUSE) * facing;
-  float w = perCell / (perCell + float(MFR_VOLUME_SHADE_EDGE) * (uTfHigh - uTfLow));
+  float w = perCell / (perCell + float(MFR_VOLUME_SHADE_EDGE) * (uTfHigh[v] - uTfLow[v]));
   return mix(1.0, lit, w);
 }
 
@@ -98,64 +109,98 @@ void opBegin(inout OpState s, ivec2 pixel) {
   vec3 rayEnd = volumeUnproject(s.ndc, 1.0);
   float rayLength = distance(rayEnd, s.rayStart);
   s.rayDir = (rayEnd - s.rayStart) / rayLength;
-  s.gridStart = (uWorldToGrid * vec4(s.rayStart, 1.0)).xyz;
-  s.gridDir = (uWorldToGrid * vec4(s.rayDir, 0.0)).xyz;
-  // Slabs of the box [0, dims - 1].
-  float t0 = 0.0, t1 = rayLength;
-  vec3 last = vec3(uGridDims - 1);
-  for (int a = 0; a < 3; ++a) {
-    if (abs(s.gridDir[a]) < 1e-30) {
-      if (s.gridStart[a] < 0.0 || s.gridStart[a] > last[a]) t1 = -1.0;
-    } else {
-      float ta = (0.0 - s.gridStart[a]) / s.gridDir[a];
-      float tb = (last[a] - s.gridStart[a]) / s.gridDir[a];
-      t0 = max(t0, min(ta, tb));
-      t1 = min(t1, max(ta, tb));
-    }
-  }
+  // The part of the ray every volume shares: inside the clip box and on the kept side of the plane.
+  float c0 = 0.0, c1 = rayLength;
   if (uClip != 0) {  // slabs of the clip box, in world space
     for (int a = 0; a < 3; ++a) {
       if (abs(s.rayDir[a]) < 1e-30) {
-        if (s.rayStart[a] < uClipMin[a] || s.rayStart[a] > uClipMax[a]) t1 = -1.0;
+        if (s.rayStart[a] < uClipMin[a] || s.rayStart[a] > uClipMax[a]) c1 = -1.0;
       } else {
         float ta = (uClipMin[a] - s.rayStart[a]) / s.rayDir[a];
         float tb = (uClipMax[a] - s.rayStart[a]) / s.rayDir[a];
-        t0 = max(t0, min(ta, tb));
-        t1 = min(t1, max(ta, tb));
+        c0 = max(c0, min(ta, tb));
+        c1 = min(c1, max(ta, tb));
       }
     }
   }
   if (uSection != 0) {  // the kept half-space of the section plane
     float s0 = dot(uSectionPlane.xyz, s.rayStart) + uSectionPlane.w, ds = dot(uSectionPlane.xyz, s.rayDir);
     if (abs(ds) < 1e-30) {
-      if (s0 < 0.0) t1 = -1.0;
+      if (s0 < 0.0) c1 = -1.0;
     } else if (ds > 0.0) {
-      t0 = max(t0, -s0 / ds);
+      c0 = max(c0, -s0 / ds);
     } else {
-      t1 = min(t1, -s0 / ds);
+      c1 = min(c1, -s0 / ds);
     }
   }
-  s.tEnter = t0;
-  s.tExit = max(t1, t0);
+  bool any = false;
+  s.tEnter = 0.0;
+  s.tExit = 0.0;
+  for (int v = 0; v < MFR_MAX_VOLUMES; ++v) {
+    s.enter[v] = 0.0;
+    s.exit[v] = 0.0;
+    if (v >= uVolumeCount) continue;
+    s.gridStart[v] = (uWorldToGrid[v] * vec4(s.rayStart, 1.0)).xyz;
+    s.gridDir[v] = (uWorldToGrid[v] * vec4(s.rayDir, 0.0)).xyz;
+    float t0 = c0, t1 = c1;
+    vec3 last = vec3(uGridDims[v] - 1);
+    for (int a = 0; a < 3; ++a) {  // slabs of the box [0, dims - 1]
+      if (abs(s.gridDir[v][a]) < 1e-30) {
+        if (s.gridStart[v][a] < 0.0 || s.gridStart[v][a] > last[a]) t1 = -1.0;
+      } else {
+        float ta = (0.0 - s.gridStart[v][a]) / s.gridDir[v][a];
+        float tb = (last[a] - s.gridStart[v][a]) / s.gridDir[v][a];
+        t0 = max(t0, min(ta, tb));
+        t1 = min(t1, max(ta, tb));
+      }
+    }
+    s.enter[v] = t0;
+    s.exit[v] = max(t1, t0);
+    if (s.exit[v] > s.enter[v]) {
+      s.tEnter = any ? min(s.tEnter, s.enter[v]) : s.enter[v];
+      s.tExit = any ? max(s.tExit, s.exit[v]) : s.exit[v];
+      any = true;
+    }
+  }
+  if (!any) {
+    s.tEnter = c0 > 0.0 ? c0 : 0.0;
+    s.tExit = s.tEnter;
+  }
   s.step = max(uVolumeStep, (s.tExit - s.tEnter) / float(MFR_VOLUME_MAX_STEPS));
   s.t = s.tEnter;
   s.next = 1;
 }
 
-// Integrates the medium from s.t to tTo (clipped to the box), one midpoint sample per interval.
+// Integrates the media from s.t to tTo (clipped to the boxes), one midpoint sample per interval.
 void volumeMarch(inout OpState s, float tTo) {
   tTo = min(tTo, s.tExit);
-  for (int it = 0; it < MFR_VOLUME_MAX_STEPS + 2 && s.t < tTo &&
+  for (int it = 0; it < MFR_VOLUME_MAX_STEPS + 2 + 2 * MFR_MAX_VOLUMES && s.t < tTo &&
                   s.transmittance >= float(MFR_VOLUME_MIN_TRANSMITTANCE);
        ++it) {
     float boundary = s.tEnter + float(s.next) * s.step;
     float end = min(boundary, tTo);
+    for (int v = 0; v < MFR_MAX_VOLUMES; ++v) {  // a box's entry or exit cuts the interval too
+      if (v >= uVolumeCount) break;
+      if (s.enter[v] > s.t && s.enter[v] < end) end = s.enter[v];
+      if (s.exit[v] > s.t && s.exit[v] < end) end = s.exit[v];
+    }
     if (end > s.t) {
-      vec3 g = s.gridStart + s.gridDir * (0.5 * (s.t + end));
-      vec4 m = volumeTransfer(volumeSample(g));
-      if (m.a > 0.0) {
-        float absorbed = 1.0 - exp(-m.a * (end - s.t));
-        s.color += s.transmittance * absorbed * m.rgb * (uVolumeShading != 0 ? volumeShade(g, s.rayDir) : 1.0);
+      float mid = 0.5 * (s.t + end);
+      float sigma = 0.0;
+      vec3 emission = vec3(0.0);
+      for (int v = 0; v < MFR_MAX_VOLUMES; ++v) {
+        if (v >= uVolumeCount) break;
+        if (!(mid > s.enter[v] && mid < s.exit[v])) continue;
+        vec3 g = s.gridStart[v] + s.gridDir[v] * mid;
+        vec4 m = volumeTransfer(v, volumeSample(v, g));
+        if (m.a > 0.0) {
+          sigma += m.a;
+          emission += m.a * m.rgb * (uVolumeShading[v] != 0 ? volumeShade(v, g, s.rayDir) : 1.0);
+        }
+      }
+      if (sigma > 0.0) {
+        float absorbed = 1.0 - exp(-sigma * (end - s.t));
+        s.color += s.transmittance * absorbed * (emission / sigma);
         s.transmittance *= 1.0 - absorbed;
       }
       s.t = end;

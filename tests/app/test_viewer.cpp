@@ -1003,7 +1003,7 @@ class ViewerTest : public QObject {
     QCOMPARE(note("volume step"), std::to_string(0.02));
     QVERIFY(std::stoull(note("volume (bytes)")) >= 96ull * 96 * 96 * 4);
     // The default (step 0) is the volume's defaultStep(), as the renderers make it.
-    QCOMPARE(m.volumeStepDefault(), m.scene().visibleVolume()->defaultStep());
+    QCOMPARE(m.volumeStepDefault(), m.scene().visibleVolumes().at(0).defaultStep());
     w->findChild<QPushButton*>("volumeStepDefault")->click();
     QCOMPARE(m.volumeStep(), 0.0);
     settle(m);
@@ -1198,7 +1198,7 @@ class ViewerTest : public QObject {
     QCOMPARE(m.method(), QStringLiteral("wboit"));
     QCOMPARE(m.operation(), QStringLiteral("oit"));
     QVERIFY(!m.volumeVisible());
-    QVERIFY(!m.scene().visibleVolume());
+    QVERIFY(!m.scene().hasVisibleVolume());
     settle(m);
     QVERIFY(note("volume step").empty());
     // A method with sorted lists is kept.
@@ -1303,7 +1303,7 @@ class ViewerTest : public QObject {
     QCOMPARE(note("volume shading"), std::string("off"));
     shade->setChecked(true);
     QVERIFY(m.volumeShading());
-    QVERIFY(m.scene().visibleVolume()->shading);
+    QVERIFY(m.scene().visibleVolumes().at(0).shading);
     settle(m);
     QCOMPARE(note("volume shading"), std::string("on"));
     const mfr::ImageRGBA8 shadedFrame = w->view().renderImage(m.renderSize());
@@ -1459,7 +1459,7 @@ class ViewerTest : public QObject {
 
     // The histogram: the viewer's counts are the grid's, outside values skipped, and the editor
     // shows them over the function's range.
-    const mfr::VolumeGrid& grid = *m.scene().visibleVolume()->grid;
+    const mfr::VolumeGrid& grid = *m.scene().visibleVolumes().at(0).grid;
     const std::vector<std::uint64_t> all = histogramOf(grid, 0.0, 1.0, 128);
     QVERIFY(m.volumeHistogram(0.0, 1.0, 128) == all);
     std::uint64_t total = 0;

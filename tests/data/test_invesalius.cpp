@@ -122,8 +122,7 @@ TEST(InvesaliusRealFile, VolumeWithTheSurfacesOnGpuEqualsTheOracle) {
     req.operation = "volume";
     req.width = w;
     req.height = h;
-    const ImageRGBA8 expected =
-        compositeVolume(oracle, camera, *scene.visibleVolume(), scene.visibleVolume()->defaultStep(), scene.background);
+    const ImageRGBA8 expected = compositeVolume(oracle, camera, scene.visibleVolumes(), 0.0, scene.background);
     for (const char* method : {"abuffer-ll", "abuffer-sbuffer"}) {
       SCOPED_TRACE(std::string(view) + " " + method);
       req.method = method;

@@ -113,7 +113,7 @@ TEST(ClipGpu, VolumeIsCroppedLikeTheOracle) {
                                    .image;
   scene.clipBox = part(scene.bounds(), {0.0, 0.0, 0.0}, {0.55, 1.0, 0.7});
   const FragmentLists oracle = castFragments(scene, camera, w, h);
-  const Volume& volume = *scene.visibleVolume();
+  const Volume volume = scene.visibleVolumes().at(0);
   const ImageRGBA8 expected =
       compositeVolume(oracle, camera, volume, volume.defaultStep(), scene.background, scene.clipBox);
   for (const char* method : {"abuffer-ll", "kplus-array"}) {

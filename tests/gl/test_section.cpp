@@ -135,7 +135,7 @@ TEST(SectionGpu, VolumeIsCroppedToTheKeptSide) {
   const ImageRGBA8 uncropped = render(scene, camera, req).image;
   scene.section = SectionPlane{scene.bounds().center(), {0.4, -1.0, 0.2}, true};
   const FragmentLists oracle = castFragments(scene, camera, w, h);
-  const Volume& volume = *scene.visibleVolume();
+  const Volume volume = scene.visibleVolumes().at(0);
   const ImageRGBA8 expected =
       compositeVolume(oracle, camera, volume, volume.defaultStep(), scene.background, scene.clipBox, scene.section);
   for (const char* method : {"abuffer-ll", "kplus-array"}) {

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <string>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "gl_fixture.hpp"
 #include "image_compare.hpp"
 #include "mfr/error.hpp"
@@ -51,8 +53,8 @@ TEST(VolumeGpu, EqualsTheOracleWithSurfacesInsideTheVolume) {
       req.width = w;
       req.height = h;
       req.volumeStep = step;
-      const ImageRGBA8 expected = compositeVolume(oracle, camera, *scene.visibleVolume(),
-                                                  volumeStepOf(req, *scene.visibleVolume()), scene.background);
+      const ImageRGBA8 expected = compositeVolume(oracle, camera, scene.visibleVolumes(),
+                                                  volumeStepOf(req, scene.visibleVolumes()), scene.background);
       for (const char* method : {"abuffer-ll", "abuffer-array", "abuffer-sbuffer", "kplus-array", "kbuffer"}) {
         SCOPED_TRACE(std::string(view) + " " + method + " step " + std::to_string(step));
         req.method = method;
@@ -89,8 +91,8 @@ TEST(VolumeGpu, ShadedEqualsTheOracle) {
     req.operation = "volume";
     req.width = w;
     req.height = h;
-    const ImageRGBA8 expected = compositeVolume(oracle, camera, *scene.visibleVolume(),
-                                                volumeStepOf(req, *scene.visibleVolume()), scene.background);
+    const ImageRGBA8 expected = compositeVolume(oracle, camera, scene.visibleVolumes(),
+                                                volumeStepOf(req, scene.visibleVolumes()), scene.background);
     for (const char* method : {"abuffer-ll", "abuffer-sbuffer"}) {
       SCOPED_TRACE(std::string(view) + " " + method);
       req.method = method;
@@ -152,8 +154,7 @@ TEST(VolumeGpu, VolumeAloneAndAutoOperation) {
   const RenderOutput out = alone.render(camera, req);
   const FragmentLists empty = castFragments(scene, camera, w, h);
   EXPECT_EQ(empty.fragments.size(), 0u);
-  const ImageRGBA8 expected =
-      compositeVolume(empty, camera, *scene.visibleVolume(), scene.visibleVolume()->defaultStep(), scene.background);
+  const ImageRGBA8 expected = compositeVolume(empty, camera, scene.visibleVolumes(), 0.0, scene.background);
   const Comparison c = compareOffEdges(empty, expected, out.image, scene.background, 2);
   EXPECT_EQ(c.compared, static_cast<std::size_t>(w * h));
   EXPECT_GT(c.volumeOnly, 600u);  // measured: 824
@@ -164,6 +165,88 @@ TEST(VolumeGpu, VolumeAloneAndAutoOperation) {
   GpuRenderer plain;
   plain.setScene(none);
   EXPECT_THROW(plain.render(none.view("iso"), req), Error);
+}
+
+// Several volumes at once (the operation's multiple volumes, up to MFR_MAX_VOLUMES, so every
+// texture unit pair): the sample's volume, a turned and moved copy with another transfer function,
+// a smaller shaded copy, and a coarse grid of its own across them — on the GPU against the oracle,
+// with the surfaces inside. Each added volume must change the image.
+Scene severalVolumesScene(std::size_t count) {
+  Scene scene = makeVolumeSampleScene();
+  const Volume base = scene.volumes[0];
+  Volume turned = base;
+  turned.name = "turned";
+  turned.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0.5, 0.2, -0.3)) *
+                     glm::rotate(glm::dmat4(1.0), glm::radians(30.0), glm::dvec3(0.0, 1.0, 0.0));
+  turned.transfer = transferPreset("fire", 0.1, 1.0, 0.3);
+  Volume small = base;
+  small.name = "small";
+  small.transform =
+      glm::translate(glm::dmat4(1.0), glm::dvec3(-0.4, 0.1, 0.3)) * glm::scale(glm::dmat4(1.0), glm::dvec3(0.6));
+  small.transfer = transferPreset("cool-warm", 0.0, 1.0, 0.2);
+  small.shading = true;
+  Volume coarse;
+  coarse.name = "coarse";
+  auto grid = std::make_shared<VolumeGrid>();
+  grid->dims = glm::ivec3(7, 5, 9);
+  for (int k = 0; k < 9; ++k)
+    for (int j = 0; j < 5; ++j)
+      for (int i = 0; i < 7; ++i) grid->values.push_back(static_cast<float>((i + 2 * j + k) % 5) / 4.0f);
+  coarse.grid = grid;
+  coarse.origin = glm::dvec3(-1.3, -0.5, -0.9);
+  coarse.spacing = glm::dvec3(0.3, 0.25, 0.2);
+  coarse.transfer = transferPreset("grayscale", 0.0, 1.0, 1.5);
+  const Volume extra[] = {turned, small, coarse};
+  for (std::size_t i = 0; i + 1 < count && i < 3; ++i) scene.volumes.push_back(extra[i]);
+  return scene;
+}
+
+TEST(VolumeGpu, SeveralVolumesEqualTheOracle) {
+  context();
+  const int w = 128, h = 112;
+  ImageRGBA8 previous;
+  for (const std::size_t count : {std::size_t{1}, std::size_t{2}, std::size_t{4}}) {
+    const Scene scene = severalVolumesScene(count);
+    ASSERT_EQ(scene.visibleVolumes().size(), count);
+    GpuRenderer gpu;
+    gpu.setScene(scene);
+    const Camera camera = scene.view("iso");
+    const FragmentLists oracle = castFragments(scene, camera, w, h);
+    RenderRequest req;
+    req.operation = "volume";
+    req.width = w;
+    req.height = h;
+    const ImageRGBA8 expected = compositeVolume(oracle, camera, scene.visibleVolumes(),
+                                                volumeStepOf(req, scene.visibleVolumes()), scene.background);
+    for (const char* method : {"abuffer-ll", "abuffer-sbuffer"}) {
+      SCOPED_TRACE(std::to_string(count) + " volumes, " + method);
+      req.method = method;
+      const RenderOutput out = gpu.render(camera, req);
+      const Comparison c = compareOffEdges(oracle, expected, out.image, scene.background, 2);
+      EXPECT_GT(c.compared, static_cast<std::size_t>(w * h) * 8 / 10);
+      EXPECT_GE(static_cast<double>(c.within) / c.compared, 0.999)
+          << c.compared - c.within << " pixels off by more than 2/255, max " << c.maxDifference;
+      const auto note = std::find_if(out.stats.notes.begin(), out.stats.notes.end(),
+                                     [](const auto& n) { return n.first == "volumes"; });
+      ASSERT_NE(note, out.stats.notes.end());
+      EXPECT_EQ(note->second, std::to_string(count));
+    }
+    if (count > 1) {
+      std::size_t changed = 0;
+      for (std::size_t i = 0; i < expected.pixels.size(); ++i)
+        changed += std::abs(int(expected.pixels[i]) - int(previous.pixels[i])) > 8;
+      EXPECT_GT(changed, 300u) << "the added volumes left the image as it was";
+    }
+    previous = expected;
+  }
+  // One more than MFR_MAX_VOLUMES visible: refused with a reason, nothing drawn.
+  Scene five = severalVolumesScene(4);
+  five.volumes.push_back(five.volumes[0]);
+  five.volumes.back().name = "fifth";
+  GpuRenderer gpu;
+  EXPECT_THROW(gpu.setScene(five), Error);
+  five.volumes.back().visible = false;
+  EXPECT_NO_THROW(gpu.setScene(five));
 }
 
 }  // namespace

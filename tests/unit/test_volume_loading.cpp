@@ -511,7 +511,8 @@ TEST_F(VolumeLoading, LoadSceneOnAVolumeFile) {
   EXPECT_EQ(scene.name, "cube.vti");
   EXPECT_TRUE(scene.objects.empty());
   ASSERT_EQ(scene.volumes.size(), 1u);
-  EXPECT_EQ(scene.visibleVolume(), &scene.volumes[0]);
+  ASSERT_EQ(scene.visibleVolumes().size(), 1u);
+  EXPECT_EQ(scene.visibleVolumes()[0].grid, scene.volumes[0].grid);
   ASSERT_EQ(scene.views.size(), 2u);
   EXPECT_EQ(scene.views[0].name, "front");
   EXPECT_EQ(scene.views[1].name, "iso");
@@ -605,7 +606,8 @@ TEST_F(SceneVolumes, VolumesWithObjectsAndAHiddenSecondVolume) {
   ASSERT_EQ(s.objects.size(), 1u);
   ASSERT_EQ(s.volumes.size(), 2u);
   EXPECT_FALSE(s.volumes[1].visible);
-  EXPECT_EQ(s.visibleVolume(), &s.volumes[0]);
+  ASSERT_EQ(s.visibleVolumes().size(), 1u);
+  EXPECT_EQ(s.visibleVolumes()[0].name, s.volumes[0].name);
   EXPECT_NO_THROW(s.validate());
   // The fitted view and the bounds include the volume (box: ±0.5, volume: 0…2).
   expectVec(s.bounds().max, {2.0, 2.0, 2.0});
@@ -660,8 +662,10 @@ TEST_F(SceneVolumes, ErrorsNameTheJsonPath) {
               "zero scale");
   expectError(R"({"volumes": [{"file": "cube.vti", "visible": "yes"}]})", "volumes[0].visible",
               "expected true or false");
-  expectError(R"({"volumes": [{"file": "cube.vti"}, {"file": "cube.vti", "name": "second"}]})", "volumes[1].visible",
-              "at most one volume can be drawn");
+  expectError(
+      R"({"volumes": [{"file": "cube.vti"}, {"file": "cube.vti", "name": "2"}, {"file": "cube.vti", "name": "3"},
+                               {"file": "cube.vti", "name": "4"}, {"file": "cube.vti", "name": "5"}]})",
+      "volumes[4].visible", "4 volumes are visible already: at most that many can be drawn at once");
 }
 
 }  // namespace

@@ -98,13 +98,13 @@ class GpuRenderer {
   std::optional<Bounds> clipBox_;  // Scene::clipBox
   std::optional<SectionPlane> section_;  // Scene::section (the surfaces come cut; the volume march is cropped)
   double thickness_ = 0.0;  // operation "zthickness" of the prepared request (scene units)
-  // Operation "volume": the scene's visible volume on the GPU (shared with shareScene; a new
-  // scene with the same grid keeps the grid texture and uploads only the transfer table).
+  // Operation "volume": the scene's visible volumes on the GPU (shared with shareScene; a new
+  // scene with the same grids keeps their textures and uploads only the transfer tables).
   struct GpuVolume;
-  std::shared_ptr<GpuVolume> volume_;
-  double volumeStep_ = 0.0;  // of the prepared request (scene units)
-  bool volumeShading_ = false;  // of the prepared request (its own, else the volume's)
-  void uploadVolume(const Scene& scene);
+  std::vector<std::shared_ptr<GpuVolume>> volumes_;
+  double volumeStep_ = 0.0;           // of the prepared request (scene units)
+  std::vector<Volume> drawnVolumes_;  // of the prepared request (volumesAsRequested: its shading)
+  void uploadVolumes(const Scene& scene);
   gl::Buffer csgVisible_;
   std::size_t csgPixels_ = 0;
   gl::Program csgShade_;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -44,11 +45,18 @@ double zThicknessDefault(const Bounds& sceneBounds);
 // The thickness a request asks for (its own, or the default); throws mfr::Error("--thickness", …)
 // for a negative, infinite or NaN value.
 double zThicknessOf(const RenderRequest& request, const Bounds& sceneBounds);
-// The step a request asks for (its own, or the volume's default); throws mfr::Error("--step", …)
-// for a negative, infinite or NaN value.
-double volumeStepOf(const RenderRequest& request, const Volume& volume);
+// The step a request asks for (its own, or the smallest default step of the volumes); throws
+// mfr::Error("--step", …) for a negative, infinite or NaN value.
+double volumeStepOf(const RenderRequest& request, std::span<const Volume> volumes);
+inline double volumeStepOf(const RenderRequest& request, const Volume& volume) {
+  return volumeStepOf(request, std::span<const Volume>(&volume, 1));
+}
 // The volume as a request draws it: a copy (sharing the grid) with the request's shading, if any.
 Volume volumeAsRequested(const RenderRequest& request, const Volume& volume);
+// The scene's visible volumes as the request draws them (Scene::visibleVolumes, volumeAsRequested).
+std::vector<Volume> volumesAsRequested(const RenderRequest& request, const Scene& scene);
+// The statistics note "volume shading": "on", "off", or "N of M" when only some volumes are shaded.
+std::string volumeShadingNote(std::span<const Volume> volumes);
 // What a request's operation means for a method (info; nullptr: the oracle) on a scene with or
 // without a visible volume: "auto" is the method's preferredOperation, except that a scene with a
 // volume gets "volume" from every method that prefers "oit" and resolves sorted lists.

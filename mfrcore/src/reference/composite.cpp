@@ -146,19 +146,30 @@ ImageRGBA8 compositeZThickness(const FragmentLists& lists, const Camera& camera,
   return image;
 }
 
-VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int width, int height, double step,
+VolumeRaySetup volumeRaySetup(std::span<const Volume> volumes, const Camera& camera, int width, int height, double step,
                               const std::optional<Bounds>& clip, const std::optional<SectionPlane>& section) {
+  if (volumes.empty()) throw Error("operation volume", "no volume to draw");
+  if (volumes.size() > MFR_MAX_VOLUMES)
+    throw Error("operation volume", std::to_string(volumes.size()) + " volumes: at most " +
+                                        std::to_string(MFR_MAX_VOLUMES) + " can be drawn at once");
   VolumeRaySetup s;
   const double aspect = static_cast<double>(width) / height;
   s.invViewProj = glm::mat4(glm::inverse(camera.projectionMatrix(aspect) * camera.viewMatrix()));
   s.viewport = glm::vec2(static_cast<float>(width), static_cast<float>(height));
-  s.worldToGrid = glm::mat4(glm::inverse(volume.gridToWorld()));
-  s.dims = volume.grid->dims;
-  s.step = static_cast<float>(step > 0.0 ? step : volume.defaultStep());
-  s.tfLow = static_cast<float>(volume.transfer.low());
-  s.tfHigh = static_cast<float>(volume.transfer.high());
-  s.table = volume.transfer.table();
-  s.shading = volume.shading;
+  double defaultStep = volumes.front().defaultStep();
+  for (const Volume& volume : volumes) {
+    VolumeMedium m;
+    m.grid = volume.grid;
+    m.worldToGrid = glm::mat4(glm::inverse(volume.gridToWorld()));
+    m.dims = volume.grid->dims;
+    m.tfLow = static_cast<float>(volume.transfer.low());
+    m.tfHigh = static_cast<float>(volume.transfer.high());
+    m.table = volume.transfer.table();
+    m.shading = volume.shading;
+    s.media.push_back(std::move(m));
+    defaultStep = std::min(defaultStep, volume.defaultStep());
+  }
+  s.step = static_cast<float>(step > 0.0 ? step : defaultStep);
   if (clip) {
     s.clip = true;
     s.clipMin = glm::vec3(clip->min);
@@ -171,34 +182,42 @@ VolumeRaySetup volumeRaySetup(const Volume& volume, const Camera& camera, int wi
   return s;
 }
 
+static_assert(Scene::kMaxVisibleVolumes == MFR_MAX_VOLUMES);
+
 namespace {
 
 // The per-pixel state of shaders/ops/volume.glsl, step for step.
 struct VolumeMarcher {
   const VolumeRaySetup& setup;
-  const VolumeGrid& grid;
   glm::vec3 color{0.0f};
   float transmittance = 1.0f;
   glm::vec2 ndc{0.0f};
-  glm::vec3 rayStart{0.0f}, rayDir{0.0f}, gridStart{0.0f}, gridDir{0.0f};
+  glm::vec3 rayStart{0.0f}, rayDir{0.0f};
+  std::array<glm::vec3, MFR_MAX_VOLUMES> gridStart{}, gridDir{};
+  std::array<float, MFR_MAX_VOLUMES> enter{}, exit{};  // each volume's part of the ray (empty: enter == exit)
   float tEnter = 0.0f, tExit = 0.0f, step = 0.0f, t = 0.0f;
   int next = 1;
+  // Optional (the probe): each medium's share of the light absorbed so far, T·absorbed·σ_i/σ summed.
+  std::vector<float>* absorbedByVolume = nullptr;
+
+  [[nodiscard]] int count() const { return static_cast<int>(setup.media.size()); }
 
   [[nodiscard]] glm::vec3 unproject(float ndcZ) const {
     const glm::vec4 p = setup.invViewProj * glm::vec4(ndc, ndcZ, 1.0f);
     return glm::vec3(p) / p.w;
   }
 
-  [[nodiscard]] glm::vec4 transfer(float v) const {
-    const float u = std::clamp((v - setup.tfLow) / (setup.tfHigh - setup.tfLow), 0.0f, 1.0f) *
-                    static_cast<float>(MFR_VOLUME_TF_SIZE - 1);
+  [[nodiscard]] glm::vec4 transfer(const VolumeMedium& m, float v) const {
+    const float u =
+        std::clamp((v - m.tfLow) / (m.tfHigh - m.tfLow), 0.0f, 1.0f) * static_cast<float>(MFR_VOLUME_TF_SIZE - 1);
     const int i = std::min(static_cast<int>(u), MFR_VOLUME_TF_SIZE - 2);
     const float f = u - static_cast<float>(i);
-    return glm::mix(setup.table[static_cast<std::size_t>(i)], setup.table[static_cast<std::size_t>(i) + 1], f);
+    return glm::mix(m.table[static_cast<std::size_t>(i)], m.table[static_cast<std::size_t>(i) + 1], f);
   }
 
   // The emission factor of a shaded volume at grid point g (shaders/ops/volume.glsl volumeShade).
-  [[nodiscard]] float shade(const glm::vec3& g) const {
+  [[nodiscard]] float shade(const VolumeMedium& m, const glm::vec3& g) const {
+    const VolumeGrid& grid = *m.grid;
     const glm::vec3 gradient =
         0.5f * glm::vec3(grid.sample(g + glm::vec3(1.0f, 0.0f, 0.0f)) - grid.sample(g - glm::vec3(1.0f, 0.0f, 0.0f)),
                          grid.sample(g + glm::vec3(0.0f, 1.0f, 0.0f)) - grid.sample(g - glm::vec3(0.0f, 1.0f, 0.0f)),
@@ -206,10 +225,10 @@ struct VolumeMarcher {
     const float perCell = glm::length(gradient);
     if (!(perCell > 0.0f)) return 1.0f;
     // ∇ in world units: the transpose of world → grid's linear part applied to ∇ in grid units.
-    const glm::vec3 world = glm::transpose(glm::mat3(setup.worldToGrid)) * gradient;
+    const glm::vec3 world = glm::transpose(glm::mat3(m.worldToGrid)) * gradient;
     const float facing = std::abs(glm::dot(world, rayDir)) / glm::length(world);
     const float lit = static_cast<float>(MFR_VOLUME_AMBIENT) + static_cast<float>(MFR_VOLUME_DIFFUSE) * facing;
-    const float w = perCell / (perCell + static_cast<float>(MFR_VOLUME_SHADE_EDGE) * (setup.tfHigh - setup.tfLow));
+    const float w = perCell / (perCell + static_cast<float>(MFR_VOLUME_SHADE_EDGE) * (m.tfHigh - m.tfLow));
     return glm::mix(1.0f, lit, w);
   }
 
@@ -219,44 +238,56 @@ struct VolumeMarcher {
     const glm::vec3 rayEnd = unproject(1.0f);
     const float rayLength = glm::distance(rayEnd, rayStart);
     rayDir = (rayEnd - rayStart) / rayLength;
-    gridStart = glm::vec3(setup.worldToGrid * glm::vec4(rayStart, 1.0f));
-    gridDir = glm::vec3(setup.worldToGrid * glm::vec4(rayDir, 0.0f));
-    float t0 = 0.0f, t1 = rayLength;
-    const glm::vec3 last = glm::vec3(setup.dims - 1);
-    for (int a = 0; a < 3; ++a) {
-      if (std::abs(gridDir[a]) < 1e-30f) {
-        if (gridStart[a] < 0.0f || gridStart[a] > last[a]) t1 = -1.0f;
-      } else {
-        const float ta = (0.0f - gridStart[a]) / gridDir[a];
-        const float tb = (last[a] - gridStart[a]) / gridDir[a];
-        t0 = std::max(t0, std::min(ta, tb));
-        t1 = std::min(t1, std::max(ta, tb));
-      }
-    }
+    // The part of the ray every volume shares: inside the clip box and on the kept side of the plane.
+    float c0 = 0.0f, c1 = rayLength;
     if (setup.clip)  // slabs of the clip box, in world space
       for (int a = 0; a < 3; ++a) {
         if (std::abs(rayDir[a]) < 1e-30f) {
-          if (rayStart[a] < setup.clipMin[a] || rayStart[a] > setup.clipMax[a]) t1 = -1.0f;
+          if (rayStart[a] < setup.clipMin[a] || rayStart[a] > setup.clipMax[a]) c1 = -1.0f;
         } else {
           const float ta = (setup.clipMin[a] - rayStart[a]) / rayDir[a];
           const float tb = (setup.clipMax[a] - rayStart[a]) / rayDir[a];
-          t0 = std::max(t0, std::min(ta, tb));
-          t1 = std::min(t1, std::max(ta, tb));
+          c0 = std::max(c0, std::min(ta, tb));
+          c1 = std::min(c1, std::max(ta, tb));
         }
       }
     if (setup.section) {  // the kept half-space of the section plane
       const glm::vec3 n(setup.sectionPlane);
       const float s0 = glm::dot(n, rayStart) + setup.sectionPlane.w, ds = glm::dot(n, rayDir);
       if (std::abs(ds) < 1e-30f) {
-        if (s0 < 0.0f) t1 = -1.0f;
+        if (s0 < 0.0f) c1 = -1.0f;
       } else if (ds > 0.0f) {
-        t0 = std::max(t0, -s0 / ds);
+        c0 = std::max(c0, -s0 / ds);
       } else {
-        t1 = std::min(t1, -s0 / ds);
+        c1 = std::min(c1, -s0 / ds);
       }
     }
-    tEnter = t0;
-    tExit = std::max(t1, t0);
+    bool any = false;
+    for (int i = 0; i < count(); ++i) {
+      const VolumeMedium& m = setup.media[static_cast<std::size_t>(i)];
+      gridStart[i] = glm::vec3(m.worldToGrid * glm::vec4(rayStart, 1.0f));
+      gridDir[i] = glm::vec3(m.worldToGrid * glm::vec4(rayDir, 0.0f));
+      float t0 = c0, t1 = c1;
+      const glm::vec3 last = glm::vec3(m.dims - 1);
+      for (int a = 0; a < 3; ++a) {  // slabs of the box [0, dims - 1]
+        if (std::abs(gridDir[i][a]) < 1e-30f) {
+          if (gridStart[i][a] < 0.0f || gridStart[i][a] > last[a]) t1 = -1.0f;
+        } else {
+          const float ta = (0.0f - gridStart[i][a]) / gridDir[i][a];
+          const float tb = (last[a] - gridStart[i][a]) / gridDir[i][a];
+          t0 = std::max(t0, std::min(ta, tb));
+          t1 = std::min(t1, std::max(ta, tb));
+        }
+      }
+      enter[i] = t0;
+      exit[i] = std::max(t1, t0);
+      if (exit[i] > enter[i]) {
+        tEnter = any ? std::min(tEnter, enter[i]) : enter[i];
+        tExit = any ? std::max(tExit, exit[i]) : exit[i];
+        any = true;
+      }
+    }
+    if (!any) tEnter = tExit = c0 > 0.0f ? c0 : 0.0f;
     step = std::max(setup.step, (tExit - tEnter) / static_cast<float>(MFR_VOLUME_MAX_STEPS));
     t = tEnter;
     next = 1;
@@ -264,17 +295,38 @@ struct VolumeMarcher {
 
   void march(float tTo) {
     tTo = std::min(tTo, tExit);
-    for (int it = 0;
-         it < MFR_VOLUME_MAX_STEPS + 2 && t < tTo && transmittance >= static_cast<float>(MFR_VOLUME_MIN_TRANSMITTANCE);
+    for (int it = 0; it < MFR_VOLUME_MAX_STEPS + 2 + 2 * MFR_MAX_VOLUMES && t < tTo &&
+                     transmittance >= static_cast<float>(MFR_VOLUME_MIN_TRANSMITTANCE);
          ++it) {
       const float boundary = tEnter + static_cast<float>(next) * step;
-      const float end = std::min(boundary, tTo);
+      float end = std::min(boundary, tTo);
+      for (int i = 0; i < count(); ++i) {  // a box's entry or exit cuts the interval too
+        if (enter[i] > t && enter[i] < end) end = enter[i];
+        if (exit[i] > t && exit[i] < end) end = exit[i];
+      }
       if (end > t) {
-        const glm::vec3 g = gridStart + gridDir * (0.5f * (t + end));
-        const glm::vec4 m = transfer(grid.sample(g));
-        if (m.a > 0.0f) {
-          const float absorbed = 1.0f - std::exp(-m.a * (end - t));
-          color += transmittance * absorbed * glm::vec3(m) * (setup.shading ? shade(g) : 1.0f);
+        const float mid = 0.5f * (t + end);
+        float sigma = 0.0f;
+        glm::vec3 emission(0.0f);
+        std::array<float, MFR_MAX_VOLUMES> sigmaOf{};
+        for (int i = 0; i < count(); ++i) {
+          if (!(mid > enter[i] && mid < exit[i])) continue;
+          const VolumeMedium& m = setup.media[static_cast<std::size_t>(i)];
+          const glm::vec3 g = gridStart[i] + gridDir[i] * mid;
+          const glm::vec4 c = transfer(m, m.grid->sample(g));
+          if (c.a > 0.0f) {
+            sigma += c.a;
+            emission += c.a * glm::vec3(c) * (m.shading ? shade(m, g) : 1.0f);
+            sigmaOf[static_cast<std::size_t>(i)] = c.a;
+          }
+        }
+        if (sigma > 0.0f) {
+          const float absorbed = 1.0f - std::exp(-sigma * (end - t));
+          if (absorbedByVolume)
+            for (int i = 0; i < count(); ++i)
+              (*absorbedByVolume)[static_cast<std::size_t>(i)] +=
+                  transmittance * absorbed * sigmaOf[static_cast<std::size_t>(i)] / sigma;
+          color += transmittance * absorbed * (emission / sigma);
           transmittance *= 1.0f - absorbed;
         }
         t = end;
@@ -302,8 +354,8 @@ struct VolumeMarcher {
 }  // namespace
 
 glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, const VolumeRaySetup& setup,
-                          const VolumeGrid& grid, const glm::vec3& background) {
-  VolumeMarcher m{setup, grid};
+                          const glm::vec3& background) {
+  VolumeMarcher m{setup};
   m.begin(glX, glY);
   for (const Fragment& f : sorted) m.fragment(f);
   m.march(m.tExit);
@@ -311,18 +363,21 @@ glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, co
 }
 
 VolumeBreakdown compositeVolumeBreakdown(std::span<const Fragment> sorted, int glX, int glY,
-                                         const VolumeRaySetup& setup, const VolumeGrid& grid,
-                                         const glm::vec3& background) {
-  VolumeMarcher m{setup, grid};
+                                         const VolumeRaySetup& setup, const glm::vec3& background) {
+  VolumeMarcher m{setup};
   m.begin(glX, glY);
   VolumeBreakdown out;
+  std::vector<float> byVolume(setup.media.size(), 0.0f);
+  m.absorbedByVolume = &byVolume;
   // The same steps as compositeVolume, with the medium marched apart from each surface.
   const auto medium = [&](float tTo) {
     const glm::vec3 before = m.color;
     const float in = m.transmittance;
+    std::fill(byVolume.begin(), byVolume.end(), 0.0f);
     m.march(tTo);
     out.mediumColor.push_back(m.color - before);
     out.mediumWeight.push_back(in - m.transmittance);
+    out.mediumWeightByVolume.push_back(byVolume);
   };
   for (const Fragment& f : sorted) {
     medium(m.tDepth(f));
@@ -336,17 +391,17 @@ VolumeBreakdown compositeVolumeBreakdown(std::span<const Fragment> sorted, int g
   return out;
 }
 
-ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, const Volume& volume, double step,
-                           const glm::vec3& background, const std::optional<Bounds>& clip,
+ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, std::span<const Volume> volumes,
+                           double step, const glm::vec3& background, const std::optional<Bounds>& clip,
                            const std::optional<SectionPlane>& section) {
-  volume.validate();
+  for (const Volume& volume : volumes) volume.validate();
   if (!std::isfinite(step) || step < 0.0)
     throw Error("--step", "must be a positive length in scene units (got " + std::to_string(step) + ")");
-  const VolumeRaySetup setup = volumeRaySetup(volume, camera, lists.width, lists.height, step, clip, section);
+  const VolumeRaySetup setup = volumeRaySetup(volumes, camera, lists.width, lists.height, step, clip, section);
   ImageRGBA8 image(lists.width, lists.height);
   for (int y = 0; y < lists.height; ++y)
     for (int x = 0; x < lists.width; ++x)
-      store(image, x, y, compositeVolume(lists.pixel(x, y), x, lists.height - 1 - y, setup, *volume.grid, background));
+      store(image, x, y, compositeVolume(lists.pixel(x, y), x, lists.height - 1 - y, setup, background));
   return image;
 }
 

@@ -431,7 +431,8 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   lists.flags.assign(pixelCount, 0);
   if (triangles.empty()) {
     // A scene of volumes only: every list is empty.
-    if (!scene.visibleVolume()) throw Error("scene '" + scene.name + "'", "nothing to render (no visible triangles)");
+    if (!scene.hasVisibleVolume())
+      throw Error("scene '" + scene.name + "'", "nothing to render (no visible triangles)");
     lists.offsets.assign(pixelCount + 1, 0);
     return lists;
   }

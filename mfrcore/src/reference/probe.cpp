@@ -111,19 +111,22 @@ void splitHybrid(PixelProbe& probe, glm::vec3 background) {
 }
 
 void splitVolume(PixelProbe& probe, const Scene& scene, const Camera& camera, const RenderRequest& request) {
-  const Volume* volume = scene.visibleVolume();
-  if (!volume) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");
-  const Volume drawn = volumeAsRequested(request, *volume);
-  const VolumeRaySetup setup = volumeRaySetup(drawn, camera, probe.width, probe.height, volumeStepOf(request, *volume),
+  const std::vector<Volume> drawn = volumesAsRequested(request, scene);
+  if (drawn.empty()) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");
+  const VolumeRaySetup setup = volumeRaySetup(drawn, camera, probe.width, probe.height, volumeStepOf(request, drawn),
                                               scene.clipBox, scene.section);
   std::vector<Fragment> sorted;
   for (const ProbeFragment& f : probe.fragments) sorted.push_back(f.fragment);
   const VolumeBreakdown b =
-      compositeVolumeBreakdown(sorted, probe.x, probe.height - 1 - probe.y, setup, *drawn.grid, scene.background);
+      compositeVolumeBreakdown(sorted, probe.x, probe.height - 1 - probe.y, setup, scene.background);
   probe.volume = true;
+  probe.volumeNames.clear();
+  for (const Volume& v : drawn) probe.volumeNames.push_back(v.name);
   for (std::size_t i = 0; i < probe.fragments.size(); ++i) probe.fragments[i].volumeWeight = b.surfaceWeight[i];
   probe.medium.clear();
-  for (std::size_t i = 0; i < b.mediumColor.size(); ++i) probe.medium.push_back({b.mediumColor[i], b.mediumWeight[i]});
+  for (std::size_t i = 0; i < b.mediumColor.size(); ++i)
+    probe.medium.push_back({b.mediumColor[i], b.mediumWeight[i],
+                            std::vector<double>(b.mediumWeightByVolume[i].begin(), b.mediumWeightByVolume[i].end())});
   probe.volumeColor = b.color;
   probe.volumeBackground = b.backgroundWeight;
 }

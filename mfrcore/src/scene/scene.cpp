@@ -60,10 +60,15 @@ std::size_t Scene::triangleCount() const {
   return n;
 }
 
-const Volume* Scene::visibleVolume() const {
+std::vector<Volume> Scene::visibleVolumes() const {
+  std::vector<Volume> out;
   for (const Volume& v : volumes)
-    if (v.visible) return &v;
-  return nullptr;
+    if (v.visible) out.push_back(v);
+  return out;
+}
+
+bool Scene::hasVisibleVolume() const {
+  return std::any_of(volumes.begin(), volumes.end(), [](const Volume& v) { return v.visible; });
 }
 
 void Scene::validate() const {
@@ -74,8 +79,9 @@ void Scene::validate() const {
   }
   if (triangleCount() == 0 && visibleVolumes == 0)
     throw Error("scene '" + name + "'", "nothing to render (no visible triangles or volume)");
-  if (visibleVolumes > 1)
-    throw Error("scene '" + name + "'", std::to_string(visibleVolumes) + " visible volumes: at most one can be drawn");
+  if (visibleVolumes > kMaxVisibleVolumes)
+    throw Error("scene '" + name + "'", std::to_string(visibleVolumes) + " visible volumes: at most " +
+                                            std::to_string(kMaxVisibleVolumes) + " can be drawn at once");
   validateCsg(*this);
   validateClipBox(clipBox, "clip box");
   validateSectionPlane(section, "section plane");

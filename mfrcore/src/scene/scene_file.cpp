@@ -442,10 +442,10 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     for (std::size_t i = 0; i < volumes.size(); ++i) {
       const std::string where = "volumes[" + std::to_string(i) + "]";
       Volume volume = parseVolume(r, volumes[i], where, baseDir, itemProgress(objectCount + i));
-      if (volume.visible && scene.visibleVolume() != nullptr)
-        r.fail(where + ".visible",
-               "volume '" + scene.visibleVolume()->name +
-                   "' is visible already: at most one volume can be drawn (set \"visible\": false)");
+      if (volume.visible && scene.visibleVolumes().size() >= Scene::kMaxVisibleVolumes)
+        r.fail(where + ".visible", std::to_string(Scene::kMaxVisibleVolumes) +
+                                       " volumes are visible already: at most that many can be drawn at once "
+                                       "(set \"visible\": false)");
       scene.volumes.push_back(std::move(volume));
     }
   }

@@ -504,7 +504,7 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
       local.open.push_back(object.name);
     object.mesh = std::make_shared<const Mesh>(std::move(open[k].cut.mesh));
   }
-  if (out.triangleCount() == 0 && !out.visibleVolume())
+  if (out.triangleCount() == 0 && !out.hasVisibleVolume())
     throw Error("section plane", "cuts away every visible surface of scene '" + scene.name + "'");
   if (report) *report = std::move(local);
   return out;

@@ -5,6 +5,7 @@
 // which of those fragments the method holds. `mfr probe` prints it; mfrview's Probe dock shows it.
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -26,10 +27,11 @@ struct ProbeFragment {
   double volumeWeight = 0.0;  // its share of the "volume" colour: α·T through surfaces and medium (splitVolume)
 };
 
-// A stretch of the volume's medium along the pixel's ray (splitVolume).
+// A stretch of the volumes' medium along the pixel's ray (splitVolume).
 struct ProbeMedium {
   glm::vec3 color{0.0f};  // what it adds to the pixel's colour
   double weight = 0.0;    // its share of the colour: the light reaching it times what it absorbs
+  std::vector<double> weightByVolume;  // weight split by volume (PixelProbe::volumeNames), σ_i/σ per step
 };
 
 struct PixelProbe {
@@ -58,6 +60,7 @@ struct PixelProbe {
   // Set by splitVolume.
   bool volume = false;
   std::vector<ProbeMedium> medium;  // fragments.size() + 1: in front of fragment i; the last behind them all
+  std::vector<std::string> volumeNames;  // the volumes drawn, in the order of weightByVolume
   glm::vec3 volumeColor{0.0f};      // the exact colour under the operation "volume"
   double volumeBackground = 0.0;
 };
@@ -86,8 +89,9 @@ void splitHybrid(PixelProbe& probe, glm::vec3 background);
 
 // The operation "volume" at the probed pixel (reference/composite.hpp compositeVolumeBreakdown, on
 // the probe's exact list): each surface's share and the medium's before, between and behind them,
-// and the exact colour — the scene's visible volume as `request` draws it (step, shading), cropped
-// by the scene's clip box and section. Throws mfr::Error when the scene has no visible volume.
+// and the exact colour — the scene's visible volumes as `request` draws them (step, shading), cropped
+// by the scene's clip box and section; each stretch also split by volume. Throws mfr::Error when
+// the scene has no visible volume.
 void splitVolume(PixelProbe& probe, const Scene& scene, const Camera& camera, const RenderRequest& request);
 
 }  // namespace mfr

@@ -48,12 +48,16 @@ struct NamedView {
 };
 
 struct Scene {
+  // The most volumes drawn at once (MFR_MAX_VOLUMES in shaders/common/bindings.h: texture units).
+  static constexpr std::size_t kMaxVisibleVolumes = 4;
+
   std::string name;  // file name or sample name, for messages
   std::vector<Object> objects;
   std::vector<NamedView> views;  // the scene's own views; "fit" is always available besides
   glm::vec3 background{1.0f, 1.0f, 1.0f};
   CsgTree csg;  // image-space CSG over some objects (operation "csg"); empty: none
-  // Scalar volumes composited with the surfaces by the operation "volume"; at most one visible.
+  // Scalar volumes composited with the surfaces by the operation "volume"; at most MFR_MAX_VOLUMES
+  // (kMaxVisibleVolumes) visible, marched together (overlapping media mix).
   std::vector<Volume> volumes;
   // The clip box (world space): only what lies inside it is drawn — surfaces are cut open along its
   // faces, the volume is cropped — by every method and by the oracle. Unset: nothing is clipped.
@@ -74,10 +78,11 @@ struct Scene {
   [[nodiscard]] Camera fit(const Camera& base) const;
   [[nodiscard]] std::size_t triangleCount() const;
   // Object ids are indices into objects; GPU and oracle both report them.
-  // The visible volume, or nullptr.
-  [[nodiscard]] const Volume* visibleVolume() const;
+  // Copies of the visible volumes (sharing their grids), in the order of `volumes`.
+  [[nodiscard]] std::vector<Volume> visibleVolumes() const;
+  [[nodiscard]] bool hasVisibleVolume() const;
   // Throws mfr::Error when there is nothing visible to draw (no triangles, no volume), when more
-  // than one volume is visible, or for an invalid volume.
+  // than kMaxVisibleVolumes volumes are visible, or for an invalid volume.
   void validate() const;
   // The named view, or the fit-all view for "fit" / empty name. Throws mfr::Error listing the
   // available names for an unknown one.
