@@ -8,6 +8,7 @@
 #include <QVBoxLayout>
 
 #include <algorithm>
+#include <vector>
 #include <cmath>
 #include <exception>
 
@@ -129,10 +130,22 @@ void ProbePanel::show(const ViewProbe& r) {
   const QColor reference = p.volume ? QColor(to8(p.volumeColor.r), to8(p.volumeColor.g), to8(p.volumeColor.b)) : exact;
   if (p.volume) {
     double medium = 0.0;
-    for (const mfr::ProbeMedium& m : p.medium) medium += m.weight;
-    text += tr(" (surfaces only), %1 with the volume (the medium's share %2 %)")
+    std::vector<double> byVolume(p.volumeNames.size(), 0.0);
+    for (const mfr::ProbeMedium& m : p.medium) {
+      medium += m.weight;
+      for (std::size_t v = 0; v < byVolume.size() && v < m.weightByVolume.size(); ++v)
+        byVolume[v] += m.weightByVolume[v];
+    }
+    // Several volumes: each one's part of the medium's share.
+    QStringList parts;
+    if (byVolume.size() > 1)
+      for (std::size_t v = 0; v < byVolume.size(); ++v)
+        parts << tr("%1 %2 %").arg(QString::fromStdString(p.volumeNames[v]),
+                                   QString::number(100.0 * byVolume[v], 'f', 1));
+    text += tr(" (surfaces only), %1 with the volume (the medium's share %2 %%3)")
                 .arg(reference.name())
-                .arg(QString::number(100.0 * medium, 'f', 1));
+                .arg(QString::number(100.0 * medium, 'f', 1))
+                .arg(parts.isEmpty() ? QString() : QStringLiteral(": ") + parts.join(QStringLiteral(", ")));
   }
   if (r.shown) {
     const int diff =

@@ -2483,6 +2483,114 @@ class ViewerTest : public QObject {
   // A scene's function that is a preset over its range (written out point by point here, as an
   // InVesalius project's "bone" over its window arrives) shows as that preset with that window;
   // the blob's own two-point function stays Custom.
+  // Two volumes drawn at once: the blob and a moved copy with another function. The Volume panel
+  // offers a chooser; the controls edit the chosen volume only; hiding one keeps the other drawn
+  // with the operation volume; the frame is the renderers' mixture; a session keeps the choice.
+  void severalVolumes() {
+    QTemporaryDir dir;
+    const QString onePath = writeBlobScene(dir, "one.mfrscene", blobTransfer());
+    QVERIFY(!onePath.isEmpty());
+    QJsonObject json = [&] {
+      QFile f(onePath);
+      f.open(QIODevice::ReadOnly);
+      return QJsonDocument::fromJson(f.readAll()).object();
+    }();
+    QJsonArray volumes = json["volumes"].toArray();
+    QJsonObject second = volumes[0].toObject();
+    second["name"] = "moved";
+    second["transform"] = QJsonObject{{"translate", QJsonArray{0.8, 0.3, 0.0}}};
+    second["transfer"] = QJsonObject{{"preset", "fire"}, {"range", QJsonArray{0.0, 1.0}}, {"unit_distance", 0.3}};
+    volumes.append(second);
+    json["volumes"] = volumes;
+    const QString path = dir.filePath("two.mfrscene");
+    {
+      QFile f(path);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(QJsonDocument(json).toJson());
+    }
+    auto w = openWindow(path);
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    const QSize size(160, 120);
+    w->view().setFixedSize(size);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), size, kTimeoutMs);
+    m.setMethod("abuffer-ll");
+    m.setCamera(m.scene().view("iso"));
+    settle(m);
+    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    auto* choice = w->findChild<QComboBox*>("hvVolume");
+    auto* show = w->findChild<QCheckBox*>("hvShow");
+    auto* preset = w->findChild<QComboBox*>("hvPreset");
+    auto* info = w->findChild<QLabel*>("hvInfo");
+    QVERIFY(choice && show && preset && info);
+    QVERIFY(choice->isVisibleTo(w.get()));
+    QCOMPARE(choice->count(), 2);
+    QCOMPARE(choice->itemText(1), QStringLiteral("moved"));
+    QCOMPARE(m.volumeCount(), 2);
+    QCOMPARE(m.visibleVolumeCount(), 2);
+    QCOMPARE(m.currentVolume(), 0);
+    QCOMPARE(QString::fromStdString(m.stats().operation), QStringLiteral("volume"));
+    const auto note = [&m](const char* key) -> std::string {
+      for (const auto& [name, value] : m.stats().notes)
+        if (name == key) return value;
+      return {};
+    };
+    QCOMPARE(note("volumes"), std::string("2"));
+    // The frame, checked at the end against the library (mfr::render's headless context is made
+    // current on this thread, so it comes after the windows' last frames).
+    const mfr::ImageRGBA8 both = w->view().renderImage(size);
+    const mfr::RenderRequest request = m.renderRequest(size);
+    const mfr::Scene bothScene = m.scene();
+    const mfr::Camera camera = m.camera();
+
+    // Choosing the second volume: the panel shows and edits it; the first keeps its function.
+    const mfr::TransferFunction firstBefore = m.scene().volumes[0].transfer;
+    choice->setCurrentIndex(1);
+    QCOMPARE(m.currentVolume(), 1);
+    QCOMPARE(m.volumeName(), QStringLiteral("moved"));
+    QVERIFY2(info->text().startsWith(QStringLiteral("moved:")), qPrintable(info->text()));
+    QCOMPARE(preset->currentData().toString(), QStringLiteral("fire"));
+    preset->setCurrentIndex(preset->findData(QStringLiteral("cool-warm")));
+    settle(m);
+    QCOMPARE(m.scene().volumes[0].transfer.points.size(), firstBefore.points.size());
+    for (std::size_t i = 0; i < firstBefore.points.size(); ++i)
+      QVERIFY(m.scene().volumes[0].transfer.points[i].color == firstBefore.points[i].color);
+    QVERIFY(!(m.scene().volumes[1].transfer.points.front().color ==
+              mfr::transferPreset("fire", 0.0, 1.0, 0.3).points.front().color));
+    // Hiding it leaves the first drawn, still by the operation volume.
+    show->setChecked(false);
+    QVERIFY(!m.scene().volumes[1].visible);
+    QVERIFY(m.scene().volumes[0].visible);
+    QCOMPARE(m.effectiveOperation(), QStringLiteral("volume"));
+    settle(m);
+    QCOMPARE(note("volumes"), std::string("1"));
+    show->setChecked(true);
+    settle(m);
+    QCOMPARE(note("volumes"), std::string("2"));
+
+    // A session keeps the chosen volume and both functions.
+    const mfr::ImageRGBA8 before = w->view().renderImage(size);
+    const QString sessionPath = dir.filePath("two.mfrsession");
+    w->saveSession(sessionPath);
+    auto again = openWindow(QString());
+    QVERIFY(again);
+    again->view().setFixedSize(size);
+    again->openSession(sessionPath);
+    ViewerModel& a = again->model();
+    QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.framesRendered() > 0, kTimeoutMs);
+    settle(a);
+    QCOMPARE(a.currentVolume(), 1);
+    QCOMPARE(again->findChild<QComboBox*>("hvVolume")->currentIndex(), 1);
+    QCOMPARE(again->findChild<QComboBox*>("hvPreset")->currentData().toString(), QStringLiteral("cool-warm"));
+    QCOMPARE(maxChannelDifference(before, again->view().renderImage(a.renderSize())), 0);
+    // The mixture the library draws (the same request through mfr::render), unlike the first
+    // volume alone.
+    QCOMPARE(maxChannelDifference(mfr::render(bothScene, camera, request).image, both), 0);
+    mfr::Scene firstOnly = bothScene;
+    firstOnly.volumes[1].visible = false;
+    QVERIFY(maxChannelDifference(mfr::render(firstOnly, camera, request).image, both) > 40);
+  }
+
   void volumePanelNamesAPresetFunction() {
     QTemporaryDir dir;
     auto w = openWindow(QString());

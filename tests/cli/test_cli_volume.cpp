@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -110,6 +111,71 @@ TEST_F(CliVolume, BadInputIsOneLine) {
   EXPECT_EQ(std::count(bench.out.begin(), bench.out.end(), '\n'), 1) << bench.out;
   EXPECT_NE(bench.out.find("step"), std::string::npos) << bench.out;
   EXPECT_FALSE(fs::exists(json));
+}
+
+// A legacy VTK structured-points file: the box [-1, 1]³ on a 5³ grid, every value 0.5.
+void writeUniformVolume(const fs::path& path) {
+  std::ofstream out(path);
+  out << "# vtk DataFile Version 3.0\nuniform\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 5 5 5\n"
+         "ORIGIN -1 -1 -1\nSPACING 0.5 0.5 0.5\nPOINT_DATA 125\nSCALARS v float 1\nLOOKUP_TABLE default\n";
+  for (int i = 0; i < 125; ++i) out << "0.5\n";
+}
+
+// Two homogeneous volumes overlapping on x ∈ [0, 1] (red: opacity 0.5 per unit, blue: 0.3, moved
+// +1 along x), seen along −z: where both lie the medium is their mixture — extinction σ_r + σ_b,
+// colour weighted by σ — against the closed form; the probe splits the medium's share by volume;
+// render and probe agree; a fifth visible volume is refused with one line.
+TEST_F(CliVolume, TwoVolumesMixWhereTheyOverlap) {
+  writeUniformVolume(dir() / "uniform.vtk");
+  const std::string volumes =
+      R"({"name": "red", "file": "uniform.vtk", "transfer": {"points": [[0, 1, 0, 0, 0.5], [1, 1, 0, 0, 0.5]], "unit_distance": 1}},
+         {"name": "blue", "file": "uniform.vtk", "transform": {"translate": [1, 0, 0]},
+          "transfer": {"points": [[0, 0, 0, 1, 0.3], [1, 0, 0, 1, 0.3]], "unit_distance": 1}})";
+  const std::string views =
+      R"("views": [{"name": "front", "eye": [0.5, 0, 5], "target": [0.5, 0, 0], "projection": "orthographic",
+                    "height": 3}])";
+  std::ofstream(dir() / "two.mfrscene") << R"({"background": [0, 0, 0], "volumes": [)" << volumes << "], " << views
+                                        << "}";
+  const std::string scene = (dir() / "two.mfrscene").string() + " --view front --size 64x64";
+  const double sr = -std::log(0.5), sb = -std::log(0.7), chord = 2.0;
+  // Pixel 32: x ≈ 0.52, inside both boxes; pixel 10: x ≈ -0.5, red only.
+  const fs::path json = dir() / "probe.json";
+  ASSERT_EQ(runCli("probe " + scene + " --pixel 32,32 --json " + json.string()).exitCode, 0);
+  const nlohmann::json j = [&] {
+    std::ifstream in(json);
+    return nlohmann::json::parse(in);
+  }();
+  ASSERT_EQ(j["volumes"], nlohmann::json({"red", "blue"}));
+  const double absorbed = 1.0 - std::exp(-(sr + sb) * chord);
+  EXPECT_NEAR(j["volume_rgb"][0].get<int>(), std::lround(255.0 * sr / (sr + sb) * absorbed), 1);
+  EXPECT_EQ(j["volume_rgb"][1].get<int>(), 0);
+  EXPECT_NEAR(j["volume_rgb"][2].get<int>(), std::lround(255.0 * sb / (sr + sb) * absorbed), 1);
+  double red = 0.0, blue = 0.0;
+  for (const nlohmann::json& m : j["medium"]) {
+    red += m["weight_by_volume"]["red"].get<double>();
+    blue += m["weight_by_volume"]["blue"].get<double>();
+  }
+  EXPECT_NEAR(red, sr / (sr + sb) * absorbed, 1e-4);
+  EXPECT_NEAR(blue, sb / (sr + sb) * absorbed, 1e-4);
+  const CliResult text = runCli("probe " + scene + " --pixel 10,32");
+  ASSERT_EQ(text.exitCode, 0) << text.out;
+  EXPECT_NE(text.out.find("(medium) red"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("(medium) blue"), std::string::npos) << text.out;       // no blue medium there
+  EXPECT_NE(text.out.find("red 75 %, blue 0 %"), std::string::npos) << text.out;  // 1 - 0.5²
+
+  // The GPU draws the same mixture.
+  const fs::path gpu = dir() / "gpu.png", oracle = dir() / "oracle.png", stats = dir() / "stats.json";
+  ASSERT_EQ(runCli("render " + scene + " -m abuffer-ll -o " + gpu.string() + " --stats " + stats.string()).exitCode, 0);
+  ASSERT_EQ(runCli("render " + scene + " -o " + oracle.string()).exitCode, 0);
+  EXPECT_LT(rmseOf(oracle, gpu), 0.002);
+  std::ifstream in(stats);
+  EXPECT_EQ(nlohmann::json::parse(in)["notes"]["volumes"], "2");
+
+  // Five visible: refused, naming the file and the entry.
+  std::ofstream(dir() / "five.mfrscene") << R"({"volumes": [)" << volumes << ", " << volumes
+                                         << R"(, {"file": "uniform.vtk"}]})";
+  expectCleanFailure("render " + (dir() / "five.mfrscene").string(), "volumes[4].visible");
+  expectCleanFailure("render " + (dir() / "five.mfrscene").string(), "five.mfrscene");
 }
 
 }  // namespace
