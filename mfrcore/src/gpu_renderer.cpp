@@ -32,43 +32,41 @@ static Operation hybridOperation() {
 
 struct GpuRenderer::GpuVolume {
   Volume volume;
-  gl::Texture grid;      // R32F, dims
-  gl::Texture transfer;  // RGBA32F, MFR_VOLUME_TF_SIZE: (rgb, σ)
-  std::size_t bytes = 0;
+  std::shared_ptr<gl::Texture> grid;  // R32F, dims; shared by volumes with the same samples
+  gl::Texture transfer;               // RGBA32F, MFR_VOLUME_TF_SIZE: (rgb, σ)
+  std::size_t bytes = 0;              // the transfer table's, and the grid's unless an earlier volume holds it
 };
 
 GpuRenderer::~GpuRenderer() = default;
 
 void GpuRenderer::uploadVolumes(const Scene& scene) {
   const std::vector<Volume> visible = scene.visibleVolumes();
-  std::vector<std::shared_ptr<GpuVolume>> previous = std::move(volumes_);
+  // Grids the previous upload holds keep their textures, and volumes sharing samples share one;
+  // textures no longer needed are freed (previous cleared) before new ones are allocated.
+  std::vector<std::shared_ptr<gl::Texture>> textures(visible.size());
+  const auto find = [&](const std::vector<std::shared_ptr<GpuVolume>>& among, const Volume& v) {
+    for (const auto& g : among)
+      if (g && g->volume.grid == v.grid) return g->grid;
+    return std::shared_ptr<gl::Texture>();
+  };
+  for (std::size_t i = 0; i < visible.size(); ++i) textures[i] = find(volumes_, visible[i]);
   volumes_.clear();
-  // Grids the previous upload holds keep their textures; the others are freed before new ones are
-  // allocated.
-  std::vector<gl::Texture> kept(visible.size());
-  for (std::size_t i = 0; i < visible.size(); ++i)
-    for (auto& old : previous)
-      if (old && old->grid.id() != 0 && old->volume.grid == visible[i].grid) {
-        kept[i] = std::move(old->grid);
-        break;
-      }
-  previous.clear();
   for (std::size_t i = 0; i < visible.size(); ++i) {
     const Volume& v = visible[i];
     auto gpu = std::make_shared<GpuVolume>();
     gpu->volume = v;
-    const glm::ivec3 d = v.grid->dims;
-    if (kept[i].id() != 0) {
-      gpu->grid = std::move(kept[i]);  // same samples: keep the texture
-    } else {
-      gpu->grid = gl::createTexture3D(GL_R32F, d.x, d.y, d.z);
+    const std::shared_ptr<gl::Texture> earlier = find(volumes_, v);
+    gpu->grid = earlier ? earlier : textures[i];
+    if (!gpu->grid) {
+      const glm::ivec3 d = v.grid->dims;
+      gpu->grid = std::make_shared<gl::Texture>(gl::createTexture3D(GL_R32F, d.x, d.y, d.z));
       glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-      glTextureSubImage3D(gpu->grid.id(), 0, 0, 0, 0, d.x, d.y, d.z, GL_RED, GL_FLOAT, v.grid->values.data());
+      glTextureSubImage3D(gpu->grid->id(), 0, 0, 0, 0, d.x, d.y, d.z, GL_RED, GL_FLOAT, v.grid->values.data());
     }
     const std::vector<glm::vec4> table = v.transfer.table();
     gpu->transfer = gl::createTexture1D(GL_RGBA32F, MFR_VOLUME_TF_SIZE);
     glTextureSubImage1D(gpu->transfer.id(), 0, 0, MFR_VOLUME_TF_SIZE, GL_RGBA, GL_FLOAT, table.data());
-    gpu->bytes = v.grid->values.size() * sizeof(float) + table.size() * sizeof(glm::vec4);
+    gpu->bytes = (earlier ? 0 : v.grid->values.size() * sizeof(float)) + table.size() * sizeof(glm::vec4);
     volumes_.push_back(std::move(gpu));
   }
 }
@@ -201,7 +199,7 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
                                       p.set(("uTfHigh" + at).c_str(), m.tfHigh);
                                       p.set(("uVolumeShading" + at).c_str(), m.shading ? 1 : 0);
                                       glBindTextureUnit(MFR_TEX_VOLUME + static_cast<GLuint>(i),
-                                                        volumes_[i]->grid.id());
+                                                        volumes_[i]->grid->id());
                                       glBindTextureUnit(MFR_TEX_VOLUME_TF + static_cast<GLuint>(i),
                                                         volumes_[i]->transfer.id());
                                     }

@@ -10,6 +10,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "common/bindings.h"
 #include "gl_fixture.hpp"
 #include "image_compare.hpp"
 #include "mfr/error.hpp"
@@ -230,6 +231,14 @@ TEST(VolumeGpu, SeveralVolumesEqualTheOracle) {
                                      [](const auto& n) { return n.first == "volumes"; });
       ASSERT_NE(note, out.stats.notes.end());
       EXPECT_EQ(note->second, std::to_string(count));
+      // The copies share the sample's grid: one texture for them (its bytes counted once), a
+      // transfer table each.
+      const auto bytes = std::find_if(out.stats.notes.begin(), out.stats.notes.end(),
+                                      [](const auto& n) { return n.first == "volume (bytes)"; });
+      ASSERT_NE(bytes, out.stats.notes.end());
+      const std::size_t sampleGrid = scene.volumes[0].grid->values.size() * sizeof(float);
+      const std::size_t grids = count < 4 ? sampleGrid : sampleGrid + 7 * 5 * 9 * sizeof(float);
+      EXPECT_EQ(bytes->second, std::to_string(grids + count * MFR_VOLUME_TF_SIZE * 4 * sizeof(float)));
     }
     if (count > 1) {
       std::size_t changed = 0;
