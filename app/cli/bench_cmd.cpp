@@ -188,13 +188,16 @@ void addBench(CLI::App& app) {
         // The reference of the operation the row ran ("auto": the method's own).
         const MethodInfo* rowInfo = findMethodInfo(req.method);
         const std::string op = effectiveOperation(req.operation, rowInfo, scene.hasVisibleVolume());
+        const auto volumeReference = [&] {
+          const std::vector<Volume> drawn = volumesAsRequested(req, scene);
+          return compositeVolume(lists, camera, drawn, volumeStepOf(req, drawn), scene.background, scene.clipBox,
+                                 scene.section);
+        };
         const ImageRGBA8 exact =
             op == "csg" ? csgReference
             : op == "zthickness"
                 ? compositeZThickness(lists, camera, zThicknessOf(req, scene.bounds()), scene.background)
-            : op == "volume" ? compositeVolume(lists, camera, volumesAsRequested(req, scene),
-                                               volumeStepOf(req, scene.visibleVolumes()), scene.background,
-                                               scene.clipBox, scene.section)
+            : op == "volume" ? volumeReference()
                              : reference;
         const double e = rmse(exact, last.image);
         const FlipResult f = flip(exact, last.image);

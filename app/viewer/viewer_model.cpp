@@ -416,11 +416,10 @@ void ViewerModel::setVolumeStep(double step) {
 double ViewerModel::volumeStepDefault() const {
   const int i = volumeIndex();
   if (i < 0) return 0.0;
-  // What the renderers use: the smallest default step of the volumes drawn (volumeStepOf).
-  double step = 0.0;
-  for (const mfr::Volume& v : scene_.volumes)
-    if (v.visible) step = step == 0.0 ? v.defaultStep() : std::min(step, v.defaultStep());
-  return step > 0.0 ? step : scene_.volumes[static_cast<std::size_t>(i)].defaultStep();
+  // What the renderers use for the volumes drawn (a request without a step of its own).
+  const std::vector<mfr::Volume> drawn = scene_.visibleVolumes();
+  return drawn.empty() ? scene_.volumes[static_cast<std::size_t>(i)].defaultStep()
+                       : mfr::volumeStepOf(mfr::RenderRequest{}, drawn);
 }
 
 void ViewerModel::volumeEdited() {
