@@ -31,7 +31,7 @@ std::string mib(std::uint64_t bytes) {
 
 void addBench(CLI::App& app) {
   struct Options {
-    std::string scene, methods, size = "512x512", view = "fit", json, label, clip, section;
+    std::string scene, methods, size = "512x512", view = "fit", json, label, clip, section, field;
     int repeat = 5, warmup = 1;
     double opacity = -1.0;
     bool noQuality = false;
@@ -50,6 +50,7 @@ void addBench(CLI::App& app) {
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view")->capture_default_str();
   cmd->add_option("--clip", opt->clip, kClipHelp);
+  cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--no-quality", opt->noQuality, "Skip the oracle and the RMSE/FLIP columns");
@@ -62,7 +63,7 @@ void addBench(CLI::App& app) {
     std::vector<RenderRequest> requests;
     for (const std::string& spec : splitList(opt->methods)) requests.push_back(parseMethodSpec(spec, w, h));
     if (requests.empty()) throw Error("--methods", "no method given");
-    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
+    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
     const Camera camera = scene.view(opt->view);

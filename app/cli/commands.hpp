@@ -25,8 +25,12 @@ void addProbe(CLI::App& app);
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);
 // Comma-separated list.
 std::vector<std::string> splitList(const std::string& text);
-// loadScene, then every object's opacity set to `opacity` unless it is negative (--opacity).
-Scene loadSceneWithOpacity(const std::string& path, double opacity);
+// loadScene (with --field: the array or grid of a volume file), then every object's opacity set to
+// `opacity` unless it is negative (--opacity).
+Scene loadSceneWithOpacity(const std::string& path, double opacity, const std::string& field = {});
+inline constexpr const char* kFieldHelp =
+    "Volume file: the point-data array (.vti, .vtk) or grid (.vdb) to read instead of the default "
+    "(see mfr info for the file's fields)";
 // Every scene loaded (with --opacity) and every view checked before any work, so that a bad file
 // or view fails at once; throws mfr::Error for an empty view list.
 std::vector<Scene> loadScenesWithViews(const std::vector<std::string>& paths, double opacity,

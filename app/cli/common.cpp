@@ -32,8 +32,8 @@ std::vector<std::string> splitList(const std::string& text) {
   return out;
 }
 
-Scene loadSceneWithOpacity(const std::string& path, double opacity) {
-  Scene scene = loadScene(path);
+Scene loadSceneWithOpacity(const std::string& path, double opacity, const std::string& field) {
+  Scene scene = loadScene(path, LoadOptions{field});
   if (opacity >= 0.0)
     for (Object& o : scene.objects) o.material.color.a = static_cast<float>(opacity);
   return scene;

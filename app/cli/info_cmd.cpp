@@ -15,7 +15,7 @@ namespace mfr::cli {
 
 void addInfo(CLI::App& app) {
   struct Options {
-    std::string scene, size = "256x256", view = "fit", json;
+    std::string scene, size = "256x256", view = "fit", json, field;
     bool methods = false, noHistogram = false;
   };
   auto opt = std::make_shared<Options>();
@@ -25,6 +25,7 @@ void addInfo(CLI::App& app) {
   cmd->add_option("--size,-s", opt->size, "Image size for the depth-complexity histogram")->capture_default_str();
   cmd->add_option("--view", opt->view, "View for the histogram")->capture_default_str();
   cmd->add_flag("--no-histogram", opt->noHistogram, "Skip the oracle pass");
+  cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--json", opt->json, "Also write the information as JSON");
   cmd->callback([opt] {
     if (opt->methods) {
@@ -33,7 +34,7 @@ void addInfo(CLI::App& app) {
     }
     if (opt->scene.empty()) throw Error("info", "needs a scene (or --methods)");
     const auto [w, h] = parseSize("--size", opt->size);
-    const Scene scene = loadScene(opt->scene);
+    const Scene scene = loadScene(opt->scene, LoadOptions{opt->field});
     nlohmann::ordered_json j;
     const Bounds b = scene.bounds();
     j["scene"] = scene.name;
@@ -67,11 +68,19 @@ void addInfo(CLI::App& app) {
                          {"transfer_range", {v.transfer.low(), v.transfer.high()}},
                          {"unit_distance", v.transfer.unitDistance},
                          {"default_step", v.defaultStep()},
-                         {"visible", v.visible}});
-      std::cout << "  volume: " << v.name << " (" << d.x << "x" << d.y << "x" << d.z << " points, spacing "
-                << v.spacing.x << " " << v.spacing.y << " " << v.spacing.z << ", values " << range.x << " … " << range.y
-                << ", transfer " << v.transfer.low() << " … " << v.transfer.high() << " per " << v.transfer.unitDistance
-                << ", default step " << v.defaultStep() << (v.visible ? "" : ", hidden") << ")\n";
+                         {"visible", v.visible},
+                         {"field", v.field},
+                         {"fields", v.fields}});
+      std::cout << "  volume: " << v.name << (v.field.empty() ? "" : " [" + v.field + "]") << " (" << d.x << "x" << d.y
+                << "x" << d.z << " points, spacing " << v.spacing.x << " " << v.spacing.y << " " << v.spacing.z
+                << ", values " << range.x << " … " << range.y << ", transfer " << v.transfer.low() << " … "
+                << v.transfer.high() << " per " << v.transfer.unitDistance << ", default step " << v.defaultStep()
+                << (v.visible ? "" : ", hidden") << ")\n";
+      if (v.fields.size() > 1) {
+        std::cout << "    fields:";
+        for (const std::string& f : v.fields) std::cout << " " << f << (f == v.field ? " (read)" : "");
+        std::cout << "\n";
+      }
     }
     j["volumes"] = volumes;
     if (!opt->noHistogram) {

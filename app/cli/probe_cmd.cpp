@@ -50,7 +50,7 @@ int to8(float c) {
 
 void addProbe(CLI::App& app) {
   struct Options {
-    std::string scene, pixel, size = "512x512", view = "fit", method, op = "auto", json, clip, section;
+    std::string scene, pixel, size = "512x512", view = "fit", method, op = "auto", json, clip, section, field;
     std::vector<std::string> params;
     double opacity = -1.0;
   };
@@ -69,6 +69,7 @@ void addProbe(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--json", opt->json, "Also write the probe as JSON");
   cmd->add_option("--clip", opt->clip, kClipHelp);
+  cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
   cmd->callback([opt] {
@@ -95,7 +96,7 @@ void addProbe(CLI::App& app) {
     }
     validateOperation(opt->op);
     req.operation = opt->op;
-    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
+    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
     const Camera camera = scene.view(opt->view);

@@ -13,7 +13,8 @@ namespace mfr::cli {
 
 void addRender(CLI::App& app) {
   struct Options {
-    std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats, clip, section;
+    std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats, clip, section,
+                       field;
     std::vector<std::string> params;
     double opacity = -1.0;
     double thickness = 0.0;
@@ -40,6 +41,7 @@ void addRender(CLI::App& app) {
                 "Operation volume: shade the volume by its gradient with a headlight (boundaries inside the medium "
                 "read as surfaces)");
   cmd->add_option("--clip", opt->clip, kClipHelp);
+  cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
@@ -66,7 +68,7 @@ void addRender(CLI::App& app) {
       if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");
       req.params[p.substr(0, eq)] = p.substr(eq + 1);
     }
-    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity);
+    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
     if (opt->shade) {

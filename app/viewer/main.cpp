@@ -25,6 +25,7 @@ namespace {
 struct CommandLine {
   QString scene = QStringLiteral("@sample");
   QString session, screenshot, windowScreenshot, view, method, op;
+  QString field;                                  // --field: the array or grid of a volume file
   std::map<QString, QJsonObject> pluginSettings;  // by plugin id
   QSize size{800, 600}, windowSize;
   std::map<std::string, std::string> params;
@@ -66,6 +67,10 @@ CommandLine parseCommandLine(const QApplication& app) {
       QStringLiteral("step"),
       QStringLiteral("Operation volume: ray-march step in scene units (default: half the volume's grid spacing)."),
       QStringLiteral("length"));
+  const QCommandLineOption field(
+      QStringLiteral("field"),
+      QStringLiteral("Volume file: the point-data array (.vti, .vtk) or grid (.vdb) to read instead of the default."),
+      QStringLiteral("name"));
   const QCommandLineOption param({QStringLiteral("p"), QStringLiteral("param")}, QStringLiteral("Method parameter (repeatable)."), QStringLiteral("name=value"));
   const QCommandLineOption view(QStringLiteral("view"), QStringLiteral("Named view of the scene, or 'fit'."), QStringLiteral("name"));
   const QCommandLineOption size({QStringLiteral("s"), QStringLiteral("size")}, QStringLiteral("Image size for --screenshot (default 800x600)."), QStringLiteral("WxH"));
@@ -75,8 +80,8 @@ CommandLine parseCommandLine(const QApplication& app) {
   const QCommandLineOption pluginSettings(QStringLiteral("plugin-settings"),
                                          QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
                                          QStringLiteral("id={json}"));
-  parser.addOptions(
-      {method, op, thickness, step, param, view, size, screenshot, windowScreenshot, windowSize, pluginSettings});
+  parser.addOptions({method, op, thickness, step, field, param, view, size, screenshot, windowScreenshot, windowSize,
+                     pluginSettings});
   parser.process(app);
 
   CommandLine cl;
@@ -97,6 +102,11 @@ CommandLine parseCommandLine(const QApplication& app) {
     if (!ok || !(cl.step > 0.0) || !std::isfinite(cl.step))
       fail(QStringLiteral("--step %1: must be a positive length in scene units").arg(parser.value(step)), 2);
   }
+  cl.field = parser.value(field);
+  if (parser.isSet(field) && cl.field.isEmpty())
+    fail(QStringLiteral("--field: expected the name of an array or grid"), 2);
+  if (!cl.field.isEmpty() && !cl.session.isEmpty())
+    fail(QStringLiteral("--field %1: a session keeps its volumes' own fields").arg(cl.field), 2);
   cl.view = parser.value(view);
   cl.screenshot = parser.value(screenshot);
   cl.windowScreenshot = parser.value(windowScreenshot);
@@ -206,7 +216,7 @@ int main(int argc, char** argv) {
     // A scripted run has no one to read the message box: a bad session file ends it.
     if (scripted && !window.lastError().isEmpty()) fail(window.lastError(), 1);
   } else {
-    window.openScene(cl.scene);
+    window.openScene(cl.scene, cl.field);
   }
   return QApplication::exec();
 }

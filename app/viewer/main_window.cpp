@@ -418,10 +418,10 @@ void MainWindow::open(const QString& path) {
     openScene(path);
 }
 
-void MainWindow::openScene(const QString& path) {
+void MainWindow::openScene(const QString& path, const QString& field) {
   pendingSession_.reset();
   // Built-ins stay as typed; files are remembered by absolute path.
-  model_->loadSceneAsync(path.startsWith('@') ? path : QFileInfo(path).absoluteFilePath());
+  model_->loadSceneAsync(path.startsWith('@') ? path : QFileInfo(path).absoluteFilePath(), field);
 }
 
 void MainWindow::openSession(const QString& path) {

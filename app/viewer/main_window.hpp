@@ -31,7 +31,8 @@ class MainWindow final : public QMainWindow {
 
   // Starts loading a model, .mfrscene, built-in (@sample) or .mfrsession file.
   void open(const QString& path);
-  void openScene(const QString& path);
+  // `field`: the array or grid of a volume file (mfr::LoadOptions::field); empty: its default.
+  void openScene(const QString& path, const QString& field = {});
   void openSession(const QString& path);
   // Throws mfr::Error naming the file.
   void saveSession(const QString& path);

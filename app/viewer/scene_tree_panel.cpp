@@ -79,14 +79,31 @@ int volumeOfRow(const QTreeWidgetItem* item) {
 }
 }  // namespace
 
+QString SceneTreePanel::volumeText(const mfr::Volume& volume, std::size_t index) {
+  // The field read, when the file has several to choose from (the Volume panel's Field).
+  const QString field =
+      volume.fields.size() > 1 ? QStringLiteral(" [%1]").arg(QString::fromStdString(volume.field)) : QString();
+  return tr("%1%2 (volume)")
+      .arg(QString::fromStdString(volume.name.empty() ? "volume " + std::to_string(index) : volume.name), field);
+}
+
+QString SceneTreePanel::gridText(const mfr::Volume& volume) {
+  const glm::ivec3 d = volume.grid ? volume.grid->dims : glm::ivec3(0);
+  return QStringLiteral("%1×%2×%3").arg(d.x).arg(d.y).arg(d.z);
+}
+
 void SceneTreePanel::showValues() {
   const auto& objects = model_.scene().objects;
   const auto& volumes = model_.scene().volumes;
   if (tree_->topLevelItemCount() != static_cast<int>(objects.size() + volumes.size())) return;
   const QSignalBlocker block(tree_);
-  for (std::size_t v = 0; v < volumes.size(); ++v)
-    tree_->topLevelItem(static_cast<int>(objects.size() + v))
-        ->setCheckState(kName, volumes[v].visible ? Qt::Checked : Qt::Unchecked);
+  for (std::size_t v = 0; v < volumes.size(); ++v) {
+    QTreeWidgetItem* item = tree_->topLevelItem(static_cast<int>(objects.size() + v));
+    item->setCheckState(kName, volumes[v].visible ? Qt::Checked : Qt::Unchecked);
+    // Another field read (the Volume panel's Field): its name and grid.
+    item->setText(kName, volumeText(volumes[v], v));
+    item->setText(kColour, gridText(volumes[v]));
+  }
   for (int i = 0; i < static_cast<int>(objects.size()); ++i) {
     QTreeWidgetItem* item = tree_->topLevelItem(i);
     const mfr::Object& o = objects[static_cast<std::size_t>(i)];
@@ -130,13 +147,10 @@ void SceneTreePanel::rebuild() {
     const mfr::Volume& volume = volumes[v];
     auto* item = new QTreeWidgetItem;
     item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsUserCheckable);
-    item->setText(kName,
-                  tr("%1 (volume)")
-                      .arg(QString::fromStdString(volume.name.empty() ? "volume " + std::to_string(v) : volume.name)));
+    item->setText(kName, volumeText(volume, v));
     item->setData(kName, Qt::UserRole, -1 - static_cast<int>(v));
     item->setCheckState(kName, volume.visible ? Qt::Checked : Qt::Unchecked);
-    const glm::ivec3 d = volume.grid ? volume.grid->dims : glm::ivec3(0);
-    item->setText(kColour, QStringLiteral("%1×%2×%3").arg(d.x).arg(d.y).arg(d.z));
+    item->setText(kColour, gridText(volume));
     item->setToolTip(kName, tr("Drawn by the operation volume, mixed with the scene's other visible volumes where they "
                                "overlap (at most 4 at once)"));
     items.push_back(item);

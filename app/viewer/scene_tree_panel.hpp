@@ -3,6 +3,10 @@
 // change) and an editable opacity, then one row per volume (name, grid size, visibility).
 #include <QWidget>
 
+#include <cstddef>
+
+#include "mfr/scene/volume.hpp"
+
 class QTreeWidget;
 class QTreeWidgetItem;
 class ViewerModel;
@@ -16,6 +20,9 @@ class SceneTreePanel final : public QWidget {
  private:
   void rebuild();
   void showValues();
+  // A volume's row: its name (with the field read, for a file with several) and its grid size.
+  static QString volumeText(const mfr::Volume& volume, std::size_t index);
+  static QString gridText(const mfr::Volume& volume);
   void itemChanged(QTreeWidgetItem* item, int column);
   void itemClicked(QTreeWidgetItem* item, int column);
 

@@ -107,7 +107,8 @@ Session captureSession(const ViewerModel& model) {
   s.hasSection = true;
   s.section = model.section();
   for (const mfr::Volume& v : model.scene().volumes)
-    s.volumes.push_back({QString::fromStdString(v.name), v.visible, v.transfer, v.shading});
+    s.volumes.push_back(
+        {QString::fromStdString(v.name), v.visible, v.transfer, v.shading, QString::fromStdString(v.field)});
   s.params = model.allParams();
   for (const mfr::Object& o : model.scene().objects) {
     s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color, o.material.vertexColors});
@@ -138,9 +139,13 @@ void applySession(const Session& session, ViewerModel& model) {
   if (session.hasClip) model.setClipBox(session.clip);
   if (session.hasSection) model.setSection(session.section);
   if (session.volumes.size() == model.scene().volumes.size())
-    for (std::size_t i = 0; i < session.volumes.size(); ++i)
-      model.setVolumeStateAt(static_cast<int>(i), session.volumes[i].visible, session.volumes[i].transfer,
-                             session.volumes[i].shading);
+    for (std::size_t i = 0; i < session.volumes.size(); ++i) {
+      const Session::VolumeState& v = session.volumes[i];
+      model.setVolumeStateAt(static_cast<int>(i), v.visible, v.transfer, v.shading);
+      // Another field of the file: read in the background; the session's function follows it.
+      if (!v.field.isEmpty() && v.field.toStdString() != model.scene().volumes[i].field)
+        model.setVolumeFieldAt(static_cast<int>(i), v.field, v.transfer);
+    }
   model.setVolumeStep(session.volumeStep);
   if (!session.operation.isEmpty()) model.setOperation(session.operation);
   if (!session.method.isEmpty()) model.setMethod(session.method);
@@ -181,6 +186,7 @@ QJsonObject sessionToJson(const Session& s) {
         QJsonObject{{"name", v.name},
                     {"visible", v.visible},
                     {"shading", v.shading},
+                    {"field", v.field},
                     {"transfer", QJsonObject{{"unit_distance", v.transfer.unitDistance}, {"points", points}}}});
   }
   QJsonArray objects;
@@ -282,8 +288,11 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
     const QJsonObject v = volumes[i].toObject();
     const QString where = QStringLiteral("volumes[%1].transfer").arg(i);
     const QJsonObject t = v.value("transfer").toObject();
-    Session::VolumeState state{
-        v.value("name").toString(), v.value("visible").toBool(true), {}, v.value("shading").toBool(false)};
+    Session::VolumeState state{v.value("name").toString(),
+                               v.value("visible").toBool(true),
+                               {},
+                               v.value("shading").toBool(false),
+                               v.value("field").toString()};
     state.transfer.unitDistance = r.number(t, "unit_distance", where, 1.0);
     const QJsonArray points = t.value("points").toArray();
     for (qsizetype j = 0; j < points.size(); ++j) {

@@ -41,6 +41,7 @@ struct Session {
     bool visible = true;
     mfr::TransferFunction transfer;
     bool shading = false;  // Volume::shading
+    QString field;         // Volume::field: the array or grid read ("" for formats without names)
   };
   std::vector<VolumeState> volumes;                                  // by volume index
   std::map<std::string, std::map<std::string, std::string>> params;  // per method

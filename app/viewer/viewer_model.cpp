@@ -243,6 +243,85 @@ void ViewerModel::setCurrentVolume(int index) {
   emit volumeChanged();  // the panel now shows this volume; nothing is drawn differently
 }
 
+QStringList ViewerModel::volumeFields() const {
+  QStringList fields;
+  if (const int i = volumeIndex(); i >= 0)
+    for (const std::string& f : scene_.volumes[static_cast<std::size_t>(i)].fields) fields << QString::fromStdString(f);
+  return fields;
+}
+
+QString ViewerModel::volumeField() const {
+  const int i = volumeIndex();
+  return i < 0 ? QString() : QString::fromStdString(scene_.volumes[static_cast<std::size_t>(i)].field);
+}
+
+void ViewerModel::setVolumeField(const QString& field) {
+  setVolumeFieldAt(volumeIndex(), field);
+}
+
+void ViewerModel::setVolumeFieldAt(int index, const QString& field,
+                                   const std::optional<mfr::TransferFunction>& transfer) {
+  if (!hasScene_ || index < 0 || index >= static_cast<int>(scene_.volumes.size()) || field.isEmpty()) return;
+  const mfr::Volume& volume = scene_.volumes[static_cast<std::size_t>(index)];
+  if (volume.file.empty() || field.toStdString() == volume.field) return;
+  if (fieldLoad_) fieldLoad_->cancel = true;  // superseded
+  auto state = std::make_shared<LoadState>();
+  fieldLoad_ = state;
+  fieldError_.clear();
+  emit volumeChanged();
+  struct Read {
+    std::optional<mfr::Volume> volume;
+    QString error;
+  };
+  runInBackground<Read>(
+      this,
+      [file = volume.file, name = field.toStdString(), state]() -> Read {
+        Read read;
+        const mfr::LoadProgress progress{[state](double) { return !state->cancel; }};
+        try {
+          read.volume = mfr::loadVolume(file, mfr::LoadOptions{name}, progress);
+        } catch (const mfr::LoadCancelled&) {
+          read.error = tr("reading stopped");
+        } catch (const std::exception& e) {
+          read.error = QString::fromUtf8(e.what());
+        }
+        return read;
+      },
+      [this, index, state, loads = sceneLoads_, transfer](Read read) {
+        if (state != fieldLoad_) return;  // superseded by another read, or by a new scene
+        fieldLoad_.reset();
+        if (loads != sceneLoads_ || index >= static_cast<int>(scene_.volumes.size())) return;
+        if (!read.volume) {
+          fieldError_ = read.error;
+          emit volumeChanged();
+          return;
+        }
+        mfr::Volume& current = scene_.volumes[static_cast<std::size_t>(index)];
+        mfr::Volume next = std::move(*read.volume);
+        // The same volume of the scene: its name, state and the scene's placement stay; the grid,
+        // its own placement (a .vdb grid's box and transform) and the default transfer are new.
+        next.name = current.name;
+        next.visible = current.visible;
+        next.shading = current.shading;
+        next.sceneTransform = current.sceneTransform;
+        next.transform = current.sceneTransform * next.transform;
+        next.transfer = mfr::defaultTransfer(*next.grid, next.bounds());
+        loadedTransfers_[static_cast<std::size_t>(index)] = next.transfer;
+        volumeRanges_[static_cast<std::size_t>(index)] = glm::dvec2(next.grid->range());
+        if (transfer) {
+          try {
+            transfer->validate("transfer function");
+            next.transfer = *transfer;
+          } catch (const std::exception&) {
+            // keeps the default
+          }
+        }
+        current = std::move(next);
+        updateSceneGeometry();
+        volumeEdited();
+      });
+}
+
 QString ViewerModel::volumeName() const {
   const int i = volumeIndex();
   return i < 0 ? QString() : QString::fromStdString(scene_.volumes[static_cast<std::size_t>(i)].name);
@@ -475,7 +554,7 @@ void ViewerModel::setDataView(DataView view, bool overImage) {
 
 // ---- scene -------------------------------------------------------------------------------
 
-void ViewerModel::loadSceneAsync(const QString& path) {
+void ViewerModel::loadSceneAsync(const QString& path, const QString& field) {
   if (load_) {
     load_->cancel = true;  // superseded: stop the previous worker early
     ++abandonedLoads_;
@@ -494,14 +573,14 @@ void ViewerModel::loadSceneAsync(const QString& path) {
   };
   runInBackground<Loaded>(
       this,
-      [path, state]() -> Loaded {
+      [path, field, state]() -> Loaded {
         Loaded loaded;
         const mfr::LoadProgress progress{[state](double fraction) {
           state->fraction = fraction;
           return !state->cancel;
         }};
         try {
-          loaded.scene = mfr::loadScene(path.toStdString(), progress);
+          loaded.scene = mfr::loadScene(path.toStdString(), mfr::LoadOptions{field.toStdString()}, progress);
         } catch (const mfr::LoadCancelled&) {
           loaded.stopped = true;
         } catch (const std::exception& e) {
@@ -553,6 +632,10 @@ void ViewerModel::cancelLoad() {
 
 void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
   scene_ = std::move(scene);
+  ++sceneLoads_;
+  if (fieldLoad_) fieldLoad_->cancel = true;  // a field of the old scene's volume
+  fieldLoad_.reset();
+  fieldError_.clear();
   loadedMaterials_.clear();
   for (const mfr::Object& o : scene_.objects) loadedMaterials_.push_back(o.material);
   scenePath_ = path;
@@ -937,7 +1020,7 @@ void ViewerModel::startMetrics(int side, const mfr::ImageRGBA8& reference) {
 }
 
 bool ViewerModel::busy() const {
-  return loading_ || abandonedLoads_ > 0 || cpuRunning_ || metricsRunning_[0] || metricsRunning_[1];
+  return loading_ || abandonedLoads_ > 0 || fieldLoad_ || cpuRunning_ || metricsRunning_[0] || metricsRunning_[1];
 }
 
 // ---- depth complexity ---------------------------------------------------------------------

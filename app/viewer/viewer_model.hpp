@@ -168,6 +168,17 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] QStringList volumeNames() const override;
   [[nodiscard]] int currentVolume() const override { return volumeIndex(); }
   void setCurrentVolume(int index) override;
+  // 1.7: the current volume's fields.
+  [[nodiscard]] QStringList volumeFields() const override;
+  [[nodiscard]] QString volumeField() const override;
+  void setVolumeField(const QString& field) override;
+  [[nodiscard]] bool volumeFieldLoading() const override { return fieldLoad_ != nullptr; }
+  [[nodiscard]] QString volumeFieldError() const override { return fieldError_; }
+  // Volume `index` re-read from its file with `field`, in the background (a new scene, or another
+  // field read before it ends, supersedes it), placed as before; its transfer function becomes
+  // `transfer` when that is valid (a session's), else the default over the new samples. Nothing
+  // happens for the field it has, or a volume not read from a file.
+  void setVolumeFieldAt(int index, const QString& field, const std::optional<mfr::TransferFunction>& transfer = {});
   // Every volume of the scene by index (the scene tree, sessions); showing one more than
   // Scene::kMaxVisibleVolumes hides the first other visible one.
   void setVolumeVisibleAt(int index, bool visible);
@@ -184,7 +195,7 @@ class ViewerModel final : public ViewerContext {
   // Scene. loadSceneAsync reads the file on a worker thread, reporting loadProgressChanged; the
   // current scene stays until the new one has loaded (sceneLoaded) — a failure (loadFailed) or
   // cancelLoad() leaves it intact. cancelLoad also stops the loader at its next progress report.
-  void loadSceneAsync(const QString& path);
+  void loadSceneAsync(const QString& path, const QString& field = {});
   void cancelLoad();
   [[nodiscard]] bool isLoading() const { return loading_; }
   [[nodiscard]] double loadProgress() const { return loadProgress_; }  // of the current or last load
@@ -343,6 +354,9 @@ class ViewerModel final : public ViewerContext {
   // Loading: the worker writes progress and reads the cancel flag of its own state.
   struct LoadState;
   std::shared_ptr<LoadState> load_;
+  std::shared_ptr<LoadState> fieldLoad_;  // setVolumeFieldAt's read in progress
+  QString fieldError_;
+  quint64 sceneLoads_ = 0;  // setScene calls: a field read for an earlier scene is dropped
   bool loading_ = false;
   double loadProgress_ = 0.0;
   bool lastCancelStoppedLoader_ = false;

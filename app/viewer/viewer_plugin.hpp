@@ -182,6 +182,17 @@ class ViewerContext : public QObject {
   [[nodiscard]] virtual QStringList volumeNames() const = 0;
   [[nodiscard]] virtual int currentVolume() const = 0;
   virtual void setCurrentVolume(int index) = 0;
+  // 1.7: the current volume's named fields (Volume::fields: a .vti/.vtk file's point-data arrays,
+  // a .vdb file's grids; empty for formats with one unnamed field) and the one read.
+  // setVolumeField reads another field of the same file in the background, in the volume's place;
+  // its transfer function becomes the default over the new samples. volumeChanged is emitted when
+  // the read starts and when it ends; while it runs volumeFieldLoading() is true; a read that
+  // failed leaves the volume as it was and says why in volumeFieldError() (empty otherwise).
+  [[nodiscard]] virtual QStringList volumeFields() const = 0;
+  [[nodiscard]] virtual QString volumeField() const = 0;
+  virtual void setVolumeField(const QString& field) = 0;
+  [[nodiscard]] virtual bool volumeFieldLoading() const = 0;
+  [[nodiscard]] virtual QString volumeFieldError() const = 0;
 
  signals:
   void sceneChanged();  // a new scene, or an object edited
@@ -195,8 +206,8 @@ class ViewerContext : public QObject {
   void dataViewChanged();
   void operationChanged(const QString& operation);
   void zThicknessChanged(double thickness);  // zThickness(), 0 = the default
-  void
-  volumeChanged();  // 1.4: a new scene, or a volume's visibility, transfer function or step; 1.6: the current volume
+  void volumeChanged();  // 1.4: a new scene, or a volume's visibility, transfer function or step; 1.6: the current
+                         // volume; 1.7: a field read started or ended
 };
 
 class MfrViewerPlugin {
@@ -220,5 +231,7 @@ class MfrViewerPlugin {
 // 1.5: volumeHistogram (the transfer-function editor's background).
 // 1.6: several volumes drawn at once: volumeCount, visibleVolumeCount, volumeNames, currentVolume,
 //      setCurrentVolume.
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.6"
+// 1.7: a volume file's fields: volumeFields, volumeField, setVolumeField, volumeFieldLoading,
+//      volumeFieldError.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.7"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -99,6 +99,26 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   layout->addWidget(volumeRow_);
   volumeRow_->hide();
 
+  // A file with several arrays (.vti, .vtk) or grids (.vdb): which one is read.
+  fieldChoice_ = new QComboBox;
+  fieldChoice_->setObjectName(QStringLiteral("hvField"));
+  fieldChoice_->setToolTip(
+      tr("The array (VTK files) or grid (OpenVDB files) of the volume's file that is drawn. Another "
+         "one is read from the file in its place; its transfer function starts at the default over "
+         "its values."));
+  fieldRow_ = new QWidget;
+  auto* fieldRow = new QHBoxLayout(fieldRow_);
+  fieldRow->setContentsMargins(0, 0, 0, 0);
+  fieldRow->addWidget(new QLabel(tr("Field")));
+  fieldRow->addWidget(fieldChoice_, 1);
+  layout->addWidget(fieldRow_);
+  fieldRow_->hide();
+  fieldNote_ = new QLabel;
+  fieldNote_->setObjectName(QStringLiteral("hvFieldNote"));
+  fieldNote_->setWordWrap(true);
+  fieldNote_->hide();
+  layout->addWidget(fieldNote_);
+
   show_ = new QCheckBox(tr("Show volume"));
   show_->setObjectName(QStringLiteral("hvShow"));
   show_->setToolTip(
@@ -247,6 +267,9 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   connect(volumeChoice_, &QComboBox::currentIndexChanged, this, [this](int index) {
     if (index >= 0) context_.setCurrentVolume(index);
   });
+  connect(fieldChoice_, &QComboBox::activated, this, [this](int index) {
+    if (index >= 0) context_.setVolumeField(fieldChoice_->itemText(index));
+  });
   connect(shade_, &QCheckBox::toggled, this, [this](bool on) { context_.setVolumeShading(on); });
   connect(&context_, &ViewerContext::operationChanged, this, &HybridVolumePanel::showState);
   connect(&context_, &ViewerContext::methodChanged, this, &HybridVolumePanel::showState);
@@ -306,8 +329,28 @@ void HybridVolumePanel::showVolumeChoice() {
   volumeRow_->setVisible(names.size() > 1);
 }
 
+void HybridVolumePanel::showFieldChoice() {
+  const QSignalBlocker block(fieldChoice_);
+  const QStringList fields = context_.hasScene() ? context_.volumeFields() : QStringList();
+  QStringList shown;
+  for (int i = 0; i < fieldChoice_->count(); ++i) shown << fieldChoice_->itemText(i);
+  if (shown != fields) {
+    fieldChoice_->clear();
+    fieldChoice_->addItems(fields);
+  }
+  fieldChoice_->setCurrentIndex(fields.indexOf(context_.hasScene() ? context_.volumeField() : QString()));
+  fieldRow_->setVisible(fields.size() > 1);
+  const bool loading = context_.hasScene() && context_.volumeFieldLoading();
+  fieldChoice_->setEnabled(!loading);
+  const QString error = context_.hasScene() ? context_.volumeFieldError() : QString();
+  fieldNote_->setText(loading ? tr("Reading the field…") : error);
+  fieldNote_->setStyleSheet(loading ? QString() : QStringLiteral("color: #b00020;"));
+  fieldNote_->setVisible(loading || !error.isEmpty());
+}
+
 void HybridVolumePanel::volumeChanged() {
   showVolumeChoice();
+  showFieldChoice();
   const bool has = context_.hasScene() && context_.hasVolume();
   controls_->setEnabled(has);
   show_->setEnabled(has);
@@ -317,7 +360,7 @@ void HybridVolumePanel::volumeChanged() {
     editor_->setHistogram({});
     histogramKey_.clear();
     showSelectedPoint();
-    info_->setText(tr("The scene has no volume: open a .vti, .vtk, .mhd/.mha, .nrrd or .inr file, or @volume."));
+    info_->setText(tr("The scene has no volume: open a .vti, .vtk, .mhd/.mha, .nrrd, .inr or .vdb file, or @volume."));
     showState();
     return;
   }
@@ -589,6 +632,8 @@ void HybridVolumePanel::showInfo() {
                .arg(s.x, 0, 'g', 4)
                .arg(s.y, 0, 'g', 4)
                .arg(s.z, 0, 'g', 4);
+  if (const QStringList fields = context_.volumeFields(); !fields.isEmpty())
+    lines << tr("field %1 (of %2)").arg(context_.volumeField(), fields.join(QStringLiteral(", ")));
   lines << tr("values %1 … %2").arg(r.x, 0, 'g', 5).arg(r.y, 0, 'g', 5);
   QString step, bytes;
   for (const auto& [name, value] : context_.stats().notes) {

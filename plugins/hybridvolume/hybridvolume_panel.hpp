@@ -57,6 +57,7 @@ class HybridVolumePanel final : public QWidget {
  private:
   void volumeChanged();
   void showVolumeChoice();
+  void showFieldChoice();
   void resetToCurrent();  // Custom, based on the context's function, its own window, scale 1
   void setShow(bool on);
   void showState();
@@ -77,6 +78,9 @@ class HybridVolumePanel final : public QWidget {
   ViewerContext& context_;
   QComboBox* volumeChoice_ = nullptr;
   QWidget* volumeRow_ = nullptr;
+  QComboBox* fieldChoice_ = nullptr;  // the file's arrays or grids, when it has several
+  QWidget* fieldRow_ = nullptr;
+  QLabel* fieldNote_ = nullptr;  // a field being read, or why it could not be
   QCheckBox* show_ = nullptr;
   QLabel* note_ = nullptr;
   QComboBox* preset_ = nullptr;

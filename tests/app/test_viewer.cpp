@@ -2591,6 +2591,142 @@ class ViewerTest : public QObject {
     QVERIFY(maxChannelDifference(mfr::render(firstOnly, camera, request).image, both) > 40);
   }
 
+  // A volume file with two arrays, in a scene that moves it: the Volume panel's Field reads the
+  // other array in the background, in the same place (the frame equals mfr render of a scene file
+  // naming that field, run as a separate program); the scene tree names it; a field the file lacks
+  // leaves the volume as it was with the reason shown; a session brings the field and its
+  // transfer function back.
+  void volumeField() {
+    QTemporaryDir dir;
+    {
+      constexpr int n = 12;
+      QString ramp, ring;
+      for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i) {
+            ramp += QString::number(i) + ' ';
+            const double r = std::hypot(i - 5.5, j - 5.5, k - 5.5);
+            ring += QString::number(std::exp(-(r - 4.0) * (r - 4.0)), 'g', 9) + ' ';
+          }
+      QFile f(dir.filePath("two.vti"));
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(QStringLiteral("<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" "
+                             "byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"0 11 0 11 0 11\" "
+                             "Origin=\"0 0 0\" Spacing=\"0.1 0.1 0.1\">\n<Piece Extent=\"0 11 0 11 0 11\">"
+                             "<PointData><DataArray type=\"Float32\" Name=\"ramp\" format=\"ascii\">%1</DataArray>"
+                             "<DataArray type=\"Float32\" Name=\"ring\" format=\"ascii\">%2</DataArray></PointData>"
+                             "<CellData></CellData></Piece>\n</ImageData>\n</VTKFile>\n")
+                  .arg(ramp, ring)
+                  .toUtf8());
+    }
+    const auto writeScene = [&](const QString& name, const QString& field) {
+      QJsonObject volume{{"file", "two.vti"}, {"transform", QJsonObject{{"translate", QJsonArray{0.4, -0.2, 0.1}}}}};
+      if (!field.isEmpty()) volume["field"] = field;
+      const QJsonObject ball{{"primitive", QJsonObject{{"type", "sphere"}, {"radius", 0.3}}},
+                             {"color", QJsonArray{0.2, 0.4, 0.9}},
+                             {"opacity", 0.5}};
+      const QJsonObject iso{{"name", "iso"}, {"eye", QJsonArray{3.0, 2.0, 4.0}}, {"fit", true}};
+      QFile f(dir.filePath(name));
+      if (!f.open(QIODevice::WriteOnly)) return QString();
+      f.write(
+          QJsonDocument(
+              QJsonObject{{"objects", QJsonArray{ball}}, {"volumes", QJsonArray{volume}}, {"views", QJsonArray{iso}}})
+              .toJson());
+      return dir.filePath(name);
+    };
+    const QString path = writeScene("ramp.mfrscene", QString());
+    const QString ringPath = writeScene("ring.mfrscene", QStringLiteral("ring"));
+    QVERIFY(!path.isEmpty() && !ringPath.isEmpty());
+    auto w = openWindow(path);
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    const QSize size(160, 120);
+    w->view().setFixedSize(size);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), size, kTimeoutMs);
+    m.setMethod("abuffer-ll");
+    m.setCamera(m.scene().view("iso"));
+    settle(m);
+    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    auto* field = w->findChild<QComboBox*>("hvField");
+    auto* fieldNote = w->findChild<QLabel*>("hvFieldNote");
+    auto* info = w->findChild<QLabel*>("hvInfo");
+    QVERIFY(field && fieldNote && info);
+    QVERIFY(field->isVisibleTo(w.get()));
+    QCOMPARE(field->count(), 2);
+    QCOMPARE(field->currentText(), QStringLiteral("ramp"));
+    QCOMPARE(m.volumeFields(), (QStringList{"ramp", "ring"}));
+    QVERIFY2(info->text().contains(QStringLiteral("field ramp (of ramp, ring)")), qPrintable(info->text()));
+    const mfr::ImageRGBA8 rampFrame = w->view().renderImage(size);
+    const mfr::Bounds before = m.volumeBounds();
+
+    emit field->activated(1);  // as a user's choice
+    QVERIFY(m.volumeFieldLoading());
+    QTRY_VERIFY_WITH_TIMEOUT(!m.volumeFieldLoading(), kTimeoutMs);
+    QVERIFY2(m.volumeFieldError().isEmpty(), qPrintable(m.volumeFieldError()));
+    QCOMPARE(m.volumeField(), QStringLiteral("ring"));
+    QCOMPARE(field->currentText(), QStringLiteral("ring"));
+    QVERIFY(!fieldNote->isVisibleTo(w.get()));
+    QVERIFY(m.volumeValueRange().y < 1.01 && m.volumeValueRange().y > 0.9);  // ring: exp(-d²) peaks at 1
+    QCOMPARE(m.volumeBounds().min, before.min);                              // the scene's translation kept
+    QCOMPARE(m.volumeBounds().max, before.max);
+    auto* tree = w->findChild<QTreeWidget*>("sceneTree");
+    QVERIFY(tree);
+    QVERIFY(!tree->findItems(QStringLiteral("two.vti [ring] (volume)"), Qt::MatchExactly).isEmpty());
+    settle(m);
+    const mfr::ImageRGBA8 ringFrame = w->view().renderImage(size);
+    QVERIFY(maxChannelDifference(ringFrame, rampFrame) > 40);
+    const QString cliPng = dir.filePath("cli.png");
+    QString out;
+    QCOMPARE(
+        runProgram(MFR_CLI,
+                   {"render", ringPath, "--size", "160x120", "--view", "iso", "-m", "abuffer-ll", "-o", cliPng}, &out),
+        0);
+    QCOMPARE(maxChannelDifference(mfr::readPng(cliPng.toStdString()), ringFrame), 0);
+
+    // A field the file lacks: the reason, and the volume as it was.
+    m.setVolumeField(QStringLiteral("rings"));
+    QTRY_VERIFY_WITH_TIMEOUT(!m.volumeFieldLoading(), kTimeoutMs);
+    QVERIFY2(m.volumeFieldError().contains(QStringLiteral("no point-data array 'rings' (arrays: ramp, ring)")),
+             qPrintable(m.volumeFieldError()));
+    QVERIFY(fieldNote->isVisibleTo(w.get()));
+    QCOMPARE(fieldNote->text(), m.volumeFieldError());
+    QCOMPARE(m.volumeField(), QStringLiteral("ring"));
+    settle(m);
+    QCOMPARE(maxChannelDifference(w->view().renderImage(size), ringFrame), 0);
+
+    // A session: the field and the function edited after it was read.
+    auto* preset = w->findChild<QComboBox*>("hvPreset");
+    QVERIFY(preset);
+    preset->setCurrentIndex(preset->findData(QStringLiteral("fire")));
+    settle(m);
+    const mfr::ImageRGBA8 fire = w->view().renderImage(size);
+    QVERIFY(maxChannelDifference(fire, ringFrame) > 20);
+    const QString sessionPath = dir.filePath("field.mfrsession");
+    w->saveSession(sessionPath);
+    auto again = openWindow(QString());
+    QVERIFY(again);
+    again->view().setFixedSize(size);
+    again->openSession(sessionPath);
+    ViewerModel& a = again->model();
+    QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.volumeField() == QStringLiteral("ring") && !a.volumeFieldLoading(),
+                             kTimeoutMs);
+    settle(a);
+    QCOMPARE(again->findChild<QComboBox*>("hvField")->currentText(), QStringLiteral("ring"));
+    QCOMPARE(maxChannelDifference(fire, again->view().renderImage(a.renderSize())), 0);
+
+    // mfrview --field opens a volume file's other array: the pixels of mfr render --field.
+    const QString vti = dir.filePath("two.vti"), viewerPng = dir.filePath("viewer.png");
+    const QStringList common{"--size", "96x72", "--view", "iso", "-m", "abuffer-ll"};
+    QCOMPARE(runProgram(MFRVIEW, QStringList{vti, "--field", "ring", "--screenshot", viewerPng} + common, &out), 0);
+    QCOMPARE(runProgram(MFR_CLI, QStringList{"render", vti, "--field", "ring", "-o", cliPng} + common, &out), 0);
+    QCOMPARE(maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString())), 0);
+    QVERIFY(runProgram(MFRVIEW, QStringList{vti, "--field", "rings", "--screenshot", viewerPng} + common, &out) != 0);
+    const QString last = out.trimmed().split(QLatin1Char('\n')).last();  // after any Qt platform chatter
+    QVERIFY2(last.startsWith(QStringLiteral("mfrview: ") + vti) &&
+                 last.contains(QStringLiteral("no point-data array 'rings' (arrays: ramp, ring)")),
+             qPrintable(out));
+  }
+
   void volumePanelNamesAPresetFunction() {
     QTemporaryDir dir;
     auto w = openWindow(QString());

@@ -121,6 +121,47 @@ void writeUniformVolume(const fs::path& path) {
   for (int i = 0; i < 125; ++i) out << "0.5\n";
 }
 
+// A legacy VTK file with two arrays over [-1, 1]³ on a 5³ grid: "ramp" rising along x, "dip" falling.
+void writeTwoArrayVolume(const fs::path& path) {
+  std::ofstream out(path);
+  out << "# vtk DataFile Version 3.0\ntwo arrays\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 5 5 5\n"
+         "ORIGIN -1 -1 -1\nSPACING 0.5 0.5 0.5\nPOINT_DATA 125\nSCALARS ramp float 1\nLOOKUP_TABLE default\n";
+  for (int i = 0; i < 125; ++i) out << i % 5 << "\n";
+  out << "SCALARS dip float 1\nLOOKUP_TABLE default\n";
+  for (int i = 0; i < 125; ++i) out << 10 - i % 5 << "\n";
+}
+
+// --field reads another array: info names the one read and lists the others, the image changes,
+// the default is the first array; an array the file lacks or --field on a model is one line.
+TEST_F(CliVolume, FieldChoosesTheArray) {
+  const fs::path vtk = dir() / "two.vtk", json = dir() / "info.json";
+  writeTwoArrayVolume(vtk);
+  const CliResult info = runCli("info " + vtk.string() + " --field dip --no-histogram --json " + json.string());
+  ASSERT_EQ(info.exitCode, 0) << info.out;
+  EXPECT_NE(info.out.find("volume: two.vtk [dip] (5x5x5 points"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("values 6 … 10"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("fields: ramp dip (read)"), std::string::npos) << info.out;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["volumes"][0]["field"], "dip");
+  EXPECT_EQ(j["volumes"][0]["fields"], nlohmann::json({"ramp", "dip"}));
+
+  const std::string common = "render " + vtk.string() + " --size 64x48 -o ";
+  const fs::path byDefault = dir() / "default.png", ramp = dir() / "ramp.png", dip = dir() / "dip.png",
+                 dipGpu = dir() / "dip-gpu.png";
+  ASSERT_EQ(runCli(common + byDefault.string()).exitCode, 0);
+  ASSERT_EQ(runCli(common + ramp.string() + " --field ramp").exitCode, 0);
+  ASSERT_EQ(runCli(common + dip.string() + " --field dip").exitCode, 0);
+  ASSERT_EQ(runCli(common + dipGpu.string() + " --field dip -m abuffer-ll").exitCode, 0);
+  EXPECT_EQ(rmseOf(byDefault, ramp), 0.0);
+  EXPECT_GT(rmseOf(ramp, dip), 0.02);
+  EXPECT_LT(rmseOf(dip, dipGpu), 0.01);
+
+  expectCleanFailure("render " + vtk.string() + " --field Dip", "no point-data array 'Dip' (arrays: ramp, dip)");
+  expectCleanFailure("render " + vtk.string() + " --field Dip", vtk.string());
+  expectCleanFailure("render @sample --field dip", "can be chosen only for a volume file");
+}
+
 // Two homogeneous volumes overlapping on x ∈ [0, 1] (red: opacity 0.5 per unit, blue: 0.3, moved
 // +1 along x), seen along −z: where both lie the medium is their mixture — extinction σ_r + σ_b,
 // colour weighted by σ — against the closed form; the probe splits the medium's share by volume;

@@ -9,8 +9,10 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <string>
+#include <vector>
 
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
@@ -120,6 +122,78 @@ TEST_F(OpenVdbFiles, VectorGridsAreReadAsTheirMagnitude) {
     largest = std::max(largest, reference.grid->values[i]);
   }
   EXPECT_GT(largest, 1.0f);  // the fog rises from 0 to 1 over a few voxels of 0.1: a gradient of several per unit
+}
+
+// A file of several grids — two level-set spheres of different radii, the fog of the smaller one
+// and its gradient (grad_fog) — read grid by grid (LoadOptions::field and a scene file's "field"), each
+// checked against the sphere it holds and against vdb_print's dimensions; the default is the first
+// float grid; a grid the file lacks, or one of point data, is one line naming the file and the
+// grids it has.
+TEST_F(OpenVdbFiles, AnyGridOfTheFileCanBeChosen) {
+  const fs::path multi = make(
+      "-sphere radius=2 voxel=0.1 name=big -sphere radius=1 voxel=0.1 name=small -ls2fog keep=1 name=fog "
+      "-grad keep=1",
+      "multi.vdb");
+  const CliResult listing = runCommand("vdb_print '" + multi.string() + "'");
+  ASSERT_EQ(listing.exitCode, 0) << listing.out;
+  std::map<std::string, glm::ivec3> printed;  // vdb_print: "name type (min)->(max) NxNxN ..."
+  const std::regex line(R"((\w+)\s+(\w+)\s+\([^)]*\)->\([^)]*\)\s+(\d+)x(\d+)x(\d+))");
+  for (auto it = std::sregex_iterator(listing.out.begin(), listing.out.end(), line); it != std::sregex_iterator(); ++it)
+    printed[(*it)[1]] = glm::ivec3(std::stoi((*it)[3]), std::stoi((*it)[4]), std::stoi((*it)[5]));
+  ASSERT_EQ(printed.size(), 4u) << listing.out;
+
+  const Volume first = loadVolume(multi);
+  std::vector<std::string> sorted = first.fields;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(sorted, (std::vector<std::string>{"big", "fog", "grad_fog", "small"}));
+  EXPECT_EQ(first.field, first.fields.front() == "grad_fog" ? first.fields[1] : first.fields.front());
+  EXPECT_EQ(first.name, "multi.vdb");
+
+  const glm::dvec3 centre(0.0);
+  const Volume big = loadVolume(multi, LoadOptions{"big"});
+  const Volume small = loadVolume(multi, LoadOptions{"small"});
+  const Volume fog = loadVolume(multi, LoadOptions{"fog"});
+  const Volume slope = loadVolume(multi, LoadOptions{"grad_fog"});
+  for (const Volume* v : {&big, &small, &fog, &slope}) {
+    SCOPED_TRACE(v->field);
+    ASSERT_TRUE(printed.count(v->field));
+    EXPECT_EQ(v->grid->dims, printed[v->field]);
+    EXPECT_EQ(v->fields, first.fields);
+  }
+  for (const glm::dvec3 dir : {glm::dvec3(1, 0, 0), glm::dvec3(0, -1, 0), glm::normalize(glm::dvec3(1, 1, 1))}) {
+    EXPECT_NEAR(crossing(big, centre, dir, 0.0, 3.0, 0.01), 2.0, 0.02);
+    EXPECT_NEAR(crossing(small, centre, dir, 0.0, 2.0, 0.01), 1.0, 0.02);
+    EXPECT_NEAR(crossing(fog, centre, dir, 0.5, 2.0, 0.01), 1.0 - 0.15, 0.02);
+  }
+  // The gradient's magnitude: ~0 deep inside the fog, steep (about 1 / (3 voxels)) across its band.
+  EXPECT_LT(sampleWorld(slope, centre), 1e-3);
+  EXPECT_GT(sampleWorld(slope, glm::dvec3(0.9, 0.0, 0.0)), 2.0);
+
+  // The scene file's "field" reads the same grid.
+  write("multi.mfrscene", R"({"volumes": [{"file": "multi.vdb", "field": "small"}]})");
+  const Scene scene = loadScene(dir() / "multi.mfrscene");
+  ASSERT_EQ(scene.volumes.size(), 1u);
+  EXPECT_EQ(scene.volumes[0].field, "small");
+  EXPECT_EQ(scene.volumes[0].grid->values, small.grid->values);
+
+  const auto expectFieldError = [](const fs::path& path, const std::string& field, const std::string& reason) {
+    try {
+      (void)loadVolume(path, LoadOptions{field});
+      ADD_FAILURE() << "no error for grid " << field;
+    } catch (const FieldNotFound& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(path.string() + ": ", 0), 0u) << what;
+      EXPECT_NE(what.find(reason), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  };
+  expectFieldError(multi, "Big", "no grid 'Big' (grids: ");
+  expectFieldError(multi, "Big", "big (float)");
+  expectFieldError(multi, "Big", "grad_fog (vec3s)");
+  const fs::path points = make("-sphere radius=1 voxel=0.1 name=ls -ls2mesh keep=1 -points2vdb name=pts", "pts.vdb");
+  EXPECT_EQ(loadVolume(points).field, "ls");
+  EXPECT_EQ(loadVolume(points).fields, std::vector<std::string>{"ls"});  // only the grids it can read
+  expectFieldError(points, "pts", "grid 'pts' holds ptdataidx32 values; a volume needs a float, double or vector grid");
 }
 
 TEST_F(OpenVdbFiles, BadFilesAreOneLineErrors) {

@@ -178,6 +178,70 @@ TEST_F(VolumeLoading, VtiTakesTheActiveScalarsElseTheFirstArray) {
   expectField(mfr::loadVolume(write("active.vti", withActive)), {4, 3, 2});
 }
 
+// Any named point-data array can be read instead (LoadOptions::field); the volume says which was
+// read and which there are; a name the file lacks, or a field for a format without named fields,
+// is one FieldNotFound line naming the file and what it has.
+TEST_F(VolumeLoading, AFieldPicksTheNamedArray) {
+  std::string ones, twice;
+  for (int n = 0; n < 24; ++n) ones += "1 ";
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i) twice += std::to_string(2 * field(i, j, k)) + " ";
+  const std::string arrays = dataArray("Int32", "ones", ones) + dataArray("Float32", "f", asciiValues(4, 3, 2)) +
+                             dataArray("Float64", "twice", twice);
+  const fs::path p = write("three.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", arrays));
+  const mfr::Volume byDefault = mfr::loadVolume(p);
+  EXPECT_EQ(byDefault.field, "ones");
+  EXPECT_EQ(byDefault.fields, (std::vector<std::string>{"ones", "f", "twice"}));
+  const mfr::Volume f = mfr::loadVolume(p, mfr::LoadOptions{"f"});
+  expectField(f, {4, 3, 2});
+  EXPECT_EQ(f.field, "f");
+  EXPECT_EQ(f.fields, byDefault.fields);
+  EXPECT_EQ(f.name, "three.vti");
+  const mfr::Volume t = mfr::loadVolume(p, mfr::LoadOptions{"twice"});
+  EXPECT_EQ(t.grid->at(3, 2, 1), 2 * field(3, 2, 1));
+  EXPECT_EQ(t.grid->range(), glm::vec2(2 * field(0, 0, 0), 2 * field(3, 2, 1)));
+  // The default transfer function follows the array read.
+  EXPECT_EQ(t.transfer.high(), 2.0 * field(3, 2, 1));
+  // loadScene passes the choice on.
+  EXPECT_EQ(mfr::loadScene(p, mfr::LoadOptions{"twice"}).volumes.at(0).field, "twice");
+
+  const auto expectMissing = [](const fs::path& path, const std::string& fieldName, const std::string& reason) {
+    try {
+      (void)mfr::loadVolume(path, mfr::LoadOptions{fieldName});
+      ADD_FAILURE() << path << ": no error for field " << fieldName;
+    } catch (const mfr::FieldNotFound& e) {
+      EXPECT_EQ(std::string(e.what()), path.string() + ": " + reason);
+    }
+  };
+  expectMissing(p, "F", "no point-data array 'F' (arrays: ones, f, twice)");
+  // Legacy VTK: every SCALARS section is an array.
+  const fs::path legacy =
+      write("two.vtk",
+            "# vtk DataFile Version 3.0\ntwo arrays\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\n"
+            "ORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 24\nSCALARS ones float 1\nLOOKUP_TABLE default\n" +
+                ones + "\nSCALARS f float 1\nLOOKUP_TABLE default\n" + asciiValues(4, 3, 2) + "\n");
+  const mfr::Volume l = mfr::loadVolume(legacy, mfr::LoadOptions{"f"});
+  expectField(l, {4, 3, 2});
+  EXPECT_EQ(l.fields, (std::vector<std::string>{"ones", "f"}));
+  EXPECT_EQ(mfr::loadVolume(legacy).field, "ones");
+  expectMissing(legacy, "g", "no point-data array 'g' (arrays: ones, f)");
+  // Formats with one unnamed field: nothing to choose, and nothing named.
+  const fs::path inr = write("small.inr", smallInr());
+  EXPECT_EQ(mfr::loadVolume(inr).field, "");
+  EXPECT_TRUE(mfr::loadVolume(inr).fields.empty());
+  expectMissing(inr, "f", "INRIMAGE files have one unnamed field; field 'f' cannot be chosen");
+  // A model or scene file has no fields to choose.
+  const fs::path model = write("tri.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  EXPECT_EQ(errorOf([&] { (void)mfr::loadScene(model, mfr::LoadOptions{"f"}); }),
+            model.string() + ": field 'f' can be chosen only for a volume file (this is not one)");
+  const fs::path scene = write("s.mfrscene", R"({"volumes": [{"file": "three.vti"}]})");
+  EXPECT_EQ(errorOf([&] { (void)mfr::loadScene(scene, mfr::LoadOptions{"f"}); }),
+            scene.string() +
+                ": field 'f' can be chosen only for a volume file (a scene file gives each volume its "
+                "own 'field')");
+}
+
 TEST_F(VolumeLoading, LegacyStructuredPointsAscii) {
   std::string s =
       "# vtk DataFile Version 3.0\nsmall grid\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\n"
@@ -626,6 +690,21 @@ TEST_F(SceneVolumes, OnlyAVolumeIsAScene) {
   EXPECT_EQ(s.volumes.size(), 1u);
 }
 
+TEST_F(SceneVolumes, AFieldPerVolume) {
+  std::string twice;
+  for (int v = 0; v < 27; ++v) twice += std::to_string(2 * v) + " ";
+  std::string values;
+  for (int v = 0; v < 27; ++v) values += std::to_string(v) + " ";
+  write("two.vti", vti("0 2 0 2 0 2", "0 0 0", "1 1 1",
+                       dataArray("Float32", "density", values) + dataArray("Float32", "twice", twice)));
+  const mfr::Scene s = parse(R"({"volumes": [{"file": "two.vti"}, {"file": "two.vti", "field": "twice"}]})");
+  ASSERT_EQ(s.volumes.size(), 2u);
+  EXPECT_EQ(s.volumes[0].field, "density");
+  EXPECT_EQ(s.volumes[1].field, "twice");
+  EXPECT_EQ(s.volumes[1].grid->range(), glm::vec2(0.0f, 52.0f));
+  EXPECT_EQ(s.volumes[1].transfer.high(), 52.0);  // the default transfer is the chosen array's
+}
+
 TEST_F(SceneVolumes, ErrorsNameTheJsonPath) {
   const auto expectError = [&](const std::string& json, const std::string& path, const std::string& reason) {
     const std::string what = errorOfScene(json);
@@ -662,6 +741,11 @@ TEST_F(SceneVolumes, ErrorsNameTheJsonPath) {
               "zero scale");
   expectError(R"({"volumes": [{"file": "cube.vti", "visible": "yes"}]})", "volumes[0].visible",
               "expected true or false");
+  expectError(R"({"volumes": [{"file": "cube.vti", "field": "mass"}]})", "volumes[0].field",
+              (dir() / "cube.vti").string() + ": no point-data array 'mass' (arrays: density)");
+  expectError(R"({"volumes": [{"file": "cube.vti", "field": ""}]})", "volumes[0].field",
+              "expected the name of an array or grid of the file");
+  expectError(R"({"volumes": [{"file": "cube.vti", "field": 2}]})", "volumes[0].field", "expected a string");
   expectError(
       R"({"volumes": [{"file": "cube.vti"}, {"file": "cube.vti", "name": "2"}, {"file": "cube.vti", "name": "3"},
                                {"file": "cube.vti", "name": "4"}, {"file": "cube.vti", "name": "5"}]})",

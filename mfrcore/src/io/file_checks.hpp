@@ -29,6 +29,10 @@ auto withFileErrors(const std::string& name, Load&& load) -> decltype(load()) {
     return load();
   } catch (const LoadCancelled&) {
     throw;
+  } catch (const FieldNotFound& e) {  // kept apart: a scene file reports it at its 'field' key
+    std::string message = oneLine(e.what());
+    if (message.rfind(name, 0) != 0) message = name + ": " + message;
+    throw FieldNotFound(message);
   } catch (const Error& e) {
     std::string message = oneLine(e.what());
     if (message.rfind(name, 0) != 0) message = name + ": " + message;

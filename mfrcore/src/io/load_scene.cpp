@@ -23,8 +23,16 @@ LoadProgress LoadProgress::part(double from, double to) const {
 
 namespace {
 
-Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadProgress& progress) {
+Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOptions& options,
+                                const LoadProgress& progress) {
   const std::string text = path.string();
+  // A field is a volume file's to choose: a scene file names its own per volume ('field').
+  if (!options.field.empty() && !isVolumeFile(path))
+    throw Error(text, "field '" + options.field + "' can be chosen only for a volume file (" +
+                          (path.extension() == ".mfrscene" || path.extension() == ".json"
+                               ? std::string("a scene file gives each volume its own 'field'")
+                               : std::string("this is not one")) +
+                          ")");
   if (text == "@sample") return makeSampleScene();
   if (text == "@csg") return makeCsgSampleScene();
   if (text == "@intersect") return makeIntersectingSampleScene();
@@ -52,7 +60,7 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadPro
     } else {
       scene.name = path.filename().string();
       if (isVolumeFile(path))
-        scene.volumes.push_back(loadVolume(path, progress));
+        scene.volumes.push_back(loadVolume(path, options, progress));
       else
         scene.objects = loadModel(path, progress);
     }
@@ -71,8 +79,12 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadPro
 }  // namespace
 
 Scene loadScene(const std::filesystem::path& path, const LoadProgress& progress) {
+  return loadScene(path, LoadOptions{}, progress);
+}
+
+Scene loadScene(const std::filesystem::path& path, const LoadOptions& options, const LoadProgress& progress) {
   progress.step(0.0);
-  Scene scene = loadSceneWithoutEndReport(path, progress);
+  Scene scene = loadSceneWithoutEndReport(path, options, progress);
   progress.step(1.0);
   return scene;
 }

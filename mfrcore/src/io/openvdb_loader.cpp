@@ -59,7 +59,8 @@ void copyDense(const GridT& grid, const openvdb::CoordBBox& box, std::vector<flo
 
 }  // namespace
 
-Volume readOpenVdb(const fs::path& path, const std::string& name, const LoadProgress& progress) {
+Volume readOpenVdb(const fs::path& path, const std::string& name, const std::string& field,
+                   const LoadProgress& progress) {
   static std::once_flag initialized;
   std::call_once(initialized, [] { openvdb::initialize(); });
   checkMagic(path, name);
@@ -67,18 +68,30 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const LoadProg
   openvdb::io::File file(path.string());
   file.open(false);  // no delayed loading: the file is read now, not when voxels are touched
   const openvdb::GridPtrVecPtr headers = file.readAllGridMetadata();
-  // The grid read: "density" if the file has that scalar grid, else its first scalar grid, else the
-  // magnitude of its first vector grid.
+  // The grid read: the one named `field`; else "density" if the file has that scalar grid, else its
+  // first scalar grid, else the magnitude of its first vector grid.
   std::string chosen, list;
+  std::vector<std::string> readable;
   int rank = 0;  // of the chosen grid: 3 density, 2 scalar, 1 vector, 0 none
   for (const openvdb::GridBase::Ptr& g : *headers) {
     list += (list.empty() ? "" : ", ") + g->getName() + " (" + g->valueType() + ")";
     const int r = scalar(*g) ? (g->getName() == "density" ? 3 : 2) : vectorValued(*g) ? 1 : 0;
-    if (r > rank) {
+    if (r > 0) readable.push_back(g->getName());
+    if (!field.empty()) {
+      if (g->getName() != field || !chosen.empty()) continue;
+      if (r == 0)
+        throw FieldNotFound(name, "grid '" + field + "' holds " + g->valueType() +
+                                      " values; a volume needs a float, double or vector grid");
+      chosen = field;
+      rank = r;
+    } else if (r > rank) {
       rank = r;
       chosen = g->getName();
     }
   }
+  if (!field.empty() && chosen.empty())
+    throw FieldNotFound(
+        name, "no grid '" + field + "' (" + (list.empty() ? std::string("the file has none") : "grids: " + list) + ")");
   if (rank == 0)
     throw Error(name, "no float, double or vector grid in the file" +
                           (list.empty() ? std::string() : " (it has " + list + ")"));
@@ -109,6 +122,8 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const LoadProg
   Volume volume;
   volume.name = chosen.empty() ? path.filename().string() : chosen;
   volume.grid = std::move(grid);
+  volume.field = chosen;
+  volume.fields = std::move(readable);
   // Grid point (i, j, k) is voxel box.min + (i, j, k); OpenVDB maps index to world as a row
   // vector times its matrix, glm as the matrix times a column vector: transposed.
   volume.origin = glm::dvec3(box.min().x(), box.min().y(), box.min().z());

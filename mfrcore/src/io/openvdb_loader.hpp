@@ -11,9 +11,12 @@
 
 namespace mfr::io {
 
-// Reads the grid named "density" if the file has one, else its first float or double grid. The
-// name is the grid's, the transfer function left empty. Checks the dense size against
-// VolumeGrid's limits before allocating. Throws mfr::Error(name, reason), LoadCancelled.
-Volume readOpenVdb(const std::filesystem::path& path, const std::string& name, const LoadProgress& progress);
+// Reads the grid named `field`; with none given, the grid named "density" if the file has one, else
+// its first float or double grid, else the magnitude of its first vector grid. The name is the
+// grid's, the transfer function left empty; field and fields (the grids it could read) are set.
+// Checks the dense size against VolumeGrid's limits before allocating. Throws
+// mfr::Error(name, reason), FieldNotFound, LoadCancelled.
+Volume readOpenVdb(const std::filesystem::path& path, const std::string& name, const std::string& field,
+                   const LoadProgress& progress);
 
 }  // namespace mfr::io

@@ -130,6 +130,11 @@ std::size_t pointCount(const glm::ivec3& dims) {
 // ---------------------------------------------------------------------------------------------
 // VTK
 
+// Formats whose fields have names in the file, so that one can be chosen (LoadOptions::field).
+bool hasNamedFields(VolumeFormat format) {
+  return format == VolumeFormat::Vti || format == VolumeFormat::LegacyVtk || format == VolumeFormat::OpenVdb;
+}
+
 const char* formatLabel(VolumeFormat format) {
   switch (format) {
     case VolumeFormat::Vti:
@@ -337,9 +342,26 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
   return orientation;
 }
 
-// The sample array: the point data's active scalars, else its first numeric array.
-vtkDataArray* sampleArray(vtkImageData* image, const std::string& name) {
+// The numeric point-data arrays of an image, by name, in file order.
+std::vector<std::string> pointArrayNames(vtkImageData* image) {
+  std::vector<std::string> names;
+  if (vtkPointData* pd = image->GetPointData(); pd != nullptr)
+    for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
+      if (vtkDataArray* a = pd->GetArray(i); a != nullptr && a->GetName() != nullptr) names.emplace_back(a->GetName());
+  return names;
+}
+
+// The sample array: the one named `field`, else the point data's active scalars, else its first
+// numeric array.
+vtkDataArray* sampleArray(vtkImageData* image, const std::string& name, const std::string& field) {
   vtkPointData* pd = image->GetPointData();
+  if (!field.empty()) {
+    if (vtkDataArray* a = pd != nullptr ? pd->GetArray(field.c_str()) : nullptr; a != nullptr) return a;
+    std::string list;
+    for (const std::string& n : pointArrayNames(image)) list += (list.empty() ? "" : ", ") + n;
+    throw FieldNotFound(name, "no point-data array '" + field + "' (" +
+                                  (list.empty() ? std::string("it has none") : "arrays: " + list) + ")");
+  }
   if (pd != nullptr) {
     if (vtkDataArray* s = pd->GetScalars(); s != nullptr) return s;
     for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
@@ -366,7 +388,7 @@ void checkDims(const std::array<std::int64_t, 3>& d, const std::string& name) {
     throw Error(name, "volume of " + dimsText(d) + " points is larger than 2^30 points (4 GiB of samples)");
 }
 
-Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::string& name,
+Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::string& name, const std::string& field,
                          const LoadProgress& progress) {
   const std::string label = formatLabel(format);
   NrrdOrientation nrrd;
@@ -423,7 +445,7 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   const std::array<std::int64_t, 3> got{dims[0], dims[1], dims[2]};
   if (got != declared)
     fail("cannot read " + label + " (read " + dimsText(got) + " points of the " + dimsText(declared) + " declared)");
-  vtkDataArray* array = sampleArray(image, name);
+  vtkDataArray* array = sampleArray(image, name, field);
   const glm::ivec3 gridDims(dims[0], dims[1], dims[2]);
   const std::size_t n = pointCount(gridDims);
   if (array->GetNumberOfComponents() < 1 || array->GetNumberOfTuples() != static_cast<vtkIdType>(n))
@@ -475,6 +497,10 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   }
   Volume volume;
   volume.grid = std::move(grid);
+  if (hasNamedFields(format)) {  // MetaImage and NRRD arrays are named by VTK's readers, not the file
+    volume.field = array->GetName() != nullptr ? array->GetName() : "";
+    volume.fields = pointArrayNames(image);
+  }
   volume.origin = glm::dvec3(o[0], o[1], o[2]) + direction * first;
   volume.spacing = spacing;
   if (nrrdOriented)
@@ -616,6 +642,10 @@ std::optional<VolumeFormat> volumeFormat(const fs::path& path) {
 namespace mfr {
 
 Volume loadVolume(const std::filesystem::path& path, const LoadProgress& progress) {
+  return loadVolume(path, LoadOptions{}, progress);
+}
+
+Volume loadVolume(const std::filesystem::path& path, const LoadOptions& options, const LoadProgress& progress) {
   const std::string name = path.string();
   return io::withFileErrors(name, [&] {
     progress.step(0.0);
@@ -634,6 +664,9 @@ Volume loadVolume(const std::filesystem::path& path, const LoadProgress& progres
       if (dataset != "STRUCTURED_POINTS")
         throw Error(name, "legacy VTK DATASET " + dataset + " is not a volume (expected STRUCTURED_POINTS)");
     }
+    if (!options.field.empty() && !io::hasNamedFields(*format))
+      throw FieldNotFound(name, std::string(io::formatLabel(*format)) + " files have one unnamed field; field '" +
+                                    options.field + "' cannot be chosen");
     Volume volume;
     switch (*format) {
       case io::VolumeFormat::Inrimage:
@@ -643,13 +676,14 @@ Volume loadVolume(const std::filesystem::path& path, const LoadProgress& progres
         volume = io::readInvesaliusProject(path, name, false, progress).volume;
         break;
       case io::VolumeFormat::OpenVdb:
-        volume = io::readOpenVdb(path, name, progress);
+        volume = io::readOpenVdb(path, name, options.field, progress);
         break;
       default:
-        volume = io::readVolumeWithVtk(*format, path, name, progress);
+        volume = io::readVolumeWithVtk(*format, path, name, options.field, progress);
         break;
     }
     volume.name = path.filename().string();
+    volume.file = path;
     volume.grid->validate(name);
     // Formats that store no display settings get the default; an InVesalius project has its own.
     if (volume.transfer.points.empty()) volume.transfer = defaultTransfer(*volume.grid, volume.bounds());

@@ -25,8 +25,9 @@ std::optional<VolumeFormat> volumeFormat(const std::filesystem::path& path);
 // an extent not starting at 0, the transform that places it) of a file of that format. The name
 // is the file's, the transfer function left empty. Checks the grid size before reading the
 // samples. Throws mfr::Error(name, reason), LoadCancelled.
+// `field`: the point-data array to read (empty: the active scalars, else the first array).
 Volume readVolumeWithVtk(VolumeFormat format, const std::filesystem::path& path, const std::string& name,
-                         const LoadProgress& progress);
+                         const std::string& field, const LoadProgress& progress);
 Volume readInrimage(const std::filesystem::path& path, const std::string& name, const LoadProgress& progress);
 
 // Throws mfr::Error(name, reason) unless a declared grid of d points per axis is within

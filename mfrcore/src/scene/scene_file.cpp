@@ -249,16 +249,24 @@ Volume parseVolume(const Reader& r, const json& j, const std::string& where, con
       v.contains("transform") ? parseTransform(r, v["transform"], where + ".transform") : glm::dmat4(1.0);
   if (v.contains("visible") && !v["visible"].is_boolean()) r.fail(where + ".visible", "expected true or false");
   if (v.contains("shading") && !v["shading"].is_boolean()) r.fail(where + ".shading", "expected true or false");
+  LoadOptions options;
+  if (v.contains("field")) {
+    options.field = r.string(v, "field", where, "");
+    if (options.field.empty()) r.fail(where + ".field", "expected the name of an array or grid of the file");
+  }
   Volume volume;
   try {
-    volume = loadVolume(baseDir / file, progress);  // its errors name the volume file
+    volume = loadVolume(baseDir / file, options, progress);  // its errors name the volume file
   } catch (const LoadCancelled&) {
     throw;
+  } catch (const FieldNotFound& e) {
+    r.fail(where + ".field", e.what());
   } catch (const Error& e) {
     r.fail(where + ".file", e.what());
   }
   volume.name = r.string(v, "name", where, volume.name);
   volume.transform = xf * volume.transform;
+  volume.sceneTransform = xf;
   volume.visible = v.value("visible", true);
   volume.shading = v.value("shading", false);
   // The defaults are relative to where the volume now is: its world diagonal.

@@ -34,6 +34,20 @@ struct LoadProgress {
   [[nodiscard]] LoadProgress part(double from, double to) const;
 };
 
+// Thrown by loadVolume when LoadOptions::field names no field the file has (or the format has no
+// named fields); its message lists the fields there are.
+class FieldNotFound : public Error {
+ public:
+  using Error::Error;
+};
+
+// What to read of a file that holds several things.
+struct LoadOptions {
+  // Volume files: the point-data array (.vti, legacy .vtk) or grid (.vdb) to read; empty: the
+  // default (see loadVolume). Given for any other file, loading fails.
+  std::string field;
+};
+
 // Loads a model file — STL, PLY (also .ply.gz), OBJ, OFF, VTP, VTK legacy, STEP, glTF/GLB and the
 // other formats assimp reads — into parts; PDB and mmCIF molecules (also .gz) become spheres, one
 // part per chain plus ligands and water. Throws mfr::Error(path, reason) for a missing, unreadable,
@@ -46,9 +60,12 @@ std::vector<std::string> supportedModelExtensions();
 // Loads a scalar volume — VTK image data (.vti), legacy VTK STRUCTURED_POINTS (.vtk), MetaImage
 // (.mhd/.mha), NRRD (.nrrd/.nhdr) and INRIMAGE (.inr, .inr.gz) — named after the file, with its
 // origin and spacing, the first component of its first point-data scalar array as float, and
-// defaultTransfer(). Throws mfr::Error(path, reason) for a missing, unreadable, truncated, corrupt,
-// too large or unsupported file; LoadCancelled when cancelled.
+// defaultTransfer(). options.field picks another array (or, in a .vdb file, another grid);
+// Volume::field and Volume::fields say which was read and which there are. Throws
+// mfr::Error(path, reason) for a missing, unreadable, truncated, corrupt, too large or unsupported
+// file, FieldNotFound for a field the file does not have; LoadCancelled when cancelled.
 Volume loadVolume(const std::filesystem::path& path, const LoadProgress& progress = {});
+Volume loadVolume(const std::filesystem::path& path, const LoadOptions& options, const LoadProgress& progress = {});
 
 // File extensions loadVolume accepts (lower case, with dot; ".inr.gz" included). ".vtk" is both a
 // model and a volume extension: see isVolumeFile.
@@ -60,7 +77,9 @@ bool isVolumeFile(const std::filesystem::path& path);
 
 // A scene from any supported file: .mfrscene → the scene it describes; a model → its parts with
 // default views ("front", "iso") fitted to them; a volume file → a scene of that one volume with
-// the same views. Throws mfr::Error naming the file, or LoadCancelled.
+// the same views. options.field is for a volume file only. Throws mfr::Error naming the file, or
+// LoadCancelled.
 Scene loadScene(const std::filesystem::path& path, const LoadProgress& progress = {});
+Scene loadScene(const std::filesystem::path& path, const LoadOptions& options, const LoadProgress& progress = {});
 
 }  // namespace mfr

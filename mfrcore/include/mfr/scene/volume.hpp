@@ -5,6 +5,7 @@
 // emission colour and an extinction coefficient. The operation "volume" ray-marches it between
 // each pixel's sorted surface fragments (shaders/ops/volume.glsl, reference/composite.hpp).
 #include <cstddef>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -85,6 +86,16 @@ struct Volume {
   // Gradient shading with a headlight (MFR_VOLUME_AMBIENT/DIFFUSE in shaders/common/bindings.h):
   // boundaries inside the medium read as surfaces. Off: pure emission-absorption.
   bool shading = false;
+  // The named field the samples came from — a VTK point-data array or an OpenVDB grid — and every
+  // field of the file that could have been read instead, in file order. Both empty for formats
+  // with one unnamed field (INRIMAGE, MetaImage, NRRD, InVesalius).
+  std::string field;
+  std::vector<std::string> fields;
+  // The file it was read from (empty: made in memory), and the part of `transform` a scene put on
+  // top of the file's own placement — so that another field of the file can be read in its place
+  // (a .vdb file's grids each have a box and transform of their own).
+  std::filesystem::path file;
+  glm::dmat4 sceneTransform{1.0};
 
   // Object → grid coordinates composed with transform: world → grid is inverse(gridToWorld()).
   [[nodiscard]] glm::dmat4 gridToWorld() const;
