@@ -1,6 +1,8 @@
 // mfr probe: what lies behind one pixel — the oracle's exact sorted list (depth, part, colour,
 // facing, share of the pixel's colour) and, with --method, which of those fragments the GPU method
 // holds and the colour it draws there.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -53,6 +55,7 @@ void addProbe(CLI::App& app) {
     std::string scene, pixel, size = "512x512", view = "fit", method, op = "auto", json, clip, section, field;
     std::vector<std::string> params;
     double opacity = -1.0;
+    double thickness = 0.0;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -67,12 +70,15 @@ void addProbe(CLI::App& app) {
                   "The method's operation, as for render (auto: hybrid for fkb, vkb, dkb, else oit). With hybrid, "
                   "each fragment's share under the method's split: the held ones the core, the rest the tail")
       ->capture_default_str();
+  CLI::Option* thicknessOption =
+      cmd->add_option("--thickness", opt->thickness,
+                      "Operation zthickness: slab thickness in scene units (default: 1 % of the scene's diagonal)");
   cmd->add_option("--json", opt->json, "Also write the probe as JSON");
   cmd->add_option("--clip", opt->clip, kClipHelp);
   cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
-  cmd->callback([opt] {
+  cmd->callback([opt, thicknessOption] {
     const auto [w, h] = parseSize("--size", opt->size);
     validateImageSize("--size", w, h);
     const auto [x, y] = parsePixel(opt->pixel);
@@ -96,6 +102,9 @@ void addProbe(CLI::App& app) {
     }
     validateOperation(opt->op);
     req.operation = opt->op;
+    if (thicknessOption->count() > 0 && !(opt->thickness > 0.0 && std::isfinite(opt->thickness)))
+      throw Error("--thickness", "must be a positive length in scene units");
+    req.thickness = opt->thickness;
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
@@ -122,6 +131,8 @@ void addProbe(CLI::App& app) {
     }
     // The operation "volume" (a volume scene's own, with or without a method): surfaces and medium.
     if (operation == "volume") splitVolume(probe, scene, camera, req);
+    // "zthickness": each surface's share of the blend.
+    if (operation == "zthickness") splitZThickness(probe, scene, camera, req);
 
     std::ostringstream text;
     text << scene.name << ", view " << opt->view << ", " << w << "x" << h << ", pixel (" << x << ", " << y
@@ -141,9 +152,10 @@ void addProbe(CLI::App& app) {
     };
     std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7s%s%s\n", "#", "eye depth", "part", "RGBA",
                   "faces", "weight", methodColumn(opt->method.c_str()).c_str(),
-                  probe.hybrid   ? "   hybrid"
-                  : probe.volume ? "   volume"
-                                 : "");
+                  probe.hybrid       ? "   hybrid"
+                  : probe.volume     ? "   volume"
+                  : probe.zthickness ? "   zthick"
+                                     : "");
     text << line;
     nlohmann::ordered_json fragments = nlohmann::ordered_json::array(), medium = nlohmann::ordered_json::array();
     // A stretch of the volume's medium that adds to the pixel: its mean colour and share.
@@ -181,6 +193,7 @@ void addProbe(CLI::App& app) {
       char share[32] = "";
       if (probe.hybrid) std::snprintf(share, sizeof share, "  %7.4f %s", f.hybridWeight, f.held ? "core" : "tail");
       if (probe.volume) std::snprintf(share, sizeof share, "  %7.4f", f.volumeWeight);
+      if (probe.zthickness) std::snprintf(share, sizeof share, "  %7.4f", f.zthicknessWeight);
       std::snprintf(line, sizeof line, "%4zu  %12.6g  %-24.24s  %-15s  %-5s  %7.4f%s%s\n", i + 1, f.eyeDepth,
                     part.c_str(), rgba(f.fragment.color).c_str(), f.fragment.frontFacing ? "front" : "back", f.weight,
                     methodColumn(f.held ? "held" : "-").c_str(), share);
@@ -196,14 +209,18 @@ void addProbe(CLI::App& app) {
       if (probe.captured) j["held"] = f.held;
       if (probe.hybrid) j["hybrid_weight"] = f.hybridWeight;
       if (probe.volume) j["volume_weight"] = f.volumeWeight;
+      if (probe.zthickness) j["zthickness_weight"] = f.zthicknessWeight;
       fragments.push_back(j);
     }
     if (probe.volume) mediumRow(probe.fragments.size());
     std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7.4f%s", "", "", "background", "", "",
                   probe.transmittance, methodColumn("").c_str());
     text << line;
-    if (probe.hybrid || probe.volume) {
-      std::snprintf(line, sizeof line, "  %7.4f", probe.hybrid ? probe.hybridBackground : probe.volumeBackground);
+    if (probe.hybrid || probe.volume || probe.zthickness) {
+      std::snprintf(line, sizeof line, "  %7.4f",
+                    probe.hybrid   ? probe.hybridBackground
+                    : probe.volume ? probe.volumeBackground
+                                   : probe.zthicknessBackground);
       text << line;
     }
     text << "\n";
@@ -211,7 +228,24 @@ void addProbe(CLI::App& app) {
     text << "exact colour (over): " << exact.r << " " << exact.g << " " << exact.b << "\n";
     // Under "volume" the exact colour is the surfaces' and the medium's together.
     const glm::ivec3 reference =
-        probe.volume ? glm::ivec3(to8(probe.volumeColor.r), to8(probe.volumeColor.g), to8(probe.volumeColor.b)) : exact;
+        probe.volume ? glm::ivec3(to8(probe.volumeColor.r), to8(probe.volumeColor.g), to8(probe.volumeColor.b))
+        : probe.zthickness
+            ? glm::ivec3(to8(probe.zthicknessColor.r), to8(probe.zthicknessColor.g), to8(probe.zthicknessColor.b))
+            : exact;
+    if (probe.zthickness) {
+      // Surfaces closer than the thickness blend: how many of them do here.
+      std::size_t blended = 0;
+      for (std::size_t i = 0; i < probe.fragments.size(); ++i) {
+        const bool nearPrevious =
+            i > 0 && probe.fragments[i].eyeDepth - probe.fragments[i - 1].eyeDepth < probe.thickness;
+        const bool nearNext = i + 1 < probe.fragments.size() &&
+                              probe.fragments[i + 1].eyeDepth - probe.fragments[i].eyeDepth < probe.thickness;
+        blended += nearPrevious || nearNext ? 1 : 0;
+      }
+      text << "exact colour (zthickness " << probe.thickness << "): " << reference.r << " " << reference.g << " "
+           << reference.b << " (" << blended << " of the " << probe.fragments.size()
+           << " surfaces lie within the thickness of a neighbour and blend)\n";
+    }
     if (probe.volume) {
       double mediumShare = 0.0;
       std::vector<double> shareByVolume(probe.volumeNames.size(), 0.0);
@@ -240,6 +274,12 @@ void addProbe(CLI::App& app) {
     j["fragments"] = fragments;
     j["background_weight"] = probe.transmittance;
     j["exact_rgb"] = {exact.r, exact.g, exact.b};
+    if (probe.zthickness) {
+      j["operation"] = "zthickness";
+      j["thickness"] = probe.thickness;
+      j["zthickness_rgb"] = {reference.r, reference.g, reference.b};
+      j["zthickness_background_weight"] = probe.zthicknessBackground;
+    }
     if (probe.volume) {
       j["operation"] = "volume";
       j["volumes"] = probe.volumeNames;

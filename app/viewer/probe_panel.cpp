@@ -42,7 +42,7 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
   table_ = new QTableWidget(0, ColumnCount, this);
   table_->setObjectName(QStringLiteral("probeTable"));
   table_->setHorizontalHeaderLabels({tr("#"), tr("Eye depth"), tr("Part"), tr("Colour"), tr("α"), tr("Faces"),
-                                     tr("Share"), tr("Held"), tr("Hybrid"), tr("Volume")});
+                                     tr("Share"), tr("Held"), tr("Hybrid"), tr("Volume"), tr("Z-thickness")});
   table_->horizontalHeaderItem(Share)->setToolTip(
       tr("The fragment's share of the pixel's colour: α·Π(1 − α) of the fragments in front of it"));
   table_->horizontalHeaderItem(Held)->setToolTip(
@@ -56,6 +56,10 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
       ->setToolTip(tr("With the operation volume: the surface's share of the pixel's colour through the medium in "
                       "front of it (the summary gives the medium's share)"));
   table_->setColumnHidden(VolumeShare, true);
+  table_->horizontalHeaderItem(ZThicknessShare)
+      ->setToolTip(tr("With the operation zthickness: the surface's share of the blended colour (surfaces closer "
+                      "than the thickness blend instead of covering each other)"));
+  table_->setColumnHidden(ZThicknessShare, true);
   table_->verticalHeader()->hide();
   table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   table_->horizontalHeader()->setSectionResizeMode(Part, QHeaderView::Stretch);
@@ -127,7 +131,24 @@ void ProbePanel::show(const ViewProbe& r) {
   const QColor exact(to8(p.exactColor.r), to8(p.exactColor.g), to8(p.exactColor.b));
   text += tr(". Exact colour %1").arg(exact.name());
   // Under "volume" the exact colour is the surfaces' and the medium's together.
-  const QColor reference = p.volume ? QColor(to8(p.volumeColor.r), to8(p.volumeColor.g), to8(p.volumeColor.b)) : exact;
+  const QColor reference = p.volume ? QColor(to8(p.volumeColor.r), to8(p.volumeColor.g), to8(p.volumeColor.b))
+                           : p.zthickness
+                               ? QColor(to8(p.zthicknessColor.r), to8(p.zthicknessColor.g), to8(p.zthicknessColor.b))
+                               : exact;
+  if (p.zthickness) {
+    // Surfaces within the thickness of a neighbour blend.
+    int blended = 0;
+    for (std::size_t i = 0; i < p.fragments.size(); ++i) {
+      const bool nearPrevious = i > 0 && p.fragments[i].eyeDepth - p.fragments[i - 1].eyeDepth < p.thickness;
+      const bool nearNext =
+          i + 1 < p.fragments.size() && p.fragments[i + 1].eyeDepth - p.fragments[i].eyeDepth < p.thickness;
+      blended += nearPrevious || nearNext ? 1 : 0;
+    }
+    text += tr(" (over), %1 with z-thickness %2 (%3 of the surfaces blend with a neighbour)")
+                .arg(reference.name())
+                .arg(p.thickness, 0, 'g', 4)
+                .arg(blended);
+  }
   if (p.volume) {
     double medium = 0.0;
     std::vector<double> byVolume(p.volumeNames.size(), 0.0);
@@ -202,6 +223,10 @@ void ProbePanel::show(const ViewProbe& r) {
     table_->setItem(
         i, VolumeShare,
         item(p.volume ? QString::number(100.0 * f.volumeWeight, 'f', 1) + QStringLiteral(" %") : QString(), right));
+    table_->setItem(
+        i, ZThicknessShare,
+        item(p.zthickness ? QString::number(100.0 * f.zthicknessWeight, 'f', 1) + QStringLiteral(" %") : QString(),
+             right));
     if (p.captured && !f.held && !p.hybrid)  // dropped; a tail fragment still counts
       for (int c = 0; c < ColumnCount; ++c)
         if (c != Colour) table_->item(i, c)->setForeground(palette().color(QPalette::Disabled, QPalette::Text));
@@ -224,4 +249,10 @@ void ProbePanel::show(const ViewProbe& r) {
     table_->item(n, VolumeShare)->setTextAlignment(right);
   }
   table_->setColumnHidden(VolumeShare, !p.volume);
+  if (p.zthickness) {
+    table_->item(n, ZThicknessShare)
+        ->setText(QString::number(100.0 * p.zthicknessBackground, 'f', 1) + QStringLiteral(" %"));
+    table_->item(n, ZThicknessShare)->setTextAlignment(right);
+  }
+  table_->setColumnHidden(ZThicknessShare, !p.zthickness);
 }

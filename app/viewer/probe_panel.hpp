@@ -23,7 +23,20 @@ class ProbePanel final : public QWidget {
 
  public:
   // Table columns.
-  enum Column { Index, EyeDepth, Part, Colour, Alpha, Faces, Share, Held, HybridShare, VolumeShare, ColumnCount };
+  enum Column {
+    Index,
+    EyeDepth,
+    Part,
+    Colour,
+    Alpha,
+    Faces,
+    Share,
+    Held,
+    HybridShare,
+    VolumeShare,
+    ZThicknessShare,
+    ColumnCount
+  };
 
   ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent = nullptr);
   // Probes `point` of the view (logical coordinates) now and after every full frame until cleared.

@@ -673,6 +673,10 @@ ViewProbe RenderView::probeAt(QPoint point) {
   if (model_.effectiveOperationOf(result.side) == QLatin1String("volume"))
     mfr::splitVolume(result.probe, model_.drawnScene(), model_.camera(),
                      model_.renderRequest(result.side, pane.size()));
+  // The operation "zthickness": each surface's share of the blend.
+  if (model_.effectiveOperationOf(result.side) == QLatin1String("zthickness"))
+    mfr::splitZThickness(result.probe, model_.drawnScene(), model_.camera(),
+                         model_.renderRequest(result.side, pane.size()));
 
   const mfr::MethodInfo* info = model_.isCpuMethod(result.method) ? nullptr : model_.methodInfo(result.method);
   result.methodHasLists = info != nullptr && info->sortedLists;

@@ -1144,6 +1144,53 @@ class ViewerTest : public QObject {
     QCOMPARE(match.captured(1), QColor(at[0], at[1], at[2]).name());
   }
 
+  // The Probe dock under the operation zthickness on @intersect: the share of each surface in the
+  // blend (its column adds up with the background's to 100 %), and the exact colour named in the
+  // summary is the oracle's zthickness image at the pixel.
+  void zthicknessProbe() {
+    auto w = openWindow(QStringLiteral("@intersect"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    RenderView& view = w->view();
+    view.setFixedSize(96, 64);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(96, 64), kTimeoutMs);
+    m.setMethod(QStringLiteral("abuffer-ll"));
+    m.setOperation(QStringLiteral("zthickness"));
+    m.setZThickness(0.2);
+    settle(m);
+    auto* table = w->findChild<QTableWidget*>("probeTable");
+    auto* summary = w->findChild<QLabel*>("probeSummary");
+    QVERIFY(table && summary);
+    const QPoint pixel(48, 30);
+    QTest::mouseClick(&view, Qt::LeftButton, Qt::ControlModifier, pixel);
+    QTRY_VERIFY2_WITH_TIMEOUT(summary->text().contains(QStringLiteral("with z-thickness 0.2")),
+                              qPrintable(summary->text()), 20000);
+    QVERIFY(!table->isColumnHidden(ProbePanel::ZThicknessShare));
+    QVERIFY(table->isColumnHidden(ProbePanel::VolumeShare));
+    QVERIFY(table->rowCount() >= 3);  // two surfaces or more, and the background
+    double total = 0.0;
+    for (int i = 0; i < table->rowCount(); ++i)
+      total += table->item(i, ProbePanel::ZThicknessShare)->text().remove(QStringLiteral(" %")).toDouble();
+    QVERIFY2(std::abs(total - 100.0) < 0.1 * table->rowCount() + 0.1, qPrintable(QString::number(total)));
+    const QRegularExpressionMatch match =
+        QRegularExpression(QStringLiteral("(#[0-9a-f]{6}) with z-thickness")).match(summary->text());
+    QVERIFY2(match.hasMatch(), qPrintable(summary->text()));
+    // Back to "over": the column goes.
+    m.setOperation(QStringLiteral("oit"));
+    settle(m);
+    QTRY_VERIFY_WITH_TIMEOUT(table->isColumnHidden(ProbePanel::ZThicknessShare), 20000);
+    // Last (mfr::render makes its own context current on this thread): the library's exact image.
+    mfr::RenderRequest oracle;
+    oracle.method = "oracle";
+    oracle.operation = "zthickness";
+    oracle.thickness = 0.2;
+    oracle.width = 96;
+    oracle.height = 64;
+    const mfr::ImageRGBA8 exact = mfr::render(m.scene(), m.camera(), oracle).image;
+    const std::uint8_t* at = exact.at(pixel.x(), pixel.y());
+    QCOMPARE(match.captured(1), QColor(at[0], at[1], at[2]).name());
+  }
+
   // The Volume plugin on @volume: the show switch (abuffer-sbuffer for a method without sorted
   // lists, and back), presets, window and opacity scale changing the transfer function and the
   // image, the preview, the step controls and the info line from the frame's notes, refusals of

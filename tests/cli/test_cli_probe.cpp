@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -162,6 +163,50 @@ TEST_F(CliProbe, VolumeScenesShowTheMediumBetweenTheSurfaces) {
     }
   }
   EXPECT_GT(mediumSeen, 0.3);  // the rays cross the medium
+}
+
+// @intersect (interpenetrating parts) under the operation zthickness: the probe's colour is the
+// oracle's rendered pixel, the method's is abuffer-ll's, the shares add up to one, and where two
+// surfaces lie within the thickness the shares are not the "over" weights.
+TEST_F(CliProbe, ZThicknessShowsEachSurfacesShareOfTheBlend) {
+  const std::string scene = "@intersect --size 64x48 --op zthickness --thickness 0.2";
+  const fs::path oracle = dir() / "oracle.png", gpu = dir() / "gpu.png";
+  ASSERT_EQ(runCli("render " + scene + " -o " + oracle.string()).exitCode, 0);
+  ASSERT_EQ(runCli("render " + scene + " -m abuffer-ll -o " + gpu.string()).exitCode, 0);
+  const mfr::ImageRGBA8 exactImage = mfr::readPng(oracle), gpuImage = mfr::readPng(gpu);
+  double largestShift = 0.0;
+  int probed = 0;
+  for (int y = 6; y < 48; y += 9)
+    for (int x = 5; x < 64; x += 9) {
+      SCOPED_TRACE(std::to_string(x) + "," + std::to_string(y));
+      const fs::path json = dir() / "probe.json";
+      const CliResult r = runCli("probe " + scene + " -m abuffer-ll --pixel " + std::to_string(x) + "," +
+                                 std::to_string(y) + " --json " + json.string());
+      ASSERT_EQ(r.exitCode, 0) << r.out;
+      const nlohmann::json j = readJsonFile(json);
+      ASSERT_EQ(j["operation"], "zthickness");
+      EXPECT_DOUBLE_EQ(j["thickness"].get<double>(), 0.2);
+      double sum = j["zthickness_background_weight"].get<double>();
+      for (const nlohmann::json& f : j["fragments"]) {
+        sum += f["zthickness_weight"].get<double>();
+        largestShift =
+            std::max(largestShift, std::abs(f["zthickness_weight"].get<double>() - f["weight"].get<double>()));
+      }
+      EXPECT_NEAR(sum, 1.0, 1e-4);
+      if (j["edge"].get<bool>()) continue;  // rasterisation may differ on an edge
+      ++probed;
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(j["zthickness_rgb"][c].get<int>(), exactImage.at(x, y)[c]) << c;
+        EXPECT_EQ(j["method"]["rgb"][c].get<int>(), gpuImage.at(x, y)[c]) << c;
+      }
+      EXPECT_NE(r.out.find("exact colour (zthickness 0.2)"), std::string::npos) << r.out;
+      EXPECT_NE(r.out.find("zthick"), std::string::npos) << r.out;
+    }
+  EXPECT_GT(probed, 20);
+  EXPECT_GT(largestShift, 0.05);  // somewhere two surfaces blend
+  const CliResult bad = runCli("probe @intersect --pixel 3,3 --op zthickness --thickness -1");
+  EXPECT_NE(bad.exitCode, 0);
+  EXPECT_NE(bad.out.find("--thickness"), std::string::npos) << bad.out;
 }
 
 TEST_F(CliProbe, BadInputIsOneLineAndWritesNoJson) {

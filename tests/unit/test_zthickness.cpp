@@ -132,6 +132,102 @@ TEST(ZThickness, AFullWindowMergesCoincidentSlabsExactly) {
   expectNear(mfr::compositeZThickness(list, kIdentityDepth, 0.1f, kWhite), want, 1e-3);
 }
 
+// Each fragment's share of the colour by brute force: Σ over midpoint steps of T(z)·σ_i(z)·dz.
+std::vector<double> sharesByBruteForce(const std::vector<mfr::Fragment>& list, double tau, int steps,
+                                       double* transmittanceOut) {
+  double lo = 1e30, hi = -1e30;
+  for (const mfr::Fragment& f : list) {
+    lo = std::min(lo, static_cast<double>(f.depth));
+    hi = std::max(hi, static_cast<double>(f.depth) + tau);
+  }
+  const double dz = (hi - lo) / steps;
+  std::vector<double> shares(list.size(), 0.0);
+  double transmittance = 1.0;
+  for (int s = 0; s < steps; ++s) {
+    const double z = lo + (s + 0.5) * dz;
+    double sigma = 0.0;
+    for (std::size_t i = 0; i < list.size(); ++i)
+      if (z >= list[i].depth && z < list[i].depth + tau) {
+        shares[i] += transmittance * sigmaOf(list[i], tau) * dz;
+        sigma += sigmaOf(list[i], tau);
+      }
+    transmittance *= std::exp(-sigma * dz);
+  }
+  *transmittanceOut = transmittance;
+  return shares;
+}
+
+// The probe's breakdown: the same colour in the same arithmetic, shares that add up with the
+// background's to one and rebuild the colour, the closed form of coincident slabs, "over" for
+// slabs apart, and a brute-force integration of each fragment's share.
+TEST(ZThickness, TheBreakdownGivesEachFragmentsShare) {
+  const glm::vec3 background(0.2f, 0.5f, 0.9f);
+  // Coincident: shares α·σ_i/(σ_1 + σ_2) whatever the order.
+  const mfr::Fragment red = frag(1.0f, 255, 0, 0, 128), blue = frag(1.0f, 0, 0, 255, 204);
+  const double tau = 0.05, s1 = sigmaOf(red, tau), s2 = sigmaOf(blue, tau);
+  const double alpha = 1.0 - (1.0 - 128.0 / 255.0) * (1.0 - 204.0 / 255.0);
+  for (const auto& pair : {std::vector{red, blue}, std::vector{blue, red}}) {
+    const mfr::ZThicknessBreakdown b =
+        mfr::compositeZThicknessBreakdown(pair, kIdentityDepth, static_cast<float>(tau), background);
+    ASSERT_EQ(b.weights.size(), 2u);
+    const bool redFirst = pair[0].color == red.color;
+    EXPECT_NEAR(b.weights[redFirst ? 0 : 1], alpha * s1 / (s1 + s2), 1e-5);
+    EXPECT_NEAR(b.weights[redFirst ? 1 : 0], alpha * s2 / (s1 + s2), 1e-5);
+    EXPECT_NEAR(b.transmittance, 1.0 - alpha, 1e-5);
+  }
+  // Apart: the "over" weights α_i·Π(1 − α_j).
+  const std::vector<mfr::Fragment> apart{frag(1.0f, 255, 0, 0, 102), frag(1.5f, 0, 255, 0, 51),
+                                         frag(2.0f, 0, 0, 255, 153)};
+  const mfr::ZThicknessBreakdown over = mfr::compositeZThicknessBreakdown(apart, kIdentityDepth, 0.1f, background);
+  double front = 1.0;
+  for (std::size_t i = 0; i < apart.size(); ++i) {
+    const double a = glm::unpackUnorm4x8(apart[i].color).a;
+    EXPECT_NEAR(over.weights[i], front * a, 1e-5) << i;
+    front *= 1.0 - a;
+  }
+  // Random overlapping lists (within the window, some coplanar, one transparent): against brute
+  // force; the colour is compositeZThickness's bit for bit and rebuilt from the shares.
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<std::uint32_t> byte(0, 255);
+  std::uniform_real_distribution<float> gap(0.0f, 0.08f);
+  for (int trial = 0; trial < 10; ++trial) {
+    std::vector<mfr::Fragment> list;
+    float z = 2.0f;
+    for (int i = 0; i < 1 + trial % MFR_ZTHICK_WINDOW; ++i) {
+      z += (i % 4 == 3) ? 0.0f : gap(rng);
+      list.push_back(frag(z, byte(rng), byte(rng), byte(rng), i == 2 ? 0 : byte(rng)));
+    }
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    const mfr::ZThicknessBreakdown b = mfr::compositeZThicknessBreakdown(list, kIdentityDepth, 0.1f, background);
+    EXPECT_EQ(b.color, mfr::compositeZThickness(list, kIdentityDepth, 0.1f, background));
+    double bruteT = 0.0;
+    const std::vector<double> brute = sharesByBruteForce(list, 0.1, 100000, &bruteT);
+    glm::dvec3 rebuilt = b.transmittance * glm::dvec3(background);
+    double sum = b.transmittance;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      EXPECT_NEAR(b.weights[i], brute[i], 2e-3) << i;
+      rebuilt += b.weights[i] * glm::dvec3(glm::unpackUnorm4x8(list[i].color));
+      sum += b.weights[i];
+    }
+    if (list.size() > 2) {
+      EXPECT_EQ(b.weights[2], 0.0);  // no opacity, no share
+    }
+    EXPECT_NEAR(b.transmittance, bruteT, 2e-3);
+    EXPECT_NEAR(sum, 1.0, 1e-5);
+    expectNear(b.color, rebuilt, 1e-5);
+  }
+  // A full window: fragments merged into the newest slab still get their own shares.
+  std::vector<mfr::Fragment> many;
+  for (int i = 0; i < MFR_ZTHICK_WINDOW + 5; ++i) many.push_back(frag(1.0f, i % 2 ? 255 : 0, 0, i % 2 ? 0 : 255, 20));
+  const mfr::ZThicknessBreakdown merged = mfr::compositeZThicknessBreakdown(many, kIdentityDepth, 0.1f, background);
+  double sum = merged.transmittance;
+  for (std::size_t i = 0; i < many.size(); ++i) {
+    EXPECT_NEAR(merged.weights[i], merged.weights[0], 1e-6) << i;  // equal opacities, one depth: equal shares
+    sum += merged.weights[i];
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-5);
+}
+
 TEST(ZThickness, DepthToEyeInvertsTheProjection) {
   for (const mfr::Projection projection : {mfr::Projection::Perspective, mfr::Projection::Orthographic}) {
     mfr::Camera camera;

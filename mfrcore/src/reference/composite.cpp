@@ -59,18 +59,24 @@ void store(ImageRGBA8& image, int x, int y, const glm::vec3& c) {
 namespace {
 
 // The open slabs of one pixel (shaders/ops/zthickness.glsl: a window of MFR_ZTHICK_WINDOW, ends
-// ascending) and the integration state.
+// ascending) and the integration state. Track: also each fragment's share of the colour (the
+// probe), which needs each slab's fragments — several once the window is full and a newer one is
+// merged into the newest slab.
+template <bool Track>
 struct ZThicknessState {
   struct Slab {
     float end = 0.0f;
     float sigma = 0.0f;
     glm::vec3 emission{0.0f};
+    std::size_t members = 0;  // Track: index into fragmentsOf
   };
   std::array<Slab, MFR_ZTHICK_WINDOW> window{};
   std::size_t first = 0, count = 0;
   glm::vec3 colour{0.0f};
   float transmittance = 1.0f;
   float position = 0.0f;
+  std::vector<std::vector<std::pair<std::size_t, float>>> fragmentsOf;  // Track: (fragment, σ) per slab
+  std::vector<double> weights;                                          // Track: per fragment
 
   Slab& slab(std::size_t i) { return window[(first + i) % window.size()]; }
 
@@ -84,6 +90,13 @@ struct ZThicknessState {
     }
     if (sigma > 0.0f) {
       const float absorbed = 1.0f - std::exp(-sigma * (z - position));
+      if constexpr (Track) {
+        // Each fragment absorbs (and so emits) its σ's part of what the stretch absorbs.
+        const double share = static_cast<double>(transmittance) * absorbed / sigma;
+        for (std::size_t i = 0; i < count; ++i)
+          for (const auto& [fragment, fragmentSigma] : fragmentsOf[slab(i).members])
+            weights[fragment] += share * fragmentSigma;
+      }
       colour += transmittance * absorbed * (emission / sigma);
       transmittance *= 1.0f - absorbed;
     }
@@ -97,34 +110,49 @@ struct ZThicknessState {
       --count;
     }
   }
+
+  void run(std::span<const Fragment> sorted, const glm::vec4& depthToEye, float thickness) {
+    if constexpr (Track) weights.assign(sorted.size(), 0.0);
+    for (std::size_t index = 0; index < sorted.size(); ++index) {
+      const Fragment& f = sorted[index];
+      const glm::vec4 c = glm::unpackUnorm4x8(f.color);
+      const float alpha = std::min(c.a, static_cast<float>(MFR_ZTHICK_MAX_ALPHA));
+      if (alpha <= 0.0f) continue;
+      const float ndc = 2.0f * f.depth - 1.0f;
+      const float z = -(depthToEye.x * ndc + depthToEye.y) / (depthToEye.z * ndc + depthToEye.w);
+      closeUntil(z);
+      if (count == 0) position = z;
+      integrate(z);
+      const float sigma = -std::log(1.0f - alpha) / thickness;
+      if (count == window.size()) {
+        Slab& newest = slab(count - 1);
+        newest.sigma += sigma;
+        newest.emission += sigma * glm::vec3(c);
+        if constexpr (Track) fragmentsOf[newest.members].emplace_back(index, sigma);
+        continue;
+      }
+      slab(count) = {z + thickness, sigma, sigma * glm::vec3(c), fragmentsOf.size()};
+      if constexpr (Track) fragmentsOf.push_back({{index, sigma}});
+      ++count;
+    }
+    closeUntil(std::numeric_limits<float>::max());
+  }
 };
 
 }  // namespace
 
 glm::vec3 compositeZThickness(std::span<const Fragment> sorted, const glm::vec4& depthToEye, float thickness,
                               const glm::vec3& background) {
-  ZThicknessState s;
-  for (const Fragment& f : sorted) {
-    const glm::vec4 c = glm::unpackUnorm4x8(f.color);
-    const float alpha = std::min(c.a, static_cast<float>(MFR_ZTHICK_MAX_ALPHA));
-    if (alpha <= 0.0f) continue;
-    const float ndc = 2.0f * f.depth - 1.0f;
-    const float z = -(depthToEye.x * ndc + depthToEye.y) / (depthToEye.z * ndc + depthToEye.w);
-    s.closeUntil(z);
-    if (s.count == 0) s.position = z;
-    s.integrate(z);
-    const float sigma = -std::log(1.0f - alpha) / thickness;
-    if (s.count == s.window.size()) {
-      ZThicknessState::Slab& newest = s.slab(s.count - 1);
-      newest.sigma += sigma;
-      newest.emission += sigma * glm::vec3(c);
-      continue;
-    }
-    s.slab(s.count) = {z + thickness, sigma, sigma * glm::vec3(c)};
-    ++s.count;
-  }
-  s.closeUntil(std::numeric_limits<float>::max());
+  ZThicknessState<false> s;
+  s.run(sorted, depthToEye, thickness);
   return s.colour + s.transmittance * background;
+}
+
+ZThicknessBreakdown compositeZThicknessBreakdown(std::span<const Fragment> sorted, const glm::vec4& depthToEye,
+                                                 float thickness, const glm::vec3& background) {
+  ZThicknessState<true> s;
+  s.run(sorted, depthToEye, thickness);
+  return {s.colour + s.transmittance * background, std::move(s.weights), s.transmittance};
 }
 
 ImageRGBA8 compositeOver(const FragmentLists& lists, const glm::vec3& background) {

@@ -131,4 +131,17 @@ void splitVolume(PixelProbe& probe, const Scene& scene, const Camera& camera, co
   probe.volumeBackground = b.backgroundWeight;
 }
 
+void splitZThickness(PixelProbe& probe, const Scene& scene, const Camera& camera, const RenderRequest& request) {
+  const double thickness = zThicknessOf(request, scene.bounds());
+  std::vector<Fragment> sorted;
+  for (const ProbeFragment& f : probe.fragments) sorted.push_back(f.fragment);
+  const ZThicknessBreakdown b = compositeZThicknessBreakdown(sorted, glm::vec4(camera.depthToEye()),
+                                                             static_cast<float>(thickness), scene.background);
+  probe.zthickness = true;
+  probe.thickness = thickness;
+  for (std::size_t i = 0; i < probe.fragments.size(); ++i) probe.fragments[i].zthicknessWeight = b.weights[i];
+  probe.zthicknessColor = b.color;
+  probe.zthicknessBackground = b.transmittance;
+}
+
 }  // namespace mfr

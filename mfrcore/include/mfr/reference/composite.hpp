@@ -30,6 +30,17 @@ ImageRGBA8 compositeOver(const FragmentLists& lists, const glm::vec3& background
 // is merged into the newest open slab). depthToEye: Camera::depthToEye().
 glm::vec3 compositeZThickness(std::span<const Fragment> sorted, const glm::vec4& depthToEye, float thickness,
                               const glm::vec3& background);
+// The same colour taken apart (the pixel probe): weights[i] is fragment i's share of it — over
+// every stretch where its slab is open, the light reaching the stretch times the part of what the
+// stretch absorbs that its own extinction takes (σᵢ/σ) — so that colour = Σ weights[i]·rgbᵢ +
+// transmittance·background (to float rounding). A fragment with no opacity has weight 0.
+struct ZThicknessBreakdown {
+  glm::vec3 color{0.0f};        // compositeZThickness's, in the same arithmetic
+  std::vector<double> weights;  // per fragment of `sorted`
+  double transmittance = 1.0;   // the background's share
+};
+ZThicknessBreakdown compositeZThicknessBreakdown(std::span<const Fragment> sorted, const glm::vec4& depthToEye,
+                                                 float thickness, const glm::vec3& background);
 // The image; throws mfr::Error("--thickness", …) unless thickness is finite and > 0.
 ImageRGBA8 compositeZThickness(const FragmentLists& lists, const Camera& camera, double thickness,
                                const glm::vec3& background);

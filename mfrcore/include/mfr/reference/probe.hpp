@@ -25,6 +25,7 @@ struct ProbeFragment {
   bool held = false;      // the method's capture holds it (matchCapture)
   double hybridWeight = 0.0;  // its share of the hybrid colour under the method's core/tail split (splitHybrid)
   double volumeWeight = 0.0;  // its share of the "volume" colour: α·T through surfaces and medium (splitVolume)
+  double zthicknessWeight = 0.0;  // its share of the "zthickness" colour, blended with the slabs it overlaps
 };
 
 // A stretch of the volumes' medium along the pixel's ray (splitVolume).
@@ -63,6 +64,12 @@ struct PixelProbe {
   std::vector<std::string> volumeNames;  // the volumes drawn, in the order of weightByVolume
   glm::vec3 volumeColor{0.0f};      // the exact colour under the operation "volume"
   double volumeBackground = 0.0;
+
+  // Set by splitZThickness.
+  bool zthickness = false;
+  double thickness = 0.0;             // the slab thickness used (world units)
+  glm::vec3 zthicknessColor{0.0f};    // the exact colour under the operation "zthickness"
+  double zthicknessBackground = 0.0;  // the background's share
 };
 
 // The probe of pixel (x, y) of a width × height image (throws mfr::Error for a pixel outside it,
@@ -93,5 +100,11 @@ void splitHybrid(PixelProbe& probe, glm::vec3 background);
 // by the scene's clip box and section; each stretch also split by volume. Throws mfr::Error when
 // the scene has no visible volume.
 void splitVolume(PixelProbe& probe, const Scene& scene, const Camera& camera, const RenderRequest& request);
+
+// The operation "zthickness" at the probed pixel (reference/composite.hpp
+// compositeZThicknessBreakdown on the probe's exact list, with the thickness `request` asks for —
+// zThicknessOf: 1 % of the scene's diagonal by default): each surface's share of the blended
+// colour, where surfaces closer than the thickness blend instead of covering each other.
+void splitZThickness(PixelProbe& probe, const Scene& scene, const Camera& camera, const RenderRequest& request);
 
 }  // namespace mfr
