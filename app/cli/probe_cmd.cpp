@@ -233,17 +233,8 @@ void addProbe(CLI::App& app) {
             ? glm::ivec3(to8(probe.zthicknessColor.r), to8(probe.zthicknessColor.g), to8(probe.zthicknessColor.b))
             : exact;
     if (probe.zthickness) {
-      // Surfaces closer than the thickness blend: how many of them do here.
-      std::size_t blended = 0;
-      for (std::size_t i = 0; i < probe.fragments.size(); ++i) {
-        const bool nearPrevious =
-            i > 0 && probe.fragments[i].eyeDepth - probe.fragments[i - 1].eyeDepth < probe.thickness;
-        const bool nearNext = i + 1 < probe.fragments.size() &&
-                              probe.fragments[i + 1].eyeDepth - probe.fragments[i].eyeDepth < probe.thickness;
-        blended += nearPrevious || nearNext ? 1 : 0;
-      }
       text << "exact colour (zthickness " << probe.thickness << "): " << reference.r << " " << reference.g << " "
-           << reference.b << " (" << blended << " of the " << probe.fragments.size()
+           << reference.b << " (" << probe.zthicknessBlended << " of the " << probe.fragments.size()
            << " surfaces lie within the thickness of a neighbour and blend)\n";
     }
     if (probe.volume) {

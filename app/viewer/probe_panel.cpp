@@ -136,18 +136,10 @@ void ProbePanel::show(const ViewProbe& r) {
                                ? QColor(to8(p.zthicknessColor.r), to8(p.zthicknessColor.g), to8(p.zthicknessColor.b))
                                : exact;
   if (p.zthickness) {
-    // Surfaces within the thickness of a neighbour blend.
-    int blended = 0;
-    for (std::size_t i = 0; i < p.fragments.size(); ++i) {
-      const bool nearPrevious = i > 0 && p.fragments[i].eyeDepth - p.fragments[i - 1].eyeDepth < p.thickness;
-      const bool nearNext =
-          i + 1 < p.fragments.size() && p.fragments[i + 1].eyeDepth - p.fragments[i].eyeDepth < p.thickness;
-      blended += nearPrevious || nearNext ? 1 : 0;
-    }
     text += tr(" (over), %1 with z-thickness %2 (%3 of the surfaces blend with a neighbour)")
                 .arg(reference.name())
                 .arg(p.thickness, 0, 'g', 4)
-                .arg(blended);
+                .arg(p.zthicknessBlended);
   }
   if (p.volume) {
     double medium = 0.0;

@@ -142,6 +142,12 @@ void splitZThickness(PixelProbe& probe, const Scene& scene, const Camera& camera
   for (std::size_t i = 0; i < probe.fragments.size(); ++i) probe.fragments[i].zthicknessWeight = b.weights[i];
   probe.zthicknessColor = b.color;
   probe.zthicknessBackground = b.transmittance;
+  probe.zthicknessBlended = 0;
+  const auto near = [&](std::size_t a, std::size_t c) {
+    return probe.fragments[c].eyeDepth - probe.fragments[a].eyeDepth < thickness;
+  };
+  for (std::size_t i = 0; i < probe.fragments.size(); ++i)
+    if ((i > 0 && near(i - 1, i)) || (i + 1 < probe.fragments.size() && near(i, i + 1))) ++probe.zthicknessBlended;
 }
 
 }  // namespace mfr

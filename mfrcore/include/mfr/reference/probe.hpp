@@ -3,6 +3,7 @@
 // fragment with its part, its distance from the eye and its share of the "over" result, and —
 // given a GPU method's capture of the same pixel (GpuRenderer::capture with a one-pixel region) —
 // which of those fragments the method holds. `mfr probe` prints it; mfrview's Probe dock shows it.
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -70,6 +71,7 @@ struct PixelProbe {
   double thickness = 0.0;             // the slab thickness used (world units)
   glm::vec3 zthicknessColor{0.0f};    // the exact colour under the operation "zthickness"
   double zthicknessBackground = 0.0;  // the background's share
+  std::size_t zthicknessBlended = 0;  // surfaces within the thickness of a neighbour (they blend)
 };
 
 // The probe of pixel (x, y) of a width × height image (throws mfr::Error for a pixel outside it,
