@@ -73,6 +73,24 @@ QDoubleSpinBox* unitSpinBox(const char* name, const QString& tip) {
   return box;
 }
 
+QComboBox* chooser(const char* name, const QString& tip) {
+  auto* box = new QComboBox;
+  box->setObjectName(QLatin1String(name));
+  box->setToolTip(tip);
+  return box;
+}
+
+// "label [widget]" on one line, hidden until there is something to choose.
+QWidget* hiddenRow(const QString& label, QWidget* widget) {
+  auto* row = new QWidget;
+  auto* layout = new QHBoxLayout(row);
+  layout->setContentsMargins(0, 0, 0, 0);
+  layout->addWidget(new QLabel(label));
+  layout->addWidget(widget, 1);
+  row->hide();
+  return row;
+}
+
 QString bytesText(double bytes) {
   if (bytes >= 1024.0 * 1024.0) return QStringLiteral("%1 MiB").arg(bytes / (1024.0 * 1024.0), 0, 'f', 1);
   if (bytes >= 1024.0) return QStringLiteral("%1 KiB").arg(bytes / 1024.0, 0, 'f', 1);
@@ -86,33 +104,17 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   auto* layout = new QVBoxLayout(this);
 
   // A scene with several volumes: which one the controls below show and edit.
-  volumeChoice_ = new QComboBox;
-  volumeChoice_->setObjectName(QStringLiteral("hvVolume"));
-  volumeChoice_->setToolTip(
-      tr("The volume these controls show and edit. Up to four volumes are drawn at once; where they "
-         "overlap their media mix (extinctions add, colours weighted by extinction)."));
-  volumeRow_ = new QWidget;
-  auto* volumeRow = new QHBoxLayout(volumeRow_);
-  volumeRow->setContentsMargins(0, 0, 0, 0);
-  volumeRow->addWidget(new QLabel(tr("Volume")));
-  volumeRow->addWidget(volumeChoice_, 1);
+  volumeChoice_ = chooser("hvVolume", tr("The volume these controls show and edit. Up to four volumes are drawn at "
+                                         "once; where they overlap their media mix (extinctions add, colours "
+                                         "weighted by extinction)."));
+  volumeRow_ = hiddenRow(tr("Volume"), volumeChoice_);
   layout->addWidget(volumeRow_);
-  volumeRow_->hide();
-
   // A file with several arrays (.vti, .vtk) or grids (.vdb): which one is read.
-  fieldChoice_ = new QComboBox;
-  fieldChoice_->setObjectName(QStringLiteral("hvField"));
-  fieldChoice_->setToolTip(
-      tr("The array (VTK files) or grid (OpenVDB files) of the volume's file that is drawn. Another "
-         "one is read from the file in its place; its transfer function starts at the default over "
-         "its values."));
-  fieldRow_ = new QWidget;
-  auto* fieldRow = new QHBoxLayout(fieldRow_);
-  fieldRow->setContentsMargins(0, 0, 0, 0);
-  fieldRow->addWidget(new QLabel(tr("Field")));
-  fieldRow->addWidget(fieldChoice_, 1);
+  fieldChoice_ = chooser("hvField", tr("The array (VTK files) or grid (OpenVDB files) of the volume's file that is "
+                                       "drawn. Another one is read from the file in its place; its transfer function "
+                                       "starts at the default over its values."));
+  fieldRow_ = hiddenRow(tr("Field"), fieldChoice_);
   layout->addWidget(fieldRow_);
-  fieldRow_->hide();
   fieldNote_ = new QLabel;
   fieldNote_->setObjectName(QStringLiteral("hvFieldNote"));
   fieldNote_->setWordWrap(true);
