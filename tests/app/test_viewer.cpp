@@ -2733,8 +2733,9 @@ class ViewerTest : public QObject {
     // A field the file lacks: the reason, and the volume as it was.
     m.setVolumeField(QStringLiteral("rings"));
     QTRY_VERIFY_WITH_TIMEOUT(!m.volumeFieldLoading(), kTimeoutMs);
-    QVERIFY2(m.volumeFieldError().contains(QStringLiteral("no point-data array 'rings' (arrays: ramp, ring)")),
-             qPrintable(m.volumeFieldError()));
+    QVERIFY2(
+        m.volumeFieldError().contains(QStringLiteral("no point-data or cell-data array 'rings' (arrays: ramp, ring)")),
+        qPrintable(m.volumeFieldError()));
     QVERIFY(fieldNote->isVisibleTo(w.get()));
     QCOMPARE(fieldNote->text(), m.volumeFieldError());
     QCOMPARE(m.volumeField(), QStringLiteral("ring"));
@@ -2770,7 +2771,7 @@ class ViewerTest : public QObject {
     QVERIFY(runProgram(MFRVIEW, QStringList{vti, "--field", "rings", "--screenshot", viewerPng} + common, &out) != 0);
     const QString last = out.trimmed().split(QLatin1Char('\n')).last();  // after any Qt platform chatter
     QVERIFY2(last.startsWith(QStringLiteral("mfrview: ") + vti) &&
-                 last.contains(QStringLiteral("no point-data array 'rings' (arrays: ramp, ring)")),
+                 last.contains(QStringLiteral("no point-data or cell-data array 'rings' (arrays: ramp, ring)")),
              qPrintable(out));
   }
 

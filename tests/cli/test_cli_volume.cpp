@@ -157,7 +157,8 @@ TEST_F(CliVolume, FieldChoosesTheArray) {
   EXPECT_GT(rmseOf(ramp, dip), 0.02);
   EXPECT_LT(rmseOf(dip, dipGpu), 0.01);
 
-  expectCleanFailure("render " + vtk.string() + " --field Dip", "no point-data array 'Dip' (arrays: ramp, dip)");
+  expectCleanFailure("render " + vtk.string() + " --field Dip",
+                     "no point-data or cell-data array 'Dip' (arrays: ramp, dip)");
   expectCleanFailure("render " + vtk.string() + " --field Dip", vtk.string());
   expectCleanFailure("render @sample --field dip", "can be chosen only for a volume file");
 }

@@ -4,6 +4,7 @@
 // written with vtkXMLImageDataWriter, vtkMetaImageWriter and vtkStructuredPointsWriter must come
 // back exactly (samples, origin, spacing). A missing file is a failure, not a skip.
 #include <gtest/gtest.h>
+#include <vtkCellData.h>
 #include <vtkDoubleArray.h>
 #include <vtkFloatArray.h>
 #include <vtkImageData.h>
@@ -319,6 +320,70 @@ TEST_F(VtkWrittenVolumes, XmlImageDataExtentAndDirection) {
     const glm::dvec3 got(toWorld * glm::dvec4(glm::dvec3(g), 1.0));
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-12) << g.x << " " << g.y << " " << g.z << " axis " << c;
   }
+}
+
+// Cell data written by VTK's own writers, placed by an extent and a direction matrix: each sample
+// is its cell's value, at the mean of the cell's eight corners as VTK places them
+// (TransformIndexToPhysicalPoint); the legacy writer's CELL_DATA the same.
+TEST_F(VtkWrittenVolumes, CellDataAtTheCellCentres) {
+  vtkNew<vtkImageData> im;
+  im->SetExtent(3, 3 + kNx - 1, -2, -2 + kNy - 1, 1, 1 + kNz - 1);
+  im->SetOrigin(1.0, 2.0, 3.0);
+  im->SetSpacing(0.5, 0.25, 2.0);
+  im->SetDirectionMatrix(0, -1, 0, 1, 0, 0, 0, 0, 1);
+  vtkNew<vtkFloatArray> points, cells;
+  points->SetName("f");
+  points->SetNumberOfTuples(kNx * kNy * kNz);
+  for (vtkIdType t = 0; t < points->GetNumberOfTuples(); ++t) points->SetValue(t, static_cast<float>(t));
+  cells->SetName("pressure");
+  cells->SetNumberOfTuples((kNx - 1) * (kNy - 1) * (kNz - 1));
+  for (vtkIdType t = 0; t < cells->GetNumberOfTuples(); ++t)
+    cells->SetValue(
+        t, static_cast<float>(analytic(static_cast<int>(t % (kNx - 1)), static_cast<int>(t / (kNx - 1) % (kNy - 1)),
+                                       static_cast<int>(t / ((kNx - 1) * (kNy - 1))))));
+  im->GetPointData()->SetScalars(points);
+  im->GetCellData()->AddArray(cells);
+  const fs::path p = dir() / "cells.vti";
+  vtkNew<vtkXMLImageDataWriter> w;
+  w->SetFileName(p.c_str());
+  w->SetInputData(im);
+  ASSERT_EQ(w->Write(), 1);
+  const mfr::Volume v = mfr::loadVolume(p, mfr::LoadOptions{"pressure"});
+  ASSERT_EQ(v.grid->dims, glm::ivec3(kNx - 1, kNy - 1, kNz - 1));
+  EXPECT_EQ(v.fields, (std::vector<std::string>{"f", "pressure"}));
+  const glm::dmat4 toWorld = v.gridToWorld();
+  for (int k = 0; k < kNz - 1; ++k)
+    for (int j = 0; j < kNy - 1; ++j)
+      for (int i = 0; i < kNx - 1; ++i) {
+        ASSERT_EQ(v.grid->at(i, j, k), static_cast<float>(analytic(i, j, k))) << i << " " << j << " " << k;
+        glm::dvec3 centre(0.0);
+        for (int corner = 0; corner < 8; ++corner) {
+          double q[3];
+          im->TransformIndexToPhysicalPoint(i + 3 + (corner & 1), j - 2 + (corner >> 1 & 1), k + 1 + (corner >> 2), q);
+          centre += glm::dvec3(q[0], q[1], q[2]) / 8.0;
+        }
+        const glm::dvec3 got(toWorld * glm::dvec4(i, j, k, 1.0));
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(got[c], centre[c], 1e-12) << i << " " << j << " " << k << " axis " << c;
+      }
+
+  // Legacy VTK (no direction matrix): CELL_DATA read by default when there is no point data.
+  vtkNew<vtkImageData> plain;
+  plain->SetDimensions(kNx, kNy, kNz);
+  plain->SetOrigin(-1.0, 0.5, 2.0);
+  plain->SetSpacing(0.5, 0.25, 2.0);
+  plain->GetCellData()->SetScalars(cells);
+  const fs::path legacy = dir() / "cells.vtk";
+  vtkNew<vtkStructuredPointsWriter> lw;
+  lw->SetFileName(legacy.c_str());
+  lw->SetInputData(plain);
+  ASSERT_EQ(lw->Write(), 1);
+  const mfr::Volume l = mfr::loadVolume(legacy);
+  EXPECT_EQ(l.field, "pressure");
+  ASSERT_EQ(l.grid->dims, glm::ivec3(kNx - 1, kNy - 1, kNz - 1));
+  ASSERT_EQ(l.grid->values.size(), v.grid->values.size());
+  for (std::size_t i = 0; i < l.grid->values.size(); ++i)  // the legacy writer's ASCII: 6 digits
+    ASSERT_NEAR(l.grid->values[i], v.grid->values[i], 1e-5f * std::max(1.0f, std::abs(v.grid->values[i]))) << i;
+  EXPECT_EQ(l.origin, glm::dvec3(-1.0 + 0.25, 0.5 + 0.125, 2.0 + 1.0));
 }
 
 TEST_F(VtkWrittenVolumes, MetaImageShort) {

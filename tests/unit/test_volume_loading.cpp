@@ -214,7 +214,7 @@ TEST_F(VolumeLoading, AFieldPicksTheNamedArray) {
       EXPECT_EQ(std::string(e.what()), path.string() + ": " + reason);
     }
   };
-  expectMissing(p, "F", "no point-data array 'F' (arrays: ones, f, twice)");
+  expectMissing(p, "F", "no point-data or cell-data array 'F' (arrays: ones, f, twice)");
   // Legacy VTK: every SCALARS section is an array.
   const fs::path legacy =
       write("two.vtk",
@@ -225,7 +225,7 @@ TEST_F(VolumeLoading, AFieldPicksTheNamedArray) {
   expectField(l, {4, 3, 2});
   EXPECT_EQ(l.fields, (std::vector<std::string>{"ones", "f"}));
   EXPECT_EQ(mfr::loadVolume(legacy).field, "ones");
-  expectMissing(legacy, "g", "no point-data array 'g' (arrays: ones, f)");
+  expectMissing(legacy, "g", "no point-data or cell-data array 'g' (arrays: ones, f)");
   // Formats with one unnamed field: nothing to choose, and nothing named.
   const fs::path inr = write("small.inr", smallInr());
   EXPECT_EQ(mfr::loadVolume(inr).field, "");
@@ -240,6 +240,53 @@ TEST_F(VolumeLoading, AFieldPicksTheNamedArray) {
             scene.string() +
                 ": field 'f' can be chosen only for a volume file (a scene file gives each volume its "
                 "own 'field')");
+}
+
+// Cell data (a simulation's per-cell values): one sample per cell at its centre, half a spacing in
+// from the extent's first point, with the image's own placement; a point array of the same file
+// stays the default; a file with only cell data reads its first cell array.
+TEST_F(VolumeLoading, CellDataIsSampledAtTheCellCentres) {
+  // Points 5x4x3 over the extent 1…5 × 0…3 × -1…1: cells 4x3x2, each holding field(i, j, k).
+  const std::string cellArray = dataArray("Float32", "pressure", asciiValues(4, 3, 2));
+  std::string ones;
+  for (int n = 0; n < 60; ++n) ones += "1 ";
+  const fs::path both =
+      write("both.vti", vti("1 5 0 3 -1 1", "10 20 30", "0.5 2 4", dataArray("Float32", "ones", ones), cellArray));
+  const mfr::Volume byDefault = mfr::loadVolume(both);
+  EXPECT_EQ(byDefault.field, "ones");
+  EXPECT_EQ(byDefault.grid->dims, glm::ivec3(5, 4, 3));
+  EXPECT_EQ(byDefault.fields, (std::vector<std::string>{"ones", "pressure"}));
+  const mfr::Volume cells = mfr::loadVolume(both, mfr::LoadOptions{"pressure"});
+  EXPECT_EQ(cells.field, "pressure");
+  expectField(cells, {4, 3, 2});
+  expectVec(cells.spacing, {0.5, 2.0, 4.0});
+  // The first cell's centre: origin + spacing ⊙ (first point + ½) = (10 + 0.5·1.5, 20 + 2·0.5, 30 + 4·(−0.5)).
+  expectVec(cells.origin, {10.75, 21.0, 28.0});
+  // Its domain is the points' box shrunk by half a spacing on each side.
+  expectVec(cells.bounds().min, byDefault.bounds().min + glm::dvec3(0.25, 1.0, 2.0));
+  expectVec(cells.bounds().max, byDefault.bounds().max - glm::dvec3(0.25, 1.0, 2.0));
+  // Only cell data: that is what is read.
+  const mfr::Volume only =
+      mfr::loadVolume(write("only.vti", vti("1 5 0 3 -1 1", "10 20 30", "0.5 2 4", "", cellArray)));
+  EXPECT_EQ(only.field, "pressure");
+  expectField(only, {4, 3, 2});
+  // The error lists both kinds.
+  try {
+    (void)mfr::loadVolume(both, mfr::LoadOptions{"Pressure"});
+    ADD_FAILURE() << "no error";
+  } catch (const mfr::FieldNotFound& e) {
+    EXPECT_EQ(std::string(e.what()),
+              both.string() + ": no point-data or cell-data array 'Pressure' (arrays: ones; cell data: pressure)");
+  }
+  // Legacy VTK's CELL_DATA sections too.
+  const fs::path legacy =
+      write("cells.vtk",
+            "# vtk DataFile Version 3.0\ncells\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 5 4 3\n"
+            "ORIGIN 0 0 0\nSPACING 1 1 1\nCELL_DATA 24\nSCALARS p float 1\nLOOKUP_TABLE default\n" +
+                asciiValues(4, 3, 2) + "\n");
+  const mfr::Volume l = mfr::loadVolume(legacy);
+  expectField(l, {4, 3, 2});
+  expectVec(l.origin, {0.5, 0.5, 0.5});
 }
 
 TEST_F(VolumeLoading, LegacyStructuredPointsAscii) {
@@ -455,9 +502,11 @@ TEST_F(VolumeLoading, CorruptInrimageHeaders) {
 TEST_F(VolumeLoading, BadVti) {
   std::string cells;
   for (int n = 0; n < 6; ++n) cells += "1 ";
+  // Cell data is read at the cells' centres (VolumeLoading.CellDataIsSampledAtTheCellCentres): 3x2x1 cells are too few.
   expectVolumeError(write("cells.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", "", dataArray("Float32", "c", cells))),
-                    "only cell data");
-  expectVolumeError(write("nodata.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", "")), "no point-data scalar array");
+                    "cell-data array 'c' of 3x2x1 cells: a volume needs at least 2 cells per axis");
+  expectVolumeError(write("nodata.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", "")),
+                    "no point-data or cell-data scalar array");
   expectVolumeError(write("short.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", dataArray("Float32", "f", "1 2 3"))),
                     "cannot read VTK image data (.vti)");
   const std::string whole = cubeVti();
@@ -478,7 +527,8 @@ TEST_F(VolumeLoading, BadLegacyMetaImageAndNrrd) {
       "# vtk DataFile Version 3.0\ng\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\n"
       "ORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 24\nSCALARS f float 1\nLOOKUP_TABLE default\n";
   expectVolumeError(write("cut.vtk", head + std::string(40, '\0')), "cannot read legacy VTK structured points");
-  expectVolumeError(write("nodata.vtk", head.substr(0, head.find("POINT_DATA"))), "no point-data scalar array");
+  expectVolumeError(write("nodata.vtk", head.substr(0, head.find("POINT_DATA"))),
+                    "no point-data or cell-data scalar array");
   expectVolumeError(write("huge.vtk",
                           "# vtk DataFile Version 3.0\ng\nBINARY\nDATASET STRUCTURED_POINTS\n"
                           "DIMENSIONS 100000 100000 100000\nSPACING 1 1 1\nORIGIN 0 0 0\nPOINT_DATA 5\n"),
@@ -742,7 +792,7 @@ TEST_F(SceneVolumes, ErrorsNameTheJsonPath) {
   expectError(R"({"volumes": [{"file": "cube.vti", "visible": "yes"}]})", "volumes[0].visible",
               "expected true or false");
   expectError(R"({"volumes": [{"file": "cube.vti", "field": "mass"}]})", "volumes[0].field",
-              (dir() / "cube.vti").string() + ": no point-data array 'mass' (arrays: density)");
+              (dir() / "cube.vti").string() + ": no point-data or cell-data array 'mass' (arrays: density)");
   expectError(R"({"volumes": [{"file": "cube.vti", "field": ""}]})", "volumes[0].field",
               "expected the name of an array or grid of the file");
   expectError(R"({"volumes": [{"file": "cube.vti", "field": 2}]})", "volumes[0].field", "expected a string");

@@ -35,6 +35,8 @@
 #include <vtkCellData.h>
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
+#include <vtkDataSetAttributes.h>
+#include <vtkFieldData.h>
 #include <vtkImageData.h>
 #include <vtkInformation.h>
 #include <vtkMatrix3x3.h>
@@ -342,35 +344,57 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
   return orientation;
 }
 
-// The numeric point-data arrays of an image, by name, in file order.
-std::vector<std::string> pointArrayNames(vtkImageData* image) {
+// The numeric arrays of an image's point or cell data, by name, in file order.
+std::vector<std::string> arrayNames(vtkFieldData* data) {
   std::vector<std::string> names;
-  if (vtkPointData* pd = image->GetPointData(); pd != nullptr)
-    for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
-      if (vtkDataArray* a = pd->GetArray(i); a != nullptr && a->GetName() != nullptr) names.emplace_back(a->GetName());
+  if (data != nullptr)
+    for (int i = 0; i < data->GetNumberOfArrays(); ++i)
+      if (vtkDataArray* a = data->GetArray(i); a != nullptr && a->GetName() != nullptr)
+        names.emplace_back(a->GetName());
   return names;
 }
 
-// The sample array: the one named `field`, else the point data's active scalars, else its first
-// numeric array.
-vtkDataArray* sampleArray(vtkImageData* image, const std::string& name, const std::string& field) {
+// What a volume file can be read as: its point arrays, then its cell arrays (a name that is both
+// reads the point array).
+std::vector<std::string> fieldNames(vtkImageData* image) {
+  std::vector<std::string> names = arrayNames(image->GetPointData());
+  for (const std::string& c : arrayNames(image->GetCellData()))
+    if (std::find(names.begin(), names.end(), c) == names.end()) names.push_back(c);
+  return names;
+}
+
+struct SampleArray {
+  vtkDataArray* array = nullptr;
+  bool cells = false;  // cell data: one sample per cell, at its centre
+};
+
+// The sample array: the one named `field` (point data first); else the point data's active
+// scalars, else its first array; else likewise the cell data's.
+SampleArray sampleArray(vtkImageData* image, const std::string& name, const std::string& field) {
   vtkPointData* pd = image->GetPointData();
-  if (!field.empty()) {
-    if (vtkDataArray* a = pd != nullptr ? pd->GetArray(field.c_str()) : nullptr; a != nullptr) return a;
-    std::string list;
-    for (const std::string& n : pointArrayNames(image)) list += (list.empty() ? "" : ", ") + n;
-    throw FieldNotFound(name, "no point-data array '" + field + "' (" +
-                                  (list.empty() ? std::string("it has none") : "arrays: " + list) + ")");
-  }
-  if (pd != nullptr) {
-    if (vtkDataArray* s = pd->GetScalars(); s != nullptr) return s;
-    for (int i = 0; i < pd->GetNumberOfArrays(); ++i)
-      if (vtkDataArray* a = pd->GetArray(i); a != nullptr) return a;
-  }
   vtkCellData* cd = image->GetCellData();
-  if (cd != nullptr && cd->GetNumberOfArrays() > 0)
-    throw Error(name, "image has only cell data; a volume needs a point-data scalar array");
-  throw Error(name, "image has no point-data scalar array");
+  if (!field.empty()) {
+    if (vtkDataArray* a = pd != nullptr ? pd->GetArray(field.c_str()) : nullptr; a != nullptr) return {a, false};
+    if (vtkDataArray* a = cd != nullptr ? cd->GetArray(field.c_str()) : nullptr; a != nullptr) return {a, true};
+    std::string list;
+    for (const std::string& n : arrayNames(pd)) list += (list.empty() ? "" : ", ") + n;
+    std::string cellList;
+    for (const std::string& n : arrayNames(cd)) cellList += (cellList.empty() ? "" : ", ") + n;
+    throw FieldNotFound(name, "no point-data or cell-data array '" + field + "' (" +
+                                  (list.empty() && cellList.empty() ? std::string("it has none")
+                                   : list.empty()                   ? "cell data: " + cellList
+                                   : cellList.empty()               ? "arrays: " + list
+                                                                    : "arrays: " + list + "; cell data: " + cellList) +
+                                  ")");
+  }
+  for (vtkDataSetAttributes* data : {static_cast<vtkDataSetAttributes*>(pd), static_cast<vtkDataSetAttributes*>(cd)}) {
+    if (data == nullptr) continue;
+    const bool cells = data == cd;
+    if (vtkDataArray* s = data->GetScalars(); s != nullptr) return {s, cells};
+    for (int i = 0; i < data->GetNumberOfArrays(); ++i)
+      if (vtkDataArray* a = data->GetArray(i); a != nullptr) return {a, cells};
+  }
+  throw Error(name, "image has no point-data or cell-data scalar array");
 }
 
 }  // namespace
@@ -445,13 +469,24 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   const std::array<std::int64_t, 3> got{dims[0], dims[1], dims[2]};
   if (got != declared)
     fail("cannot read " + label + " (read " + dimsText(got) + " points of the " + dimsText(declared) + " declared)");
-  vtkDataArray* array = sampleArray(image, name, field);
-  const glm::ivec3 gridDims(dims[0], dims[1], dims[2]);
+  const auto [array, cells] = sampleArray(image, name, field);
+  // Cell data: a grid of the cells' centres, one fewer per axis.
+  const int less = cells ? 1 : 0;
+  const glm::ivec3 gridDims(dims[0] - less, dims[1] - less, dims[2] - less);
+  if (cells) {
+    try {
+      checkDims({gridDims.x, gridDims.y, gridDims.z}, name);
+    } catch (const Error&) {
+      throw Error(name, "cell-data array '" + std::string(array->GetName() ? array->GetName() : "") + "' of " +
+                            dimsText({gridDims.x, gridDims.y, gridDims.z}) +
+                            " cells: a volume needs at least 2 cells per axis");
+    }
+  }
   const std::size_t n = pointCount(gridDims);
   if (array->GetNumberOfComponents() < 1 || array->GetNumberOfTuples() != static_cast<vtkIdType>(n))
     throw Error(name, "scalar array '" + std::string(array->GetName() ? array->GetName() : "") + "' has " +
                           std::to_string(array->GetNumberOfTuples()) + " values for " + std::to_string(n) +
-                          " points (truncated?)");
+                          (cells ? " cells" : " points") + " (truncated?)");
   progress.step(0.7);
 
   auto grid = std::make_shared<VolumeGrid>();
@@ -492,14 +527,14 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
       throw Error(name, "spacing must be non-zero and finite, the origin finite (spacing " + std::to_string(s[0]) +
                             " " + std::to_string(s[1]) + " " + std::to_string(s[2]) + ")");
     spacing[a] = std::abs(s[a]);
-    first[a] = s[a] * start[a];
+    first[a] = s[a] * (start[a] + 0.5 * less);  // a cell's centre is half a spacing in
     if (s[a] < 0.0) axes[a] = -axes[a];
   }
   Volume volume;
   volume.grid = std::move(grid);
   if (hasNamedFields(format)) {  // MetaImage and NRRD arrays are named by VTK's readers, not the file
     volume.field = array->GetName() != nullptr ? array->GetName() : "";
-    volume.fields = pointArrayNames(image);
+    volume.fields = fieldNames(image);
   }
   volume.origin = glm::dvec3(o[0], o[1], o[2]) + direction * first;
   volume.spacing = spacing;
