@@ -242,6 +242,47 @@ TEST_F(VolumeLoading, AFieldPicksTheNamedArray) {
                 "own 'field')");
 }
 
+// An array of several components (a velocity): "v" reads its first component, "v:N" component N,
+// "v:magnitude" each tuple's length; the file's fields list them; a component it lacks is refused
+// with the ones it has.
+TEST_F(VolumeLoading, VectorArraysByComponentOrMagnitude) {
+  std::ostringstream tuples;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i) tuples << field(i, j, k) << ' ' << 2 * i << ' ' << -j << ' ';
+  const std::string array = "<DataArray type=\"Float64\" Name=\"v\" NumberOfComponents=\"3\" format=\"ascii\">" +
+                            tuples.str() + "</DataArray>";
+  const fs::path p = write("vectors.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", array));
+  const mfr::Volume first = mfr::loadVolume(p);
+  expectField(first, {4, 3, 2});
+  EXPECT_EQ(first.field, "v");
+  EXPECT_EQ(first.fields, (std::vector<std::string>{"v", "v:1", "v:2", "v:magnitude"}));
+  expectField(mfr::loadVolume(p, mfr::LoadOptions{"v:0"}), {4, 3, 2});
+  const mfr::Volume second = mfr::loadVolume(p, mfr::LoadOptions{"v:1"});
+  const mfr::Volume length = mfr::loadVolume(p, mfr::LoadOptions{"v:magnitude"});
+  EXPECT_EQ(length.field, "v:magnitude");
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i) {
+        EXPECT_EQ(second.grid->at(i, j, k), static_cast<float>(2 * i));
+        const double f = field(i, j, k);
+        EXPECT_FLOAT_EQ(length.grid->at(i, j, k), static_cast<float>(std::sqrt(f * f + 4.0 * i * i + j * j)));
+      }
+  for (const char* bad : {"v:3", "v:x", "v:-1", "v:"}) {
+    try {
+      (void)mfr::loadVolume(p, mfr::LoadOptions{bad});
+      ADD_FAILURE() << bad << ": no error";
+    } catch (const mfr::FieldNotFound& e) {
+      EXPECT_EQ(std::string(e.what()), p.string() + ": array 'v' has 3 components (v:0 … v:2, or v:magnitude)") << bad;
+    }
+  }
+  // A scalar array has one component, and a name with a colon is still looked up whole first.
+  const fs::path scalar =
+      write("colon.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", dataArray("Float32", "a:b", asciiValues(4, 3, 2))));
+  expectField(mfr::loadVolume(scalar, mfr::LoadOptions{"a:b"}), {4, 3, 2});
+  EXPECT_EQ(mfr::loadVolume(scalar).fields, std::vector<std::string>{"a:b"});
+}
+
 // Cell data (a simulation's per-cell values): one sample per cell at its centre, half a spacing in
 // from the extent's first point, with the image's own placement; a point array of the same file
 // stays the default; a file with only cell data reads its first cell array.

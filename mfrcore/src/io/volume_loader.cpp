@@ -354,19 +354,68 @@ std::vector<std::string> arrayNames(vtkFieldData* data) {
   return names;
 }
 
+// The other ways to read an array of several components (a vector or tensor): "name" is its
+// first component, "name:N" component N, "name:magnitude" the length of each tuple.
+std::vector<std::string> componentFields(vtkDataArray* a) {
+  std::vector<std::string> names;
+  const int n = a != nullptr && a->GetName() != nullptr ? a->GetNumberOfComponents() : 1;
+  for (int c = 1; c < n; ++c) names.push_back(std::string(a->GetName()) + ":" + std::to_string(c));
+  if (n > 1) names.push_back(std::string(a->GetName()) + ":magnitude");
+  return names;
+}
+
 // What a volume file can be read as: its point arrays, then its cell arrays (a name that is both
-// reads the point array).
+// reads the point array), each followed by its components.
 std::vector<std::string> fieldNames(vtkImageData* image) {
-  std::vector<std::string> names = arrayNames(image->GetPointData());
-  for (const std::string& c : arrayNames(image->GetCellData()))
-    if (std::find(names.begin(), names.end(), c) == names.end()) names.push_back(c);
+  std::vector<std::string> names;
+  for (vtkFieldData* data :
+       {static_cast<vtkFieldData*>(image->GetPointData()), static_cast<vtkFieldData*>(image->GetCellData())})
+    for (const std::string& n : arrayNames(data)) {
+      if (std::find(names.begin(), names.end(), n) != names.end()) continue;
+      names.push_back(n);
+      for (std::string& c : componentFields(data->GetArray(n.c_str()))) names.push_back(std::move(c));
+    }
   return names;
 }
 
 struct SampleArray {
+  static constexpr int kMagnitude = -1;
   vtkDataArray* array = nullptr;
   bool cells = false;  // cell data: one sample per cell, at its centre
+  int component = 0;   // kMagnitude: the tuple's length
 };
+
+// The array named `field` ("name", "name:N", "name:magnitude"; point data first), if any.
+std::optional<SampleArray> namedArray(vtkPointData* pd, vtkCellData* cd, const std::string& field,
+                                      const std::string& name) {
+  const auto find = [&](const std::string& arrayName) -> std::optional<SampleArray> {
+    if (vtkDataArray* a = pd != nullptr ? pd->GetArray(arrayName.c_str()) : nullptr; a != nullptr)
+      return SampleArray{a, false};
+    if (vtkDataArray* a = cd != nullptr ? cd->GetArray(arrayName.c_str()) : nullptr; a != nullptr)
+      return SampleArray{a, true};
+    return std::nullopt;
+  };
+  if (std::optional<SampleArray> whole = find(field)) return whole;
+  const std::size_t colon = field.rfind(':');
+  if (colon == std::string::npos || colon == 0) return std::nullopt;
+  const std::string base = field.substr(0, colon), which = field.substr(colon + 1);
+  std::optional<SampleArray> array = find(base);
+  if (!array) return std::nullopt;
+  const int n = array->array->GetNumberOfComponents();
+  if (which == "magnitude") {
+    array->component = SampleArray::kMagnitude;
+    return array;
+  }
+  const bool digits = !which.empty() && which.size() < 4 &&
+                      std::all_of(which.begin(), which.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (digits && std::stoi(which) < n) {
+    array->component = std::stoi(which);
+    return array;
+  }
+  throw FieldNotFound(name, "array '" + base + "' has " + std::to_string(n) + " component" + (n == 1 ? "" : "s") +
+                                " (" + base + ":0 … " + base + ":" + std::to_string(n - 1) + ", or " + base +
+                                ":magnitude)");
+}
 
 // The sample array: the one named `field` (point data first); else the point data's active
 // scalars, else its first array; else likewise the cell data's.
@@ -374,8 +423,7 @@ SampleArray sampleArray(vtkImageData* image, const std::string& name, const std:
   vtkPointData* pd = image->GetPointData();
   vtkCellData* cd = image->GetCellData();
   if (!field.empty()) {
-    if (vtkDataArray* a = pd != nullptr ? pd->GetArray(field.c_str()) : nullptr; a != nullptr) return {a, false};
-    if (vtkDataArray* a = cd != nullptr ? cd->GetArray(field.c_str()) : nullptr; a != nullptr) return {a, true};
+    if (std::optional<SampleArray> named = namedArray(pd, cd, field, name)) return *named;
     std::string list;
     for (const std::string& n : arrayNames(pd)) list += (list.empty() ? "" : ", ") + n;
     std::string cellList;
@@ -469,7 +517,9 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   const std::array<std::int64_t, 3> got{dims[0], dims[1], dims[2]};
   if (got != declared)
     fail("cannot read " + label + " (read " + dimsText(got) + " points of the " + dimsText(declared) + " declared)");
-  const auto [array, cells] = sampleArray(image, name, field);
+  const SampleArray sample = sampleArray(image, name, field);
+  vtkDataArray* const array = sample.array;
+  const bool cells = sample.cells;
   // Cell data: a grid of the cells' centres, one fewer per axis.
   const int less = cells ? 1 : 0;
   const glm::ivec3 gridDims(dims[0] - less, dims[1] - less, dims[2] - less);
@@ -493,7 +543,15 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   grid->dims = gridDims;
   grid->values.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    grid->values[i] = static_cast<float>(array->GetComponent(static_cast<vtkIdType>(i), 0));
+    const auto t = static_cast<vtkIdType>(i);
+    if (sample.component == SampleArray::kMagnitude) {
+      double sum = 0.0;
+      for (int c = 0; c < array->GetNumberOfComponents(); ++c)
+        sum += array->GetComponent(t, c) * array->GetComponent(t, c);
+      grid->values[i] = static_cast<float>(std::sqrt(sum));
+    } else {
+      grid->values[i] = static_cast<float>(array->GetComponent(t, sample.component));
+    }
     if ((i + 1) % kProgressChunk == 0) progress.step(0.7 + 0.25 * static_cast<double>(i + 1) / static_cast<double>(n));
   }
 
@@ -533,7 +591,7 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   Volume volume;
   volume.grid = std::move(grid);
   if (hasNamedFields(format)) {  // MetaImage and NRRD arrays are named by VTK's readers, not the file
-    volume.field = array->GetName() != nullptr ? array->GetName() : "";
+    volume.field = !field.empty() ? field : array->GetName() != nullptr ? array->GetName() : "";
     volume.fields = fieldNames(image);
   }
   volume.origin = glm::dvec3(o[0], o[1], o[2]) + direction * first;
