@@ -287,10 +287,9 @@ void ViewerModel::setVolumeFieldAt(int index, const QString& field,
         }
         return read;
       },
-      [this, index, state, loads = sceneLoads_, transfer](Read read) {
-        if (state != fieldLoad_) return;  // superseded by another read, or by a new scene
+      [this, index, state, transfer](Read read) {
+        if (state != fieldLoad_) return;  // superseded by another read, or by a new scene (setScene)
         fieldLoad_.reset();
-        if (loads != sceneLoads_ || index >= static_cast<int>(scene_.volumes.size())) return;
         if (!read.volume) {
           fieldError_ = read.error;
           emit volumeChanged();
@@ -632,8 +631,7 @@ void ViewerModel::cancelLoad() {
 
 void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
   scene_ = std::move(scene);
-  ++sceneLoads_;
-  if (fieldLoad_) fieldLoad_->cancel = true;  // a field of the old scene's volume
+  if (fieldLoad_) fieldLoad_->cancel = true;  // a field of the old scene's volume: its read is dropped
   fieldLoad_.reset();
   fieldError_.clear();
   loadedMaterials_.clear();

@@ -356,7 +356,6 @@ class ViewerModel final : public ViewerContext {
   std::shared_ptr<LoadState> load_;
   std::shared_ptr<LoadState> fieldLoad_;  // setVolumeFieldAt's read in progress
   QString fieldError_;
-  quint64 sceneLoads_ = 0;  // setScene calls: a field read for an earlier scene is dropped
   bool loading_ = false;
   double loadProgress_ = 0.0;
   bool lastCancelStoppedLoader_ = false;
