@@ -80,6 +80,15 @@ QComboBox* chooser(const char* name, const QString& tip) {
   return box;
 }
 
+// The combo box's items, replaced only when they differ (the current index is set by the caller).
+void setItems(QComboBox* box, const QStringList& items) {
+  QStringList shown;
+  for (int i = 0; i < box->count(); ++i) shown << box->itemText(i);
+  if (shown == items) return;
+  box->clear();
+  box->addItems(items);
+}
+
 // "label [widget]" on one line, hidden until there is something to choose.
 QWidget* hiddenRow(const QString& label, QWidget* widget) {
   auto* row = new QWidget;
@@ -321,12 +330,7 @@ void HybridVolumePanel::showScaleValue() {
 void HybridVolumePanel::showVolumeChoice() {
   const QSignalBlocker block(volumeChoice_);
   const QStringList names = context_.hasScene() ? context_.volumeNames() : QStringList();
-  QStringList shown;
-  for (int i = 0; i < volumeChoice_->count(); ++i) shown << volumeChoice_->itemText(i);
-  if (shown != names) {
-    volumeChoice_->clear();
-    volumeChoice_->addItems(names);
-  }
+  setItems(volumeChoice_, names);
   volumeChoice_->setCurrentIndex(context_.hasScene() ? context_.currentVolume() : -1);
   volumeRow_->setVisible(names.size() > 1);
 }
@@ -334,12 +338,7 @@ void HybridVolumePanel::showVolumeChoice() {
 void HybridVolumePanel::showFieldChoice() {
   const QSignalBlocker block(fieldChoice_);
   const QStringList fields = context_.hasScene() ? context_.volumeFields() : QStringList();
-  QStringList shown;
-  for (int i = 0; i < fieldChoice_->count(); ++i) shown << fieldChoice_->itemText(i);
-  if (shown != fields) {
-    fieldChoice_->clear();
-    fieldChoice_->addItems(fields);
-  }
+  setItems(fieldChoice_, fields);
   fieldChoice_->setCurrentIndex(fields.indexOf(context_.hasScene() ? context_.volumeField() : QString()));
   fieldRow_->setVisible(fields.size() > 1);
   const bool loading = context_.hasScene() && context_.volumeFieldLoading();

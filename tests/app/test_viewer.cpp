@@ -299,6 +299,18 @@ class ViewerTest : public QObject {
   }
 
  private:
+  // The view at `size`, abuffer-ll from the scene's "iso" view, settled and drawn without error.
+  static bool showAbufferIso(MainWindow& w, QSize size) {
+    ViewerModel& m = w.model();
+    w.view().setFixedSize(size);
+    if (!QTest::qWaitFor([&] { return m.renderSize() == size; }, kTimeoutMs)) return false;
+    m.setMethod("abuffer-ll");
+    m.setCamera(m.scene().view("iso"));
+    settle(m);
+    if (!m.renderError().isEmpty()) qWarning("render error: %s", qPrintable(m.renderError()));
+    return m.renderError().isEmpty();
+  }
+
   std::unique_ptr<MainWindow> openWindow(const QString& scene = QStringLiteral("@sample")) {
     auto w = std::make_unique<MainWindow>(MainWindow::Options{.restoreSettings = false, .loadPlugins = true});
     w->resize(1100, 700);
@@ -2559,12 +2571,7 @@ class ViewerTest : public QObject {
     QVERIFY(w);
     ViewerModel& m = w->model();
     const QSize size(160, 120);
-    w->view().setFixedSize(size);
-    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), size, kTimeoutMs);
-    m.setMethod("abuffer-ll");
-    m.setCamera(m.scene().view("iso"));
-    settle(m);
-    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    QVERIFY(showAbufferIso(*w, size));
     auto* choice = w->findChild<QComboBox*>("hvVolume");
     auto* show = w->findChild<QCheckBox*>("hvShow");
     auto* preset = w->findChild<QComboBox*>("hvPreset");
@@ -2688,12 +2695,7 @@ class ViewerTest : public QObject {
     QVERIFY(w);
     ViewerModel& m = w->model();
     const QSize size(160, 120);
-    w->view().setFixedSize(size);
-    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), size, kTimeoutMs);
-    m.setMethod("abuffer-ll");
-    m.setCamera(m.scene().view("iso"));
-    settle(m);
-    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    QVERIFY(showAbufferIso(*w, size));
     auto* field = w->findChild<QComboBox*>("hvField");
     auto* fieldNote = w->findChild<QLabel*>("hvFieldNote");
     auto* info = w->findChild<QLabel*>("hvInfo");
