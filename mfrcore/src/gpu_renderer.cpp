@@ -235,6 +235,8 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
     stats.notes.emplace_back("volumes", std::to_string(volumes_.size()));
     stats.notes.emplace_back("volume (bytes)", std::to_string(bytes));
     stats.notes.emplace_back("volume shading", volumeShadingNote(drawnVolumes_));
+    if (const std::string fields = volumeFieldsNote(drawnVolumes_); !fields.empty())
+      stats.notes.emplace_back("volume fields", fields);
   } else if (!volumes_.empty()) {
     stats.notes.emplace_back("volume", "not drawn (operation " + operation_ + ")");
   }

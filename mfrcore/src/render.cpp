@@ -61,6 +61,16 @@ std::string volumeShadingNote(std::span<const Volume> volumes) {
   return on == 0 ? "off" : on == volumes.size() ? "on" : std::to_string(on) + " of " + std::to_string(volumes.size());
 }
 
+std::string volumeFieldsNote(std::span<const Volume> volumes) {
+  std::string note;
+  bool named = false;
+  for (const Volume& v : volumes) {
+    note += (note.empty() ? "" : ", ") + (v.field.empty() ? std::string("-") : v.field);
+    named = named || !v.field.empty();
+  }
+  return named ? note : std::string();
+}
+
 std::vector<Volume> volumesAsRequested(const RenderRequest& request, const Scene& scene) {
   std::vector<Volume> volumes = scene.visibleVolumes();
   for (Volume& v : volumes) v = volumeAsRequested(request, v);
@@ -221,6 +231,8 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     out.stats.notes.emplace_back("volume step", std::to_string(step));
     out.stats.notes.emplace_back("volumes", std::to_string(drawn.size()));
     out.stats.notes.emplace_back("volume shading", volumeShadingNote(drawn));
+    if (const std::string fields = volumeFieldsNote(drawn); !fields.empty())
+      out.stats.notes.emplace_back("volume fields", fields);
   } else if (operation == "zthickness") {
     const double thickness = zThicknessOf(request, scene.bounds());
     out.image = compositeZThickness(lists, camera, thickness, scene.background);

@@ -152,7 +152,15 @@ TEST_F(CliVolume, FieldChoosesTheArray) {
   ASSERT_EQ(runCli(common + byDefault.string()).exitCode, 0);
   ASSERT_EQ(runCli(common + ramp.string() + " --field ramp").exitCode, 0);
   ASSERT_EQ(runCli(common + dip.string() + " --field dip").exitCode, 0);
-  ASSERT_EQ(runCli(common + dipGpu.string() + " --field dip -m abuffer-ll").exitCode, 0);
+  const fs::path stats = dir() / "stats.json", oracleStats = dir() / "oracle-stats.json";
+  ASSERT_EQ(runCli(common + dipGpu.string() + " --field dip -m abuffer-ll --stats " + stats.string()).exitCode, 0);
+  // The stats say which field was drawn (GPU and oracle alike).
+  ASSERT_EQ(runCli(common + dir().string() + "/o.png --field dip --stats " + oracleStats.string()).exitCode, 0);
+  for (const fs::path& file : {stats, oracleStats}) {
+    std::ifstream statsIn(file);
+    const nlohmann::json s = nlohmann::json::parse(statsIn);
+    EXPECT_EQ(s["notes"]["volume fields"], "dip") << file;
+  }
   EXPECT_EQ(rmseOf(byDefault, ramp), 0.0);
   EXPECT_GT(rmseOf(ramp, dip), 0.02);
   EXPECT_LT(rmseOf(dip, dipGpu), 0.01);

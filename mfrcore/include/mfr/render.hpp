@@ -57,6 +57,9 @@ Volume volumeAsRequested(const RenderRequest& request, const Volume& volume);
 std::vector<Volume> volumesAsRequested(const RenderRequest& request, const Scene& scene);
 // The statistics note "volume shading": "on", "off", or "N of M" when only some volumes are shaded.
 std::string volumeShadingNote(std::span<const Volume> volumes);
+// The statistics note "volume fields": each volume's Volume::field in order, comma-separated ("-"
+// for one without); empty (no note) when none has a named field.
+std::string volumeFieldsNote(std::span<const Volume> volumes);
 // What a request's operation means for a method (info; nullptr: the oracle) on a scene with or
 // without a visible volume: "auto" is the method's preferredOperation, except that a scene with a
 // volume gets "volume" from every method that prefers "oit" and resolves sorted lists.
