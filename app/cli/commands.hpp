@@ -52,6 +52,9 @@ inline constexpr const char* kSectionHelp =
     "Section plane: AXIS=VALUE (x, y, z, -x, -y, -z; keeps the side the axis points to) or "
     "px,py,pz,nx,ny,nz (point, normal of the kept side), optionally :nocaps; closed surfaces get caps; "
     "'none' removes the scene's own";
+// --thickness (operation zthickness) as given: 0 when absent (the scene's default); throws
+// mfr::Error naming --thickness for a given value that is not a positive finite length.
+double thicknessOption(const CLI::Option& option, double value);
 // The whole text as a finite number, or nothing ("1.5" yes; "1.5x", "", "nan", "inf" no).
 std::optional<double> parseNumber(const std::string& text);
 // "name" or "name:key=value:key=value" → request of w×h (a method run with several settings);

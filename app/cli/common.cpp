@@ -50,6 +50,12 @@ std::vector<Scene> loadScenesWithViews(const std::vector<std::string>& paths, do
   return scenes;
 }
 
+double thicknessOption(const CLI::Option& option, double value) {
+  if (option.count() == 0) return 0.0;
+  if (!(value > 0.0 && std::isfinite(value))) throw Error("--thickness", "must be a positive length in scene units");
+  return value;
+}
+
 std::optional<double> parseNumber(const std::string& text) {
   std::size_t used = 0;
   double v = 0;

@@ -70,7 +70,7 @@ void addProbe(CLI::App& app) {
                   "The method's operation, as for render (auto: hybrid for fkb, vkb, dkb, else oit). With hybrid, "
                   "each fragment's share under the method's split: the held ones the core, the rest the tail")
       ->capture_default_str();
-  CLI::Option* thicknessOption =
+  CLI::Option* thicknessGiven =
       cmd->add_option("--thickness", opt->thickness,
                       "Operation zthickness: slab thickness in scene units (default: 1 % of the scene's diagonal)");
   cmd->add_option("--json", opt->json, "Also write the probe as JSON");
@@ -78,7 +78,7 @@ void addProbe(CLI::App& app) {
   cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
-  cmd->callback([opt, thicknessOption] {
+  cmd->callback([opt, thicknessGiven] {
     const auto [w, h] = parseSize("--size", opt->size);
     validateImageSize("--size", w, h);
     const auto [x, y] = parsePixel(opt->pixel);
@@ -102,9 +102,7 @@ void addProbe(CLI::App& app) {
     }
     validateOperation(opt->op);
     req.operation = opt->op;
-    if (thicknessOption->count() > 0 && !(opt->thickness > 0.0 && std::isfinite(opt->thickness)))
-      throw Error("--thickness", "must be a positive length in scene units");
-    req.thickness = opt->thickness;
+    req.thickness = thicknessOption(*thicknessGiven, opt->thickness);
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);

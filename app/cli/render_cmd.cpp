@@ -32,7 +32,7 @@ void addRender(CLI::App& app) {
                   "volume (the scene's volume ray-marched between the sorted surfaces; auto picks it for a scene "
                   "with a volume; oracle, A-buffers, k-buffers)")
       ->capture_default_str();
-  CLI::Option* thicknessOption =
+  CLI::Option* thicknessGiven =
       cmd->add_option("--thickness", opt->thickness,
                       "Operation zthickness: slab thickness in scene units (default: 1 % of the scene's diagonal)");
   CLI::Option* stepOption = cmd->add_option(
@@ -50,16 +50,14 @@ void addRender(CLI::App& app) {
   cmd->add_option("--stats", opt->stats, "Write Stats as JSON to this file");
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1): see through opaque CAD parts")
       ->check(CLI::Range(0.0, 1.0));
-  cmd->callback([opt, thicknessOption, stepOption] {
+  cmd->callback([opt, thicknessGiven, stepOption] {
     const auto [w, h] = parseSize("--size", opt->size);
     RenderRequest req;
     req.method = opt->method;
     req.operation = opt->op;
     req.width = w;
     req.height = h;
-    if (thicknessOption->count() > 0 && !(opt->thickness > 0.0 && std::isfinite(opt->thickness)))
-      throw Error("--thickness", "must be a positive length in scene units");
-    req.thickness = opt->thickness;
+    req.thickness = thicknessOption(*thicknessGiven, opt->thickness);
     if (stepOption->count() > 0 && !(opt->step > 0.0 && std::isfinite(opt->step)))
       throw Error("--step", "must be a positive length in scene units");
     req.volumeStep = opt->step;

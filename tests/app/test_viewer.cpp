@@ -299,6 +299,14 @@ class ViewerTest : public QObject {
   }
 
  private:
+  // The sum of a Probe dock column's "N %" cells (fragments and background).
+  static double columnPercent(const QTableWidget& table, int column) {
+    double total = 0.0;
+    for (int i = 0; i < table.rowCount(); ++i)
+      total += table.item(i, column)->text().remove(QStringLiteral(" %")).toDouble();
+    return total;
+  }
+
   // The view at `size`, abuffer-ll from the scene's "iso" view, settled and drawn without error.
   static bool showAbufferIso(MainWindow& w, QSize size) {
     ViewerModel& m = w.model();
@@ -1143,8 +1151,7 @@ class ViewerTest : public QObject {
     QVERIFY2(match.hasMatch(), qPrintable(summary->text()));
     double total = match.captured(2).toDouble();
     QVERIFY2(total > 10.0, qPrintable(summary->text()));  // the ray crosses the medium
-    for (int i = 0; i < table->rowCount(); ++i)
-      total += table->item(i, ProbePanel::VolumeShare)->text().remove(QStringLiteral(" %")).toDouble();
+    total += columnPercent(*table, ProbePanel::VolumeShare);
     QVERIFY2(std::abs(total - 100.0) < 0.1 * table->rowCount() + 0.1, qPrintable(QString::number(total)));
     mfr::RenderRequest oracle;
     oracle.method = "oracle";
@@ -1181,8 +1188,7 @@ class ViewerTest : public QObject {
     QVERIFY(table->isColumnHidden(ProbePanel::VolumeShare));
     QVERIFY(table->rowCount() >= 3);  // two surfaces or more, and the background
     double total = 0.0;
-    for (int i = 0; i < table->rowCount(); ++i)
-      total += table->item(i, ProbePanel::ZThicknessShare)->text().remove(QStringLiteral(" %")).toDouble();
+    total += columnPercent(*table, ProbePanel::ZThicknessShare);
     QVERIFY2(std::abs(total - 100.0) < 0.1 * table->rowCount() + 0.1, qPrintable(QString::number(total)));
     const QRegularExpressionMatch match =
         QRegularExpression(QStringLiteral("(#[0-9a-f]{6}) with z-thickness")).match(summary->text());
