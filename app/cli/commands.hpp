@@ -52,6 +52,16 @@ inline constexpr const char* kSectionHelp =
     "Section plane: AXIS=VALUE (x, y, z, -x, -y, -z; keeps the side the axis points to) or "
     "px,py,pz,nx,ny,nz (point, normal of the kept side), optionally :nocaps; closed surfaces get caps; "
     "'none' removes the scene's own";
+// --color-by FIELD [--color-map NAME] [--color-range LO,HI]: colour every part whose mesh has the
+// field by it (colorByField) — before any section, so that caps get the field too.
+struct ColorByOptions {
+  std::string field, map, range;
+  void add(CLI::App* cmd);
+  // Throws mfr::Error naming the option: a map or range without --color-by, an unknown map, a bad
+  // range, or a field no part has (listing the fields there are).
+  void apply(Scene& scene) const;
+};
+
 // --thickness (operation zthickness) as given: 0 when absent (the scene's default); throws
 // mfr::Error naming --thickness for a given value that is not a positive finite length.
 double thicknessOption(const CLI::Option& option, double value);

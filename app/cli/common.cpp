@@ -9,6 +9,7 @@
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/render.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "mfr/scene/section.hpp"
 
 namespace mfr::cli {
@@ -204,6 +205,49 @@ void applyClipOption(Scene& scene, const std::string& text) {
   if (!ok) throw Error("--clip " + text, "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax (or none)");
   if (!box.valid()) throw Error("--clip " + text, "min must not exceed max on any axis");
   scene.clipBox = box;
+}
+
+void ColorByOptions::add(CLI::App* cmd) {
+  std::string maps;
+  for (const std::string& n : colorMapNames()) maps += (maps.empty() ? "" : ", ") + n;
+  cmd->add_option("--color-by", field,
+                  "Colour every part that has this point-data or cell-data array by it (name, name:N for a "
+                  "component, name:magnitude; see mfr info for the fields)");
+  cmd->add_option("--color-map", map, "Colour map of --color-by: " + maps + " (default cool-warm)");
+  cmd->add_option("--color-range", range, "Values at the ends of the colour map LO,HI (default: the field's range)");
+}
+
+void ColorByOptions::apply(Scene& scene) const {
+  if (field.empty()) {
+    if (!map.empty()) throw Error("--color-map " + map, "needs --color-by");
+    if (!range.empty()) throw Error("--color-range " + range, "needs --color-by");
+    return;
+  }
+  const std::string colourMap = map.empty() ? "cool-warm" : map;
+  const std::vector<std::string>& maps = colorMapNames();
+  if (std::find(maps.begin(), maps.end(), colourMap) == maps.end()) {
+    std::string list;
+    for (const std::string& n : maps) list += (list.empty() ? "" : ", ") + n;
+    throw Error("--color-map " + colourMap, "unknown colour map (available: " + list + ")");
+  }
+  std::optional<glm::dvec2> values;
+  if (!range.empty()) {
+    const std::vector<std::string> items = splitList(range);
+    std::optional<double> low, high;
+    if (items.size() == 2) {
+      low = parseNumber(items[0]);
+      high = parseNumber(items[1]);
+    }
+    if (!low || !high || !(*high > *low)) throw Error("--color-range " + range, "expected LO,HI with LO < HI");
+    values = glm::dvec2(*low, *high);
+  }
+  std::vector<Object*> objects;
+  for (Object& o : scene.objects) objects.push_back(&o);
+  try {
+    colorObjectsByField(objects, field, colourMap, values, scene.name);
+  } catch (const Error& e) {
+    throw Error("--color-by " + field, e.what());
+  }
 }
 
 namespace {

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
@@ -42,6 +43,17 @@ void addInfo(CLI::App& app) {
     j["triangles"] = scene.triangleCount();
     j["bounds"] = {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};
     j["views"] = scene.viewNames();
+    nlohmann::ordered_json parts = nlohmann::ordered_json::array();
+    for (const Object& o : scene.objects) {
+      nlohmann::ordered_json fields = nlohmann::ordered_json::array();
+      for (const std::string& f : fieldNames(*o.mesh)) {
+        const FieldValues v = fieldValues(*o.mesh, f, o.name);
+        const glm::dvec2 r = fieldRange(v.values);
+        fields.push_back({{"name", f}, {"cell_data", v.cellData}, {"range", {r.x, r.y}}});
+      }
+      parts.push_back({{"name", o.name}, {"triangles", o.mesh->triangleCount()}, {"fields", fields}});
+    }
+    j["part_list"] = parts;
     std::cout << "scene      " << scene.name << "\nparts      " << scene.objects.size() << "\ntriangles  "
               << scene.triangleCount() << "\nbounds     [" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – ["
               << b.max.x << ", " << b.max.y << ", " << b.max.z << "]\nviews     ";
@@ -53,6 +65,16 @@ void addInfo(CLI::App& app) {
       std::cout << "  part " << i << ": " << o.name << " (" << o.mesh->triangleCount() << " triangles, rgba "
                 << o.material.color.r << " " << o.material.color.g << " " << o.material.color.b << " "
                 << o.material.color.a << ")\n";
+      if (!o.mesh->fields.empty()) {
+        // What --color-by can use, with each field's range (cell data marked).
+        std::cout << "    fields:";
+        for (const std::string& f : fieldNames(*o.mesh)) {
+          const FieldValues v = fieldValues(*o.mesh, f, o.name);
+          const glm::dvec2 r = fieldRange(v.values);
+          std::cout << " " << f << (v.cellData ? " (cells)" : "") << " [" << r.x << ", " << r.y << "]";
+        }
+        std::cout << "\n";
+      }
     }
     if (shown < scene.objects.size()) std::cout << "  … " << scene.objects.size() - shown << " more parts\n";
     nlohmann::ordered_json volumes = nlohmann::ordered_json::array();

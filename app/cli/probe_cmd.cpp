@@ -52,6 +52,7 @@ int to8(float c) {
 
 void addProbe(CLI::App& app) {
   struct Options {
+    ColorByOptions colorBy;
     std::string scene, pixel, size = "512x512", view = "fit", method, op = "auto", json, clip, section, field;
     std::vector<std::string> params;
     double opacity = -1.0;
@@ -75,6 +76,7 @@ void addProbe(CLI::App& app) {
                       "Operation zthickness: slab thickness in scene units (default: 1 % of the scene's diagonal)");
   cmd->add_option("--json", opt->json, "Also write the probe as JSON");
   cmd->add_option("--clip", opt->clip, kClipHelp);
+  opt->colorBy.add(cmd);
   cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
@@ -104,6 +106,7 @@ void addProbe(CLI::App& app) {
     req.operation = opt->op;
     req.thickness = thicknessOption(*thicknessGiven, opt->thickness);
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
+    opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
     const Camera camera = scene.view(opt->view);

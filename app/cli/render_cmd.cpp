@@ -13,6 +13,7 @@ namespace mfr::cli {
 
 void addRender(CLI::App& app) {
   struct Options {
+    ColorByOptions colorBy;
     std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats, clip, section,
                        field;
     std::vector<std::string> params;
@@ -41,6 +42,7 @@ void addRender(CLI::App& app) {
                 "Operation volume: shade the volume by its gradient with a headlight (boundaries inside the medium "
                 "read as surfaces)");
   cmd->add_option("--clip", opt->clip, kClipHelp);
+  opt->colorBy.add(cmd);
   cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
@@ -67,6 +69,7 @@ void addRender(CLI::App& app) {
       req.params[p.substr(0, eq)] = p.substr(eq + 1);
     }
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
+    opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
     if (opt->shade) {

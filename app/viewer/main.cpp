@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <exception>
 #include <map>
+#include <optional>
 
 #include "main_window.hpp"
 #include "mfr/scene/scene.hpp"
@@ -26,6 +27,8 @@ struct CommandLine {
   QString scene = QStringLiteral("@sample");
   QString session, screenshot, windowScreenshot, view, method, op;
   QString field;                                  // --field: the array or grid of a volume file
+  QString colorBy, colorMap;                      // --color-by, --color-map: surfaces coloured by a field
+  std::optional<glm::dvec2> colorRange;           // --color-range
   std::map<QString, QJsonObject> pluginSettings;  // by plugin id
   QSize size{800, 600}, windowSize;
   std::map<std::string, std::string> params;
@@ -71,6 +74,16 @@ CommandLine parseCommandLine(const QApplication& app) {
       QStringLiteral("field"),
       QStringLiteral("Volume file: the point-data array (.vti, .vtk) or grid (.vdb) to read instead of the default."),
       QStringLiteral("name"));
+  const QCommandLineOption colorBy(
+      QStringLiteral("color-by"),
+      QStringLiteral("Colour every part that has this point-data or cell-data array by it (as mfr render)."),
+      QStringLiteral("field"));
+  const QCommandLineOption colorMap(QStringLiteral("color-map"),
+                                    QStringLiteral("Colour map of --color-by (default cool-warm)."),
+                                    QStringLiteral("name"));
+  const QCommandLineOption colorRange(
+      QStringLiteral("color-range"),
+      QStringLiteral("Values at the ends of the colour map (default: the field's range)."), QStringLiteral("lo,hi"));
   const QCommandLineOption param({QStringLiteral("p"), QStringLiteral("param")}, QStringLiteral("Method parameter (repeatable)."), QStringLiteral("name=value"));
   const QCommandLineOption view(QStringLiteral("view"), QStringLiteral("Named view of the scene, or 'fit'."), QStringLiteral("name"));
   const QCommandLineOption size({QStringLiteral("s"), QStringLiteral("size")}, QStringLiteral("Image size for --screenshot (default 800x600)."), QStringLiteral("WxH"));
@@ -80,8 +93,8 @@ CommandLine parseCommandLine(const QApplication& app) {
   const QCommandLineOption pluginSettings(QStringLiteral("plugin-settings"),
                                          QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
                                          QStringLiteral("id={json}"));
-  parser.addOptions({method, op, thickness, step, field, param, view, size, screenshot, windowScreenshot, windowSize,
-                     pluginSettings});
+  parser.addOptions({method, op, thickness, step, field, colorBy, colorMap, colorRange, param, view, size, screenshot,
+                     windowScreenshot, windowSize, pluginSettings});
   parser.process(app);
 
   CommandLine cl;
@@ -107,6 +120,19 @@ CommandLine parseCommandLine(const QApplication& app) {
     fail(QStringLiteral("--field: expected the name of an array or grid"), 2);
   if (!cl.field.isEmpty() && !cl.session.isEmpty())
     fail(QStringLiteral("--field %1: a session keeps its volumes' own fields").arg(cl.field), 2);
+  cl.colorBy = parser.value(colorBy);
+  cl.colorMap = parser.value(colorMap);
+  if ((parser.isSet(colorMap) || parser.isSet(colorRange)) && cl.colorBy.isEmpty())
+    fail(QStringLiteral("--%1: needs --color-by").arg(parser.isSet(colorMap) ? "color-map" : "color-range"), 2);
+  if (parser.isSet(colorRange)) {
+    const QStringList ends = parser.value(colorRange).split(QLatin1Char(','));
+    bool okLow = false, okHigh = false;
+    const double low = ends.size() == 2 ? ends[0].toDouble(&okLow) : 0.0;
+    const double high = ends.size() == 2 ? ends[1].toDouble(&okHigh) : 0.0;
+    if (!okLow || !okHigh || !std::isfinite(low) || !std::isfinite(high) || !(high > low))
+      fail(QStringLiteral("--color-range %1: expected LO,HI with LO < HI").arg(parser.value(colorRange)), 2);
+    cl.colorRange = glm::dvec2(low, high);
+  }
   cl.view = parser.value(view);
   cl.screenshot = parser.value(screenshot);
   cl.windowScreenshot = parser.value(windowScreenshot);
@@ -163,6 +189,13 @@ int main(int argc, char** argv) {
     // A new scene starts at the default thickness (scene units): --thickness applies to this one.
     if (cl.thickness > 0.0) model.setZThickness(cl.thickness);
     if (cl.step > 0.0) model.setVolumeStep(cl.step);  // likewise the volume step
+    if (!cl.colorBy.isEmpty() &&
+        !model.setFieldColoring(cl.colorBy, cl.colorMap.isEmpty() ? QStringLiteral("cool-warm") : cl.colorMap,
+                                cl.colorRange)) {
+      const QString message = QStringLiteral("--color-by %1: %2").arg(cl.colorBy, model.fieldColoringError());
+      if (scripted) fail(message, 1);
+      window.statusBar()->showMessage(message);
+    }
     if (!cl.view.isEmpty()) {
       try {
         model.setCamera(model.scene().view(cl.view.toStdString()));

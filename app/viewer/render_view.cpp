@@ -598,6 +598,11 @@ void RenderView::updateOverlays() {
         legend->setMap(title, std::max<std::uint32_t>(1, map.maxValue),
                        tr("min %1 · max %2").arg(map.minValue).arg(map.maxValue));
       legendShown = true;
+    } else if (const std::optional<mfr::FieldColors> field = model_.fieldColoring(); shown && field) {
+      // The colour legend of the field the surfaces show (Scene dock, Colour by).
+      legend->setFieldMap(QString::fromStdString(field->field), QString::fromStdString(field->map), field->range.x,
+                          field->range.y, QString::fromStdString(field->map));
+      legendShown = true;
     }
     if (legendShown) {
       const int x = split && side == 1 ? area.right() - legend->width() - 6 : area.left() + 6;

@@ -1,9 +1,14 @@
 #include "scene_tree_panel.hpp"
 
 #include <QColorDialog>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QGridLayout>
 #include <QHeaderView>
+#include <QLabel>
 #include <QMenu>
 #include <QPixmap>
+#include <QPushButton>
 #include <QTreeWidget>
 #include <QVBoxLayout>
 
@@ -12,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "mfr/scene/color_map.hpp"
 #include "viewer_model.hpp"
 
 namespace {
@@ -25,6 +31,7 @@ QColor colourOf(const mfr::Object& o) {
 // The colour column's text: the colour's name, or "file colours" while the mesh's per-vertex colours
 // show (multiplied by the swatch's colour, white for molecules).
 QString colourText(const mfr::Object& o) {
+  if (o.material.fieldColors) return QString::fromStdString(o.material.fieldColors->field);
   const bool perVertex = o.material.vertexColors && o.mesh && !o.mesh->colors.empty();
   return perVertex ? QObject::tr("file colours") : colourOf(o).name();
 }
@@ -40,6 +47,48 @@ QIcon swatch(const QColor& colour) {
 SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(parent), model_(model) {
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
+  // Colour by a field (mfr::colorObjectsByField): ParaView's "Color by", map and range.
+  fieldRow_ = new QWidget;
+  auto* fields = new QGridLayout(fieldRow_);
+  fields->setContentsMargins(4, 4, 4, 0);
+  colorBy_ = new QComboBox;
+  colorBy_->setObjectName(QStringLiteral("colorByField"));
+  colorBy_->setToolTip(tr("Colour every part that has this point-data or cell-data array by it"));
+  colorMap_ = new QComboBox;
+  colorMap_->setObjectName(QStringLiteral("colorByMap"));
+  for (const std::string& name : mfr::colorMapNames()) colorMap_->addItem(QString::fromStdString(name));
+  rangeLow_ = new QDoubleSpinBox;
+  rangeHigh_ = new QDoubleSpinBox;
+  rangeLow_->setObjectName(QStringLiteral("colorRangeLow"));
+  rangeHigh_->setObjectName(QStringLiteral("colorRangeHigh"));
+  for (QDoubleSpinBox* box : {rangeLow_, rangeHigh_}) {
+    box->setRange(-1e30, 1e30);
+    box->setDecimals(6);
+    box->setKeyboardTracking(false);
+    box->setToolTip(tr("The values at the ends of the colour map (values outside get the end colours)"));
+  }
+  dataRange_ = new QPushButton(tr("Data Range"));
+  dataRange_->setObjectName(QStringLiteral("colorRangeReset"));
+  dataRange_->setToolTip(tr("Map the field's smallest and largest value (over every part that has it) to the ends"));
+  fieldNote_ = new QLabel;
+  fieldNote_->setObjectName(QStringLiteral("colorByNote"));
+  fieldNote_->setWordWrap(true);
+  fields->addWidget(new QLabel(tr("Colour by")), 0, 0);
+  fields->addWidget(colorBy_, 0, 1);
+  fields->addWidget(colorMap_, 0, 2, 1, 2);
+  fields->addWidget(new QLabel(tr("Range")), 1, 0);
+  fields->addWidget(rangeLow_, 1, 1);
+  fields->addWidget(rangeHigh_, 1, 2);
+  fields->addWidget(dataRange_, 1, 3);
+  fields->addWidget(fieldNote_, 2, 0, 1, 4);
+  fields->setColumnStretch(1, 1);
+  fields->setColumnStretch(2, 1);
+  layout->addWidget(fieldRow_);
+  connect(colorBy_, &QComboBox::activated, this, [this] { applyFieldColoring(true); });
+  connect(colorMap_, &QComboBox::activated, this, [this] { applyFieldColoring(false); });
+  connect(rangeLow_, &QDoubleSpinBox::valueChanged, this, [this] { applyFieldColoring(false); });
+  connect(rangeHigh_, &QDoubleSpinBox::valueChanged, this, [this] { applyFieldColoring(false); });
+  connect(dataRange_, &QPushButton::clicked, this, [this] { applyFieldColoring(true); });
   tree_ = new QTreeWidget;
   tree_->setObjectName(QStringLiteral("sceneTree"));
   tree_->setColumnCount(4);
@@ -92,7 +141,38 @@ QString SceneTreePanel::gridText(const mfr::Volume& volume) {
   return QStringLiteral("%1×%2×%3").arg(d.x).arg(d.y).arg(d.z);
 }
 
+void SceneTreePanel::showFieldColoring() {
+  const QStringList fields = model_.surfaceFields();
+  fieldRow_->setVisible(!fields.isEmpty());
+  const std::optional<mfr::FieldColors> shown = model_.fieldColoring();
+  const QSignalBlocker blockField(colorBy_), blockMap(colorMap_), blockLow(rangeLow_), blockHigh(rangeHigh_);
+  if (colorBy_->count() != fields.size() + 1) {
+    colorBy_->clear();
+    colorBy_->addItem(tr("Part colours"), QString());
+    for (const QString& f : fields) colorBy_->addItem(f, f);
+  }
+  colorBy_->setCurrentIndex(shown ? std::max(0, colorBy_->findData(QString::fromStdString(shown->field))) : 0);
+  if (shown) {
+    colorMap_->setCurrentText(QString::fromStdString(shown->map));
+    rangeLow_->setValue(shown->range.x);
+    rangeHigh_->setValue(shown->range.y);
+  }
+  for (QWidget* w : std::initializer_list<QWidget*>{colorMap_, rangeLow_, rangeHigh_, dataRange_})
+    w->setEnabled(shown.has_value());
+  fieldNote_->setText(model_.fieldColoringError());
+  fieldNote_->setVisible(!model_.fieldColoringError().isEmpty());
+}
+
+void SceneTreePanel::applyFieldColoring(bool dataRange) {
+  const QString field = colorBy_->currentData().toString();
+  std::optional<glm::dvec2> range;
+  if (!dataRange && !field.isEmpty()) range = glm::dvec2(rangeLow_->value(), rangeHigh_->value());
+  model_.setFieldColoring(field, colorMap_->currentText(), range);
+  showFieldColoring();  // the range picked, or the refusal
+}
+
 void SceneTreePanel::showValues() {
+  showFieldColoring();
   const auto& objects = model_.scene().objects;
   const auto& volumes = model_.scene().volumes;
   if (tree_->topLevelItemCount() != static_cast<int>(objects.size() + volumes.size())) return;
@@ -119,6 +199,8 @@ void SceneTreePanel::showValues() {
 
 void SceneTreePanel::rebuild() {
   rebuilding_ = true;
+  colorBy_->clear();  // another scene: its own fields
+  showFieldColoring();
   tree_->clear();
   const auto& objects = model_.scene().objects;
   QList<QTreeWidgetItem*> items;

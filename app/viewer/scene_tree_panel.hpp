@@ -1,12 +1,18 @@
 #pragma once
 // The scene dock: one row per object with a visibility check box, a colour swatch (click to
-// change) and an editable opacity, then one row per volume (name, grid size, visibility).
+// change) and an editable opacity, then one row per volume (name, grid size, visibility). Above
+// them, for parts with data arrays: Colour by (a field, or the parts' own colours), the colour map
+// and the range mapped to its ends.
 #include <QWidget>
 
 #include <cstddef>
 
 #include "mfr/scene/volume.hpp"
 
+class QComboBox;
+class QDoubleSpinBox;
+class QLabel;
+class QPushButton;
 class QTreeWidget;
 class QTreeWidgetItem;
 class ViewerModel;
@@ -25,8 +31,17 @@ class SceneTreePanel final : public QWidget {
   static QString gridText(const mfr::Volume& volume);
   void itemChanged(QTreeWidgetItem* item, int column);
   void itemClicked(QTreeWidgetItem* item, int column);
+  void showFieldColoring();                 // the model's colouring in the Colour-by controls
+  void applyFieldColoring(bool dataRange);  // the controls' colouring to the model
 
   ViewerModel& model_;
   QTreeWidget* tree_ = nullptr;
+  QWidget* fieldRow_ = nullptr;  // hidden when no part has a field
+  QComboBox* colorBy_ = nullptr;
+  QComboBox* colorMap_ = nullptr;
+  QDoubleSpinBox* rangeLow_ = nullptr;
+  QDoubleSpinBox* rangeHigh_ = nullptr;
+  QPushButton* dataRange_ = nullptr;
+  QLabel* fieldNote_ = nullptr;
   bool rebuilding_ = false;
 };

@@ -106,6 +106,8 @@ Session captureSession(const ViewerModel& model) {
   s.clip = model.clipBox();
   s.hasSection = true;
   s.section = model.section();
+  s.hasColorBy = true;
+  s.colorBy = model.fieldColoring();
   for (const mfr::Volume& v : model.scene().volumes)
     s.volumes.push_back(
         {QString::fromStdString(v.name), v.visible, v.transfer, v.shading, QString::fromStdString(v.field)});
@@ -138,6 +140,10 @@ void applySession(const Session& session, ViewerModel& model) {
   model.setZThickness(session.thickness);
   if (session.hasClip) model.setClipBox(session.clip);
   if (session.hasSection) model.setSection(session.section);
+  if (session.hasColorBy)
+    model.setFieldColoring(session.colorBy ? QString::fromStdString(session.colorBy->field) : QString(),
+                           session.colorBy ? QString::fromStdString(session.colorBy->map) : QString(),
+                           session.colorBy ? std::optional<glm::dvec2>(session.colorBy->range) : std::nullopt);
   if (session.volumes.size() == model.scene().volumes.size())
     for (std::size_t i = 0; i < session.volumes.size(); ++i) {
       const Session::VolumeState& v = session.volumes[i];
@@ -218,7 +224,11 @@ QJsonObject sessionToJson(const Session& s) {
                                   {"point", QJsonArray{s.section->point.x, s.section->point.y, s.section->point.z}},
                                   {"normal", QJsonArray{s.section->normal.x, s.section->normal.y, s.section->normal.z}},
                                   {"caps", s.section->caps}})
-                            : QJsonValue(QJsonValue::Null)}};
+                            : QJsonValue(QJsonValue::Null)},
+      {"color_by", s.colorBy ? QJsonValue(QJsonObject{{"field", QString::fromStdString(s.colorBy->field)},
+                                                      {"map", QString::fromStdString(s.colorBy->map)},
+                                                      {"range", QJsonArray{s.colorBy->range.x, s.colorBy->range.y}}})
+                             : QJsonValue(QJsonValue::Null)}};
 }
 
 Session sessionFromJson(const QJsonObject& json, const QString& file) {
@@ -281,6 +291,20 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
         r.fail(QStringLiteral("section"), QStringLiteral("caps: expected true or false"));
       plane.caps = section.value("caps").toBool(true);
       s.section = plane;
+    }
+  }
+  if (json.contains("color_by")) {
+    s.hasColorBy = true;
+    if (!json.value("color_by").isNull()) {
+      const QJsonObject c = json.value("color_by").toObject();
+      const QJsonArray range = c.value("range").toArray();
+      if (!json.value("color_by").isObject() || !c.value("field").isString() || c.value("field").toString().isEmpty() ||
+          !c.value("map").isString() || range.size() != 2 || !range[0].isDouble() || !range[1].isDouble() ||
+          !(range[1].toDouble() > range[0].toDouble()))
+        r.fail(QStringLiteral("color_by"), QStringLiteral("expected null or {field, map, range: [low, high]}"));
+      s.colorBy = mfr::FieldColors{c.value("field").toString().toStdString(),
+                                   c.value("map").toString().toStdString(),
+                                   {range[0].toDouble(), range[1].toDouble()}};
     }
   }
   const QJsonArray volumes = json.value("volumes").toArray();

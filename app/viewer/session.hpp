@@ -36,6 +36,10 @@ struct Session {
   // (an older session), so the scene keeps its own.
   bool hasSection = false;
   std::optional<mfr::SectionPlane> section;
+  // Surfaces coloured by a field ("color_by": null or {field, map, range}); hasColorBy false: no key
+  // (an older session), so the scene keeps its own colouring.
+  bool hasColorBy = false;
+  std::optional<mfr::FieldColors> colorBy;
   struct VolumeState {
     QString name;
     bool visible = true;

@@ -5,6 +5,7 @@
 #include <QPainter>
 
 #include "mfr/reference/metrics.hpp"
+#include "mfr/scene/color_map.hpp"
 
 namespace {
 
@@ -22,6 +23,20 @@ QLinearGradient magmaGradient(QPointF from, QPointF to) {
   }
   const std::uint8_t* last = ramp.at(255, 0);
   gradient.setColorAt(1.0, QColor(last[0], last[1], last[2]));
+  return gradient;
+}
+
+// A surface colour map's table (mfr::colorMap) as gradient stops.
+QLinearGradient fieldGradient(const std::string& name, QPointF from, QPointF to) {
+  const mfr::ColorMap& map = mfr::colorMap(name);
+  QLinearGradient gradient(from, to);
+  const auto last = static_cast<int>(map.table.size()) - 1;
+  for (int i = 0; i <= last; i += 15) {
+    const glm::vec3 c = map.table[static_cast<std::size_t>(i)];
+    gradient.setColorAt(static_cast<double>(i) / last, QColor::fromRgbF(c.r, c.g, c.b));
+  }
+  const glm::vec3 c = map.table.back();
+  gradient.setColorAt(1.0, QColor::fromRgbF(c.r, c.g, c.b));
   return gradient;
 }
 
@@ -45,7 +60,20 @@ MapLegend::MapLegend(QWidget* parent) : QWidget(parent) {
 void MapLegend::setMap(const QString& title, double scaleMax, const QString& range) {
   title_ = title;
   text_ = range;
+  scaleMin_ = 0.0;
   scaleMax_ = scaleMax;
+  map_.clear();
+  bar_ = true;
+  resize(sizeHint());
+  update();
+}
+
+void MapLegend::setFieldMap(const QString& title, const QString& map, double low, double high, const QString& text) {
+  title_ = title;
+  text_ = text;
+  scaleMin_ = low;
+  scaleMax_ = high;
+  map_ = map;
   bar_ = true;
   resize(sizeHint());
   update();
@@ -74,10 +102,12 @@ void MapLegend::paintEvent(QPaintEvent*) {
   y += fm.height() + 2;
   if (bar_) {
     const QRect bar(8, y, width() - 16, 12);
-    p.fillRect(bar, magmaGradient(bar.topLeft(), bar.topRight()));
+    p.fillRect(bar, map_.isEmpty() ? magmaGradient(bar.topLeft(), bar.topRight())
+                                   : fieldGradient(map_.toStdString(), bar.topLeft(), bar.topRight()));
     p.drawRect(bar.adjusted(0, 0, -1, -1));
     y += 14;
-    p.drawText(QRect(8, y, width() - 16, fm.height()), Qt::AlignLeft | Qt::AlignVCenter, QStringLiteral("0"));
+    p.drawText(QRect(8, y, width() - 16, fm.height()), Qt::AlignLeft | Qt::AlignVCenter,
+               QString::number(scaleMin_, 'g', 4));
     p.drawText(QRect(8, y, width() - 16, fm.height()), Qt::AlignRight | Qt::AlignVCenter,
                QString::number(scaleMax_, 'g', 4));
     y += fm.height();

@@ -5,8 +5,8 @@
 #include <QLabel>
 #include <QWidget>
 
-// Colour bar of a heat map (the magma map of mfr::heatmap) with its title and value range, or
-// only a note (e.g. "no k(p) for this method").
+// Colour bar of a heat map (the magma map of mfr::heatmap) or of the colour map a field is shown
+// with, with its title and value range, or only a note (e.g. "no k(p) for this method").
 class MapLegend final : public QWidget {
   Q_OBJECT
 
@@ -15,6 +15,9 @@ class MapLegend final : public QWidget {
   // The bar spans 0 … scaleMax; `range` is the text under it (e.g. "min 0 · max 14").
   void setMap(const QString& title, double scaleMax, const QString& range);
   void setNote(const QString& title, const QString& note);
+  // The bar of a surface colour map (mfr::colorMap) from `low` to `high`: a field's colour legend.
+  void setFieldMap(const QString& title, const QString& map, double low, double high, const QString& text);
+  [[nodiscard]] const QString& mapName() const { return map_; }
   [[nodiscard]] const QString& title() const { return title_; }
   [[nodiscard]] const QString& text() const { return text_; }
   [[nodiscard]] QSize sizeHint() const override;
@@ -24,7 +27,8 @@ class MapLegend final : public QWidget {
 
  private:
   QString title_, text_;
-  double scaleMax_ = 1.0;
+  double scaleMin_ = 0.0, scaleMax_ = 1.0;
+  QString map_;  // empty: magma (heat maps)
   bool bar_ = false;
 };
 

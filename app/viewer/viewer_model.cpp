@@ -14,6 +14,7 @@
 #include "mfr/methods/registry.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/oracle.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "mfr/scene/scene_file.hpp"
 
 namespace {
@@ -635,7 +636,12 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
   fieldLoad_.reset();
   fieldError_.clear();
   loadedMaterials_.clear();
-  for (const mfr::Object& o : scene_.objects) loadedMaterials_.push_back(o.material);
+  loadedMeshes_.clear();
+  for (const mfr::Object& o : scene_.objects) {
+    loadedMaterials_.push_back(o.material);
+    loadedMeshes_.push_back(o.mesh);
+  }
+  fieldColoringError_.clear();
   scenePath_ = path;
   hasScene_ = true;
   ++sceneRevision_;
@@ -784,6 +790,69 @@ void ViewerModel::setObjectMaterial(int index, const glm::vec4& rgba, bool verte
   material.color = rgba;
   material.vertexColors = vertexColors;
   sceneEdited();
+}
+
+// ---- field colours ------------------------------------------------------------------------
+
+QStringList ViewerModel::surfaceFields() const {
+  QStringList fields;
+  for (const std::shared_ptr<const mfr::Mesh>& mesh : loadedMeshes_)
+    if (mesh)
+      for (const std::string& f : mfr::fieldNames(*mesh))
+        if (!fields.contains(QString::fromStdString(f))) fields << QString::fromStdString(f);
+  return fields;
+}
+
+std::optional<mfr::FieldColors> ViewerModel::fieldColoring() const {
+  for (const mfr::Object& o : scene_.objects)
+    if (o.material.fieldColors) return o.material.fieldColors;
+  return std::nullopt;
+}
+
+glm::dvec2 ViewerModel::fieldDataRange(const QString& field) const {
+  // The range colorObjectsByField picks without one: colour copies of the loaded parts.
+  std::vector<mfr::Object> copies;
+  for (const std::shared_ptr<const mfr::Mesh>& mesh : loadedMeshes_)
+    if (mesh && mfr::hasField(*mesh, field.toStdString())) {
+      mfr::Object copy;
+      copy.mesh = mesh;
+      copies.push_back(std::move(copy));
+    }
+  std::vector<mfr::Object*> parts;
+  for (mfr::Object& o : copies) parts.push_back(&o);
+  try {
+    mfr::colorObjectsByField(parts, field.toStdString(), "cool-warm", std::nullopt, "");
+  } catch (const mfr::Error&) {
+    return {0.0, 1.0};
+  }
+  return parts.front()->material.fieldColors->range;
+}
+
+bool ViewerModel::setFieldColoring(const QString& field, const QString& map, const std::optional<glm::dvec2>& range) {
+  if (loadedMeshes_.size() != scene_.objects.size()) return false;
+  std::vector<mfr::Object> parts = scene_.objects;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    parts[i].mesh = loadedMeshes_[i];
+    parts[i].material.fieldColors.reset();
+  }
+  if (!field.isEmpty()) {
+    std::vector<mfr::Object*> pointers;
+    for (mfr::Object& o : parts) pointers.push_back(&o);
+    try {
+      mfr::colorObjectsByField(pointers, field.toStdString(), map.toStdString(), range, scene_.name);
+    } catch (const mfr::Error& e) {
+      fieldColoringError_ = QString::fromUtf8(e.what());
+      emit sceneChanged();  // panels show the refusal
+      return false;
+    }
+  }
+  fieldColoringError_.clear();
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    scene_.objects[i].mesh = parts[i].mesh;
+    scene_.objects[i].material.fieldColors = parts[i].material.fieldColors;
+  }
+  sceneEdited();
+  return true;
 }
 
 // ---- camera ------------------------------------------------------------------------------

@@ -227,6 +227,19 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] double loadedObjectOpacity(int index) const override;
   void setObjectMaterial(int index, const glm::vec4& rgba, bool vertexColors = true);
 
+  // Surfaces coloured by a field (ParaView's "Color by"; mfr::colorObjectsByField on the meshes as
+  // loaded): every part whose mesh has the field, one colour map, one range. The fields the parts
+  // have, in first-seen order; the colouring shown (that of the first coloured part); the field's
+  // range over the parts that have it.
+  [[nodiscard]] QStringList surfaceFields() const;
+  [[nodiscard]] std::optional<mfr::FieldColors> fieldColoring() const;
+  [[nodiscard]] glm::dvec2 fieldDataRange(const QString& field) const;
+  // An empty field: every part back to its own colour. No range: the field's data range. Returns
+  // false, leaving the scene as it was, when refused (fieldColoringError() says why).
+  bool setFieldColoring(const QString& field, const QString& map = QStringLiteral("cool-warm"),
+                        const std::optional<glm::dvec2>& range = std::nullopt);
+  [[nodiscard]] const QString& fieldColoringError() const { return fieldColoringError_; }
+
   // Camera: setCamera refits near/far around the visible objects, so navigation never clips.
   [[nodiscard]] const mfr::Camera& camera() const { return camera_; }
   void setCamera(const mfr::Camera& camera);
@@ -320,6 +333,9 @@ class ViewerModel final : public ViewerContext {
   mfr::SectionReport sectionReport_;
   QString sectionError_;
   std::vector<mfr::Material> loadedMaterials_;  // of scene_'s objects as loaded, for resetObjectColor
+  // scene_'s meshes as loaded: what setFieldColoring colours (not a mesh coloured before).
+  std::vector<std::shared_ptr<const mfr::Mesh>> loadedMeshes_;
+  QString fieldColoringError_;
   bool hasScene_ = false;
   QString scenePath_;
   quint64 sceneRevision_ = 0;

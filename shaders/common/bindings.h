@@ -8,6 +8,7 @@
 #define MFR_ATTR_POSITION 0
 #define MFR_ATTR_NORMAL 1
 #define MFR_ATTR_COLOR 2
+#define MFR_ATTR_SCALAR 3  // Mesh::scalars: the field a surface is coloured by (0 without one)
 
 // Uniform block with the per-frame camera
 #define MFR_UBO_FRAME 0
@@ -43,6 +44,11 @@
 // transfer-function table (RGBA32F, 1D) on MFR_TEX_VOLUME_TF + i, i < MFR_MAX_VOLUMES.
 #define MFR_TEX_VOLUME 4
 #define MFR_TEX_VOLUME_TF 8
+// Surfaces coloured by a field (common/color_map.glsl): every colour map's table, one row per map
+// (RGBA32F 2D, texelFetch), MFR_COLOR_MAP_SIZE entries evenly over the map's [0, 1] and then the
+// colour of NaN at x = MFR_COLOR_MAP_SIZE.
+#define MFR_TEX_COLOR_MAPS 12
+#define MFR_COLOR_MAP_SIZE 256
 
 // Invalid index / end of a linked list
 #define MFR_NIL 0xFFFFFFFFu

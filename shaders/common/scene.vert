@@ -1,11 +1,12 @@
 // [Multifragment rendering infrastructure — Vasilakis, Vardis, Papaioannou, "A Survey of Multifragment
 // Rendering", Computer Graphics Forum 39(2), 2020.] Scene vertex shader shared by every capture pass: world-space normal, material × vertex colour
-// (the material's alone when uVertexColors is 0), object id. Multifragment capture itself happens in each method's *.geom.frag.
+// (the material's alone when uVertexColors is 0), the field value a surface may be coloured by, object id. Multifragment capture itself happens in each method's *.geom.frag.
 #include "common/bindings.h"
 
 layout(location = MFR_ATTR_POSITION) in vec3 aPosition;
 layout(location = MFR_ATTR_NORMAL) in vec3 aNormal;
 layout(location = MFR_ATTR_COLOR) in vec4 aColor;
+layout(location = MFR_ATTR_SCALAR) in float aScalar;
 
 uniform mat4 uViewProj;
 uniform mat4 uModel;
@@ -20,6 +21,7 @@ out float gl_ClipDistance[6];
 
 out vec3 vNormal;
 out vec4 vColor;
+out float vScalar;  // mapped per fragment (common/color_map.glsl), after interpolation
 // Multi-pass methods compare a fragment's depth across programs (peeling, the nearest and
 // farthest passes, the tail runs): GLSL guarantees equal positions across programs only for an
 // invariant output.
@@ -28,6 +30,7 @@ invariant gl_Position;
 void main() {
   vNormal = uNormalMatrix * aNormal;
   vColor = uVertexColors != 0 ? uColor * aColor : uColor;
+  vScalar = aScalar;
   vec4 world = uModel * vec4(aPosition, 1.0);
   gl_Position = uViewProj * world;
   vec3 below = world.xyz - uClipMin, above = uClipMax - world.xyz;

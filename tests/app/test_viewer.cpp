@@ -2783,6 +2783,170 @@ class ViewerTest : public QObject {
              qPrintable(out));
   }
 
+  void colorByField() {
+    // A sheet with point data "pressure" (x + y²/4, −2 … 3) and cell data "zone" (1 left, 2 right).
+    QTemporaryDir dir;
+    {
+      constexpr int n = 9;
+      QString points, pressure, connectivity, offsets, zone;
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          const double x = -2.0 + 4.0 * i / (n - 1), y = -2.0 + 4.0 * j / (n - 1);
+          points += QStringLiteral("%1 %2 %3 ").arg(x).arg(y).arg(0.3 * std::sin(x));
+          pressure += QString::number(x + y * y / 4.0) + ' ';
+        }
+      int quads = 0;
+      for (int j = 0; j + 1 < n; ++j)
+        for (int i = 0; i + 1 < n; ++i) {
+          const int a = j * n + i;
+          connectivity += QStringLiteral("%1 %2 %3 %4 ").arg(a).arg(a + 1).arg(a + 1 + n).arg(a + n);
+          offsets += QString::number(4 * ++quads) + ' ';
+          zone += QString::number(i < (n - 1) / 2 ? 1 : 2) + ' ';
+        }
+      QFile f(dir.filePath("sheet.vtp"));
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(QStringLiteral("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" "
+                             "byte_order=\"LittleEndian\"><PolyData><Piece NumberOfPoints=\"%1\" NumberOfPolys=\"%2\">"
+                             "<PointData><DataArray type=\"Float32\" Name=\"pressure\" format=\"ascii\">%3</DataArray>"
+                             "</PointData><CellData><DataArray type=\"Int32\" Name=\"zone\" format=\"ascii\">%4"
+                             "</DataArray></CellData><Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" "
+                             "format=\"ascii\">%5</DataArray></Points><Polys><DataArray type=\"Int32\" "
+                             "Name=\"connectivity\" format=\"ascii\">%6</DataArray><DataArray type=\"Int32\" "
+                             "Name=\"offsets\" format=\"ascii\">%7</DataArray></Polys></Piece></PolyData></VTKFile>\n")
+                  .arg(n * n)
+                  .arg(quads)
+                  .arg(pressure, zone, points, connectivity, offsets)
+                  .toUtf8());
+    }
+    {
+      const QJsonObject sheet{{"file", "sheet.vtp"}, {"opacity", 0.7}};
+      const QJsonObject iso{{"name", "iso"}, {"eye", QJsonArray{1.0, -2.0, 4.0}}, {"fit", true}};
+      QFile f(dir.filePath("sheet.mfrscene"));
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(QJsonDocument(QJsonObject{{"objects", QJsonArray{sheet}}, {"views", QJsonArray{iso}}}).toJson());
+    }
+    const QString scene = dir.filePath("sheet.mfrscene");
+    auto w = openWindow(scene);
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    const QSize size(160, 120);
+    QVERIFY(showAbufferIso(*w, size));
+    auto* colorBy = w->findChild<QComboBox*>("colorByField");
+    auto* map = w->findChild<QComboBox*>("colorByMap");
+    auto* low = w->findChild<QDoubleSpinBox*>("colorRangeLow");
+    auto* high = w->findChild<QDoubleSpinBox*>("colorRangeHigh");
+    auto* dataRange = w->findChild<QPushButton*>("colorRangeReset");
+    auto* note = w->findChild<QLabel*>("colorByNote");
+    auto* legend = w->findChild<MapLegend*>("mapLegendA");
+    QVERIFY(colorBy && map && low && high && dataRange && note && legend);
+    QVERIFY(colorBy->isVisibleTo(w.get()));
+    QCOMPARE(m.surfaceFields(), (QStringList{"pressure", "zone"}));
+    QCOMPARE(colorBy->count(), 3);
+    QCOMPARE(colorBy->currentIndex(), 0);  // the parts' own colours
+    QVERIFY(!map->isEnabled());
+    QVERIFY(!legend->isVisible());
+    const mfr::ImageRGBA8 plain = w->view().renderImage(size);
+
+    // The frame equals mfr render of the same scene with the same colouring, in a separate process.
+    const auto expectCli = [&](const QStringList& colouring, const mfr::ImageRGBA8& frame) {
+      const QString png = dir.filePath("cli.png");
+      QString out;
+      if (runProgram(MFR_CLI,
+                     QStringList{"render", scene, "--size", "160x120", "--view", "iso", "-m", "abuffer-ll", "-o", png} +
+                         colouring,
+                     &out) != 0)
+        return 256;
+      return maxChannelDifference(mfr::readPng(png.toStdString()), frame);
+    };
+    colorBy->setCurrentIndex(1);
+    emit colorBy->activated(1);  // as a user's choice
+    QVERIFY(m.fieldColoring());
+    QCOMPARE(m.fieldColoring()->field, std::string("pressure"));
+    QCOMPARE(m.fieldColoring()->range, glm::dvec2(-2.0, 3.0));
+    QCOMPARE(low->value(), -2.0);
+    QCOMPARE(high->value(), 3.0);
+    QVERIFY(map->isEnabled());
+    settle(m);
+    const mfr::ImageRGBA8 pressure = w->view().renderImage(size);
+    QVERIFY(maxChannelDifference(pressure, plain) > 60);
+    QCOMPARE(expectCli({"--color-by", "pressure"}, pressure), 0);
+    QVERIFY(legend->isVisible());
+    QCOMPARE(legend->title(), QStringLiteral("pressure"));
+    QCOMPARE(legend->mapName(), QStringLiteral("cool-warm"));
+    auto* tree = w->findChild<QTreeWidget*>("sceneTree");
+    QVERIFY(tree && tree->topLevelItemCount() == 1);
+    QCOMPARE(tree->topLevelItem(0)->text(1), QStringLiteral("pressure"));
+
+    map->setCurrentIndex(map->findText(QStringLiteral("viridis")));
+    emit map->activated(map->currentIndex());
+    low->setValue(0.0);  // applies [0, 3]
+    settle(m);
+    const mfr::ImageRGBA8 viridis = w->view().renderImage(size);
+    QCOMPARE(m.fieldColoring()->range, glm::dvec2(0.0, 3.0));
+    QCOMPARE(legend->mapName(), QStringLiteral("viridis"));
+    QCOMPARE(expectCli({"--color-by", "pressure", "--color-map", "viridis", "--color-range", "0,3"}, viridis), 0);
+
+    // An empty range is refused with its reason; the colouring stays.
+    low->setValue(5.0);
+    QVERIFY(note->isVisibleTo(w.get()));
+    QVERIFY2(note->text().contains(QStringLiteral("low < high")), qPrintable(note->text()));
+    QCOMPARE(m.fieldColoring()->range, glm::dvec2(0.0, 3.0));
+    dataRange->click();
+    QCOMPARE(m.fieldColoring()->range, glm::dvec2(-2.0, 3.0));
+    QVERIFY(!note->isVisibleTo(w.get()));
+    QCOMPARE(low->value(), -2.0);
+
+    // Cell data, then a session round trip.
+    colorBy->setCurrentIndex(2);
+    emit colorBy->activated(2);
+    settle(m);
+    const mfr::ImageRGBA8 zone = w->view().renderImage(size);
+    QCOMPARE(expectCli({"--color-by", "zone", "--color-map", "viridis"}, zone), 0);
+    const QString sessionPath = dir.filePath("colour.mfrsession");
+    w->saveSession(sessionPath);
+    auto again = openWindow(QString());
+    QVERIFY(again);
+    again->view().setFixedSize(size);
+    again->openSession(sessionPath);
+    ViewerModel& a = again->model();
+    QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.fieldColoring().has_value(), kTimeoutMs);
+    settle(a);
+    QCOMPARE(a.fieldColoring()->field, std::string("zone"));
+    QCOMPARE(again->findChild<QComboBox*>("colorByField")->currentText(), QStringLiteral("zone"));
+    QCOMPARE(maxChannelDifference(zone, again->view().renderImage(a.renderSize())), 0);
+
+    // Back to the parts' own colours: the first frame again.
+    colorBy->setCurrentIndex(0);
+    emit colorBy->activated(0);
+    settle(m);
+    QVERIFY(!m.fieldColoring());
+    QCOMPARE(maxChannelDifference(plain, w->view().renderImage(size)), 0);
+    QVERIFY(!legend->isVisible());
+
+    // mfrview --color-by: the pixels of mfr render --color-by; a field the parts lack is one line.
+    const QString viewerPng = dir.filePath("viewer.png"), cliPng = dir.filePath("cli-options.png");
+    const QStringList common{"--size",
+                             "96x72",
+                             "--view",
+                             "iso",
+                             "-m",
+                             "abuffer-ll",
+                             "--color-by",
+                             "pressure",
+                             "--color-map",
+                             "magma",
+                             "--color-range=-1,2"};
+    QString out;
+    QCOMPARE(runProgram(MFRVIEW, QStringList{scene, "--screenshot", viewerPng} + common, &out), 0);
+    QCOMPARE(runProgram(MFR_CLI, QStringList{"render", scene, "-o", cliPng} + common, &out), 0);
+    QCOMPARE(maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString())), 0);
+    QVERIFY(runProgram(MFRVIEW, QStringList{scene, "--color-by", "nope", "--screenshot", viewerPng}, &out) != 0);
+    const QString last = out.trimmed().split(QLatin1Char('\n')).last();
+    QVERIFY2(last.startsWith(QStringLiteral("mfrview: --color-by nope: ")) &&
+                 last.contains(QStringLiteral("no point-data or cell-data array 'nope' (fields: pressure, zone)")),
+             qPrintable(out));
+  }
+
   void volumePanelNamesAPresetFunction() {
     QTemporaryDir dir;
     auto w = openWindow(QString());

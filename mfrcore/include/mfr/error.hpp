@@ -13,4 +13,12 @@ class Error : public std::runtime_error {
   Error(const std::string& what, const std::string& reason) : std::runtime_error(what + ": " + reason) {}
 };
 
+// Thrown when a named field is not there: by loadVolume for a LoadOptions::field the file does not
+// have (or a format without named fields), by colorByField for a field the mesh does not have. Its
+// message lists the fields there are.
+class FieldNotFound : public Error {
+ public:
+  using Error::Error;
+};
+
 }  // namespace mfr

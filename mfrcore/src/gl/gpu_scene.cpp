@@ -1,6 +1,7 @@
 #include "mfr/gl/gpu_scene.hpp"
 
 #include "common/bindings.h"
+#include "mfr/scene/color_map.hpp"
 
 namespace mfr::gl {
 namespace {
@@ -8,10 +9,28 @@ struct Vertex {
   glm::vec3 position;
   glm::vec3 normal;
   glm::vec4 color;
+  float scalar;
 };
+
+// Every colour map's table, one row each (common/color_map.glsl).
+Texture colorMapTexture() {
+  const std::vector<std::string>& names = colorMapNames();
+  const int width = MFR_COLOR_MAP_SIZE + 1, height = static_cast<int>(names.size());
+  std::vector<glm::vec4> texels;
+  texels.reserve(static_cast<std::size_t>(width * height));
+  for (const std::string& name : names) {
+    const ColorMap& map = colorMap(name);
+    for (const glm::vec3& c : map.table) texels.emplace_back(c, 1.0f);
+    texels.emplace_back(map.nanColor, 1.0f);
+  }
+  Texture t = createTexture2D(GL_RGBA32F, width, height);
+  glTextureSubImage2D(t.id(), 0, 0, 0, width, height, GL_RGBA, GL_FLOAT, texels.data());
+  return t;
+}
 }  // namespace
 
 GpuScene::GpuScene(const Scene& scene, const GpuScene* previous) {
+  colorMaps_ = colorMapTexture();
   std::map<const Mesh*, std::shared_ptr<const GpuMesh>> before;
   if (previous)
     for (const std::shared_ptr<const GpuMesh>& g : previous->meshes_) before.emplace(g->source.get(), g);
@@ -28,7 +47,7 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous) {
         std::vector<Vertex> v(m.positions.size());
         for (std::size_t k = 0; k < v.size(); ++k)
           v[k] = {m.positions[k], m.normals.empty() ? glm::vec3(0, 0, 1) : m.normals[k],
-                  m.colors.empty() ? glm::vec4(1.0f) : m.colors[k]};
+                  m.colors.empty() ? glm::vec4(1.0f) : m.colors[k], m.scalars.empty() ? 0.0f : m.scalars[k]};
         auto g = std::make_shared<GpuMesh>();
         g->source = o.mesh;
         g->vertices = createBuffer(v.size() * sizeof(Vertex), v.data(), 0);
@@ -46,6 +65,7 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous) {
         attrib(MFR_ATTR_POSITION, 3, offsetof(Vertex, position));
         attrib(MFR_ATTR_NORMAL, 3, offsetof(Vertex, normal));
         attrib(MFR_ATTR_COLOR, 4, offsetof(Vertex, color));
+        attrib(MFR_ATTR_SCALAR, 1, offsetof(Vertex, scalar));
         g->bytes = v.size() * sizeof(Vertex) + m.indices.size() * sizeof(std::uint32_t);
         uploaded_ += g->bytes;
         meshes_.push_back(std::move(g));
@@ -53,8 +73,12 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous) {
       bytes_ += meshes_.back()->bytes;
     }
     const glm::mat4 model(o.transform);
+    // A field colouring needs the field's values on the mesh (colorByField puts them there).
+    const std::optional<FieldColors>& field = o.material.fieldColors;
+    const bool mapped = field && o.mesh->scalars.size() == o.mesh->positions.size();
     items_.push_back({it->second, model, glm::mat3(glm::transpose(glm::inverse(o.transform))), o.material.color,
-                      o.material.vertexColors, static_cast<std::uint32_t>(i)});
+                      o.material.vertexColors, static_cast<std::uint32_t>(i), mapped ? colorMapIndex(field->map) : -1,
+                      mapped ? glm::vec2(field->range) : glm::vec2(0.0f, 1.0f)});
     triangles_ += o.mesh->triangleCount();
   }
 }
@@ -66,6 +90,7 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
   program.set("uPayload", frame.payload);
   program.set("uClipMin", frame.clipMin);
   program.set("uClipMax", frame.clipMax);
+  glBindTextureUnit(MFR_TEX_COLOR_MAPS, colorMaps_.id());
   // Six planes, enabled only while this draw runs (full-screen passes write no clip distances).
   for (int i = 0; i < 6; ++i) {
     if (frame.clip)
@@ -80,6 +105,8 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
     program.set("uColor", item.color);
     program.set("uVertexColors", item.vertexColors ? 1 : 0);
     program.set("uObjectId", item.objectId);
+    program.set("uColorMapRow", item.colorMapRow);
+    program.set("uColorMapRange", item.colorMapRange);
     glBindVertexArray(m.vao.id());
     glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
   }

@@ -156,14 +156,32 @@ std::uint32_t toId(double v, Parser& p) {
   return static_cast<std::uint32_t>(v);
 }
 
-void addCells(PolygonSoup& soup, const std::vector<std::uint64_t>& offsets, const std::vector<std::uint32_t>& conn,
-              bool strips, Parser& p) {
+// The cells of each kind the file declares, and for every soup polygon the cell it came from:
+// cell data is indexed in VTK's order (vertices, lines, polygons, strips), whatever the file's.
+enum CellKind { kVertices = 0, kLines = 1, kPolygons = 2, kStrips = 3 };
+struct CellSources {
+  std::array<std::uint64_t, 4> counts{};
+  std::vector<std::pair<CellKind, std::uint64_t>> polygonCell;  // per soup polygon
+  [[nodiscard]] std::uint64_t total() const { return counts[0] + counts[1] + counts[2] + counts[3]; }
+  [[nodiscard]] std::uint64_t index(std::size_t polygon) const {
+    const auto [kind, i] = polygonCell[polygon];
+    std::uint64_t before = 0;
+    for (int k = 0; k < kind; ++k) before += counts[static_cast<std::size_t>(k)];
+    return before + i;
+  }
+};
+
+void addCells(PolygonSoup& soup, CellSources& sources, CellKind kind, const std::vector<std::uint64_t>& offsets,
+              const std::vector<std::uint32_t>& conn, Parser& p) {
+  const bool strips = kind == kStrips;
+  const std::uint64_t first = sources.counts[kind];
   for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
     const std::uint64_t begin = offsets[c], end = offsets[c + 1];
     if (begin > end || end > conn.size()) p.fail("cell offsets out of order or beyond the connectivity");
     if (end - begin < 3) continue;
     if (!strips) {
       soup.addPolygon(conn.data() + begin, static_cast<std::size_t>(end - begin));
+      sources.polygonCell.emplace_back(kind, first + c);
       continue;
     }
     for (std::uint64_t k = begin; k + 2 < end; ++k) {
@@ -171,13 +189,14 @@ void addCells(PolygonSoup& soup, const std::vector<std::uint64_t>& offsets, cons
       const bool odd = ((k - begin) & 1) != 0;
       const std::uint32_t t[3] = {conn[k + (odd ? 1 : 0)], conn[k + (odd ? 0 : 1)], conn[k + 2]};
       soup.addPolygon(t, 3);
+      sources.polygonCell.emplace_back(kind, first + c);
     }
   }
 }
 
 // One cell block: classic "n size" followed by size values, or 5.1 "nOffsets nConn" followed by
 // OFFSETS and CONNECTIVITY arrays.
-void readCells(Parser& p, bool binary, PolygonSoup* soup, bool strips) {
+void readCells(Parser& p, bool binary, PolygonSoup& soup, CellSources& sources, CellKind kind) {
   const std::uint64_t a = p.count("cell count");
   const std::uint64_t b = p.count("cell size");
   std::vector<std::uint64_t> offsets{0};
@@ -216,7 +235,8 @@ void readCells(Parser& p, bool binary, PolygonSoup* soup, bool strips) {
       offsets.push_back(conn.size());
     }
   }
-  if (soup != nullptr) addCells(*soup, offsets, conn, strips, p);
+  if (kind == kPolygons || kind == kStrips) addCells(soup, sources, kind, offsets, conn, p);
+  sources.counts[kind] += offsets.size() - 1;
 }
 
 void skipMetadata(Parser& p) {
@@ -246,6 +266,138 @@ void skipField(Parser& p, bool binary) {
   }
 }
 
+// "%20"-style escapes in legacy array names (VTK writes spaces and other specials that way).
+std::string decodeName(std::string_view t) {
+  std::string out;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    int hex = 0;
+    if (t[i] == '%' && i + 2 < t.size() &&
+        std::from_chars(t.data() + i + 1, t.data() + i + 3, hex, 16).ptr == t.data() + i + 3) {
+      out += static_cast<char>(hex);
+      i += 2;
+    } else {
+      out += t[i];
+    }
+  }
+  return out;
+}
+
+// tuples × components values of type t, the header line already consumed.
+std::vector<float> readValues(Parser& p, bool binary, Scalar t, std::uint64_t tuples, std::uint64_t components) {
+  if (components == 0 || components > 64) p.fail("bad component count " + std::to_string(components));
+  p.requireValues(tuples, components * (binary ? sizeOf(t) : 2), "data values");
+  std::vector<float> v;
+  v.reserve(tuples * components);
+  for (std::uint64_t k = 0; k < tuples * components; ++k) v.push_back(static_cast<float>(p.value(t, binary)));
+  return v;
+}
+
+// The POINT_DATA / CELL_DATA sections after the geometry, from `keyword` on: SCALARS, VECTORS,
+// TENSORS and FIELD arrays become soup fields (cell data mapped from VTK's cell order to the
+// soup's polygons), point COLOR_SCALARS of 3 or 4 values the soup's colours; NORMALS,
+// TEXTURE_COORDINATES, LOOKUP_TABLE and METADATA are read past; another keyword ends the reading.
+void readDataSections(Parser& p, bool binary, std::string_view keyword, PolygonSoup& soup, const CellSources& sources) {
+  bool cells = false;
+  std::uint64_t tuples = 0;
+  bool inSection = false;
+  const auto add = [&](std::string name, std::uint64_t components, std::vector<float> values) {
+    MeshField f{std::move(name), cells, static_cast<int>(components), {}};
+    if (!cells) {
+      f.values = std::move(values);
+    } else {
+      f.values.reserve(soup.polygonCount() * components);
+      for (std::size_t poly = 0; poly < soup.polygonCount(); ++poly) {
+        const std::uint64_t c = sources.index(poly);
+        f.values.insert(f.values.end(), values.begin() + static_cast<std::ptrdiff_t>(c * components),
+                        values.begin() + static_cast<std::ptrdiff_t>((c + 1) * components));
+      }
+    }
+    soup.fields.push_back(std::move(f));
+  };
+  for (; !keyword.empty(); keyword = p.token()) {
+    if (keyword == "POINT_DATA" || keyword == "CELL_DATA") {
+      cells = keyword == "CELL_DATA";
+      tuples = p.count(cells ? "cell data count" : "point data count");
+      const std::uint64_t expected = cells ? sources.total() : soup.points.size();
+      if (tuples != expected)
+        p.fail(std::string(keyword) + " " + std::to_string(tuples) + " differs from the " + std::to_string(expected) +
+               (cells ? " cells" : " points") + " of the file");
+      inSection = true;
+      continue;
+    }
+    if (!inSection) p.fail("unexpected keyword '" + std::string(keyword.substr(0, 32)) + "' in legacy VTK POLYDATA");
+    if (keyword == "SCALARS") {
+      std::string name = decodeName(p.token());
+      const Scalar t = p.type(p.token());
+      const std::string_view rest = p.line();  // an optional component count
+      std::uint64_t components = 1;
+      if (const std::size_t digit = rest.find_first_not_of(" \t"); digit != std::string_view::npos) {
+        const auto [ptr, ec] = std::from_chars(rest.data() + digit, rest.data() + rest.size(), components);
+        if (ec != std::errc()) p.fail("bad SCALARS component count");
+      }
+      if (p.peek() == "LOOKUP_TABLE") {
+        p.token();
+        p.token();
+        p.skipRestOfLine();
+      }
+      add(std::move(name), components, readValues(p, binary, t, tuples, components));
+    } else if (keyword == "VECTORS" || keyword == "NORMALS" || keyword == "TENSORS" || keyword == "TENSORS6") {
+      std::string name = decodeName(p.token());
+      const Scalar t = p.type(p.token());
+      p.skipRestOfLine();
+      const std::uint64_t components = keyword == "TENSORS" ? 9 : keyword == "TENSORS6" ? 6 : 3;
+      std::vector<float> values = readValues(p, binary, t, tuples, components);
+      if (keyword != "NORMALS") add(std::move(name), components, std::move(values));
+    } else if (keyword == "TEXTURE_COORDINATES") {
+      p.token();
+      const std::uint64_t dim = p.count("texture dimension");
+      const Scalar t = p.type(p.token());
+      p.skipRestOfLine();
+      readValues(p, binary, t, tuples, dim);
+    } else if (keyword == "COLOR_SCALARS") {
+      p.token();
+      const std::uint64_t components = p.count("colour component count");
+      p.skipRestOfLine();
+      // Bytes in binary files, values in [0, 1] in ASCII ones.
+      std::vector<float> values = readValues(p, binary, binary ? Scalar::UInt8 : Scalar::Float32, tuples, components);
+      if (!cells && (components == 3 || components == 4)) {
+        soup.colors.assign(tuples, glm::vec4(1.0f));
+        for (std::uint64_t i = 0; i < tuples; ++i)
+          for (std::uint64_t c = 0; c < components; ++c)
+            soup.colors[i][static_cast<int>(c)] =
+                std::clamp(values[i * components + c] / (binary ? 255.0f : 1.0f), 0.0f, 1.0f);
+      }
+    } else if (keyword == "LOOKUP_TABLE") {
+      p.token();
+      const std::uint64_t size = p.count("lookup table size");
+      p.skipRestOfLine();
+      readValues(p, binary, binary ? Scalar::UInt8 : Scalar::Float32, size, 4);
+    } else if (keyword == "FIELD") {
+      p.token();  // field name
+      const std::uint64_t arrays = p.count("field array count");
+      for (std::uint64_t i = 0; i < arrays; ++i) {
+        std::string name = decodeName(p.token());
+        const std::uint64_t components = p.count("component count");
+        const std::uint64_t n = p.count("tuple count");
+        const Scalar t = p.type(p.token());
+        p.skipRestOfLine();
+        std::vector<float> values = readValues(p, binary, t, n, components);
+        if (n == tuples) add(std::move(name), components, std::move(values));  // else not per point or cell
+        if (p.peek() == "METADATA") {
+          p.token();
+          skipMetadata(p);
+        }
+      }
+    } else if (keyword == "METADATA") {
+      skipMetadata(p);
+    } else {
+      // An attribute this reader does not know (GLOBAL_IDS, EDGE_FLAGS, …): the geometry and the
+      // fields before it are kept; its size is unknown, so reading stops here.
+      return;
+    }
+  }
+}
+
 }  // namespace
 
 PolygonSoup parseLegacyVtk(std::string_view bytes, const std::string& name) {
@@ -264,9 +416,11 @@ PolygonSoup parseLegacyVtk(std::string_view bytes, const std::string& name) {
     p.fail("legacy VTK dataset type '" + std::string(type.substr(0, 32)) + "' is not supported (only POLYDATA)");
 
   PolygonSoup soup;
+  CellSources sources;
   bool havePoints = false;
+  std::string_view keyword;
   while (true) {
-    const std::string_view keyword = p.token();
+    keyword = p.token();
     if (keyword.empty() || keyword == "POINT_DATA" || keyword == "CELL_DATA") break;
     if (keyword == "POINTS") {
       const std::uint64_t n = p.count("point count");
@@ -279,10 +433,12 @@ PolygonSoup parseLegacyVtk(std::string_view bytes, const std::string& name) {
         soup.points.emplace_back(x, y, z);
       }
       havePoints = true;
-    } else if (keyword == "POLYGONS" || keyword == "TRIANGLE_STRIPS") {
-      readCells(p, binary, &soup, keyword == "TRIANGLE_STRIPS");
-    } else if (keyword == "VERTICES" || keyword == "LINES") {
-      readCells(p, binary, nullptr, false);
+    } else if (keyword == "POLYGONS" || keyword == "TRIANGLE_STRIPS" || keyword == "VERTICES" || keyword == "LINES") {
+      const CellKind kind = keyword == "POLYGONS"          ? kPolygons
+                            : keyword == "TRIANGLE_STRIPS" ? kStrips
+                            : keyword == "VERTICES"        ? kVertices
+                                                           : kLines;
+      readCells(p, binary, soup, sources, kind);
     } else if (keyword == "FIELD") {
       skipField(p, binary);
     } else if (keyword == "METADATA") {
@@ -293,6 +449,7 @@ PolygonSoup parseLegacyVtk(std::string_view bytes, const std::string& name) {
   }
   if (!havePoints) p.fail("no POINTS in legacy VTK POLYDATA");
   if (soup.polygonCount() == 0) p.fail("no triangles (no POLYGONS or TRIANGLE_STRIPS)");
+  readDataSections(p, binary, keyword, soup, sources);
   return soup;
 }
 

@@ -11,7 +11,9 @@ namespace mfr::io {
 
 // ASCII and BINARY (big-endian) POLYDATA, in the classic cell layout ("POLYGONS n size") and the
 // 5.1 layout (OFFSETS / CONNECTIVITY). POINTS, POLYGONS and TRIANGLE_STRIPS are read; vertices,
-// lines, FIELD and METADATA blocks are skipped; POINT_DATA / CELL_DATA end the geometry.
+// lines, FIELD and METADATA blocks are skipped; POINT_DATA / CELL_DATA end the geometry, and
+// their SCALARS, VECTORS, TENSORS and FIELD arrays become the soup's fields (COLOR_SCALARS its
+// colours).
 // Throws mfr::Error(name, reason).
 PolygonSoup parseLegacyVtk(std::string_view bytes, const std::string& name);
 

@@ -16,6 +16,8 @@
 #include <unistd.h>
 
 #include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkIdTypeArray.h>
 #include <vtkDataArray.h>
 #include <vtkFloatArray.h>
 #include <vtkIdList.h>
@@ -40,6 +42,8 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr const char* kSoupColorArray = "mfr_colors";
+// Cell data of triangulate's output: the input cell each triangle came from (for the file's cell data).
+constexpr const char* kSourceCellArray = "mfr_source_cell";
 
 // ---------------------------------------------------------------------------------------------
 // VTK reports problems through a global output window (and vtkLogger), which prints to stderr.
@@ -258,11 +262,16 @@ vtkDataArray* colorArray(vtkPolyData* pd) {
 
 // Polygons and strips to triangles. Ear cutting (vtkPolygon) handles concave polygons; where it
 // gives up (non-planar or partly degenerate polygons, where vtkTriangleFilter silently drops
-// triangles) a fan keeps the n−2 triangles the file implies. Points and point data are shared.
+// triangles) a fan keeps the n−2 triangles the file implies. Points and point data are shared; each
+// triangle's input cell id is its cell data kSourceCellArray.
 vtkSmartPointer<vtkPolyData> triangulate(vtkPolyData* in) {
   auto out = vtkSmartPointer<vtkPolyData>::New();
   out->SetPoints(in->GetPoints());
   out->GetPointData()->ShallowCopy(in->GetPointData());
+  vtkNew<vtkIdTypeArray> source;
+  source->SetName(kSourceCellArray);
+  // vtkPolyData numbers its cells vertices first, then lines, polygons and strips.
+  vtkIdType cellId = in->GetNumberOfVerts() + in->GetNumberOfLines();
   vtkNew<vtkCellArray> triangles;
   triangles->AllocateEstimate(in->GetNumberOfPolys() + in->GetNumberOfStrips(), 3);
   vtkNew<vtkPolygon> polygon;
@@ -270,10 +279,12 @@ vtkSmartPointer<vtkPolyData> triangulate(vtkPolyData* in) {
   vtkIdType n = 0;
   const vtkIdType* ids = nullptr;
   vtkCellArray* polys = in->GetPolys();
-  for (polys->InitTraversal(); polys->GetNextCell(n, ids) != 0;) {
+  for (polys->InitTraversal(); polys->GetNextCell(n, ids) != 0; ++cellId) {
     if (n < 3) continue;
+    const vtkIdType before = triangles->GetNumberOfCells();
     if (n == 3) {
       triangles->InsertNextCell(3, ids);
+      source->InsertNextValue(cellId);
       continue;
     }
     polygon->PointIds->SetNumberOfIds(n);
@@ -294,16 +305,55 @@ vtkSmartPointer<vtkPolyData> triangulate(vtkPolyData* in) {
         triangles->InsertNextCell(3, t);
       }
     }
+    for (vtkIdType t = before; t < triangles->GetNumberOfCells(); ++t) source->InsertNextValue(cellId);
   }
   vtkCellArray* strips = in->GetStrips();
-  for (strips->InitTraversal(); strips->GetNextCell(n, ids) != 0;)
+  for (strips->InitTraversal(); strips->GetNextCell(n, ids) != 0; ++cellId)
     for (vtkIdType k = 0; k + 2 < n; ++k) {
       // Every other strip triangle is wound the other way round.
       const vtkIdType t[3] = {ids[k + (k & 1)], ids[k + 1 - (k & 1)], ids[k + 2]};
       triangles->InsertNextCell(3, t);
+      source->InsertNextValue(cellId);
     }
   out->SetPolys(triangles);
+  out->GetCellData()->AddArray(source);
   return out;
+}
+
+// The numeric arrays of a file's point and cell data as Mesh::fields (what a surface can be
+// coloured by), except the normals and the colours read as colours. Point data comes from `out`
+// (whose points the normals filter may have split: each copy keeps its values); cell data from the
+// input, one tuple per triangle of `out` by its kSourceCellArray.
+void readFields(vtkPolyData* input, vtkPolyData* out, Mesh& mesh) {
+  vtkPointData* pd = out->GetPointData();
+  const vtkDataArray* colors = colorArray(out);
+  for (int i = 0; i < pd->GetNumberOfArrays(); ++i) {
+    vtkDataArray* a = pd->GetArray(i);
+    if (a == nullptr || a->GetName() == nullptr || a == pd->GetNormals() || a == colors ||
+        std::strcmp(a->GetName(), kSoupColorArray) == 0 || a->GetNumberOfTuples() != out->GetNumberOfPoints())
+      continue;
+    MeshField f{a->GetName(), false, a->GetNumberOfComponents(), {}};
+    f.values.reserve(static_cast<std::size_t>(a->GetNumberOfTuples() * f.components));
+    for (vtkIdType t = 0; t < a->GetNumberOfTuples(); ++t)
+      for (int c = 0; c < f.components; ++c) f.values.push_back(static_cast<float>(a->GetComponent(t, c)));
+    mesh.fields.push_back(std::move(f));
+  }
+  vtkCellData* cd = input->GetCellData();
+  vtkDataArray* source = out->GetCellData()->GetArray(kSourceCellArray);
+  if (source == nullptr || source->GetNumberOfTuples() != static_cast<vtkIdType>(mesh.triangleCount())) return;
+  for (int i = 0; i < cd->GetNumberOfArrays(); ++i) {
+    vtkDataArray* a = cd->GetArray(i);
+    if (a == nullptr || a->GetName() == nullptr || a == cd->GetNormals() ||
+        a->GetNumberOfTuples() != input->GetNumberOfCells())
+      continue;
+    MeshField f{a->GetName(), true, a->GetNumberOfComponents(), {}};
+    f.values.reserve(mesh.triangleCount() * static_cast<std::size_t>(f.components));
+    for (vtkIdType t = 0; t < source->GetNumberOfTuples(); ++t) {
+      const auto cell = static_cast<vtkIdType>(source->GetComponent(t, 0));
+      for (int c = 0; c < f.components; ++c) f.values.push_back(static_cast<float>(a->GetComponent(cell, c)));
+    }
+    mesh.fields.push_back(std::move(f));
+  }
 }
 
 // Triangulates, adds feature-angle normals when missing, and converts to a Mesh.
@@ -368,6 +418,7 @@ Mesh finish(vtkPolyData* input, const std::string& name) {
     for (vtkIdType k = 0; k < 3; ++k) mesh.indices.push_back(static_cast<std::uint32_t>(ids[k]));
   }
   if (mesh.normals.empty()) mesh.computeSmoothNormals();
+  readFields(input, out, mesh);
   return mesh;
 }
 
@@ -417,6 +468,25 @@ vtkSmartPointer<vtkPolyData> polyDataFromSoup(const PolygonSoup& soup, const std
       normals->SetTypedTuple(static_cast<vtkIdType>(i), &n.x);
     }
     pd->GetPointData()->SetNormals(normals);
+  }
+  // Fields: point data as is; cell data for the polygons kept above (three corners or more).
+  for (const MeshField& f : soup.fields) {
+    vtkNew<vtkFloatArray> a;
+    a->SetName(f.name.c_str());
+    a->SetNumberOfComponents(f.components);
+    const auto n = static_cast<std::size_t>(f.components);
+    if (!f.cellData) {
+      if (f.values.size() != np * n) throw Error(name, "internal error: point field '" + f.name + "' size");
+      a->SetNumberOfTuples(static_cast<vtkIdType>(np));
+      for (std::size_t i = 0; i < np; ++i) a->SetTypedTuple(static_cast<vtkIdType>(i), f.values.data() + i * n);
+      pd->GetPointData()->AddArray(a);
+      continue;
+    }
+    if (f.values.size() != soup.polygonCount() * n)
+      throw Error(name, "internal error: cell field '" + f.name + "' size");
+    for (std::size_t c = 0; c < soup.polygonCount(); ++c)
+      if (soup.offsets[c + 1] - soup.offsets[c] >= 3) a->InsertNextTypedTuple(f.values.data() + c * n);
+    pd->GetCellData()->AddArray(a);
   }
   if (soup.colors.size() == np && np > 0) {
     vtkNew<vtkFloatArray> colors;

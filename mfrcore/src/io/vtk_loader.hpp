@@ -23,6 +23,9 @@ struct PolygonSoup {
   std::vector<glm::vec4> colors;           // empty or one RGBA in [0,1] per point
   std::vector<std::uint32_t> offsets{0};   // polygon i is ids[offsets[i] .. offsets[i+1])
   std::vector<std::uint32_t> ids;
+  // The file's data arrays (Mesh::fields): point fields one tuple per point, cell fields one per
+  // polygon of the soup (MeshField::cellData marks them).
+  std::vector<MeshField> fields;
 
   void addPolygon(const std::uint32_t* first, std::size_t count) {
     ids.insert(ids.end(), first, first + count);

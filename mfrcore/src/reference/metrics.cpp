@@ -177,6 +177,11 @@ double weightedPercentile(std::vector<float> values, double p) {
   return weightedPercentileSorted(values, total, p);
 }
 
+glm::vec3 magmaEntry(int index) {
+  const float* rgb = kMagma[std::clamp(index, 0, 255)];
+  return {rgb[0], rgb[1], rgb[2]};
+}
+
 ImageRGBA8 magma(const ImageF& values) {
   checkScalar("magma", values);
   ImageRGBA8 out(values.width, values.height);

@@ -40,6 +40,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "mfr/error.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "mfr/scene/section.hpp"
 
 namespace mfr::shading {
@@ -72,6 +73,9 @@ struct ObjectShading {
   glm::dmat3 normalMatrix{1.0};  // inverse transpose of the object transform's linear part
   glm::vec4 materialColor{1.0f};
   bool vertexColors = true;  // Material::vertexColors
+  // Material::fieldColors with the mesh's scalars there: the map and its range; else null.
+  const ColorMap* colorMap = nullptr;
+  glm::vec2 colorMapRange{0.0f, 1.0f};
 };
 
 struct Hit {
@@ -231,7 +235,12 @@ std::uint32_t shade(const WorldTriangle& tri, const ObjectShading& obj, double u
   if (!(glm::dot(normal, normal) > 1e-24))
     normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
   glm::vec4 base = obj.materialColor;
-  if (obj.vertexColors && mesh.colors.size() == mesh.positions.size()) {
+  if (obj.colorMap != nullptr) {
+    // Interpolated, then mapped, as common/color_map.glsl does (in float, as the GPU's varying).
+    float value = 0.0f;
+    for (int k = 0; k < 3; ++k) value += static_cast<float>(w[k]) * mesh.scalars[tri.vertex[k]];
+    base = glm::vec4(mapFieldValue(*obj.colorMap, value, obj.colorMapRange), base.a);
+  } else if (obj.vertexColors && mesh.colors.size() == mesh.positions.size()) {
     glm::dvec4 c(0.0);
     for (int k = 0; k < 3; ++k) c += w[k] * glm::dvec4(mesh.colors[tri.vertex[k]]);
     base *= glm::vec4(c);
@@ -419,6 +428,11 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     object.mesh->validate(object.name);
     objects[o] = {object.mesh.get(), glm::transpose(glm::inverse(glm::dmat3(object.transform))), object.material.color,
                   object.material.vertexColors};
+    if (const std::optional<FieldColors>& field = object.material.fieldColors;
+        field && object.mesh->scalars.size() == object.mesh->positions.size()) {
+      objects[o].colorMap = &colorMap(field->map);
+      objects[o].colorMapRange = glm::vec2(field->range);
+    }
   }
   const std::shared_ptr<const PreparedGeometry> geometry = preparedGeometry(scene);
   const std::vector<WorldTriangle>& triangles = geometry->triangles;

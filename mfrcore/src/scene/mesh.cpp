@@ -19,6 +19,14 @@ void Mesh::validate(const std::string& name) const {
     throw Error(name, "normal count differs from vertex count");
   if (!colors.empty() && colors.size() != positions.size())
     throw Error(name, "colour count differs from vertex count");
+  if (!scalars.empty() && scalars.size() != positions.size())
+    throw Error(name, "scalar count differs from vertex count");
+  for (const MeshField& f : fields) {
+    const std::size_t tuples = f.cellData ? triangleCount() : positions.size();
+    if (f.components < 1 || f.values.size() != tuples * static_cast<std::size_t>(f.components))
+      throw Error(name, "field '" + f.name + "' has " + std::to_string(f.values.size()) + " values, expected " +
+                            std::to_string(tuples) + " tuples of " + std::to_string(f.components));
+  }
   for (std::uint32_t i : indices)
     if (i >= positions.size())
       throw Error(name, "vertex index " + std::to_string(i) + " out of range (" +

@@ -10,6 +10,7 @@
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "mfr/scene/csg.hpp"
 #include "mfr/scene/primitives.hpp"
 #include "mfr/scene/sample.hpp"
@@ -163,6 +164,42 @@ glm::vec4 parseColor(const Reader& r, const json& o, const std::string& where, g
     color.a = static_cast<float>(a);
   }
   return color;
+}
+
+// An object's "color_by": "field" or {"field", "map", "range"}, applied to each part whose mesh has
+// the field (colorByField); at least one must.
+void parseColorBy(const Reader& r, const json& o, const std::string& where, const std::vector<Object*>& parts,
+                  const std::string& what) {
+  if (!o.contains("color_by")) return;
+  const std::string at = where + ".color_by";
+  const json& c = o["color_by"];
+  std::string field, map = "cool-warm";
+  std::optional<glm::dvec2> range;
+  if (c.is_string()) {
+    field = c.get<std::string>();
+  } else {
+    r.object(c, at);
+    field = r.string(c, "field", at, "");
+    map = r.string(c, "map", at, map);
+    if (c.contains("range")) {
+      const json& v = c["range"];
+      if (!v.is_array() || v.size() != 2) r.fail(at + ".range", "expected [low, high]");
+      range = glm::dvec2(r.number(v[0], at + ".range[0]"), r.number(v[1], at + ".range[1]"));
+      if (!(range->y > range->x)) r.fail(at + ".range", "high must be greater than low");
+    }
+  }
+  if (field.empty()) r.fail(at, "expected the name of a point-data or cell-data array of the file");
+  const auto& names = colorMapNames();
+  if (std::find(names.begin(), names.end(), map) == names.end()) {
+    std::string list;
+    for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+    r.fail(at + ".map", "unknown colour map '" + map + "' (" + list + ")");
+  }
+  try {
+    colorObjectsByField(parts, field, map, range, what);
+  } catch (const Error& e) {
+    r.fail(at, e.what());
+  }
 }
 
 Camera parseView(const Reader& r, const json& v, const std::string& where, const Bounds& bounds, double radius) {
@@ -428,18 +465,22 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
         obj.transform = xf;
         obj.material.color = parseColor(r, o, where, obj.material.color);
         obj.visible = visible;
+        parseColorBy(r, o, where, {&obj}, objName);
         scene.objects.push_back(std::move(obj));
       } else {
         const std::filesystem::path file = baseDir / r.string(o, "file", where, "");
         std::vector<Object> parts = loadModel(file, objectProgress);  // its errors name the model file
+        std::vector<Object*> colourable;
         for (Object& part : parts) {
           part.name = parts.size() == 1 ? objName : objName + "/" + part.name;
           part.transform = xf * part.transform;
           part.material.color = parseColor(r, o, where, part.material.color);
           if (o.contains("color")) part.material.vertexColors = false;  // replaces the file's colours
           part.visible = visible;
-          scene.objects.push_back(std::move(part));
+          colourable.push_back(&part);
         }
+        parseColorBy(r, o, where, colourable, file.filename().string());
+        for (Object& part : parts) scene.objects.push_back(std::move(part));
       }
       objectProgress.step(1.0);
     }

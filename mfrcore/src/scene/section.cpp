@@ -254,7 +254,7 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
   }
 
   Mesh& m = out.mesh;
-  const bool hasNormals = !mesh.normals.empty(), hasColors = !mesh.colors.empty();
+  const bool hasNormals = !mesh.normals.empty(), hasColors = !mesh.colors.empty(), hasScalars = !mesh.scalars.empty();
   std::vector<std::uint32_t> keptIndex(mesh.positions.size(), kNoVertex);
   const auto keep = [&](std::uint32_t i) {
     if (keptIndex[i] == kNoVertex) {
@@ -262,6 +262,7 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
       m.positions.push_back(mesh.positions[i]);
       if (hasNormals) m.normals.push_back(mesh.normals[i]);
       if (hasColors) m.colors.push_back(mesh.colors[i]);
+      if (hasScalars) m.scalars.push_back(mesh.scalars[i]);
     }
     return keptIndex[i];
   };
@@ -281,6 +282,8 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
       m.normals.push_back(length > 0.0 ? glm::vec3(normal / length) : mesh.normals[a]);
     }
     if (hasColors) m.colors.push_back(glm::vec4(glm::mix(glm::dvec4(mesh.colors[a]), glm::dvec4(mesh.colors[b]), t)));
+    if (hasScalars)
+      m.scalars.push_back(static_cast<float>(glm::mix(double(mesh.scalars[a]), double(mesh.scalars[b]), t)));
     return it->second;
   };
   std::vector<std::pair<std::uint32_t, std::uint32_t>> cutLine;  // on the plane, in the surface's winding
@@ -324,6 +327,11 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
         if (hasColors) {
           const glm::vec4 colour = m.colors[c];
           m.colors.push_back(colour);
+        }
+        // The cap is coloured by the field where the surface meets the plane, along its rim.
+        if (hasScalars) {
+          const float value = m.scalars[c];
+          m.scalars.push_back(value);
         }
       }
       out.outcome = SectionOutcome::kCapped;
@@ -434,10 +442,12 @@ std::vector<bool> capJointly(std::vector<Object>& objects, std::vector<OpenCut>&
         const glm::vec3 position =
             part == owner ? source.positions[v] : glm::vec3(toOwner * glm::dvec4(open[part].world[v], 1.0));
         const glm::vec4 colour = source.colors.empty() ? glm::vec4(1.0f) : source.colors[v];
+        const float value = source.scalars.empty() ? 0.0f : source.scalars[v];
         m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
         m.positions.push_back(position);
         if (!m.normals.empty()) m.normals.push_back(normal);
         if (!m.colors.empty()) m.colors.push_back(colour);
+        if (!m.scalars.empty()) m.scalars.push_back(value);
       }
     }
     open[owner].cut.capTriangles = corners.size() / 3;

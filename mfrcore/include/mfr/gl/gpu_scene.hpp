@@ -1,8 +1,8 @@
 #pragma once
 // A scene uploaded to the GPU: one vertex/index buffer pair per distinct mesh, drawn object by
 // object with the per-object uniforms every capture shader receives through
-// shaders/common/scene.vert (uModel, uNormalMatrix, uColor, uVertexColors, uObjectId) plus the
-// per-frame uViewProj and uViewDir.
+// shaders/common/scene.vert (uModel, uNormalMatrix, uColor, uVertexColors, uObjectId) and
+// common/color_map.glsl (uColorMapRow, uColorMapRange), plus the per-frame uViewProj and uViewDir.
 #include <map>
 #include <memory>
 #include <vector>
@@ -55,9 +55,12 @@ class GpuScene {
     glm::vec4 color;
     bool vertexColors;
     std::uint32_t objectId;
+    int colorMapRow;  // Material::fieldColors' map (colorMapIndex); -1: not field-coloured
+    glm::vec2 colorMapRange;
   };
   std::vector<std::shared_ptr<const GpuMesh>> meshes_;
   std::vector<DrawItem> items_;
+  Texture colorMaps_;  // every colour map's table (common/color_map.glsl), bound while drawing
   std::size_t triangles_ = 0;
   std::size_t bytes_ = 0;
   std::size_t uploaded_ = 0;

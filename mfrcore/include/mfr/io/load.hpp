@@ -34,13 +34,6 @@ struct LoadProgress {
   [[nodiscard]] LoadProgress part(double from, double to) const;
 };
 
-// Thrown by loadVolume when LoadOptions::field names no field the file has (or the format has no
-// named fields); its message lists the fields there are.
-class FieldNotFound : public Error {
- public:
-  using Error::Error;
-};
-
 // What to read of a file that holds several things.
 struct LoadOptions {
   // Volume files: the point-data array (.vti, legacy .vtk) or grid (.vdb) to read; empty: the

@@ -1,6 +1,8 @@
 #pragma once
 // Image-quality metrics against a reference: RMSE and FLIP (Andersson et al., "FLIP: A Difference
 // Evaluator for Alternating Images", Proc. ACM CGIT 3(2), 2020), plus error heat maps.
+#include <glm/glm.hpp>
+
 #include "mfr/image.hpp"
 
 namespace mfr {
@@ -32,6 +34,9 @@ double weightedPercentile(std::vector<float> values, double p);
 // (perceptually uniform and readable in grey). Both take 1-channel images and throw mfr::Error
 // otherwise; heatmap also for maxValue ≤ 0.
 ImageRGBA8 magma(const ImageF& values);  // values in [0,1]
+// Entry `index` (clamped to [0, 255]) of matplotlib's magma table, RGB in [0, 1]; also a colour
+// map for surfaces coloured by a field (scene/color_map.hpp).
+glm::vec3 magmaEntry(int index);
 ImageRGBA8 heatmap(const ImageF& values, float maxValue);
 
 // Per-pixel absolute RGB difference (max over channels, in [0,1]) — input to heatmap().

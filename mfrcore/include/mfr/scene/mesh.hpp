@@ -26,6 +26,16 @@ struct Bounds {
   [[nodiscard]] double radius() const { return 0.5 * glm::length(max - min); }
 };
 
+// A named data array of the file a mesh was read from (VTK point or cell data): `components` values
+// per tuple, one tuple per position (point data) or per triangle, in index order (cell data).
+struct MeshField {
+  std::string name;
+  bool cellData = false;
+  int components = 1;
+  std::vector<float> values;
+  bool operator==(const MeshField&) const = default;
+};
+
 // Indexed triangle mesh in object space. normals always has one entry per position (loaders
 // compute them when the file has none); colors is empty or one RGBA per position, multiplied
 // with the object's material colour (unless the material sets vertexColors false).
@@ -34,6 +44,12 @@ struct Mesh {
   std::vector<glm::vec3> normals;
   std::vector<glm::vec4> colors;
   std::vector<std::uint32_t> indices;  // 3 per triangle
+  // The file's data arrays, in file order (point data, then cell data); what colorByField
+  // (scene/color_map.hpp) can colour the surface by.
+  std::vector<MeshField> fields;
+  // Empty, or one value per position: the field a material's FieldColors maps to colours
+  // (set by colorByField; interpolated across each triangle, then mapped, by both renderers).
+  std::vector<float> scalars;
 
   [[nodiscard]] std::size_t triangleCount() const { return indices.size() / 3; }
   [[nodiscard]] Bounds bounds() const;

@@ -15,12 +15,25 @@
 
 namespace mfr {
 
+// Colouring a surface by a field of its mesh (ParaView's "Color by"): the colour map turns each
+// value of Mesh::scalars, taken at a point of a triangle by interpolating its corners' values,
+// into the colour there. Set by colorByField (scene/color_map.hpp).
+struct FieldColors {
+  std::string field;              // what Mesh::scalars holds: "name", "name:N" or "name:magnitude"
+  std::string map = "cool-warm";  // colorMapNames()
+  glm::dvec2 range{0.0, 1.0};     // the values mapped to the map's two ends (clamped outside)
+  bool operator==(const FieldColors&) const = default;
+};
+
 struct Material {
   glm::vec4 color{0.8f, 0.8f, 0.8f, 0.5f};  // RGB display values in [0,1], A = opacity
   // Whether the mesh's per-vertex colours (Mesh::colors) multiply `color`. False once the part is
   // given a colour of its own (a scene file's "color", the viewer's colour picker): `color` then
   // replaces the file's colours, as it does for meshes without any.
   bool vertexColors = true;
+  // Set: the colour map of the mesh's scalars replaces `color`'s RGB and the vertex colours;
+  // `color.a` stays the opacity.
+  std::optional<FieldColors> fieldColors;
 };
 
 struct Object {

@@ -1,0 +1,68 @@
+#pragma once
+// Surfaces coloured by a field of their mesh (ParaView's "Color by"): the named colour maps, the
+// value → colour arithmetic both renderers share, and colorByField, which puts a field of the
+// mesh (Mesh::fields) into Mesh::scalars and sets the material's FieldColors.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/scene/mesh.hpp"
+#include "mfr/scene/scene.hpp"
+
+namespace mfr {
+
+struct ColorMap {
+  std::string name;
+  std::vector<glm::vec3> table;  // MFR_COLOR_MAP_SIZE entries evenly over [0, 1]
+  glm::vec3 nanColor{1.0f, 1.0f, 0.0f};
+};
+
+// "cool-warm" (Moreland's diverging map, ParaView's default), "viridis", "magma", "rainbow"
+// (blue → red through the hues) and "grayscale", in this order (the GPU's table rows).
+const std::vector<std::string>& colorMapNames();
+// Throws mfr::Error("colour map NAME", "unknown … (available: …)").
+const ColorMap& colorMap(const std::string& name);
+int colorMapIndex(const std::string& name);  // its row; throws like colorMap
+
+// The colour of `value` under `map` over [range.x, range.y]: clamped to the ends, the map's NaN
+// colour for NaN, the middle of the map for an empty range. The arithmetic of
+// shaders/common/color_map.glsl, in the same float precision.
+glm::vec3 mapFieldValue(const ColorMap& map, float value, const glm::vec2& range);
+
+// The fields a mesh can be coloured by: each of Mesh::fields by name and, for one of several
+// components (a vector), also "name:N" for N ≥ 1 and "name:magnitude" ("name" is component 0).
+std::vector<std::string> fieldNames(const Mesh& mesh);
+
+// One value per tuple of `field` (a name of fieldNames) and whether it is cell data. Throws
+// FieldNotFound(what, …) listing the fields there are.
+struct FieldValues {
+  std::vector<float> values;
+  bool cellData = false;
+};
+FieldValues fieldValues(const Mesh& mesh, const std::string& field, const std::string& what);
+
+// The smallest and largest finite value (an empty span widened to value ± 1; [0, 1] without any).
+glm::dvec2 fieldRange(const std::vector<float>& values);
+
+// Colours `object` by `field` of its mesh with `map` over `range` (default: fieldRange of the
+// field). The object gets a mesh of its own (others sharing its mesh keep theirs) whose scalars
+// hold the field: per vertex for point data; for cell data every triangle gets corners of its own,
+// all with its value (the mesh's point fields are carried along). Throws FieldNotFound for a field
+// the mesh does not have, mfr::Error for an unknown map or a range that is not finite with
+// low < high — naming `object.name`.
+void colorByField(Object& object, const std::string& field, const std::string& map = "cool-warm",
+                  const std::optional<glm::dvec2>& range = std::nullopt);
+
+// Whether the mesh has the array `field` names ("name", or the array before ":N" / ":magnitude").
+bool hasField(const Mesh& mesh, const std::string& field);
+
+// colorByField on every object whose mesh has the field (hasField), all with one range: `range`, or
+// the field's range over all of them (as ParaView maps a multi-block dataset). Returns how many it
+// coloured; none is FieldNotFound(what, …) listing the fields the objects have. Other refusals as
+// colorByField's (an unknown map, a bad range, a component the array lacks).
+std::size_t colorObjectsByField(const std::vector<Object*>& objects, const std::string& field, const std::string& map,
+                                const std::optional<glm::dvec2>& range, const std::string& what);
+
+}  // namespace mfr

@@ -1,0 +1,263 @@
+#include "mfr/scene/color_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include <vtkColorTransferFunction.h>
+#include <vtkNew.h>
+
+#include "common/bindings.h"
+#include "mfr/error.hpp"
+#include "mfr/reference/metrics.hpp"
+
+namespace mfr {
+namespace {
+
+struct Stop {
+  double x;
+  double r, g, b;
+};
+
+// The table of a map given by stops, interpolated by VTK's colour transfer function in `space`
+// (VTK_CTF_RGB, _HSV, _LAB, _DIVERGING): the colour science is VTK's, as in ParaView.
+ColorMap sampled(std::string name, const std::vector<Stop>& stops, int space, glm::vec3 nan) {
+  vtkNew<vtkColorTransferFunction> f;
+  f->SetColorSpace(space);
+  f->HSVWrapOff();  // hue from blue down to red through green, not through magenta
+  for (const Stop& s : stops) f->AddRGBPoint(s.x, s.r, s.g, s.b);
+  ColorMap map{std::move(name), {}, nan};
+  map.table.resize(MFR_COLOR_MAP_SIZE);
+  for (int i = 0; i < MFR_COLOR_MAP_SIZE; ++i) {
+    double rgb[3];
+    f->GetColor(static_cast<double>(i) / (MFR_COLOR_MAP_SIZE - 1), rgb);
+    map.table[static_cast<std::size_t>(i)] = glm::clamp(glm::vec3(rgb[0], rgb[1], rgb[2]), 0.0f, 1.0f);
+  }
+  return map;
+}
+
+std::vector<ColorMap> makeMaps() {
+  std::vector<ColorMap> maps;
+  // ParaView's "Cool to Warm": Moreland's end points, interpolated in his Msh space.
+  maps.push_back(sampled("cool-warm",
+                         {{0.0, 0.231372549, 0.298039216, 0.752941176}, {1.0, 0.705882353, 0.015686275, 0.149019608}},
+                         VTK_CTF_DIVERGING, {1.0f, 1.0f, 0.0f}));
+  // matplotlib's viridis at nine evenly spaced entries (#440154 … #FDE725), in CIELAB between them.
+  const auto hex = [](double x, unsigned rgb) {
+    return Stop{x, ((rgb >> 16) & 0xFF) / 255.0, ((rgb >> 8) & 0xFF) / 255.0, (rgb & 0xFF) / 255.0};
+  };
+  maps.push_back(
+      sampled("viridis",
+              {hex(0.0, 0x440154), hex(0.125, 0x472D7B), hex(0.25, 0x3B528B), hex(0.375, 0x2C728E), hex(0.5, 0x21908C),
+               hex(0.625, 0x27AD81), hex(0.75, 0x5DC863), hex(0.875, 0xAADC32), hex(1.0, 0xFDE725)},
+              VTK_CTF_LAB, {1.0f, 0.0f, 0.0f}));
+  // matplotlib's magma, all 256 entries (the table FLIP's error maps use).
+  ColorMap magma{"magma", {}, {0.0f, 1.0f, 0.0f}};
+  static_assert(MFR_COLOR_MAP_SIZE == 256, "magma has 256 entries");
+  for (int i = 0; i < MFR_COLOR_MAP_SIZE; ++i) magma.table.push_back(magmaEntry(i));
+  maps.push_back(std::move(magma));
+  // ParaView's "Blue to Red Rainbow": hue from 2/3 to 0 at full saturation and value.
+  maps.push_back(sampled("rainbow", {{0.0, 0.0, 0.0, 1.0}, {1.0, 1.0, 0.0, 0.0}}, VTK_CTF_HSV,
+                         {0.498039216f, 0.498039216f, 0.498039216f}));
+  maps.push_back(sampled("grayscale", {{0.0, 0.0, 0.0, 0.0}, {1.0, 1.0, 1.0, 1.0}}, VTK_CTF_RGB, {1.0f, 0.0f, 0.0f}));
+  return maps;
+}
+
+const std::vector<ColorMap>& maps() {
+  static const std::vector<ColorMap> all = makeMaps();
+  return all;
+}
+
+std::string list(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+}  // namespace
+
+const std::vector<std::string>& colorMapNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const ColorMap& m : maps()) n.push_back(m.name);
+    return n;
+  }();
+  return names;
+}
+
+int colorMapIndex(const std::string& name) {
+  const std::vector<ColorMap>& all = maps();
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if (all[i].name == name) return static_cast<int>(i);
+  throw Error("colour map " + name, "unknown colour map (available: " + list(colorMapNames()) + ")");
+}
+
+const ColorMap& colorMap(const std::string& name) {
+  return maps()[static_cast<std::size_t>(colorMapIndex(name))];
+}
+
+glm::vec3 mapFieldValue(const ColorMap& map, float value, const glm::vec2& range) {
+  if (std::isnan(value)) return map.nanColor;
+  const float span = range.y - range.x;
+  const float t = span > 0.0f ? std::clamp((value - range.x) / span, 0.0f, 1.0f) : 0.5f;
+  const float x = t * static_cast<float>(MFR_COLOR_MAP_SIZE - 1);
+  const int i = std::min(static_cast<int>(x), MFR_COLOR_MAP_SIZE - 2);
+  const glm::vec3 a = map.table[static_cast<std::size_t>(i)], b = map.table[static_cast<std::size_t>(i) + 1];
+  return glm::mix(a, b, x - static_cast<float>(i));
+}
+
+std::vector<std::string> fieldNames(const Mesh& mesh) {
+  std::vector<std::string> names;
+  for (const MeshField& f : mesh.fields) {
+    names.push_back(f.name);
+    for (int c = 1; c < f.components; ++c) names.push_back(f.name + ":" + std::to_string(c));
+    if (f.components > 1) names.push_back(f.name + ":magnitude");
+  }
+  return names;
+}
+
+FieldValues fieldValues(const Mesh& mesh, const std::string& field, const std::string& what) {
+  const auto find = [&](const std::string& name) -> const MeshField* {
+    for (const MeshField& f : mesh.fields)
+      if (f.name == name) return &f;
+    return nullptr;
+  };
+  const MeshField* array = find(field);
+  int component = 0;  // -1: the magnitude
+  if (array == nullptr) {
+    const std::size_t colon = field.rfind(':');
+    if (colon != std::string::npos && colon > 0) array = find(field.substr(0, colon));
+    if (array != nullptr) {
+      const std::string base = field.substr(0, colon), which = field.substr(colon + 1);
+      const bool digits = !which.empty() && which.size() < 4 &&
+                          std::all_of(which.begin(), which.end(), [](char c) { return c >= '0' && c <= '9'; });
+      if (which == "magnitude")
+        component = -1;
+      else if (digits && std::stoi(which) < array->components)
+        component = std::stoi(which);
+      else
+        throw FieldNotFound(what, "array '" + base + "' has " + std::to_string(array->components) + " component" +
+                                      (array->components == 1 ? "" : "s") + " (" + base + ":0 … " + base + ":" +
+                                      std::to_string(array->components - 1) + ", or " + base + ":magnitude)");
+    }
+  }
+  if (array == nullptr) {
+    const std::vector<std::string> names = fieldNames(mesh);
+    throw FieldNotFound(what, "no point-data or cell-data array '" + field + "' (" +
+                                  (names.empty() ? std::string("it has none") : "fields: " + list(names)) + ")");
+  }
+  const auto n = static_cast<std::size_t>(array->components);
+  FieldValues out{std::vector<float>(array->values.size() / n), array->cellData};
+  for (std::size_t t = 0; t < out.values.size(); ++t) {
+    if (component >= 0) {
+      out.values[t] = array->values[t * n + static_cast<std::size_t>(component)];
+    } else {
+      double sum = 0.0;
+      for (std::size_t c = 0; c < n; ++c) sum += double(array->values[t * n + c]) * array->values[t * n + c];
+      out.values[t] = static_cast<float>(std::sqrt(sum));
+    }
+  }
+  return out;
+}
+
+glm::dvec2 fieldRange(const std::vector<float>& values) {
+  double low = std::numeric_limits<double>::infinity(), high = -low;
+  for (const float v : values)
+    if (std::isfinite(v)) {
+      low = std::min(low, double(v));
+      high = std::max(high, double(v));
+    }
+  if (!(low <= high)) return {0.0, 1.0};
+  if (low == high) return {low - 1.0, high + 1.0};
+  return {low, high};
+}
+
+void colorByField(Object& object, const std::string& field, const std::string& map,
+                  const std::optional<glm::dvec2>& range) {
+  const std::string what = object.name.empty() ? std::string("object") : object.name;
+  if (!object.mesh) throw Error(what, "has no mesh to colour");
+  colorMapIndex(map);  // an unknown name throws
+  if (range && !(std::isfinite(range->x) && std::isfinite(range->y) && range->x < range->y))
+    throw Error(what, "colour range must be two finite values, low < high");
+  const Mesh& source = *object.mesh;
+  FieldValues values = fieldValues(source, field, what);
+  auto mesh = std::make_shared<Mesh>();
+  if (!values.cellData) {
+    *mesh = source;
+    mesh->scalars = values.values;
+  } else {
+    // Corners of its own for every triangle, so that its value is constant across it.
+    const std::size_t corners = source.indices.size();
+    mesh->positions.reserve(corners);
+    for (std::size_t c = 0; c < corners; ++c) {
+      const std::uint32_t v = source.indices[c];
+      mesh->positions.push_back(source.positions[v]);
+      if (!source.normals.empty()) mesh->normals.push_back(source.normals[v]);
+      if (!source.colors.empty()) mesh->colors.push_back(source.colors[v]);
+      mesh->indices.push_back(static_cast<std::uint32_t>(c));
+      mesh->scalars.push_back(values.values[c / 3]);
+    }
+    for (const MeshField& f : source.fields) {
+      if (f.cellData) {
+        mesh->fields.push_back(f);
+        continue;
+      }
+      MeshField corner{f.name, false, f.components, {}};
+      const auto n = static_cast<std::size_t>(f.components);
+      corner.values.reserve(corners * n);
+      for (std::size_t c = 0; c < corners; ++c)
+        for (std::size_t k = 0; k < n; ++k) corner.values.push_back(f.values[source.indices[c] * n + k]);
+      mesh->fields.push_back(std::move(corner));
+    }
+  }
+  object.mesh = std::move(mesh);
+  object.material.fieldColors = FieldColors{field, map, range ? *range : fieldRange(values.values)};
+}
+
+bool hasField(const Mesh& mesh, const std::string& field) {
+  const std::size_t colon = field.rfind(':');
+  for (const MeshField& f : mesh.fields)
+    if (f.name == field || (colon != std::string::npos && f.name == field.substr(0, colon))) return true;
+  return false;
+}
+
+std::size_t colorObjectsByField(const std::vector<Object*>& objects, const std::string& field, const std::string& map,
+                                const std::optional<glm::dvec2>& range, const std::string& what) {
+  colorMapIndex(map);
+  if (range && !(std::isfinite(range->x) && std::isfinite(range->y) && range->x < range->y))
+    throw Error(what, "colour range must be two finite values, low < high");
+  std::vector<Object*> having;
+  std::vector<std::string> available;
+  glm::dvec2 span(std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity());
+  for (Object* o : objects) {
+    if (o == nullptr || !o->mesh) continue;
+    if (!hasField(*o->mesh, field)) {
+      for (const std::string& n : fieldNames(*o->mesh))
+        if (std::find(available.begin(), available.end(), n) == available.end()) available.push_back(n);
+      continue;
+    }
+    const FieldValues values = fieldValues(*o->mesh, field, o->name);
+    const glm::dvec2 r = fieldRange(values.values);
+    const bool finite =
+        std::any_of(values.values.begin(), values.values.end(), [](float v) { return std::isfinite(v); });
+    if (finite) span = glm::dvec2(std::min(span.x, r.x), std::max(span.y, r.y));
+    having.push_back(o);
+  }
+  if (having.empty())
+    throw FieldNotFound(what, "no point-data or cell-data array '" + field + "' (" +
+                                  (available.empty() ? std::string("it has none") : "fields: " + list(available)) +
+                                  ")");
+  // One range for all: the union of the parts' ranges (fieldRange's rules when it is empty).
+  glm::dvec2 shared = range.value_or(span);
+  if (!range) {
+    if (!(span.x <= span.y))
+      shared = {0.0, 1.0};
+    else if (span.x == span.y)
+      shared = {span.x - 1.0, span.y + 1.0};
+  }
+  for (Object* o : having) colorByField(*o, field, map, shared);
+  return having.size();
+}
+
+}  // namespace mfr

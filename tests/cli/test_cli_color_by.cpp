@@ -1,0 +1,180 @@
+// --color-by end to end on a VTP sheet with point and cell data: mfr info lists the fields and
+// their ranges, the GPU image equals the oracle's, the map and the range show, a pixel of a sheet
+// seen head-on is exactly the map's colour, a scene file's "color_by" draws the same image as the
+// options, and bad fields, maps and ranges are one line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <string>
+
+#include "mfr/image.hpp"
+#include "mfr/reference/metrics.hpp"
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using mfr::test::CliResult;
+using mfr::test::runCli;
+
+using CliColorBy = mfr::test::CliTest;
+
+constexpr int kN = 9;  // points per side of the sheet
+
+// A flat sheet of 9 × 9 points over [-2, 2]² at z = 0, facing +Z, as ASCII VTK XML PolyData:
+// point data "pressure" = x + y² / 4 (from −2 to 3) and "velocity" (3 components), cell data
+// "zone" = 1 on the left half of the quads, 2 on the right.
+std::string sheet() {
+  std::ostringstream points, pressure, velocity, connectivity, offsets, zone;
+  for (int j = 0; j < kN; ++j)
+    for (int i = 0; i < kN; ++i) {
+      const double x = -2.0 + 4.0 * i / (kN - 1), y = -2.0 + 4.0 * j / (kN - 1);
+      points << x << " " << y << " 0 ";
+      pressure << x + y * y / 4.0 << " ";
+      velocity << y << " " << -x << " 1 ";
+    }
+  int quads = 0;
+  for (int j = 0; j + 1 < kN; ++j)
+    for (int i = 0; i + 1 < kN; ++i) {
+      const int a = j * kN + i;
+      connectivity << a << " " << a + 1 << " " << a + 1 + kN << " " << a + kN << " ";
+      offsets << 4 * ++quads << " ";
+      zone << (i < (kN - 1) / 2 ? 1 : 2) << " ";
+    }
+  std::ostringstream s;
+  s << R"(<?xml version="1.0"?>
+<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">
+  <PolyData>
+    <Piece NumberOfPoints=")"
+    << kN * kN << R"(" NumberOfVerts="0" NumberOfLines="0" NumberOfStrips="0" NumberOfPolys=")" << quads << R"(">
+      <PointData>
+        <DataArray type="Float32" Name="pressure" format="ascii">)"
+    << pressure.str() << R"(</DataArray>
+        <DataArray type="Float32" Name="velocity" NumberOfComponents="3" format="ascii">)"
+    << velocity.str() << R"(</DataArray>
+      </PointData>
+      <CellData>
+        <DataArray type="Int32" Name="zone" format="ascii">)"
+    << zone.str() << R"(</DataArray>
+      </CellData>
+      <Points>
+        <DataArray type="Float32" NumberOfComponents="3" format="ascii">)"
+    << points.str() << R"(</DataArray>
+      </Points>
+      <Polys>
+        <DataArray type="Int32" Name="connectivity" format="ascii">)"
+    << connectivity.str() << R"(</DataArray>
+        <DataArray type="Int32" Name="offsets" format="ascii">)"
+    << offsets.str() << R"(</DataArray>
+      </Polys>
+    </Piece>
+  </PolyData>
+</VTKFile>
+)";
+  return s.str();
+}
+
+TEST_F(CliColorBy, InfoListsTheFieldsWithTheirRanges) {
+  const fs::path file = write("sheet.vtp", sheet());
+  const CliResult r = runCli("info " + file.string() + " --no-histogram");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("fields: pressure [-2, 3] velocity [-2, 2] velocity:1 [-2, 2] velocity:2 [0, 2] "
+                       "velocity:magnitude [1, 3] zone (cells) [1, 2]"),
+            std::string::npos)
+      << r.out;
+}
+
+TEST_F(CliColorBy, GpuEqualsOracleAndTheMapAndRangeShow) {
+  const fs::path file = write("sheet.vtp", sheet());
+  // 60 × 50: no pixel centre lies on the sheet's grid lines (there ray casting and rasterisation
+  // may disagree on which triangle the pixel sees: the oracle's edge pixels).
+  const std::string common = "render " + file.string() + " --size 60x50 --opacity 0.7 ";
+  const auto image = [&](const std::string& args, const std::string& name) {
+    const fs::path out = dir() / name;
+    const CliResult r = runCli(common + args + " -o " + out.string());
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    return mfr::readPng(out);
+  };
+  const mfr::ImageRGBA8 plain = image("-m abuffer-ll", "plain.png");
+  const mfr::ImageRGBA8 gpu = image("-m abuffer-ll --color-by pressure", "gpu.png");
+  const mfr::ImageRGBA8 oracle = image("--color-by pressure", "oracle.png");
+  const mfr::ImageRGBA8 viridis = image("-m abuffer-ll --color-by pressure --color-map viridis", "viridis.png");
+  const mfr::ImageRGBA8 narrow = image("-m abuffer-ll --color-by pressure --color-range 0,1", "narrow.png");
+  const mfr::ImageRGBA8 zone = image("-m kplus-array -p k=4 --color-by zone --color-map grayscale", "zone.png");
+  const mfr::ImageRGBA8 zoneOracle = image("--color-by zone --color-map grayscale", "zone-oracle.png");
+  EXPECT_LT(mfr::rmse(oracle, gpu), 0.01);
+  EXPECT_LT(mfr::rmse(zoneOracle, zone), 0.012);  // a few pixels on a diagonal edge differ
+  EXPECT_GT(mfr::rmse(plain, gpu), 0.05);
+  EXPECT_GT(mfr::rmse(gpu, viridis), 0.05);
+  EXPECT_GT(mfr::rmse(gpu, narrow), 0.02);
+  // Cell data: the left half of the sheet is the map's low end (black, over the white background
+  // at opacity 0.7: 0.3 · 255 ≈ 77), the right half its high end (white).
+  EXPECT_NEAR(zone.at(18, 25)[0], 77, 2);
+  EXPECT_NEAR(zone.at(42, 25)[0], 255, 1);
+  EXPECT_LT(plain.at(42, 25)[0], 240);  // the sheet is there (its grey over the background)
+}
+
+TEST_F(CliColorBy, AHeadOnPixelIsExactlyTheMapsColour) {
+  // Opaque, seen head-on (the headlight gives full light): every pixel of the sheet is the map's
+  // colour of its value; with the range above every value, cool-warm's low end, Moreland's
+  // (59, 76, 192).
+  const fs::path file = write("sheet.vtp", sheet());
+  const fs::path out = dir() / "low.png";
+  const CliResult r =
+      runCli("render " + file.string() +
+             " --size 32x32 --opacity 1 -m abuffer-ll --color-by pressure --color-range 10,20 -o " + out.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const mfr::ImageRGBA8 low = mfr::readPng(out);
+  for (const auto& [x, y] : {std::pair{16, 16}, {10, 20}, {22, 9}}) {
+    EXPECT_EQ(low.at(x, y)[0], 59) << x << "," << y;
+    EXPECT_EQ(low.at(x, y)[1], 76);
+    EXPECT_EQ(low.at(x, y)[2], 192);
+  }
+}
+
+TEST_F(CliColorBy, SceneFileColorByEqualsTheOptions) {
+  const fs::path file = write("sheet.vtp", sheet());
+  const fs::path scene = write("s.mfrscene", R"({"objects": [{"file": "sheet.vtp", "opacity": 0.7,
+         "color_by": {"field": "velocity:magnitude", "map": "magma", "range": [1, 2.5]}}]})");
+  const fs::path fromFile = dir() / "f.png", fromOptions = dir() / "o.png";
+  ASSERT_EQ(runCli("render " + scene.string() + " --size 48x48 -m abuffer-ll -o " + fromFile.string()).exitCode, 0);
+  const CliResult r =
+      runCli("render " + file.string() +
+             " --size 48x48 --opacity 0.7 -m abuffer-ll --color-by velocity:magnitude --color-map magma "
+             "--color-range 1,2.5 -o " +
+             fromOptions.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_EQ(mfr::rmse(mfr::readPng(fromFile), mfr::readPng(fromOptions)), 0.0);
+  // The scene file's short form: a field name alone (cool-warm over the data range).
+  const fs::path shortForm = write("short.mfrscene", R"({"objects": [{"file": "sheet.vtp", "color_by": "pressure"}]})");
+  const fs::path a = dir() / "a.png", b = dir() / "b.png";
+  ASSERT_EQ(runCli("render " + shortForm.string() + " --size 32x32 -m abuffer-ll -o " + a.string()).exitCode, 0);
+  ASSERT_EQ(
+      runCli("render " + file.string() + " --size 32x32 -m abuffer-ll --color-by pressure -o " + b.string()).exitCode,
+      0);
+  EXPECT_EQ(mfr::rmse(mfr::readPng(a), mfr::readPng(b)), 0.0);
+}
+
+TEST_F(CliColorBy, BadFieldsMapsAndRangesAreOneLine) {
+  const fs::path file = write("sheet.vtp", sheet());
+  const std::string render = "render " + file.string() + " --size 16x16 ";
+  expectCleanFailure(render + "--color-by nope",
+                     "no point-data or cell-data array 'nope' (fields: pressure, velocity, "
+                     "velocity:1, velocity:2, velocity:magnitude, zone)");
+  expectCleanFailure(render + "--color-by velocity:3", "array 'velocity' has 3 components");
+  expectCleanFailure(render + "--color-by pressure --color-map jet", "--color-map jet: unknown colour map");
+  expectCleanFailure(render + "--color-by pressure --color-range 2,1", "--color-range 2,1: expected LO,HI");
+  expectCleanFailure(render + "--color-by pressure --color-range 0,nan", "--color-range 0,nan");
+  expectCleanFailure(render + "--color-map viridis", "--color-map viridis: needs --color-by");
+  expectCleanFailure("render @sample --size 16x16 --color-by pressure", "(it has none)");
+  const fs::path bad = write("bad.mfrscene", R"({"objects": [{"file": "sheet.vtp", "color_by": {"field": "nope"}}]})");
+  expectCleanFailure("render " + bad.string() + " --size 16x16", "objects[0].color_by: sheet.vtp: no point-data");
+  const fs::path badMap =
+      write("map.mfrscene", R"({"objects": [{"file": "sheet.vtp", "color_by": {"field": "zone", "map": "jet"}}]})");
+  expectCleanFailure("render " + badMap.string() + " --size 16x16", "objects[0].color_by.map: unknown colour map");
+}
+
+}  // namespace
