@@ -263,5 +263,67 @@ TEST(FieldColoring, ASectionCarriesTheFieldOntoItsCutAndCaps) {
   EXPECT_TRUE(cut.objects[0].material.fieldColors);
 }
 
+// PLY files carry fields as extra scalar properties (MeshLab's "quality", a scanner's
+// "confidence"): per vertex and per face, ASCII and binary alike.
+TEST(FieldColoring, PlyScalarPropertiesAreFields) {
+  const test::TempDir dir;
+  // Five vertices: a unit square and one corner above it; a triangle and a quad.
+  const float xyz[5][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {2, 0, 1}};
+  std::string header =
+      "ply\nformat FORMAT 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+      "property float z\nproperty float quality\nproperty uchar red\nproperty uchar green\n"
+      "property uchar blue\nproperty uchar confidence\nelement face 2\n"
+      "property list uchar int vertex_indices\nproperty int flags\nend_header\n";
+  std::string ascii = header, binary = header;
+  ascii.replace(ascii.find("FORMAT"), 6, "ascii");
+  binary.replace(binary.find("FORMAT"), 6, "binary_little_endian");
+  const auto put = [&binary](const auto& v) { binary.append(reinterpret_cast<const char*>(&v), sizeof(v)); };
+  for (int v = 0; v < 5; ++v) {
+    const float quality = 10.0f * xyz[v][0] + xyz[v][1];
+    const auto confidence = static_cast<std::uint8_t>(50 * v);
+    ascii += std::to_string(xyz[v][0]) + " " + std::to_string(xyz[v][1]) + " " + std::to_string(xyz[v][2]) + " " +
+             std::to_string(quality) + " 200 100 50 " + std::to_string(confidence) + "\n";
+    for (float c : xyz[v]) put(c);
+    put(quality);
+    put(std::uint8_t{200});
+    put(std::uint8_t{100});
+    put(std::uint8_t{50});
+    put(confidence);
+  }
+  ascii += "3 1 4 2 7\n4 0 1 2 3 -3\n";
+  put(std::uint8_t{3});
+  for (int i : {1, 4, 2}) put(i);
+  put(7);
+  put(std::uint8_t{4});
+  for (int i : {0, 1, 2, 3}) put(i);
+  put(-3);
+  for (const auto& [file, bytes] : {std::pair{"a.ply", ascii}, {"b.ply", binary}}) {
+    SCOPED_TRACE(file);
+    const std::vector<Object> parts = loadModel(dir.write(file, bytes));
+    ASSERT_EQ(parts.size(), 1u);
+    const Mesh& m = *parts[0].mesh;
+    EXPECT_EQ(fieldNames(m), (std::vector<std::string>{"quality", "confidence", "flags"}));
+    ASSERT_EQ(m.colors.size(), m.positions.size());  // red, green, blue stay colours
+    const FieldValues quality = fieldValues(m, "quality", file), confidence = fieldValues(m, "confidence", file);
+    for (std::size_t v = 0; v < m.positions.size(); ++v) {
+      const glm::vec3 p = m.positions[v];
+      EXPECT_FLOAT_EQ(quality.values[v], 10.0f * p.x + p.y) << v;
+      int corner = 0;
+      while (corner < 5 && glm::vec3(xyz[corner][0], xyz[corner][1], xyz[corner][2]) != p) ++corner;
+      EXPECT_EQ(confidence.values[v], 50.0f * static_cast<float>(corner)) << v;
+    }
+    // The triangle (its corner at z = 1) has flags 7, the quad's two triangles −3.
+    const FieldValues flags = fieldValues(m, "flags", file);
+    ASSERT_TRUE(flags.cellData);
+    ASSERT_EQ(flags.values.size(), 3u);
+    for (std::size_t t = 0; t < 3; ++t) {
+      bool raised = false;
+      for (int k = 0; k < 3; ++k)
+        raised = raised || m.positions[m.indices[3 * t + static_cast<std::size_t>(k)]].z > 0.5f;
+      EXPECT_EQ(flags.values[t], raised ? 7.0f : -3.0f) << t;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace mfr

@@ -282,6 +282,23 @@ PolygonSoup parsePly(std::string_view bytes, const std::string& name) {
   const int ca = find(*vertexElement, {"alpha", "diffuse_alpha", "a"});
   const bool hasNormals = nx >= 0 && ny >= 0 && nz >= 0;
   const bool hasColors = cr >= 0 && cg >= 0 && cb >= 0;
+  // Every other scalar property is a field to colour by (MeshLab's "quality", a scanner's
+  // "confidence" or "intensity"): per vertex, and per face for the face element's scalars.
+  struct FieldProperty {
+    std::size_t property;
+    std::size_t field;
+  };
+  std::vector<FieldProperty> vertexFields, faceFields;
+  PolygonSoup soup;
+  for (std::size_t i = 0; i < vertexElement->properties.size(); ++i) {
+    const int index = static_cast<int>(i);
+    if (vertexElement->properties[i].list || index == px || index == py || index == pz ||
+        (hasNormals && (index == nx || index == ny || index == nz)) ||
+        (hasColors && (index == cr || index == cg || index == cb || index == ca)))
+      continue;
+    vertexFields.push_back({i, soup.fields.size()});
+    soup.fields.push_back(MeshField{vertexElement->properties[i].name, false, 1, {}});
+  }
 
   int faceList = -1;
   if (faceElement != nullptr) {
@@ -293,6 +310,11 @@ PolygonSoup parsePly(std::string_view bytes, const std::string& name) {
   }
   if (faceElement == nullptr || faceElement->count == 0)
     throw Error(name, "no triangles (the PLY file has no faces)");
+  for (std::size_t i = 0; i < faceElement->properties.size(); ++i)
+    if (!faceElement->properties[i].list) {
+      faceFields.push_back({i, soup.fields.size()});
+      soup.fields.push_back(MeshField{faceElement->properties[i].name, true, 1, {}});
+    }
 
   // Header counts against the data size, before anything is allocated.
   {
@@ -307,7 +329,6 @@ PolygonSoup parsePly(std::string_view bytes, const std::string& name) {
     }
   }
 
-  PolygonSoup soup;
   soup.points.reserve(vertexElement->count);
   if (hasNormals) soup.normals.reserve(vertexElement->count);
   if (hasColors) soup.colors.reserve(vertexElement->count);
@@ -344,7 +365,12 @@ PolygonSoup parsePly(std::string_view bytes, const std::string& name) {
         }
         if (keep) soup.addPolygon(polygon.data(), polygon.size());
       }
+      if (isFace)
+        for (const FieldProperty& f : faceFields)
+          soup.fields[f.field].values.push_back(static_cast<float>(values[f.property]));
       if (isVertex) {
+        for (const FieldProperty& f : vertexFields)
+          soup.fields[f.field].values.push_back(static_cast<float>(values[f.property]));
         soup.points.emplace_back(values[static_cast<std::size_t>(px)], values[static_cast<std::size_t>(py)],
                                  values[static_cast<std::size_t>(pz)]);
         if (hasNormals)
