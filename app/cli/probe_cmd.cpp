@@ -151,12 +151,16 @@ void addProbe(CLI::App& app) {
       std::snprintf(column, sizeof column, "  %-*s", methodWidth, held);
       return std::string(column);
     };
-    std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7s%s%s\n", "#", "eye depth", "part", "RGBA",
+    // Parts coloured by a field: each fragment's value there, in a last column.
+    const bool values =
+        std::any_of(probe.fragments.begin(), probe.fragments.end(), [](const ProbeFragment& f) { return f.hasValue; });
+    std::snprintf(line, sizeof line, "%4s  %12s  %-24s  %-15s  %-5s  %7s%s%s%s\n", "#", "eye depth", "part", "RGBA",
                   "faces", "weight", methodColumn(opt->method.c_str()).c_str(),
                   probe.hybrid       ? "   hybrid"
                   : probe.volume     ? "   volume"
                   : probe.zthickness ? "   zthick"
-                                     : "");
+                                     : "",
+                  values ? "  field value" : "");
     text << line;
     nlohmann::ordered_json fragments = nlohmann::ordered_json::array(), medium = nlohmann::ordered_json::array();
     // A stretch of the volume's medium that adds to the pixel: its mean colour and share.
@@ -195,9 +199,14 @@ void addProbe(CLI::App& app) {
       if (probe.hybrid) std::snprintf(share, sizeof share, "  %7.4f %s", f.hybridWeight, f.held ? "core" : "tail");
       if (probe.volume) std::snprintf(share, sizeof share, "  %7.4f", f.volumeWeight);
       if (probe.zthickness) std::snprintf(share, sizeof share, "  %7.4f", f.zthicknessWeight);
-      std::snprintf(line, sizeof line, "%4zu  %12.6g  %-24.24s  %-15s  %-5s  %7.4f%s%s\n", i + 1, f.eyeDepth,
+      std::string value;
+      if (f.hasValue)
+        value = "  " + scene.objects[object].material.fieldColors->field + " " + std::to_string(f.value);
+      else if (values)
+        value = "  -";
+      std::snprintf(line, sizeof line, "%4zu  %12.6g  %-24.24s  %-15s  %-5s  %7.4f%s%s%s\n", i + 1, f.eyeDepth,
                     part.c_str(), rgba(f.fragment.color).c_str(), f.fragment.frontFacing ? "front" : "back", f.weight,
-                    methodColumn(f.held ? "held" : "-").c_str(), share);
+                    methodColumn(f.held ? "held" : "-").c_str(), share, value.c_str());
       text << line;
       nlohmann::ordered_json j;
       j["depth"] = f.fragment.depth;
@@ -211,6 +220,10 @@ void addProbe(CLI::App& app) {
       if (probe.hybrid) j["hybrid_weight"] = f.hybridWeight;
       if (probe.volume) j["volume_weight"] = f.volumeWeight;
       if (probe.zthickness) j["zthickness_weight"] = f.zthicknessWeight;
+      if (f.hasValue) {
+        j["field"] = scene.objects[object].material.fieldColors->field;
+        j["field_value"] = f.value;
+      }
       fragments.push_back(j);
     }
     if (probe.volume) mediumRow(probe.fragments.size());

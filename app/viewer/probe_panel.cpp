@@ -42,7 +42,8 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
   table_ = new QTableWidget(0, ColumnCount, this);
   table_->setObjectName(QStringLiteral("probeTable"));
   table_->setHorizontalHeaderLabels({tr("#"), tr("Eye depth"), tr("Part"), tr("Colour"), tr("α"), tr("Faces"),
-                                     tr("Share"), tr("Held"), tr("Hybrid"), tr("Volume"), tr("Z-thickness")});
+                                     tr("Share"), tr("Held"), tr("Hybrid"), tr("Volume"), tr("Z-thickness"),
+                                     tr("Field value")});
   table_->horizontalHeaderItem(Share)->setToolTip(
       tr("The fragment's share of the pixel's colour: α·Π(1 − α) of the fragments in front of it"));
   table_->horizontalHeaderItem(Held)->setToolTip(
@@ -60,6 +61,9 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
       ->setToolTip(tr("With the operation zthickness: the surface's share of the blended colour (surfaces closer "
                       "than the thickness blend instead of covering each other)"));
   table_->setColumnHidden(ZThicknessShare, true);
+  table_->horizontalHeaderItem(FieldValue)
+      ->setToolTip(tr("For a part coloured by a field (Colour by): the field's value where the pixel's ray meets it"));
+  table_->setColumnHidden(FieldValue, true);
   table_->verticalHeader()->hide();
   table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   table_->horizontalHeader()->setSectionResizeMode(Part, QHeaderView::Stretch);
@@ -219,6 +223,12 @@ void ProbePanel::show(const ViewProbe& r) {
         i, ZThicknessShare,
         item(p.zthickness ? QString::number(100.0 * f.zthicknessWeight, 'f', 1) + QStringLiteral(" %") : QString(),
              right));
+    table_->setItem(i, FieldValue,
+                    item(f.hasValue ? QStringLiteral("%1 %2")
+                                          .arg(QString::fromStdString(objects[id].material.fieldColors->field))
+                                          .arg(static_cast<double>(f.value), 0, 'g', 6)
+                                    : QString(),
+                         right));
     if (p.captured && !f.held && !p.hybrid)  // dropped; a tail fragment still counts
       for (int c = 0; c < ColumnCount; ++c)
         if (c != Colour) table_->item(i, c)->setForeground(palette().color(QPalette::Disabled, QPalette::Text));
@@ -247,4 +257,6 @@ void ProbePanel::show(const ViewProbe& r) {
     table_->item(n, ZThicknessShare)->setTextAlignment(right);
   }
   table_->setColumnHidden(ZThicknessShare, !p.zthickness);
+  table_->setColumnHidden(FieldValue, std::none_of(p.fragments.begin(), p.fragments.end(),
+                                                   [](const mfr::ProbeFragment& f) { return f.hasValue; }));
 }

@@ -35,6 +35,7 @@ class ProbePanel final : public QWidget {
     HybridShare,
     VolumeShare,
     ZThicknessShare,
+    FieldValue,
     ColumnCount
   };
 

@@ -2876,6 +2876,29 @@ class ViewerTest : public QObject {
     auto* tree = w->findChild<QTreeWidget*>("sceneTree");
     QVERIFY(tree && tree->topLevelItemCount() == 1);
     QCOMPARE(tree->topLevelItem(0)->text(1), QStringLiteral("pressure"));
+    // The Probe dock gives the field's value under the pixel: mfr probe's at the same pixel.
+    {
+      auto* table = w->findChild<QTableWidget*>("probeTable");
+      QVERIFY(table);
+      QVERIFY(table->isColumnHidden(ProbePanel::FieldValue));
+      const QPoint pixel(80, 60);
+      QTest::mouseClick(&w->view(), Qt::LeftButton, Qt::ControlModifier, pixel);
+      QTRY_VERIFY_WITH_TIMEOUT(!table->isColumnHidden(ProbePanel::FieldValue), 20000);
+      const QString shown = table->item(0, ProbePanel::FieldValue)->text();
+      QVERIFY2(shown.startsWith(QStringLiteral("pressure ")), qPrintable(shown));
+      const QString json = dir.filePath("probe.json");
+      QString out;
+      QCOMPARE(runProgram(MFR_CLI,
+                          {"probe", scene, "--size", "160x120", "--view", "iso", "--pixel", "80,60", "--color-by",
+                           "pressure", "--json", json},
+                          &out),
+               0);
+      QFile f(json);
+      QVERIFY(f.open(QIODevice::ReadOnly));
+      const QJsonObject first =
+          QJsonDocument::fromJson(f.readAll()).object().value("fragments").toArray()[0].toObject();
+      QCOMPARE(shown, QStringLiteral("pressure %1").arg(first.value("field_value").toDouble(), 0, 'g', 6));
+    }
 
     map->setCurrentIndex(map->findText(QStringLiteral("viridis")));
     emit map->activated(map->currentIndex());

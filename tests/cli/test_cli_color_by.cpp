@@ -9,7 +9,12 @@
 #include <sstream>
 #include <string>
 
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
 #include "mfr/image.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "mfr/reference/metrics.hpp"
 #include "test_files.hpp"
 
@@ -133,6 +138,29 @@ TEST_F(CliColorBy, AHeadOnPixelIsExactlyTheMapsColour) {
     EXPECT_EQ(low.at(x, y)[1], 76);
     EXPECT_EQ(low.at(x, y)[2], 192);
   }
+}
+
+TEST_F(CliColorBy, TheProbeGivesEachFragmentsValue) {
+  // Opaque and head-on: the fragment's colour is exactly the map's colour of the value the probe
+  // reports, and the value lies in the field's range.
+  const fs::path file = write("sheet.vtp", sheet()), json = dir() / "probe.json";
+  const CliResult r =
+      runCli("probe " + file.string() +
+             " --size 40x40 --pixel 13,22 --opacity 1 --color-by pressure --color-map rainbow --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("field value"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("pressure "), std::string::npos) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["fragments"].size(), 1u);
+  const nlohmann::json& f = j["fragments"][0];
+  EXPECT_EQ(f["field"], "pressure");
+  const float value = f["field_value"].get<float>();
+  EXPECT_GT(value, -2.0f);
+  EXPECT_LT(value, 3.0f);
+  const glm::vec3 expected = mfr::mapFieldValue(mfr::colorMap("rainbow"), value, {-2.0f, 3.0f});
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(f["rgba"][static_cast<std::size_t>(c)].get<double>(), std::round(expected[c] * 255.0f), 1.0) << c;
 }
 
 TEST_F(CliColorBy, SceneFileColorByEqualsTheOptions) {

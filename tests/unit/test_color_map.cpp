@@ -15,6 +15,7 @@
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/reference/oracle.hpp"
+#include "mfr/reference/probe.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/primitives.hpp"
 #include "mfr/scene/section.hpp"
@@ -261,6 +262,35 @@ TEST(FieldColoring, ASectionCarriesTheFieldOntoItsCutAndCaps) {
   }
   EXPECT_GT(onPlane, 4);
   EXPECT_TRUE(cut.objects[0].material.fieldColors);
+}
+
+TEST(FieldColoring, TheProbeGivesTheFieldValueAtEachFragment) {
+  // Two squares facing the camera: in front (z = 0) coloured by x, behind (z = −2) first by
+  // nothing, then by v:1 (= y). Orthographic from +Z, 20 × 20 units on 40 × 40 pixels.
+  Scene scene;
+  scene.name = "squares";
+  for (const double z : {0.0, -2.0}) {
+    Object o;
+    o.name = z == 0.0 ? "front" : "back";
+    o.mesh = square();
+    o.transform[3] = glm::dvec4(0.0, 0.0, z, 1.0);
+    o.material.color.a = 0.5f;
+    scene.objects.push_back(o);
+  }
+  colorByField(scene.objects[0], "x", "viridis");
+  for (const auto& [c, r] : {std::pair{3, 5}, {20, 20}, {37, 11}, {26, 33}}) {
+    const PixelProbe p = probePixel(scene, topCamera(), 40, 40, c, r);
+    ASSERT_EQ(p.fragments.size(), 2u);
+    EXPECT_TRUE(p.fragments[0].hasValue);
+    EXPECT_NEAR(p.fragments[0].value, (c + 0.5) / 2.0 - 10.0, 1e-4) << c << "," << r;
+    EXPECT_FALSE(p.fragments[1].hasValue);
+  }
+  colorByField(scene.objects[1], "v:1", "magma");
+  const PixelProbe p = probePixel(scene, topCamera(), 40, 40, 26, 33);
+  ASSERT_EQ(p.fragments.size(), 2u);
+  EXPECT_NEAR(p.fragments[0].value, 26.5 / 2.0 - 10.0, 1e-4);
+  ASSERT_TRUE(p.fragments[1].hasValue);
+  EXPECT_NEAR(p.fragments[1].value, 10.0 - 33.5 / 2.0, 1e-4);
 }
 
 // PLY files carry fields as extra scalar properties (MeshLab's "quality", a scanner's

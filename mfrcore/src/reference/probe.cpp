@@ -17,6 +17,53 @@ std::uint32_t PixelProbe::heldCount() const {
   return n;
 }
 
+namespace {
+
+// The field value at each fragment of a field-coloured part: the ray through the pixel's centre
+// meets its part's triangles (Möller–Trumbore, in double); the hit nearest the fragment's eye
+// depth gives the barycentric weights for Mesh::scalars.
+void probeFieldValues(PixelProbe& probe, const Scene& scene, const Camera& camera) {
+  const double aspect = static_cast<double>(probe.width) / probe.height;
+  const glm::dmat4 view = camera.viewMatrix();
+  const glm::dmat4 toWorld = glm::inverse(camera.projectionMatrix(aspect) * view);
+  const glm::dvec2 ndc(2.0 * (probe.x + 0.5) / probe.width - 1.0, 1.0 - 2.0 * (probe.y + 0.5) / probe.height);
+  const glm::dvec4 nearH = toWorld * glm::dvec4(ndc, -1.0, 1.0), farH = toWorld * glm::dvec4(ndc, 1.0, 1.0);
+  const glm::dvec3 origin = glm::dvec3(nearH) / nearH.w, dir = glm::dvec3(farH) / farH.w - origin;
+  for (ProbeFragment& f : probe.fragments) {
+    const std::uint32_t id = f.fragment.objectId;
+    if (id >= scene.objects.size()) continue;
+    const Object& o = scene.objects[id];
+    if (!o.material.fieldColors || !o.mesh || o.mesh->scalars.size() != o.mesh->positions.size()) continue;
+    const Mesh& m = *o.mesh;
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+      glm::dvec3 p[3];
+      for (int k = 0; k < 3; ++k)
+        p[k] = glm::dvec3(o.transform *
+                          glm::dvec4(glm::dvec3(m.positions[m.indices[t + static_cast<std::size_t>(k)]]), 1.0));
+      const glm::dvec3 e1 = p[1] - p[0], e2 = p[2] - p[0], q = glm::cross(dir, e2);
+      const double det = glm::dot(e1, q);
+      if (std::abs(det) < 1e-300) continue;
+      const glm::dvec3 s = origin - p[0];
+      const double u = glm::dot(s, q) / det;
+      const glm::dvec3 r = glm::cross(s, e1);
+      const double v = glm::dot(dir, r) / det;
+      const double slack = 1e-9;  // a ray through an edge meets one of its triangles
+      if (u < -slack || v < -slack || u + v > 1.0 + slack) continue;
+      const glm::dvec3 hit = origin + (glm::dot(e2, r) / det) * dir;
+      const double eyeDepth = -(view * glm::dvec4(hit, 1.0)).z;
+      if (std::abs(eyeDepth - f.eyeDepth) >= best) continue;
+      best = std::abs(eyeDepth - f.eyeDepth);
+      const float w[3] = {static_cast<float>(1.0 - u - v), static_cast<float>(u), static_cast<float>(v)};
+      f.value = 0.0f;
+      for (int k = 0; k < 3; ++k) f.value += w[k] * m.scalars[m.indices[t + static_cast<std::size_t>(k)]];
+      f.hasValue = true;
+    }
+  }
+}
+
+}  // namespace
+
 PixelProbe probePixel(const Scene& scene, const Camera& camera, int width, int height, int x, int y,
                       const OracleOptions& options) {
   OracleOptions one = options;
@@ -45,6 +92,7 @@ PixelProbe probePixel(const Scene& scene, const Camera& camera, int width, int h
   }
   probe.transmittance = transmittance;
   probe.exactColor = compositeOver(sorted, scene.background);
+  probeFieldValues(probe, scene, camera);
   return probe;
 }
 

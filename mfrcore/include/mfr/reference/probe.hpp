@@ -27,6 +27,10 @@ struct ProbeFragment {
   double hybridWeight = 0.0;  // its share of the hybrid colour under the method's core/tail split (splitHybrid)
   double volumeWeight = 0.0;  // its share of the "volume" colour: α·T through surfaces and medium (splitVolume)
   double zthicknessWeight = 0.0;  // its share of the "zthickness" colour, blended with the slabs it overlaps
+  // Its part coloured by a field (Material::fieldColors): the field's value where the pixel's ray
+  // meets the surface (Mesh::scalars interpolated at the hit, as the colour was made).
+  bool hasValue = false;
+  float value = 0.0f;
 };
 
 // A stretch of the volumes' medium along the pixel's ray (splitVolume).
@@ -75,7 +79,9 @@ struct PixelProbe {
 };
 
 // The probe of pixel (x, y) of a width × height image (throws mfr::Error for a pixel outside it,
-// an empty scene or a bad camera, like castFragments). Casts only that pixel.
+// an empty scene or a bad camera, like castFragments). Casts only that pixel; the field value of
+// every fragment of a field-coloured part comes from the triangle of its part that the pixel's ray
+// meets at the fragment's depth.
 PixelProbe probePixel(const Scene& scene, const Camera& camera, int width, int height, int x, int y,
                       const OracleOptions& options = {});
 
