@@ -49,6 +49,10 @@
 // colour of NaN at x = MFR_COLOR_MAP_SIZE.
 #define MFR_TEX_COLOR_MAPS 12
 #define MFR_COLOR_MAP_SIZE 256
+// Before interpolation each vertex's value is clamped to the range widened by this many spans on
+// either side: infinities (and values so large that their differences overflow) would otherwise
+// interpolate into NaN on the GPU. Beyond the range the map saturates, so colours barely change.
+#define MFR_COLOR_MAP_BAND 1000.0
 
 // Invalid index / end of a linked list
 #define MFR_NIL 0xFFFFFFFFu

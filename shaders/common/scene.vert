@@ -13,6 +13,7 @@ uniform mat4 uModel;
 uniform mat3 uNormalMatrix;
 uniform vec4 uColor;
 uniform int uVertexColors;  // 0: the object's colour replaces the mesh's per-vertex colours
+uniform vec2 uColorMapRange;  // common/color_map.glsl: the field's values at the map's ends
 // Scene::clipBox (world space): distances to its six faces, positive inside. GL clips with them
 // only while GpuScene::draw enables GL_CLIP_DISTANCE0…5 (a scene with a clip box).
 uniform vec3 uClipMin;
@@ -30,7 +31,9 @@ invariant gl_Position;
 void main() {
   vNormal = uNormalMatrix * aNormal;
   vColor = uVertexColors != 0 ? uColor * aColor : uColor;
-  vScalar = aScalar;
+  // Bounded before interpolation (MFR_COLOR_MAP_BAND), as mfr::boundFieldValue does; NaN stays NaN.
+  float band = float(MFR_COLOR_MAP_BAND) * (uColorMapRange.y - uColorMapRange.x);
+  vScalar = isnan(aScalar) ? aScalar : clamp(aScalar, uColorMapRange.x - band, uColorMapRange.y + band);
   vec4 world = uModel * vec4(aPosition, 1.0);
   gl_Position = uViewProj * world;
   vec3 below = world.xyz - uClipMin, above = uClipMax - world.xyz;

@@ -4,6 +4,7 @@
 // methods, a k-buffer and depth peeling, and on a sectioned scene whose caps carry the field.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -129,6 +130,38 @@ TEST(FieldColorsGpu, SectionCapsCarryTheField) {
   const std::uint8_t* right = image.at(58, 40);
   EXPECT_GT(left[2], left[0]);
   EXPECT_GT(right[0], right[2]);
+}
+
+TEST(FieldColorsGpu, NaNAndInfiniteValuesAreDrawnAsTheOracleDrawsThem) {
+  // Some values missing (NaN: the map's NaN colour on every triangle touching them) and some out
+  // of any range (±infinity: the map's ends).
+  context();
+  Scene scene = fieldScene();
+  auto sphere = std::make_shared<Mesh>(*scene.objects[0].mesh);
+  for (std::size_t v = 0; v < sphere->positions.size(); ++v) {
+    float& h = sphere->fields[0].values[v];
+    if (v % 17 == 3) h = std::numeric_limits<float>::quiet_NaN();
+    if (v % 23 == 5) h = (v % 2 == 0 ? 1.0f : -1.0f) * std::numeric_limits<float>::infinity();
+  }
+  scene.objects[0].mesh = sphere;
+  scene.objects.resize(1);
+  colorByField(scene.objects[0], "height", "viridis");
+  EXPECT_EQ(scene.objects[0].material.fieldColors->range, glm::dvec2(-1.0, 1.0));  // the finite values' range
+  const Camera camera = scene.fit(view());
+  RenderRequest req;
+  req.method = "abuffer-ll";
+  req.width = 80;
+  req.height = 80;
+  const OracleMatch m = expectGpuMatchesOracle(scene, camera, req);
+  EXPECT_GT(m.lists.compared, 2000u);
+  // The NaN colour (red for viridis) shows.
+  std::size_t red = 0;
+  for (int y = 0; y < 80; ++y)
+    for (int x = 0; x < 80; ++x) {
+      const std::uint8_t* p = m.out.image.at(x, y);
+      red += p[0] > 200 && p[1] < 140 && p[2] < 140 ? 1 : 0;
+    }
+  EXPECT_GT(red, 50u);
 }
 
 }  // namespace

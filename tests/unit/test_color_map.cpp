@@ -99,6 +99,11 @@ TEST(ColorMaps, ValuesAreClampedInterpolatedAndNaNHasItsColour) {
   const glm::vec3 half = 0.5f * (m.table[127] + m.table[128]);
   EXPECT_NEAR(mapFieldValue(m, 15.0f, range).r, half.r, 1e-6f);
   EXPECT_NEAR(mapFieldValue(m, 12.5f, range).g, 0.25f, 1e-6f);
+  // Before interpolation vertices are bounded to the range ± 1000 spans; NaN stays missing.
+  EXPECT_EQ(boundFieldValue(std::numeric_limits<float>::infinity(), {0.0f, 1.0f}), 1001.0f);
+  EXPECT_EQ(boundFieldValue(-std::numeric_limits<float>::infinity(), {0.0f, 1.0f}), -1000.0f);
+  EXPECT_EQ(boundFieldValue(0.25f, {0.0f, 1.0f}), 0.25f);
+  EXPECT_TRUE(std::isnan(boundFieldValue(std::numeric_limits<float>::quiet_NaN(), {0.0f, 1.0f})));
   // An empty range maps everything to the middle.
   EXPECT_NEAR(mapFieldValue(m, 3.0f, {1.0f, 1.0f}).b, 0.5f, 1e-6f);
   EXPECT_EQ(colorMapNames().size(), 5u);

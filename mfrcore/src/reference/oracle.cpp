@@ -238,7 +238,8 @@ std::uint32_t shade(const WorldTriangle& tri, const ObjectShading& obj, double u
   if (obj.colorMap != nullptr) {
     // Interpolated, then mapped, as common/color_map.glsl does (in float, as the GPU's varying).
     float value = 0.0f;
-    for (int k = 0; k < 3; ++k) value += static_cast<float>(w[k]) * mesh.scalars[tri.vertex[k]];
+    for (int k = 0; k < 3; ++k)
+      value += static_cast<float>(w[k]) * boundFieldValue(mesh.scalars[tri.vertex[k]], obj.colorMapRange);
     base = glm::vec4(mapFieldValue(*obj.colorMap, value, obj.colorMapRange), base.a);
   } else if (obj.vertexColors && mesh.colors.size() == mesh.positions.size()) {
     glm::dvec4 c(0.0);

@@ -107,6 +107,12 @@ glm::vec3 mapFieldValue(const ColorMap& map, float value, const glm::vec2& range
   return glm::mix(a, b, x - static_cast<float>(i));
 }
 
+float boundFieldValue(float value, const glm::vec2& range) {
+  if (std::isnan(value)) return value;
+  const float band = static_cast<float>(MFR_COLOR_MAP_BAND) * (range.y - range.x);
+  return std::clamp(value, range.x - band, range.y + band);
+}
+
 std::vector<std::string> fieldNames(const Mesh& mesh) {
   std::vector<std::string> names;
   for (const MeshField& f : mesh.fields) {

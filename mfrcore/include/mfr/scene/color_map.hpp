@@ -31,6 +31,11 @@ int colorMapIndex(const std::string& name);  // its row; throws like colorMap
 // shaders/common/color_map.glsl, in the same float precision.
 glm::vec3 mapFieldValue(const ColorMap& map, float value, const glm::vec2& range);
 
+// A vertex's value as both renderers interpolate it: clamped to the range widened by
+// MFR_COLOR_MAP_BAND spans on either side (infinities would interpolate into NaN); NaN stays NaN.
+// The same float arithmetic as shaders/common/scene.vert.
+float boundFieldValue(float value, const glm::vec2& range);
+
 // The fields a mesh can be coloured by: each of Mesh::fields by name and, for one of several
 // components (a vector), also "name:N" for N ≥ 1 and "name:magnitude" ("name" is component 0).
 std::vector<std::string> fieldNames(const Mesh& mesh);
