@@ -15,6 +15,7 @@
 #include "gl_fixture.hpp"
 #include "image_compare.hpp"
 #include "mfr/io/load.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "mfr/io_util.hpp"
 #include "mfr/reference/composite.hpp"
 #include "test_files.hpp"
@@ -101,6 +102,40 @@ TEST(InvesaliusRealFile, SurfacesLieOnTheirMasksThresholdsInTheVolume) {
     EXPECT_GT(near / n, 0.99);
     EXPECT_LT(deviation[deviation.size() / 2], 30.0);
     EXPECT_LT(nearUnmirrored / n, 0.1);
+  }
+}
+
+// Every part gets the scene's volume as a field ("@" + its name, mfr::addVolumeFields): each
+// surface, coloured by the CT it was extracted from, shows its mask's threshold — the field's
+// median deviation from it as small as the direct sampling's above; other values as the CT has.
+TEST(InvesaliusRealFile, SurfacesColouredByTheCtShowTheirThresholds) {
+  const Scene& scene = cranium();
+  ASSERT_EQ(scene.volumes.size(), 1u);
+  const std::string field = "@" + scene.volumes[0].name;
+  EXPECT_EQ(field, "@ProMED CT 0051");
+  for (std::size_t s = 0; s < 2; ++s) {
+    SCOPED_TRACE(scene.objects[s].name);
+    const double threshold = s == 0 ? 226.0 : -142.0;
+    const Mesh& mesh = *scene.objects[s].mesh;
+    const std::vector<std::string> names = fieldNames(mesh);
+    ASSERT_NE(std::find(names.begin(), names.end(), field), names.end());
+    const FieldValues values = fieldValues(mesh, field, scene.objects[s].name);
+    ASSERT_EQ(values.values.size(), mesh.positions.size());
+    std::vector<double> deviation;
+    for (const float v : values.values) {
+      ASSERT_TRUE(std::isfinite(v));  // every vertex lies inside the CT's box
+      deviation.push_back(std::abs(v - threshold));
+    }
+    std::nth_element(deviation.begin(), deviation.begin() + deviation.size() / 2, deviation.end());
+    EXPECT_LT(deviation[deviation.size() / 2], 30.0);
+    // Coloured by it over the CT's window: the default range is the field's own.
+    Object part = scene.objects[s];
+    colorByField(part, field, "cool-warm");
+    const glm::dvec2 r = part.material.fieldColors->range;
+    EXPECT_LT(r.x, threshold);
+    EXPECT_GT(r.y, threshold);
+    EXPECT_GE(r.x, -1024.0);
+    EXPECT_LE(r.y, 2986.0);
   }
 }
 

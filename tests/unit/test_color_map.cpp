@@ -298,6 +298,60 @@ TEST(FieldColoring, TheProbeGivesTheFieldValueAtEachFragment) {
   EXPECT_NEAR(p.fragments[1].value, 10.0 - 33.5 / 2.0, 1e-4);
 }
 
+// A volume's values at the parts' vertices: a grid whose value is 2x − y + 3z (trilinear
+// interpolation reproduces it exactly) sampled on a moved sphere, NaN beyond half a voxel outside
+// the grid's box.
+TEST(FieldColoring, VolumesAreSampledAtEveryVertex) {
+  Scene scene;
+  scene.name = "ramp";
+  auto grid = std::make_shared<VolumeGrid>();
+  grid->dims = {9, 7, 5};
+  for (int k = 0; k < 5; ++k)
+    for (int j = 0; j < 7; ++j)
+      for (int i = 0; i < 9; ++i) {
+        const glm::dvec3 p = glm::dvec3(-2.0, -1.5, -1.0) + 0.5 * glm::dvec3(i, j, k);  // origin + spacing · index
+        grid->values.push_back(static_cast<float>(2.0 * p.x - p.y + 3.0 * p.z));
+      }
+  Volume volume;
+  volume.name = "ramp";
+  volume.grid = grid;
+  volume.origin = {-2.0, -1.5, -1.0};
+  volume.spacing = {0.5, 0.5, 0.5};
+  volume.transfer = defaultTransfer(*grid, volume.bounds());
+  scene.volumes.push_back(volume);
+  Object inside, across;
+  inside.name = "inside";
+  inside.mesh = std::make_shared<Mesh>(makeSphere(0.5, 12, 6));
+  inside.transform[3] = glm::dvec4(0.4, 0.2, -0.1, 1.0);
+  across.name = "across";
+  across.mesh = inside.mesh;
+  across.transform[3] = glm::dvec4(2.0, 0.0, 0.0, 1.0);  // half of it beyond x = 2
+  scene.objects = {inside, across};
+  addVolumeFields(scene);
+  EXPECT_NE(scene.objects[0].mesh, scene.objects[1].mesh);  // instances sample their own places
+  for (const Object& o : scene.objects) {
+    SCOPED_TRACE(o.name);
+    const FieldValues v = fieldValues(*o.mesh, "@ramp", o.name);
+    std::size_t outside = 0;
+    for (std::size_t i = 0; i < v.values.size(); ++i) {
+      const glm::dvec3 p(o.transform * glm::dvec4(glm::dvec3(o.mesh->positions[i]), 1.0));
+      // Up to half a voxel (0.25) beyond the last sample: the face's value; farther: none.
+      if (p.x > 2.25 + 1e-6) {
+        EXPECT_TRUE(std::isnan(v.values[i])) << i;
+        ++outside;
+      } else {
+        EXPECT_NEAR(v.values[i], 2.0 * std::min(p.x, 2.0) - p.y + 3.0 * p.z, 1e-4) << i;
+      }
+    }
+    EXPECT_EQ(outside > 0, o.name == "across");
+  }
+  // Idempotent: a second call adds nothing.
+  const std::shared_ptr<const Mesh> before = scene.objects[0].mesh;
+  addVolumeFields(scene);
+  EXPECT_EQ(scene.objects[0].mesh, before);
+  EXPECT_EQ(fieldNames(*scene.objects[0].mesh), (std::vector<std::string>{"@ramp"}));
+}
+
 // PLY files carry fields as extra scalar properties (MeshLab's "quality", a scanner's
 // "confidence"): per vertex and per face, ASCII and binary alike.
 TEST(FieldColoring, PlyScalarPropertiesAreFields) {

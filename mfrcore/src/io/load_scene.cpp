@@ -4,6 +4,7 @@
 #include "invesalius_loader.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "mfr/scene/sample.hpp"
 #include "mfr/scene/scene_file.hpp"
 
@@ -85,6 +86,7 @@ Scene loadScene(const std::filesystem::path& path, const LoadProgress& progress)
 Scene loadScene(const std::filesystem::path& path, const LoadOptions& options, const LoadProgress& progress) {
   progress.step(0.0);
   Scene scene = loadSceneWithoutEndReport(path, options, progress);
+  addVolumeFields(scene);  // a .mfrscene has them already (its color_by may use them)
   progress.step(1.0);
   return scene;
 }

@@ -221,6 +221,35 @@ void colorByField(Object& object, const std::string& field, const std::string& m
   object.material.fieldColors = FieldColors{field, map, range ? *range : fieldRange(values.values)};
 }
 
+void addVolumeFields(Scene& scene) {
+  for (Object& o : scene.objects) {
+    if (!o.mesh) continue;
+    std::shared_ptr<Mesh> mesh;
+    for (std::size_t v = 0; v < scene.volumes.size(); ++v) {
+      const Volume& volume = scene.volumes[v];
+      if (!volume.grid) continue;
+      const std::string name = "@" + (volume.name.empty() ? "volume " + std::to_string(v) : volume.name);
+      if (hasField(mesh ? *mesh : *o.mesh, name)) continue;
+      if (!mesh) mesh = std::make_shared<Mesh>(*o.mesh);
+      // Object → grid coordinates. A point is inside when every coordinate is within half a voxel of
+      // [0, dims − 1] (each sample stands for the voxel around it: surfaces extracted from the
+      // volume reach a little beyond its first and last samples); there the nearest face's value.
+      const glm::dmat4 toGrid = glm::inverse(volume.gridToWorld()) * o.transform;
+      const glm::dvec3 last(volume.grid->dims - 1);
+      MeshField f{name, false, 1, {}};
+      f.values.reserve(mesh->positions.size());
+      for (const glm::vec3& p : mesh->positions) {
+        const glm::dvec3 g(toGrid * glm::dvec4(glm::dvec3(p), 1.0));
+        const bool inside =
+            glm::all(glm::greaterThanEqual(g, glm::dvec3(-0.5))) && glm::all(glm::lessThanEqual(g, last + 0.5));
+        f.values.push_back(inside ? volume.grid->sample(glm::vec3(g)) : std::numeric_limits<float>::quiet_NaN());
+      }
+      mesh->fields.push_back(std::move(f));
+    }
+    if (mesh) o.mesh = std::move(mesh);
+  }
+}
+
 bool hasField(const Mesh& mesh, const std::string& field) {
   const std::size_t colon = field.rfind(':');
   for (const MeshField& f : mesh.fields)

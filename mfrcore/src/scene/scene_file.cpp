@@ -441,6 +441,14 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     return progress.part(static_cast<double>(item) / count, static_cast<double>(item + 1) / count);
   };
 
+  // An object's color_by, applied once the volumes are loaded (it may name one: "@NAME").
+  struct ColorBy {
+    const json* object;
+    std::string where;
+    std::size_t first, last;  // its parts in scene.objects
+    std::string what;
+  };
+  std::vector<ColorBy> colorBy;
   if (doc.contains("objects")) {
     const json& objects = doc["objects"];
     if (!objects.is_array()) r.fail("objects", "expected an array");
@@ -465,21 +473,20 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
         obj.transform = xf;
         obj.material.color = parseColor(r, o, where, obj.material.color);
         obj.visible = visible;
-        parseColorBy(r, o, where, {&obj}, objName);
+        colorBy.push_back({&o, where, scene.objects.size(), scene.objects.size() + 1, objName});
         scene.objects.push_back(std::move(obj));
       } else {
         const std::filesystem::path file = baseDir / r.string(o, "file", where, "");
         std::vector<Object> parts = loadModel(file, objectProgress);  // its errors name the model file
-        std::vector<Object*> colourable;
+        colorBy.push_back(
+            {&o, where, scene.objects.size(), scene.objects.size() + parts.size(), file.filename().string()});
         for (Object& part : parts) {
           part.name = parts.size() == 1 ? objName : objName + "/" + part.name;
           part.transform = xf * part.transform;
           part.material.color = parseColor(r, o, where, part.material.color);
           if (o.contains("color")) part.material.vertexColors = false;  // replaces the file's colours
           part.visible = visible;
-          colourable.push_back(&part);
         }
-        parseColorBy(r, o, where, colourable, file.filename().string());
         for (Object& part : parts) scene.objects.push_back(std::move(part));
       }
       objectProgress.step(1.0);
@@ -497,6 +504,12 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
                                        "(set \"visible\": false)");
       scene.volumes.push_back(std::move(volume));
     }
+  }
+  addVolumeFields(scene);
+  for (const ColorBy& c : colorBy) {
+    std::vector<Object*> parts;
+    for (std::size_t i = c.first; i < c.last; ++i) parts.push_back(&scene.objects[i]);
+    parseColorBy(r, *c.object, c.where, parts, c.what);
   }
   if (doc.contains("csg")) {
     scene.csg.root = parseCsgNode(r, doc["csg"], "csg", scene);

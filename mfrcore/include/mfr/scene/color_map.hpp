@@ -60,6 +60,13 @@ glm::dvec2 fieldRange(const std::vector<float>& values);
 void colorByField(Object& object, const std::string& field, const std::string& map = "cool-warm",
                   const std::optional<glm::dvec2>& range = std::nullopt);
 
+// The scene's volumes sampled at every vertex of every part (ParaView's "Resample With Dataset"):
+// a point field "@NAME" per volume (its name, else "volume N"), trilinear as the renderers sample
+// it, NaN farther than half a voxel outside its box (within it: the nearest face's value) — so a surface can be
+// coloured by the volume it lies in. Each part with a volume gets a mesh of its own; a part that has the field already
+// keeps it. Loading a scene (loadScene, .mfrscene files before their "color_by") calls it.
+void addVolumeFields(Scene& scene);
+
 // Whether the mesh has the array `field` names ("name", or the array before ":N" / ":magnitude").
 bool hasField(const Mesh& mesh, const std::string& field);
 
