@@ -318,8 +318,30 @@ void ViewerModel::setVolumeFieldAt(int index, const QString& field,
         }
         current = std::move(next);
         updateSceneGeometry();
+        resampleVolumeFields();
         volumeEdited();
       });
+}
+
+void ViewerModel::resampleVolumeFields() {
+  // The parts as loaded, without their "@" fields, sampled again (mfr::addVolumeFields).
+  mfr::Scene parts;
+  parts.volumes = scene_.volumes;
+  for (std::size_t i = 0; i < loadedMeshes_.size() && i < scene_.objects.size(); ++i) {
+    mfr::Object o;
+    o.transform = scene_.objects[i].transform;
+    if (loadedMeshes_[i]) {
+      auto mesh = std::make_shared<mfr::Mesh>(*loadedMeshes_[i]);
+      std::erase_if(mesh->fields, [](const mfr::MeshField& f) { return !f.name.empty() && f.name.front() == '@'; });
+      o.mesh = std::move(mesh);
+    }
+    parts.objects.push_back(std::move(o));
+  }
+  mfr::addVolumeFields(parts);
+  for (std::size_t i = 0; i < parts.objects.size(); ++i) loadedMeshes_[i] = parts.objects[i].mesh;
+  // A surface shown by a volume's field shows its new values, over the same range and map.
+  if (const std::optional<mfr::FieldColors> shown = fieldColoring(); shown && shown->field.starts_with('@'))
+    setFieldColoring(QString::fromStdString(shown->field), QString::fromStdString(shown->map), shown->range);
 }
 
 QString ViewerModel::volumeName() const {

@@ -321,6 +321,9 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] bool metricsWanted(int side) const;
   void sceneEdited();
   void updateSceneGeometry();
+  // After another field of a volume was read: the parts' "@NAME" fields sampled anew (and the
+  // colouring by one of them redrawn).
+  void resampleVolumeFields();
   void updateDrawnScene();  // drawn_ and the section report from scene_
   void startCpuJob();
   void updateMetrics();

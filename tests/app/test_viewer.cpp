@@ -2970,6 +2970,79 @@ class ViewerTest : public QObject {
              qPrintable(out));
   }
 
+  void colorByVolumeField() {
+    // A sphere inside a volume of two arrays: "ramp" (value = x index) and "half" (x index / 2).
+    QTemporaryDir dir;
+    {
+      constexpr int n = 12;
+      QString ramp, half;
+      for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+          for (int i = 0; i < n; ++i) {
+            ramp += QString::number(i) + ' ';
+            half += QString::number(i / 2.0) + ' ';
+          }
+      QFile f(dir.filePath("two.vti"));
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(QStringLiteral("<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" "
+                             "byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"0 11 0 11 0 11\" "
+                             "Origin=\"0 0 0\" Spacing=\"0.1 0.1 0.1\">\n<Piece Extent=\"0 11 0 11 0 11\">"
+                             "<PointData><DataArray type=\"Float32\" Name=\"ramp\" format=\"ascii\">%1</DataArray>"
+                             "<DataArray type=\"Float32\" Name=\"half\" format=\"ascii\">%2</DataArray></PointData>"
+                             "<CellData></CellData></Piece>\n</ImageData>\n</VTKFile>\n")
+                  .arg(ramp, half)
+                  .toUtf8());
+      const QJsonObject ball{{"primitive", QJsonObject{{"type", "sphere"}, {"radius", 0.3}}},
+                             {"transform", QJsonObject{{"translate", QJsonArray{0.55, 0.55, 0.55}}}},
+                             {"opacity", 0.8}};
+      const QJsonObject iso{{"name", "iso"}, {"eye", QJsonArray{3.0, 2.0, 4.0}}, {"fit", true}};
+      for (const QString& field : {QStringLiteral("ramp"), QStringLiteral("half")}) {
+        QFile scene(dir.filePath(field + ".mfrscene"));
+        QVERIFY(scene.open(QIODevice::WriteOnly));
+        scene.write(
+            QJsonDocument(QJsonObject{{"objects", QJsonArray{ball}},
+                                      {"volumes", QJsonArray{QJsonObject{
+                                                      {"file", "two.vti"}, {"field", field}, {"visible", false}}}},
+                                      {"views", QJsonArray{iso}}})
+                .toJson());
+      }
+    }
+    auto w = openWindow(dir.filePath("ramp.mfrscene"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    const QSize size(120, 96);
+    QVERIFY(showAbufferIso(*w, size));
+    QVERIFY(m.surfaceFields().contains(QStringLiteral("@two.vti")));
+    // The sphere spans x from 0.25 to 0.85: ramp values 2.5 … 8.5.
+    const glm::dvec2 ramp = m.fieldDataRange(QStringLiteral("@two.vti"));
+    QVERIFY2(std::abs(ramp.x - 2.5) < 0.05 && std::abs(ramp.y - 8.5) < 0.05,
+             qPrintable(QStringLiteral("%1 %2").arg(ramp.x).arg(ramp.y)));
+    QVERIFY(m.setFieldColoring(QStringLiteral("@two.vti"), QStringLiteral("viridis"), glm::dvec2(0.0, 10.0)));
+    settle(m);
+    const mfr::ImageRGBA8 byRamp = w->view().renderImage(size);
+    // Another array of the volume: the surface's samples follow it, over the same map and range.
+    m.setVolumeField(QStringLiteral("half"));
+    QTRY_VERIFY_WITH_TIMEOUT(!m.volumeFieldLoading(), kTimeoutMs);
+    QCOMPARE(m.volumeField(), QStringLiteral("half"));
+    const glm::dvec2 half = m.fieldDataRange(QStringLiteral("@two.vti"));
+    QVERIFY2(std::abs(half.x - 1.25) < 0.05 && std::abs(half.y - 4.25) < 0.05,
+             qPrintable(QStringLiteral("%1 %2").arg(half.x).arg(half.y)));
+    QVERIFY(m.fieldColoring());
+    QCOMPARE(m.fieldColoring()->range, glm::dvec2(0.0, 10.0));
+    settle(m);
+    const mfr::ImageRGBA8 byHalf = w->view().renderImage(size);
+    QVERIFY(maxChannelDifference(byHalf, byRamp) > 30);
+    const QString png = dir.filePath("cli.png");
+    QString out;
+    QCOMPARE(
+        runProgram(MFR_CLI,
+                   {"render", dir.filePath("half.mfrscene"), "--size", "120x96", "--view", "iso", "-m", "abuffer-ll",
+                    "--color-by", "@two.vti", "--color-map", "viridis", "--color-range", "0,10", "-o", png},
+                   &out),
+        0);
+    QCOMPARE(maxChannelDifference(mfr::readPng(png.toStdString()), byHalf), 0);
+  }
+
   void volumePanelNamesAPresetFunction() {
     QTemporaryDir dir;
     auto w = openWindow(QString());
