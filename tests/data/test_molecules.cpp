@@ -24,6 +24,7 @@
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/reference/oracle.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "test_files.hpp"
 
 namespace fs = std::filesystem;
@@ -51,6 +52,9 @@ struct RefAtom {
   std::string part;
   glm::dvec3 position;
   std::string element;  // upper case
+  // PDB only (columns 61–66, 55–60, 23–26): the fields a sphere is coloured by.
+  bool hasFields = false;
+  float bFactor = 0.0f, occupancy = 0.0f, residue = 0.0f;
 };
 
 // A part: name and atoms in file order. Parts in the loader's order: chains as they first
@@ -110,6 +114,10 @@ RefParts readPdb(const std::string& text) {
     else
       a.part = "ligands";
     a.position = {std::stod(line.substr(30, 8)), std::stod(line.substr(38, 8)), std::stod(line.substr(46, 8))};
+    a.hasFields = true;
+    a.occupancy = std::stof(line.substr(54, 6));
+    a.bFactor = std::stof(line.substr(60, 6));
+    a.residue = std::stof(line.substr(22, 4));
     if (line.size() >= 78 && (std::isalpha(static_cast<unsigned char>(line[76])) != 0 ||
                               std::isalpha(static_cast<unsigned char>(line[77])) != 0)) {
       a.element = trim(line.substr(76, 2));
@@ -261,6 +269,16 @@ void expectParts(const std::vector<mfr::Object>& objects, const RefParts& expect
         ASSERT_NEAR(glm::length(mesh.normals[k]), 1.0f, 1e-5f);
         ASSERT_GT(glm::dot(glm::dvec3(mesh.normals[k]), offset / r), 1.0 - 1e-4) << "normal not radial, sphere " << s;
         ASSERT_EQ(mesh.colors[k], rgba(look->second.rgb)) << "sphere " << s << " (" << atom.element << ")";
+      }
+      if (atom.hasFields) {
+        // Every vertex of the sphere carries its atom's B-factor, occupancy and residue number.
+        ASSERT_EQ(mesh.fields.size(), 3u);
+        ASSERT_EQ(mfr::fieldNames(mesh), (std::vector<std::string>{"b_factor", "occupancy", "residue"}));
+        for (std::size_t k = first; k < first + verticesPerSphere; ++k) {
+          ASSERT_EQ(mesh.fields[0].values[k], atom.bFactor) << "b_factor of sphere " << s;
+          ASSERT_EQ(mesh.fields[1].values[k], atom.occupancy) << "occupancy of sphere " << s;
+          ASSERT_EQ(mesh.fields[2].values[k], atom.residue) << "residue of sphere " << s;
+        }
       }
       if (!sawOxygen && atom.element == "O") {
         sawOxygen = true;  // the first oxygen is red: (255, 13, 13)

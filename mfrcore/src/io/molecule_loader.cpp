@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <sstream>
@@ -217,6 +218,11 @@ std::string reason(std::string message, const std::string& name) {
 struct Atom {
   glm::dvec3 position;
   gemmi::El element;
+  // Colour-by fields (Mesh::fields) of its sphere: the B-factor (Å²), occupancy and residue
+  // sequence number as the file gives them (PyMOL's b, q and resi).
+  float bFactor = 0.0f;
+  float occupancy = 1.0f;
+  float residue = 0.0f;
 };
 
 struct Part {
@@ -260,7 +266,9 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
         } else {
           part = residue.entity_type == gemmi::EntityType::Water ? &water : &ligands;
         }
-        part->atoms.push_back({p, atom.element.elem});
+        const float number = residue.seqid.num.has_value() ? static_cast<float>(*residue.seqid.num)
+                                                           : std::numeric_limits<float>::quiet_NaN();
+        part->atoms.push_back({p, atom.element.elem, atom.b_iso, atom.occ, number});
       }
     }
   }
@@ -278,7 +286,12 @@ Mesh sphereMesh(const std::vector<Atom>& atoms, const UnitSphere& unit) {
   mesh.indices.reserve(atoms.size() * unit.indices.size());
   std::vector<glm::vec3> normals;
   for (const glm::dvec3& u : unit.vertices) normals.push_back(glm::normalize(glm::vec3(u)));
+  MeshField bFactor{"b_factor", false, 1, {}}, occupancy{"occupancy", false, 1, {}}, residue{"residue", false, 1, {}};
+  for (MeshField* f : {&bFactor, &occupancy, &residue}) f->values.reserve(atoms.size() * nv);
   for (const Atom& atom : atoms) {
+    bFactor.values.insert(bFactor.values.end(), nv, atom.bFactor);
+    occupancy.values.insert(occupancy.values.end(), nv, atom.occupancy);
+    residue.values.insert(residue.values.end(), nv, atom.residue);
     const auto base = static_cast<std::uint32_t>(mesh.positions.size());
     const double r = gemmi::vdw_radius(atom.element);
     const glm::vec4 color = elementColor(atom.element);
@@ -289,6 +302,7 @@ Mesh sphereMesh(const std::vector<Atom>& atoms, const UnitSphere& unit) {
     }
     for (const std::uint32_t i : unit.indices) mesh.indices.push_back(base + i);
   }
+  mesh.fields = {std::move(bFactor), std::move(occupancy), std::move(residue)};
   return mesh;
 }
 
