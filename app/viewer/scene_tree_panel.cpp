@@ -153,6 +153,12 @@ void SceneTreePanel::showFieldColoring() {
   }
   colorBy_->setCurrentIndex(shown ? std::max(0, colorBy_->findData(QString::fromStdString(shown->field))) : 0);
   if (shown) {
+    // Four significant digits of the field's data range: 5.000 for B-factors, 0.0001250 for a tiny span.
+    const glm::dvec2 values = model_.fieldDataRange(QString::fromStdString(shown->field));
+    const double span = std::max(std::abs(values.y - values.x), 1e-30);
+    const int decimals = std::clamp(3 - static_cast<int>(std::floor(std::log10(span))), 0, 12);
+    rangeLow_->setDecimals(decimals);
+    rangeHigh_->setDecimals(decimals);
     colorMap_->setCurrentText(QString::fromStdString(shown->map));
     rangeLow_->setValue(shown->range.x);
     rangeHigh_->setValue(shown->range.y);

@@ -832,22 +832,13 @@ std::optional<mfr::FieldColors> ViewerModel::fieldColoring() const {
 }
 
 glm::dvec2 ViewerModel::fieldDataRange(const QString& field) const {
-  // The range colorObjectsByField picks without one: colour copies of the loaded parts.
-  std::vector<mfr::Object> copies;
-  for (const std::shared_ptr<const mfr::Mesh>& mesh : loadedMeshes_)
-    if (mesh && mfr::hasField(*mesh, field.toStdString())) {
-      mfr::Object copy;
-      copy.mesh = mesh;
-      copies.push_back(std::move(copy));
-    }
-  std::vector<mfr::Object*> parts;
-  for (mfr::Object& o : copies) parts.push_back(&o);
+  std::vector<const mfr::Mesh*> meshes;
+  for (const std::shared_ptr<const mfr::Mesh>& mesh : loadedMeshes_) meshes.push_back(mesh.get());
   try {
-    mfr::colorObjectsByField(parts, field.toStdString(), "cool-warm", std::nullopt, "");
+    return mfr::sharedFieldRange(meshes, field.toStdString());
   } catch (const mfr::Error&) {
-    return {0.0, 1.0};
+    return {0.0, 1.0};  // a component the array lacks
   }
-  return parts.front()->material.fieldColors->range;
 }
 
 bool ViewerModel::setFieldColoring(const QString& field, const QString& map, const std::optional<glm::dvec2>& range) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include <vtkColorTransferFunction.h>
 #include <vtkNew.h>
@@ -67,6 +68,18 @@ std::vector<ColorMap> makeMaps() {
 const std::vector<ColorMap>& maps() {
   static const std::vector<ColorMap> all = makeMaps();
   return all;
+}
+
+// The smallest and largest finite value, if there is one.
+std::optional<glm::dvec2> finiteSpan(const std::vector<float>& values) {
+  double low = std::numeric_limits<double>::infinity(), high = -low;
+  for (const float v : values)
+    if (std::isfinite(v)) {
+      low = std::min(low, double(v));
+      high = std::max(high, double(v));
+    }
+  if (!(low <= high)) return std::nullopt;
+  return glm::dvec2(low, high);
 }
 
 std::string list(const std::vector<std::string>& names) {
@@ -168,15 +181,10 @@ FieldValues fieldValues(const Mesh& mesh, const std::string& field, const std::s
 }
 
 glm::dvec2 fieldRange(const std::vector<float>& values) {
-  double low = std::numeric_limits<double>::infinity(), high = -low;
-  for (const float v : values)
-    if (std::isfinite(v)) {
-      low = std::min(low, double(v));
-      high = std::max(high, double(v));
-    }
-  if (!(low <= high)) return {0.0, 1.0};
-  if (low == high) return {low - 1.0, high + 1.0};
-  return {low, high};
+  const std::optional<glm::dvec2> span = finiteSpan(values);
+  if (!span) return {0.0, 1.0};
+  if (span->x == span->y) return {span->x - 1.0, span->y + 1.0};
+  return *span;
 }
 
 void colorByField(Object& object, const std::string& field, const std::string& map,
@@ -257,14 +265,26 @@ bool hasField(const Mesh& mesh, const std::string& field) {
   return false;
 }
 
+glm::dvec2 sharedFieldRange(const std::vector<const Mesh*>& meshes, const std::string& field) {
+  std::vector<float> ends;  // each mesh's smallest and largest finite value
+  for (const Mesh* mesh : meshes) {
+    if (mesh == nullptr || !hasField(*mesh, field)) continue;
+    if (const std::optional<glm::dvec2> span = finiteSpan(fieldValues(*mesh, field, "").values)) {
+      ends.push_back(static_cast<float>(span->x));
+      ends.push_back(static_cast<float>(span->y));
+    }
+  }
+  return fieldRange(ends);
+}
+
 std::size_t colorObjectsByField(const std::vector<Object*>& objects, const std::string& field, const std::string& map,
                                 const std::optional<glm::dvec2>& range, const std::string& what) {
   colorMapIndex(map);
   if (range && !(std::isfinite(range->x) && std::isfinite(range->y) && range->x < range->y))
     throw Error(what, "colour range must be two finite values, low < high");
   std::vector<Object*> having;
+  std::vector<const Mesh*> meshes;
   std::vector<std::string> available;
-  glm::dvec2 span(std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity());
   for (Object* o : objects) {
     if (o == nullptr || !o->mesh) continue;
     if (!hasField(*o->mesh, field)) {
@@ -272,25 +292,15 @@ std::size_t colorObjectsByField(const std::vector<Object*>& objects, const std::
         if (std::find(available.begin(), available.end(), n) == available.end()) available.push_back(n);
       continue;
     }
-    const FieldValues values = fieldValues(*o->mesh, field, o->name);
-    const glm::dvec2 r = fieldRange(values.values);
-    const bool finite =
-        std::any_of(values.values.begin(), values.values.end(), [](float v) { return std::isfinite(v); });
-    if (finite) span = glm::dvec2(std::min(span.x, r.x), std::max(span.y, r.y));
+    (void)fieldValues(*o->mesh, field, o->name);  // a component the array lacks throws here, naming the part
     having.push_back(o);
+    meshes.push_back(o->mesh.get());
   }
   if (having.empty())
     throw FieldNotFound(what, "no point-data or cell-data array '" + field + "' (" +
                                   (available.empty() ? std::string("it has none") : "fields: " + list(available)) +
                                   ")");
-  // One range for all: the union of the parts' ranges (fieldRange's rules when it is empty).
-  glm::dvec2 shared = range.value_or(span);
-  if (!range) {
-    if (!(span.x <= span.y))
-      shared = {0.0, 1.0};
-    else if (span.x == span.y)
-      shared = {span.x - 1.0, span.y + 1.0};
-  }
+  const glm::dvec2 shared = range.value_or(sharedFieldRange(meshes, field));
   for (Object* o : having) colorByField(*o, field, map, shared);
   return having.size();
 }

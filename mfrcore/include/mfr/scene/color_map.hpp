@@ -70,6 +70,10 @@ void addVolumeFields(Scene& scene);
 // Whether the mesh has the array `field` names ("name", or the array before ":N" / ":magnitude").
 bool hasField(const Mesh& mesh, const std::string& field);
 
+// The range colorObjectsByField gives `field` by default: the union of its finite values over the
+// meshes that have it (fieldRange's rules when that is empty). Meshes without it are passed over.
+glm::dvec2 sharedFieldRange(const std::vector<const Mesh*>& meshes, const std::string& field);
+
 // colorByField on every object whose mesh has the field (hasField), all with one range: `range`, or
 // the field's range over all of them (as ParaView maps a multi-block dataset). Returns how many it
 // coloured; none is FieldNotFound(what, …) listing the fields the objects have. Other refusals as
