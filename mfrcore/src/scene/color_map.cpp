@@ -300,7 +300,7 @@ std::size_t colorObjectsByField(const std::vector<Object*>& objects, const std::
     throw FieldNotFound(what, "no point-data or cell-data array '" + field + "' (" +
                                   (available.empty() ? std::string("it has none") : "fields: " + list(available)) +
                                   ")");
-  const glm::dvec2 shared = range.value_or(sharedFieldRange(meshes, field));
+  const glm::dvec2 shared = range ? *range : sharedFieldRange(meshes, field);
   for (Object* o : having) colorByField(*o, field, map, shared);
   return having.size();
 }
