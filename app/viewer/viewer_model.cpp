@@ -757,6 +757,7 @@ void ViewerModel::setObjectColor(int index, const QColor& rgb) {
   glm::vec4& c = material.color;
   c = glm::vec4(static_cast<float>(rgb.redF()), static_cast<float>(rgb.greenF()), static_cast<float>(rgb.blueF()), c.a);
   material.vertexColors = false;
+  material.fieldColors.reset();  // a colour chosen for the part replaces its field's colours too
   sceneEdited();
 }
 

@@ -215,7 +215,8 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] const QString& scenePath() const { return scenePath_; }
   [[nodiscard]] quint64 sceneRevision() const { return sceneRevision_; }
   void setObjectVisible(int index, bool visible);
-  // A colour chosen for a part replaces its file's per-vertex colours (Material::vertexColors).
+  // A colour chosen for a part replaces its file's per-vertex colours (Material::vertexColors) and
+  // a field colouring of it.
   void setObjectColor(int index, const QColor& rgb);
   // The colour the part had when its scene was loaded (its file's per-vertex colours, e.g. a
   // molecule's element colours, included); the opacity stays as it is.

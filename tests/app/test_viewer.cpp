@@ -2938,6 +2938,14 @@ class ViewerTest : public QObject {
     QCOMPARE(again->findChild<QComboBox*>("colorByField")->currentText(), QStringLiteral("zone"));
     QCOMPARE(maxChannelDifference(zone, again->view().renderImage(a.renderSize())), 0);
 
+    // A colour chosen for the part replaces the field's colours (the Colour column's picker).
+    m.setObjectColor(0, QColor(200, 40, 40));
+    settle(m);
+    QVERIFY(!m.fieldColoring());
+    QCOMPARE(colorBy->currentIndex(), 0);
+    QVERIFY(maxChannelDifference(zone, w->view().renderImage(size)) > 60);
+    m.resetObjectColor(0);
+
     // Back to the parts' own colours: the first frame again.
     colorBy->setCurrentIndex(0);
     emit colorBy->activated(0);
