@@ -153,7 +153,7 @@ void SceneTreePanel::showFieldColoring() {
   }
   colorBy_->setCurrentIndex(shown ? std::max(0, colorBy_->findData(QString::fromStdString(shown->field))) : 0);
   if (shown) {
-    // Four significant digits of the field's data range: 5.000 for B-factors, 0.0001250 for a tiny span.
+    // About four significant digits of the data range's span: 5.00 for B-factors (a span of 80).
     const glm::dvec2 values = model_.fieldDataRange(QString::fromStdString(shown->field));
     const double span = std::max(std::abs(values.y - values.x), 1e-30);
     const int decimals = std::clamp(3 - static_cast<int>(std::floor(std::log10(span))), 0, 12);
