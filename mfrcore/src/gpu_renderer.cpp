@@ -90,6 +90,7 @@ void GpuRenderer::setScene(const Scene& original) {
   sceneBounds_ = scene.bounds();
   clipBox_ = scene.clipBox;
   section_ = scene.section;
+  fieldColorsNote_ = fieldColorsNote(scene);
   uploadVolumes(scene);
   gl::checkErrors("scene upload");
 }
@@ -104,6 +105,7 @@ void GpuRenderer::shareScene(const GpuRenderer& other) {
   sceneBounds_ = other.sceneBounds_;
   clipBox_ = other.clipBox_;
   section_ = other.section_;
+  fieldColorsNote_ = other.fieldColorsNote_;
   volumes_ = other.volumes_;
 }
 
@@ -227,6 +229,7 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
     stats.passes += 1;  // the shading pass
     stats.notes.emplace_back("csg buffer (bytes)", std::to_string(csgBytes));
   }
+  if (!fieldColorsNote_.empty()) stats.notes.emplace_back("field colours", fieldColorsNote_);
   if (operation_ == "zthickness") stats.notes.emplace_back("z-thickness", std::to_string(thickness_));
   if (operation_ == "volume") {
     stats.notes.emplace_back("volume step", std::to_string(volumeStep_));

@@ -1,6 +1,7 @@
 #include "mfr/render.hpp"
 
 #include <algorithm>
+#include <sstream>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -69,6 +70,28 @@ std::string volumeFieldsNote(std::span<const Volume> volumes) {
     named = named || !v.field.empty();
   }
   return named ? note : std::string();
+}
+
+std::string fieldColorsNote(const Scene& scene) {
+  std::vector<std::pair<FieldColors, std::size_t>> colourings;
+  std::size_t visible = 0;
+  for (const Object& o : scene.objects) {
+    if (!o.visible || !o.mesh) continue;
+    ++visible;
+    if (!o.material.fieldColors) continue;
+    auto it = std::find_if(colourings.begin(), colourings.end(),
+                           [&](const auto& c) { return c.first == *o.material.fieldColors; });
+    if (it == colourings.end()) it = colourings.insert(colourings.end(), {*o.material.fieldColors, 0});
+    ++it->second;
+  }
+  std::string note;
+  for (const auto& [c, parts] : colourings) {
+    std::ostringstream one;
+    one << c.field << " (" << c.map << ", " << c.range.x << " … " << c.range.y << ") on " << parts << " of " << visible
+        << " parts";
+    note += (note.empty() ? "" : "; ") + one.str();
+  }
+  return note;
 }
 
 std::vector<Volume> volumesAsRequested(const RenderRequest& request, const Scene& scene) {
@@ -210,6 +233,8 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     return out;
   }
   RenderOutput out;
+  if (const std::string fields = fieldColorsNote(scene); !fields.empty())
+    out.stats.notes.emplace_back("field colours", fields);
   const std::string operation = effectiveOperation(request.operation, nullptr, scene.hasVisibleVolume());
   const FragmentLists lists = castFragments(scene, camera, request.width, request.height);
   if (operation == "hybrid") {

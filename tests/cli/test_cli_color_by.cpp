@@ -176,6 +176,17 @@ TEST_F(CliColorBy, SceneFileColorByEqualsTheOptions) {
              fromOptions.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_EQ(mfr::rmse(mfr::readPng(fromFile), mfr::readPng(fromOptions)), 0.0);
+  // The stats say what the parts show, from the GPU renderer and the oracle alike.
+  for (const std::string method : {"abuffer-ll", "oracle"}) {
+    const fs::path stats = dir() / ("stats-" + method + ".json");
+    ASSERT_EQ(runCli("render " + scene.string() + " --size 16x16 -m " + method + " -o " + (dir() / "s.png").string() +
+                     " --stats " + stats.string())
+                  .exitCode,
+              0);
+    std::ifstream in(stats);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["notes"]["field colours"], "velocity:magnitude (magma, 1 … 2.5) on 1 of 1 parts") << method;
+  }
   // The scene file's short form: a field name alone (cool-warm over the data range).
   const fs::path shortForm = write("short.mfrscene", R"({"objects": [{"file": "sheet.vtp", "color_by": "pressure"}]})");
   const fs::path a = dir() / "a.png", b = dir() / "b.png";

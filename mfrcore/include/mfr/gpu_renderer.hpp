@@ -103,6 +103,7 @@ class GpuRenderer {
   struct GpuVolume;
   std::vector<std::shared_ptr<GpuVolume>> volumes_;
   double volumeStep_ = 0.0;           // of the prepared request (scene units)
+  std::string fieldColorsNote_;       // of the scene set (fieldColorsNote)
   std::vector<Volume> drawnVolumes_;  // of the prepared request (volumesAsRequested: its shading)
   void uploadVolumes(const Scene& scene);
   gl::Buffer csgVisible_;

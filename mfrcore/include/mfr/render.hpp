@@ -60,6 +60,9 @@ std::string volumeShadingNote(std::span<const Volume> volumes);
 // The statistics note "volume fields": each volume's Volume::field in order, comma-separated ("-"
 // for one without); empty (no note) when none has a named field.
 std::string volumeFieldsNote(std::span<const Volume> volumes);
+// The statistics note "field colours": each distinct colouring of the visible parts coloured by a
+// field, "FIELD (MAP, LOW … HIGH) on N of M parts", "; "-separated; empty (no note) when none is.
+std::string fieldColorsNote(const Scene& scene);
 // What a request's operation means for a method (info; nullptr: the oracle) on a scene with or
 // without a visible volume: "auto" is the method's preferredOperation, except that a scene with a
 // volume gets "volume" from every method that prefers "oit" and resolves sorted lists.
