@@ -28,6 +28,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <cstdlib>
 #include <cstring>
 #include <optional>
@@ -317,6 +318,32 @@ class ViewerTest : public QObject {
     settle(m);
     if (!m.renderError().isEmpty()) qWarning("render error: %s", qPrintable(m.renderError()));
     return m.renderError().isEmpty();
+  }
+
+  // A 12³ .vti (spacing 0.1 from the origin) with two point-data arrays, each a function of the
+  // grid index (i, j, k). Returns false when it cannot be written.
+  static bool writeTwoArrayVti(const QString& path, const QString& firstName,
+                               const std::function<double(int, int, int)>& first, const QString& secondName,
+                               const std::function<double(int, int, int)>& second) {
+    constexpr int n = 12;
+    QString a, b;
+    for (int k = 0; k < n; ++k)
+      for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+          a += QString::number(first(i, j, k), 'g', 9) + ' ';
+          b += QString::number(second(i, j, k), 'g', 9) + ' ';
+        }
+    QFile f(path);
+    if (!f.open(QIODevice::WriteOnly)) return false;
+    f.write(QStringLiteral("<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" "
+                           "byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"0 11 0 11 0 11\" "
+                           "Origin=\"0 0 0\" Spacing=\"0.1 0.1 0.1\">\n<Piece Extent=\"0 11 0 11 0 11\">"
+                           "<PointData><DataArray type=\"Float32\" Name=\"%1\" format=\"ascii\">%2</DataArray>"
+                           "<DataArray type=\"Float32\" Name=\"%3\" format=\"ascii\">%4</DataArray></PointData>"
+                           "<CellData></CellData></Piece>\n</ImageData>\n</VTKFile>\n")
+                .arg(firstName, a, secondName, b)
+                .toUtf8());
+    return true;
   }
 
   std::unique_ptr<MainWindow> openWindow(const QString& scene = QStringLiteral("@sample")) {
@@ -2658,27 +2685,12 @@ class ViewerTest : public QObject {
   // transfer function back.
   void volumeField() {
     QTemporaryDir dir;
-    {
-      constexpr int n = 12;
-      QString ramp, ring;
-      for (int k = 0; k < n; ++k)
-        for (int j = 0; j < n; ++j)
-          for (int i = 0; i < n; ++i) {
-            ramp += QString::number(i) + ' ';
-            const double r = std::hypot(i - 5.5, j - 5.5, k - 5.5);
-            ring += QString::number(std::exp(-(r - 4.0) * (r - 4.0)), 'g', 9) + ' ';
-          }
-      QFile f(dir.filePath("two.vti"));
-      QVERIFY(f.open(QIODevice::WriteOnly));
-      f.write(QStringLiteral("<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" "
-                             "byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"0 11 0 11 0 11\" "
-                             "Origin=\"0 0 0\" Spacing=\"0.1 0.1 0.1\">\n<Piece Extent=\"0 11 0 11 0 11\">"
-                             "<PointData><DataArray type=\"Float32\" Name=\"ramp\" format=\"ascii\">%1</DataArray>"
-                             "<DataArray type=\"Float32\" Name=\"ring\" format=\"ascii\">%2</DataArray></PointData>"
-                             "<CellData></CellData></Piece>\n</ImageData>\n</VTKFile>\n")
-                  .arg(ramp, ring)
-                  .toUtf8());
-    }
+    QVERIFY(writeTwoArrayVti(
+        dir.filePath("two.vti"), QStringLiteral("ramp"), [](int i, int, int) { return i; }, QStringLiteral("ring"),
+        [](int i, int j, int k) {
+          const double r = std::hypot(i - 5.5, j - 5.5, k - 5.5);
+          return std::exp(-(r - 4.0) * (r - 4.0));
+        }));
     const auto writeScene = [&](const QString& name, const QString& field) {
       QJsonObject volume{{"file", "two.vti"}, {"transform", QJsonObject{{"translate", QJsonArray{0.4, -0.2, 0.1}}}}};
       if (!field.isEmpty()) volume["field"] = field;
@@ -2982,24 +2994,9 @@ class ViewerTest : public QObject {
     // A sphere inside a volume of two arrays: "ramp" (value = x index) and "half" (x index / 2).
     QTemporaryDir dir;
     {
-      constexpr int n = 12;
-      QString ramp, half;
-      for (int k = 0; k < n; ++k)
-        for (int j = 0; j < n; ++j)
-          for (int i = 0; i < n; ++i) {
-            ramp += QString::number(i) + ' ';
-            half += QString::number(i / 2.0) + ' ';
-          }
-      QFile f(dir.filePath("two.vti"));
-      QVERIFY(f.open(QIODevice::WriteOnly));
-      f.write(QStringLiteral("<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" "
-                             "byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"0 11 0 11 0 11\" "
-                             "Origin=\"0 0 0\" Spacing=\"0.1 0.1 0.1\">\n<Piece Extent=\"0 11 0 11 0 11\">"
-                             "<PointData><DataArray type=\"Float32\" Name=\"ramp\" format=\"ascii\">%1</DataArray>"
-                             "<DataArray type=\"Float32\" Name=\"half\" format=\"ascii\">%2</DataArray></PointData>"
-                             "<CellData></CellData></Piece>\n</ImageData>\n</VTKFile>\n")
-                  .arg(ramp, half)
-                  .toUtf8());
+      QVERIFY(writeTwoArrayVti(
+          dir.filePath("two.vti"), QStringLiteral("ramp"), [](int i, int, int) { return i; }, QStringLiteral("half"),
+          [](int i, int, int) { return i / 2.0; }));
       const QJsonObject ball{{"primitive", QJsonObject{{"type", "sphere"}, {"radius", 0.3}}},
                              {"transform", QJsonObject{{"translate", QJsonArray{0.55, 0.55, 0.55}}}},
                              {"opacity", 0.8}};
