@@ -50,6 +50,7 @@
 #include <vtkXMLImageDataReader.h>
 
 #include "mfr/error.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "file_checks.hpp"
 #include "invesalius_loader.hpp"
 #include "openvdb_loader.hpp"
@@ -401,20 +402,9 @@ std::optional<SampleArray> namedArray(vtkPointData* pd, vtkCellData* cd, const s
   const std::string base = field.substr(0, colon), which = field.substr(colon + 1);
   std::optional<SampleArray> array = find(base);
   if (!array) return std::nullopt;
-  const int n = array->array->GetNumberOfComponents();
-  if (which == "magnitude") {
-    array->component = SampleArray::kMagnitude;
-    return array;
-  }
-  const bool digits = !which.empty() && which.size() < 4 &&
-                      std::all_of(which.begin(), which.end(), [](char c) { return c >= '0' && c <= '9'; });
-  if (digits && std::stoi(which) < n) {
-    array->component = std::stoi(which);
-    return array;
-  }
-  throw FieldNotFound(name, "array '" + base + "' has " + std::to_string(n) + " component" + (n == 1 ? "" : "s") +
-                                " (" + base + ":0 … " + base + ":" + std::to_string(n - 1) + ", or " + base +
-                                ":magnitude)");
+  const int component = fieldComponent(base, which, array->array->GetNumberOfComponents(), name);
+  array->component = component < 0 ? SampleArray::kMagnitude : component;
+  return array;
 }
 
 // The sample array: the one named `field` (point data first); else the point data's active

@@ -126,6 +126,16 @@ float boundFieldValue(float value, const glm::vec2& range) {
   return std::clamp(value, range.x - band, range.y + band);
 }
 
+int fieldComponent(const std::string& base, const std::string& which, int components, const std::string& what) {
+  if (which == "magnitude") return -1;
+  const bool digits = !which.empty() && which.size() < 4 &&
+                      std::all_of(which.begin(), which.end(), [](char c) { return c >= '0' && c <= '9'; });
+  if (digits && std::stoi(which) < components) return std::stoi(which);
+  throw FieldNotFound(what, "array '" + base + "' has " + std::to_string(components) + " component" +
+                                (components == 1 ? "" : "s") + " (" + base + ":0 … " + base + ":" +
+                                std::to_string(components - 1) + ", or " + base + ":magnitude)");
+}
+
 std::vector<std::string> fieldNames(const Mesh& mesh) {
   std::vector<std::string> names;
   for (const MeshField& f : mesh.fields) {
@@ -147,19 +157,8 @@ FieldValues fieldValues(const Mesh& mesh, const std::string& field, const std::s
   if (array == nullptr) {
     const std::size_t colon = field.rfind(':');
     if (colon != std::string::npos && colon > 0) array = find(field.substr(0, colon));
-    if (array != nullptr) {
-      const std::string base = field.substr(0, colon), which = field.substr(colon + 1);
-      const bool digits = !which.empty() && which.size() < 4 &&
-                          std::all_of(which.begin(), which.end(), [](char c) { return c >= '0' && c <= '9'; });
-      if (which == "magnitude")
-        component = -1;
-      else if (digits && std::stoi(which) < array->components)
-        component = std::stoi(which);
-      else
-        throw FieldNotFound(what, "array '" + base + "' has " + std::to_string(array->components) + " component" +
-                                      (array->components == 1 ? "" : "s") + " (" + base + ":0 … " + base + ":" +
-                                      std::to_string(array->components - 1) + ", or " + base + ":magnitude)");
-    }
+    if (array != nullptr)
+      component = fieldComponent(field.substr(0, colon), field.substr(colon + 1), array->components, what);
   }
   if (array == nullptr) {
     const std::vector<std::string> names = fieldNames(mesh);

@@ -36,6 +36,11 @@ glm::vec3 mapFieldValue(const ColorMap& map, float value, const glm::vec2& range
 // The same float arithmetic as shaders/common/scene.vert.
 float boundFieldValue(float value, const glm::vec2& range);
 
+// The component `which` names of an array `base` with `components` components — "N" (0 ≤ N <
+// components) or "magnitude" (-1) — as in "velocity:2" / "velocity:magnitude" for surface fields and
+// volume files alike; anything else throws FieldNotFound(what, …) listing the valid spellings.
+int fieldComponent(const std::string& base, const std::string& which, int components, const std::string& what);
+
 // The fields a mesh can be coloured by: each of Mesh::fields by name and, for one of several
 // components (a vector), also "name:N" for N ≥ 1 and "name:magnitude" ("name" is component 0).
 std::vector<std::string> fieldNames(const Mesh& mesh);
