@@ -32,6 +32,7 @@ std::string mib(std::uint64_t bytes) {
 void addBench(CLI::App& app) {
   struct Options {
     ColorByOptions colorBy;
+    ContourOptions contours;
     std::string scene, methods, size = "512x512", view = "fit", json, label, clip, section, field;
     int repeat = 5, warmup = 1;
     double opacity = -1.0;
@@ -52,6 +53,7 @@ void addBench(CLI::App& app) {
   cmd->add_option("--view", opt->view, "Named view")->capture_default_str();
   cmd->add_option("--clip", opt->clip, kClipHelp);
   opt->colorBy.add(cmd);
+  opt->contours.add(cmd);
   cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
@@ -66,6 +68,7 @@ void addBench(CLI::App& app) {
     for (const std::string& spec : splitList(opt->methods)) requests.push_back(parseMethodSpec(spec, w, h));
     if (requests.empty()) throw Error("--methods", "no method given");
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
+    opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);

@@ -62,6 +62,19 @@ struct ColorByOptions {
   void apply(Scene& scene) const;
 };
 
+// --contour [VOLUME=]V1,V2,… [--contour-opacity A] [--keep-volume]: isosurfaces of the scene's
+// volume (the one named, when it has several) at the values, added as parts (addContours) — before
+// --color-by, so that they can be coloured by a volume field. Their opacity: --contour-opacity, else
+// --opacity, else 0.5. The volume they come from is hidden (ParaView hides a filter's input) unless
+// --keep-volume. Throws mfr::Error naming the option.
+struct ContourOptions {
+  std::string values;
+  double opacity = -1.0;
+  bool keepVolume = false;
+  void add(CLI::App* cmd);
+  void apply(Scene& scene, double sceneOpacity) const;
+};
+
 // --thickness (operation zthickness) as given: 0 when absent (the scene's default); throws
 // mfr::Error naming --thickness for a given value that is not a positive finite length.
 double thicknessOption(const CLI::Option& option, double value);

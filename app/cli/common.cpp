@@ -10,6 +10,7 @@
 #include "mfr/io/load.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/color_map.hpp"
+#include "mfr/scene/contour.hpp"
 #include "mfr/scene/section.hpp"
 
 namespace mfr::cli {
@@ -248,6 +249,58 @@ void ColorByOptions::apply(Scene& scene) const {
   } catch (const Error& e) {
     throw Error("--color-by " + field, e.what());
   }
+}
+
+void ContourOptions::add(CLI::App* cmd) {
+  cmd->add_option("--contour", values,
+                  "Isosurfaces of the scene's volume at these values, added as parts: V1,V2,… or VOLUME=V1,V2,… "
+                  "when the scene has several volumes (at most " +
+                      std::to_string(kMaxContourValues) + "); the volume itself is hidden unless --keep-volume");
+  cmd->add_option("--contour-opacity", opacity, "Opacity of the --contour parts (default: --opacity, else 0.5)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_flag("--keep-volume", keepVolume, "With --contour: keep drawing the volume the isosurfaces come from");
+}
+
+void ContourOptions::apply(Scene& scene, double sceneOpacity) const {
+  if (values.empty()) {
+    if (opacity >= 0.0) throw Error("--contour-opacity", "needs --contour");
+    if (keepVolume) throw Error("--keep-volume", "needs --contour");
+    return;
+  }
+  const std::string what = "--contour " + values;
+  ContourRequest request;
+  std::string list = values;
+  const std::size_t eq = values.find('=');
+  if (eq != std::string::npos) {
+    const std::string name = values.substr(0, eq);
+    list = values.substr(eq + 1);
+    const auto it =
+        std::find_if(scene.volumes.begin(), scene.volumes.end(), [&](const Volume& v) { return v.name == name; });
+    if (it == scene.volumes.end()) {
+      std::string names;
+      for (const Volume& v : scene.volumes) names += (names.empty() ? "" : ", ") + v.name;
+      throw Error(what, "no volume '" + name + "' in scene '" + scene.name + "'" +
+                            (names.empty() ? std::string(" (it has none)") : " (volumes: " + names + ")"));
+    }
+    request.volume = static_cast<std::size_t>(it - scene.volumes.begin());
+  } else if (scene.volumes.size() > 1) {
+    throw Error(what, "scene '" + scene.name + "' has " + std::to_string(scene.volumes.size()) +
+                          " volumes: say which, as VOLUME=V1,V2,… (e.g. '" + scene.volumes[0].name + "=…')");
+  }
+  for (std::size_t start = 0;;) {  // every item, empty ones too ("0.3," is a mistake, not one value)
+    const std::size_t end = list.find(',', start);
+    const std::string item = list.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    const std::optional<double> v = parseNumber(item);
+    if (!v)
+      throw Error(what, (item.empty() ? std::string("an empty value") : "'" + item + "' is not a number") +
+                            " (expected V1,V2,… or VOLUME=V1,V2,…)");
+    request.values.push_back(*v);
+    if (end == std::string::npos) break;
+    start = end + 1;
+  }
+  request.opacity = static_cast<float>(opacity >= 0.0 ? opacity : sceneOpacity >= 0.0 ? sceneOpacity : 0.5);
+  addContours(scene, request, what);
+  if (!keepVolume) scene.volumes[request.volume].visible = false;
 }
 
 namespace {

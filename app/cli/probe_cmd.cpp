@@ -53,6 +53,7 @@ int to8(float c) {
 void addProbe(CLI::App& app) {
   struct Options {
     ColorByOptions colorBy;
+    ContourOptions contours;
     std::string scene, pixel, size = "512x512", view = "fit", method, op = "auto", json, clip, section, field;
     std::vector<std::string> params;
     double opacity = -1.0;
@@ -77,6 +78,7 @@ void addProbe(CLI::App& app) {
   cmd->add_option("--json", opt->json, "Also write the probe as JSON");
   cmd->add_option("--clip", opt->clip, kClipHelp);
   opt->colorBy.add(cmd);
+  opt->contours.add(cmd);
   cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
@@ -106,6 +108,7 @@ void addProbe(CLI::App& app) {
     req.operation = opt->op;
     req.thickness = thicknessOption(*thicknessGiven, opt->thickness);
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
+    opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);

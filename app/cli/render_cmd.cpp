@@ -14,6 +14,7 @@ namespace mfr::cli {
 void addRender(CLI::App& app) {
   struct Options {
     ColorByOptions colorBy;
+    ContourOptions contours;
     std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats, clip, section,
                        field;
     std::vector<std::string> params;
@@ -43,6 +44,7 @@ void addRender(CLI::App& app) {
                 "read as surfaces)");
   cmd->add_option("--clip", opt->clip, kClipHelp);
   opt->colorBy.add(cmd);
+  opt->contours.add(cmd);
   cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
@@ -69,6 +71,7 @@ void addRender(CLI::App& app) {
       req.params[p.substr(0, eq)] = p.substr(eq + 1);
     }
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
+    opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);

@@ -11,6 +11,7 @@
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
 #include "mfr/scene/color_map.hpp"
+#include "mfr/scene/contour.hpp"
 #include "mfr/scene/csg.hpp"
 #include "mfr/scene/primitives.hpp"
 #include "mfr/scene/sample.hpp"
@@ -27,6 +28,8 @@ class Reader {
   [[noreturn]] void fail(const std::string& where, const std::string& reason) const {
     throw Error(file_, where + ": " + reason);
   }
+  // An error whose message already says where in the file ("volumes[0].contours: …").
+  [[noreturn]] void fail(const Error& e) const { throw Error(file_, e.what()); }
 
   double number(const json& j, const std::string& where) const {
     if (!j.is_number()) fail(where, "expected a number");
@@ -317,6 +320,28 @@ Volume parseVolume(const Reader& r, const json& j, const std::string& where, con
   return volume;
 }
 
+// A volume's "contours": [values…] or {"values": [values…], "opacity": a} — isosurfaces added as
+// parts (scene/contour.hpp).
+ContourRequest parseContours(const Reader& r, const json& j, const std::string& where, std::size_t volume) {
+  ContourRequest request;
+  request.volume = volume;
+  const json* values = &j;
+  if (j.is_object()) {
+    for (const auto& item : j.items())
+      if (item.key() != "values" && item.key() != "opacity")
+        r.fail(where + "." + item.key(), "unknown key (expected values, opacity)");
+    if (!j.contains("values")) r.fail(where, "needs 'values' (the isosurfaces' values)");
+    values = &j["values"];
+    const double opacity = r.number(j, "opacity", where, request.opacity);
+    if (opacity < 0.0 || opacity > 1.0) r.fail(where + ".opacity", "must be in [0, 1]");
+    request.opacity = static_cast<float>(opacity);
+  }
+  if (!values->is_array()) r.fail(where, "expected an array of values or {\"values\": [...], \"opacity\": a}");
+  for (std::size_t i = 0; i < values->size(); ++i)
+    request.values.push_back(r.number((*values)[i], where + "[" + std::to_string(i) + "]"));
+  return request;
+}
+
 // A CSG node: an object's name, or {"union" | "intersection" | "difference": [≥ 2 nodes]}.
 CsgNode parseCsgNode(const Reader& r, const json& j, const std::string& where, const Scene& scene) {
   CsgNode node;
@@ -495,6 +520,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
   if (doc.contains("volumes")) {
     const json& volumes = doc["volumes"];
     if (!volumes.is_array()) r.fail("volumes", "expected an array");
+    const std::size_t firstVolume = scene.volumes.size();
     for (std::size_t i = 0; i < volumes.size(); ++i) {
       const std::string where = "volumes[" + std::to_string(i) + "]";
       Volume volume = parseVolume(r, volumes[i], where, baseDir, itemProgress(objectCount + i));
@@ -503,6 +529,17 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
                                        " volumes are visible already: at most that many can be drawn at once "
                                        "(set \"visible\": false)");
       scene.volumes.push_back(std::move(volume));
+    }
+    // Isosurfaces once every volume is there (a part's "@NAME" fields name them all).
+    for (std::size_t i = 0; i < volumes.size(); ++i) {
+      if (!volumes[i].contains("contours")) continue;
+      const std::string where = "volumes[" + std::to_string(i) + "].contours";
+      const ContourRequest request = parseContours(r, volumes[i]["contours"], where, firstVolume + i);
+      try {
+        addContours(scene, request, where);
+      } catch (const Error& e) {
+        r.fail(e);
+      }
     }
   }
   addVolumeFields(scene);

@@ -1,0 +1,132 @@
+// mfr render / probe / bench --contour end to end: isosurfaces of the scene's volume become parts
+// that every method draws like any other (the GPU agrees with the oracle), the volume is hidden
+// unless --keep-volume, a scene with several volumes needs the volume's name, the parts can be
+// coloured by a volume field, and bad input fails with one line and no output.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using mfr::test::CliResult;
+using mfr::test::runCli;
+
+class CliContour : public mfr::test::CliTest {
+ protected:
+  double rmseOf(const fs::path& a, const fs::path& b) {
+    const CliResult r = runCli("compare " + a.string() + " " + b.string() + " --metric rmse");
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    return std::stod(r.out.substr(r.out.find("rmse ") + 5));
+  }
+  nlohmann::json stats(const fs::path& path) {
+    std::ifstream in(path);
+    return nlohmann::json::parse(in);
+  }
+};
+
+TEST_F(CliContour, IsosurfacesAreDrawnByEveryMethodAndHideTheirVolume) {
+  const std::string common = "render @volume --view iso --size 96x80 --contour 0.3,0.6";
+  const fs::path oracle = dir() / "oracle.png", gpu = dir() / "gpu.png", kept = dir() / "kept.png",
+                 plain = dir() / "plain.png", gpuStats = dir() / "gpu.json", keptStats = dir() / "kept.json";
+  ASSERT_EQ(runCli(common + " -o " + oracle.string()).exitCode, 0);
+  const CliResult g = runCli(common + " -m abuffer-sbuffer -o " + gpu.string() + " --stats " + gpuStats.string());
+  ASSERT_EQ(g.exitCode, 0) << g.out;
+  EXPECT_LT(rmseOf(oracle, gpu), 0.01);  // edge pixels only
+  // auto is "oit": the volume is hidden, only surfaces are left.
+  const nlohmann::json s = stats(gpuStats);
+  EXPECT_EQ(s["operation"], "oit");
+  // Without --contour the image is another one; with --keep-volume the medium is there again.
+  ASSERT_EQ(runCli("render @volume --view iso --size 96x80 --op oit -m abuffer-sbuffer -o " + plain.string()).exitCode,
+            0);
+  EXPECT_GT(rmseOf(gpu, plain), 0.02);
+  ASSERT_EQ(runCli(common + " --keep-volume -m abuffer-sbuffer -o " + kept.string() + " --stats " + keptStats.string())
+                .exitCode,
+            0);
+  EXPECT_EQ(stats(keptStats)["operation"], "volume");
+  EXPECT_GT(rmseOf(gpu, kept), 0.004);  // the faint medium (measured 0.0097)
+}
+
+TEST_F(CliContour, ProbeNamesTheIsosurfacesAndTheirOpacity) {
+  const CliResult r = runCli(
+      "probe @volume --view iso --size 96x80 --pixel 48,40 --contour 0.3,0.6 --contour-opacity 0.25 -m abuffer-ll");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("field = 0.3"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("field = 0.6"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" 64  front"), std::string::npos) << r.out;  // alpha 0.25 → 64/255
+  // --opacity reaches the isosurfaces when --contour-opacity is not given.
+  const CliResult o = runCli("probe @volume --view iso --size 96x80 --pixel 48,40 --contour 0.3 --opacity 0.8");
+  ASSERT_EQ(o.exitCode, 0) << o.out;
+  EXPECT_NE(o.out.find("204  front"), std::string::npos) << o.out;
+}
+
+TEST_F(CliContour, ColouredByAVolumeFieldTheyShowTheirValue) {
+  // A probe of the isosurface at 0.6 coloured by the volume with grayscale: the field value the
+  // probe reads at the fragment is the isosurface's, and the colour a gray.
+  const CliResult r = runCli(
+      "probe @volume --view iso --size 96x80 --pixel 48,40 --contour 0.6 --color-by @field --color-map grayscale "
+      "--color-range 0,1");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const std::size_t at = r.out.find("field = 0.6");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
+  EXPECT_NE(line.find("@field 0.600"), std::string::npos) << line;
+  EXPECT_NE(line.find("148 148 148"), std::string::npos) << line;  // grayscale at 0.6 (ColorMaps.* check the map)
+}
+
+TEST_F(CliContour, BenchAcceptsIsosurfaces) {
+  const fs::path json = dir() / "b.json";
+  const CliResult r =
+      runCli("bench @volume --view iso --size 64x48 --contour 0.5 -m abuffer-ll --repeat 1 --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_TRUE(fs::exists(json));
+}
+
+// Two copies of a 5³ ramp volume in one scene file.
+fs::path writeTwoVolumeScene(const fs::path& dir) {
+  std::ofstream grid(dir / "ramp.vtk");
+  grid << "# vtk DataFile Version 3.0\nramp\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 5 5 5\n"
+          "ORIGIN -1 -1 -1\nSPACING 0.5 0.5 0.5\nPOINT_DATA 125\nSCALARS ramp float 1\nLOOKUP_TABLE default\n";
+  for (int i = 0; i < 125; ++i) grid << i % 5 << "\n";
+  grid.close();
+  std::ofstream scene(dir / "two.mfrscene");
+  scene << R"({"volumes": [{"file": "ramp.vtk", "name": "a"},
+                           {"file": "ramp.vtk", "name": "b", "transform": {"translate": [3, 0, 0]}}]})";
+  return dir / "two.mfrscene";
+}
+
+TEST_F(CliContour, SeveralVolumesNeedTheVolumesName) {
+  const fs::path scene = writeTwoVolumeScene(dir());
+  expectCleanFailure("render " + scene.string() + " --contour 1.5", "say which, as VOLUME=V1,V2");
+  expectCleanFailure("render " + scene.string() + " --contour c=1.5", "no volume 'c' in scene");
+  const fs::path out = dir() / "b.png", json = dir() / "b.json";
+  const CliResult r = runCli("render " + scene.string() + " --contour b=1.5,2.5 -m abuffer-ll -o " + out.string() +
+                             " --stats " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_EQ(stats(json)["operation"], "volume");  // volume a is still drawn
+  const CliResult info =
+      runCli("probe " + scene.string() + " --contour b=1.5 --size 64x64 --view orbit:40:20 --pixel 52,32");
+  ASSERT_EQ(info.exitCode, 0) << info.out;
+  EXPECT_NE(info.out.find("b = 1.5"), std::string::npos) << info.out;
+}
+
+TEST_F(CliContour, BadInputIsOneLine) {
+  expectCleanFailure("render @volume --contour abc", "--contour abc: 'abc' is not a number");
+  expectCleanFailure("render @volume --contour 0.3,", "--contour 0.3,");
+  expectCleanFailure("render @volume --contour 5", "5 lies outside the open range");
+  expectCleanFailure("render @volume --contour nan", "--contour nan");
+  expectCleanFailure("render @volume --contour 1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1", "at most 16");
+  expectCleanFailure("render @sample --contour 0.5", "has no volume");
+  expectCleanFailure("render @volume --contour-opacity 0.5", "--contour-opacity: needs --contour");
+  expectCleanFailure("render @volume --keep-volume", "--keep-volume: needs --contour");
+  expectCleanFailure("render @volume --contour 0.5 --contour-opacity 2", "--contour-opacity");
+}
+
+}  // namespace
