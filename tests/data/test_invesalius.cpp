@@ -5,8 +5,17 @@
 // threshold t must lie where the volume crosses t), and the oracle's image of the loaded scene.
 #include <gtest/gtest.h>
 
+#include <vtkCellArray.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkStaticCellLocator.h>
+
 #include <algorithm>
 #include <cstdint>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -16,6 +25,7 @@
 #include "image_compare.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/scene/color_map.hpp"
+#include "mfr/scene/contour.hpp"
 #include "mfr/io_util.hpp"
 #include "mfr/reference/composite.hpp"
 #include "test_files.hpp"
@@ -136,6 +146,83 @@ TEST(InvesaliusRealFile, SurfacesColouredByTheCtShowTheirThresholds) {
     EXPECT_GT(r.y, threshold);
     EXPECT_GE(r.x, -1024.0);
     EXPECT_LE(r.y, 2986.0);
+  }
+}
+
+// mfr's isosurfaces of the CT (addContours: VTK's flying edges on the samples) against the peer's:
+// InVesalius extracted "Superfície 1" and "Superfície 2" from masks thresholded at 226 (bone) and
+// −142 (skin) with its own pipeline (mask, marching cubes, decimation, smoothing). Distances from each
+// surface's vertices to the other surface, in mm (the CT's voxels are 0.96 × 0.96 × 1.5 mm).
+TEST(InvesaliusRealFile, IsosurfacesAtTheMasksThresholdsLieOnInvesaliusSurfaces) {
+  Scene scene = cranium();
+  ASSERT_EQ(scene.objects.size(), 2u);
+  const std::vector<std::size_t> added = addContours(scene, {0, {226.0, -142.0}, 0.5f}, "test");
+  ASSERT_EQ(added.size(), 2u);
+  EXPECT_EQ(scene.objects[added[0]].name, "ProMED CT 0051 = 226");
+  EXPECT_EQ(scene.objects[added[1]].name, "ProMED CT 0051 = -142");
+
+  // World-space polydata of a part.
+  const auto polyData = [](const Object& o) {
+    vtkNew<vtkPoints> points;
+    for (const glm::vec3& p : o.mesh->positions) {
+      const glm::dvec3 w(o.transform * glm::dvec4(glm::dvec3(p), 1.0));
+      points->InsertNextPoint(w.x, w.y, w.z);
+    }
+    vtkNew<vtkCellArray> triangles;
+    for (std::size_t t = 0; t < o.mesh->indices.size(); t += 3) {
+      const vtkIdType ids[3] = {o.mesh->indices[t], o.mesh->indices[t + 1], o.mesh->indices[t + 2]};
+      triangles->InsertNextCell(3, ids);
+    }
+    vtkSmartPointer<vtkPolyData> poly = vtkSmartPointer<vtkPolyData>::New();
+    poly->SetPoints(points);
+    poly->SetPolys(triangles);
+    return poly;
+  };
+  // Distances from every 7th vertex of `from` to the surface `to`, sorted.
+  const auto distances = [&](const Object& from, const Object& to) {
+    const vtkSmartPointer<vtkPolyData> target = polyData(to);
+    vtkNew<vtkStaticCellLocator> locator;
+    locator->SetDataSet(target);
+    locator->BuildLocator();
+    std::vector<double> d;
+    for (std::size_t i = 0; i < from.mesh->positions.size(); i += 7) {
+      const glm::dvec3 w(from.transform * glm::dvec4(glm::dvec3(from.mesh->positions[i]), 1.0));
+      double x[3] = {w.x, w.y, w.z}, closest[3], d2 = 0.0;
+      vtkIdType cell = 0;
+      int sub = 0;
+      locator->FindClosestPoint(x, closest, cell, sub, d2);
+      d.push_back(std::sqrt(d2));
+    }
+    std::sort(d.begin(), d.end());
+    return d;
+  };
+  const auto at = [](const std::vector<double>& d, double q) {
+    return d[static_cast<std::size_t>(q * static_cast<double>(d.size() - 1))];
+  };
+  for (std::size_t s = 0; s < 2; ++s) {
+    const Object& ours = scene.objects[added[s]];
+    const Object& theirs = scene.objects[s];
+    SCOPED_TRACE(ours.name);
+    const std::vector<double> theirsToOurs = distances(theirs, ours), oursToTheirs = distances(ours, theirs);
+    // Measured (bone; skin): InVesalius → mfr median 0.023; 0.017, 99 % 0.16; 0.15, max 0.25; 0.27 mm;
+    // mfr → InVesalius median 0.025; 0.018, 99 % 0.23; 0.21 mm, max 16; 13 mm (small islands of the
+    // mask InVesalius left out). A surface one voxel off would be ~1 mm away nearly everywhere.
+    EXPECT_LT(at(theirsToOurs, 0.5), 0.1);
+    EXPECT_LT(at(theirsToOurs, 0.99), 0.5);
+    EXPECT_LT(theirsToOurs.back(), 1.0);
+    EXPECT_LT(at(oursToTheirs, 0.5), 0.1);
+    EXPECT_LT(at(oursToTheirs, 0.99), 0.5);
+    // The same extent in the world (the mirror of the InVesalius placement included).
+    const auto worldBounds = [](const Object& o) {
+      Bounds b;
+      for (const glm::vec3& p : o.mesh->positions) b.extend(glm::dvec3(o.transform * glm::dvec4(glm::dvec3(p), 1.0)));
+      return b;
+    };
+    const Bounds bo = worldBounds(ours), bt = worldBounds(theirs);
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(bo.min[a], bt.min[a], 0.5) << "axis " << a;
+      EXPECT_NEAR(bo.max[a], bt.max[a], 0.5) << "axis " << a;
+    }
   }
 }
 

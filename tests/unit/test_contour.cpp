@@ -212,6 +212,23 @@ TEST(Contour, AddContoursMakesNamedColouredPartsPlacedLikeTheVolume) {
   EXPECT_EQ(contourPartName("ct", 0.125), "ct = 0.125");
 }
 
+TEST(Contour, AMirroredVolumesIsosurfacesFaceOutwardsInTheWorld) {
+  // A density sphere placed with a mirror (x → −x, as InVesalius projects flip y): in the world the
+  // triangles must still wind counter-clockwise seen from outside.
+  for (const double mirror : {1.0, -1.0}) {
+    Scene scene;
+    scene.name = "m";
+    Volume v = boxVolume(glm::ivec3(21), [](glm::dvec3 p) { return 1.0 - glm::length(p); });
+    v.transform = glm::dmat4(1.0);
+    v.transform[0][0] = mirror;
+    scene.volumes.push_back(v);
+    addContours(scene, {0, {0.5}, 0.5f}, "test");
+    Mesh world = *scene.objects.at(0).mesh;
+    for (glm::vec3& p : world.positions) p = glm::vec3(scene.objects[0].transform * glm::dvec4(glm::dvec3(p), 1.0));
+    EXPECT_GT(signedVolume(world), 0.9 * 4.0 / 3.0 * glm::pi<double>() * 0.125) << "mirror " << mirror;
+  }
+}
+
 void expectRefused(const ContourRequest& request, const std::string& message) {
   Scene scene = volumeScene();
   const std::shared_ptr<const Mesh> before = scene.objects[0].mesh;

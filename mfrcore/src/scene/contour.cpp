@@ -143,6 +143,10 @@ std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request
     Mesh mesh = contourVolume(volume, value);
     if (mesh.triangleCount() == 0)
       throw Error(what, "volume '" + volume.name + "' has no surface at " + valueText(value));
+    // A mirroring placement (InVesalius projects flip y) turns counter-clockwise into clockwise in the
+    // world: wind the other way there, so that the side the normals point to is the front face.
+    if (glm::determinant(glm::dmat3(volume.transform)) < 0.0)
+      for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
     mesh.validate(contourPartName(volume.name, value));
     Object part;
     part.name = contourPartName(volume.name, value);
