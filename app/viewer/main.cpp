@@ -29,6 +29,7 @@ struct CommandLine {
   QString field;                                  // --field: the array or grid of a volume file
   QString colorBy, colorMap;                      // --color-by, --color-map: surfaces coloured by a field
   std::optional<glm::dvec2> colorRange;           // --color-range
+  std::vector<double> contour;                    // --contour: isosurfaces of the current volume
   std::map<QString, QJsonObject> pluginSettings;  // by plugin id
   QSize size{800, 600}, windowSize;
   std::map<std::string, std::string> params;
@@ -84,6 +85,11 @@ CommandLine parseCommandLine(const QApplication& app) {
   const QCommandLineOption colorRange(
       QStringLiteral("color-range"),
       QStringLiteral("Values at the ends of the colour map (default: the field's range)."), QStringLiteral("lo,hi"));
+  const QCommandLineOption contour(
+      QStringLiteral("contour"),
+      QStringLiteral("Isosurfaces of the scene's (current) volume at these values, as parts; the volume is hidden "
+                     "(the Volume panel's Isosurfaces)."),
+      QStringLiteral("v1,v2,..."));
   const QCommandLineOption param({QStringLiteral("p"), QStringLiteral("param")}, QStringLiteral("Method parameter (repeatable)."), QStringLiteral("name=value"));
   const QCommandLineOption view(QStringLiteral("view"), QStringLiteral("Named view of the scene, or 'fit'."), QStringLiteral("name"));
   const QCommandLineOption size({QStringLiteral("s"), QStringLiteral("size")}, QStringLiteral("Image size for --screenshot (default 800x600)."), QStringLiteral("WxH"));
@@ -93,8 +99,8 @@ CommandLine parseCommandLine(const QApplication& app) {
   const QCommandLineOption pluginSettings(QStringLiteral("plugin-settings"),
                                          QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
                                          QStringLiteral("id={json}"));
-  parser.addOptions({method, op, thickness, step, field, colorBy, colorMap, colorRange, param, view, size, screenshot,
-                     windowScreenshot, windowSize, pluginSettings});
+  parser.addOptions({method, op, thickness, step, field, colorBy, colorMap, colorRange, contour, param, view, size,
+                     screenshot, windowScreenshot, windowSize, pluginSettings});
   parser.process(app);
 
   CommandLine cl;
@@ -132,6 +138,15 @@ CommandLine parseCommandLine(const QApplication& app) {
     if (!okLow || !okHigh || !std::isfinite(low) || !std::isfinite(high) || !(high > low))
       fail(QStringLiteral("--color-range %1: expected LO,HI with LO < HI").arg(parser.value(colorRange)), 2);
     cl.colorRange = glm::dvec2(low, high);
+  }
+  if (parser.isSet(contour)) {
+    for (const QString& item : parser.value(contour).split(QLatin1Char(','))) {
+      bool ok = false;
+      const double v = item.toDouble(&ok);
+      if (!ok || !std::isfinite(v))
+        fail(QStringLiteral("--contour %1: '%2' is not a number").arg(parser.value(contour), item), 2);
+      cl.contour.push_back(v);
+    }
   }
   cl.view = parser.value(view);
   cl.screenshot = parser.value(screenshot);
@@ -189,6 +204,17 @@ int main(int argc, char** argv) {
     // A new scene starts at the default thickness (scene units): --thickness applies to this one.
     if (cl.thickness > 0.0) model.setZThickness(cl.thickness);
     if (cl.step > 0.0) model.setVolumeStep(cl.step);  // likewise the volume step
+    if (!cl.contour.empty()) {
+      // Before --color-by, which then colours them too.
+      QStringList texts;
+      for (const double v : cl.contour) texts << QString::number(v, 'g', 17);
+      const QString reason = model.setIsosurfaces(cl.contour, 0.5);
+      if (!reason.isEmpty()) {
+        const QString message = QStringLiteral("--contour %1: %2").arg(texts.join(QLatin1Char(',')), reason);
+        if (scripted) fail(message, 1);
+        window.statusBar()->showMessage(message);
+      }
+    }
     if (!cl.colorBy.isEmpty() &&
         !model.setFieldColoring(cl.colorBy, cl.colorMap.isEmpty() ? QStringLiteral("cool-warm") : cl.colorMap,
                                 cl.colorRange)) {

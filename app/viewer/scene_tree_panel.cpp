@@ -116,6 +116,7 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
     menu.exec(tree_->viewport()->mapToGlobal(at));
   });
   connect(&model_, &ViewerModel::sceneLoaded, this, &SceneTreePanel::rebuild);
+  connect(&model_, &ViewerModel::partsChanged, this, &SceneTreePanel::rebuild);  // isosurfaces added or removed
   // Edits from elsewhere (a session's overrides, plugins) show up in the rows.
   connect(&model_, &ViewerModel::sceneChanged, this, &SceneTreePanel::showValues);
 }

@@ -108,9 +108,12 @@ Session captureSession(const ViewerModel& model) {
   s.section = model.section();
   s.hasColorBy = true;
   s.colorBy = model.fieldColoring();
-  for (const mfr::Volume& v : model.scene().volumes)
-    s.volumes.push_back(
-        {QString::fromStdString(v.name), v.visible, v.transfer, v.shading, QString::fromStdString(v.field)});
+  for (std::size_t i = 0; i < model.scene().volumes.size(); ++i) {
+    const mfr::Volume& v = model.scene().volumes[i];
+    s.volumes.push_back({QString::fromStdString(v.name), v.visible, v.transfer, v.shading,
+                         QString::fromStdString(v.field), model.isosurfaceValuesAt(static_cast<int>(i)),
+                         model.isosurfaceOpacityAt(static_cast<int>(i))});
+  }
   s.params = model.allParams();
   for (const mfr::Object& o : model.scene().objects) {
     s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color, o.material.vertexColors});
@@ -128,6 +131,10 @@ Session captureSession(const ViewerModel& model) {
 }
 
 void applySession(const Session& session, ViewerModel& model) {
+  // The isosurfaces first: their parts are among the session's objects.
+  if (session.volumes.size() == model.scene().volumes.size())
+    for (std::size_t i = 0; i < session.volumes.size(); ++i)
+      model.setIsosurfacesAt(static_cast<int>(i), session.volumes[i].isosurfaces, session.volumes[i].isosurfaceOpacity);
   if (session.objects.size() == model.scene().objects.size()) {
     for (std::size_t i = 0; i < session.objects.size(); ++i) {
       const Session::ObjectState& o = session.objects[i];
@@ -188,12 +195,17 @@ QJsonObject sessionToJson(const Session& s) {
     QJsonArray points;
     for (const mfr::TransferPoint& p : v.transfer.points)
       points.append(QJsonArray{p.value, p.color.r, p.color.g, p.color.b, p.color.a});
-    volumes.append(
-        QJsonObject{{"name", v.name},
-                    {"visible", v.visible},
-                    {"shading", v.shading},
-                    {"field", v.field},
-                    {"transfer", QJsonObject{{"unit_distance", v.transfer.unitDistance}, {"points", points}}}});
+    QJsonObject volume{{"name", v.name},
+                       {"visible", v.visible},
+                       {"shading", v.shading},
+                       {"field", v.field},
+                       {"transfer", QJsonObject{{"unit_distance", v.transfer.unitDistance}, {"points", points}}}};
+    if (!v.isosurfaces.empty()) {
+      QJsonArray values;
+      for (const double value : v.isosurfaces) values.append(value);
+      volume.insert("isosurfaces", QJsonObject{{"values", values}, {"opacity", v.isosurfaceOpacity}});
+    }
+    volumes.append(volume);
   }
   QJsonArray objects;
   for (const Session::ObjectState& o : s.objects)
@@ -316,7 +328,9 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
                                v.value("visible").toBool(true),
                                {},
                                v.value("shading").toBool(false),
-                               v.value("field").toString()};
+                               v.value("field").toString(),
+                               {},
+                               0.5};
     state.transfer.unitDistance = r.number(t, "unit_distance", where, 1.0);
     const QJsonArray points = t.value("points").toArray();
     for (qsizetype j = 0; j < points.size(); ++j) {
@@ -330,6 +344,18 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
       state.transfer.validate("transfer function");
     } catch (const std::exception& e) {
       r.fail(where, QString::fromUtf8(e.what()));
+    }
+    // Optional (sessions written before isosurfaces have none); the viewer checks the values.
+    if (v.contains("isosurfaces")) {
+      const QString at = QStringLiteral("volumes[%1].isosurfaces").arg(i);
+      const QJsonObject iso = v.value("isosurfaces").toObject();
+      const QJsonArray values = iso.value("values").toArray();
+      for (qsizetype j = 0; j < values.size(); ++j) {
+        if (!values[j].isDouble())
+          r.fail(at + QStringLiteral(".values[%1]").arg(j), QStringLiteral("expected a number"));
+        state.isosurfaces.push_back(values[j].toDouble());
+      }
+      state.isosurfaceOpacity = r.number(iso, "opacity", at, 0.5);
     }
     s.volumes.push_back(std::move(state));
   }

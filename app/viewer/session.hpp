@@ -46,6 +46,8 @@ struct Session {
     mfr::TransferFunction transfer;
     bool shading = false;  // Volume::shading
     QString field;         // Volume::field: the array or grid read ("" for formats without names)
+    std::vector<double> isosurfaces;  // the values of the isosurfaces made in the viewer (none: empty)
+    double isosurfaceOpacity = 0.5;
   };
   std::vector<VolumeState> volumes;                                  // by volume index
   std::map<std::string, std::map<std::string, std::string>> params;  // per method

@@ -15,6 +15,7 @@
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "mfr/scene/color_map.hpp"
+#include "mfr/scene/contour.hpp"
 #include "mfr/scene/scene_file.hpp"
 
 namespace {
@@ -317,6 +318,19 @@ void ViewerModel::setVolumeFieldAt(int index, const QString& field,
           }
         }
         current = std::move(next);
+        // Its isosurfaces are made again from the new samples, at the values still inside their range.
+        if (IsosurfaceSet& set = isosurfaces_[static_cast<std::size_t>(index)]; !set.values.empty()) {
+          const glm::dvec2 range = volumeRanges_[static_cast<std::size_t>(index)];
+          std::vector<double> values;
+          for (const double v : set.values)
+            if (v > range.x && v < range.y) values.push_back(v);
+          const double opacity = set.opacity;
+          set = {};
+          set.opacity = opacity;
+          const bool shown = current.visible;
+          if (values.empty() || !setIsosurfacesAt(index, values, opacity).isEmpty()) spliceIsosurfaces();
+          if (shown) showVolume(index, true);  // making them hides the volume; it was shown
+        }
         updateSceneGeometry();
         resampleVolumeFields();
         volumeEdited();
@@ -391,6 +405,89 @@ std::vector<std::uint64_t> ViewerModel::volumeHistogram(double low, double high,
 bool ViewerModel::volumeVisible() const {
   const int i = volumeIndex();
   return i >= 0 && scene_.volumes[static_cast<std::size_t>(i)].visible;
+}
+
+// ---- isosurfaces ---------------------------------------------------------------------------
+
+std::vector<double> ViewerModel::isosurfaceValues() const {
+  return isosurfaceValuesAt(volumeIndex());
+}
+
+double ViewerModel::isosurfaceOpacity() const {
+  return isosurfaceOpacityAt(volumeIndex());
+}
+
+QString ViewerModel::setIsosurfaces(const std::vector<double>& values, double opacity) {
+  return setIsosurfacesAt(volumeIndex(), values, opacity);
+}
+
+std::vector<double> ViewerModel::isosurfaceValuesAt(int index) const {
+  if (index < 0 || index >= static_cast<int>(isosurfaces_.size())) return {};
+  return isosurfaces_[static_cast<std::size_t>(index)].values;
+}
+
+double ViewerModel::isosurfaceOpacityAt(int index) const {
+  if (index < 0 || index >= static_cast<int>(isosurfaces_.size())) return 0.5;
+  return isosurfaces_[static_cast<std::size_t>(index)].opacity;
+}
+
+QString ViewerModel::setIsosurfacesAt(int index, const std::vector<double>& values, double opacity) {
+  if (!hasScene_ || index < 0 || index >= static_cast<int>(scene_.volumes.size()) ||
+      isosurfaces_.size() != scene_.volumes.size())
+    return tr("the scene has no volume");
+  IsosurfaceSet& set = isosurfaces_[static_cast<std::size_t>(index)];
+  if (values == set.values && opacity == set.opacity) return {};
+  IsosurfaceSet next;
+  next.values = values;
+  next.opacity = opacity;
+  if (!values.empty()) {
+    // Made on a scene of this volume alone, so that a refusal leaves scene_ as it is.
+    mfr::Scene scratch;
+    scratch.name = scene_.name;
+    scratch.volumes = {scene_.volumes[static_cast<std::size_t>(index)]};
+    try {
+      mfr::addContours(scratch, {0, values, static_cast<float>(opacity)}, "isosurfaces");
+    } catch (const std::exception& e) {
+      return QString::fromUtf8(e.what());
+    }
+    next.parts = std::move(scratch.objects);
+  }
+  set = std::move(next);
+  spliceIsosurfaces();
+  if (!values.empty() && scene_.volumes[static_cast<std::size_t>(index)].visible) {
+    showVolume(index, false);  // ParaView hides a filter's input; the Volume panel shows it again
+    updateSceneGeometry();
+    volumeEdited();
+  }
+  return {};
+}
+
+void ViewerModel::spliceIsosurfaces() {
+  const std::size_t base = loadedPartCount_;
+  // A CSG tree over an isosurface part no longer knows its primitives.
+  for (const std::uint32_t primitive : scene_.csg.primitives())
+    if (primitive >= base) {
+      scene_.csg = {};
+      break;
+    }
+  scene_.objects.resize(base);
+  loadedMaterials_.resize(base);
+  loadedMeshes_.resize(base);
+  for (const IsosurfaceSet& set : isosurfaces_)
+    for (const mfr::Object& part : set.parts) scene_.objects.push_back(part);
+  mfr::addVolumeFields(scene_);  // the other volumes' "@NAME" fields on the new parts
+  for (std::size_t i = base; i < scene_.objects.size(); ++i) {
+    loadedMaterials_.push_back(scene_.objects[i].material);
+    loadedMeshes_.push_back(scene_.objects[i].mesh);
+  }
+  updateSceneGeometry();
+  emit partsChanged();
+  // A colouring by a field covers the new parts too.
+  std::optional<mfr::FieldColors> shown;
+  for (std::size_t i = 0; i < base && !shown; ++i) shown = scene_.objects[i].material.fieldColors;
+  if (!shown ||
+      !setFieldColoring(QString::fromStdString(shown->field), QString::fromStdString(shown->map), shown->range))
+    sceneEdited();
 }
 
 void ViewerModel::setVolumeVisible(bool visible) {
@@ -684,6 +781,8 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
     }
   loadedTransfers_.clear();
   volumeRanges_.clear();
+  isosurfaces_.assign(scene_.volumes.size(), {});
+  loadedPartCount_ = scene_.objects.size();
   for (const mfr::Volume& v : scene_.volumes) {
     loadedTransfers_.push_back(v.transfer);
     volumeRanges_.push_back(v.grid ? glm::dvec2(v.grid->range()) : glm::dvec2(0.0));

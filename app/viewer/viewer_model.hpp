@@ -174,6 +174,14 @@ class ViewerModel final : public ViewerContext {
   void setVolumeField(const QString& field) override;
   [[nodiscard]] bool volumeFieldLoading() const override { return fieldLoad_ != nullptr; }
   [[nodiscard]] QString volumeFieldError() const override { return fieldError_; }
+  // 1.8: the current volume's isosurfaces.
+  [[nodiscard]] std::vector<double> isosurfaceValues() const override;
+  [[nodiscard]] double isosurfaceOpacity() const override;
+  QString setIsosurfaces(const std::vector<double>& values, double opacity) override;
+  // Volume `index`'s isosurfaces (sessions; setIsosurfaces is the current volume's case).
+  QString setIsosurfacesAt(int index, const std::vector<double>& values, double opacity);
+  [[nodiscard]] std::vector<double> isosurfaceValuesAt(int index) const;
+  [[nodiscard]] double isosurfaceOpacityAt(int index) const;
   // Volume `index` re-read from its file with `field`, in the background (a new scene, or another
   // field read before it ends, supersedes it), placed as before; its transfer function becomes
   // `transfer` when that is valid (a session's), else the default over the new samples. Nothing
@@ -315,6 +323,7 @@ class ViewerModel final : public ViewerContext {
   void frameImageWanted();       // a frame quality was requested: the view reads back what it shows
   void depthComplexityWanted();  // requestDepthComplexity: the view counts n(p) on the GPU
   void renderErrorChanged(const QString& message);
+  void partsChanged();  // parts added or removed (isosurfaces), followed by sceneChanged
 
  private:
   [[nodiscard]] static std::size_t index(int side) { return side == 1 ? 1 : 0; }
@@ -322,6 +331,7 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] bool metricsWanted(int side) const;
   void sceneEdited();
   void updateSceneGeometry();
+  void spliceIsosurfaces();  // scene_'s parts after the loaded ones: isosurfaces_'s, in volume order
   // After another field of a volume was read: the parts' "@NAME" fields sampled anew (and the
   // colouring by one of them redrawn).
   void resampleVolumeFields();
@@ -359,6 +369,15 @@ class ViewerModel final : public ViewerContext {
   void showVolume(int index, bool visible);             // keeps at most kMaxVisibleVolumes shown
   std::vector<mfr::TransferFunction> loadedTransfers_;  // of scene_'s volumes as loaded
   std::vector<glm::dvec2> volumeRanges_;                // of scene_'s volumes' grids
+  // Isosurfaces made in the viewer, per volume: their values, opacity and parts (made once, spliced
+  // into scene_.objects after its first loadedPartCount_ parts, the scene's own).
+  struct IsosurfaceSet {
+    std::vector<double> values;
+    double opacity = 0.5;
+    std::vector<mfr::Object> parts;
+  };
+  std::vector<IsosurfaceSet> isosurfaces_;
+  std::size_t loadedPartCount_ = 0;
 
   bool compare_ = false;
   CompareLayout layout_ = CompareLayout::SideBySide;

@@ -193,6 +193,16 @@ class ViewerContext : public QObject {
   virtual void setVolumeField(const QString& field) = 0;
   [[nodiscard]] virtual bool volumeFieldLoading() const = 0;
   [[nodiscard]] virtual QString volumeFieldError() const = 0;
+  // 1.8: isosurfaces of the current volume (ParaView's Contour; mfr::addContours): parts named
+  // "VOLUME = VALUE", coloured by their value, after the scene's own parts (sceneChanged, and the
+  // scene tree lists them). setIsosurfaces replaces the current volume's set — an empty list removes
+  // it — and hides the volume when it makes any (ParaView hides a filter's input); it returns an empty
+  // string, or the one-line reason it was refused (a value outside the volume's range, more than
+  // mfr::kMaxContourValues, an opacity outside 0 … 1), nothing changed then. A field read in the
+  // volume's place (setVolumeField) makes its set again, over the values still inside the new range.
+  [[nodiscard]] virtual std::vector<double> isosurfaceValues() const = 0;
+  [[nodiscard]] virtual double isosurfaceOpacity() const = 0;  // of the current set; 0.5 without one
+  virtual QString setIsosurfaces(const std::vector<double>& values, double opacity) = 0;
 
  signals:
   void sceneChanged();  // a new scene, or an object edited
@@ -233,5 +243,6 @@ class MfrViewerPlugin {
 //      setCurrentVolume.
 // 1.7: a volume file's fields: volumeFields, volumeField, setVolumeField, volumeFieldLoading,
 //      volumeFieldError.
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.7"
+// 1.8: isosurfaces of a volume: isosurfaceValues, isosurfaceOpacity, setIsosurfaces.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.8"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -7,9 +7,11 @@
 #include <QHBoxLayout>
 #include <QJsonArray>
 #include <QLabel>
+#include <QLineEdit>
 #include <QPainter>
 #include <QPixmap>
 #include <QPushButton>
+#include <QRegularExpression>
 #include <QSignalBlocker>
 #include <QSlider>
 #include <QVBoxLayout>
@@ -265,6 +267,29 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   stepRow->addWidget(step_, 1);
   stepRow->addWidget(stepDefault);
   form->addRow(tr("Scene units"), stepRow);
+
+  // Isosurfaces (ParaView's Contour): parts of their own, drawn by every method like any other.
+  isoValues_ = new QLineEdit;
+  isoValues_->setObjectName(QStringLiteral("hvIsoValues"));
+  isoValues_->setPlaceholderText(tr("values, e.g. -142, 226"));
+  isoValues_->setToolTip(
+      tr("Isosurfaces of the volume at these values (at most 16, inside its range), each a part "
+         "named \"volume = value\" coloured by its value; the volume is hidden while they are "
+         "made (Show volume draws it again). Empty: none"));
+  isoOpacity_ = unitSpinBox("hvIsoOpacity", tr("Opacity of the isosurfaces"));
+  isoOpacity_->setDecimals(2);
+  isoOpacity_->setValue(0.5);
+  auto* isoApply = new QPushButton(tr("Apply"));
+  isoApply->setObjectName(QStringLiteral("hvIsoApply"));
+  auto* isoRow = new QHBoxLayout;
+  isoRow->addWidget(isoValues_, 3);
+  isoRow->addWidget(isoOpacity_, 1);
+  isoRow->addWidget(isoApply);
+  form->addRow(tr("Isosurfaces"), isoRow);
+  isoNote_ = new QLabel;
+  isoNote_->setObjectName(QStringLiteral("hvIsoNote"));
+  isoNote_->setWordWrap(true);
+  form->addRow(isoNote_);
   layout->addWidget(controls_);
 
   info_ = new QLabel;
@@ -286,6 +311,7 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   connect(&context_, &ViewerContext::methodChanged, this, &HybridVolumePanel::showState);
   connect(&context_, &ViewerContext::volumeChanged, this, &HybridVolumePanel::volumeChanged);
   connect(&context_, &ViewerContext::frameRendered, this, &HybridVolumePanel::showInfo);
+  connect(&context_, &ViewerContext::sceneChanged, this, &HybridVolumePanel::showIsosurfaces);
   connect(preset_, &QComboBox::currentIndexChanged, this, &HybridVolumePanel::applyTransfer);
   connect(windowMin_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
     windowLow_ = v;
@@ -310,6 +336,8 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
     error_->setVisible(!reason.isEmpty());
     resetToCurrent();
   });
+  connect(isoApply, &QPushButton::clicked, this, &HybridVolumePanel::applyIsosurfaces);
+  connect(isoValues_, &QLineEdit::returnPressed, this, &HybridVolumePanel::applyIsosurfaces);
   connect(stepSlider_, &QSlider::valueChanged, this, &HybridVolumePanel::stepFromSlider);
   connect(step_, &QDoubleSpinBox::valueChanged, this, [this](double v) { context_.setVolumeStep(v); });
   connect(stepDefault, &QPushButton::clicked, this, [this] { context_.setVolumeStep(0.0); });
@@ -387,6 +415,49 @@ void HybridVolumePanel::volumeChanged() {
   showStep();
   showState();
   showInfo();
+  showIsosurfaces();
+}
+
+// ---- isosurfaces ----------------------------------------------------------------------------
+
+void HybridVolumePanel::showIsosurfaces() {
+  const std::vector<double> values = context_.isosurfaceValues();
+  QStringList texts;
+  for (const double v : values) texts << QString::number(v, 'g', 8);
+  if (isoError_.isEmpty()) isoValues_->setText(texts.join(QStringLiteral(", ")));
+  if (!values.empty()) {
+    const QSignalBlocker block(isoOpacity_);
+    isoOpacity_->setValue(context_.isosurfaceOpacity());
+  }
+  const glm::dvec2 range = context_.volumeValueRange();
+  isoNote_->setStyleSheet(isoError_.isEmpty() ? QString() : QStringLiteral("color: #b00020;"));
+  isoNote_->setText(!isoError_.isEmpty() ? isoError_
+                    : values.empty()
+                        ? tr("Values inside %1 … %2").arg(range.x, 0, 'g', 6).arg(range.y, 0, 'g', 6)
+                        : (values.size() == 1 ? tr("1 isosurface, in the scene tree as a part")
+                                              : tr("%1 isosurfaces, in the scene tree as parts").arg(values.size())));
+}
+
+void HybridVolumePanel::applyIsosurfaces() {
+  if (!context_.hasScene() || !context_.hasVolume()) return;
+  std::vector<double> values;
+  isoError_.clear();
+  for (const QString& item :
+       isoValues_->text().split(QRegularExpression(QStringLiteral("[,;\\s]+")), Qt::SkipEmptyParts)) {
+    bool ok = false;
+    const double v = item.toDouble(&ok);
+    if (!ok) {
+      isoError_ = tr("'%1' is not a number").arg(item);
+      showIsosurfaces();
+      return;
+    }
+    values.push_back(v);
+  }
+  const bool wasShown = show_->isChecked();
+  isoError_ = context_.setIsosurfaces(values, isoOpacity_->value());
+  // Making them hid the volume: give back the method and operation the Show switch had replaced.
+  if (isoError_.isEmpty() && wasShown && !context_.volumeVisible()) setShow(false);
+  showIsosurfaces();
 }
 
 void HybridVolumePanel::resetToCurrent() {

@@ -20,6 +20,9 @@
 //   the points.
 // - Step: a logarithmic slider (0.1× … 10× the default), a spin box in scene units and Default,
 //   all on ViewerContext::volumeStep (shared with the method panel's Step row).
+// - Isosurfaces: values (and an opacity) of the volume's isosurfaces, made as parts of their own
+//   (ViewerContext::setIsosurfaces); the volume is hidden when they are made, and the method and
+//   operation "Show volume" replaced come back; a refusal is shown under them.
 // - An info line: grid size, spacing, value range, and the last frame's step and GPU bytes (its
 //   stats notes "volume step" and "volume (bytes)").
 #include <QJsonObject>
@@ -31,6 +34,7 @@ class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
+class QLineEdit;
 class QPushButton;
 class QSlider;
 class TransferFunctionEditor;
@@ -74,6 +78,8 @@ class HybridVolumePanel final : public QWidget {
   void showStep();
   void stepFromSlider(int position);
   void showInfo();
+  void showIsosurfaces();
+  void applyIsosurfaces();
 
   ViewerContext& context_;
   QComboBox* volumeChoice_ = nullptr;
@@ -102,6 +108,10 @@ class HybridVolumePanel final : public QWidget {
   QSlider* stepSlider_ = nullptr;
   QDoubleSpinBox* step_ = nullptr;
   QLabel* info_ = nullptr;
+  QLineEdit* isoValues_ = nullptr;
+  QDoubleSpinBox* isoOpacity_ = nullptr;
+  QLabel* isoNote_ = nullptr;
+  QString isoError_;  // why the last Apply was refused
   QWidget* controls_ = nullptr;
 
   QString sceneKey_;               // the volume the panel was set up for

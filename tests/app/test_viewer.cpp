@@ -2795,6 +2795,98 @@ class ViewerTest : public QObject {
              qPrintable(out));
   }
 
+  void isosurfaces() {
+    // The Volume panel's Isosurfaces: parts "field = V" in the scene tree, the volume hidden, the
+    // pixels of mfr render --contour; refusals leave the scene as it was; sessions keep them.
+    QTemporaryDir dir;
+    auto w = openWindow(QStringLiteral("@volume"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    const QSize size(160, 120);
+    QVERIFY(showAbufferIso(*w, size));
+    const std::size_t loaded = m.scene().objects.size();
+    auto* values = w->findChild<QLineEdit*>("hvIsoValues");
+    auto* opacity = w->findChild<QDoubleSpinBox*>("hvIsoOpacity");
+    auto* apply = w->findChild<QPushButton*>("hvIsoApply");
+    auto* note = w->findChild<QLabel*>("hvIsoNote");
+    auto* show = w->findChild<QCheckBox*>("hvShow");
+    auto* tree = w->findChild<QTreeWidget*>("sceneTree");
+    QVERIFY(values && opacity && apply && note && show && tree);
+    QVERIFY(m.volumeVisible());
+    const mfr::ImageRGBA8 volumeFrame = w->view().renderImage(size);
+
+    values->setText(QStringLiteral("0.3, 0.6"));
+    opacity->setValue(0.25);
+    QTest::mouseClick(apply, Qt::LeftButton);
+    QCOMPARE(m.scene().objects.size(), loaded + 2);
+    QCOMPARE(QString::fromStdString(m.scene().objects[loaded].name), QStringLiteral("field = 0.3"));
+    QCOMPARE(QString::fromStdString(m.scene().objects[loaded + 1].name), QStringLiteral("field = 0.6"));
+    QCOMPARE(m.isosurfaceValues(), (std::vector<double>{0.3, 0.6}));
+    QVERIFY(!tree->findItems(QStringLiteral("field = 0.6"), Qt::MatchExactly).isEmpty());
+    QVERIFY(!m.volumeVisible());
+    QVERIFY(!show->isChecked());
+    QVERIFY2(note->text().contains(QStringLiteral("2 isosurfaces")), qPrintable(note->text()));
+    settle(m);
+    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    const mfr::ImageRGBA8 isoFrame = w->view().renderImage(size);
+    QVERIFY(maxChannelDifference(isoFrame, volumeFrame) > 20);
+    const QString cliPng = dir.filePath("cli.png");
+    QString out;
+    QCOMPARE(runProgram(MFR_CLI,
+                        {"render", "@volume", "--contour", "0.3,0.6", "--contour-opacity", "0.25", "--size", "160x120",
+                         "--view", "iso", "-m", "abuffer-ll", "-o", cliPng},
+                        &out),
+             0);
+    QCOMPARE(maxChannelDifference(mfr::readPng(cliPng.toStdString()), isoFrame), 0);
+
+    // Refused: a value outside the volume's range, a word; the isosurfaces stay as they were.
+    values->setText(QStringLiteral("0.3, 5"));
+    QTest::mouseClick(apply, Qt::LeftButton);
+    QVERIFY2(note->text().contains(QStringLiteral("5 lies outside the open range")), qPrintable(note->text()));
+    QCOMPARE(values->text(), QStringLiteral("0.3, 5"));  // the user's text stays, to be mended
+    values->setText(QStringLiteral("0.3 abc"));
+    QTest::mouseClick(apply, Qt::LeftButton);
+    QCOMPARE(note->text(), QStringLiteral("'abc' is not a number"));
+    QCOMPARE(m.scene().objects.size(), loaded + 2);
+    QCOMPARE(m.isosurfaceValues(), (std::vector<double>{0.3, 0.6}));
+
+    // A session brings them back, with their pixels.
+    const QString sessionPath = dir.filePath("iso.mfrsession");
+    w->saveSession(sessionPath);
+    auto again = openWindow(QString());
+    QVERIFY(again);
+    again->view().setFixedSize(size);
+    again->openSession(sessionPath);
+    ViewerModel& a = again->model();
+    QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.scene().objects.size() == loaded + 2, kTimeoutMs);
+    settle(a);
+    QCOMPARE(a.isosurfaceValues(), (std::vector<double>{0.3, 0.6}));
+    QCOMPARE(a.isosurfaceOpacity(), 0.25);
+    QCOMPARE(maxChannelDifference(isoFrame, again->view().renderImage(a.renderSize())), 0);
+    again.reset();
+
+    // Empty: none again; Show volume draws the volume as before.
+    values->clear();
+    QTest::mouseClick(apply, Qt::LeftButton);
+    QCOMPARE(m.scene().objects.size(), loaded);
+    QVERIFY(tree->findItems(QStringLiteral("field = 0.6"), Qt::MatchExactly).isEmpty());
+    show->setChecked(true);
+    settle(m);
+    QCOMPARE(maxChannelDifference(w->view().renderImage(size), volumeFrame), 0);
+
+    // mfrview --contour: the pixels of mfr render --contour (opacity 0.5 in both).
+    const QString viewerPng = dir.filePath("viewer.png");
+    const QStringList common{"--size", "96x72", "--view", "iso", "-m", "abuffer-ll"};
+    QCOMPARE(runProgram(MFRVIEW, QStringList{"@volume", "--contour", "0.45", "--screenshot", viewerPng} + common, &out),
+             0);
+    QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@volume", "--contour", "0.45", "-o", cliPng} + common, &out),
+             0);
+    QCOMPARE(maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString())), 0);
+    QVERIFY(runProgram(MFRVIEW, QStringList{"@volume", "--contour", "7", "--screenshot", viewerPng} + common, &out) !=
+            0);
+    QVERIFY2(out.contains(QStringLiteral("--contour 7: isosurfaces: 7 lies outside the open range")), qPrintable(out));
+  }
+
   void colorByField() {
     // A sheet with point data "pressure" (x + y²/4, −2 … 3) and cell data "zone" (1 left, 2 right).
     QTemporaryDir dir;
