@@ -38,6 +38,7 @@
 #include "main_window.hpp"
 #include "probe_panel.hpp"
 #include "session.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "mfr/scene/section.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
@@ -2793,6 +2794,30 @@ class ViewerTest : public QObject {
     QVERIFY2(last.startsWith(QStringLiteral("mfrview: ") + vti) &&
                  last.contains(QStringLiteral("no point-data or cell-data array 'rings' (arrays: ramp, ring)")),
              qPrintable(out));
+
+    // Isosurfaces follow a field read in the volume's place: made again from the new samples (each
+    // vertex samples to the value in the new grid), values outside the new range dropped.
+    const std::size_t parts = m.scene().objects.size();
+    const auto isoValuesInVolume = [&] {
+      std::vector<float> values;
+      const mfr::Mesh& mesh = *m.scene().objects.at(parts).mesh;
+      for (const float v : mfr::fieldValues(mesh, "@two.vti", "").values) values.push_back(v);
+      return values;
+    };
+    QVERIFY(m.setIsosurfaces({0.5}, 0.4).isEmpty());  // on ring
+    QCOMPARE(m.scene().objects.size(), parts + 1);
+    m.setVolumeField(QStringLiteral("ramp"));
+    QTRY_VERIFY_WITH_TIMEOUT(!m.volumeFieldLoading() && m.volumeField() == QStringLiteral("ramp"), kTimeoutMs);
+    QCOMPARE(m.isosurfaceValues(), std::vector<double>{0.5});
+    QCOMPARE(m.scene().objects.size(), parts + 1);
+    for (const float v : isoValuesInVolume()) QVERIFY2(std::abs(v - 0.5f) < 1e-4f, qPrintable(QString::number(v)));
+    QVERIFY(m.setIsosurfaces({0.5, 5.0}, 0.4).isEmpty());  // 5: inside ramp's 0 … 11 only
+    QCOMPARE(m.scene().objects.size(), parts + 2);
+    m.setVolumeField(QStringLiteral("ring"));
+    QTRY_VERIFY_WITH_TIMEOUT(!m.volumeFieldLoading() && m.volumeField() == QStringLiteral("ring"), kTimeoutMs);
+    QCOMPARE(m.isosurfaceValues(), std::vector<double>{0.5});
+    QCOMPARE(m.scene().objects.size(), parts + 1);
+    for (const float v : isoValuesInVolume()) QVERIFY2(std::abs(v - 0.5f) < 1e-4f, qPrintable(QString::number(v)));
   }
 
   void isosurfaces() {

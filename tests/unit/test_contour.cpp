@@ -199,7 +199,8 @@ TEST(Contour, AddContoursMakesNamedColouredPartsPlacedLikeTheVolume) {
     const Object& o = scene.objects[added[i]];
     EXPECT_EQ(o.name, i == 0 ? "ct = 20" : "ct = 60");
     EXPECT_EQ(o.transform, scene.volumes[0].transform);
-    const glm::vec3 rgb = mapFieldValue(colorMap("cool-warm"), static_cast<float>(values[i]), range);
+    // Two values: the map spans them, the first at its blue end, the second at its red end.
+    const glm::vec3 rgb = mapFieldValue(colorMap("cool-warm"), i == 0 ? 0.0f : 1.0f, glm::vec2(0.0f, 1.0f));
     EXPECT_EQ(o.material.color, glm::vec4(rgb, 0.25f));
     // Sphere of radius 1 − value/100 in object space.
     const glm::vec3 p = o.mesh->positions.front();
@@ -210,6 +211,10 @@ TEST(Contour, AddContoursMakesNamedColouredPartsPlacedLikeTheVolume) {
   }
   EXPECT_NE(scene.objects[0].mesh->fields.size(), 0u);  // the other part got it too
   EXPECT_EQ(contourPartName("ct", 0.125), "ct = 0.125");
+  // One value: its colour over the grid's range.
+  Scene one = volumeScene();
+  addContours(one, {0, {20.0}, 1.0f}, "test");
+  EXPECT_EQ(one.objects[1].material.color, glm::vec4(mapFieldValue(colorMap("cool-warm"), 20.0f, range), 1.0f));
 }
 
 TEST(Contour, AMirroredVolumesIsosurfacesFaceOutwardsInTheWorld) {

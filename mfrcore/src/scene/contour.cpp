@@ -137,6 +137,13 @@ std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request
       throw Error(what, valueText(value) + " lies outside the open range " + rangeText + " of volume '" + volume.name +
                             "': no surface");
   }
+  // Several isosurfaces span the map between the lowest and the highest value, so that they differ
+  // most; one gets the map's colour at its value over the grid's range.
+  glm::vec2 colourRange = range;
+  if (request.values.size() > 1) {
+    const auto [low, high] = std::minmax_element(request.values.begin(), request.values.end());
+    if (*high > *low) colourRange = glm::vec2(static_cast<float>(*low), static_cast<float>(*high));
+  }
   // Every surface is made before the scene is touched, so that a failure leaves it as it was.
   std::vector<Object> parts;
   for (const double value : request.values) {
@@ -152,7 +159,7 @@ std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request
     part.name = contourPartName(volume.name, value);
     part.mesh = std::make_shared<const Mesh>(std::move(mesh));
     part.transform = volume.transform;
-    const glm::vec3 rgb = mapFieldValue(colorMap("cool-warm"), static_cast<float>(value), range);
+    const glm::vec3 rgb = mapFieldValue(colorMap("cool-warm"), static_cast<float>(value), colourRange);
     part.material.color = glm::vec4(rgb, request.opacity);
     parts.push_back(std::move(part));
   }

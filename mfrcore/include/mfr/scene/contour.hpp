@@ -32,8 +32,9 @@ struct ContourRequest {
 };
 
 // Adds one part per value to scene.objects, named "<volume name> = <value>" (the value as %g), with
-// the volume's transform, coloured by its value through the cool-warm map over the grid's range
-// (ParaView colours contours by their value), with request.opacity — wound so that their normals'
+// the volume's transform, coloured by its value through the cool-warm map (ParaView colours contours
+// by their value) — over [lowest, highest] of several values, so that they differ most (the lowest
+// blue, the highest red); over the grid's range for one — with request.opacity, wound so that their normals'
 // side is the front face in the world, also under a mirroring transform; then addVolumeFields, so that
 // they too can be coloured by any volume of the scene ("@NAME"). Returns the new parts' indices.
 // Throws mfr::Error(what, reason), leaving the scene unchanged, for: no such volume, no value, more
