@@ -1,12 +1,14 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "commands.hpp"
 #include "mfr/error.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
+#include "mfr/legend.hpp"
 #include "mfr/render.hpp"
 
 namespace mfr::cli {
@@ -22,6 +24,7 @@ void addRender(CLI::App& app) {
     double thickness = 0.0;
     double step = 0.0;
     bool shade = false;
+    bool legend = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method and write a PNG (and stats JSON)");
@@ -42,6 +45,9 @@ void addRender(CLI::App& app) {
   cmd->add_flag("--shade", opt->shade,
                 "Operation volume: shade the volume by its gradient with a headlight (boundaries inside the medium "
                 "read as surfaces)");
+  cmd->add_flag("--legend", opt->legend,
+                "Draw the colour map of --color-by (or the scene's color_by) with its field and values in the lower "
+                "right corner, as ParaView's scalar bar");
   cmd->add_option("--clip", opt->clip, kClipHelp);
   opt->colorBy.add(cmd);
   opt->contours.add(cmd);
@@ -79,8 +85,21 @@ void addRender(CLI::App& app) {
       if (scene.volumes.empty()) throw Error("--shade", "scene '" + scene.name + "' has no volume");
       req.volumeShading = true;
     }
+    std::optional<FieldColors> legend;
+    if (opt->legend) {
+      for (const Object& o : scene.objects)
+        if (o.material.fieldColors) {
+          legend = o.material.fieldColors;
+          break;
+        }
+      if (!legend) throw Error("--legend", "nothing is coloured by a field (use --color-by, or a scene's color_by)");
+      if (w < kMinLegendImageSize || h < kMinLegendImageSize)
+        throw Error("--legend", "the image " + opt->size + " is too small for one: at least " +
+                                    std::to_string(kMinLegendImageSize) + " pixels a side");
+    }
     const Camera camera = scene.view(opt->view);
-    const RenderOutput out = render(scene, camera, req);
+    RenderOutput out = render(scene, camera, req);
+    if (legend) drawColorLegend(out.image, *legend, scene.background);
     // Both outputs are produced before either is written, and each is written atomically.
     writePng(opt->output, out.image);
     if (!opt->stats.empty()) writeFileAtomically(opt->stats, toJson(out.stats) + "\n");

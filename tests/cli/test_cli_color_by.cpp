@@ -4,6 +4,8 @@
 // options, and bad fields, maps and ranges are one line.
 #include <gtest/gtest.h>
 
+#include <cstring>
+
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -120,6 +122,30 @@ TEST_F(CliColorBy, GpuEqualsOracleAndTheMapAndRangeShow) {
   EXPECT_NEAR(zone.at(18, 25)[0], 77, 2);
   EXPECT_NEAR(zone.at(42, 25)[0], 255, 1);
   EXPECT_LT(plain.at(42, 25)[0], 240);  // the sheet is there (its grey over the background)
+}
+
+TEST_F(CliColorBy, LegendIsDrawnInTheLowerRightCornerOnly) {
+  const fs::path file = write("sheet.vtp", sheet());
+  const std::string common = "render " + file.string() + " --size 320x240 -m abuffer-ll --color-by pressure ";
+  const fs::path plainPath = dir() / "plain.png", legendPath = dir() / "legend.png";
+  ASSERT_EQ(runCli(common + "-o " + plainPath.string()).exitCode, 0);
+  const CliResult r = runCli(common + "--legend -o " + legendPath.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const mfr::ImageRGBA8 plain = mfr::readPng(plainPath), legend = mfr::readPng(legendPath);
+  std::size_t differLowerRight = 0;
+  for (int y = 0; y < plain.height; ++y)
+    for (int x = 0; x < plain.width; ++x) {
+      const bool differ = std::memcmp(plain.at(x, y), legend.at(x, y), 3) != 0;
+      if (x < plain.width / 2 || y < plain.height / 4) {
+        ASSERT_FALSE(differ) << x << ", " << y;  // the legend stays in its corner
+      } else {
+        differLowerRight += differ;
+      }
+    }
+  EXPECT_GT(differLowerRight, 500u);
+  expectCleanFailure("render " + file.string() + " --legend", "--legend: nothing is coloured by a field");
+  expectCleanFailure("render " + file.string() + " --size 64x64 -m abuffer-ll --color-by pressure --legend",
+                     "--legend: the image 64x64 is too small");
 }
 
 TEST_F(CliColorBy, AHeadOnPixelIsExactlyTheMapsColour) {
