@@ -81,7 +81,7 @@ Mesh contourVolume(const Volume& volume, double value) {
 
   // Orientation: VTK's normals point down the gradient (towards lower values); make the normals
   // point there whichever way a VTK version signs them (checked against the samples' own difference
-  // across the surface), then wind each triangle to face the side its normals point to.
+  // across the surface), then wind the triangles to face the side the normals point to.
   const glm::dmat4 gridFromObject =
       glm::inverse(glm::dmat4(glm::dvec4(volume.spacing.x, 0, 0, 0), glm::dvec4(0, volume.spacing.y, 0, 0),
                               glm::dvec4(0, 0, volume.spacing.z, 0), glm::dvec4(volume.origin, 1.0)));
@@ -95,14 +95,19 @@ Mesh contourVolume(const Volume& volume, double value) {
   }
   if (agree < 0.0)
     for (glm::vec3& n : mesh.normals) n = -n;
+  // Flying edges winds its triangles consistently (every shared edge run both ways): turn them all
+  // or none, by the majority of their agreement with the normals — per triangle, noisy samples would
+  // turn single triangles against their neighbours.
+  double facing = 0.0;
   for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
     const glm::vec3 a = mesh.positions[mesh.indices[t]], b = mesh.positions[mesh.indices[t + 1]],
                     c = mesh.positions[mesh.indices[t + 2]];
-    const glm::vec3 faceNormal = glm::cross(b - a, c - a);
     const glm::vec3 vertexNormals =
         mesh.normals[mesh.indices[t]] + mesh.normals[mesh.indices[t + 1]] + mesh.normals[mesh.indices[t + 2]];
-    if (glm::dot(faceNormal, vertexNormals) < 0.0f) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+    facing += glm::dot(glm::cross(b - a, c - a), vertexNormals) > 0.0f ? 1.0 : -1.0;
   }
+  if (facing < 0.0)
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
   return mesh;
 }
 
@@ -150,10 +155,6 @@ std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request
     Mesh mesh = contourVolume(volume, value);
     if (mesh.triangleCount() == 0)
       throw Error(what, "volume '" + volume.name + "' has no surface at " + valueText(value));
-    // A mirroring placement (InVesalius projects flip y) turns counter-clockwise into clockwise in the
-    // world: wind the other way there, so that the side the normals point to is the front face.
-    if (glm::determinant(glm::dmat3(volume.transform)) < 0.0)
-      for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
     mesh.validate(contourPartName(volume.name, value));
     Object part;
     part.name = contourPartName(volume.name, value);

@@ -20,7 +20,9 @@ inline constexpr std::size_t kMaxContourValues = 16;
 // where the edge's two samples, interpolated linearly, equal `value` — so the volume's trilinear
 // sample (VolumeGrid::sample) is `value` at every vertex. Normals are the samples' gradient, pointing
 // towards lower values (out of the region above `value`: bone into soft tissue, skin into air), and
-// each triangle winds counter-clockwise seen from the side its normals point to. An isosurface that
+// each triangle winds counter-clockwise seen from the side its normals point to — in object space, as
+// every part's (a mirroring transform reverses its facing in the world; CSG and section caps allow
+// for that, as for any mirrored part). An isosurface that
 // reaches the grid's boundary is open there. Empty when the samples do not cross `value`.
 Mesh contourVolume(const Volume& volume, double value);
 
@@ -34,8 +36,7 @@ struct ContourRequest {
 // Adds one part per value to scene.objects, named "<volume name> = <value>" (the value as %g), with
 // the volume's transform, coloured by its value through the cool-warm map (ParaView colours contours
 // by their value) — over [lowest, highest] of several values, so that they differ most (the lowest
-// blue, the highest red); over the grid's range for one — with request.opacity, wound so that their normals'
-// side is the front face in the world, also under a mirroring transform; then addVolumeFields, so that
+// blue, the highest red); over the grid's range for one — with request.opacity; then addVolumeFields, so that
 // they too can be coloured by any volume of the scene ("@NAME"). Returns the new parts' indices.
 // Throws mfr::Error(what, reason), leaving the scene unchanged, for: no such volume, no value, more
 // than kMaxContourValues, a non-finite value, a value outside the open interval of the grid's range
