@@ -4,13 +4,14 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
-#include "mfr/scene/color_map.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "mfr/render.hpp"
+#include "mfr/scene/color_map.hpp"
+#include "mfr/scene/measure.hpp"
 
 namespace mfr::cli {
 
@@ -18,6 +19,7 @@ void addInfo(CLI::App& app) {
   struct Options {
     std::string scene, size = "256x256", view = "fit", json, field;
     bool methods = false, noHistogram = false;
+    ContourOptions contours;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("info", "Describe a scene: parts, triangles, bounds, depth-complexity histogram");
@@ -27,6 +29,7 @@ void addInfo(CLI::App& app) {
   cmd->add_option("--view", opt->view, "View for the histogram")->capture_default_str();
   cmd->add_flag("--no-histogram", opt->noHistogram, "Skip the oracle pass");
   cmd->add_option("--field", opt->field, kFieldHelp);
+  opt->contours.add(cmd);
   cmd->add_option("--json", opt->json, "Also write the information as JSON");
   cmd->callback([opt] {
     if (opt->methods) {
@@ -35,7 +38,10 @@ void addInfo(CLI::App& app) {
     }
     if (opt->scene.empty()) throw Error("info", "needs a scene (or --methods)");
     const auto [w, h] = parseSize("--size", opt->size);
-    const Scene scene = loadScene(opt->scene, LoadOptions{opt->field});
+    Scene scene = loadScene(opt->scene, LoadOptions{opt->field});
+    opt->contours.apply(scene, -1.0);
+    std::vector<SurfaceMeasures> measures;
+    for (const Object& o : scene.objects) measures.push_back(measureSurface(*o.mesh, o.transform));
     nlohmann::ordered_json j;
     const Bounds b = scene.bounds();
     j["scene"] = scene.name;
@@ -51,7 +57,16 @@ void addInfo(CLI::App& app) {
         const glm::dvec2 r = fieldRange(v.values);
         fields.push_back({{"name", f}, {"cell_data", v.cellData}, {"range", {r.x, r.y}}});
       }
-      parts.push_back({{"name", o.name}, {"triangles", o.mesh->triangleCount()}, {"fields", fields}});
+      const SurfaceMeasures& m = measures[static_cast<std::size_t>(&o - scene.objects.data())];
+      parts.push_back({{"name", o.name},
+                       {"triangles", o.mesh->triangleCount()},
+                       {"area", m.area},
+                       {"closed", m.closed()},
+                       {"volume", m.closed() ? nlohmann::ordered_json(m.volume) : nlohmann::ordered_json()},
+                       {"boundary_edges", m.boundaryEdges},
+                       {"non_manifold_edges", m.nonManifoldEdges},
+                       {"orientation_flips", m.orientationFlips},
+                       {"fields", fields}});
     }
     j["part_list"] = parts;
     std::cout << "scene      " << scene.name << "\nparts      " << scene.objects.size() << "\ntriangles  "
@@ -65,6 +80,18 @@ void addInfo(CLI::App& app) {
       std::cout << "  part " << i << ": " << o.name << " (" << o.mesh->triangleCount() << " triangles, rgba "
                 << o.material.color.r << " " << o.material.color.g << " " << o.material.color.b << " "
                 << o.material.color.a << ")\n";
+      // Its surface in the world: area, and the volume it encloses when it is closed.
+      const SurfaceMeasures& m = measures[i];
+      std::cout << "    area " << m.area;
+      if (m.closed()) {
+        std::cout << ", closed, volume " << m.volume << (m.volume < 0.0 ? " (inside out)" : "");
+      } else {
+        std::cout << ", not closed (" << m.boundaryEdges << " boundary edges";
+        if (m.nonManifoldEdges > 0) std::cout << ", " << m.nonManifoldEdges << " non-manifold";
+        if (m.orientationFlips > 0) std::cout << ", " << m.orientationFlips << " wound against a neighbour";
+        std::cout << "): no enclosed volume";
+      }
+      std::cout << "\n";
       if (!o.mesh->fields.empty()) {
         // What --color-by can use, with each field's range (cell data marked).
         std::cout << "    fields:";

@@ -173,6 +173,31 @@ TEST_F(Cli, InfoReportsTrianglesAndHistogram) {
   EXPECT_NE(r.out.find("n=7: 1024 pixels"), std::string::npos) << r.out;  // every pixel has 7 layers
 }
 
+// Each part's area and, when it is closed, the volume it encloses — in the world (the transform's
+// scale included) — in the text and in --json.
+TEST_F(Cli, InfoMeasuresEachPartsSurface) {
+  const fs::path scene = write("m.mfrscene", R"({"objects": [
+    {"name": "brick", "primitive": {"type": "box", "size": [1, 2, 3]}, "transform": {"scale": [2, 1, 1]}},
+    {"name": "sheet", "primitive": {"type": "plane", "width": 2, "height": 1}}]})");
+  const fs::path json = dir() / "info.json";
+  const CliResult r = runCli("info " + scene.string() + " --no-histogram --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("area 32, closed, volume 12\n"), std::string::npos) << r.out;  // 2 × 2 × 3
+  EXPECT_NE(r.out.find("area 2, not closed (4 boundary edges): no enclosed volume"), std::string::npos) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_NEAR(j["part_list"][0]["area"].get<double>(), 32.0, 1e-9);  // 2 (2·2 + 2·3 + 2·3)
+  EXPECT_EQ(j["part_list"][0]["closed"], true);
+  EXPECT_NEAR(j["part_list"][0]["volume"].get<double>(), 12.0, 1e-9);
+  EXPECT_EQ(j["part_list"][1]["closed"], false);
+  EXPECT_TRUE(j["part_list"][1]["volume"].is_null());
+  EXPECT_EQ(j["part_list"][1]["boundary_edges"], 4);
+  // With --contour, the isosurfaces are measured too.
+  const CliResult c = runCli("info @volume --no-histogram --contour 0.5");
+  ASSERT_EQ(c.exitCode, 0) << c.out;
+  EXPECT_NE(c.out.find("part 3: field = 0.5"), std::string::npos) << c.out;
+}
+
 // The budget commands: dataset → train → render with the trained weights → evaluate, end to end
 // on a tiny image; then their bad input.
 TEST_F(Cli, DatasetTrainRenderEvaluate) {
