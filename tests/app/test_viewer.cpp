@@ -347,6 +347,17 @@ class ViewerTest : public QObject {
     return true;
   }
 
+  // Saves w's session to `path` and opens it in a new window whose view is `size` (null when no
+  // window could be made).
+  std::unique_ptr<MainWindow> reopenedSession(MainWindow& w, const QString& path, QSize size) {
+    w.saveSession(path);
+    auto again = openWindow(QString());
+    if (!again) return again;
+    again->view().setFixedSize(size);
+    again->openSession(path);
+    return again;
+  }
+
   std::unique_ptr<MainWindow> openWindow(const QString& scene = QStringLiteral("@sample")) {
     auto w = std::make_unique<MainWindow>(MainWindow::Options{.restoreSettings = false, .loadPlugins = true});
     w->resize(1100, 700);
@@ -2659,11 +2670,8 @@ class ViewerTest : public QObject {
     // A session keeps the chosen volume and both functions.
     const mfr::ImageRGBA8 before = w->view().renderImage(size);
     const QString sessionPath = dir.filePath("two.mfrsession");
-    w->saveSession(sessionPath);
-    auto again = openWindow(QString());
+    auto again = reopenedSession(*w, sessionPath, size);
     QVERIFY(again);
-    again->view().setFixedSize(size);
-    again->openSession(sessionPath);
     ViewerModel& a = again->model();
     QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.framesRendered() > 0, kTimeoutMs);
     settle(a);
@@ -2771,11 +2779,8 @@ class ViewerTest : public QObject {
     const mfr::ImageRGBA8 fire = w->view().renderImage(size);
     QVERIFY(maxChannelDifference(fire, ringFrame) > 20);
     const QString sessionPath = dir.filePath("field.mfrsession");
-    w->saveSession(sessionPath);
-    auto again = openWindow(QString());
+    auto again = reopenedSession(*w, sessionPath, size);
     QVERIFY(again);
-    again->view().setFixedSize(size);
-    again->openSession(sessionPath);
     ViewerModel& a = again->model();
     QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.volumeField() == QStringLiteral("ring") && !a.volumeFieldLoading(),
                              kTimeoutMs);
@@ -2877,11 +2882,8 @@ class ViewerTest : public QObject {
 
     // A session brings them back, with their pixels.
     const QString sessionPath = dir.filePath("iso.mfrsession");
-    w->saveSession(sessionPath);
-    auto again = openWindow(QString());
+    auto again = reopenedSession(*w, sessionPath, size);
     QVERIFY(again);
-    again->view().setFixedSize(size);
-    again->openSession(sessionPath);
     ViewerModel& a = again->model();
     QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.scene().objects.size() == loaded + 2, kTimeoutMs);
     settle(a);
@@ -3055,11 +3057,8 @@ class ViewerTest : public QObject {
     const mfr::ImageRGBA8 zone = w->view().renderImage(size);
     QCOMPARE(expectCli({"--color-by", "zone", "--color-map", "viridis"}, zone), 0);
     const QString sessionPath = dir.filePath("colour.mfrsession");
-    w->saveSession(sessionPath);
-    auto again = openWindow(QString());
+    auto again = reopenedSession(*w, sessionPath, size);
     QVERIFY(again);
-    again->view().setFixedSize(size);
-    again->openSession(sessionPath);
     ViewerModel& a = again->model();
     QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.fieldColoring().has_value(), kTimeoutMs);
     settle(a);

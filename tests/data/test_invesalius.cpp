@@ -5,9 +5,7 @@
 // threshold t must lie where the volume crosses t), and the oracle's image of the loaded scene.
 #include <gtest/gtest.h>
 
-#include <vtkCellArray.h>
 #include <vtkNew.h>
-#include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkStaticCellLocator.h>
@@ -29,6 +27,7 @@
 #include "mfr/io_util.hpp"
 #include "mfr/reference/composite.hpp"
 #include "test_files.hpp"
+#include "world_polydata.hpp"
 
 namespace fs = std::filesystem;
 
@@ -161,26 +160,9 @@ TEST(InvesaliusRealFile, IsosurfacesAtTheMasksThresholdsLieOnInvesaliusSurfaces)
   EXPECT_EQ(scene.objects[added[0]].name, "ProMED CT 0051 = 226");
   EXPECT_EQ(scene.objects[added[1]].name, "ProMED CT 0051 = -142");
 
-  // World-space polydata of a part.
-  const auto polyData = [](const Object& o) {
-    vtkNew<vtkPoints> points;
-    for (const glm::vec3& p : o.mesh->positions) {
-      const glm::dvec3 w(o.transform * glm::dvec4(glm::dvec3(p), 1.0));
-      points->InsertNextPoint(w.x, w.y, w.z);
-    }
-    vtkNew<vtkCellArray> triangles;
-    for (std::size_t t = 0; t < o.mesh->indices.size(); t += 3) {
-      const vtkIdType ids[3] = {o.mesh->indices[t], o.mesh->indices[t + 1], o.mesh->indices[t + 2]};
-      triangles->InsertNextCell(3, ids);
-    }
-    vtkSmartPointer<vtkPolyData> poly = vtkSmartPointer<vtkPolyData>::New();
-    poly->SetPoints(points);
-    poly->SetPolys(triangles);
-    return poly;
-  };
   // Distances from every 7th vertex of `from` to the surface `to`, sorted.
   const auto distances = [&](const Object& from, const Object& to) {
-    const vtkSmartPointer<vtkPolyData> target = polyData(to);
+    const vtkSmartPointer<vtkPolyData> target = worldPolyData(to);
     vtkNew<vtkStaticCellLocator> locator;
     locator->SetDataSet(target);
     locator->BuildLocator();

@@ -3,11 +3,8 @@
 // what measures reveal: consistently wound, manifold, open only where the grid ends.
 #include <gtest/gtest.h>
 
-#include <vtkCellArray.h>
 #include <vtkMassProperties.h>
 #include <vtkNew.h>
-#include <vtkPoints.h>
-#include <vtkPolyData.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -17,6 +14,7 @@
 #include "mfr/io/load.hpp"
 #include "mfr/scene/contour.hpp"
 #include "mfr/scene/measure.hpp"
+#include "world_polydata.hpp"
 
 namespace fs = std::filesystem;
 
@@ -29,21 +27,8 @@ struct VtkMass {
 
 // vtkMassProperties of the part's world-space triangles.
 VtkMass vtkMass(const Object& o) {
-  vtkNew<vtkPoints> points;
-  for (const glm::vec3& p : o.mesh->positions) {
-    const glm::dvec3 w(o.transform * glm::dvec4(glm::dvec3(p), 1.0));
-    points->InsertNextPoint(w.x, w.y, w.z);
-  }
-  vtkNew<vtkCellArray> triangles;
-  for (std::size_t t = 0; t < o.mesh->indices.size(); t += 3) {
-    const vtkIdType ids[3] = {o.mesh->indices[t], o.mesh->indices[t + 1], o.mesh->indices[t + 2]};
-    triangles->InsertNextCell(3, ids);
-  }
-  vtkNew<vtkPolyData> poly;
-  poly->SetPoints(points);
-  poly->SetPolys(triangles);
   vtkNew<vtkMassProperties> mass;
-  mass->SetInputData(poly);
+  mass->SetInputData(worldPolyData(o));
   mass->Update();
   return {mass->GetSurfaceArea(), mass->GetVolume()};
 }
