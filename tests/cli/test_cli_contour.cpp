@@ -21,11 +21,6 @@ using mfr::test::runCli;
 
 class CliContour : public mfr::test::CliTest {
  protected:
-  double rmseOf(const fs::path& a, const fs::path& b) {
-    const CliResult r = runCli("compare " + a.string() + " " + b.string() + " --metric rmse");
-    EXPECT_EQ(r.exitCode, 0) << r.out;
-    return std::stod(r.out.substr(r.out.find("rmse ") + 5));
-  }
   nlohmann::json stats(const fs::path& path) {
     std::ifstream in(path);
     return nlohmann::json::parse(in);

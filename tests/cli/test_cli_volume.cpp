@@ -20,14 +20,7 @@ namespace {
 using mfr::test::CliResult;
 using mfr::test::runCli;
 
-class CliVolume : public mfr::test::CliTest {
- protected:
-  double rmseOf(const fs::path& a, const fs::path& b) {
-    const CliResult r = runCli("compare " + a.string() + " " + b.string() + " --metric rmse");
-    EXPECT_EQ(r.exitCode, 0) << r.out;
-    return std::stod(r.out.substr(r.out.find("rmse ") + 5));
-  }
-};
+using CliVolume = mfr::test::CliTest;
 
 TEST_F(CliVolume, OracleAndGpuAgreeAndTheStepMatters) {
   const std::string common = "render @volume --view iso --size 96x80";

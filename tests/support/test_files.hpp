@@ -171,6 +171,12 @@ inline CliResult runCli(const std::string& args) {
 // A temporary folder and the check every bad-input case of the command line makes.
 class CliTest : public TempDirTest {
  protected:
+  // RMSE of two PNGs as `mfr compare --metric rmse` prints it.
+  double rmseOf(const std::filesystem::path& a, const std::filesystem::path& b) {
+    const CliResult r = runCli("compare " + a.string() + " " + b.string() + " --metric rmse");
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    return std::stod(r.out.substr(r.out.find("rmse ") + 5));
+  }
   // Bad input: exit code non-zero (1 or 2), no crash (< 128), one line starting "mfr: " that
   // mentions `mention`, and neither the output file (-o, in dir()) nor a temporary of it left.
   void expectCleanFailure(const std::string& args, const std::string& mention) {
