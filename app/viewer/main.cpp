@@ -30,6 +30,7 @@ struct CommandLine {
   QString colorBy, colorMap;                      // --color-by, --color-map: surfaces coloured by a field
   std::optional<glm::dvec2> colorRange;           // --color-range
   std::vector<double> contour;                    // --contour: isosurfaces of the current volume
+  bool legend = false;                            // --legend: the scalar bar in the --screenshot
   std::map<QString, QJsonObject> pluginSettings;  // by plugin id
   QSize size{800, 600}, windowSize;
   std::map<std::string, std::string> params;
@@ -90,6 +91,9 @@ CommandLine parseCommandLine(const QApplication& app) {
       QStringLiteral("Isosurfaces of the scene's (current) volume at these values, as parts; the volume is hidden "
                      "(the Volume panel's Isosurfaces)."),
       QStringLiteral("v1,v2,..."));
+  const QCommandLineOption legend(
+      QStringLiteral("legend"),
+      QStringLiteral("--screenshot: draw the field colouring's colour map with its values into it (as mfr render)."));
   const QCommandLineOption param({QStringLiteral("p"), QStringLiteral("param")}, QStringLiteral("Method parameter (repeatable)."), QStringLiteral("name=value"));
   const QCommandLineOption view(QStringLiteral("view"), QStringLiteral("Named view of the scene, or 'fit'."), QStringLiteral("name"));
   const QCommandLineOption size({QStringLiteral("s"), QStringLiteral("size")}, QStringLiteral("Image size for --screenshot (default 800x600)."), QStringLiteral("WxH"));
@@ -99,8 +103,8 @@ CommandLine parseCommandLine(const QApplication& app) {
   const QCommandLineOption pluginSettings(QStringLiteral("plugin-settings"),
                                          QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
                                          QStringLiteral("id={json}"));
-  parser.addOptions({method, op, thickness, step, field, colorBy, colorMap, colorRange, contour, param, view, size,
-                     screenshot, windowScreenshot, windowSize, pluginSettings});
+  parser.addOptions({method, op, thickness, step, field, colorBy, colorMap, colorRange, contour, legend, param, view,
+                     size, screenshot, windowScreenshot, windowSize, pluginSettings});
   parser.process(app);
 
   CommandLine cl;
@@ -139,6 +143,7 @@ CommandLine parseCommandLine(const QApplication& app) {
       fail(QStringLiteral("--color-range %1: expected LO,HI with LO < HI").arg(parser.value(colorRange)), 2);
     cl.colorRange = glm::dvec2(low, high);
   }
+  cl.legend = parser.isSet(legend);
   if (parser.isSet(contour)) {
     for (const QString& item : parser.value(contour).split(QLatin1Char(','))) {
       bool ok = false;
@@ -255,7 +260,7 @@ int main(int argc, char** argv) {
       }
       poll->stop();
       try {
-        if (!cl.screenshot.isEmpty()) window.exportImage(cl.screenshot, cl.size);
+        if (!cl.screenshot.isEmpty()) window.exportImage(cl.screenshot, cl.size, cl.legend);
         if (!cl.windowScreenshot.isEmpty()) {
           // Plugins' panels update from the frame's signals; let them paint first.
           QApplication::processEvents();

@@ -33,6 +33,7 @@
 #include "compare_panel.hpp"
 #include "mfr/error.hpp"
 #include "mfr/image.hpp"
+#include "mfr/legend.hpp"
 #include "mfr/io/load.hpp"
 #include "method_panel.hpp"
 #include "probe_panel.hpp"
@@ -444,8 +445,21 @@ void MainWindow::saveSession(const QString& path) {
   addRecentFile(QFileInfo(path).absoluteFilePath());
 }
 
-void MainWindow::exportImage(const QString& path, QSize size) {
-  mfr::writePng(path.toStdString(), view_->renderImage(size));
+void MainWindow::exportImage(const QString& path, QSize size, bool legend) {
+  std::optional<mfr::FieldColors> colors;
+  if (legend) {
+    colors = model_->fieldColoring();
+    if (!colors) throw mfr::Error("--legend", "nothing is coloured by a field (use --color-by, or a scene's color_by)");
+    if (size.width() < mfr::kMinLegendImageSize || size.height() < mfr::kMinLegendImageSize)
+      throw mfr::Error("--legend", QStringLiteral("the image %1x%2 is too small for one: at least %3 pixels a side")
+                                       .arg(size.width())
+                                       .arg(size.height())
+                                       .arg(mfr::kMinLegendImageSize)
+                                       .toStdString());
+  }
+  mfr::ImageRGBA8 image = view_->renderImage(size);
+  if (colors) mfr::drawColorLegend(image, *colors, model_->scene().background);
+  mfr::writePng(path.toStdString(), image);
 }
 
 void MainWindow::chooseFileToOpen() {
@@ -484,7 +498,10 @@ void MainWindow::chooseImageToExport() {
   if (path.isEmpty()) return;
   if (!path.endsWith(QStringLiteral(".png"), Qt::CaseInsensitive)) path += QStringLiteral(".png");
   try {
-    exportImage(path, size);
+    // As on screen: the legend of a field colouring, when it fits.
+    const bool legend = model_->fieldColoring().has_value() && size.width() >= mfr::kMinLegendImageSize &&
+                        size.height() >= mfr::kMinLegendImageSize;
+    exportImage(path, size, legend);
     statusBar()->showMessage(tr("Wrote %1").arg(path), 5000);
   } catch (const std::exception& e) {
     showError(tr("Cannot export the image"), QString::fromUtf8(e.what()));

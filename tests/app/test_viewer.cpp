@@ -3104,6 +3104,18 @@ class ViewerTest : public QObject {
     QVERIFY2(last.startsWith(QStringLiteral("mfrview: --color-by nope: ")) &&
                  last.contains(QStringLiteral("no point-data or cell-data array 'nope' (fields: pressure, zone)")),
              qPrintable(out));
+    // --legend: the scalar bar in the screenshot, the pixels of mfr render --legend (and another
+    // picture than without it); refused without a field colouring.
+    QStringList larger = common;
+    larger[1] = QStringLiteral("200x150");  // room for the legend
+    QCOMPARE(runProgram(MFRVIEW, QStringList{scene, "--screenshot", viewerPng, "--legend"} + larger, &out), 0);
+    QCOMPARE(runProgram(MFR_CLI, QStringList{"render", scene, "-o", cliPng, "--legend"} + larger, &out), 0);
+    const mfr::ImageRGBA8 withLegend = mfr::readPng(viewerPng.toStdString());
+    QCOMPARE(maxChannelDifference(withLegend, mfr::readPng(cliPng.toStdString())), 0);
+    QCOMPARE(runProgram(MFR_CLI, QStringList{"render", scene, "-o", cliPng} + larger, &out), 0);
+    QVERIFY(maxChannelDifference(withLegend, mfr::readPng(cliPng.toStdString())) > 100);
+    QVERIFY(runProgram(MFRVIEW, QStringList{scene, "--legend", "--screenshot", viewerPng}, &out) != 0);
+    QVERIFY2(out.contains(QStringLiteral("mfrview: --legend: nothing is coloured by a field")), qPrintable(out));
   }
 
   void colorByVolumeField() {
