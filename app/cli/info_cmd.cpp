@@ -81,17 +81,7 @@ void addInfo(CLI::App& app) {
                 << o.material.color.r << " " << o.material.color.g << " " << o.material.color.b << " "
                 << o.material.color.a << ")\n";
       // Its surface in the world: area, and the volume it encloses when it is closed.
-      const SurfaceMeasures& m = measures[i];
-      std::cout << "    area " << m.area;
-      if (m.closed()) {
-        std::cout << ", closed, volume " << m.volume << (m.volume < 0.0 ? " (inside out)" : "");
-      } else {
-        std::cout << ", not closed (" << m.boundaryEdges << " boundary edges";
-        if (m.nonManifoldEdges > 0) std::cout << ", " << m.nonManifoldEdges << " non-manifold";
-        if (m.orientationFlips > 0) std::cout << ", " << m.orientationFlips << " wound against a neighbour";
-        std::cout << "): no enclosed volume";
-      }
-      std::cout << "\n";
+      std::cout << "    " << describeSurface(measures[i]) << "\n";
       if (!o.mesh->fields.empty()) {
         // What --color-by can use, with each field's range (cell data marked).
         std::cout << "    fields:";

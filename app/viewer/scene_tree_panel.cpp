@@ -18,6 +18,7 @@
 #include <cmath>
 
 #include "mfr/scene/color_map.hpp"
+#include "mfr/scene/measure.hpp"
 #include "viewer_model.hpp"
 
 namespace {
@@ -35,6 +36,30 @@ QString colourText(const mfr::Object& o) {
   const bool perVertex = o.material.vertexColors && o.mesh && !o.mesh->colors.empty();
   return perVertex ? QObject::tr("file colours") : colourOf(o).name();
 }
+
+// A part's row. Its Triangles cell's tooltip measures the part's surface in the world
+// (mfr::measureSurface, as mfr info prints it) the first time it is asked for, not at every rebuild:
+// a CT's surfaces take a fraction of a second each.
+class PartItem final : public QTreeWidgetItem {
+ public:
+  PartItem(const ViewerModel& model, int index) : model_(model), index_(index) {}
+  [[nodiscard]] QVariant data(int column, int role) const override {
+    if (column != kTriangles || role != Qt::ToolTipRole) return QTreeWidgetItem::data(column, role);
+    if (measured_.isEmpty()) {
+      const auto& objects = model_.scene().objects;
+      if (index_ < 0 || index_ >= static_cast<int>(objects.size()) || !objects[static_cast<std::size_t>(index_)].mesh)
+        return {};
+      const mfr::Object& o = objects[static_cast<std::size_t>(index_)];
+      measured_ = QString::fromStdString(mfr::describeSurface(mfr::measureSurface(*o.mesh, o.transform)));
+    }
+    return measured_;
+  }
+
+ private:
+  const ViewerModel& model_;
+  int index_;
+  mutable QString measured_;
+};
 
 QIcon swatch(const QColor& colour) {
   QPixmap pixmap(16, 16);
@@ -214,7 +239,7 @@ void SceneTreePanel::rebuild() {
   items.reserve(static_cast<qsizetype>(objects.size()));
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const mfr::Object& o = objects[i];
-    auto* item = new QTreeWidgetItem;
+    auto* item = new PartItem(model_, static_cast<int>(i));
     item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsSelectable | Qt::ItemIsUserCheckable | Qt::ItemIsEditable);
     item->setText(kName, QString::fromStdString(o.name.empty() ? "object " + std::to_string(i) : o.name));
     item->setData(kName, Qt::UserRole, static_cast<int>(i));

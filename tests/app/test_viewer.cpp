@@ -2852,7 +2852,12 @@ class ViewerTest : public QObject {
     QCOMPARE(QString::fromStdString(m.scene().objects[loaded].name), QStringLiteral("field = 0.3"));
     QCOMPARE(QString::fromStdString(m.scene().objects[loaded + 1].name), QStringLiteral("field = 0.6"));
     QCOMPARE(m.isosurfaceValues(), (std::vector<double>{0.3, 0.6}));
-    QVERIFY(!tree->findItems(QStringLiteral("field = 0.6"), Qt::MatchExactly).isEmpty());
+    const QList<QTreeWidgetItem*> rows = tree->findItems(QStringLiteral("field = 0.6"), Qt::MatchExactly);
+    QCOMPARE(rows.size(), 1);
+    // The Triangles cell's tooltip measures the part as mfr info does (area, closed, volume).
+    const QString measured = rows[0]->data(3, Qt::ToolTipRole).toString();
+    QVERIFY2(measured.startsWith(QStringLiteral("area ")) && measured.contains(QStringLiteral(", closed, volume ")),
+             qPrintable(measured));
     QVERIFY(!m.volumeVisible());
     QVERIFY(!show->isChecked());
     QVERIFY2(note->text().contains(QStringLiteral("2 isosurfaces")), qPrintable(note->text()));
@@ -2868,6 +2873,8 @@ class ViewerTest : public QObject {
                         &out),
              0);
     QCOMPARE(maxChannelDifference(mfr::readPng(cliPng.toStdString()), isoFrame), 0);
+    QCOMPARE(runProgram(MFR_CLI, {"info", "@volume", "--no-histogram", "--contour", "0.3,0.6"}, &out), 0);
+    QVERIFY2(out.contains(QStringLiteral("    ") + measured + QStringLiteral("\n")), qPrintable(out + measured));
 
     // Refused: a value outside the volume's range, a word; the isosurfaces stay as they were.
     values->setText(QStringLiteral("0.3, 5"));

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <sstream>
 #include <unordered_map>
 #include <vector>
 
@@ -118,6 +119,20 @@ SurfaceMeasures measureSurface(const Mesh& mesh, const glm::dmat4& transform) {
   m.nonManifoldEdges = best.nonManifold;
   m.orientationFlips = best.flips;
   return m;
+}
+
+std::string describeSurface(const SurfaceMeasures& m) {
+  std::ostringstream text;  // default stream formatting: six significant digits
+  text << "area " << m.area;
+  if (m.closed()) {
+    text << ", closed, volume " << m.volume << (m.volume < 0.0 ? " (inside out)" : "");
+  } else {
+    text << ", not closed (" << m.boundaryEdges << " boundary edges";
+    if (m.nonManifoldEdges > 0) text << ", " << m.nonManifoldEdges << " non-manifold";
+    if (m.orientationFlips > 0) text << ", " << m.orientationFlips << " wound against a neighbour";
+    text << "): no enclosed volume";
+  }
+  return text.str();
 }
 
 }  // namespace mfr

@@ -3,6 +3,7 @@
 // reports for a surface, FreeCAD's measurements): area, whether it is closed, and the volume it
 // encloses when it is.
 #include <cstddef>
+#include <string>
 
 #include <glm/glm.hpp>
 
@@ -27,5 +28,11 @@ struct SurfaceMeasures {
 // tessellation's seam rounded apart — positions welded within 10⁻⁶ of the mesh's diagonal; a
 // degenerate triangle (two corners at one vertex) adds no edge. Linear in the triangles (hashes).
 SurfaceMeasures measureSurface(const Mesh& mesh, const glm::dmat4& transform);
+
+// One line, as mfr info and the viewer's scene tree print it: "area 32, closed, volume 12" (with
+// " (inside out)" for a negative volume), or "area 2, not closed (4 boundary edges[, N
+// non-manifold][, N wound against a neighbour]): no enclosed volume"; numbers with six significant
+// digits.
+std::string describeSurface(const SurfaceMeasures& measures);
 
 }  // namespace mfr
