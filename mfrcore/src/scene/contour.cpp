@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "mfr/error.hpp"
 #include "mfr/scene/color_map.hpp"
@@ -64,19 +65,26 @@ Mesh contourVolume(const Volume& volume, double value) {
   }
 
   // The gradient normals where they are usable; the surface's own smooth normals where the gradient
-  // vanishes (a flat run of samples equal to the value) or the filter gave none.
-  Mesh smooth = mesh;
-  smooth.computeSmoothNormals();
-  mesh.normals = smooth.normals;
+  // vanishes (a flat run of samples equal to the value) or the filter gave none — computed only then.
+  mesh.normals.assign(mesh.positions.size(), glm::vec3(0.0f));
+  std::vector<std::size_t> missing;
   vtkDataArray* normals = out->GetPointData()->GetNormals();
-  if (normals != nullptr && normals->GetNumberOfTuples() == pointCount && normals->GetNumberOfComponents() == 3) {
-    for (vtkIdType i = 0; i < pointCount; ++i) {
-      double n[3];
-      normals->GetTuple(i, n);
-      const glm::dvec3 g(n[0], n[1], n[2]);
-      const double length = glm::length(g);
-      if (std::isfinite(length) && length > 1e-6) mesh.normals[static_cast<std::size_t>(i)] = glm::vec3(g / length);
-    }
+  const bool given =
+      normals != nullptr && normals->GetNumberOfTuples() == pointCount && normals->GetNumberOfComponents() == 3;
+  for (vtkIdType i = 0; i < pointCount; ++i) {
+    double n[3] = {0.0, 0.0, 0.0};
+    if (given) normals->GetTuple(i, n);
+    const glm::dvec3 g(n[0], n[1], n[2]);
+    const double length = glm::length(g);
+    if (std::isfinite(length) && length > 1e-6)
+      mesh.normals[static_cast<std::size_t>(i)] = glm::vec3(g / length);
+    else
+      missing.push_back(static_cast<std::size_t>(i));
+  }
+  if (!missing.empty()) {
+    Mesh smooth = mesh;
+    smooth.computeSmoothNormals();
+    for (const std::size_t i : missing) mesh.normals[i] = smooth.normals[i];
   }
 
   // Orientation: VTK's normals point down the gradient (towards lower values); make the normals
