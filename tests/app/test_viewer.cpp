@@ -2803,10 +2803,13 @@ class ViewerTest : public QObject {
     // Isosurfaces follow a field read in the volume's place: made again from the new samples (each
     // vertex samples to the value in the new grid), values outside the new range dropped.
     const std::size_t parts = m.scene().objects.size();
-    const auto isoValuesInVolume = [&] {
+    const auto isoValuesInVolume = [&] {  // the volume's samples at the isosurface's vertices
       std::vector<float> values;
-      const mfr::Mesh& mesh = *m.scene().objects.at(parts).mesh;
-      for (const float v : mfr::fieldValues(mesh, "@two.vti", "").values) values.push_back(v);
+      const mfr::Object& o = m.scene().objects.at(parts);
+      const mfr::Volume& v = m.scene().volumes.at(0);
+      const glm::dmat4 toGrid = glm::inverse(v.gridToWorld()) * o.transform;
+      for (const glm::vec3& p : o.mesh->positions)
+        values.push_back(v.grid->sample(glm::vec3(toGrid * glm::dvec4(glm::dvec3(p), 1.0))));
       return values;
     };
     QVERIFY(m.setIsosurfaces({0.5}, 0.4).isEmpty());  // on ring
