@@ -67,12 +67,18 @@ struct ColorByOptions {
 // --color-by, so that they can be coloured by a volume field. Their opacity: --contour-opacity, else
 // --opacity, else 0.5. The volume they come from is hidden (ParaView hides a filter's input) unless
 // --keep-volume. Throws mfr::Error naming the option.
+// Returns, when it made isosurfaces, what --legend draws for them: the cool-warm map over
+// contourColorRange, titled by the volume, ticked at their values.
+struct ContourLegend {
+  FieldColors colors;
+  std::vector<double> ticks;
+};
 struct ContourOptions {
   std::string values;
   double opacity = -1.0;
   bool keepVolume = false;
   void add(CLI::App* cmd);
-  void apply(Scene& scene, double sceneOpacity) const;
+  std::optional<ContourLegend> apply(Scene& scene, double sceneOpacity) const;
 };
 
 // --thickness (operation zthickness) as given: 0 when absent (the scene's default); throws

@@ -261,11 +261,11 @@ void ContourOptions::add(CLI::App* cmd) {
   cmd->add_flag("--keep-volume", keepVolume, "With --contour: keep drawing the volume the isosurfaces come from");
 }
 
-void ContourOptions::apply(Scene& scene, double sceneOpacity) const {
+std::optional<ContourLegend> ContourOptions::apply(Scene& scene, double sceneOpacity) const {
   if (values.empty()) {
     if (opacity >= 0.0) throw Error("--contour-opacity", "needs --contour");
     if (keepVolume) throw Error("--keep-volume", "needs --contour");
-    return;
+    return std::nullopt;
   }
   const std::string what = "--contour " + values;
   ContourRequest request;
@@ -300,7 +300,10 @@ void ContourOptions::apply(Scene& scene, double sceneOpacity) const {
   }
   request.opacity = static_cast<float>(opacity >= 0.0 ? opacity : sceneOpacity >= 0.0 ? sceneOpacity : 0.5);
   addContours(scene, request, what);
-  if (!keepVolume) scene.volumes[request.volume].visible = false;
+  Volume& volume = scene.volumes[request.volume];
+  if (!keepVolume) volume.visible = false;
+  const glm::dvec2 range = contourColorRange(request.values, glm::dvec2(volume.grid->range()));
+  return ContourLegend{{volume.name, "cool-warm", range}, request.values};
 }
 
 namespace {

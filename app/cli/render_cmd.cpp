@@ -77,7 +77,7 @@ void addRender(CLI::App& app) {
       req.params[p.substr(0, eq)] = p.substr(eq + 1);
     }
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
-    opt->contours.apply(scene, opt->opacity);
+    const std::optional<ContourLegend> contourLegend = opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
@@ -85,21 +85,26 @@ void addRender(CLI::App& app) {
       if (scene.volumes.empty()) throw Error("--shade", "scene '" + scene.name + "' has no volume");
       req.volumeShading = true;
     }
-    std::optional<FieldColors> legend;
+    // --legend: the field colouring's map, else the isosurfaces' (ticked at their values).
+    std::optional<ContourLegend> legend;
     if (opt->legend) {
       for (const Object& o : scene.objects)
         if (o.material.fieldColors) {
-          legend = o.material.fieldColors;
+          legend = ContourLegend{*o.material.fieldColors, {}};
           break;
         }
-      if (!legend) throw Error("--legend", "nothing is coloured by a field (use --color-by, or a scene's color_by)");
+      if (!legend) legend = contourLegend;
+      if (!legend)
+        throw Error("--legend",
+                    "nothing is coloured by a field (use --color-by, or a scene's color_by) and there is "
+                    "no --contour");
       if (w < kMinLegendImageSize || h < kMinLegendImageSize)
         throw Error("--legend", "the image " + opt->size + " is too small for one: at least " +
                                     std::to_string(kMinLegendImageSize) + " pixels a side");
     }
     const Camera camera = scene.view(opt->view);
     RenderOutput out = render(scene, camera, req);
-    if (legend) drawColorLegend(out.image, *legend, scene.background);
+    if (legend) drawColorLegend(out.image, legend->colors, scene.background, legend->ticks);
     // Both outputs are produced before either is written, and each is written atomically.
     writePng(opt->output, out.image);
     if (!opt->stats.empty()) writeFileAtomically(opt->stats, toJson(out.stats) + "\n");

@@ -11,6 +11,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <limits>
+#include <vector>
 #include <mutex>
 
 #include "mfr/error.hpp"
@@ -83,7 +86,8 @@ std::string legendValueText(double value) {
   return text;
 }
 
-LegendLayout drawColorLegend(ImageRGBA8& image, const FieldColors& colors, const glm::vec3& background) {
+LegendLayout drawColorLegend(ImageRGBA8& image, const FieldColors& colors, const glm::vec3& background,
+                             const std::vector<double>& ticks) {
   if (image.width < kMinLegendImageSize || image.height < kMinLegendImageSize)
     throw Error("legend", "the image (" + std::to_string(image.width) + "x" + std::to_string(image.height) +
                               ") is too small for one: at least " + std::to_string(kMinLegendImageSize) +
@@ -99,9 +103,12 @@ LegendLayout drawColorLegend(ImageRGBA8& image, const FieldColors& colors, const
   const int font = std::clamp(side / 32, 10, 24);
   const int margin = font;
   const double low = colors.range.x, high = colors.range.y;
-  const Glyphs labels[3] = {renderText(legendValueText(high), font),
-                            renderText(legendValueText(0.5 * (low + high)), font),
-                            renderText(legendValueText(low), font)};
+  // The labelled values, highest first: the ends and the middle, or the caller's inside the range.
+  std::vector<double> values = ticks.empty() ? std::vector<double>{high, 0.5 * (low + high), low} : ticks;
+  std::erase_if(values, [&](double v) { return !(v >= low && v <= high); });
+  std::sort(values.begin(), values.end(), std::greater<>());
+  std::vector<Glyphs> labels;
+  for (const double v : values) labels.push_back(renderText(legendValueText(v), font));
   const Glyphs title = renderText(colors.field, font);
   int labelWidth = 0;
   for (const Glyphs& g : labels) labelWidth = std::max(labelWidth, g.width);
@@ -111,9 +118,14 @@ LegendLayout drawColorLegend(ImageRGBA8& image, const FieldColors& colors, const
   l.barHeight = std::max(16, static_cast<int>(std::lround(0.35 * image.height)));
   l.barX = image.width - margin - labelWidth - gap - tick - l.barWidth;
   l.barY = image.height - margin - font / 2 - l.barHeight;
-  const int tickRows[3] = {l.barY, l.barY + (l.barHeight - 1) / 2, l.barY + l.barHeight - 1};
-  // The title above the bar and above the high end's label.
-  const int titleTop = std::min(l.barY - 1, tickRows[0] - labels[0].height / 2) - gap - title.height;
+  // The row of value v: the top row is the high end.
+  const auto rowOf = [&](double v) {
+    const double t = high > low ? (v - low) / (high - low) : 0.5;
+    return l.barY + static_cast<int>(std::lround((1.0 - t) * (l.barHeight - 1)));
+  };
+  const int topLabel = labels.empty() ? l.barY : rowOf(values.front()) - labels.front().height / 2;
+  // The title above the bar and above the highest label.
+  const int titleTop = std::min(l.barY - 1, topLabel) - gap - title.height;
   const int titleLeft = std::max(0, std::min(l.barX, image.width - margin - title.width));
 
   // The bar: top row the high end, bottom row the low end.
@@ -123,22 +135,29 @@ LegendLayout drawColorLegend(ImageRGBA8& image, const FieldColors& colors, const
     const glm::u8vec3 rgb(glm::round(glm::clamp(c, 0.0f, 1.0f) * 255.0f));
     fill(image, l.barX, l.barY + r, l.barWidth, 1, rgb);
   }
-  // A one-pixel frame around it, and ticks at the high end, the middle and the low end.
+  // A one-pixel frame around it, and a tick and label per value; a label that would overlap the
+  // one above it is left out (its tick stays).
   fill(image, l.barX - 1, l.barY - 1, l.barWidth + 2, 1, l.textColor);
   fill(image, l.barX - 1, l.barY + l.barHeight, l.barWidth + 2, 1, l.textColor);
   fill(image, l.barX - 1, l.barY, 1, l.barHeight, l.textColor);
   fill(image, l.barX + l.barWidth, l.barY, 1, l.barHeight, l.textColor);
-  for (int i = 0; i < 3; ++i) {
-    fill(image, l.barX + l.barWidth + 1, tickRows[i], tick, 1, l.textColor);
-    drawText(image, labels[i], l.barX + l.barWidth + 1 + tick + gap, tickRows[i] - labels[i].height / 2, l.textColor);
+  int labelBottom = std::numeric_limits<int>::min();
+  int boxBottom = l.barY + l.barHeight + 1;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const int row = rowOf(values[i]);
+    fill(image, l.barX + l.barWidth + 1, row, tick, 1, l.textColor);
+    const int top = row - labels[i].height / 2;
+    if (top < labelBottom) continue;
+    drawText(image, labels[i], l.barX + l.barWidth + 1 + tick + gap, top, l.textColor);
+    labelBottom = top + labels[i].height;
+    boxBottom = std::max(boxBottom, labelBottom);
   }
   drawText(image, title, titleLeft, titleTop, l.textColor);
 
   const int boxLeft = std::min(l.barX - 1, titleLeft);
-  const int boxTop = std::max(0, std::min(titleTop, tickRows[0] - labels[0].height / 2));
+  const int boxTop = std::max(0, std::min(titleTop, topLabel));
   int boxRight = l.barX + l.barWidth + 1 + tick + gap + labelWidth;
   boxRight = std::max(boxRight, titleLeft + title.width);
-  const int boxBottom = std::max(l.barY + l.barHeight + 1, tickRows[2] - labels[2].height / 2 + labels[2].height);
   l.boxX = std::max(0, boxLeft);
   l.boxY = boxTop;
   l.boxWidth = std::min(image.width, boxRight) - l.boxX;

@@ -4,12 +4,14 @@
 // coloured by a volume field, and bad input fails with one line and no output.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "mfr/image.hpp"
 #include "test_files.hpp"
 
 namespace fs = std::filesystem;
@@ -110,6 +112,36 @@ TEST_F(CliContour, SeveralVolumesNeedTheVolumesName) {
       runCli("probe " + scene.string() + " --contour b=1.5 --size 64x64 --view orbit:40:20 --pixel 52,32");
   ASSERT_EQ(info.exitCode, 0) << info.out;
   EXPECT_NE(info.out.find("b = 1.5"), std::string::npos) << info.out;
+}
+
+TEST_F(CliContour, LegendShowsTheIsosurfacesMapInTheCorner) {
+  const std::string common = "render @volume --view iso --size 240x180 -m abuffer-ll --contour 0.3,0.6 ";
+  const fs::path plainPath = dir() / "plain.png", legendPath = dir() / "legend.png";
+  ASSERT_EQ(runCli(common + "-o " + plainPath.string()).exitCode, 0);
+  const CliResult r = runCli(common + "--legend -o " + legendPath.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const mfr::ImageRGBA8 plain = mfr::readPng(plainPath), legend = mfr::readPng(legendPath);
+  std::size_t differ = 0;
+  for (int y = 0; y < plain.height; ++y)
+    for (int x = 0; x < plain.width; ++x) {
+      const bool changed = std::memcmp(plain.at(x, y), legend.at(x, y), 3) != 0;
+      if (x < plain.width / 2 || y < plain.height / 4) {
+        ASSERT_FALSE(changed) << x << ", " << y;
+      }
+      differ += changed;
+    }
+  EXPECT_GT(differ, 300u);
+  // The bar's ends are the isosurfaces' colours: the cool-warm map's published ends, ParaView's
+  // (59, 76, 192) and (180, 4, 38) — 0.3 blue, 0.6 red.
+  bool blue = false, red = false;
+  for (int y = plain.height / 4; y < plain.height; ++y)
+    for (int x = plain.width / 2; x < plain.width; ++x) {
+      const std::uint8_t* p = legend.at(x, y);
+      blue = blue || (p[0] == 59 && p[1] == 76 && p[2] == 192);
+      red = red || (p[0] == 180 && p[1] == 4 && p[2] == 38);
+    }
+  EXPECT_TRUE(blue && red);
+  expectCleanFailure("render @volume --legend", "and there is no --contour");
 }
 
 TEST_F(CliContour, BadInputIsOneLine) {

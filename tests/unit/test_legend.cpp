@@ -7,6 +7,7 @@
 
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 #include "mfr/error.hpp"
 #include "mfr/legend.hpp"
@@ -117,6 +118,40 @@ TEST(Legend, WhiteTextOnDarkBackgrounds) {
       if (!(x >= l.barX && x < l.barX + l.barWidth && y >= l.barY && y < l.barY + l.barHeight))
         light += image.at(x, y)[0] > 200;
   EXPECT_GT(light, 50u);
+}
+
+TEST(Legend, TicksMarkTheGivenValuesOnly) {
+  // Ticks are one text-coloured row right of the bar, at the row of their value (top: the high end).
+  const auto tickRows = [](const ImageRGBA8& image, const LegendLayout& l) {
+    std::vector<int> rows;
+    const int x = l.barX + l.barWidth + 2;  // inside every tick, left of every label
+    for (int y = l.barY; y < l.barY + l.barHeight; ++y)
+      if (image.at(x, y)[0] < 128) rows.push_back(y);
+    return rows;
+  };
+  ImageRGBA8 image = filled(400, 300, {255, 255, 255});
+  const LegendLayout l = drawColorLegend(image, {"ct", "cool-warm", {1.0, 3.0}}, glm::vec3(1.0f), {1.5, 3.0, 7.0});
+  const auto rowOf = [&](double v) {
+    return l.barY + static_cast<int>(std::lround((1.0 - (v - 1.0) / 2.0) * (l.barHeight - 1)));
+  };
+  EXPECT_EQ(tickRows(image, l), (std::vector<int>{rowOf(3.0), rowOf(1.5)}));  // 7 lies outside: no tick
+  // The default: the ends and the middle.
+  ImageRGBA8 plain = filled(400, 300, {255, 255, 255});
+  const LegendLayout p = drawColorLegend(plain, {"ct", "cool-warm", {1.0, 3.0}}, glm::vec3(1.0f));
+  EXPECT_EQ(tickRows(plain, p), (std::vector<int>{rowOf(3.0), rowOf(2.0), rowOf(1.0)}));
+  // Two values a pixel apart: both ticks, one label — the higher one's; the lower one's would overlap it.
+  ImageRGBA8 close = filled(400, 300, {255, 255, 255}), one = close;
+  const LegendLayout lc = drawColorLegend(close, {"ct", "cool-warm", {1.0, 3.0}}, glm::vec3(1.0f), {2.0, 2.01});
+  drawColorLegend(one, {"ct", "cool-warm", {1.0, 3.0}}, glm::vec3(1.0f), {2.01});
+  EXPECT_EQ(tickRows(close, lc).size(), 2u);
+  std::size_t labelPixels[2] = {0, 0};
+  for (int y = 0; y < close.height; ++y)
+    for (int x = lc.barX + lc.barWidth + 2 + lc.barWidth; x < close.width; ++x) {
+      labelPixels[0] += close.at(x, y)[0] < 128;
+      labelPixels[1] += one.at(x, y)[0] < 128;
+    }
+  EXPECT_EQ(labelPixels[0], labelPixels[1]);  // "2.01" drawn, "2" left out
+  EXPECT_GT(labelPixels[1], 0u);
 }
 
 TEST(Legend, TooSmallAnImageIsRefused) {

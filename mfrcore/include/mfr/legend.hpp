@@ -5,6 +5,7 @@
 // FreeType tools (their embedded sans-serif font), in black or white, whichever stands out from
 // the background.
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -25,9 +26,12 @@ inline constexpr int kMinLegendImageSize = 96;
 
 // Draws the legend of `colors` (field, map, range) onto `image` over a scene with `background`.
 // The bar's row at height t ∈ [0, 1] from its bottom shows the map's colour of
-// range.x + t·(range.y − range.x) (mapFieldValue), the values are printed with four significant
-// digits. Throws mfr::Error("legend", …) for an image smaller than kMinLegendImageSize on a side.
-LegendLayout drawColorLegend(ImageRGBA8& image, const FieldColors& colors, const glm::vec3& background);
+// range.x + t·(range.y − range.x) (mapFieldValue). Ticks and labels (four significant digits) mark
+// `ticks` — the isosurfaces' values, say — or, when empty, the range's ends and middle; values
+// outside the range are left out, and so is a label that would overlap the one above it (not its
+// tick). Throws mfr::Error("legend", …) for an image smaller than kMinLegendImageSize on a side.
+LegendLayout drawColorLegend(ImageRGBA8& image, const FieldColors& colors, const glm::vec3& background,
+                             const std::vector<double>& ticks = {});
 
 // A legend's value: four significant digits, as %.4g ("0.5", "1234", "1.235e+05").
 std::string legendValueText(double value);

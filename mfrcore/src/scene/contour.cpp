@@ -131,6 +131,16 @@ std::string contourPartName(const std::string& volumeName, double value) {
   return volumeName + " = " + valueText(value);
 }
 
+glm::dvec2 contourColorRange(const std::vector<double>& values, const glm::dvec2& gridRange) {
+  // Several isosurfaces span the map between the lowest and the highest value, so that they differ
+  // most; one gets the map's colour at its value over the grid's range.
+  if (values.size() > 1) {
+    const auto [low, high] = std::minmax_element(values.begin(), values.end());
+    if (*high > *low) return {*low, *high};
+  }
+  return gridRange;
+}
+
 std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request, const std::string& what) {
   if (request.volume >= scene.volumes.size())
     throw Error(what, scene.volumes.empty() ? "scene '" + scene.name + "' has no volume"
@@ -150,13 +160,7 @@ std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request
       throw Error(what, valueText(value) + " lies outside the open range " + rangeText + " of volume '" + volume.name +
                             "': no surface");
   }
-  // Several isosurfaces span the map between the lowest and the highest value, so that they differ
-  // most; one gets the map's colour at its value over the grid's range.
-  glm::vec2 colourRange = range;
-  if (request.values.size() > 1) {
-    const auto [low, high] = std::minmax_element(request.values.begin(), request.values.end());
-    if (*high > *low) colourRange = glm::vec2(static_cast<float>(*low), static_cast<float>(*high));
-  }
+  const glm::vec2 colourRange(contourColorRange(request.values, glm::dvec2(range)));
   // Every surface is made before the scene is touched, so that a failure leaves it as it was.
   std::vector<Object> parts;
   for (const double value : request.values) {

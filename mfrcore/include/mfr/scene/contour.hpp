@@ -43,6 +43,11 @@ struct ContourRequest {
 // (it gives no surface), an opacity outside [0, 1].
 std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request, const std::string& what);
 
+// The values addContours maps to the cool-warm map's ends: [lowest, highest] of several values, the
+// grid's range for one (what a legend of the isosurfaces shows: drawColorLegend with their values
+// as ticks).
+glm::dvec2 contourColorRange(const std::vector<double>& values, const glm::dvec2& gridRange);
+
 // "<volume name> = <value>": the name addContours gives the part.
 std::string contourPartName(const std::string& volumeName, double value);
 
