@@ -34,6 +34,7 @@
 #include "mfr/error.hpp"
 #include "mfr/image.hpp"
 #include "mfr/legend.hpp"
+#include "mfr/scene/contour.hpp"
 #include "mfr/io/load.hpp"
 #include "method_panel.hpp"
 #include "probe_panel.hpp"
@@ -447,9 +448,19 @@ void MainWindow::saveSession(const QString& path) {
 
 void MainWindow::exportImage(const QString& path, QSize size, bool legend) {
   std::optional<mfr::FieldColors> colors;
+  std::vector<double> ticks;
   if (legend) {
+    // The field colouring's map, else the current volume's isosurfaces' (as mfr render --legend).
     colors = model_->fieldColoring();
-    if (!colors) throw mfr::Error("--legend", "nothing is coloured by a field (use --color-by, or a scene's color_by)");
+    if (!colors && !model_->isosurfaceValues().empty()) {
+      ticks = model_->isosurfaceValues();
+      colors = mfr::FieldColors{model_->volumeName().toStdString(), "cool-warm",
+                                mfr::contourColorRange(ticks, model_->volumeValueRange())};
+    }
+    if (!colors)
+      throw mfr::Error("--legend",
+                       "nothing is coloured by a field (use --color-by, or a scene's color_by) and there are no "
+                       "isosurfaces");
     if (size.width() < mfr::kMinLegendImageSize || size.height() < mfr::kMinLegendImageSize)
       throw mfr::Error("--legend", QStringLiteral("the image %1x%2 is too small for one: at least %3 pixels a side")
                                        .arg(size.width())
@@ -458,7 +469,7 @@ void MainWindow::exportImage(const QString& path, QSize size, bool legend) {
                                        .toStdString());
   }
   mfr::ImageRGBA8 image = view_->renderImage(size);
-  if (colors) mfr::drawColorLegend(image, *colors, model_->scene().background);
+  if (colors) mfr::drawColorLegend(image, *colors, model_->scene().background, ticks);
   mfr::writePng(path.toStdString(), image);
 }
 

@@ -37,8 +37,9 @@ class MainWindow final : public QMainWindow {
   // Throws mfr::Error naming the file.
   void saveSession(const QString& path);
   // Renders the current view at `size` (see RenderView::renderImage) and writes a PNG; with
-  // `legend`, the field colouring's scalar bar drawn into it as mfr render --legend does (throws
-  // mfr::Error when nothing is coloured by a field or the image is too small for one).
+  // `legend`, the field colouring's scalar bar — else the current volume's isosurfaces' — drawn
+  // into it as mfr render --legend does (throws mfr::Error when there is neither or the image is too
+  // small for one).
   void exportImage(const QString& path, QSize size, bool legend = false);
 
   [[nodiscard]] ViewerModel& model() { return *model_; }

@@ -2919,6 +2919,18 @@ class ViewerTest : public QObject {
     QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@volume", "--contour", "0.45", "-o", cliPng} + common, &out),
              0);
     QCOMPARE(maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString())), 0);
+    // --legend: the isosurfaces' map, as mfr render --legend draws it.
+    QStringList larger = common;
+    larger[1] = QStringLiteral("200x150");
+    QCOMPARE(runProgram(MFRVIEW,
+                        QStringList{"@volume", "--contour", "0.3,0.6", "--legend", "--screenshot", viewerPng} + larger,
+                        &out),
+             0);
+    QCOMPARE(
+        runProgram(MFR_CLI, QStringList{"render", "@volume", "--contour", "0.3,0.6", "--legend", "-o", cliPng} + larger,
+                   &out),
+        0);
+    QCOMPARE(maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString())), 0);
     QVERIFY(runProgram(MFRVIEW, QStringList{"@volume", "--contour", "7", "--screenshot", viewerPng} + common, &out) !=
             0);
     QVERIFY2(out.contains(QStringLiteral("--contour 7: isosurfaces: 7 lies outside the open range")), qPrintable(out));
