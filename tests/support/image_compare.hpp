@@ -34,6 +34,19 @@ inline std::size_t pixelsDifferingBy(const ImageRGBA8& a, const ImageRGBA8& b, i
   return n;
 }
 
+// Pixels whose RGB differs, by where they lie: in the corner a legend is drawn in (the right half,
+// below the top quarter: mfr render --legend) or anywhere else.
+struct CornerDifference {
+  std::size_t inCorner = 0, elsewhere = 0;
+};
+inline CornerDifference legendCornerDifference(const ImageRGBA8& a, const ImageRGBA8& b) {
+  CornerDifference d;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x)
+      if (rgbDifference(a, b, x, y) > 0) ++(x >= a.width / 2 && y >= a.height / 4 ? d.inCorner : d.elsewhere);
+  return d;
+}
+
 struct OffEdgeComparison {
   std::size_t compared = 0;  // pixels off the edges
   std::size_t within = 0;    // of those, within the tolerance
