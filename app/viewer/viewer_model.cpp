@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cmath>
 #include <exception>
+#include <map>
 
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
@@ -470,6 +471,16 @@ void ViewerModel::spliceIsosurfaces() {
       scene_.csg = {};
       break;
     }
+  // What the scene tree made of the parts before: a part made again with the same name and the same
+  // material as before (its value, colour range and opacity unchanged) keeps its edited colour,
+  // opacity and visibility.
+  struct Edited {
+    mfr::Material made, now;
+    bool visible = true;
+  };
+  std::map<std::string, Edited> edited;
+  for (std::size_t i = base; i < scene_.objects.size() && i < loadedMaterials_.size(); ++i)
+    edited[scene_.objects[i].name] = {loadedMaterials_[i], scene_.objects[i].material, scene_.objects[i].visible};
   scene_.objects.resize(base);
   loadedMaterials_.resize(base);
   loadedMeshes_.resize(base);
@@ -477,8 +488,15 @@ void ViewerModel::spliceIsosurfaces() {
     for (const mfr::Object& part : set.parts) scene_.objects.push_back(part);
   mfr::addVolumeFields(scene_);  // the other volumes' "@NAME" fields on the new parts
   for (std::size_t i = base; i < scene_.objects.size(); ++i) {
-    loadedMaterials_.push_back(scene_.objects[i].material);
-    loadedMeshes_.push_back(scene_.objects[i].mesh);
+    mfr::Object& part = scene_.objects[i];
+    loadedMaterials_.push_back(part.material);
+    loadedMeshes_.push_back(part.mesh);
+    const auto it = edited.find(part.name);
+    if (it != edited.end() && it->second.made.color == part.material.color) {
+      part.material = it->second.now;
+      part.material.fieldColors.reset();  // a colouring by a field is laid on again below
+      part.visible = it->second.visible;
+    }
   }
   updateSceneGeometry();
   emit partsChanged();

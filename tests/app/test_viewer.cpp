@@ -2902,6 +2902,29 @@ class ViewerTest : public QObject {
     QCOMPARE(maxChannelDifference(isoFrame, again->view().renderImage(a.renderSize())), 0);
     again.reset();
 
+    // Parts made again unchanged keep what the scene tree did to them; a new one has the set's look.
+    const auto partIndex = [&](const char* name) {
+      for (std::size_t i = 0; i < m.scene().objects.size(); ++i)
+        if (m.scene().objects[i].name == name) return static_cast<int>(i);
+      return -1;
+    };
+    m.setObjectColor(partIndex("field = 0.3"), QColor(0, 255, 0));
+    m.setObjectVisible(partIndex("field = 0.6"), false);
+    const glm::vec4 green = m.scene().objects[static_cast<std::size_t>(partIndex("field = 0.3"))].material.color;
+    values->setText(QStringLiteral("0.3, 0.45, 0.6"));  // the same colour range: 0.3 and 0.6 unchanged
+    QTest::mouseClick(apply, Qt::LeftButton);
+    QCOMPARE(m.scene().objects.size(), loaded + 3);
+    QCOMPARE(m.scene().objects[static_cast<std::size_t>(partIndex("field = 0.3"))].material.color, green);
+    QVERIFY(!m.scene().objects[static_cast<std::size_t>(partIndex("field = 0.6"))].visible);
+    QVERIFY(m.scene().objects[static_cast<std::size_t>(partIndex("field = 0.45"))].visible);
+    values->setText(QStringLiteral("0.3, 0.9"));  // another range: 0.3 made again as it was, 0.9 new
+    QTest::mouseClick(apply, Qt::LeftButton);
+    QCOMPARE(m.scene().objects.size(), loaded + 2);
+    QCOMPARE(m.scene().objects[static_cast<std::size_t>(partIndex("field = 0.3"))].material.color, green);
+    opacity->setValue(0.5);  // another opacity: every part made anew, edits gone
+    QTest::mouseClick(apply, Qt::LeftButton);
+    QVERIFY(m.scene().objects[static_cast<std::size_t>(partIndex("field = 0.3"))].material.color != green);
+
     // Empty: none again; Show volume draws the volume as before.
     values->clear();
     QTest::mouseClick(apply, Qt::LeftButton);
