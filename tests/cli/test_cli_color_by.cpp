@@ -126,11 +126,8 @@ TEST_F(CliColorBy, GpuEqualsOracleAndTheMapAndRangeShow) {
 TEST_F(CliColorBy, LegendIsDrawnInTheLowerRightCornerOnly) {
   const fs::path file = write("sheet.vtp", sheet());
   const std::string common = "render " + file.string() + " --size 320x240 -m abuffer-ll --color-by pressure ";
-  const fs::path plainPath = dir() / "plain.png", legendPath = dir() / "legend.png";
-  ASSERT_EQ(runCli(common + "-o " + plainPath.string()).exitCode, 0);
-  const CliResult r = runCli(common + "--legend -o " + legendPath.string());
-  ASSERT_EQ(r.exitCode, 0) << r.out;
-  const mfr::ImageRGBA8 plain = mfr::readPng(plainPath), legend = mfr::readPng(legendPath);
+  const mfr::ImageRGBA8 plain = renderedPng(common, "plain.png"),
+                        legend = renderedPng(common + "--legend", "legend.png");
   const mfr::test::CornerDifference d = mfr::test::legendCornerDifference(plain, legend);
   EXPECT_EQ(d.elsewhere, 0u);  // the legend stays in its corner
   EXPECT_GT(d.inCorner, 500u);

@@ -116,11 +116,8 @@ TEST_F(CliContour, SeveralVolumesNeedTheVolumesName) {
 
 TEST_F(CliContour, LegendShowsTheIsosurfacesMapInTheCorner) {
   const std::string common = "render @volume --view iso --size 240x180 -m abuffer-ll --contour 0.3,0.6 ";
-  const fs::path plainPath = dir() / "plain.png", legendPath = dir() / "legend.png";
-  ASSERT_EQ(runCli(common + "-o " + plainPath.string()).exitCode, 0);
-  const CliResult r = runCli(common + "--legend -o " + legendPath.string());
-  ASSERT_EQ(r.exitCode, 0) << r.out;
-  const mfr::ImageRGBA8 plain = mfr::readPng(plainPath), legend = mfr::readPng(legendPath);
+  const mfr::ImageRGBA8 plain = renderedPng(common, "plain.png"),
+                        legend = renderedPng(common + "--legend", "legend.png");
   const mfr::test::CornerDifference d = mfr::test::legendCornerDifference(plain, legend);
   EXPECT_EQ(d.elsewhere, 0u);  // the legend stays in its corner
   EXPECT_GT(d.inCorner, 300u);

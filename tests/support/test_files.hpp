@@ -21,6 +21,7 @@
 #include <system_error>
 
 #include "mfr/error.hpp"
+#include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
 
 namespace mfr::test {
@@ -171,6 +172,14 @@ inline CliResult runCli(const std::string& args) {
 // A temporary folder and the check every bad-input case of the command line makes.
 class CliTest : public TempDirTest {
  protected:
+  // Runs `mfr <args> -o dir()/<name>`, expects it to succeed, and reads the PNG back (an empty
+  // image when it failed).
+  mfr::ImageRGBA8 renderedPng(const std::string& args, const std::string& name) {
+    const std::filesystem::path out = dir() / name;
+    const CliResult r = runCli(args + " -o " + out.string());
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    return r.exitCode == 0 ? mfr::readPng(out) : mfr::ImageRGBA8();
+  }
   // RMSE of two PNGs as `mfr compare --metric rmse` prints it.
   double rmseOf(const std::filesystem::path& a, const std::filesystem::path& b) {
     const CliResult r = runCli("compare " + a.string() + " " + b.string() + " --metric rmse");
