@@ -16,16 +16,21 @@ uint mfrCursorBegin(ivec2 pixel) {
   return 0u;
 }
 
+// One exit, the cursor copied in and out explicitly: NVIDIA's compiler (driver 580, H200) ran the
+// earlier form (a for loop over the inout cursor with a return inside) so that the cursor advanced
+// two slots per step, and every other slot went unread.
 bool mfrNext(inout uint cursor, out MfrFragment f) {
-  for (; cursor < gResolveK; ++cursor) {  // bounded by k
-    uvec2 e = kbEntries[gResolveBase + cursor * gResolveStride];
-    if (e.y != KB_EMPTY) {
-      f = mfrUnpack(e);
-      ++cursor;
-      return true;
-    }
+  uint c = cursor;
+  uvec2 e = uvec2(0u, KB_EMPTY);
+  bool found = false;
+  while (!found && c < gResolveK) {  // bounded by k
+    e = kbEntries[gResolveBase + c * gResolveStride];
+    c += 1u;
+    found = e.y != KB_EMPTY;
   }
-  return false;
+  cursor = c;
+  f = mfrUnpack(e);
+  return found;
 }
 
 #include "common/resolve.glsl"

@@ -67,7 +67,9 @@ void main() {
   uint cursor = mfrCursorBegin(p);
   MfrFragment f;
   uint walk = min(uMaxListLength, MFR_MAX_LIST_WALK);
-  for (uint it = 0u; it < walk && mfrNext(cursor, f); ++it) {
+  // mfrNext advances the cursor: it is called once per step, in the body, never in a loop condition.
+  for (uint it = 0u; it < walk; ++it) {
+    if (!mfrNext(cursor, f)) break;
     if (n < uint(MFR_RESOLVE_LOCAL)) {
       gLocal[n] = f;
       gIndex[n] = n;
@@ -87,7 +89,8 @@ void main() {
     for (uint r = 0u; r < rounds; ++r) {
       uint m = 0u;  // gLocal[0..m) sorted ascending, the m nearest after the last key
       cursor = mfrCursorBegin(p);
-      for (uint i = 0u; i < n && mfrNext(cursor, f); ++i) {
+      for (uint i = 0u; i < n; ++i) {
+        if (!mfrNext(cursor, f)) break;
         if (!first && !keyLess(lastDepth, lastIndex, f.depth, i)) continue;
         if (m == uint(MFR_RESOLVE_LOCAL) &&
             !keyLess(f.depth, i, gLocal[m - 1u].depth, gIndex[m - 1u]))

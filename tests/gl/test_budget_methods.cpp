@@ -149,30 +149,37 @@ TEST_P(VariableK, NeverExceedsTheBudget) {
   }
 }
 
-// The hybrid image equals the oracle's hybrid composite with the GPU's own k(p) map.
+// The hybrid image equals the oracle's hybrid composite with the GPU's own k(p) map, with the
+// spin lock and, where the driver has it, with the fragment shader interlock.
 TEST_P(VariableK, HybridEqualsTheOracleForTheSameKMap) {
-  context();
+  std::vector<std::string> syncs{"spinlock"};
+  if (context().info().fragmentShaderInterlock) syncs.emplace_back("interlock");
   const SampleReference& ref = reference();
   GpuRenderer gpu;
   gpu.setScene(ref.scene);
   const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
-  for (double fraction : {0.2, 0.5}) {
-    const RenderOutput out = gpu.render(
-        ref.camera,
-        budgetRequest(GetParam(), layout.bytes(static_cast<std::uint64_t>(fraction * ref.oracle.fragments.size()))));
-    const std::vector<std::uint32_t> kMap = gpu.kMap();  // image rows, like the oracle
-    const ImageRGBA8 expected = compositeHybrid(ref.oracle, kMap, ref.scene.background);
-    const ImageComparison c = compareImages(ref.oracle, expected, out.image, 2);
-    EXPECT_GT(c.compared, pixels() * 6 / 10);
-    EXPECT_GE(c.fraction(), 0.999) << "max difference " << c.maxDifference;
-    // Not trivially equal: the hybrid with this k(p) differs from the exact image.
-    const ImageComparison vsExact =
-        compareImages(ref.oracle, compositeOver(ref.oracle, ref.scene.background), out.image, 2);
-    EXPECT_LT(vsExact.within, vsExact.compared);
-    std::cout << "[ budget ] " << GetParam() << " at " << fraction << " of the fragments: " << c.within << " of "
-              << c.compared << " pixels within 2/255 of the oracle's hybrid, max " << c.maxDifference << "; k "
-              << out.stats.kMin << ".." << out.stats.kMax << "\n";
-  }
+  for (const std::string& sync : syncs)
+    for (double fraction : {0.2, 0.5}) {
+      SCOPED_TRACE(sync);
+      RenderRequest req =
+          budgetRequest(GetParam(), layout.bytes(static_cast<std::uint64_t>(fraction * ref.oracle.fragments.size())));
+      req.params["sync"] = sync;
+      const RenderOutput out = gpu.render(ref.camera, req);
+      EXPECT_EQ(out.stats.sync, sync);
+      const std::vector<std::uint32_t> kMap = gpu.kMap();  // image rows, like the oracle
+      const ImageRGBA8 expected = compositeHybrid(ref.oracle, kMap, ref.scene.background);
+      const ImageComparison c = compareImages(ref.oracle, expected, out.image, 2);
+      EXPECT_GT(c.compared, pixels() * 6 / 10);
+      EXPECT_GE(c.fraction(), 0.999) << "max difference " << c.maxDifference;
+      // Not trivially equal: the hybrid with this k(p) differs from the exact image.
+      const ImageComparison vsExact =
+          compareImages(ref.oracle, compositeOver(ref.oracle, ref.scene.background), out.image, 2);
+      EXPECT_LT(vsExact.within, vsExact.compared);
+      std::cout << "[ budget ] " << GetParam() << " (" << sync << ") at " << fraction
+                << " of the fragments: " << c.within << " of " << c.compared
+                << " pixels within 2/255 of the oracle's hybrid, max " << c.maxDifference << "; k " << out.stats.kMin
+                << ".." << out.stats.kMax << "\n";
+    }
 }
 
 // With exact_tail (and tail_runs off), a budget of Σ max(1, n − 1) slots gives every pixel k = max(1, n − 1) and so

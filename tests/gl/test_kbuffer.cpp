@@ -272,8 +272,8 @@ INSTANTIATE_TEST_SUITE_P(
                       ExactCase{"kplus-dynamic", {{"robustness", "1"}, {"budget_mib", "256"}}, "full"}),
     exactCaseName);
 
-// Interlock: used where the driver has it, refused with a clear message where it does not
-// (llvmpipe).
+// Interlock: used where the driver has it, and then capturing the oracle's k nearest like the
+// spin lock; refused with a clear message where it does not (llvmpipe).
 TEST(KBuffer, InterlockIsUsedOrRefused) {
   const bool has = context().info().fragmentShaderInterlock;
   const SampleReference& ref = reference();
@@ -286,6 +286,22 @@ TEST(KBuffer, InterlockIsUsedOrRefused) {
     if (has) {
       const RenderOutput out = gpu.render(ref.camera, req);
       EXPECT_EQ(out.stats.sync, "interlock");
+      EXPECT_EQ(out.stats.lockFailures, 0u);
+      EXPECT_EQ(out.stats.fragmentsGenerated, out.stats.fragmentsStored + out.stats.fragmentsDropped);
+      if (std::string(method) == "kplus-dynamic") continue;
+      // The critical section must give what the spin lock gives: the k nearest, or with k-peeling
+      // (exact for every k) every fragment.
+      const bool exact = std::string(method) == "kpeel";
+      for (int k : {1, 4, 16}) {
+        SCOPED_TRACE("k=" + std::to_string(k));
+        const RenderRequest kreq = request(method, {{"sync", "interlock"}}, k);
+        const ListComparison lc = compareLists(ref.oracle, gpu.capture(ref.camera, kreq, exact ? 64 : k),
+                                               exact ? 0u : static_cast<std::uint32_t>(k));
+        EXPECT_GT(lc.compared, lc.pixels * 7 / 10);
+        EXPECT_EQ(lc.countMismatches, 0u) << lc.firstMismatch;
+        EXPECT_EQ(lc.depthMismatches, 0u) << lc.firstMismatch;
+        EXPECT_EQ(lc.colorMismatches, 0u) << lc.firstMismatch;
+      }
     } else {
       try {
         gpu.render(ref.camera, req);
