@@ -22,13 +22,13 @@ INSTANTIATE_TEST_SUITE_P(ABufferFixedArray, ExactMethod,
 namespace {
 
 // True when `kept` (sorted) is a sub-list of `all` (sorted): each kept fragment matches a distinct
-// fragment of the pixel in depth (relative 1e-5) and colour (2/255).
+// fragment of the pixel in depth (rasterDepthTolerance) and colour (2/255).
 bool isSubList(const Fragment* kept, std::uint32_t n, std::span<const Fragment> all) {
   std::size_t j = 0;
   for (std::uint32_t i = 0; i < n; ++i) {
-    const double tol = 1e-5 * std::max(1.0, std::abs(static_cast<double>(kept[i].depth)));
-    while (j < all.size() && !(std::abs(static_cast<double>(all[j].depth) - kept[i].depth) <= tol &&
-                               channelDiff(all[j].color, kept[i].color) <= 2))
+    while (j < all.size() &&
+           !(std::abs(static_cast<double>(all[j].depth) - kept[i].depth) <= rasterDepthTolerance(all[j]) &&
+             channelDiff(all[j].color, kept[i].color) <= 2))
       ++j;
     if (j == all.size()) return false;
     ++j;

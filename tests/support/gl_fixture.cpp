@@ -45,8 +45,7 @@ ListComparison compareLists(const FragmentLists& oracle, const CapturedLists& gp
         const std::uint32_t m = std::min<std::uint32_t>(expected, static_cast<std::uint32_t>(gpu.maxPerPixel));
         bool depthBad = false, colorBad = false;
         for (std::uint32_t i = 0; i < m; ++i) {
-          const double tol = 1e-5 * std::max(1.0, std::abs(static_cast<double>(exact[i].depth)));
-          if (std::abs(static_cast<double>(f[i].depth) - exact[i].depth) > tol) {
+          if (std::abs(static_cast<double>(f[i].depth) - exact[i].depth) > rasterDepthTolerance(exact[i])) {
             if (!depthBad)
               why << "pixel (" << x << "," << y << ") fragment " << i << ": depth " << f[i].depth << ", oracle "
                   << exact[i].depth;

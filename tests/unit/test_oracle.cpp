@@ -257,6 +257,9 @@ TEST(OracleDepth, PerspectivePlanesGiveProjectionFormulaDepth) {
       ASSERT_EQ(px.size(), 2u) << x << "," << y;
       EXPECT_NEAR(px[0].depth, 18.0 / 19.0, 1e-6);
       EXPECT_NEAR(px[1].depth, 240.0 / 247.0, 1e-6);
+      // Planes facing the view: the depth does not change across the image.
+      EXPECT_NEAR(px[0].depthSlope, 0.0, 1e-9);
+      EXPECT_NEAR(px[1].depthSlope, 0.0, 1e-9);
       EXPECT_TRUE(px[0].frontFacing);
       ++checked;
     }
@@ -266,7 +269,8 @@ TEST(OracleDepth, PerspectivePlanesGiveProjectionFormulaDepth) {
 TEST(OracleDepth, GroundPlaneCrossingEyeAndFarPlanes) {
   // A ground plane y = −1 reaching from behind the eye (z = 10) to beyond the far plane: GL clips it
   // at both. A pixel with NDC y = ny < 0 sees the ground at eye depth z_eye = −1/(|ny|·tan 20°); it
-  // has one fragment with the projection-formula depth when −20 ≤ z_eye ≤ −1, none otherwise.
+  // has one fragment with the projection-formula depth (and its change per pixel, depthSlope) when
+  // −20 ≤ z_eye ≤ −1, none otherwise.
   Scene scene;
   scene.name = "ground";
   addObject(scene, makePlane(200.0, 200.0),
@@ -289,6 +293,9 @@ TEST(OracleDepth, GroundPlaneCrossingEyeAndFarPlanes) {
       ASSERT_EQ(lists.count(x, y), 1u);
       const Fragment& frag = lists.pixel(x, y)[0];
       EXPECT_NEAR(frag.depth, 0.5 * ((f + n) / (f - n) + 2.0 * f * n / ((f - n) * zEye)) + 0.5, 1e-6);
+      // depth = const − f·n·tan 20°·|ny|/(f − n) on the ground: affine in ny, which changes by 1/32
+      // per pixel, and independent of x.
+      EXPECT_NEAR(frag.depthSlope, f * n * tanHalfFov / ((f - n) * 32.0), 1e-7);
       EXPECT_TRUE(frag.frontFacing);  // seen from above
       ++withFragment;
     }

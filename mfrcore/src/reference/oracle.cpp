@@ -479,6 +479,24 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     origin = glm::dvec3(n4) / n4.w;
     dir = glm::dvec3(f4) / f4.w - origin;
   };
+  // |∂z/∂x| + |∂z/∂y| of the window depth on the triangle's plane at window point (wx, wy), where
+  // the plane's depth is `depth`: window depth is affine in window x and y on a plane, so the
+  // differences to the plane's depths one pixel right and one up are exact. Edge-on: 1 (the
+  // whole depth range; such pixels are flagged anyway).
+  const auto depthSlope = [&](const WorldTriangle& tri, const glm::dvec3& normal, double depth, double wx, double wy) {
+    double slope = 0.0;
+    for (int i = 0; i < 2; ++i) {
+      glm::dvec3 o, d;
+      windowRay(wx + (i == 0 ? 1.0 : 0.0), wy + (i == 1 ? 1.0 : 0.0), o, d);
+      const double facing = glm::dot(normal, d);
+      if (facing == 0.0) return 1.0;
+      const glm::dvec3 p = o + d * (glm::dot(normal, tri.p[0] - o) / facing);
+      const glm::dvec4 clip = viewProj * glm::dvec4(p, 1.0);
+      if (!(clip.w != 0.0)) return 1.0;
+      slope += std::abs(0.5 * clip.z / clip.w + 0.5 - depth);
+    }
+    return std::min(slope, 1.0);
+  };
   const std::optional<Bounds>& clipBox = scene.clipBox;
   // Whether the line where the triangle's plane meets a face of the clip box passes within
   // edgeEpsilon pixels of the centre whose ray hits that plane at p: each face coordinate's change
@@ -534,6 +552,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
         const glm::dvec3 normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
         Fragment frag;
         frag.depth = static_cast<float>(depth);
+        frag.depthSlope = static_cast<float>(depthSlope(tri, normal, depth, x + 0.5, wy));
         frag.color = shade(tri, objects[tri.objectId], u, v, viewDir);
         frag.objectId = tri.objectId;
         frag.frontFacing = glm::dot(normal, dir) < 0.0;
@@ -545,8 +564,11 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
         return a.triangle < b.triangle;
       });
       for (std::size_t i = 0; i < hits.size(); ++i) {
-        if (i > 0 && std::abs(hits[i].depth - hits[i - 1].depth) <
-                         options.depthTieEpsilon * std::max({1e-30, std::abs(hits[i].depth), std::abs(hits[i - 1].depth)}))
+        if (i > 0 &&
+            std::abs(hits[i].depth - hits[i - 1].depth) <
+                options.depthTieEpsilon * std::max({1e-30, std::abs(hits[i].depth), std::abs(hits[i - 1].depth)}) +
+                    kSubpixelStep * (static_cast<double>(hits[i].fragment.depthSlope) +
+                                     static_cast<double>(hits[i - 1].fragment.depthSlope)))
           rayFlags[pixel] |= FragmentLists::kDepthTie;
         out.push_back(hits[i].fragment);
       }

@@ -103,14 +103,13 @@ void matchCapture(PixelProbe& probe, std::span<const Fragment> fragments, std::u
   probe.unmatched = 0;
   for (ProbeFragment& f : probe.fragments) f.held = false;
   for (const Fragment& got : fragments) {
-    const double tol = depthTolerance * std::max(1.0, std::abs(static_cast<double>(got.depth)));
     ProbeFragment* best = nullptr;
     double bestDepth = std::numeric_limits<double>::infinity();
     int bestColour = 0;
     for (ProbeFragment& f : probe.fragments) {
       if (f.held) continue;
       const double d = std::abs(static_cast<double>(f.fragment.depth) - got.depth);
-      if (d > tol) continue;
+      if (d > rasterDepthTolerance(f.fragment, depthTolerance)) continue;
       const glm::ivec4 a(glm::round(glm::unpackUnorm4x8(f.fragment.color) * 255.0f));
       const glm::ivec4 b(glm::round(glm::unpackUnorm4x8(got.color) * 255.0f));
       const glm::ivec4 diff = glm::abs(a - b);

@@ -17,7 +17,22 @@ struct Fragment {
   std::uint32_t color = 0;  // shaded RGBA, packed like GLSL packUnorm4x8 (R in the low byte)
   std::uint32_t objectId = 0;
   bool frontFacing = false;  // counter-clockwise in window space, like gl_FrontFacing
+  // Oracle fragments: |∂z/∂x| + |∂z/∂y|, the window depth's change per pixel on the fragment's
+  // plane (0 in fragments read back from a GPU). See rasterDepthTolerance.
+  float depthSlope = 0.0f;
 };
+
+// GL rasterisers snap vertex positions to 2^-GL_SUBPIXEL_BITS of a pixel (8 bits on llvmpipe and
+// on NVIDIA's driver), and some (NVIDIA) interpolate depth over the snapped triangle: its plane
+// moves by up to this much along x and y, and gl_FragCoord.z with it.
+inline constexpr double kSubpixelStep = 1.0 / 256.0;
+
+// How far a rasteriser's window depth for an exact fragment may lie from the exact value:
+// `relative` of the depth (float rounding) plus the plane's change over one subpixel step.
+inline double rasterDepthTolerance(const Fragment& exact, double relative = 1e-5) {
+  const double z = exact.depth < 0.0f ? -static_cast<double>(exact.depth) : static_cast<double>(exact.depth);
+  return relative * (z > 1.0 ? z : 1.0) + kSubpixelStep * static_cast<double>(exact.depthSlope);
+}
 
 // A rectangle of pixels in image coordinates (y = 0 is the top row); empty means the whole image.
 struct PixelRect {
@@ -33,7 +48,9 @@ struct OracleOptions {
   // Screen-space distance (pixels) under which a pixel centre counts as lying on a triangle edge:
   // there rasterisation tie rules and vertex snapping (1/256 px) decide, so tests exclude it.
   double edgeEpsilon = 0.02;
-  // Relative depth difference under which two fragments of a pixel count as tied in depth.
+  // Relative depth difference under which two fragments of a pixel count as tied in depth; the
+  // subpixel step is added too (each fragment's kSubpixelStep · depthSlope): a rasteriser that
+  // snaps vertices may order such fragments either way.
   double depthTieEpsilon = 1e-6;
   int threads = 0;  // 0: hardware concurrency
   // Cast only these pixels (a probe of one pixel, a zoomed-in check); the others get empty lists
@@ -48,7 +65,8 @@ struct FragmentLists {
   std::vector<std::uint32_t> offsets;  // width*height+1 prefix offsets into fragments
   std::vector<Fragment> fragments;     // per pixel, sorted by depth (near first)
   // Per pixel bit flags: kEdge (centre within edgeEpsilon of a projected triangle edge, hit or
-  // missed), kDepthTie (two fragments closer than depthTieEpsilon: their order is undefined).
+  // missed), kDepthTie (two fragments closer than depthTieEpsilon plus their subpixel-snap
+  // tolerance: their order is undefined).
   std::vector<std::uint8_t> flags;
 
   static constexpr std::uint8_t kEdge = 1;

@@ -86,8 +86,9 @@ PixelProbe probePixel(const Scene& scene, const Camera& camera, int width, int h
                       const OracleOptions& options = {});
 
 // Marks the oracle fragments a method holds: each captured fragment is paired with the unpaired
-// oracle fragment nearest in depth within `depthTolerance` (window depth, relative above 1 —
-// the tolerance of the GPU-versus-oracle tests), the closer colour deciding between equal depths.
+// oracle fragment nearest in depth within rasterDepthTolerance(oracle fragment, depthTolerance)
+// (window depth: `depthTolerance` relative above 1 plus the subpixel-snap term — the tolerance of
+// the GPU-versus-oracle tests), the closer colour deciding between equal depths.
 // `count` is what the method reports holding (it may exceed fragments.size() when the read-back
 // kept fewer).
 void matchCapture(PixelProbe& probe, std::span<const Fragment> fragments, std::uint32_t count,
