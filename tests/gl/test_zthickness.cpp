@@ -139,23 +139,30 @@ TEST(ZThicknessMergeKBuffer, WithRoomForEveryFragmentEqualsTheOracle) {
 // Merging keeps every pixel's opacity: a merged segment's optical depth is the sum of its parts',
 // so the transmittance Π(1 - α_i) of all the pixel's fragments (α clamped as the operation does)
 // survives any number of merges, while a k-buffer that drops fragments loses it. Measured through
-// the image: rendered over a black and over a white background, the difference is the
-// transmittance.
+// the image: with every part black (shading keeps black black), a pixel over a white background
+// is the transmittance itself. (Black parts make the merged colour 0 whatever order the fragments
+// arrive in: with coloured parts, the colour's 8-bit rounding at each merge depends on the
+// order, which a GPU changes from frame to frame.)
 TEST(ZThicknessMergeKBuffer, MergingKeepsEveryPixelsOpacity) {
   context();
   const int w = 128, h = 128;
-  Scene black = sampleReference("front", w, h).scene, white = black;
-  black.background = glm::vec3(0.0f);
+  Scene white = sampleReference("front", w, h).scene;
   white.background = glm::vec3(1.0f);
-  const Camera camera = black.view("front");
-  const FragmentLists& oracle = sampleReference("front", w, h).oracle;
-  GpuRenderer onBlack, onWhite;
-  onBlack.setScene(black);
+  for (Object& o : white.objects) {
+    o.material.color = glm::vec4(0.0f, 0.0f, 0.0f, o.material.color.a);
+    o.material.vertexColors = false;
+    o.material.fieldColors.reset();
+  }
+  const Camera camera = white.view("front");
+  const FragmentLists& oracle = sampleReference("front", w, h).oracle;  // the same geometry and opacities
+  GpuRenderer onWhite;
   onWhite.setScene(white);
+  std::string firstWrong;
   const auto wrongPixels = [&](const RenderRequest& req, std::size_t& deep) {
-    const ImageRGBA8 b = onBlack.render(camera, req).image, t = onWhite.render(camera, req).image;
+    const RenderOutput out = onWhite.render(camera, req);
     std::size_t wrong = 0;
     deep = 0;
+    firstWrong = "lock failures " + std::to_string(out.stats.lockFailures);
     for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
         if (oracle.isEdge(x, y)) continue;
@@ -164,9 +171,12 @@ TEST(ZThicknessMergeKBuffer, MergingKeepsEveryPixelsOpacity) {
           transmittance *= 1.0 - std::min<double>((f.color >> 24) / 255.0, MFR_ZTHICK_MAX_ALPHA);
         deep += oracle.count(x, y) > 4u;
         for (int ch = 0; ch < 3; ++ch) {
-          const int measured = int(t.at(x, y)[ch]) - int(b.at(x, y)[ch]);
-          if (std::abs(measured - transmittance * 255.0) > 2.5) {
-            ++wrong;
+          const int measured = out.image.at(x, y)[ch];
+          if (std::abs(measured - transmittance * 255.0) > 1.5) {
+            if (++wrong == 1)
+              firstWrong += "; pixel (" + std::to_string(x) + "," + std::to_string(y) + ") of " +
+                            std::to_string(oracle.count(x, y)) + " fragments: transmittance " +
+                            std::to_string(measured / 255.0) + ", oracle " + std::to_string(transmittance);
             break;
           }
         }
@@ -182,7 +192,7 @@ TEST(ZThicknessMergeKBuffer, MergingKeepsEveryPixelsOpacity) {
     merge.height = h;
     merge.params["k"] = k;
     std::size_t deep = 0;
-    EXPECT_EQ(wrongPixels(merge, deep), 0u);
+    EXPECT_EQ(wrongPixels(merge, deep), 0u) << firstWrong;
     EXPECT_GT(deep, 2000u);  // pixels with more fragments than slots: merging happened there
     // The k nearest alone (kplus-array) lose the rest's opacity: the check can fail.
     RenderRequest drop = merge;
