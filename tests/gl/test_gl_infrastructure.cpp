@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <iostream>
 
 #include "gl_fixture.hpp"
 #include "mfr/error.hpp"
@@ -42,6 +43,8 @@ TEST(GlInfrastructure, ContextIsOpenGL45Core) {
   glGetIntegerv(GL_CONTEXT_PROFILE_MASK, &profile);
   EXPECT_GE(major * 10 + minor, 45);
   EXPECT_TRUE(profile & GL_CONTEXT_CORE_PROFILE_BIT);
+  std::cout << "[ context ] " << info.vendor << " | " << info.renderer << " | " << info.version << " | platform "
+            << info.platform << " | interlock " << (info.fragmentShaderInterlock ? "yes" : "no") << "\n";
 }
 
 TEST(GlInfrastructure, DebugOutputBecomesAnError) {
