@@ -479,18 +479,28 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     origin = glm::dvec3(n4) / n4.w;
     dir = glm::dvec3(f4) / f4.w - origin;
   };
+  // Where the rays through the next pixel centres right of and above window point (wx, wy) meet
+  // the plane of a triangle with this normal; false when one of them runs in the plane (edge-on).
+  const auto neighbourPlanePoints = [&](const WorldTriangle& tri, const glm::dvec3& normal, double wx, double wy,
+                                        glm::dvec3(&onPlane)[2]) {
+    for (int i = 0; i < 2; ++i) {
+      glm::dvec3 o, d;
+      windowRay(wx + (i == 0 ? 1.0 : 0.0), wy + (i == 1 ? 1.0 : 0.0), o, d);
+      const double facing = glm::dot(normal, d);
+      if (facing == 0.0) return false;
+      onPlane[i] = o + d * (glm::dot(normal, tri.p[0] - o) / facing);
+    }
+    return true;
+  };
   // |∂z/∂x| + |∂z/∂y| of the window depth on the triangle's plane at window point (wx, wy), where
   // the plane's depth is `depth`: window depth is affine in window x and y on a plane, so the
   // differences to the plane's depths one pixel right and one up are exact. Edge-on: 1 (the
   // whole depth range; such pixels are flagged anyway).
   const auto depthSlope = [&](const WorldTriangle& tri, const glm::dvec3& normal, double depth, double wx, double wy) {
+    glm::dvec3 onPlane[2];
+    if (!neighbourPlanePoints(tri, normal, wx, wy, onPlane)) return 1.0;
     double slope = 0.0;
-    for (int i = 0; i < 2; ++i) {
-      glm::dvec3 o, d;
-      windowRay(wx + (i == 0 ? 1.0 : 0.0), wy + (i == 1 ? 1.0 : 0.0), o, d);
-      const double facing = glm::dot(normal, d);
-      if (facing == 0.0) return 1.0;
-      const glm::dvec3 p = o + d * (glm::dot(normal, tri.p[0] - o) / facing);
+    for (const glm::dvec3& p : onPlane) {
       const glm::dvec4 clip = viewProj * glm::dvec4(p, 1.0);
       if (!(clip.w != 0.0)) return 1.0;
       slope += std::abs(0.5 * clip.z / clip.w + 0.5 - depth);
@@ -502,16 +512,10 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   // edgeEpsilon pixels of the centre whose ray hits that plane at p: each face coordinate's change
   // per pixel on the plane comes from the rays through the next centres right and up. There GL's
   // clipping (in float, then snapped) and the exact test may disagree, like at a triangle's edge.
-  const auto nearClipFace = [&](const WorldTriangle& tri, const glm::dvec3& p, double wx, double wy) {
-    const glm::dvec3 normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
+  const auto nearClipFace = [&](const WorldTriangle& tri, const glm::dvec3& normal, const glm::dvec3& p, double wx,
+                                double wy) {
     glm::dvec3 onPlane[2];
-    for (int i = 0; i < 2; ++i) {
-      glm::dvec3 o, d;
-      windowRay(wx + (i == 0 ? 1.0 : 0.0), wy + (i == 1 ? 1.0 : 0.0), o, d);
-      const double facing = glm::dot(normal, d);
-      if (facing == 0.0) return true;  // edge-on: no measure; treat as ambiguous
-      onPlane[i] = o + d * (glm::dot(normal, tri.p[0] - o) / facing);
-    }
+    if (!neighbourPlanePoints(tri, normal, wx, wy, onPlane)) return true;  // edge-on: no measure; ambiguous
     for (int a = 0; a < 3; ++a) {
       const double perPixel = std::hypot(onPlane[0][a] - p[a], onPlane[1][a] - p[a]);
       for (const double face : {clipBox->min[a], clipBox->max[a]})
@@ -545,11 +549,11 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
           rayFlags[pixel] |= FragmentLists::kEdge;
           continue;
         }
+        const glm::dvec3 normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
         if (clipBox) {
-          if (nearClipFace(tri, p, x + 0.5, wy)) rayFlags[pixel] |= FragmentLists::kEdge;
+          if (nearClipFace(tri, normal, p, x + 0.5, wy)) rayFlags[pixel] |= FragmentLists::kEdge;
           if (!insideClipBox(clipBox, p)) continue;
         }
-        const glm::dvec3 normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
         Fragment frag;
         frag.depth = static_cast<float>(depth);
         frag.depthSlope = static_cast<float>(depthSlope(tri, normal, depth, x + 0.5, wy));
