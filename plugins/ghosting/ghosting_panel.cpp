@@ -21,6 +21,15 @@ namespace {
 
 const QString kZThickness = QStringLiteral("zthickness");
 
+// Each name with the count of equal names before it ("Part#0", "Part#1"): parts of one scene
+// matched across a change of its part list, repeated names included.
+QStringList occurrenceKeys(const QStringList& names) {
+  QMap<QString, int> seen;
+  QStringList keys;
+  for (const QString& name : names) keys.append(name + QLatin1Char('#') + QString::number(seen[name]++));
+  return keys;
+}
+
 // Slider position ↔ % of the diagonal, logarithmic between the panel's limits.
 double percentAt(int position) {
   const double f = static_cast<double>(position) / GhostingPanel::kSliderSteps;
@@ -143,20 +152,53 @@ bool GhostingPanel::isFocus(int objectId) const {
   return item && item->checkState() == Qt::Checked;
 }
 
+// Whether a part is one of the viewer's isosurfaces ("VOLUME = VALUE", ViewerContext 1.8).
+bool GhostingPanel::isIsosurface(const QString& name) const {
+  const QStringList volumes = context_.volumeNames();
+  return std::any_of(volumes.begin(), volumes.end(),
+                     [&name](const QString& v) { return name.startsWith(v + QStringLiteral(" = ")); });
+}
+
+// The names without the isosurfaces: the scene's own parts.
+QStringList GhostingPanel::ownParts(const QStringList& names) const {
+  QStringList own;
+  for (const QString& name : names)
+    if (!isIsosurface(name)) own.append(name);
+  return own;
+}
+
 void GhostingPanel::sceneChanged() {
   const QStringList names = context_.hasScene() ? context_.objectNames() : QStringList{};
   if (names != names_) {
-    // Another scene: nothing of it is ghosted yet.
+    // Isosurfaces added or removed (the scene's own parts unchanged): the parts that stay keep
+    // their focus, and ghosting goes on over the new ones. Another scene: nothing of it is ghosted.
+    const bool sameScene = !names_.isEmpty() && ownParts(names) == ownParts(names_);
+    QMap<QString, Qt::CheckState> focus;
+    QMap<QString, double> before;  // opacities before ghosting, of the parts still ghosted
+    if (sameScene) {
+      const QStringList keys = occurrenceKeys(names_);
+      for (int id = 0; id < parts_->count(); ++id) {
+        focus.insert(keys[id], parts_->item(id)->checkState());
+        // A part at the ghost opacity is still ghosted; one made again has an opacity of its own.
+        if (saved_.contains(id) && std::abs(context_.objectOpacity(id) - ghostOpacity()) < 1e-6)
+          before.insert(keys[id], saved_.value(id));
+      }
+    }
     names_ = names;
     saved_.clear();
-    const QSignalBlocker blockList(parts_), blockGhost(ghost_);
-    ghost_->setChecked(false);
-    parts_->clear();
-    for (const QString& name : names) {
-      auto* item = new QListWidgetItem(name, parts_);
-      item->setFlags(item->flags() | Qt::ItemIsUserCheckable);
-      item->setCheckState(Qt::Unchecked);
+    {
+      const QSignalBlocker blockList(parts_), blockGhost(ghost_);
+      if (!sameScene) ghost_->setChecked(false);
+      parts_->clear();
+      const QStringList keys = occurrenceKeys(names);
+      for (int id = 0; id < names.size(); ++id) {
+        auto* item = new QListWidgetItem(names[id], parts_);
+        item->setFlags(item->flags() | Qt::ItemIsUserCheckable);
+        item->setCheckState(focus.value(keys[id], Qt::Unchecked));
+        if (before.contains(keys[id])) saved_.insert(id, before.value(keys[id]));
+      }
     }
+    if (sameScene && ghost_->isChecked()) applyGhosting();
   }
   showThickness();  // the default follows the scene's size
 }

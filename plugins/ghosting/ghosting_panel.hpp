@@ -9,7 +9,8 @@
 //   part to the ghost opacity (live while the slider moves) and, switched off, gives each ghosted
 //   part the opacity it had before; "Restore opacities" brings back the opacities of the scene as
 //   loaded. Opacities go through ViewerContext::setObjectOpacities: the scene tree's path, so every
-//   pane (CPU images included) sees them.
+//   pane (CPU images included) sees them. Isosurfaces added or removed keep the focus and ghosting
+//   of the parts that stay, and new parts are ghosted too; another scene starts unghosted.
 #include <QJsonObject>
 #include <QMap>
 #include <QWidget>
@@ -48,6 +49,8 @@ class GhostingPanel final : public QWidget {
   [[nodiscard]] double diagonal() const;
   [[nodiscard]] double ghostOpacity() const;
   [[nodiscard]] bool isFocus(int objectId) const;
+  [[nodiscard]] bool isIsosurface(const QString& name) const;
+  [[nodiscard]] QStringList ownParts(const QStringList& names) const;
 
   ViewerContext& context_;
   QCheckBox* blend_ = nullptr;

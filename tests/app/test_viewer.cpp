@@ -2828,6 +2828,54 @@ class ViewerTest : public QObject {
     for (const float v : isoValuesInVolume()) QVERIFY2(std::abs(v - 0.5f) < 1e-4f, qPrintable(QString::number(v)));
   }
 
+  void ghostingFollowsIsosurfaces() {
+    // The Ghosting panel while isosurfaces come and go: the scene's own parts keep their focus and
+    // ghosting, new isosurfaces are ghosted too, an isosurface in focus stays so while others are
+    // removed, and ghosting off gives every part its own opacity; another scene starts unghosted.
+    auto w = openWindow(QStringLiteral("@volume"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    auto* parts = w->findChild<QListWidget*>("ghostParts");
+    auto* ghost = w->findChild<QCheckBox*>("ghostOthers");
+    QVERIFY(parts && ghost);
+    const int loaded = static_cast<int>(m.objectNames().size());
+    QVERIFY2(loaded >= 2, "needs a part in focus and a ghosted one");
+    std::vector<double> own;
+    for (int i = 0; i < loaded; ++i) own.push_back(m.objectOpacity(i));
+    const auto opacityIs = [&m](int id, double value) { return std::abs(m.objectOpacity(id) - value) < 1e-6; };
+    parts->item(0)->setCheckState(Qt::Checked);
+    ghost->setChecked(true);
+    QVERIFY(opacityIs(0, own[0]) && opacityIs(1, 0.15));
+
+    QVERIFY(m.setIsosurfaces({0.3, 0.6}, 0.25).isEmpty());
+    QCOMPARE(parts->count(), loaded + 2);
+    QVERIFY(ghost->isChecked());
+    QCOMPARE(parts->item(0)->checkState(), Qt::Checked);
+    QVERIFY(opacityIs(0, own[0]));
+    for (int id = 1; id < loaded + 2; ++id) QVERIFY2(opacityIs(id, 0.15), qPrintable(parts->item(id)->text()));
+    // "field = 0.6" into focus: its own 0.25; removing "field = 0.3" keeps it so.
+    QCOMPARE(parts->item(loaded + 1)->text(), QStringLiteral("field = 0.6"));
+    parts->item(loaded + 1)->setCheckState(Qt::Checked);
+    QVERIFY(opacityIs(loaded + 1, 0.25));
+    QVERIFY(m.setIsosurfaces({0.6}, 0.25).isEmpty());
+    QCOMPARE(parts->count(), loaded + 1);
+    QCOMPARE(parts->item(loaded)->text(), QStringLiteral("field = 0.6"));
+    QCOMPARE(parts->item(loaded)->checkState(), Qt::Checked);
+    QVERIFY(opacityIs(loaded, 0.25) && opacityIs(1, 0.15) && ghost->isChecked());
+    // Ghosting off: each part's own opacity, the loaded ones and the isosurface's.
+    ghost->setChecked(false);
+    for (int id = 0; id < loaded; ++id) QVERIFY(opacityIs(id, own[static_cast<std::size_t>(id)]));
+    QVERIFY(opacityIs(loaded, 0.25));
+
+    // Another scene: nothing in focus, nothing ghosted.
+    ghost->setChecked(true);
+    w->openScene(QStringLiteral("@intersect"));
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.scenePath() == QStringLiteral("@intersect"), kTimeoutMs);
+    QVERIFY(!ghost->isChecked());
+    QCOMPARE(parts->count(), static_cast<int>(m.objectNames().size()));
+    for (int id = 0; id < parts->count(); ++id) QCOMPARE(parts->item(id)->checkState(), Qt::Unchecked);
+  }
+
   void isosurfaces() {
     // The Volume panel's Isosurfaces: parts "field = V" in the scene tree, the volume hidden, the
     // pixels of mfr render --contour; refusals leave the scene as it was; sessions keep them.
