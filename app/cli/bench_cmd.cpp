@@ -188,6 +188,10 @@ void addBench(CLI::App& app) {
       row["bytes_used"] = last.stats.bytesUsed;
       row["fragments_generated"] = last.stats.fragmentsGenerated;
       row["fragments_stored"] = last.stats.fragmentsStored;
+      row["fragments_dropped"] = last.stats.fragmentsDropped;
+      // How the k-buffers synchronised (spin lock or interlock) and what the spin lock lost.
+      row["sync"] = last.stats.sync;
+      row["lock_failures"] = last.stats.lockFailures;
       row["overflow"] = last.stats.overflow;
       row["passes"] = last.stats.passes;
       std::string rmseText = "-", flipText = "-";

@@ -152,6 +152,15 @@ TEST_F(Cli, BenchRowsAndOrders) {
       EXPECT_GT(row.at("bytes_allocated").get<std::uint64_t>(), 0u);
       EXPECT_EQ(row.at("fragments_generated"), runs[order].at("oracle_fragments")) << row.at("method");
     }
+    // The k-buffer's synchronisation and its accounting: every fragment stored, dropped or lost.
+    EXPECT_EQ(rows[0].at("sync"), "atomics");
+    EXPECT_EQ(rows[1].at("sync"), "spinlock");
+    EXPECT_EQ(rows[1].at("lock_failures").get<std::uint64_t>(), 0u);  // llvmpipe runs a pixel's fragments in turn
+    EXPECT_GT(rows[1].at("fragments_dropped").get<std::uint64_t>(), 0u);
+    EXPECT_EQ(rows[1].at("fragments_generated").get<std::uint64_t>(),
+              rows[1].at("fragments_stored").get<std::uint64_t>() +
+                  rows[1].at("fragments_dropped").get<std::uint64_t>() +
+                  rows[1].at("lock_failures").get<std::uint64_t>());
     EXPECT_LT(rows[0].at("rmse").get<double>(), 0.01);                                     // every fragment
     EXPECT_GT(rows[1].at("rmse").get<double>(), rows[0].at("rmse").get<double>() + 0.01);  // two of them
   }
