@@ -152,18 +152,15 @@ bool GhostingPanel::isFocus(int objectId) const {
   return item && item->checkState() == Qt::Checked;
 }
 
-// Whether a part is one of the viewer's isosurfaces ("VOLUME = VALUE", ViewerContext 1.8).
-bool GhostingPanel::isIsosurface(const QString& name) const {
-  const QStringList volumes = context_.volumeNames();
-  return std::any_of(volumes.begin(), volumes.end(),
-                     [&name](const QString& v) { return name.startsWith(v + QStringLiteral(" = ")); });
-}
-
-// The names without the isosurfaces: the scene's own parts.
+// The names without the viewer's isosurfaces ("VOLUME = VALUE", ViewerContext 1.8): the scene's
+// own parts.
 QStringList GhostingPanel::ownParts(const QStringList& names) const {
+  const QStringList volumes = context_.volumeNames();
   QStringList own;
   for (const QString& name : names)
-    if (!isIsosurface(name)) own.append(name);
+    if (std::none_of(volumes.begin(), volumes.end(),
+                     [&name](const QString& v) { return name.startsWith(v + QStringLiteral(" = ")); }))
+      own.append(name);
   return own;
 }
 

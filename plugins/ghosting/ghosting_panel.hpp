@@ -49,7 +49,6 @@ class GhostingPanel final : public QWidget {
   [[nodiscard]] double diagonal() const;
   [[nodiscard]] double ghostOpacity() const;
   [[nodiscard]] bool isFocus(int objectId) const;
-  [[nodiscard]] bool isIsosurface(const QString& name) const;
   [[nodiscard]] QStringList ownParts(const QStringList& names) const;
 
   ViewerContext& context_;
