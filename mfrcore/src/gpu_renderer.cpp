@@ -57,6 +57,9 @@ void GpuRenderer::uploadVolumes(const Scene& scene) {
     gpu->volume = v;
     const std::shared_ptr<gl::Texture> earlier = find(volumes_, v);
     gpu->grid = earlier ? earlier : textures[i];
+    // A surface coloured by the volume holds its grid already (counted in the scene's bytes).
+    const std::shared_ptr<gl::Texture> inScene = scene_->fieldGrid(v.grid.get());
+    if (!gpu->grid) gpu->grid = inScene;
     if (!gpu->grid) {
       const glm::ivec3 d = v.grid->dims;
       gpu->grid = std::make_shared<gl::Texture>(gl::createTexture3D(GL_R32F, d.x, d.y, d.z));
@@ -66,7 +69,7 @@ void GpuRenderer::uploadVolumes(const Scene& scene) {
     const std::vector<glm::vec4> table = v.transfer.table();
     gpu->transfer = gl::createTexture1D(GL_RGBA32F, MFR_VOLUME_TF_SIZE);
     glTextureSubImage1D(gpu->transfer.id(), 0, 0, MFR_VOLUME_TF_SIZE, GL_RGBA, GL_FLOAT, table.data());
-    gpu->bytes = (earlier ? 0 : v.grid->values.size() * sizeof(float)) + table.size() * sizeof(glm::vec4);
+    gpu->bytes = (earlier || inScene ? 0 : v.grid->values.size() * sizeof(float)) + table.size() * sizeof(glm::vec4);
     volumes_.push_back(std::move(gpu));
   }
 }
@@ -82,7 +85,11 @@ void GpuRenderer::setScene(const Scene& original) {
   const Scene& scene = cut ? *cut : original;
   // Meshes the previous upload holds are shared, not uploaded again (an edit of colours, visibility,
   // the clip box, or a section that leaves parts uncut).
-  scene_ = std::make_shared<const gl::GpuScene>(scene, scene_.get());
+  scene_ = std::make_shared<const gl::GpuScene>(scene, scene_.get(), [this](const VolumeGrid* grid) {
+    for (const auto& v : volumes_)
+      if (v->volume.grid.get() == grid) return v->grid;
+    return std::shared_ptr<gl::Texture>();
+  });
   background_ = scene.background;
   csg_ = scene.csg;
   csgMirrored_ = csgMirroredPrimitives(scene);

@@ -49,6 +49,9 @@
 // colour of NaN at x = MFR_COLOR_MAP_SIZE.
 #define MFR_TEX_COLOR_MAPS 12
 #define MFR_COLOR_MAP_SIZE 256
+// A surface coloured by a volume ("@NAME"): that volume's grid (R32F, texelFetch), sampled at each
+// fragment (common/fragment.glsl).
+#define MFR_TEX_FIELD_GRID 13
 // Before interpolation each vertex's value is clamped to the range widened by this many spans on
 // either side: infinities (and values so large that their differences overflow) would otherwise
 // interpolate into NaN on the GPU. Beyond the range the map saturates, so colours barely change.

@@ -33,6 +33,7 @@ uniform vec4 uSectionPlane;
 // dynamically uniform as GLSL 4.50 requires.
 layout(binding = MFR_TEX_VOLUME) uniform sampler3D uVolume[MFR_MAX_VOLUMES];
 layout(binding = MFR_TEX_VOLUME_TF) uniform sampler1D uTransfer[MFR_MAX_VOLUMES];
+#include "common/volume_sample.glsl"
 
 struct OpState {
   vec3 color;
@@ -50,26 +51,7 @@ struct OpState {
 };
 
 // Trilinear interpolation, clamped to the grid (VolumeGrid::sample).
-float volumeSample(int v, vec3 g) {
-  ivec3 dims = uGridDims[v];
-  vec3 last = vec3(dims - 1);
-  vec3 c = clamp(g, vec3(0.0), last);
-  ivec3 i0 = min(ivec3(floor(c)), dims - 2);
-  vec3 f = c - vec3(i0);
-  float v000 = texelFetch(uVolume[v], i0, 0).r;
-  float v100 = texelFetch(uVolume[v], i0 + ivec3(1, 0, 0), 0).r;
-  float v010 = texelFetch(uVolume[v], i0 + ivec3(0, 1, 0), 0).r;
-  float v110 = texelFetch(uVolume[v], i0 + ivec3(1, 1, 0), 0).r;
-  float v001 = texelFetch(uVolume[v], i0 + ivec3(0, 0, 1), 0).r;
-  float v101 = texelFetch(uVolume[v], i0 + ivec3(1, 0, 1), 0).r;
-  float v011 = texelFetch(uVolume[v], i0 + ivec3(0, 1, 1), 0).r;
-  float v111 = texelFetch(uVolume[v], i0 + ivec3(1, 1, 1), 0).r;
-  float x00 = mix(v000, v100, f.x);
-  float x10 = mix(v010, v110, f.x);
-  float x01 = mix(v001, v101, f.x);
-  float x11 = mix(v011, v111, f.x);
-  return mix(mix(x00, x10, f.y), mix(x01, x11, f.y), f.z);
-}
+float volumeSample(int v, vec3 g) { return mfrTrilinear(uVolume[v], uGridDims[v], g); }
 
 // (rgb, σ) of a scalar: volume v's table interpolated linearly (TransferFunction::table).
 vec4 volumeTransfer(int v, float value) {

@@ -1,7 +1,8 @@
 // Surfaces coloured by a field on the GPU (common/color_map.glsl: the value interpolated across the
 // triangle, then mapped through the map's table) against the oracle, which interpolates at the ray's
 // hit and maps with mfr::mapFieldValue: point data and cell data, several maps, through the exact
-// methods, a k-buffer and depth peeling, and on a sectioned scene whose caps carry the field.
+// methods, a k-buffer and depth peeling, and on a sectioned scene whose caps carry the field. A
+// surface coloured by a volume ("@NAME") takes the volume's value at each of its points instead.
 #include <gtest/gtest.h>
 
 #include <limits>
@@ -12,6 +13,7 @@
 
 #include "gl_fixture.hpp"
 #include "image_compare.hpp"
+#include "mfr/reference/probe.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/primitives.hpp"
@@ -162,6 +164,143 @@ TEST(FieldColorsGpu, NaNAndInfiniteValuesAreDrawnAsTheOracleDrawsThem) {
       red += p[0] > 200 && p[1] < 140 && p[2] < 140 ? 1 : 0;
     }
   EXPECT_GT(red, 50u);
+}
+
+// A volume "xy" whose value is x·y (bilinear, so trilinear interpolation of its samples gives
+// exactly x·y at every point) over [-2, 2]² × [-1.5, 1.5].
+Volume xyVolume() {
+  auto grid = std::make_shared<VolumeGrid>();
+  grid->dims = {9, 9, 7};
+  for (int k = 0; k < 7; ++k)
+    for (int j = 0; j < 9; ++j)
+      for (int i = 0; i < 9; ++i) grid->values.push_back(static_cast<float>((-2.0 + 0.5 * i) * (-2.0 + 0.5 * j)));
+  Volume volume;
+  volume.name = "xy";
+  volume.grid = grid;
+  volume.origin = {-2.0, -2.0, -1.5};
+  volume.spacing = {0.5, 0.5, 0.5};
+  volume.transfer = defaultTransfer(*grid, volume.bounds());
+  volume.visible = false;  // only a field here
+  return volume;
+}
+
+// The square [-1.5, 1.5]² at z = 0 facing +z, opaque, as cells × cells quads.
+std::shared_ptr<Mesh> squareMesh(int cells) {
+  auto m = std::make_shared<Mesh>();
+  for (int j = 0; j <= cells; ++j)
+    for (int i = 0; i <= cells; ++i) {
+      m->positions.emplace_back(-1.5f + 3.0f * static_cast<float>(i) / static_cast<float>(cells),
+                                -1.5f + 3.0f * static_cast<float>(j) / static_cast<float>(cells), 0.0f);
+      m->normals.emplace_back(0.0f, 0.0f, 1.0f);
+    }
+  const auto at = [cells](int i, int j) { return static_cast<std::uint32_t>(j * (cells + 1) + i); };
+  for (int j = 0; j < cells; ++j)
+    for (int i = 0; i < cells; ++i)
+      m->indices.insert(m->indices.end(),
+                        {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+  return m;
+}
+
+// Two triangles coloured by the volume x·y show x·y at every pixel — the same image, within 2/255,
+// as a 120 × 120 grid of the square carrying x·y at its vertices (interpolated there, off by at most
+// 6·10⁻⁵ of the range) — where interpolating the four corners' values (±2.25) would draw a
+// different picture; on the GPU as in the oracle, through an A-buffer and a k-buffer.
+TEST(FieldColorsGpu, VolumeColoursAreSampledAtEachPointNotInterpolated) {
+  context();
+  Scene coarse;
+  coarse.name = "coarse";
+  coarse.volumes = {xyVolume()};
+  Object square;
+  square.name = "square";
+  square.mesh = squareMesh(1);
+  coarse.objects = {square};
+  addVolumeFields(coarse);
+  colorByField(coarse.objects[0], "@xy", "grayscale", glm::dvec2(-2.25, 2.25));
+
+  Scene fine;
+  fine.name = "fine";
+  Object reference = square;
+  auto grid = squareMesh(120);
+  MeshField xy{"xy", false, 1, {}};
+  for (const glm::vec3& p : grid->positions) xy.values.push_back(p.x * p.y);
+  grid->fields = {xy};
+  reference.mesh = grid;
+  fine.objects = {reference};
+  colorByField(fine.objects[0], "xy", "grayscale", glm::dvec2(-2.25, 2.25));
+
+  Camera camera;
+  camera.eye = {0.6, -0.8, 5.0};  // a little oblique: the fragments' points are perspective-correct
+  camera.target = {0.0, 0.0, 0.0};
+  camera = coarse.fit(camera);
+  RenderRequest oracle;
+  oracle.method = "oracle";
+  oracle.width = 96;
+  oracle.height = 96;
+  const ImageRGBA8 expected = render(fine, camera, oracle).image;
+  const FragmentLists lists = castFragments(coarse, camera, oracle.width, oracle.height);
+  const ImageRGBA8 sampled = render(coarse, camera, oracle).image;
+  const OffEdgeComparison c = compareOffEdges(lists, expected, sampled, 2, [](int, int, int) {});
+  EXPECT_GT(c.compared, 4000u);
+  EXPECT_GE(c.within, c.compared * 999 / 1000) << "max difference " << c.maxDifference;
+  for (const char* method : {"abuffer-ll", "kplus-array"}) {
+    SCOPED_TRACE(method);
+    RenderRequest req = oracle;
+    req.method = method;
+    if (std::string(method) == "kplus-array") req.params["k"] = "2";
+    const OracleMatch m = expectGpuMatchesOracle(coarse, camera, req);
+    EXPECT_GT(m.lists.compared, 4000u);
+    const OffEdgeComparison g = compareOffEdges(lists, expected, m.out.image, 2, [](int, int, int) {});
+    EXPECT_GE(g.within, g.compared * 999 / 1000) << "max difference " << g.maxDifference;
+  }
+}
+
+// A section cap coloured by the volume it cuts shows the volume's values inside it (ParaView's
+// slice), not a blend of its rim: the probe's value at pixels inside the cap is x·y where the
+// pixel's ray meets the plane z = 0, and the GPU draws the cap as the oracle does.
+TEST(FieldColorsGpu, SectionCapsShowTheVolumeInside) {
+  context();
+  Scene scene;
+  scene.name = "capped";
+  scene.volumes = {xyVolume()};
+  Object ball;
+  ball.name = "ball";
+  ball.mesh = std::make_shared<Mesh>(makeSphere(1.2, 48, 24));
+  scene.objects = {ball};
+  addVolumeFields(scene);
+  colorByField(scene.objects[0], "@xy", "rainbow", glm::dvec2(-1.0, 1.0));
+  scene.section = SectionPlane{{0.0, 0.0, 0.0}, {0.0, 0.0, -1.0}, true};
+  SectionReport report;
+  const Scene cut = sectionedScene(scene, &report);
+  ASSERT_EQ(report.capped, 1u);
+  Camera camera;
+  camera.eye = {0.3, 0.2, 4.0};
+  camera.target = {0.0, 0.0, 0.0};
+  camera = cut.fit(camera);
+  const int w = 80, h = 80;
+  RenderRequest req;
+  req.method = "abuffer-ll";
+  req.width = w;
+  req.height = h;
+  const OracleMatch m = expectGpuMatchesOracle(cut, camera, req);
+  EXPECT_GT(m.lists.compared, 2000u);
+
+  const glm::dmat4 toWorld = glm::inverse(camera.projectionMatrix(static_cast<double>(w) / h) * camera.viewMatrix());
+  int probed = 0;
+  for (const glm::ivec2 px : {glm::ivec2(30, 30), glm::ivec2(52, 28), glm::ivec2(47, 50), glm::ivec2(28, 47)}) {
+    SCOPED_TRACE(::testing::Message() << "pixel " << px.x << "," << px.y);
+    const glm::dvec2 ndc(2.0 * (px.x + 0.5) / w - 1.0, 1.0 - 2.0 * (px.y + 0.5) / h);
+    const glm::dvec4 a = toWorld * glm::dvec4(ndc, -1.0, 1.0), b = toWorld * glm::dvec4(ndc, 1.0, 1.0);
+    const glm::dvec3 origin = glm::dvec3(a) / a.w, dir = glm::dvec3(b) / b.w - origin;
+    const glm::dvec3 hit = origin - (origin.z / dir.z) * dir;  // on the plane z = 0
+    ASSERT_LT(glm::length(glm::dvec2(hit)), 1.0);              // well inside the cap
+    const PixelProbe probe = probePixel(cut, camera, w, h, px.x, px.y);
+    ASSERT_FALSE(probe.fragments.empty());
+    const ProbeFragment& front = probe.fragments.front();  // the cap, nearest the camera
+    ASSERT_TRUE(front.hasValue);
+    EXPECT_NEAR(front.value, hit.x * hit.y, 1e-4);
+    ++probed;
+  }
+  EXPECT_EQ(probed, 4);
 }
 
 }  // namespace

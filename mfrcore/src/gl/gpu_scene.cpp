@@ -1,5 +1,7 @@
 #include "mfr/gl/gpu_scene.hpp"
 
+#include <algorithm>
+
 #include "common/bindings.h"
 #include "mfr/scene/color_map.hpp"
 
@@ -29,7 +31,8 @@ Texture colorMapTexture() {
 }
 }  // namespace
 
-GpuScene::GpuScene(const Scene& scene, const GpuScene* previous) {
+GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
+                   const std::function<std::shared_ptr<Texture>(const VolumeGrid*)>& knownGrid) {
   colorMaps_ = colorMapTexture();
   std::map<const Mesh*, std::shared_ptr<const GpuMesh>> before;
   if (previous)
@@ -79,8 +82,37 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous) {
     items_.push_back({it->second, model, glm::mat3(glm::transpose(glm::inverse(o.transform))), o.material.color,
                       o.material.vertexColors, static_cast<std::uint32_t>(i), mapped ? colorMapIndex(field->map) : -1,
                       mapped ? glm::vec2(field->range) : glm::vec2(0.0f, 1.0f)});
+    if (const std::optional<VolumeFieldSampler> sampler = volumeFieldSampler(scene, o)) {
+      DrawItem& item = items_.back();
+      const VolumeGrid* grid = sampler->grid.get();
+      auto known = std::find_if(fieldGrids_.begin(), fieldGrids_.end(),
+                                [&](const FieldGrid& f) { return f.source.get() == grid; });
+      if (known == fieldGrids_.end()) {
+        std::shared_ptr<Texture> texture = previous ? previous->fieldGrid(grid) : nullptr;
+        if (!texture && knownGrid) texture = knownGrid(grid);
+        if (!texture) {
+          const glm::ivec3 d = grid->dims;
+          texture = std::make_shared<Texture>(createTexture3D(GL_R32F, d.x, d.y, d.z));
+          glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+          glTextureSubImage3D(texture->id(), 0, 0, 0, 0, d.x, d.y, d.z, GL_RED, GL_FLOAT, grid->values.data());
+          uploaded_ += grid->values.size() * sizeof(float);
+        }
+        fieldGrids_.push_back({sampler->grid, std::move(texture)});
+        bytes_ += grid->values.size() * sizeof(float);
+        known = fieldGrids_.end() - 1;
+      }
+      item.fieldGrid = static_cast<int>(known - fieldGrids_.begin());
+      item.fieldToGrid = glm::mat4(sampler->objectToGrid);
+      item.fieldGridDims = grid->dims;
+    }
     triangles_ += o.mesh->triangleCount();
   }
+}
+
+std::shared_ptr<Texture> GpuScene::fieldGrid(const VolumeGrid* grid) const {
+  for (const FieldGrid& f : fieldGrids_)
+    if (f.source.get() == grid) return f.texture;
+  return nullptr;
 }
 
 void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
@@ -107,6 +139,12 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
     program.set("uObjectId", item.objectId);
     program.set("uColorMapRow", item.colorMapRow);
     program.set("uColorMapRange", item.colorMapRange);
+    program.set("uFieldGrid", item.fieldGrid >= 0 ? 1 : 0);
+    program.set("uFieldToGrid", item.fieldToGrid);
+    if (item.fieldGrid >= 0) {
+      program.set("uFieldGridDims", item.fieldGridDims);
+      glBindTextureUnit(MFR_TEX_FIELD_GRID, fieldGrids_[static_cast<std::size_t>(item.fieldGrid)].texture->id());
+    }
     glBindVertexArray(m.vao.id());
     glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);
   }

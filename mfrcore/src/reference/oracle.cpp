@@ -76,6 +76,8 @@ struct ObjectShading {
   // Material::fieldColors with the mesh's scalars there: the map and its range; else null.
   const ColorMap* colorMap = nullptr;
   glm::vec2 colorMapRange{0.0f, 1.0f};
+  // Coloured by a volume: sampled at the hit, not interpolated from the vertices (VolumeFieldSampler).
+  std::optional<VolumeFieldSampler> fieldSampler;
 };
 
 struct Hit {
@@ -236,10 +238,17 @@ std::uint32_t shade(const WorldTriangle& tri, const ObjectShading& obj, double u
     normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
   glm::vec4 base = obj.materialColor;
   if (obj.colorMap != nullptr) {
-    // Interpolated, then mapped, as common/color_map.glsl does (in float, as the GPU's varying).
+    // Interpolated, then mapped, as common/color_map.glsl does (in float, as the GPU's varying); a
+    // volume's value sampled at the hit and bounded, as common/fragment.glsl does.
     float value = 0.0f;
-    for (int k = 0; k < 3; ++k)
-      value += static_cast<float>(w[k]) * boundFieldValue(mesh.scalars[tri.vertex[k]], obj.colorMapRange);
+    if (obj.fieldSampler) {
+      glm::dvec3 p(0.0);
+      for (int k = 0; k < 3; ++k) p += w[k] * glm::dvec3(mesh.positions[tri.vertex[k]]);
+      value = boundFieldValue(obj.fieldSampler->at(p), obj.colorMapRange);
+    } else {
+      for (int k = 0; k < 3; ++k)
+        value += static_cast<float>(w[k]) * boundFieldValue(mesh.scalars[tri.vertex[k]], obj.colorMapRange);
+    }
     base = glm::vec4(mapFieldValue(*obj.colorMap, value, obj.colorMapRange), base.a);
   } else if (obj.vertexColors && mesh.colors.size() == mesh.positions.size()) {
     glm::dvec4 c(0.0);
@@ -427,12 +436,16 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     const Object& object = scene.objects[o];
     if (!object.visible || !object.mesh || object.mesh->triangleCount() == 0) continue;
     object.mesh->validate(object.name);
-    objects[o] = {object.mesh.get(), glm::transpose(glm::inverse(glm::dmat3(object.transform))), object.material.color,
-                  object.material.vertexColors};
+    ObjectShading& shading = objects[o];
+    shading.mesh = object.mesh.get();
+    shading.normalMatrix = glm::transpose(glm::inverse(glm::dmat3(object.transform)));
+    shading.materialColor = object.material.color;
+    shading.vertexColors = object.material.vertexColors;
     if (const std::optional<FieldColors>& field = object.material.fieldColors;
         field && object.mesh->scalars.size() == object.mesh->positions.size()) {
       objects[o].colorMap = &colorMap(field->map);
       objects[o].colorMapRange = glm::vec2(field->range);
+      objects[o].fieldSampler = volumeFieldSampler(scene, object);
     }
   }
   const std::shared_ptr<const PreparedGeometry> geometry = preparedGeometry(scene);

@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "mfr/reference/composite.hpp"
 #include "mfr/error.hpp"
 #include "mfr/reference/hybrid.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "mfr/render.hpp"
 
 namespace mfr {
@@ -21,7 +23,8 @@ namespace {
 
 // The field value at each fragment of a field-coloured part: the ray through the pixel's centre
 // meets its part's triangles (Möller–Trumbore, in double); the hit nearest the fragment's eye
-// depth gives the barycentric weights for Mesh::scalars.
+// depth gives the barycentric weights for Mesh::scalars — or the point where a volume that colours
+// the part is sampled (VolumeFieldSampler), as the renderers sample it.
 void probeFieldValues(PixelProbe& probe, const Scene& scene, const Camera& camera) {
   const double aspect = static_cast<double>(probe.width) / probe.height;
   const glm::dmat4 view = camera.viewMatrix();
@@ -35,6 +38,7 @@ void probeFieldValues(PixelProbe& probe, const Scene& scene, const Camera& camer
     const Object& o = scene.objects[id];
     if (!o.material.fieldColors || !o.mesh || o.mesh->scalars.size() != o.mesh->positions.size()) continue;
     const Mesh& m = *o.mesh;
+    const std::optional<VolumeFieldSampler> sampler = volumeFieldSampler(scene, o);  // at the hit, if a volume
     double best = std::numeric_limits<double>::infinity();
     for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
       glm::dvec3 p[3];
@@ -56,7 +60,15 @@ void probeFieldValues(PixelProbe& probe, const Scene& scene, const Camera& camer
       best = std::abs(eyeDepth - f.eyeDepth);
       const float w[3] = {static_cast<float>(1.0 - u - v), static_cast<float>(u), static_cast<float>(v)};
       f.value = 0.0f;
-      for (int k = 0; k < 3; ++k) f.value += w[k] * m.scalars[m.indices[t + static_cast<std::size_t>(k)]];
+      if (sampler) {
+        const double wd[3] = {1.0 - u - v, u, v};
+        glm::dvec3 objectPoint(0.0);
+        for (int k = 0; k < 3; ++k)
+          objectPoint += wd[k] * glm::dvec3(m.positions[m.indices[t + static_cast<std::size_t>(k)]]);
+        f.value = sampler->at(objectPoint);
+      } else {
+        for (int k = 0; k < 3; ++k) f.value += w[k] * m.scalars[m.indices[t + static_cast<std::size_t>(k)]];
+      }
       f.hasValue = true;
     }
   }

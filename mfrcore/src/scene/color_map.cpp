@@ -228,6 +228,34 @@ void colorByField(Object& object, const std::string& field, const std::string& m
   object.material.fieldColors = FieldColors{field, map, range ? *range : fieldRange(values.values)};
 }
 
+float VolumeFieldSampler::at(const glm::dvec3& objectPoint) const {
+  // Each sample stands for the voxel around it: surfaces extracted from the volume reach a little
+  // beyond its first and last samples.
+  const glm::dvec3 g(objectToGrid * glm::dvec4(objectPoint, 1.0));
+  const glm::dvec3 last(grid->dims - 1);
+  const bool inside =
+      glm::all(glm::greaterThanEqual(g, glm::dvec3(-0.5))) && glm::all(glm::lessThanEqual(g, last + 0.5));
+  return inside ? grid->sample(glm::vec3(g)) : std::numeric_limits<float>::quiet_NaN();
+}
+
+std::string volumeFieldName(const Scene& scene, std::size_t v) {
+  const Volume& volume = scene.volumes.at(v);
+  return "@" + (volume.name.empty() ? "volume " + std::to_string(v) : volume.name);
+}
+
+std::optional<VolumeFieldSampler> volumeFieldSampler(const Scene& scene, const Object& object) {
+  const std::optional<FieldColors>& field = object.material.fieldColors;
+  if (!field || field->field.empty() || field->field.front() != '@' || !object.mesh ||
+      object.mesh->scalars.size() != object.mesh->positions.size())
+    return std::nullopt;
+  for (std::size_t v = 0; v < scene.volumes.size(); ++v) {
+    const Volume& volume = scene.volumes[v];
+    if (volume.grid && volumeFieldName(scene, v) == field->field)
+      return VolumeFieldSampler{volume.grid, glm::inverse(volume.gridToWorld()) * object.transform};
+  }
+  return std::nullopt;
+}
+
 void addVolumeFields(Scene& scene) {
   for (Object& o : scene.objects) {
     if (!o.mesh) continue;
@@ -235,22 +263,13 @@ void addVolumeFields(Scene& scene) {
     for (std::size_t v = 0; v < scene.volumes.size(); ++v) {
       const Volume& volume = scene.volumes[v];
       if (!volume.grid) continue;
-      const std::string name = "@" + (volume.name.empty() ? "volume " + std::to_string(v) : volume.name);
+      const std::string name = volumeFieldName(scene, v);
       if (hasField(mesh ? *mesh : *o.mesh, name)) continue;
       if (!mesh) mesh = std::make_shared<Mesh>(*o.mesh);
-      // Object → grid coordinates. A point is inside when every coordinate is within half a voxel of
-      // [0, dims − 1] (each sample stands for the voxel around it: surfaces extracted from the
-      // volume reach a little beyond its first and last samples); there the nearest face's value.
-      const glm::dmat4 toGrid = glm::inverse(volume.gridToWorld()) * o.transform;
-      const glm::dvec3 last(volume.grid->dims - 1);
+      const VolumeFieldSampler sampler{volume.grid, glm::inverse(volume.gridToWorld()) * o.transform};
       MeshField f{name, false, 1, {}};
       f.values.reserve(mesh->positions.size());
-      for (const glm::vec3& p : mesh->positions) {
-        const glm::dvec3 g(toGrid * glm::dvec4(glm::dvec3(p), 1.0));
-        const bool inside =
-            glm::all(glm::greaterThanEqual(g, glm::dvec3(-0.5))) && glm::all(glm::lessThanEqual(g, last + 0.5));
-        f.values.push_back(inside ? volume.grid->sample(glm::vec3(g)) : std::numeric_limits<float>::quiet_NaN());
-      }
+      for (const glm::vec3& p : mesh->positions) f.values.push_back(sampler.at(glm::dvec3(p)));
       mesh->fields.push_back(std::move(f));
     }
     if (mesh) o.mesh = std::move(mesh);

@@ -2,7 +2,10 @@
 // A scene uploaded to the GPU: one vertex/index buffer pair per distinct mesh, drawn object by
 // object with the per-object uniforms every capture shader receives through
 // shaders/common/scene.vert (uModel, uNormalMatrix, uColor, uVertexColors, uObjectId) and
-// common/color_map.glsl (uColorMapRow, uColorMapRange), plus the per-frame uViewProj and uViewDir.
+// common/color_map.glsl (uColorMapRow, uColorMapRange) and common/fragment.glsl (a volume that
+// colours the surface: uFieldGrid, uFieldToGrid, uFieldGridDims and its grid's texture), plus the
+// per-frame uViewProj and uViewDir.
+#include <functional>
 #include <map>
 #include <memory>
 #include <vector>
@@ -32,12 +35,18 @@ class GpuScene {
   // `previous`: a scene uploaded before in the same context. Meshes it holds that this scene still
   // draws (the same Mesh objects: an edit of colours, visibility, transforms, the clip box or a
   // section that leaves a part uncut keeps them) are shared with it, not uploaded again.
-  explicit GpuScene(const Scene& scene, const GpuScene* previous = nullptr);
+  // `knownGrid`: textures of volume grids the caller holds already (its volume operation's), used for
+  // a surface coloured by that volume instead of a second upload; previous's are used likewise.
+  explicit GpuScene(const Scene& scene, const GpuScene* previous = nullptr,
+                    const std::function<std::shared_ptr<Texture>(const VolumeGrid*)>& knownGrid = {});
   // Draws every visible object with program (already configured by the caller: state, buffers).
   void draw(const Program& program, const FrameUniforms& frame) const;
   [[nodiscard]] std::size_t triangleCount() const { return triangles_; }
   [[nodiscard]] std::size_t bytes() const { return bytes_; }             // of every mesh it draws, shared or not
   [[nodiscard]] std::size_t uploadedBytes() const { return uploaded_; }  // of the meshes it uploaded itself
+  // The texture (R32F) of a volume grid that colours a surface here (mfr::VolumeFieldSampler), else
+  // null: the renderer's volume operation uses it rather than upload the grid twice.
+  [[nodiscard]] std::shared_ptr<Texture> fieldGrid(const VolumeGrid* grid) const;
 
  private:
   struct GpuMesh {
@@ -57,8 +66,17 @@ class GpuScene {
     std::uint32_t objectId;
     int colorMapRow;  // Material::fieldColors' map (colorMapIndex); -1: not field-coloured
     glm::vec2 colorMapRange;
+    // Coloured by a volume: its grid's index in fieldGrids_, object → grid coordinates; else -1.
+    int fieldGrid = -1;
+    glm::mat4 fieldToGrid{1.0f};
+    glm::ivec3 fieldGridDims{2};
+  };
+  struct FieldGrid {
+    std::shared_ptr<const VolumeGrid> source;  // kept alive, so that its address names it while shared
+    std::shared_ptr<Texture> texture;
   };
   std::vector<std::shared_ptr<const GpuMesh>> meshes_;
+  std::vector<FieldGrid> fieldGrids_;
   std::vector<DrawItem> items_;
   Texture colorMaps_;  // every colour map's table (common/color_map.glsl), bound while drawing
   std::size_t triangles_ = 0;

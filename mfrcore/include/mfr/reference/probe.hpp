@@ -28,7 +28,8 @@ struct ProbeFragment {
   double volumeWeight = 0.0;  // its share of the "volume" colour: α·T through surfaces and medium (splitVolume)
   double zthicknessWeight = 0.0;  // its share of the "zthickness" colour, blended with the slabs it overlaps
   // Its part coloured by a field (Material::fieldColors): the field's value where the pixel's ray
-  // meets the surface (Mesh::scalars interpolated at the hit, as the colour was made).
+  // meets the surface, as the colour was made (Mesh::scalars interpolated at the hit; a volume's
+  // value sampled there, VolumeFieldSampler).
   bool hasValue = false;
   float value = 0.0f;
 };

@@ -2,6 +2,7 @@
 // Surfaces coloured by a field of their mesh (ParaView's "Color by"): the named colour maps, the
 // value → colour arithmetic both renderers share, and colorByField, which puts a field of the
 // mesh (Mesh::fields) into Mesh::scalars and sets the material's FieldColors.
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 
 #include "mfr/scene/mesh.hpp"
 #include "mfr/scene/scene.hpp"
+#include "mfr/scene/volume.hpp"
 
 namespace mfr {
 
@@ -65,12 +67,31 @@ glm::dvec2 fieldRange(const std::vector<float>& values);
 void colorByField(Object& object, const std::string& field, const std::string& map = "cool-warm",
                   const std::optional<glm::dvec2>& range = std::nullopt);
 
-// The scene's volumes sampled at every vertex of every part (ParaView's "Resample With Dataset"):
+// The scene's volumes sampled at every vertex of every part (ParaView's "Resample With Dataset"; the
+// renderers sample the volume itself at each point, VolumeFieldSampler, and these values give the
+// default range):
 // a point field "@NAME" per volume (its name, else "volume N"), trilinear as the renderers sample
 // it, NaN farther than half a voxel outside its box (within it: the nearest face's value) — so a surface can be
 // coloured by the volume it lies in. Each part with a volume gets a mesh of its own; a part that has the field already
 // keeps it. Loading a scene (loadScene, .mfrscene files before their "color_by") calls it.
 void addVolumeFields(Scene& scene);
+
+// A surface coloured by a volume ("@NAME", addVolumeFields' names) takes the volume's value at each
+// of its points, not its vertices' values interpolated: a section cap or a large triangle through
+// the volume shows the samples inside it (ParaView's slice), not a blend of its rim. The GPU samples
+// per fragment (common/fragment.glsl) exactly as `at` does for the oracle and the probe.
+struct VolumeFieldSampler {
+  std::shared_ptr<const VolumeGrid> grid;
+  glm::dmat4 objectToGrid{1.0};  // the object's transform, then world → grid coordinates
+  // Trilinear (VolumeGrid::sample); NaN farther than half a voxel outside the grid's box (within
+  // it: the nearest face's value).
+  [[nodiscard]] float at(const glm::dvec3& objectPoint) const;
+};
+// The field name "@NAME" of the scene's volume v (its name, else "volume v").
+std::string volumeFieldName(const Scene& scene, std::size_t v);
+// The sampler of the volume `object` is coloured by (Material::fieldColors names one of the
+// scene's volumes and the mesh has its vertex samples, which give the default range); else null.
+std::optional<VolumeFieldSampler> volumeFieldSampler(const Scene& scene, const Object& object);
 
 // Whether the mesh has the array `field` names ("name", or the array before ":N" / ":magnitude").
 bool hasField(const Mesh& mesh, const std::string& field);
