@@ -34,7 +34,6 @@
 #include "mfr/error.hpp"
 #include "mfr/image.hpp"
 #include "mfr/legend.hpp"
-#include "mfr/scene/contour.hpp"
 #include "mfr/io/load.hpp"
 #include "method_panel.hpp"
 #include "probe_panel.hpp"
@@ -447,17 +446,11 @@ void MainWindow::saveSession(const QString& path) {
 }
 
 void MainWindow::exportImage(const QString& path, QSize size, bool legend) {
-  std::optional<mfr::FieldColors> colors;
-  std::vector<double> ticks;
+  std::optional<ViewerModel::ColorLegend> shown;
   if (legend) {
     // The field colouring's map, else the current volume's isosurfaces' (as mfr render --legend).
-    colors = model_->fieldColoring();
-    if (!colors && !model_->isosurfaceValues().empty()) {
-      ticks = model_->isosurfaceValues();
-      colors = mfr::FieldColors{model_->volumeName().toStdString(), "cool-warm",
-                                mfr::contourColorRange(ticks, model_->volumeValueRange())};
-    }
-    if (!colors)
+    shown = model_->colorLegend();
+    if (!shown)
       throw mfr::Error("--legend",
                        "nothing is coloured by a field (use --color-by, or a scene's color_by) and there are no "
                        "isosurfaces");
@@ -469,7 +462,7 @@ void MainWindow::exportImage(const QString& path, QSize size, bool legend) {
                                        .toStdString());
   }
   mfr::ImageRGBA8 image = view_->renderImage(size);
-  if (colors) mfr::drawColorLegend(image, *colors, model_->scene().background, ticks);
+  if (shown) mfr::drawColorLegend(image, shown->colors, model_->scene().background, shown->ticks);
   mfr::writePng(path.toStdString(), image);
 }
 
@@ -509,8 +502,8 @@ void MainWindow::chooseImageToExport() {
   if (path.isEmpty()) return;
   if (!path.endsWith(QStringLiteral(".png"), Qt::CaseInsensitive)) path += QStringLiteral(".png");
   try {
-    // As on screen: the legend of a field colouring, when it fits.
-    const bool legend = model_->fieldColoring().has_value() && size.width() >= mfr::kMinLegendImageSize &&
+    // As on screen: the legend of a field colouring or of the isosurfaces, when it fits.
+    const bool legend = model_->colorLegend().has_value() && size.width() >= mfr::kMinLegendImageSize &&
                         size.height() >= mfr::kMinLegendImageSize;
     exportImage(path, size, legend);
     statusBar()->showMessage(tr("Wrote %1").arg(path), 5000);

@@ -598,10 +598,18 @@ void RenderView::updateOverlays() {
         legend->setMap(title, std::max<std::uint32_t>(1, map.maxValue),
                        tr("min %1 · max %2").arg(map.minValue).arg(map.maxValue));
       legendShown = true;
-    } else if (const std::optional<mfr::FieldColors> field = model_.fieldColoring(); shown && field) {
-      // The colour legend of the field the surfaces show (Scene dock, Colour by).
-      legend->setFieldMap(QString::fromStdString(field->field), QString::fromStdString(field->map), field->range.x,
-                          field->range.y, QString::fromStdString(field->map));
+    } else if (const std::optional<ViewerModel::ColorLegend> colors = model_.colorLegend(); shown && colors) {
+      // The colour legend of the field the surfaces show (Scene dock, Colour by), else of the
+      // volume's isosurfaces (Volume panel), ticked at their values.
+      const mfr::FieldColors& field = colors->colors;
+      QString text = QString::fromStdString(field.map);
+      if (!colors->ticks.empty()) {
+        QStringList values;
+        for (const double v : colors->ticks) values << QString::number(v, 'g', 4);
+        text = tr("isosurfaces at %1").arg(values.join(QStringLiteral(", ")));
+      }
+      legend->setFieldMap(QString::fromStdString(field.field), QString::fromStdString(field.map), field.range.x,
+                          field.range.y, text, colors->ticks);
       legendShown = true;
     }
     if (legendShown) {

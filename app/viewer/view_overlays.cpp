@@ -4,6 +4,9 @@
 #include <QMouseEvent>
 #include <QPainter>
 
+#include <algorithm>
+#include <cmath>
+
 #include "mfr/reference/metrics.hpp"
 #include "mfr/scene/color_map.hpp"
 
@@ -63,12 +66,15 @@ void MapLegend::setMap(const QString& title, double scaleMax, const QString& ran
   scaleMin_ = 0.0;
   scaleMax_ = scaleMax;
   map_.clear();
+  ticks_.clear();
   bar_ = true;
   resize(sizeHint());
   update();
 }
 
-void MapLegend::setFieldMap(const QString& title, const QString& map, double low, double high, const QString& text) {
+void MapLegend::setFieldMap(const QString& title, const QString& map, double low, double high, const QString& text,
+                            const std::vector<double>& ticks) {
+  ticks_ = ticks;
   title_ = title;
   text_ = text;
   scaleMin_ = low;
@@ -105,6 +111,12 @@ void MapLegend::paintEvent(QPaintEvent*) {
     p.fillRect(bar, map_.isEmpty() ? magmaGradient(bar.topLeft(), bar.topRight())
                                    : fieldGradient(map_.toStdString(), bar.topLeft(), bar.topRight()));
     p.drawRect(bar.adjusted(0, 0, -1, -1));
+    for (const double t : ticks_) {  // a mark across the bar at each value
+      if (!(scaleMax_ > scaleMin_)) break;
+      const double f = std::clamp((t - scaleMin_) / (scaleMax_ - scaleMin_), 0.0, 1.0);
+      const int x = bar.left() + static_cast<int>(std::lround(f * (bar.width() - 1)));
+      p.drawLine(x, bar.top() - 2, x, bar.bottom() + 2);
+    }
     y += 14;
     p.drawText(QRect(8, y, width() - 16, fm.height()), Qt::AlignLeft | Qt::AlignVCenter,
                QString::number(scaleMin_, 'g', 4));

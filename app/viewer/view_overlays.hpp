@@ -5,6 +5,8 @@
 #include <QLabel>
 #include <QWidget>
 
+#include <vector>
+
 // Colour bar of a heat map (the magma map of mfr::heatmap) or of the colour map a field is shown
 // with, with its title and value range, or only a note (e.g. "no k(p) for this method").
 class MapLegend final : public QWidget {
@@ -16,7 +18,10 @@ class MapLegend final : public QWidget {
   void setMap(const QString& title, double scaleMax, const QString& range);
   void setNote(const QString& title, const QString& note);
   // The bar of a surface colour map (mfr::colorMap) from `low` to `high`: a field's colour legend.
-  void setFieldMap(const QString& title, const QString& map, double low, double high, const QString& text);
+  // `ticks`: values marked on the bar (the isosurfaces'), none when empty.
+  void setFieldMap(const QString& title, const QString& map, double low, double high, const QString& text,
+                   const std::vector<double>& ticks = {});
+  [[nodiscard]] const std::vector<double>& ticks() const { return ticks_; }
   [[nodiscard]] const QString& mapName() const { return map_; }
   [[nodiscard]] const QString& title() const { return title_; }
   [[nodiscard]] const QString& text() const { return text_; }
@@ -29,6 +34,7 @@ class MapLegend final : public QWidget {
   QString title_, text_;
   double scaleMin_ = 0.0, scaleMax_ = 1.0;
   QString map_;  // empty: magma (heat maps)
+  std::vector<double> ticks_;
   bool bar_ = false;
 };
 

@@ -949,6 +949,14 @@ std::optional<mfr::FieldColors> ViewerModel::fieldColoring() const {
   return std::nullopt;
 }
 
+std::optional<ViewerModel::ColorLegend> ViewerModel::colorLegend() const {
+  if (std::optional<mfr::FieldColors> colors = fieldColoring()) return ColorLegend{std::move(*colors), {}};
+  std::vector<double> values = isosurfaceValues();
+  if (values.empty()) return std::nullopt;
+  const glm::dvec2 range = mfr::contourColorRange(values, volumeValueRange());
+  return ColorLegend{mfr::FieldColors{volumeName().toStdString(), "cool-warm", range}, std::move(values)};
+}
+
 glm::dvec2 ViewerModel::fieldDataRange(const QString& field) const {
   std::vector<const mfr::Mesh*> meshes;
   for (const std::shared_ptr<const mfr::Mesh>& mesh : loadedMeshes_) meshes.push_back(mesh.get());

@@ -242,6 +242,14 @@ class ViewerModel final : public ViewerContext {
   // range over the parts that have it.
   [[nodiscard]] QStringList surfaceFields() const;
   [[nodiscard]] std::optional<mfr::FieldColors> fieldColoring() const;
+  // What the colour legend shows (the view's corner, Export Image): the field colouring's map; else
+  // the current volume's isosurfaces' — cool-warm over contourColorRange, ticked at their values, as
+  // mfr render --contour … --legend draws it; else nothing.
+  struct ColorLegend {
+    mfr::FieldColors colors;
+    std::vector<double> ticks;  // empty: the range's ends and middle
+  };
+  [[nodiscard]] std::optional<ColorLegend> colorLegend() const;
   [[nodiscard]] glm::dvec2 fieldDataRange(const QString& field) const;
   // An empty field: every part back to its own colour. No range: the field's data range. Returns
   // false, leaving the scene as it was, when refused (fieldColoringError() says why).

@@ -2916,6 +2916,15 @@ class ViewerTest : public QObject {
     QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
     const mfr::ImageRGBA8 isoFrame = w->view().renderImage(size);
     QVERIFY(maxChannelDifference(isoFrame, volumeFrame) > 20);
+    // The view's legend: the isosurfaces' map, ticked at their values (what Export Image draws).
+    auto* legend = w->findChild<MapLegend*>("mapLegendA");
+    QVERIFY(legend);
+    QTRY_VERIFY_WITH_TIMEOUT(legend->isVisible(), kTimeoutMs);
+    QCOMPARE(legend->title(), QStringLiteral("field"));
+    QCOMPARE(legend->mapName(), QStringLiteral("cool-warm"));
+    QCOMPARE(legend->ticks(), (std::vector<double>{0.3, 0.6}));
+    QVERIFY2(legend->text().contains(QStringLiteral("0.3, 0.6")), qPrintable(legend->text()));
+    QVERIFY(m.colorLegend() && m.colorLegend()->colors.range == glm::dvec2(0.3, 0.6));
     const QString cliPng = dir.filePath("cli.png");
     QString out;
     QCOMPARE(runProgram(MFR_CLI,
@@ -2980,6 +2989,8 @@ class ViewerTest : public QObject {
     QVERIFY(tree->findItems(QStringLiteral("field = 0.6"), Qt::MatchExactly).isEmpty());
     show->setChecked(true);
     settle(m);
+    QVERIFY(!m.colorLegend());
+    QTRY_VERIFY_WITH_TIMEOUT(!legend->isVisible(), kTimeoutMs);
     QCOMPARE(maxChannelDifference(w->view().renderImage(size), volumeFrame), 0);
 
     // mfrview --contour: the pixels of mfr render --contour (opacity 0.5 in both).
