@@ -23,8 +23,8 @@ void addProbe(CLI::App& app);
 
 // "WxH" → (w, h); throws mfr::Error naming the option.
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);
-// Comma-separated list.
-std::vector<std::string> splitList(const std::string& text);
+// A list separated by commas (or `separator`), empty items dropped.
+std::vector<std::string> splitList(const std::string& text, char separator = ',');
 // loadScene (with --field: the array or grid of a volume file), then every object's opacity set to
 // `opacity` unless it is negative (--opacity).
 Scene loadSceneWithOpacity(const std::string& path, double opacity, const std::string& field = {});
@@ -43,14 +43,15 @@ inline constexpr const char* kClipHelp =
     "open, the volume cropped); 'none' removes the scene's own";
 // --section: "AXIS=VALUE" (AXIS one of x y z -x -y -z: the plane AXIS = VALUE, keeping the side the
 // axis points to; "-z=0.5" keeps z <= 0.5) or "px,py,pz,nx,ny,nz" (a point and the normal of the kept
-// side), each optionally followed by ":nocaps"; "none" removes the scene's own; empty text leaves the
-// scene as it is. Then the scene is cut by its section (the option's or the scene file's; once, so that
-// every renderer gets the cut scene), with a one-line note on stderr naming cut parts left without a
-// cap because they are not closed. Throws mfr::Error naming --section.
+// side), each optionally followed by ":nocaps" and/or ":slice" (SectionPlane::slice); "none" removes the scene's own;
+// empty text leaves the scene as it is. Then the scene is cut by its section (the option's or the scene file's; once,
+// so that every renderer gets the cut scene), with a one-line note on stderr naming cut parts left without a cap
+// because they are not closed. Throws mfr::Error naming --section.
 void applySectionOption(Scene& scene, const std::string& text);
 inline constexpr const char* kSectionHelp =
     "Section plane: AXIS=VALUE (x, y, z, -x, -y, -z; keeps the side the axis points to) or "
-    "px,py,pz,nx,ny,nz (point, normal of the kept side), optionally :nocaps; closed surfaces get caps; "
+    "px,py,pz,nx,ny,nz (point, normal of the kept side), optionally :nocaps and/or :slice (each volume's slice, "
+    "grayscale over its transfer range); closed surfaces get caps; "
     "'none' removes the scene's own";
 // --color-by FIELD [--color-map NAME] [--color-range LO,HI]: colour every part whose mesh has the
 // field by it (colorByField) — before any section, so that caps get the field too.

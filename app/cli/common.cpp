@@ -25,11 +25,11 @@ std::pair<int, int> parseSize(const std::string& option, const std::string& text
   return {w, h};
 }
 
-std::vector<std::string> splitList(const std::string& text) {
+std::vector<std::string> splitList(const std::string& text, char separator) {
   std::vector<std::string> out;
   std::string item;
   std::istringstream in(text);
-  while (std::getline(in, item, ','))
+  while (std::getline(in, item, separator))
     if (!item.empty()) out.push_back(item);
   return out;
 }
@@ -310,8 +310,12 @@ namespace {
 
 void cutBySection(Scene& scene) {
   if (!scene.section || scene.sectionCut) return;
+  if (scene.section->slice && scene.volumes.empty())
+    throw Error("section", "slice: scene '" + scene.name + "' has no volume");
   SectionReport report;
   scene = sectionedScene(scene, &report);
+  if (scene.section->slice && report.slices == 0)
+    std::cerr << "note: section: the plane misses every volume's box, so there is no slice\n";
   if (report.open.empty()) return;
   std::string names;
   for (std::size_t i = 0; i < report.open.size() && i < 5; ++i) names += (i ? ", " : "") + report.open[i];
@@ -335,8 +339,14 @@ void applySectionOption(Scene& scene, const std::string& text) {
   std::string plane = text;
   SectionPlane section;
   if (const std::size_t colon = text.find(':'); colon != std::string::npos) {
-    if (text.substr(colon + 1) != "nocaps") throw Error(what, "the only suffix is :nocaps");
-    section.caps = false;
+    for (const std::string& suffix : splitList(text.substr(colon + 1), ':')) {
+      if (suffix == "nocaps")
+        section.caps = false;
+      else if (suffix == "slice")
+        section.slice = true;
+      else
+        throw Error(what, "the suffixes are :nocaps and :slice");
+    }
     plane = text.substr(0, colon);
   }
   if (const std::size_t eq = plane.find('='); eq != std::string::npos) {

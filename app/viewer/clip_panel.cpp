@@ -66,6 +66,10 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
   sectionCaps_->setObjectName(QStringLiteral("sectionCaps"));
   sectionCaps_->setToolTip(tr("Close every cut closed part with its cross-section"));
   sectionCaps_->setChecked(true);
+  sectionSlice_ = new QCheckBox(tr("Volume slice"), this);
+  sectionSlice_->setObjectName(QStringLiteral("sectionSlice"));
+  sectionSlice_->setToolTip(
+      tr("Show each volume's samples on the plane, grayscale over its transfer function's range (a CT's slice)"));
   sectionOffset_ = new QSlider(Qt::Horizontal, this);
   sectionOffset_->setObjectName(QStringLiteral("sectionOffset"));
   sectionOffset_->setRange(0, kSteps);
@@ -82,7 +86,8 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
   sectionAlign_->setObjectName(QStringLiteral("sectionAlign"));
   sectionAlign_->setToolTip(
       tr("The plane through the view's target, facing away from the eye: the near half is cut away"));
-  section->addWidget(sectionAlign_, 2, 0, 1, 3, Qt::AlignRight);
+  section->addWidget(sectionSlice_, 2, 0);
+  section->addWidget(sectionAlign_, 2, 1, 1, 2, Qt::AlignRight);
   sectionReport_ = new QLabel(this);
   sectionReport_->setObjectName(QStringLiteral("sectionReport"));
   sectionReport_->setWordWrap(true);
@@ -94,10 +99,12 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
   connect(sectionAxis_, &QComboBox::currentIndexChanged, this, [this] { apply(); });
   connect(sectionFlip_, &QCheckBox::toggled, this, [this] { apply(); });
   connect(sectionCaps_, &QCheckBox::toggled, this, [this] { apply(); });
+  connect(sectionSlice_, &QCheckBox::toggled, this, [this] { apply(); });
   connect(sectionOffset_, &QSlider::valueChanged, this, [this] { apply(); });
   connect(sectionAlign_, &QPushButton::clicked, this, [this] {
     const mfr::Camera& camera = model_.camera();
-    model_.setSection(mfr::SectionPlane{camera.target, camera.forward(), sectionCaps_->isChecked()});
+    model_.setSection(
+        mfr::SectionPlane{camera.target, camera.forward(), sectionCaps_->isChecked(), sectionSlice_->isChecked()});
     showModel();
   });
 
@@ -142,12 +149,13 @@ std::pair<double, double> extentAlong(const mfr::Bounds& b, const glm::dvec3& n)
 }  // namespace
 
 mfr::SectionPlane ClipPanel::sectionFromPosition(const mfr::Bounds& bounds, const glm::dvec3& axis, int position,
-                                                 bool flip, bool caps) {
+                                                 bool flip, bool caps, bool slice) {
   const auto [lo, hi] = extentAlong(bounds, axis);
   mfr::SectionPlane plane;
   plane.point = axis * (lo + (hi - lo) * position / kSteps);
   plane.normal = flip ? -axis : axis;
   plane.caps = caps;
+  plane.slice = slice;
   return plane;
 }
 
@@ -200,6 +208,7 @@ void ClipPanel::showModel() {
     }
     sectionFlip_->setChecked(flip);
     sectionCaps_->setChecked(section->caps);
+    sectionSlice_->setChecked(section->slice);
     const auto [lo, hi] = extentAlong(bounds, base);
     const double at = glm::dot(base, section->point);
     sectionOffset_->setValue(
@@ -220,6 +229,10 @@ void ClipPanel::showModel() {
           for (const std::string& name : report.open) names += QString::fromStdString(name) + QLatin1Char('\n');
         }
       }
+      if (section->slice)
+        text += report.slices == 0   ? tr("; the plane misses the volume")
+                : report.slices == 1 ? tr("; 1 volume slice")
+                                     : tr("; %1 volume slices").arg(report.slices);
       sectionReport_->setText(text);
       sectionReport_->setToolTip(names.trimmed());
     }
@@ -230,6 +243,7 @@ void ClipPanel::showModel() {
   }
   for (QWidget* w : std::initializer_list<QWidget*>{sectionAxis_, sectionFlip_, sectionCaps_, sectionOffset_})
     w->setEnabled(usable && section.has_value());
+  sectionSlice_->setEnabled(usable && section.has_value() && !model_.scene().volumes.empty());
   showing_ = false;
 }
 
@@ -253,7 +267,8 @@ void ClipPanel::apply() {
       axis[index] = 1.0;
     }
     model_.setSection(sectionFromPosition(model_.scene().bounds(), axis, sectionOffset_->value(),
-                                          sectionFlip_->isChecked(), sectionCaps_->isChecked()));
+                                          sectionFlip_->isChecked(), sectionCaps_->isChecked(),
+                                          sectionSlice_->isChecked()));
   } else {
     model_.setSection(std::nullopt);
   }

@@ -7,7 +7,8 @@
 // sessions save the box.
 // Below it, the section plane (mfr::Scene::section): perpendicular to X, Y or Z (or a scene file's
 // own normal, "Custom"), moved by a slider across the scene's extent along that normal, keeping the
-// side the normal points to unless flipped; closed parts are capped unless Caps is off. "Align to
+// side the normal points to unless flipped; closed parts are capped unless Caps is off, and with
+// Volume slice each volume shows its samples on the plane (SectionPlane::slice). "Align to
 // view" puts it through the view's target, facing away from the eye (the near half is cut away).
 // A line below says how many cut parts got a cap and names those that did not (open along the cut).
 #include <QWidget>
@@ -38,7 +39,7 @@ class ClipPanel final : public QWidget {
   // The plane perpendicular to unit `axis` at slider `position` of the bounds' extent along it,
   // keeping the side `axis` points to (the other with `flip`).
   [[nodiscard]] static mfr::SectionPlane sectionFromPosition(const mfr::Bounds& bounds, const glm::dvec3& axis,
-                                                             int position, bool flip, bool caps);
+                                                             int position, bool flip, bool caps, bool slice = false);
 
  private:
   void showModel();  // controls from the model's clip box
@@ -55,6 +56,7 @@ class ClipPanel final : public QWidget {
   QSlider* sectionOffset_ = nullptr;
   QCheckBox* sectionFlip_ = nullptr;
   QCheckBox* sectionCaps_ = nullptr;
+  QCheckBox* sectionSlice_ = nullptr;  // SectionPlane::slice (a scene with a volume)
   QLabel* sectionValue_ = nullptr;
   QPushButton* sectionAlign_ = nullptr;
   QLabel* sectionReport_ = nullptr;         // how many cut parts are capped; the others' names in its tooltip

@@ -192,7 +192,8 @@ void ProbePanel::show(const ViewProbe& r) {
   summary_->setText(text);
 
   table_->setRowCount(n + 1);
-  const auto& objects = model_.scene().objects;
+  // The probe's ids are the drawn scene's: a section's volume slices come after the scene's parts.
+  const auto& objects = model_.drawnScene().objects;
   const Qt::Alignment right = Qt::AlignRight | Qt::AlignVCenter;
   for (int i = 0; i < n; ++i) {
     const mfr::ProbeFragment& f = p.fragments[static_cast<std::size_t>(i)];

@@ -235,7 +235,8 @@ QJsonObject sessionToJson(const Session& s) {
       {"section", s.section ? QJsonValue(QJsonObject{
                                   {"point", QJsonArray{s.section->point.x, s.section->point.y, s.section->point.z}},
                                   {"normal", QJsonArray{s.section->normal.x, s.section->normal.y, s.section->normal.z}},
-                                  {"caps", s.section->caps}})
+                                  {"caps", s.section->caps},
+                                  {"slice", s.section->slice}})
                             : QJsonValue(QJsonValue::Null)},
       {"color_by", s.colorBy ? QJsonValue(QJsonObject{{"field", QString::fromStdString(s.colorBy->field)},
                                                       {"map", QString::fromStdString(s.colorBy->map)},
@@ -292,7 +293,7 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
     s.hasSection = true;
     if (!json.value("section").isNull()) {
       if (!json.value("section").isObject())
-        r.fail(QStringLiteral("section"), QStringLiteral("expected null or {point, normal, caps}"));
+        r.fail(QStringLiteral("section"), QStringLiteral("expected null or {point, normal, caps, slice}"));
       const QJsonObject section = json.value("section").toObject();
       mfr::SectionPlane plane;
       plane.point = r.vec3(section, "point", "section");
@@ -302,6 +303,9 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
       if (section.contains("caps") && !section.value("caps").isBool())
         r.fail(QStringLiteral("section"), QStringLiteral("caps: expected true or false"));
       plane.caps = section.value("caps").toBool(true);
+      if (section.contains("slice") && !section.value("slice").isBool())
+        r.fail(QStringLiteral("section"), QStringLiteral("slice: expected true or false"));
+      plane.slice = section.value("slice").toBool(false);
       s.section = plane;
     }
   }

@@ -3323,6 +3323,8 @@ class ViewerTest : public QObject {
     QVERIFY(!offset->isEnabled());
     enabled->setChecked(true);
     QVERIFY(m.section().has_value());
+    auto* slice = w->findChild<QCheckBox*>("sectionSlice");
+    QVERIFY(slice && !slice->isEnabled());  // no volume to slice here (app.sectionVolumeSlice)
     axis->setCurrentIndex(0);
     offset->setValue(400);
     flip->setChecked(true);
@@ -3408,6 +3410,82 @@ class ViewerTest : public QObject {
     QVERIFY(glm::length(m.section()->normal - m.camera().forward()) < 1e-12);
     settle(m);
     QVERIFY(maxChannelDifference(w->view().renderImage(QSize(200, 150)), whole) > 50);
+  }
+
+  void sectionVolumeSlice() {
+    // Volume slice: each volume's samples on the plane (SectionPlane::slice), the pixels of mfr
+    // render --section …:slice, counted in the report line, kept by sessions.
+    QTemporaryDir dir;
+    auto w = openWindow(QStringLiteral("@volume"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    const QSize size(160, 120);
+    QVERIFY(showAbufferIso(*w, size));
+    auto* enabled = w->findChild<QCheckBox*>("sectionEnabled");
+    auto* axis = w->findChild<QComboBox*>("sectionAxis");
+    auto* offset = w->findChild<QSlider*>("sectionOffset");
+    auto* flip = w->findChild<QCheckBox*>("sectionFlip");
+    auto* slice = w->findChild<QCheckBox*>("sectionSlice");
+    auto* reportLabel = w->findChild<QLabel*>("sectionReport");
+    QVERIFY(enabled && axis && offset && flip && slice && reportLabel);
+    QVERIFY(!slice->isEnabled());  // no plane yet
+    enabled->setChecked(true);
+    axis->setCurrentIndex(2);
+    offset->setValue(550);
+    flip->setChecked(true);
+    QVERIFY(slice->isEnabled());
+    QVERIFY(!m.section()->slice);
+    settle(m);
+    const mfr::ImageRGBA8 plain = w->view().renderImage(size);
+    slice->setChecked(true);
+    QVERIFY(m.section()->slice);
+    QVERIFY2(reportLabel->text().endsWith(QStringLiteral("; 1 volume slice")), qPrintable(reportLabel->text()));
+    settle(m);
+    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
+    const mfr::ImageRGBA8 sliced = w->view().renderImage(size);
+    QVERIFY(maxChannelDifference(sliced, plain) > 50);
+    const mfr::SectionPlane plane = *m.section();
+    const QString planeText =
+        QString::asprintf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g:slice", plane.point.x, plane.point.y, plane.point.z,
+                          plane.normal.x, plane.normal.y, plane.normal.z);
+    const QString cliPng = dir.filePath("cli.png");
+    QString out;
+    QCOMPARE(runProgram(MFR_CLI,
+                        {"render", "@volume", "--size", "160x120", "--view", "iso", "-m", "abuffer-ll", "--section",
+                         planeText, "-o", cliPng},
+                        &out),
+             0);
+    QCOMPARE(maxChannelDifference(mfr::readPng(cliPng.toStdString()), sliced), 0);
+    // The Probe dock names the slice (a part of the drawn scene only) and gives the volume's value.
+    const mfr::Scene& drawn = m.drawnScene();
+    QCOMPARE(drawn.objects.size(), m.scene().objects.size() + 1);
+    QCOMPARE(QString::fromStdString(drawn.objects.back().name), QStringLiteral("field slice"));
+    const auto sliceId = static_cast<std::uint32_t>(drawn.objects.size() - 1);
+    const mfr::FragmentLists lists = mfr::castFragments(drawn, m.camera(), size.width(), size.height());
+    QPoint onSlice(-1, -1);
+    for (int y = 30; y < 90 && onSlice.x() < 0; ++y)
+      for (int x = 40; x < 120 && onSlice.x() < 0; ++x)
+        if (!lists.isAmbiguous(x, y) && lists.count(x, y) > 0 && lists.pixel(x, y)[0].objectId == sliceId)
+          onSlice = QPoint(x, y);
+    QVERIFY(onSlice.x() >= 0);
+    auto* table = w->findChild<QTableWidget*>("probeTable");
+    QVERIFY(table);
+    QTest::mouseClick(&w->view(), Qt::LeftButton, Qt::ControlModifier, onSlice);
+    QTRY_VERIFY_WITH_TIMEOUT(table->rowCount() > 1 && table->item(0, ProbePanel::Part) &&
+                                 table->item(0, ProbePanel::Part)->text() == QStringLiteral("field slice"),
+                             20000);
+    QVERIFY2(table->item(0, ProbePanel::FieldValue)->text().startsWith(QStringLiteral("@field ")),
+             qPrintable(table->item(0, ProbePanel::FieldValue)->text()));
+    // A session keeps it.
+    const QString sessionPath = dir.filePath("slice.mfrsession");
+    writeSessionFile(sessionPath, captureSession(m));
+    slice->setChecked(false);
+    QVERIFY(!m.section()->slice);
+    applySession(readSessionFile(sessionPath), m);
+    QCOMPARE(*m.section(), plane);
+    QVERIFY(slice->isChecked());
+    settle(m);
+    QCOMPARE(maxChannelDifference(w->view().renderImage(size), sliced), 0);
   }
 };
 

@@ -79,13 +79,33 @@ TEST_F(CliSection, CsgRunsOnCutSolids) {
   EXPECT_GT(mfr::rmse(w, g), 0.05);
 }
 
+// :slice adds each volume's slice: the GPU draws it as the oracle does, it changes the picture,
+// and :nocaps:slice is accepted too.
+TEST_F(CliSection, VolumeSliceOnGpuEqualsTheOracle) {
+  const fs::path oracle = dir() / "o.png", gpu = dir() / "g.png", plain = dir() / "p.png";
+  const std::string common = "render @volume --size 64x48 --view iso --section -z=0.1";
+  ASSERT_EQ(runCli(common + ":slice -m oracle -o " + oracle.string()).exitCode, 0);
+  const CliResult g = runCli(common + ":slice -m abuffer-ll -o " + gpu.string());
+  ASSERT_EQ(g.exitCode, 0) << g.out;
+  ASSERT_EQ(runCli(common + " -m abuffer-ll -o " + plain.string()).exitCode, 0);
+  EXPECT_EQ(runCli(common + ":nocaps:slice -m abuffer-ll -o " + plain.string()).exitCode, 0);
+  ASSERT_EQ(runCli(common + " -m abuffer-ll -o " + plain.string()).exitCode, 0);
+  const mfr::ImageRGBA8 o = mfr::readPng(oracle.string()), s = mfr::readPng(gpu.string()),
+                        p = mfr::readPng(plain.string());
+  EXPECT_LT(mfr::rmse(o, s), 0.02);
+  EXPECT_GT(mfr::rmse(p, s), 0.05);
+  const CliResult miss = runCli("render @volume --size 16x16 --section -z=5:slice -m abuffer-ll -o " + plain.string());
+  EXPECT_NE(miss.out.find("misses every volume's box"), std::string::npos) << miss.out;
+}
+
 TEST_F(CliSection, BadPlanesAreRefused) {
   expectCleanFailure("render @sample --size 16x16 --section 1,2,3",
                      "--section 1,2,3: expected AXIS=VALUE or six numbers");
   expectCleanFailure("render @sample --size 16x16 --section w=1", "expected AXIS=VALUE with AXIS one of");
   expectCleanFailure("render @sample --size 16x16 --section x=nan", "expected AXIS=VALUE");
   expectCleanFailure("render @sample --size 16x16 --section 0,0,0,0,0,0", "the normal must not be zero");
-  expectCleanFailure("render @sample --size 16x16 --section x=0:caps", "the only suffix is :nocaps");
+  expectCleanFailure("render @sample --size 16x16 --section x=0:caps", "the suffixes are :nocaps and :slice");
+  expectCleanFailure("render @sample --size 16x16 --section x=0:slice", "slice: scene 'sample' has no volume");
   expectCleanFailure("render @sample --size 16x16 --section x=100", "section plane: cuts away every visible surface");
 }
 

@@ -5,6 +5,8 @@
 // surface coloured by a volume ("@NAME") takes the volume's value at each of its points instead.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <memory>
 #include <string>
@@ -298,6 +300,64 @@ TEST(FieldColorsGpu, SectionCapsShowTheVolumeInside) {
     const ProbeFragment& front = probe.fragments.front();  // the cap, nearest the camera
     ASSERT_TRUE(front.hasValue);
     EXPECT_NEAR(front.value, hit.x * hit.y, 1e-4);
+    ++probed;
+  }
+  EXPECT_EQ(probed, 4);
+}
+
+// SectionPlane::slice: the volume's slice on the plane shows the volume at each point — the
+// probe's value at pixels on it is x·y where the ray meets it — and the GPU draws it, over a
+// capped part in front of it, as the oracle does.
+TEST(FieldColorsGpu, AVolumeSliceShowsTheVolumeOnThePlane) {
+  context();
+  Scene scene;
+  scene.name = "sliced";
+  scene.volumes = {xyVolume()};
+  scene.volumes[0].visible = true;
+  Object ball;
+  ball.name = "ball";
+  ball.mesh = std::make_shared<Mesh>(makeSphere(0.6, 32, 16));
+  ball.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0.8, 0.5, 0.0));
+  ball.material.color = {0.9f, 0.3f, 0.1f, 0.6f};
+  scene.objects = {ball};
+  scene.section = SectionPlane{{0.0, 0.0, 0.25}, {0.0, 0.0, -1.0}, true, true};
+  SectionReport report;
+  const Scene cut = sectionedScene(scene, &report);
+  ASSERT_EQ(report.slices, 1u);
+  ASSERT_EQ(report.capped, 1u);
+  ASSERT_EQ(cut.objects.back().name, "xy slice");
+  Camera camera;
+  camera.eye = {-0.4, -0.6, 4.0};
+  camera.target = {0.0, 0.0, 0.0};
+  camera = cut.fit(camera);
+  const int w = 80, h = 80;
+  RenderRequest req;
+  req.method = "abuffer-ll";
+  req.operation = "oit";
+  req.width = w;
+  req.height = h;
+  const OracleMatch m = expectGpuMatchesOracle(cut, camera, req);
+  EXPECT_GT(m.lists.compared, 4000u);
+
+  const glm::dmat4 toWorld = glm::inverse(camera.projectionMatrix(static_cast<double>(w) / h) * camera.viewMatrix());
+  int probed = 0;
+  // The slice lies 10⁻⁴ of the box's diagonal behind the plane (sectionedScene), so caps are in front.
+  const Bounds box = scene.volumes[0].bounds();
+  const double sliceZ = 0.25 - 1e-4 * glm::length(box.max - box.min);
+  for (const glm::ivec2 px : {glm::ivec2(20, 20), glm::ivec2(25, 60), glm::ivec2(40, 40), glm::ivec2(50, 30)}) {
+    SCOPED_TRACE(::testing::Message() << "pixel " << px.x << "," << px.y);
+    const glm::dvec2 ndc(2.0 * (px.x + 0.5) / w - 1.0, 1.0 - 2.0 * (px.y + 0.5) / h);
+    const glm::dvec4 a = toWorld * glm::dvec4(ndc, -1.0, 1.0), b = toWorld * glm::dvec4(ndc, 1.0, 1.0);
+    const glm::dvec3 origin = glm::dvec3(a) / a.w, dir = glm::dvec3(b) / b.w - origin;
+    const glm::dvec3 hit = origin + ((sliceZ - origin.z) / dir.z) * dir;
+    ASSERT_LT(std::max(std::abs(hit.x), std::abs(hit.y)), 1.9);  // inside the volume's box
+    const PixelProbe probe = probePixel(cut, camera, w, h, px.x, px.y);
+    const auto slice = std::find_if(probe.fragments.begin(), probe.fragments.end(), [&](const ProbeFragment& f) {
+      return cut.objects[f.fragment.objectId].name == "xy slice";
+    });
+    ASSERT_NE(slice, probe.fragments.end());
+    ASSERT_TRUE(slice->hasValue);
+    EXPECT_NEAR(slice->value, hit.x * hit.y, 1e-4);
     ++probed;
   }
   EXPECT_EQ(probed, 4);

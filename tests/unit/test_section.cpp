@@ -487,6 +487,57 @@ TEST(Section, TheOracleSeesACappedBoxAsTheBoxOfThatShape) {
   EXPECT_GT(withFragments, static_cast<std::size_t>(w * h / 8));
 }
 
+// A volume's slice is the plane's cross-section of its box: a grid-aligned plane gives the box's
+// face (area and corners exactly), a plane x + y + z = 1.5 through a unit cube the regular hexagon
+// of side √2/2 (area 3√3/4), each wound with the normal −n (a cap's); a plane beside the box or through one
+// corner only gives nothing.
+TEST(Section, AVolumeSliceIsThePlanesCrossSectionOfItsBox) {
+  const auto polygonArea = [](const std::vector<glm::dvec3>& p) {
+    glm::dvec3 sum(0.0);
+    for (std::size_t i = 1; i + 1 < p.size(); ++i) sum += glm::cross(p[i] - p[0], p[i + 1] - p[0]);
+    return 0.5 * sum;  // its vector area: |sum| the area, the direction the winding's normal
+  };
+  auto grid = std::make_shared<VolumeGrid>();
+  grid->dims = {5, 3, 9};
+  grid->values.assign(5 * 3 * 9, 1.0f);
+  Volume box;
+  box.grid = grid;
+  box.origin = {1.0, -2.0, 0.0};
+  box.spacing = {0.5, 2.0, 0.25};  // [1, 3] × [-2, 2] × [0, 2]
+  const std::vector<glm::dvec3> face = volumeSlicePolygon(box, glm::dvec4(0.0, 0.0, -1.0, 0.5));  // keeps z <= 0.5
+  ASSERT_EQ(face.size(), 4u);
+  for (const glm::dvec3& p : face) {
+    EXPECT_NEAR(p.z, 0.5, 1e-12);
+    EXPECT_TRUE(std::abs(p.x - 1.0) < 1e-12 || std::abs(p.x - 3.0) < 1e-12) << p.x;
+    EXPECT_TRUE(std::abs(p.y + 2.0) < 1e-12 || std::abs(p.y - 2.0) < 1e-12) << p.y;
+  }
+  EXPECT_NEAR(polygonArea(face).z, 8.0, 1e-9);  // 2 × 4, facing +z = −n
+
+  // Rotated and moved: the same face, moved with it.
+  Volume turned = box;
+  turned.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 0.0, 10.0)) *
+                     glm::rotate(glm::dmat4(1.0), glm::radians(90.0), glm::dvec3(0.0, 0.0, 1.0));
+  const std::vector<glm::dvec3> moved = volumeSlicePolygon(turned, glm::dvec4(0.0, 0.0, 1.0, -10.5));
+  ASSERT_EQ(moved.size(), 4u);
+  EXPECT_NEAR(polygonArea(moved).z, -8.0, 1e-9);  // facing −z = −n
+
+  auto unit = std::make_shared<VolumeGrid>();
+  unit->dims = {2, 2, 2};
+  unit->values.assign(8, 0.0f);
+  Volume cube;
+  cube.grid = unit;
+  const glm::dvec3 n = glm::normalize(glm::dvec3(1.0));
+  const std::vector<glm::dvec3> hexagon = volumeSlicePolygon(cube, glm::dvec4(n, -1.5 / std::sqrt(3.0)));
+  ASSERT_EQ(hexagon.size(), 6u);
+  const glm::dvec3 area = polygonArea(hexagon);
+  EXPECT_NEAR(glm::length(area), 3.0 * std::sqrt(3.0) / 4.0, 1e-12);
+  EXPECT_NEAR(glm::dot(glm::normalize(area), -n), 1.0, 1e-12);
+  for (const glm::dvec3& p : hexagon) EXPECT_NEAR(p.x + p.y + p.z, 1.5, 1e-12);
+
+  EXPECT_TRUE(volumeSlicePolygon(cube, glm::dvec4(0.0, 0.0, 1.0, -2.0)).empty());               // beside it
+  EXPECT_TRUE(volumeSlicePolygon(cube, glm::dvec4(n, -3.0 / std::sqrt(3.0) + 1e-15)).empty());  // a corner
+}
+
 using SceneFileSection = test::TempDirTest;
 
 TEST_F(SceneFileSection, SectionKeyAndItsErrors) {
@@ -497,6 +548,11 @@ TEST_F(SceneFileSection, SectionKeyAndItsErrors) {
   EXPECT_EQ(scene.section->point, glm::dvec3(0, 0.1, 0));
   EXPECT_EQ(scene.section->normal, glm::dvec3(0, -1, 0));
   EXPECT_FALSE(scene.section->caps);
+  EXPECT_FALSE(scene.section->slice);
+  EXPECT_TRUE(
+      loadScene(write("v.mfrscene",
+                      "{" + objects + R"(, "section": {"point": [0, 0, 0], "normal": [1, 0, 0], "slice": true}})"))
+          .section->slice);
   EXPECT_TRUE(
       loadScene(write("d.mfrscene", "{" + objects + R"(, "section": {"point": [0, 0, 0], "normal": [1, 0, 0]}})"))
           .section->caps);
@@ -507,6 +563,8 @@ TEST_F(SceneFileSection, SectionKeyAndItsErrors) {
       {R"("section": {"point": [0, 0], "normal": [1, 0, 0]})", "section.point: expected an array of 3 numbers"},
       {R"("section": {"point": [0, 0, 0], "normal": [0, 0, 0]})", "section.normal: must not be zero"},
       {R"("section": {"point": [0, 0, 0], "normal": [0, 0, 1], "caps": 1})", "section.caps: expected true or false"},
+      {R"("section": {"point": [0, 0, 0], "normal": [0, 0, 1], "slice": "yes"})",
+       "section.slice: expected true or false"},
   };
   for (const auto& [json, mention] : bad) {
     SCOPED_TRACE(json);

@@ -455,6 +455,10 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
       if (!section["caps"].is_boolean()) r.fail("section.caps", "expected true or false");
       plane.caps = section["caps"].get<bool>();
     }
+    if (section.contains("slice")) {
+      if (!section["slice"].is_boolean()) r.fail("section.slice", "expected true or false");
+      plane.slice = section["slice"].get<bool>();
+    }
     scene.section = plane;
   }
 

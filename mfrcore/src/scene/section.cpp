@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <memory>
+#include <optional>
 #include <tuple>
 #include <unordered_map>
 #include <utility>
@@ -15,6 +17,7 @@
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
 #include "mfr/error.hpp"
+#include "mfr/scene/color_map.hpp"
 
 namespace mfr {
 namespace {
@@ -459,6 +462,86 @@ std::vector<bool> capJointly(std::vector<Object>& objects, std::vector<OpenCut>&
 
 }  // namespace
 
+std::vector<glm::dvec3> volumeSlicePolygon(const Volume& volume, const glm::dvec4& plane) {
+  if (!volume.grid) return {};
+  const glm::dvec3 n(plane);
+  const glm::dmat4 toWorld = volume.gridToWorld();
+  // The plane in grid coordinates (world p = A·g + t), then where it crosses the box's 12 edges.
+  const glm::dmat3 a(toWorld);
+  const glm::dvec3 t(toWorld[3]);
+  const glm::dvec4 gridPlane(glm::transpose(a) * n, glm::dot(n, t) + plane.w);
+  const glm::dvec3 last(volume.grid->dims - 1);
+  const auto corner = [&](int i) {
+    return glm::dvec3((i & 1) ? last.x : 0.0, (i & 2) ? last.y : 0.0, (i & 4) ? last.z : 0.0);
+  };
+  const double scale = glm::length(glm::dvec3(gridPlane)) * glm::length(last);
+  std::vector<glm::dvec3> points;
+  for (int i = 0; i < 8; ++i)
+    for (int axis = 0; axis < 3; ++axis) {
+      const int j = i | (1 << axis);
+      if (j == i) continue;
+      const glm::dvec3 p = corner(i), q = corner(j);
+      const double dp = glm::dot(glm::dvec3(gridPlane), p) + gridPlane.w;
+      const double dq = glm::dot(glm::dvec3(gridPlane), q) + gridPlane.w;
+      if ((dp < 0.0) == (dq < 0.0) || dp == dq) continue;
+      const glm::dvec3 g = p + (q - p) * (dp / (dp - dq));
+      const glm::dvec3 w(toWorld * glm::dvec4(g, 1.0));
+      // A plane through a corner crosses three edges there: one point.
+      if (std::none_of(points.begin(), points.end(),
+                       [&](const glm::dvec3& o) { return glm::length(o - w) <= 1e-9 * (1.0 + scale); }))
+        points.push_back(w);
+    }
+  if (points.size() < 3) return {};
+  // Counter-clockwise about −n: sorted by angle in a basis (u, v) of the plane with u × v = −n.
+  glm::dvec3 centre(0.0);
+  for (const glm::dvec3& p : points) centre += p / static_cast<double>(points.size());
+  const glm::dvec3 facing = -glm::normalize(n);
+  const glm::dvec3 u = glm::normalize(points[0] - centre);
+  const glm::dvec3 v = glm::cross(facing, u);
+  std::sort(points.begin(), points.end(), [&](const glm::dvec3& p, const glm::dvec3& q) {
+    return std::atan2(glm::dot(p - centre, v), glm::dot(p - centre, u)) <
+           std::atan2(glm::dot(q - centre, v), glm::dot(q - centre, u));
+  });
+  // Only touching (every point on a line): no area.
+  double area = 0.0;
+  for (std::size_t i = 1; i + 1 < points.size(); ++i)
+    area += glm::dot(glm::cross(points[i] - points[0], points[i + 1] - points[0]), facing);
+  if (!(area > 1e-12 * glm::dot(volume.bounds().max - volume.bounds().min, volume.bounds().max - volume.bounds().min)))
+    return {};
+  return points;
+}
+
+namespace {
+
+// SectionPlane::slice: volume v's slice as a part (sectionedScene's contract).
+std::optional<Object> volumeSlice(const Scene& scene, std::size_t v, const glm::dvec4& plane) {
+  const Volume& volume = scene.volumes[v];
+  std::vector<glm::dvec3> polygon = volumeSlicePolygon(volume, plane);
+  if (polygon.empty()) return std::nullopt;
+  const Bounds box = volume.bounds();
+  const glm::dvec3 inward = glm::normalize(glm::dvec3(plane)) * (1e-4 * glm::length(box.max - box.min));
+  auto mesh = std::make_shared<Mesh>();
+  const glm::vec3 normal(-glm::normalize(glm::dvec3(plane)));
+  for (const glm::dvec3& p : polygon) {
+    mesh->positions.emplace_back(p + inward);
+    mesh->normals.push_back(normal);
+  }
+  for (std::uint32_t i = 1; i + 1 < polygon.size(); ++i) mesh->indices.insert(mesh->indices.end(), {0u, i, i + 1});
+  const std::string field = volumeFieldName(scene, v);
+  Object slice;
+  slice.name = field.substr(1) + " slice";
+  slice.material.color = glm::vec4(1.0f);
+  const VolumeFieldSampler sampler{volume.grid, glm::inverse(volume.gridToWorld())};
+  MeshField samples{field, false, 1, {}};
+  for (const glm::vec3& p : mesh->positions) samples.values.push_back(sampler.at(glm::dvec3(p)));
+  mesh->fields.push_back(std::move(samples));
+  slice.mesh = std::move(mesh);
+  colorByField(slice, field, "grayscale", glm::dvec2(volume.transfer.low(), volume.transfer.high()));
+  return slice;
+}
+
+}  // namespace
+
 Scene sectionedScene(const Scene& scene, SectionReport* report) {
   if (!scene.section || scene.sectionCut) return scene;
   const glm::dvec4 world = sectionPlaneEquation(*scene.section);
@@ -514,6 +597,12 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
       local.open.push_back(object.name);
     object.mesh = std::make_shared<const Mesh>(std::move(open[k].cut.mesh));
   }
+  if (scene.section->slice)
+    for (std::size_t v = 0; v < scene.volumes.size(); ++v)
+      if (std::optional<Object> slice = volumeSlice(scene, v, world)) {
+        out.objects.push_back(std::move(*slice));
+        ++local.slices;
+      }
   if (out.triangleCount() == 0 && !out.hasVisibleVolume())
     throw Error("section plane", "cuts away every visible surface of scene '" + scene.name + "'");
   if (report) *report = std::move(local);

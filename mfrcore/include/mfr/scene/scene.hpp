@@ -52,6 +52,10 @@ struct SectionPlane {
   glm::dvec3 point{0.0};
   glm::dvec3 normal{0.0, 0.0, 1.0};  // need not be unit length; never zero
   bool caps = true;
+  // Each volume's slice: the plane's cross-section of the volume's box as a part "NAME slice",
+  // opaque, coloured by the volume at each point (grayscale over its transfer function's range) —
+  // ParaView's Slice of an image, a CT viewer's plane (sectionedScene).
+  bool slice = false;
   bool operator==(const SectionPlane&) const = default;
 };
 

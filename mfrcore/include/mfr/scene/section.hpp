@@ -54,15 +54,25 @@ struct SectionReport {
   std::size_t capped = 0;  // of those, capped (alone or together with the other parts of their solid)
   std::size_t removed = 0;
   std::vector<std::string> open;  // names of objects cut without a cap though caps were asked for
+  std::size_t slices = 0;         // volume slices added (SectionPlane::slice)
 };
+
+// The plane's cross-section of a volume's box (grid points [0, dims − 1], as Volume::bounds): a
+// convex polygon in world space wound counter-clockwise seen from the cut-away side (its normal is
+// −n, as a cap's), empty when the plane misses the box or only touches it. plane: (n, d), kept where
+// dot(n, p) + d >= 0 (sectionPlaneEquation).
+std::vector<glm::dvec3> volumeSlicePolygon(const Volume& volume, const glm::dvec4& plane);
 
 // The scene with its section applied to the surfaces: cut objects get new meshes, objects entirely
 // on the cut-away side become invisible, and sectionCut is set. Objects that are open along the cut
 // but whose cut lines join into closed loops together (one solid split over several parts: a glTF
 // mesh with a primitive per material) get one cap, on the part with the most of the joint cut line;
 // both then count as capped. The section itself stays: the renderers crop the volume's march with
-// it. A scene without a section, or already cut, is returned unchanged. Throws mfr::Error("section plane", …) when
-// nothing visible is left.
+// it. With SectionPlane::slice each volume gets a part "NAME slice" (NAME as volumeFieldName
+// without its "@"): its volumeSlicePolygon, moved 10⁻⁴ of the box's diagonal into the kept side
+// so that caps in the plane lie in front of it, coloured by the volume at each point (grayscale
+// over the transfer function's range), opaque. A scene without a section, or already cut, is returned unchanged. Throws
+// mfr::Error("section plane", …) when nothing visible is left.
 Scene sectionedScene(const Scene& scene, SectionReport* report = nullptr);
 
 // The plane of a section as (n, d), n unit length, kept where dot(n, p) + d >= 0 (world space).
