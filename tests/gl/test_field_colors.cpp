@@ -256,6 +256,15 @@ TEST(FieldColorsGpu, VolumeColoursAreSampledAtEachPointNotInterpolated) {
   }
 }
 
+// Where the ray through pixel px's centre (image rows top-down) meets the plane z = planeZ.
+glm::dvec3 pixelRayHitAtZ(const Camera& camera, int w, int h, const glm::ivec2& px, double planeZ) {
+  const glm::dmat4 toWorld = glm::inverse(camera.projectionMatrix(static_cast<double>(w) / h) * camera.viewMatrix());
+  const glm::dvec2 ndc(2.0 * (px.x + 0.5) / w - 1.0, 1.0 - 2.0 * (px.y + 0.5) / h);
+  const glm::dvec4 a = toWorld * glm::dvec4(ndc, -1.0, 1.0), b = toWorld * glm::dvec4(ndc, 1.0, 1.0);
+  const glm::dvec3 origin = glm::dvec3(a) / a.w, dir = glm::dvec3(b) / b.w - origin;
+  return origin + ((planeZ - origin.z) / dir.z) * dir;
+}
+
 // A section cap coloured by the volume it cuts shows the volume's values inside it (ParaView's
 // slice), not a blend of its rim: the probe's value at pixels inside the cap is x·y where the
 // pixel's ray meets the plane z = 0, and the GPU draws the cap as the oracle does.
@@ -286,14 +295,10 @@ TEST(FieldColorsGpu, SectionCapsShowTheVolumeInside) {
   const OracleMatch m = expectGpuMatchesOracle(cut, camera, req);
   EXPECT_GT(m.lists.compared, 2000u);
 
-  const glm::dmat4 toWorld = glm::inverse(camera.projectionMatrix(static_cast<double>(w) / h) * camera.viewMatrix());
   int probed = 0;
   for (const glm::ivec2 px : {glm::ivec2(30, 30), glm::ivec2(52, 28), glm::ivec2(47, 50), glm::ivec2(28, 47)}) {
     SCOPED_TRACE(::testing::Message() << "pixel " << px.x << "," << px.y);
-    const glm::dvec2 ndc(2.0 * (px.x + 0.5) / w - 1.0, 1.0 - 2.0 * (px.y + 0.5) / h);
-    const glm::dvec4 a = toWorld * glm::dvec4(ndc, -1.0, 1.0), b = toWorld * glm::dvec4(ndc, 1.0, 1.0);
-    const glm::dvec3 origin = glm::dvec3(a) / a.w, dir = glm::dvec3(b) / b.w - origin;
-    const glm::dvec3 hit = origin - (origin.z / dir.z) * dir;  // on the plane z = 0
+    const glm::dvec3 hit = pixelRayHitAtZ(camera, w, h, px, 0.0);
     ASSERT_LT(glm::length(glm::dvec2(hit)), 1.0);              // well inside the cap
     const PixelProbe probe = probePixel(cut, camera, w, h, px.x, px.y);
     ASSERT_FALSE(probe.fragments.empty());
@@ -339,17 +344,13 @@ TEST(FieldColorsGpu, AVolumeSliceShowsTheVolumeOnThePlane) {
   const OracleMatch m = expectGpuMatchesOracle(cut, camera, req);
   EXPECT_GT(m.lists.compared, 4000u);
 
-  const glm::dmat4 toWorld = glm::inverse(camera.projectionMatrix(static_cast<double>(w) / h) * camera.viewMatrix());
   int probed = 0;
   // The slice lies 10⁻⁴ of the box's diagonal behind the plane (sectionedScene), so caps are in front.
   const Bounds box = scene.volumes[0].bounds();
   const double sliceZ = 0.25 - 1e-4 * glm::length(box.max - box.min);
   for (const glm::ivec2 px : {glm::ivec2(20, 20), glm::ivec2(25, 60), glm::ivec2(40, 40), glm::ivec2(50, 30)}) {
     SCOPED_TRACE(::testing::Message() << "pixel " << px.x << "," << px.y);
-    const glm::dvec2 ndc(2.0 * (px.x + 0.5) / w - 1.0, 1.0 - 2.0 * (px.y + 0.5) / h);
-    const glm::dvec4 a = toWorld * glm::dvec4(ndc, -1.0, 1.0), b = toWorld * glm::dvec4(ndc, 1.0, 1.0);
-    const glm::dvec3 origin = glm::dvec3(a) / a.w, dir = glm::dvec3(b) / b.w - origin;
-    const glm::dvec3 hit = origin + ((sliceZ - origin.z) / dir.z) * dir;
+    const glm::dvec3 hit = pixelRayHitAtZ(camera, w, h, px, sliceZ);
     ASSERT_LT(std::max(std::abs(hit.x), std::abs(hit.y)), 1.9);  // inside the volume's box
     const PixelProbe probe = probePixel(cut, camera, w, h, px.x, px.y);
     const auto slice = std::find_if(probe.fragments.begin(), probe.fragments.end(), [&](const ProbeFragment& f) {
