@@ -103,7 +103,6 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
       }
       item.fieldGrid = static_cast<int>(known - fieldGrids_.begin());
       item.fieldToGrid = glm::mat4(sampler->objectToGrid);
-      item.fieldGridDims = grid->dims;
     }
     triangles_ += o.mesh->triangleCount();
   }
@@ -142,8 +141,9 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
     program.set("uFieldGrid", item.fieldGrid >= 0 ? 1 : 0);
     program.set("uFieldToGrid", item.fieldToGrid);
     if (item.fieldGrid >= 0) {
-      program.set("uFieldGridDims", item.fieldGridDims);
-      glBindTextureUnit(MFR_TEX_FIELD_GRID, fieldGrids_[static_cast<std::size_t>(item.fieldGrid)].texture->id());
+      const FieldGrid& grid = fieldGrids_[static_cast<std::size_t>(item.fieldGrid)];
+      program.set("uFieldGridDims", grid.source->dims);
+      glBindTextureUnit(MFR_TEX_FIELD_GRID, grid.texture->id());
     }
     glBindVertexArray(m.vao.id());
     glDrawElements(GL_TRIANGLES, m.indexCount, GL_UNSIGNED_INT, nullptr);

@@ -238,6 +238,17 @@ float VolumeFieldSampler::at(const glm::dvec3& objectPoint) const {
   return inside ? grid->sample(glm::vec3(g)) : std::numeric_limits<float>::quiet_NaN();
 }
 
+VolumeFieldSampler VolumeFieldSampler::of(const Volume& volume, const glm::dmat4& objectTransform) {
+  return {volume.grid, glm::inverse(volume.gridToWorld()) * objectTransform};
+}
+
+MeshField VolumeFieldSampler::atVertices(const std::string& name, const Mesh& mesh) const {
+  MeshField f{name, false, 1, {}};
+  f.values.reserve(mesh.positions.size());
+  for (const glm::vec3& p : mesh.positions) f.values.push_back(at(glm::dvec3(p)));
+  return f;
+}
+
 std::string volumeFieldName(const Scene& scene, std::size_t v) {
   const Volume& volume = scene.volumes.at(v);
   return "@" + (volume.name.empty() ? "volume " + std::to_string(v) : volume.name);
@@ -251,7 +262,7 @@ std::optional<VolumeFieldSampler> volumeFieldSampler(const Scene& scene, const O
   for (std::size_t v = 0; v < scene.volumes.size(); ++v) {
     const Volume& volume = scene.volumes[v];
     if (volume.grid && volumeFieldName(scene, v) == field->field)
-      return VolumeFieldSampler{volume.grid, glm::inverse(volume.gridToWorld()) * object.transform};
+      return VolumeFieldSampler::of(volume, object.transform);
   }
   return std::nullopt;
 }
@@ -266,11 +277,7 @@ void addVolumeFields(Scene& scene) {
       const std::string name = volumeFieldName(scene, v);
       if (hasField(mesh ? *mesh : *o.mesh, name)) continue;
       if (!mesh) mesh = std::make_shared<Mesh>(*o.mesh);
-      const VolumeFieldSampler sampler{volume.grid, glm::inverse(volume.gridToWorld()) * o.transform};
-      MeshField f{name, false, 1, {}};
-      f.values.reserve(mesh->positions.size());
-      for (const glm::vec3& p : mesh->positions) f.values.push_back(sampler.at(glm::dvec3(p)));
-      mesh->fields.push_back(std::move(f));
+      mesh->fields.push_back(VolumeFieldSampler::of(volume, o.transform).atVertices(name, *mesh));
     }
     if (mesh) o.mesh = std::move(mesh);
   }

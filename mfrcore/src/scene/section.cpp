@@ -531,10 +531,7 @@ std::optional<Object> volumeSlice(const Scene& scene, std::size_t v, const glm::
   Object slice;
   slice.name = field.substr(1) + " slice";
   slice.material.color = glm::vec4(1.0f);
-  const VolumeFieldSampler sampler{volume.grid, glm::inverse(volume.gridToWorld())};
-  MeshField samples{field, false, 1, {}};
-  for (const glm::vec3& p : mesh->positions) samples.values.push_back(sampler.at(glm::dvec3(p)));
-  mesh->fields.push_back(std::move(samples));
+  mesh->fields.push_back(VolumeFieldSampler::of(volume, glm::dmat4(1.0)).atVertices(field, *mesh));
   slice.mesh = std::move(mesh);
   colorByField(slice, field, "grayscale", glm::dvec2(volume.transfer.low(), volume.transfer.high()));
   return slice;

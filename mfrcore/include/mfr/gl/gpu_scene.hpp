@@ -69,7 +69,6 @@ class GpuScene {
     // Coloured by a volume: its grid's index in fieldGrids_, object → grid coordinates; else -1.
     int fieldGrid = -1;
     glm::mat4 fieldToGrid{1.0f};
-    glm::ivec3 fieldGridDims{2};
   };
   struct FieldGrid {
     std::shared_ptr<const VolumeGrid> source;  // kept alive, so that its address names it while shared

@@ -86,6 +86,10 @@ struct VolumeFieldSampler {
   // Trilinear (VolumeGrid::sample); NaN farther than half a voxel outside the grid's box (within
   // it: the nearest face's value).
   [[nodiscard]] float at(const glm::dvec3& objectPoint) const;
+  // `volume` seen from an object placed by `objectTransform`.
+  [[nodiscard]] static VolumeFieldSampler of(const Volume& volume, const glm::dmat4& objectTransform);
+  // The point field `name`: `at` each of the mesh's vertices.
+  [[nodiscard]] MeshField atVertices(const std::string& name, const Mesh& mesh) const;
 };
 // The field name "@NAME" of the scene's volume v (its name, else "volume v").
 std::string volumeFieldName(const Scene& scene, std::size_t v);
