@@ -538,6 +538,55 @@ TEST(Section, AVolumeSliceIsThePlanesCrossSectionOfItsBox) {
   EXPECT_TRUE(volumeSlicePolygon(cube, glm::dvec4(n, -3.0 / std::sqrt(3.0) + 1e-15)).empty());  // a corner
 }
 
+// Two volumes whose boxes overlap: their slices are not coplanar (they would z-fight) but one step
+// apart, the first volume's in front, both inside the kept side. The oracle sees no depth tie over
+// the overlap, and the first slice nearest.
+TEST(Section, OverlappingVolumesSlicesAreOrderedNotTied) {
+  const auto cube = [](const std::string& name, glm::dvec3 origin, float value) {
+    auto grid = std::make_shared<VolumeGrid>();
+    grid->dims = {3, 3, 3};
+    grid->values.assign(27, value);
+    Volume v;
+    v.name = name;
+    v.grid = grid;
+    v.origin = origin;  // spacing 1: the box [origin, origin + 2]
+    v.transfer = transferPreset("grayscale", 0.0, 1.0, 1.0);
+    return v;
+  };
+  Scene scene;
+  scene.name = "two volumes";
+  scene.volumes = {cube("a", {0.0, 0.0, 0.0}, 0.2f), cube("b", {1.0, 1.0, 0.0}, 0.8f)};
+  scene.section = SectionPlane{{0.0, 0.0, 1.0}, {0.0, 0.0, -1.0}, true, true};  // keeps z <= 1
+  SectionReport report;
+  const Scene cut = sectionedScene(scene, &report);
+  ASSERT_EQ(report.slices, 2u);
+  ASSERT_EQ(cut.objects.size(), 2u);
+  EXPECT_EQ(cut.objects[0].name, "a slice");
+  EXPECT_EQ(cut.objects[1].name, "b slice");
+  const double step = 1e-4 * std::sqrt(12.0);  // 10⁻⁴ of the (largest) box's diagonal
+  for (std::size_t i = 0; i < 2; ++i)
+    for (const glm::vec3& p : cut.objects[i].mesh->positions)
+      EXPECT_NEAR(p.z, 1.0 - step * static_cast<double>(i + 1), 1e-6) << cut.objects[i].name;
+
+  Camera camera;
+  camera.eye = {1.5, 1.5, 6.0};
+  camera.target = {1.5, 1.5, 0.0};
+  camera.up = {0.0, 1.0, 0.0};
+  const int w = 48, h = 48;
+  const FragmentLists lists = castFragments(cut, camera, w, h);
+  std::size_t overlap = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const auto list = lists.pixel(x, y);
+      if (list.size() != 2) continue;
+      ++overlap;
+      EXPECT_FALSE(lists.flags[lists.index(x, y)] & FragmentLists::kDepthTie) << x << "," << y;
+      EXPECT_EQ(list[0].objectId, 0u) << x << "," << y;
+      EXPECT_EQ(list[1].objectId, 1u) << x << "," << y;
+    }
+  EXPECT_GT(overlap, static_cast<std::size_t>(w * h / 20));
+}
+
 using SceneFileSection = test::TempDirTest;
 
 TEST_F(SceneFileSection, SectionKeyAndItsErrors) {

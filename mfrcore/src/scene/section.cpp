@@ -513,13 +513,13 @@ std::vector<glm::dvec3> volumeSlicePolygon(const Volume& volume, const glm::dvec
 
 namespace {
 
-// SectionPlane::slice: volume v's slice as a part (sectionedScene's contract).
-std::optional<Object> volumeSlice(const Scene& scene, std::size_t v, const glm::dvec4& plane) {
+// SectionPlane::slice: volume v's slice as a part (sectionedScene's contract), `depth` behind the
+// plane.
+std::optional<Object> volumeSlice(const Scene& scene, std::size_t v, const glm::dvec4& plane, double depth) {
   const Volume& volume = scene.volumes[v];
   std::vector<glm::dvec3> polygon = volumeSlicePolygon(volume, plane);
   if (polygon.empty()) return std::nullopt;
-  const Bounds box = volume.bounds();
-  const glm::dvec3 inward = glm::normalize(glm::dvec3(plane)) * (1e-4 * glm::length(box.max - box.min));
+  const glm::dvec3 inward = glm::normalize(glm::dvec3(plane)) * depth;
   auto mesh = std::make_shared<Mesh>();
   const glm::vec3 normal(-glm::normalize(glm::dvec3(plane)));
   for (const glm::dvec3& p : polygon) {
@@ -594,12 +594,18 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
       local.open.push_back(object.name);
     object.mesh = std::make_shared<const Mesh>(std::move(open[k].cut.mesh));
   }
-  if (scene.section->slice)
+  if (scene.section->slice) {
+    // Slices of overlapping volumes would be coplanar and z-fight: each lies one step of 10⁻⁴ of
+    // the largest box's diagonal deeper than the one before, so the first volume's shows.
+    double step = 0.0;
+    for (const Volume& volume : scene.volumes)
+      if (volume.grid) step = std::max(step, 1e-4 * glm::length(volume.bounds().max - volume.bounds().min));
     for (std::size_t v = 0; v < scene.volumes.size(); ++v)
-      if (std::optional<Object> slice = volumeSlice(scene, v, world)) {
+      if (std::optional<Object> slice = volumeSlice(scene, v, world, step * static_cast<double>(v + 1))) {
         out.objects.push_back(std::move(*slice));
         ++local.slices;
       }
+  }
   if (out.triangleCount() == 0 && !out.hasVisibleVolume())
     throw Error("section plane", "cuts away every visible surface of scene '" + scene.name + "'");
   if (report) *report = std::move(local);

@@ -69,8 +69,9 @@ std::vector<glm::dvec3> volumeSlicePolygon(const Volume& volume, const glm::dvec
 // mesh with a primitive per material) get one cap, on the part with the most of the joint cut line;
 // both then count as capped. The section itself stays: the renderers crop the volume's march with
 // it. With SectionPlane::slice each volume gets a part "NAME slice" (NAME as volumeFieldName
-// without its "@"): its volumeSlicePolygon, moved 10⁻⁴ of the box's diagonal into the kept side
-// so that caps in the plane lie in front of it, coloured by the volume at each point (grayscale
+// without its "@"): its volumeSlicePolygon, moved (v + 1)·10⁻⁴ of the largest volume box's
+// diagonal into the kept side — caps in the plane lie in front of it, and where volumes overlap the
+// first one's slice is in front, without z-fighting — coloured by the volume at each point (grayscale
 // over the transfer function's range), opaque. A scene without a section, or already cut, is returned unchanged. Throws
 // mfr::Error("section plane", …) when nothing visible is left.
 Scene sectionedScene(const Scene& scene, SectionReport* report = nullptr);
