@@ -8,6 +8,7 @@
 
 #include "mfr/render.hpp"
 #include "mfr/scene/scene.hpp"
+#include "mfr/scene/section.hpp"
 
 namespace mfr::cli {
 
@@ -46,8 +47,9 @@ inline constexpr const char* kClipHelp =
 // side), each optionally followed by ":nocaps" and/or ":slice" (SectionPlane::slice); "none" removes the scene's own;
 // empty text leaves the scene as it is. Then the scene is cut by its section (the option's or the scene file's; once,
 // so that every renderer gets the cut scene), with a one-line note on stderr naming cut parts left without a cap
-// because they are not closed. Throws mfr::Error naming --section.
-void applySectionOption(Scene& scene, const std::string& text);
+// because they are not closed; `report`, when given, gets sectionedScene's report (cleared when
+// there is no section). Throws mfr::Error naming --section.
+void applySectionOption(Scene& scene, const std::string& text, SectionReport* report = nullptr);
 inline constexpr const char* kSectionHelp =
     "Section plane: AXIS=VALUE (x, y, z, -x, -y, -z; keeps the side the axis points to) or "
     "px,py,pz,nx,ny,nz (point, normal of the kept side), optionally :nocaps and/or :slice (each volume's slice, "

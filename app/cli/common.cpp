@@ -308,11 +308,11 @@ std::optional<ContourLegend> ContourOptions::apply(Scene& scene, double sceneOpa
 
 namespace {
 
-void cutBySection(Scene& scene) {
+void cutBySection(Scene& scene, SectionReport& report) {
+  report = {};
   if (!scene.section || scene.sectionCut) return;
   if (scene.section->slice && scene.volumes.empty())
     throw Error("section", "slice: scene '" + scene.name + "' has no volume");
-  SectionReport report;
   scene = sectionedScene(scene, &report);
   if (scene.section->slice && report.slices == 0)
     std::cerr << "note: section: the plane misses every volume's box, so there is no slice\n";
@@ -326,13 +326,16 @@ void cutBySection(Scene& scene) {
 
 }  // namespace
 
-void applySectionOption(Scene& scene, const std::string& text) {
+void applySectionOption(Scene& scene, const std::string& text, SectionReport* report) {
+  SectionReport local;
+  SectionReport& out = report ? *report : local;
   if (text == "none") {
+    out = {};
     scene.section.reset();
     return;
   }
   if (text.empty()) {
-    cutBySection(scene);
+    cutBySection(scene, out);
     return;
   }
   const std::string what = "--section " + text;
@@ -373,7 +376,7 @@ void applySectionOption(Scene& scene, const std::string& text) {
     if (!(glm::length(section.normal) > 0.0)) throw Error(what, "the normal must not be zero");
   }
   scene.section = section;
-  cutBySection(scene);
+  cutBySection(scene, out);
 }
 
 }  // namespace mfr::cli

@@ -1,5 +1,6 @@
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -17,7 +18,7 @@ namespace mfr::cli {
 
 void addInfo(CLI::App& app) {
   struct Options {
-    std::string scene, size = "256x256", view = "fit", json, field;
+    std::string scene, size = "256x256", view = "fit", json, field, section;
     bool methods = false, noHistogram = false;
     ContourOptions contours;
   };
@@ -30,6 +31,10 @@ void addInfo(CLI::App& app) {
   cmd->add_flag("--no-histogram", opt->noHistogram, "Skip the oracle pass");
   cmd->add_option("--field", opt->field, kFieldHelp);
   opt->contours.add(cmd);
+  cmd->add_option("--section", opt->section,
+                  std::string(kSectionHelp) +
+                      "; parts are then measured as cut (a capped solid's kept volume "
+                      "and its cross-section area)");
   cmd->add_option("--json", opt->json, "Also write the information as JSON");
   cmd->callback([opt] {
     if (opt->methods) {
@@ -40,6 +45,15 @@ void addInfo(CLI::App& app) {
     const auto [w, h] = parseSize("--size", opt->size);
     Scene scene = loadScene(opt->scene, LoadOptions{opt->field});
     opt->contours.apply(scene, -1.0);
+    SectionReport section;
+    applySectionOption(scene, opt->section, &section);
+    const bool sectioned = !section.outcomes.empty();
+    const auto outcome = [&](std::size_t i) { return sectioned ? section.outcomes[i] : SectionOutcome::kKept; };
+    const auto sixDigits = [](double v) {  // describeSurface's number format
+      std::ostringstream text;
+      text << v;
+      return text.str();
+    };
     std::vector<SurfaceMeasures> measures;
     for (const Object& o : scene.objects) measures.push_back(measureSurface(*o.mesh, o.transform));
     nlohmann::ordered_json j;
@@ -49,6 +63,16 @@ void addInfo(CLI::App& app) {
     j["triangles"] = scene.triangleCount();
     j["bounds"] = {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};
     j["views"] = scene.viewNames();
+    if (sectioned) {
+      const SectionPlane& plane = *scene.section;
+      j["section"] = {{"point", {plane.point.x, plane.point.y, plane.point.z}},
+                      {"normal", {plane.normal.x, plane.normal.y, plane.normal.z}},
+                      {"cut", section.cut},
+                      {"capped", section.capped},
+                      {"removed", section.removed},
+                      {"open", section.open},
+                      {"cross_section_area", section.totalCapArea()}};
+    }
     nlohmann::ordered_json parts = nlohmann::ordered_json::array();
     for (const Object& o : scene.objects) {
       nlohmann::ordered_json fields = nlohmann::ordered_json::array();
@@ -57,16 +81,28 @@ void addInfo(CLI::App& app) {
         const glm::dvec2 r = fieldRange(v.values);
         fields.push_back({{"name", f}, {"cell_data", v.cellData}, {"range", {r.x, r.y}}});
       }
-      const SurfaceMeasures& m = measures[static_cast<std::size_t>(&o - scene.objects.data())];
-      parts.push_back({{"name", o.name},
-                       {"triangles", o.mesh->triangleCount()},
-                       {"area", m.area},
-                       {"closed", m.closed()},
-                       {"volume", m.closed() ? nlohmann::ordered_json(m.volume) : nlohmann::ordered_json()},
-                       {"boundary_edges", m.boundaryEdges},
-                       {"non_manifold_edges", m.nonManifoldEdges},
-                       {"orientation_flips", m.orientationFlips},
-                       {"fields", fields}});
+      const std::size_t i = static_cast<std::size_t>(&o - scene.objects.data());
+      const SurfaceMeasures& m = measures[i];
+      nlohmann::ordered_json part = {
+          {"name", o.name},
+          {"triangles", o.mesh->triangleCount()},
+          {"area", m.area},
+          {"closed", m.closed()},
+          {"volume", m.closed() ? nlohmann::ordered_json(m.volume) : nlohmann::ordered_json()},
+          {"boundary_edges", m.boundaryEdges},
+          {"non_manifold_edges", m.nonManifoldEdges},
+          {"orientation_flips", m.orientationFlips},
+          {"fields", fields}};
+      if (sectioned) {
+        static const char* const kOutcomes[] = {"kept", "removed", "cut", "capped"};
+        part["section"] = kOutcomes[static_cast<int>(outcome(i))];
+        part["cross_section_area"] = section.capAreas[i];
+        if (outcome(i) == SectionOutcome::kRemoved)  // nothing of it is left to measure
+          for (const char* key :
+               {"area", "closed", "volume", "boundary_edges", "non_manifold_edges", "orientation_flips"})
+            part[key] = nullptr;
+      }
+      parts.push_back(std::move(part));
     }
     j["part_list"] = parts;
     std::cout << "scene      " << scene.name << "\nparts      " << scene.objects.size() << "\ntriangles  "
@@ -74,14 +110,31 @@ void addInfo(CLI::App& app) {
               << b.max.x << ", " << b.max.y << ", " << b.max.z << "]\nviews     ";
     for (const std::string& v : scene.viewNames()) std::cout << " " << v;
     std::cout << "\n";
+    if (sectioned) {
+      const SectionPlane& plane = *scene.section;
+      std::cout << "section    point " << plane.point.x << " " << plane.point.y << " " << plane.point.z << ", normal "
+                << plane.normal.x << " " << plane.normal.y << " " << plane.normal.z << ": " << section.cut
+                << " parts cut (" << section.capped << " capped), " << section.removed
+                << " removed; cross-section area " << section.totalCapArea() << "\n";
+    }
     const std::size_t shown = std::min<std::size_t>(scene.objects.size(), 20);
     for (std::size_t i = 0; i < shown; ++i) {
       const Object& o = scene.objects[i];
       std::cout << "  part " << i << ": " << o.name << " (" << o.mesh->triangleCount() << " triangles, rgba "
                 << o.material.color.r << " " << o.material.color.g << " " << o.material.color.b << " "
                 << o.material.color.a << ")\n";
-      // Its surface in the world: area, and the volume it encloses when it is closed.
-      std::cout << "    " << describeSurface(measures[i]) << "\n";
+      // Its surface in the world: area, and the volume it encloses when it is closed — as cut by the
+      // section, whose cap makes a cut solid closed: the volume kept, and the cut's area.
+      if (outcome(i) == SectionOutcome::kRemoved)
+        std::cout << "    removed by the section\n";
+      else
+        std::cout << "    " << describeSurface(measures[i])
+                  << (outcome(i) == SectionOutcome::kCapped && section.capAreas[i] > 0.0
+                          ? "; cut, cross-section area " + sixDigits(section.capAreas[i])
+                      : outcome(i) == SectionOutcome::kCut    ? "; cut"
+                      : outcome(i) == SectionOutcome::kCapped ? "; cut, capped with another part"
+                                                              : "")
+                  << "\n";
       if (!o.mesh->fields.empty()) {
         // What --color-by can use, with each field's range (cell data marked).
         std::cout << "    fields:";

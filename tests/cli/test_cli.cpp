@@ -207,6 +207,57 @@ TEST_F(Cli, InfoMeasuresEachPartsSurface) {
   EXPECT_NE(c.out.find("part 3: field = 0.5"), std::string::npos) << c.out;
 }
 
+// With a section (--section, or the scene file's own) parts are measured as cut: a capped solid is
+// closed, with the volume kept and the cap's area as its cross-section; a part on the cut-away side
+// is removed, with nothing to measure.
+TEST_F(Cli, InfoMeasuresPartsAsTheSectionCutsThem) {
+  const std::string objects = R"("objects": [
+    {"name": "brick", "primitive": {"type": "box", "size": [1, 2, 3]}, "transform": {"scale": [2, 1, 1]}},
+    {"name": "sheet", "primitive": {"type": "plane", "width": 2, "height": 1}},
+    {"name": "gone", "primitive": {"type": "box"}, "transform": {"translate": [0, 0, 10]}}])";
+  const fs::path scene = write("s.mfrscene", "{" + objects + "}");
+  const fs::path json = dir() / "info.json";
+  CliResult r = runCli("info " + scene.string() + " --no-histogram --section=-z=0.5 --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  // The brick is [-1, 1] × [-1, 1] × [-1.5, 1.5]; kept up to z = 0.5: 2 × 2 × 2 over a 2 × 2 cut.
+  EXPECT_NE(r.out.find("area 24, closed, volume 8; cut, cross-section area 4\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 parts cut (1 capped), 1 removed; cross-section area 4\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("    removed by the section\n"), std::string::npos) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["section"]["cut"], 1);
+  EXPECT_EQ(j["section"]["removed"], 1);
+  EXPECT_NEAR(j["section"]["cross_section_area"].get<double>(), 4.0, 1e-6);
+  EXPECT_EQ(j["section"]["normal"][2], -1.0);
+  EXPECT_EQ(j["part_list"][0]["section"], "capped");
+  EXPECT_NEAR(j["part_list"][0]["volume"].get<double>(), 8.0, 1e-6);
+  EXPECT_NEAR(j["part_list"][0]["cross_section_area"].get<double>(), 4.0, 1e-6);
+  EXPECT_EQ(j["part_list"][1]["section"], "kept");
+  EXPECT_NEAR(j["part_list"][1]["area"].get<double>(), 2.0, 1e-9);
+  EXPECT_EQ(j["part_list"][2]["section"], "removed");
+  EXPECT_TRUE(j["part_list"][2]["area"].is_null());
+  EXPECT_TRUE(j["part_list"][2]["volume"].is_null());
+
+  // The scene file's own section, and "none" to measure the whole parts.
+  const fs::path sectioned =
+      write("t.mfrscene", "{" + objects + R"(, "section": {"point": [0, 0, 0.5], "normal": [0, 0, -1]}})");
+  r = runCli("info " + sectioned.string() + " --no-histogram");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("volume 8; cut, cross-section area 4\n"), std::string::npos) << r.out;
+  r = runCli("info " + sectioned.string() + " --no-histogram --section none --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("area 32, closed, volume 12\n"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("section"), std::string::npos) << r.out;
+  std::ifstream whole(json);
+  EXPECT_FALSE(nlohmann::json::parse(whole).contains("section"));
+
+  fs::remove(json);
+  r = runCli("info " + scene.string() + " --section z --json " + json.string());
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find("--section z: expected AXIS=VALUE"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(json));
+}
+
 // The budget commands: dataset → train → render with the trained weights → evaluate, end to end
 // on a tiny image; then their bad input.
 TEST_F(Cli, DatasetTrainRenderEvaluate) {

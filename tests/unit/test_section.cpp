@@ -257,6 +257,18 @@ TEST(Section, SceneObjectsAreCutInWorldSpaceWhateverTheirTransform) {
     const glm::vec3 capNormal = part.mesh->normals.back();
     EXPECT_NEAR(glm::dot(glm::normalize(normalMatrix * glm::dvec3(capNormal)), glm::dvec3(0.0, 0.0, -1.0)), 1.0, 1e-6);
   }
+  // The ellipsoid's cross-section at z = 0.05: an ellipse of semi-axes 0.8·r and 1.6·r, r² = 1 − zc²
+  // (zc below), in world units — the transform's scale included.
+  ASSERT_EQ(report.outcomes.size(), 4u);
+  EXPECT_EQ(report.outcomes[2], SectionOutcome::kKept);
+  EXPECT_EQ(report.outcomes[3], SectionOutcome::kRemoved);
+  EXPECT_EQ(report.capAreas[2], 0.0);
+  EXPECT_EQ(report.capAreas[3], 0.0);
+  {
+    const double zc = 0.05 / 0.4;
+    const double ellipse = std::numbers::pi * 0.8 * 1.6 * (1.0 - zc * zc);
+    EXPECT_NEAR(report.capAreas[1], ellipse, 5e-3 * ellipse);
+  }
   // The sphere's world volume: an ellipsoid (semi-axes 0.8, 1.6, 0.4, centre z = 0) above z = 0.05.
   const double c = 0.4, zc = 0.05 / c;  // in the unit-sphere frame of the z axis
   const double expected = std::numbers::pi * 0.8 * 1.6 * c * (2.0 / 3.0 - zc + zc * zc * zc / 3.0);
@@ -268,6 +280,38 @@ TEST(Section, SceneObjectsAreCutInWorldSpaceWhateverTheirTransform) {
   EXPECT_THROW((void)sectionedScene(scene), Error);
   scene.section->normal = {0.0, 0.0, 0.0};
   EXPECT_THROW(scene.validate(), Error);
+}
+
+// The report's cross-section areas are the caps' world areas: a cylinder of n sides (axis y, radius
+// r, height 1) cut across its axis has the regular n-gon's area n/2 · r² · sin(2π/n), scaled by the
+// transform's x and z scale, and keeps that area times the height left; a unit box cut by the
+// oblique plane x = z + 0.1 keeps a prism of ½ · 0.9² × 1 over a 0.9·√2 × 1 rectangle.
+TEST(Section, CrossSectionAreasAreTheCapsWorldAreas) {
+  const int sides = 24;
+  const double r = 0.5;
+  const glm::dmat4 stretched = glm::scale(glm::translate(glm::dmat4(1.0), {4.0, 1.0, 0.0}), {2.0, 3.0, 1.5});
+  Scene scene;
+  scene.name = "cylinder and box";
+  scene.objects.push_back(object("cylinder", makeCylinder(r, 1.0, sides), stretched));
+  scene.objects.push_back(object("box", makeBox({1.0, 1.0, 1.0}), glm::dmat4(1.0)));
+  scene.section = SectionPlane{{0.0, 1.39, 0.0}, {0.0, -1.0, 0.0}, true};  // keeps y ≤ 1.39
+  SectionReport report;
+  Scene cut = sectionedScene(scene, &report);
+  ASSERT_EQ(report.outcomes.size(), 2u);
+  EXPECT_EQ(report.outcomes[0], SectionOutcome::kCapped);
+  EXPECT_EQ(report.outcomes[1], SectionOutcome::kKept);  // the box lies below the plane
+  const double polygon = 0.5 * sides * r * r * std::sin(2.0 * std::numbers::pi / sides) * 2.0 * 1.5;
+  EXPECT_NEAR(report.capAreas[0], polygon, 1e-6 * polygon);
+  EXPECT_NEAR(report.totalCapArea(), polygon, 1e-6 * polygon);
+  // World y of the cylinder: 1 + 3·[-0.5, 0.5] = [-0.5, 2.5]; kept up to 1.39.
+  EXPECT_NEAR(signedVolume(*cut.objects[0].mesh, stretched), polygon * (1.39 + 0.5), 1e-5);
+
+  scene.section = SectionPlane{{0.1, 0.0, 0.0}, {1.0, 0.0, -1.0}, true};  // keeps x ≥ z + 0.1
+  cut = sectionedScene(scene, &report);
+  EXPECT_EQ(report.outcomes[0], SectionOutcome::kKept);  // the cylinder lies at x ≥ 3, z ≤ 0.75
+  EXPECT_EQ(report.outcomes[1], SectionOutcome::kCapped);
+  EXPECT_NEAR(report.capAreas[1], 0.9 * std::sqrt(2.0), 1e-6);                    // 0.9·√2 × 1
+  EXPECT_NEAR(signedVolume(*cut.objects[1].mesh, glm::dmat4(1.0)), 0.405, 1e-6);  // ½ · 0.9² × 1
 }
 
 // An L-shaped prism, y in [0, 1]: [0, 2] × [0, 1] in x × z below, [0, 1] × [1, 2] above, so its
@@ -398,6 +442,15 @@ TEST(Section, ASolidSplitOverTwoPartsIsCappedOnce) {
     EXPECT_NEAR(signedVolume(joined), 0.4, 1e-6);
     EXPECT_GT(capTriangles[0] + capTriangles[1], 0u);
     EXPECT_TRUE(capTriangles[0] == 0 || capTriangles[1] == 0);  // one cap, on one part
+    // The cross-section, the box's unit square, is reported once, on the part holding the cap.
+    ASSERT_EQ(report.capAreas.size(), 3u);
+    EXPECT_NEAR(report.capAreas[0] + report.capAreas[1], 1.0, 1e-6);
+    EXPECT_EQ(report.capAreas[capTriangles[0] > 0 ? 1 : 0], 0.0);
+    EXPECT_EQ(report.capAreas[2], 0.0);
+    EXPECT_NEAR(report.totalCapArea(), 1.0, 1e-6);
+    EXPECT_EQ(report.outcomes[0], SectionOutcome::kCapped);
+    EXPECT_EQ(report.outcomes[1], SectionOutcome::kCapped);
+    EXPECT_EQ(report.outcomes[2], SectionOutcome::kCut);
     // Caps off: no joint cap either.
     scene.section->caps = false;
     (void)sectionedScene(scene, &report);

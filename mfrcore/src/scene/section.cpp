@@ -460,7 +460,28 @@ std::vector<bool> capJointly(std::vector<Object>& objects, std::vector<OpenCut>&
   return capped;
 }
 
+// The world area of the cap: the last capTriangles triangles of the cut mesh.
+double capArea(const SectionedMesh& cut, const glm::dmat4& transform) {
+  const Mesh& m = cut.mesh;
+  double area = 0.0;
+  const std::size_t triangles = m.triangleCount();
+  for (std::size_t t = triangles - std::min(cut.capTriangles, triangles); t < triangles; ++t) {
+    glm::dvec3 p[3];
+    for (int c = 0; c < 3; ++c)
+      p[c] = glm::dvec3(transform *
+                        glm::dvec4(glm::dvec3(m.positions[m.indices[3 * t + static_cast<std::size_t>(c)]]), 1.0));
+    area += 0.5 * glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+  }
+  return area;
+}
+
 }  // namespace
+
+double SectionReport::totalCapArea() const {
+  double sum = 0.0;
+  for (const double a : capAreas) sum += a;
+  return sum;
+}
 
 std::vector<glm::dvec3> volumeSlicePolygon(const Volume& volume, const glm::dvec4& plane) {
   if (!volume.grid) return {};
@@ -546,6 +567,8 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
   Scene out = scene;
   out.sectionCut = true;
   SectionReport local;
+  local.outcomes.assign(out.objects.size(), SectionOutcome::kKept);
+  local.capAreas.assign(out.objects.size(), 0.0);
   std::vector<OpenCut> open;
   for (std::size_t i = 0; i < out.objects.size(); ++i) {
     Object& object = out.objects[i];
@@ -556,6 +579,7 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
     const glm::dvec4 plane(glm::transpose(a) * n, glm::dot(n, t) + world.w);
     if (!(glm::length(glm::dvec3(plane)) > 0.0)) continue;  // a flattened object: left as it is
     SectionedMesh cut = sectionMesh(*object.mesh, plane, scene.section->caps);
+    local.outcomes[i] = cut.outcome;
     switch (cut.outcome) {
       case SectionOutcome::kKept:
         break;
@@ -581,6 +605,7 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
           break;
         }
         if (scene.section->caps && cut.outcome == SectionOutcome::kCut) local.open.push_back(object.name);
+        if (cut.outcome == SectionOutcome::kCapped) local.capAreas[i] = capArea(cut, object.transform);
         object.mesh = std::make_shared<const Mesh>(std::move(cut.mesh));
         break;
     }
@@ -588,10 +613,13 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
   const std::vector<bool> joint = capJointly(out.objects, open, -glm::normalize(n));
   for (std::size_t k = 0; k < open.size(); ++k) {
     Object& object = out.objects[open[k].object];
-    if (joint[k])
+    if (joint[k]) {
       ++local.capped;
-    else
+      local.outcomes[open[k].object] = SectionOutcome::kCapped;
+      local.capAreas[open[k].object] = capArea(open[k].cut, object.transform);  // 0 but on the cap's owner
+    } else {
       local.open.push_back(object.name);
+    }
     object.mesh = std::make_shared<const Mesh>(std::move(open[k].cut.mesh));
   }
   if (scene.section->slice) {
