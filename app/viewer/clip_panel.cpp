@@ -224,6 +224,8 @@ void ClipPanel::showModel() {
       QString names;
       if (section->caps) {
         text += tr(", %1 capped").arg(report.capped);
+        // The caps' area: the cut solids' cross-section (mfr info --section per part).
+        if (report.totalCapArea() > 0.0) text += tr(", cross-section %1").arg(report.totalCapArea(), 0, 'g', 6);
         if (!report.open.empty()) {
           text += tr("; %1 open along the cut, without a cap").arg(report.open.size());
           for (const std::string& name : report.open) names += QString::fromStdString(name) + QLatin1Char('\n');

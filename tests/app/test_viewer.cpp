@@ -3342,6 +3342,9 @@ class ViewerTest : public QObject {
              qPrintable(reportLabel->text()));
     QVERIFY2(reportLabel->text().contains(QStringLiteral("%1 capped").arg(report.capped)),
              qPrintable(reportLabel->text()));
+    QVERIFY(report.totalCapArea() > 0.0);
+    QVERIFY2(reportLabel->text().contains(QStringLiteral("cross-section %1").arg(report.totalCapArea(), 0, 'g', 6)),
+             qPrintable(reportLabel->text()));
     QCOMPARE(reportLabel->toolTip().isEmpty(), report.open.empty());
     QCOMPARE(plane.point.x, b.min.x + (b.max.x - b.min.x) * 400 / 1000);
     QVERIFY(plane.caps);
