@@ -308,11 +308,12 @@ std::optional<ContourLegend> ContourOptions::apply(Scene& scene, double sceneOpa
 
 namespace {
 
-void cutBySection(Scene& scene, SectionReport& report) {
+// `what`: the option that asked for the section, or "section" for the scene file's own.
+void cutBySection(Scene& scene, SectionReport& report, const std::string& what) {
   report = {};
   if (!scene.section || scene.sectionCut) return;
   if (scene.section->slice && scene.volumes.empty())
-    throw Error("section", "slice: scene '" + scene.name + "' has no volume");
+    throw Error(what, "slice: scene '" + scene.name + "' has no volume");
   scene = sectionedScene(scene, &report);
   if (scene.section->slice && report.slices == 0)
     std::cerr << "note: section: the plane misses every volume's box, so there is no slice\n";
@@ -335,7 +336,7 @@ void applySectionOption(Scene& scene, const std::string& text, SectionReport* re
     return;
   }
   if (text.empty()) {
-    cutBySection(scene, out);
+    cutBySection(scene, out, "section");
     return;
   }
   const std::string what = "--section " + text;
@@ -376,7 +377,7 @@ void applySectionOption(Scene& scene, const std::string& text, SectionReport* re
     if (!(glm::length(section.normal) > 0.0)) throw Error(what, "the normal must not be zero");
   }
   scene.section = section;
-  cutBySection(scene, out);
+  cutBySection(scene, out, what);
 }
 
 }  // namespace mfr::cli

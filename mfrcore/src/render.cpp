@@ -165,8 +165,9 @@ RenderOutput renderOptimalK(const Scene& scene, const Camera& camera, const Rend
   const VariableKLayout layout = variableKLayout(pixels);
   if (budgetBytes < layout.bytes(1))
     throw Error("--param budget_mib=" + params.text("budget_mib"),
-                "below what optimal-k's variable-k layout needs at " + std::to_string(request.width) + "x" +
-                    std::to_string(request.height) + " (" + std::to_string(layout.bytes(1)) + " bytes)");
+                "below the fixed part of optimal-k's variable-k layout at " + std::to_string(request.width) + "x" +
+                    std::to_string(request.height) + " (" + std::to_string(layout.bytes(1)) +
+                    " bytes with one slot; it needs a slot per non-empty pixel)");
   const FragmentLists lists = castFragments(scene, camera, request.width, request.height);
   const HybridErrorTable errors = hybridErrorTable(lists, scene.background);
   const std::uint64_t slots = std::min<std::uint64_t>(layout.slotBudget(budgetBytes), lists.fragments.size());
@@ -174,7 +175,8 @@ RenderOutput renderOptimalK(const Scene& scene, const Camera& camera, const Rend
   if (slots < nonEmpty)
     throw Error("--param budget_mib=" + params.text("budget_mib"),
                 "holds " + std::to_string(slots) + " slots, fewer than the " + std::to_string(nonEmpty) +
-                    " non-empty pixels: optimal-k needs one per non-empty pixel");
+                    " non-empty pixels: optimal-k needs one per non-empty pixel (" +
+                    std::to_string(layout.bytes(nonEmpty)) + " bytes here)");
   std::string solver;
   const KAllocation best = optimalKBest(errors, slots, &solver);
   RenderOutput out;

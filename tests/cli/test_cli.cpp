@@ -6,7 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <map>
+#include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -434,6 +436,35 @@ TEST_F(Cli, BudgetCommandsBadInput) {
   expectCleanFailure("render @sample -s 16x16 -m vkb -p budget_mib=0", "--param budget_mib=0");
   expectCleanFailure("render @sample -s 16x16 -m fkb -p budget_mib=0.001", "--param budget_mib=0.001");
   expectCleanFailure("render @sample -s 16x16 -m optimal-k --op oit", "--op oit");
+  // optimal-k's two refusals say what they need, and that much is enough: below the layout's fixed
+  // part, then below a slot per non-empty pixel (after the cast), then it renders.
+  {
+    const fs::path png = dir() / "optimal.png";
+    const auto bytesIn = [](const std::string& out, const std::string& before) {
+      const std::size_t at = out.rfind(before);
+      if (at == std::string::npos) return std::uint64_t{0};
+      const std::size_t open = out.rfind('(', at);
+      return static_cast<std::uint64_t>(std::stoull(out.substr(open + 1, at - open - 1)));
+    };
+    const auto mib = [](std::uint64_t bytes) {
+      std::ostringstream text;
+      text << std::setprecision(17) << (static_cast<double>(bytes) + 0.5) / (1024.0 * 1024.0);
+      return text.str();
+    };
+    CliResult r = runCli("render @sample -s 48x40 -m optimal-k -p budget_mib=0.0001 -o " + png.string());
+    ASSERT_EQ(r.exitCode, 1) << r.out;
+    const std::uint64_t fixed = bytesIn(r.out, " bytes with one slot");
+    ASSERT_GT(fixed, 0u) << r.out;
+    r = runCli("render @sample -s 48x40 -m optimal-k -p budget_mib=" + mib(fixed) + " -o " + png.string());
+    ASSERT_EQ(r.exitCode, 1) << r.out;
+    EXPECT_NE(r.out.find("fewer than the"), std::string::npos) << r.out;
+    const std::uint64_t needed = bytesIn(r.out, " bytes here");
+    ASSERT_GT(needed, fixed) << r.out;
+    EXPECT_FALSE(fs::exists(png));
+    r = runCli("render @sample -s 48x40 -m optimal-k -p budget_mib=" + mib(needed) + " -o " + png.string());
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_TRUE(fs::exists(png));
+  }
   // evaluate writes no PNG; its --json must not appear on failure.
   const fs::path json = dir() / "e.json";
   for (const auto& [args, mention] :
