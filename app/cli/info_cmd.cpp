@@ -1,6 +1,5 @@
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -49,11 +48,6 @@ void addInfo(CLI::App& app) {
     applySectionOption(scene, opt->section, &section);
     const bool sectioned = !section.outcomes.empty();
     const auto outcome = [&](std::size_t i) { return sectioned ? section.outcomes[i] : SectionOutcome::kKept; };
-    const auto sixDigits = [](double v) {  // describeSurface's number format
-      std::ostringstream text;
-      text << v;
-      return text.str();
-    };
     std::vector<SurfaceMeasures> measures;
     for (const Object& o : scene.objects) measures.push_back(measureSurface(*o.mesh, o.transform));
     nlohmann::ordered_json j;
@@ -126,15 +120,10 @@ void addInfo(CLI::App& app) {
       // Its surface in the world: area, and the volume it encloses when it is closed — as cut by the
       // section, whose cap makes a cut solid closed: the volume kept, and the cut's area.
       if (outcome(i) == SectionOutcome::kRemoved)
-        std::cout << "    removed by the section\n";
+        std::cout << "    " << describeCut(outcome(i), 0.0) << "\n";
       else
         std::cout << "    " << describeSurface(measures[i])
-                  << (outcome(i) == SectionOutcome::kCapped && section.capAreas[i] > 0.0
-                          ? "; cut, cross-section area " + sixDigits(section.capAreas[i])
-                      : outcome(i) == SectionOutcome::kCut    ? "; cut"
-                      : outcome(i) == SectionOutcome::kCapped ? "; cut, capped with another part"
-                                                              : "")
-                  << "\n";
+                  << describeCut(outcome(i), sectioned ? section.capAreas[i] : 0.0) << "\n";
       if (!o.mesh->fields.empty()) {
         // What --color-by can use, with each field's range (cell data marked).
         std::cout << "    fields:";

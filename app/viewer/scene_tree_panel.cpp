@@ -39,18 +39,35 @@ QString colourText(const mfr::Object& o) {
 
 // A part's row. Its Triangles cell's tooltip measures the part's surface in the world
 // (mfr::measureSurface, as mfr info prints it) the first time it is asked for, not at every rebuild:
-// a CT's surfaces take a fraction of a second each.
+// a CT's surfaces take a fraction of a second each. With a section plane it measures the part as
+// drawn — a capped solid's kept volume and cross-section, as mfr info --section — and the whole
+// part below; measured again after an edit (the cut may have changed).
 class PartItem final : public QTreeWidgetItem {
  public:
   PartItem(const ViewerModel& model, int index) : model_(model), index_(index) {}
   [[nodiscard]] QVariant data(int column, int role) const override {
     if (column != kTriangles || role != Qt::ToolTipRole) return QTreeWidgetItem::data(column, role);
-    if (measured_.isEmpty()) {
-      const auto& objects = model_.scene().objects;
-      if (index_ < 0 || index_ >= static_cast<int>(objects.size()) || !objects[static_cast<std::size_t>(index_)].mesh)
-        return {};
-      const mfr::Object& o = objects[static_cast<std::size_t>(index_)];
-      measured_ = QString::fromStdString(mfr::describeSurface(mfr::measureSurface(*o.mesh, o.transform)));
+    const auto i = static_cast<std::size_t>(index_);
+    const auto& objects = model_.scene().objects;
+    if (index_ < 0 || i >= objects.size() || !objects[i].mesh) return {};
+    const mfr::Object& whole = objects[i];
+    const mfr::SectionReport& report = model_.sectionReport();
+    const mfr::Scene& drawn = model_.drawnScene();
+    const bool sectioned = &drawn != &model_.scene() && i < report.outcomes.size() && i < drawn.objects.size();
+    const mfr::SectionOutcome outcome = sectioned ? report.outcomes[i] : mfr::SectionOutcome::kKept;
+    const mfr::Mesh* shown = sectioned ? drawn.objects[i].mesh.get() : whole.mesh.get();
+    // The model's revision: every edit (a section moved included) makes a new cut.
+    if (measured_.isEmpty() || measuredRevision_ != model_.sceneRevision()) {
+      const std::string wholeText = mfr::describeSurface(mfr::measureSurface(*whole.mesh, whole.transform));
+      if (outcome == mfr::SectionOutcome::kKept)
+        measured_ = QString::fromStdString(wholeText);
+      else if (outcome == mfr::SectionOutcome::kRemoved)
+        measured_ = QString::fromStdString(mfr::describeCut(outcome, 0.0) + "\nwhole part: " + wholeText);
+      else
+        measured_ =
+            QString::fromStdString(mfr::describeSurface(mfr::measureSurface(*shown, drawn.objects[i].transform)) +
+                                   mfr::describeCut(outcome, report.capAreas[i]) + "\nwhole part: " + wholeText);
+      measuredRevision_ = model_.sceneRevision();
     }
     return measured_;
   }
@@ -59,6 +76,7 @@ class PartItem final : public QTreeWidgetItem {
   const ViewerModel& model_;
   int index_;
   mutable QString measured_;
+  mutable quint64 measuredRevision_ = 0;
 };
 
 QIcon swatch(const QColor& colour) {

@@ -39,6 +39,7 @@
 #include "probe_panel.hpp"
 #include "session.hpp"
 #include "mfr/scene/color_map.hpp"
+#include "mfr/scene/measure.hpp"
 #include "mfr/scene/section.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
@@ -3345,6 +3346,25 @@ class ViewerTest : public QObject {
     QVERIFY(report.totalCapArea() > 0.0);
     QVERIFY2(reportLabel->text().contains(QStringLiteral("cross-section %1").arg(report.totalCapArea(), 0, 'g', 6)),
              qPrintable(reportLabel->text()));
+    // A capped part's Triangles tooltip measures it as cut (mfr info --section), then the whole part.
+    {
+      const auto capped =
+          std::find_if(report.capAreas.begin(), report.capAreas.end(), [](double a) { return a > 0.0; });
+      QVERIFY(capped != report.capAreas.end());
+      const auto i = static_cast<std::size_t>(capped - report.capAreas.begin());
+      const mfr::Object& cutPart = m.drawnScene().objects[i];
+      const mfr::Object& wholePart = m.scene().objects[i];
+      const QList<QTreeWidgetItem*> rows =
+          w->findChild<QTreeWidget*>("sceneTree")
+              ->findItems(QString::fromStdString(wholePart.name), Qt::MatchExactly | Qt::MatchRecursive);
+      QVERIFY(!rows.isEmpty());
+      const QString expected =
+          QString::fromStdString(mfr::describeSurface(mfr::measureSurface(*cutPart.mesh, cutPart.transform)) +
+                                 mfr::describeCut(mfr::SectionOutcome::kCapped, *capped) + "\nwhole part: " +
+                                 mfr::describeSurface(mfr::measureSurface(*wholePart.mesh, wholePart.transform)));
+      QCOMPARE(rows[0]->data(3, Qt::ToolTipRole).toString(), expected);
+      QVERIFY(expected.contains(QStringLiteral("; cut, cross-section area ")));
+    }
     QCOMPARE(reportLabel->toolTip().isEmpty(), report.open.empty());
     QCOMPARE(plane.point.x, b.min.x + (b.max.x - b.min.x) * 400 / 1000);
     QVERIFY(plane.caps);

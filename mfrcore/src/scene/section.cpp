@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <tuple>
 #include <unordered_map>
 #include <utility>
@@ -476,6 +477,23 @@ double capArea(const SectionedMesh& cut, const glm::dmat4& transform) {
 }
 
 }  // namespace
+
+std::string describeCut(SectionOutcome outcome, double capArea) {
+  switch (outcome) {
+    case SectionOutcome::kKept:
+      return {};
+    case SectionOutcome::kRemoved:
+      return "removed by the section";
+    case SectionOutcome::kCut:
+      return "; cut";
+    case SectionOutcome::kCapped:
+      break;
+  }
+  if (!(capArea > 0.0)) return "; cut, capped with another part";
+  std::ostringstream text;  // describeSurface's format: six significant digits
+  text << "; cut, cross-section area " << capArea;
+  return text.str();
+}
 
 double SectionReport::totalCapArea() const {
   double sum = 0.0;

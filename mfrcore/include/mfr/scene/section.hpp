@@ -82,6 +82,12 @@ std::vector<glm::dvec3> volumeSlicePolygon(const Volume& volume, const glm::dvec
 // mfr::Error("section plane", …) when nothing visible is left.
 Scene sectionedScene(const Scene& scene, SectionReport* report = nullptr);
 
+// What mfr info and the viewer's scene tree add after a part's measures (describeSurface) when a
+// section cut it: "; cut, cross-section area 4" (capped; six significant digits), "; cut, capped
+// with another part" (capped jointly, the cap on another part), "; cut" (no cap); "" when kept. A
+// removed part has no measures: "removed by the section" is the whole line.
+std::string describeCut(SectionOutcome outcome, double capArea);
+
 // The plane of a section as (n, d), n unit length, kept where dot(n, p) + d >= 0 (world space).
 glm::dvec4 sectionPlaneEquation(const SectionPlane& plane);
 
