@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -8,7 +9,10 @@
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
+#include "mfr/gpu_renderer.hpp"
 #include "mfr/legend.hpp"
+#include "mfr/reference/metrics.hpp"
+#include "mfr/reference/oracle.hpp"
 #include "mfr/render.hpp"
 
 namespace mfr::cli {
@@ -18,13 +22,14 @@ void addRender(CLI::App& app) {
     ColorByOptions colorBy;
     ContourOptions contours;
     std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats, clip, section,
-                       field;
+                       field, dataView;
     std::vector<std::string> params;
     double opacity = -1.0;
     double thickness = 0.0;
     double step = 0.0;
     bool shade = false;
     bool legend = false;
+    bool blend = false;
   };
   auto opt = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method and write a PNG (and stats JSON)");
@@ -48,6 +53,12 @@ void addRender(CLI::App& app) {
   cmd->add_flag("--legend", opt->legend,
                 "Draw the colour map of --color-by (or the scene's color_by) with its field and values in the lower "
                 "right corner, as ParaView's scalar bar");
+  cmd->add_option("--data-view", opt->dataView,
+                  "Write a per-pixel count instead of the image, as mfrview's data views (magma over 0 … its "
+                  "largest value; --legend names it): depth-complexity (n(p), the fragments each pixel receives) or "
+                  "capacity (k(p), the slots the method gave each pixel)")
+      ->check(CLI::IsMember({"depth-complexity", "capacity"}));
+  cmd->add_flag("--blend", opt->blend, "With --data-view: the map over the image, 1:1 (empty pixels show the image)");
   cmd->add_option("--clip", opt->clip, kClipHelp);
   opt->colorBy.add(cmd);
   opt->contours.add(cmd);
@@ -85,9 +96,16 @@ void addRender(CLI::App& app) {
       if (scene.volumes.empty()) throw Error("--shade", "scene '" + scene.name + "' has no volume");
       req.volumeShading = true;
     }
+    if (opt->blend && opt->dataView.empty()) throw Error("--blend", "needs --data-view");
+    if (opt->dataView == "capacity" && opt->method == "oracle")
+      throw Error("--data-view capacity", "the oracle keeps every fragment: it has no k(p) (use a method that does)");
     // --legend: the field colouring's map, else the isosurfaces' (ticked at their values).
     std::optional<ContourLegend> legend;
-    if (opt->legend) {
+    if (opt->legend && !opt->dataView.empty()) {
+      if (w < kMinLegendImageSize || h < kMinLegendImageSize)
+        throw Error("--legend", "the image " + opt->size + " is too small for one: at least " +
+                                    std::to_string(kMinLegendImageSize) + " pixels a side");
+    } else if (opt->legend) {
       for (const Object& o : scene.objects)
         if (o.material.fieldColors) {
           legend = ContourLegend{*o.material.fieldColors, {}};
@@ -104,7 +122,35 @@ void addRender(CLI::App& app) {
     }
     const Camera camera = scene.view(opt->view);
     RenderOutput out = render(scene, camera, req);
-    if (legend) drawColorLegend(out.image, legend->colors, scene.background, legend->ticks);
+    if (!opt->dataView.empty()) {
+      // n(p): the GPU's count pass for a GPU method, the oracle's lists for the CPU ones; k(p): the
+      // method's own (GpuRenderer::kMap, optimal-k's allocation).
+      const bool cpu = req.method == "oracle" || req.method == "optimal-k";
+      const bool depth = opt->dataView == "depth-complexity";
+      std::vector<std::uint32_t> counts;
+      if (depth && cpu) {
+        const FragmentLists lists = castFragments(scene, camera, w, h);
+        counts.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+        for (int y = 0; y < h; ++y)
+          for (int x = 0; x < w; ++x) counts[lists.index(x, y)] = lists.count(x, y);
+      } else if (depth) {
+        counts = headlessRenderer().depthComplexity(camera, w, h);
+      } else {
+        counts = cpu ? out.kMap : headlessRenderer().kMap();
+      }
+      if (counts.size() != static_cast<std::size_t>(w) * static_cast<std::size_t>(h))
+        throw Error("--data-view capacity", "method " + req.method + " has no per-pixel capacity k(p)");
+      const auto [lo, hi] = std::minmax_element(counts.begin(), counts.end());
+      const std::string name = depth ? "n(p)" : "k(p)";
+      out.stats.notes.emplace_back("data view", name + " " + std::to_string(*lo) + " … " + std::to_string(*hi));
+      out.image = countHeatmap(counts, w, h, opt->blend ? &out.image : nullptr);
+      if (opt->legend)
+        drawColorLegend(out.image, FieldColors{name, "magma", glm::dvec2(0.0, std::max<std::uint32_t>(1, *hi))},
+                        scene.background);
+      std::cout << (depth ? "depth complexity " : "capacity ") << name << ": " << *lo << " … " << *hi << "\n";
+    } else if (legend) {
+      drawColorLegend(out.image, legend->colors, scene.background, legend->ticks);
+    }
     // Both outputs are produced before either is written, and each is written atomically.
     writePng(opt->output, out.image);
     if (!opt->stats.empty()) writeFileAtomically(opt->stats, toJson(out.stats) + "\n");

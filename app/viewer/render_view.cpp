@@ -25,18 +25,7 @@ const char* sideName(int side) {
 // The heat map of a data map (magma over 0 … max); over `image` (same size) it is blended 1:1
 // where the value is non-zero and leaves the image alone where it is zero.
 mfr::ImageRGBA8 colourise(const RenderView::DataMap& map, const mfr::ImageRGBA8* image) {
-  mfr::ImageF values(map.width, map.height, 1);
-  for (std::size_t i = 0; i < map.values.size(); ++i) values.data[i] = static_cast<float>(map.values[i]);
-  mfr::ImageRGBA8 heat = mfr::heatmap(values, static_cast<float>(std::max<std::uint32_t>(1, map.maxValue)));
-  if (!image) return heat;
-  for (std::size_t i = 0; i < map.values.size(); ++i) {
-    std::uint8_t* out = &heat.pixels[i * 4];
-    const std::uint8_t* in = &image->pixels[i * 4];
-    for (int c = 0; c < 3; ++c)
-      out[c] = map.values[i] == 0 ? in[c] : static_cast<std::uint8_t>((in[c] + out[c] + 1) / 2);
-    out[3] = 255;
-  }
-  return heat;
+  return mfr::countHeatmap(map.values, map.width, map.height, image);
 }
 
 }  // namespace

@@ -208,4 +208,29 @@ ImageRGBA8 heatmap(const ImageF& values, float maxValue) {
   return magma(scaled);
 }
 
+ImageRGBA8 countHeatmap(const std::vector<std::uint32_t>& counts, int width, int height, const ImageRGBA8* under) {
+  const std::size_t pixels =
+      static_cast<std::size_t>(std::max(width, 0)) * static_cast<std::size_t>(std::max(height, 0));
+  if (counts.size() != pixels || pixels == 0)
+    throw Error("count map", "has " + std::to_string(counts.size()) + " values for " + std::to_string(width) + "x" +
+                                 std::to_string(height) + " pixels");
+  if (under && (under->width != width || under->height != height))
+    throw Error("count map", "the image under it has another size");
+  ImageF values(width, height, 1);
+  std::uint32_t largest = 1;
+  for (std::size_t i = 0; i < pixels; ++i) {
+    values.data[i] = static_cast<float>(counts[i]);
+    largest = std::max(largest, counts[i]);
+  }
+  ImageRGBA8 heat = heatmap(values, static_cast<float>(largest));
+  if (!under) return heat;
+  for (std::size_t i = 0; i < pixels; ++i) {
+    std::uint8_t* out = &heat.pixels[i * 4];
+    const std::uint8_t* in = &under->pixels[i * 4];
+    for (int c = 0; c < 3; ++c) out[c] = counts[i] == 0 ? in[c] : static_cast<std::uint8_t>((in[c] + out[c] + 1) / 2);
+    out[3] = 255;
+  }
+  return heat;
+}
+
 }  // namespace mfr

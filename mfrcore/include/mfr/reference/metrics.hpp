@@ -1,6 +1,9 @@
 #pragma once
 // Image-quality metrics against a reference: RMSE and FLIP (Andersson et al., "FLIP: A Difference
 // Evaluator for Alternating Images", Proc. ACM CGIT 3(2), 2020), plus error heat maps.
+#include <cstdint>
+#include <vector>
+
 #include <glm/glm.hpp>
 
 #include "mfr/image.hpp"
@@ -38,6 +41,12 @@ ImageRGBA8 magma(const ImageF& values);  // values in [0,1]
 // map for surfaces coloured by a field (scene/color_map.hpp).
 glm::vec3 magmaEntry(int index);
 ImageRGBA8 heatmap(const ImageF& values, float maxValue);
+// A per-pixel count — depth complexity n(p), capacity k(p) — as mfrview's data views and mfr render
+// --data-view show it: heatmap over 0 … max(1, largest count); with `under` (an image of the same
+// size) every pixel with a count averaged with it, empty pixels left as it is (the views' Blend).
+// Throws mfr::Error for counts that are not width·height or an `under` of another size.
+ImageRGBA8 countHeatmap(const std::vector<std::uint32_t>& counts, int width, int height,
+                        const ImageRGBA8* under = nullptr);
 
 // Per-pixel absolute RGB difference (max over channels, in [0,1]) — input to heatmap().
 ImageF absoluteDifference(const ImageRGBA8& reference, const ImageRGBA8& test);
