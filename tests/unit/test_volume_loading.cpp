@@ -563,6 +563,30 @@ TEST_F(VolumeLoading, BadVti) {
       "spacing must be non-zero");
 }
 
+// VTK 9.1's XML reader crashes on a String array: such arrays are skipped (the numbers beside them
+// are read), asked for by name they are refused, and a file with nothing else has no samples.
+TEST_F(VolumeLoading, VtiTextArraysAreSkippedNotRead) {
+  const std::string numbers = dataArray("Float32", "f", asciiValues(4, 3, 2));
+  std::string words;
+  for (int n = 0; n < 24; ++n) words += "w" + std::to_string(n) + " ";
+  const std::string text = dataArray("String", "label", words);
+  for (const std::string& arrays : {text + numbers, numbers + text}) {
+    const fs::path path = write("mixed.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", arrays));
+    const mfr::Volume v = mfr::loadVolume(path);
+    EXPECT_EQ(v.field, "f");
+    expectField(v, {4, 3, 2});
+    EXPECT_NE(errorOf([&] {
+                (void)mfr::loadVolume(path, mfr::LoadOptions{"label"});
+              }).find("mixed.vti: array 'label' holds text, not numbers"),
+              std::string::npos);
+  }
+  expectVolumeError(write("text.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", text)),
+                    "no point-data or cell-data scalar array");
+  const mfr::Volume cellText = mfr::loadVolume(write(
+      "celltext.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", numbers, dataArray("String", "names", "a b c d e f"))));
+  EXPECT_EQ(cellText.field, "f");  // the cell data's text skipped, the point data read
+}
+
 TEST_F(VolumeLoading, BadLegacyMetaImageAndNrrd) {
   const std::string head =
       "# vtk DataFile Version 3.0\ng\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\n"

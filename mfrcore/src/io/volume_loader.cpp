@@ -35,6 +35,7 @@
 #include <vtkCellData.h>
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
+#include <vtkDataArraySelection.h>
 #include <vtkDataSetAttributes.h>
 #include <vtkFieldData.h>
 #include <vtkImageData.h>
@@ -435,6 +436,60 @@ SampleArray sampleArray(vtkImageData* image, const std::string& name, const std:
   throw Error(name, "image has no point-data or cell-data scalar array");
 }
 
+// VTK 9.1's XML image reader crashes on a DataArray of type String in the point or cell data:
+// such arrays (text, never samples) are found in the XML, which comes before any appended binary
+// data, and left unread. (name, whether it is cell data); FieldData's are refused, as VTK cannot
+// be told to skip them.
+std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, const std::string& name) {
+  std::ifstream in(path, std::ios::binary);
+  std::string xml;
+  std::string chunk(1 << 16, '\0');
+  while (in) {
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    xml.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
+    if (const std::size_t appended = xml.find("<AppendedData"); appended != std::string::npos) {
+      xml.resize(appended);
+      break;
+    }
+  }
+  const auto attribute = [](std::string_view tag, std::string_view key) -> std::string {
+    for (std::size_t at = tag.find(key); at != std::string_view::npos; at = tag.find(key, at + 1)) {
+      const bool word = at > 0 && std::isspace(static_cast<unsigned char>(tag[at - 1]));
+      std::size_t i = at + key.size();
+      while (i < tag.size() && std::isspace(static_cast<unsigned char>(tag[i]))) ++i;
+      if (!word || i >= tag.size() || tag[i] != '=') continue;
+      ++i;
+      while (i < tag.size() && std::isspace(static_cast<unsigned char>(tag[i]))) ++i;
+      if (i >= tag.size() || (tag[i] != '"' && tag[i] != '\'')) continue;
+      const std::size_t end = tag.find(tag[i], i + 1);
+      if (end == std::string_view::npos) return {};
+      return std::string(tag.substr(i + 1, end - i - 1));
+    }
+    return {};
+  };
+  std::vector<std::pair<std::string, bool>> found;
+  enum class Section { kNone, kPoints, kCells, kField } section = Section::kNone;
+  for (std::size_t open = xml.find('<'); open != std::string::npos; open = xml.find('<', open + 1)) {
+    const std::size_t close = xml.find('>', open);
+    if (close == std::string::npos) break;
+    const std::string_view tag(xml.data() + open + 1, close - open - 1);
+    const auto is = [&](std::string_view element) {
+      return tag.substr(0, element.size()) == element &&
+             (tag.size() == element.size() || std::isspace(static_cast<unsigned char>(tag[element.size()])) ||
+              tag[element.size()] == '/');
+    };
+    if (is("PointData")) section = Section::kPoints;
+    if (is("CellData")) section = Section::kCells;
+    if (is("FieldData")) section = Section::kField;
+    if (is("/PointData") || is("/CellData") || is("/FieldData")) section = Section::kNone;
+    if (!is("DataArray") || attribute(tag, "type") != "String") continue;
+    if (section == Section::kField)
+      throw Error(name, "field data array '" + attribute(tag, "Name") + "' holds text, which VTK's reader cannot skip");
+    if (section != Section::kNone) found.emplace_back(attribute(tag, "Name"), section == Section::kCells);
+  }
+  return found;
+}
+
 }  // namespace
 
 // The declared size, before anything is allocated for it.
@@ -493,6 +548,12 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
                                              std::int64_t{extent[3]} - extent[2] + 1,
                                              std::int64_t{extent[5]} - extent[4] + 1};
   checkDims(declared, name);
+  if (auto* xml = vtkXMLImageDataReader::SafeDownCast(reader))
+    for (const auto& [array, cells] : xmlStringArrays(path, name)) {
+      if (!field.empty() && (field == array || field.rfind(array + ":", 0) == 0))
+        throw Error(name, "array '" + array + "' holds text, not numbers");
+      (cells ? xml->GetCellDataArraySelection() : xml->GetPointDataArraySelection())->DisableArray(array.c_str());
+    }
   progress.step(0.1);
 
   messages.clear();
