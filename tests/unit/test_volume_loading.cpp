@@ -606,6 +606,16 @@ TEST_F(VolumeLoading, BadLegacyMetaImageAndNrrd) {
   write("data.raw", std::string(40, '\0'));
   expectVolumeError(write("short.mhd", mhd), "cannot read MetaImage");
   expectVolumeError(write("garbage.mhd", "this is not a header\n"), "cannot read MetaImage");
+  // Headers that made vtkMetaImageReader loop forever (NDims negative or huge) or read zeros.
+  for (const char* dims : {"-1", "1e308", "2", "3.5"}) {
+    std::string header = mhd;
+    header.replace(header.find("NDims = 3"), 9, std::string("NDims = ") + dims);
+    expectVolumeError(write("dims.mhd", header), std::string("MetaImage NDims = ") + dims + ": only 3-dimensional");
+  }
+  expectVolumeError(write("channels.mhd",
+                          "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementNumberOfChannels = 0\n"
+                          "ElementType = MET_FLOAT\nElementDataFile = data.raw\n"),
+                    "MetaImage ElementNumberOfChannels = 0: needs a positive count");
   expectVolumeError(write("huge.mha",
                           "ObjectType = Image\nNDims = 3\nDimSize = 5000 5000 5000\nElementType = MET_FLOAT\n"
                           "ElementDataFile = LOCAL\n"),

@@ -275,6 +275,37 @@ std::vector<std::optional<glm::dvec3>> nrrdDirections(const std::string& text, c
   return out;
 }
 
+// vtkMetaImageReader loops forever on a negative or huge NDims and reads zeros for 0 channels:
+// the header's keys are checked first (up to ElementDataFile, its last key).
+void checkMetaImageHeader(const fs::path& path, const std::string& name) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  for (int lines = 0; lines < 4096 && std::getline(in, line); ++lines) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::size_t eq = line.find('=');
+    if (eq == std::string::npos) continue;
+    std::string key = line.substr(0, eq), value = line.substr(eq + 1);
+    const auto trim = [](std::string& t) {
+      t.erase(0, t.find_first_not_of(" \t"));
+      t.erase(t.find_last_not_of(" \t") + 1);
+    };
+    trim(key);
+    trim(value);
+    const auto integer = [&]() -> std::optional<long> {
+      char* end = nullptr;
+      errno = 0;
+      const long v = std::strtol(value.c_str(), &end, 10);
+      if (value.empty() || errno != 0 || end == nullptr || *end != '\0') return std::nullopt;
+      return v;
+    };
+    if (key == "NDims" && integer() != 3L)
+      throw Error(name, "MetaImage NDims = " + value.substr(0, 32) + ": only 3-dimensional images are volumes");
+    if (key == "ElementNumberOfChannels" && !(integer().value_or(0) >= 1))
+      throw Error(name, "MetaImage ElementNumberOfChannels = " + value.substr(0, 32) + ": needs a positive count");
+    if (key == "ElementDataFile") return;
+  }
+}
+
 NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
   NrrdOrientation orientation;
   std::ifstream in(path, std::ios::binary);
@@ -510,6 +541,7 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   const std::string label = formatLabel(format);
   NrrdOrientation nrrd;
   if (format == VolumeFormat::Nrrd) nrrd = checkNrrdHeader(path, name);
+  if (format == VolumeFormat::MetaImage) checkMetaImageHeader(path, name);
   VtkMessages messages;  // before the reader: VTK's output window goes quiet
   std::optional<CerrCapture> metaIo;
   if (format == VolumeFormat::MetaImage) metaIo.emplace();
