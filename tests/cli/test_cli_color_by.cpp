@@ -221,6 +221,13 @@ TEST_F(CliColorBy, BadFieldsMapsAndRangesAreOneLine) {
   expectCleanFailure(render + "--color-by pressure --color-map jet", "--color-map jet: unknown colour map");
   expectCleanFailure(render + "--color-by pressure --color-range 2,1", "--color-range 2,1: expected LO,HI");
   expectCleanFailure(render + "--color-by pressure --color-range 0,nan", "--color-range 0,nan");
+  // Beyond single precision the renderers' map had an infinite span (the oracle indexed its table
+  // with NaN and crashed, with --legend every method).
+  for (const char* range : {"-1e308,1e308", "0,1e39", "1,1.00000001"})
+    for (const char* method : {"oracle", "abuffer-ll"})
+      expectCleanFailure("render " + file.string() + " --size 128x128 -m " + method +
+                             " --color-by pressure --legend --color-range " + range,
+                         "colour range must be two finite values, low < high, within single precision");
   expectCleanFailure(render + "--color-map viridis", "--color-map viridis: needs --color-by");
   expectCleanFailure("render @sample --size 16x16 --color-by pressure", "(it has none)");
   const fs::path bad = write("bad.mfrscene", R"({"objects": [{"file": "sheet.vtp", "color_by": {"field": "nope"}}]})");

@@ -113,7 +113,8 @@ const ColorMap& colorMap(const std::string& name) {
 glm::vec3 mapFieldValue(const ColorMap& map, float value, const glm::vec2& range) {
   if (std::isnan(value)) return map.nanColor;
   const float span = range.y - range.x;
-  const float t = span > 0.0f ? std::clamp((value - range.x) / span, 0.0f, 1.0f) : 0.5f;
+  float t = span > 0.0f && std::isfinite(span) ? std::clamp((value - range.x) / span, 0.0f, 1.0f) : 0.5f;
+  if (std::isnan(t)) t = 0.5f;  // an infinite value in an infinite range: never an index out of the table
   const float x = t * static_cast<float>(MFR_COLOR_MAP_SIZE - 1);
   const int i = std::min(static_cast<int>(x), MFR_COLOR_MAP_SIZE - 2);
   const glm::vec3 a = map.table[static_cast<std::size_t>(i)], b = map.table[static_cast<std::size_t>(i) + 1];
@@ -186,13 +187,26 @@ glm::dvec2 fieldRange(const std::vector<float>& values) {
   return *span;
 }
 
+namespace {
+
+// The renderers map in single precision (shaders, mapFieldValue): both ends and their span must be
+// finite floats.
+bool usableColorRange(const glm::dvec2& range) {
+  const auto low = static_cast<float>(range.x), high = static_cast<float>(range.y);
+  return std::isfinite(range.x) && std::isfinite(range.y) && range.x < range.y && std::isfinite(low) &&
+         std::isfinite(high) && std::isfinite(high - low) && high > low;
+}
+constexpr const char* kColorRangeRule =
+    "colour range must be two finite values, low < high, within single precision (±3.4e38, distinct as floats)";
+
+}  // namespace
+
 void colorByField(Object& object, const std::string& field, const std::string& map,
                   const std::optional<glm::dvec2>& range) {
   const std::string what = object.name.empty() ? std::string("object") : object.name;
   if (!object.mesh) throw Error(what, "has no mesh to colour");
   colorMapIndex(map);  // an unknown name throws
-  if (range && !(std::isfinite(range->x) && std::isfinite(range->y) && range->x < range->y))
-    throw Error(what, "colour range must be two finite values, low < high");
+  if (range && !usableColorRange(*range)) throw Error(what, kColorRangeRule);
   const Mesh& source = *object.mesh;
   FieldValues values = fieldValues(source, field, what);
   auto mesh = std::make_shared<Mesh>();
@@ -305,8 +319,7 @@ glm::dvec2 sharedFieldRange(const std::vector<const Mesh*>& meshes, const std::s
 std::size_t colorObjectsByField(const std::vector<Object*>& objects, const std::string& field, const std::string& map,
                                 const std::optional<glm::dvec2>& range, const std::string& what) {
   colorMapIndex(map);
-  if (range && !(std::isfinite(range->x) && std::isfinite(range->y) && range->x < range->y))
-    throw Error(what, "colour range must be two finite values, low < high");
+  if (range && !usableColorRange(*range)) throw Error(what, kColorRangeRule);
   std::vector<Object*> having;
   std::vector<const Mesh*> meshes;
   std::vector<std::string> available;
