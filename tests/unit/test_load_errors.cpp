@@ -332,6 +332,31 @@ TEST_F(LoadModel, GarbageGlb) {
   expectLoadError(write("garbage.glb", "glTF but not really, just text\n"), "cannot read glb");
 }
 
+// assimp parses glTF's JSON recursively: 200,000 nested arrays overflowed the stack (signal 11).
+// Refused before the import, as .gltf and as a .glb's JSON chunk; brackets inside strings do not count.
+TEST_F(LoadModel, DeeplyNestedGltfJsonIsRefusedNotACrash) {
+  const std::string deep = std::string(200000, '[') + std::string(200000, ']');
+  const std::string gltf = R"({"asset": {"version": "2.0"}, "extras": )" + deep + "}";
+  expectLoadError(write("deep.gltf", gltf), "glTF JSON nested deeper than 512 levels");
+  std::string glb = "glTF";
+  const auto word = [&](std::uint32_t v) { glb.append(reinterpret_cast<const char*>(&v), 4); };
+  word(2);
+  word(static_cast<std::uint32_t>(20 + gltf.size()));
+  word(static_cast<std::uint32_t>(gltf.size()));
+  glb += "JSON" + gltf;
+  expectLoadError(write("deep.glb", glb), "glTF JSON nested deeper than 512 levels");
+  const std::string quoted = R"({"asset": {"version": "2.0"}, "extras": ")" + std::string(2000, '[') + "\"}";
+  const std::string error = [&] {
+    try {
+      (void)mfr::loadModel(write("quoted.gltf", quoted));
+    } catch (const mfr::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  }();
+  EXPECT_EQ(error.find("nested deeper"), std::string::npos) << error;
+}
+
 // ---- small valid files ------------------------------------------------------------------------
 
 TEST_F(LoadModel, AsciiStl) {

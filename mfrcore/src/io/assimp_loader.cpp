@@ -3,11 +3,16 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <iterator>
 #include <streambuf>
 #include <set>
+#include <string_view>
 #include <utility>
 
 #include <assimp/Importer.hpp>
@@ -151,11 +156,57 @@ class ImportProgress final : public Assimp::ProgressHandler {
   bool cancelled_ = false;
 };
 
+// assimp's glTF importers parse JSON with rapidjson's recursive parser: a document nested tens of
+// thousands deep overflows the stack. A real glTF needs a depth of about ten: deeper than
+// kMaxJsonDepth is refused before the import. The JSON is the .gltf file, or a .glb's first chunk.
+constexpr int kMaxJsonDepth = 512;
+
+void checkGltfJsonDepth(const std::filesystem::path& path, const std::string* contents, const std::string& extension,
+                        const std::string& name) {
+  if (extension != ".gltf" && extension != ".glb") return;
+  std::string bytes;
+  if (contents != nullptr) {
+    bytes = *contents;
+  } else {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  std::string_view json(bytes);
+  if (extension == ".glb" || json.substr(0, 4) == "glTF") {
+    if (json.size() < 20) return;  // assimp says what is wrong with it
+    std::uint32_t length = 0;
+    std::memcpy(&length, json.data() + 12, sizeof length);  // little-endian, as every host mfr builds on
+    json = json.substr(20, length);
+  }
+  int depth = 0;
+  bool inString = false, escaped = false;
+  for (const char c : json) {
+    if (inString) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        inString = false;
+      continue;
+    }
+    if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        throw Error(name, "glTF JSON nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std::string* contents,
                                    const std::string& extension, const std::string& name,
                                    const LoadProgress& progress) {
+  checkGltfJsonDepth(path, contents, extension, name);
   Assimp::Importer importer;
   // The importer owns (and deletes) its progress handler; the import takes the first 80 %.
   auto* importProgress = new ImportProgress(progress.part(0.0, 0.8));
