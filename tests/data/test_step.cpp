@@ -523,6 +523,15 @@ TEST(StepBadInput, OneLineErrorsNamingTheFile) {
                             "FILE_NAME('p','',(''),(''),'','','');\nFILE_SCHEMA(('AUTOMOTIVE_DESIGN'));\nENDSEC;\n"
                             "DATA;\n#1=CARTESIAN_POINT('',(0.,0.,0.));\nENDSEC;\nEND-ISO-10303-21;\n"),
                   "no shapes");
+  // An entity id beyond Open CASCADE's 32-bit ints made its model dereference a null entity
+  // (signal 11): refused, naming the line. The largest int is an ordinary id.
+  {
+    ASSERT_NE(screw.find("\n#338 ="), std::string::npos);
+    const std::regex point("#338(?![0-9])");  // the definition and every reference to it
+    expectLoadError(dir.write("bigid.step", std::regex_replace(screw, point, "#2147483648")),
+                    "entity id #2147483648 out of range");
+    EXPECT_NO_THROW((void)mfr::loadModel(dir.write("maxid.step", std::regex_replace(screw, point, "#2147483647"))));
+  }
   // A product whose shape is one edge: nothing to draw.
   const fs::path wire = dir.path() / "wire.step";
   ASSERT_TRUE(writeDemo(wire, /*edgeOnly=*/true));

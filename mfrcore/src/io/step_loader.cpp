@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
@@ -565,7 +566,8 @@ std::string readFile(const std::filesystem::path& path, const std::string& name)
 // Real numbers of magnitude 1e100 or more are infinite to Open CASCADE (Precision::Infinite() is
 // 2e100) and no CAD model has them; in a B-spline's knots, Open CASCADE 7.6's shape healing
 // loops forever on one (found by fuzzing). Such a file is refused: "" when there is none, else
-// where the first one is. Strings, comments, entity ids, keywords and enumerations are skipped.
+// where the first one is; so is an entity id beyond 32 bits. Strings, comments, keywords and
+// enumerations are skipped.
 std::string firstHugeNumber(const std::string& text) {
   std::size_t line = 1;
   const std::size_t n = text.size();
@@ -596,6 +598,17 @@ std::string firstHugeNumber(const std::string& text) {
       line += static_cast<std::size_t>(std::count(text.begin() + static_cast<std::ptrdiff_t>(i),
                                                   text.begin() + static_cast<std::ptrdiff_t>(stop), '\n'));
       i = stop;
+    } else if (c == '#' && isDigit(i + 1)) {
+      // An entity id: Open CASCADE keeps them in a 32-bit int, and one beyond (#2147483648)
+      // made its model dereference a null entity (found by fuzzing).
+      const std::size_t start = i;
+      std::uint64_t id = 0;
+      for (++i; isDigit(i); ++i)
+        id = std::min<std::uint64_t>(id * 10 + static_cast<std::uint64_t>(text[i] - '0'), 1ULL << 40);
+      if (id > static_cast<std::uint64_t>(std::numeric_limits<std::int32_t>::max()))
+        return "line " + std::to_string(line) + ": entity id " +
+               text.substr(start, std::min<std::size_t>(i - start, 24)) + " out of range";
+      for (; isWord(i);) ++i;
     } else if (c == '#' || std::isalpha(static_cast<unsigned char>(c)) != 0 || c == '_') {
       for (++i; isWord(i);) ++i;
     } else if (c == '.' && i + 1 < n && std::isalpha(static_cast<unsigned char>(text[i + 1])) != 0) {
