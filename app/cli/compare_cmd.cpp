@@ -54,6 +54,8 @@ void addCompare(CLI::App& app) {
       if (!opt->heatmap.empty()) heat = magma(f.errorMap);
     }
     if (!opt->heatmap.empty() && heat.empty()) heat = heatmap(absoluteDifference(ref, test), 1.0f);
+    if (!opt->heatmap.empty()) checkOutputPath(opt->heatmap);  // both checked before either is written
+    if (!opt->json.empty()) checkOutputPath(opt->json);
     if (!opt->heatmap.empty()) writePng(opt->heatmap, heat);
     if (!opt->json.empty()) writeFileAtomically(opt->json, j.dump(2) + "\n");
   });

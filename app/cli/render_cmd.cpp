@@ -73,6 +73,9 @@ void addRender(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0));
   cmd->callback([opt, thicknessGiven, stepOption] {
     const auto [w, h] = parseSize("--size", opt->size);
+    // Both outputs checked before the work, so that a bad second path leaves no first file behind.
+    checkOutputPath(opt->output);
+    if (!opt->stats.empty()) checkOutputPath(opt->stats);
     RenderRequest req;
     req.method = opt->method;
     req.operation = opt->op;

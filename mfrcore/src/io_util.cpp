@@ -26,11 +26,21 @@ std::string readFile(const std::filesystem::path& path) {
   return ss.str();
 }
 
-void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
+void checkOutputPath(const std::filesystem::path& path) {
   if (path.empty()) throw Error("output", "empty file name");
   const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec)) throw Error(path.string(), "folder does not exist");
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw Error(path.string(), std::filesystem::is_directory(status)
+                                   ? "is a folder, not a file"
+                                   : "exists and is not a regular file (a device or pipe): not replaced");
+}
+
+void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
+  checkOutputPath(path);
+  std::error_code ec;
   // Temporary beside the target (same file system), renamed over it only when complete.
   std::filesystem::path tmp = path;
   tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(std::random_device{}() & 0xFFFFFF);
@@ -46,8 +56,9 @@ void writeFileAtomically(const std::filesystem::path& path, std::string_view byt
   }
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
+    const std::string why = ec.message();  // before remove() reuses ec
     std::filesystem::remove(tmp, ec);
-    throw Error(path.string(), "cannot replace file (" + ec.message() + ")");
+    throw Error(path.string(), "cannot replace file (" + why + ")");
   }
 }
 

@@ -13,6 +13,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
+
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/image.hpp"
 #include "test_files.hpp"
@@ -90,6 +92,35 @@ TEST_F(Cli, MissingOutputFolder) {
   const CliResult r = runCli("render @sample --size 16x16 -o " + (dir() / "no" / "such" / "dir.png").string());
   EXPECT_EQ(r.exitCode, 1) << r.out;
   EXPECT_NE(r.out.find("folder does not exist"), std::string::npos) << r.out;
+}
+
+// Every output is checked before anything is written: a bad --stats path leaves no PNG behind, and
+// a path that is a folder or a device (a pipe here; /dev/full was replaced by a PNG, found by
+// fuzzing) is refused and left as it is.
+TEST_F(Cli, BadOutputsLeaveNothingAndReplaceNoDevice) {
+  const fs::path png = dir() / "r.png";
+  CliResult r =
+      runCli("render @sample --size 16x16 -o " + png.string() + " --stats " + (dir() / "no" / "s.json").string());
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find("s.json: folder does not exist"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(png));
+  r = runCli("render @sample --size 16x16 -o " + png.string() + " --stats " + dir().string());
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find(": is a folder, not a file"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(png));
+  const fs::path pipe = dir() / "pipe";
+  ASSERT_EQ(::mkfifo(pipe.c_str(), 0600), 0);
+  r = runCli("render @sample --size 16x16 -o " + pipe.string());
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find("pipe: exists and is not a regular file"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::is_fifo(pipe));
+  // compare: the heat map and the JSON alike.
+  mfr::writePng(dir() / "a.png", mfr::ImageRGBA8(4, 4));
+  const fs::path heat = dir() / "heat.png";
+  r = runCli("compare " + (dir() / "a.png").string() + " " + (dir() / "a.png").string() + " --heatmap " +
+             heat.string() + " --json " + (dir() / "no" / "c.json").string());
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_FALSE(fs::exists(heat));
 }
 
 TEST_F(Cli, CompareSizeMismatchAndCorruptPng) {

@@ -6,8 +6,14 @@
 
 namespace mfr {
 
-// Writes bytes to path.tmp-XXXX then renames over path. Throws mfr::Error naming path.
+// Writes bytes to path.tmp-XXXX then renames over path. Throws mfr::Error naming path (and first
+// checkOutputPath's refusals).
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
+// Whether an output could be written there, before anything is: its folder exists, and the path is
+// not something other than a regular file (a folder, a device such as /dev/full, a pipe), which a
+// rename would replace. Commands with several outputs check them all first, so that a bad second
+// path leaves no first file behind. Throws mfr::Error naming path.
+void checkOutputPath(const std::filesystem::path& path);
 
 // Reads a whole file. Throws mfr::Error naming path when missing or unreadable.
 std::string readFile(const std::filesystem::path& path);
