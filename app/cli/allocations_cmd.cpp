@@ -48,7 +48,7 @@ void addAllocations(CLI::App& app) {
   cmd->add_option("--views", opt->views, "Comma-separated views")->capture_default_str();
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--weights", opt->weights, "dkb weights file (default: the built-in weights)");
-  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->add_option("--json", opt->json, "Write all results as JSON");
   cmd->callback([opt] {
     const auto [w, h] = parseSize("--size", opt->size);

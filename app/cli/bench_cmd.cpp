@@ -56,7 +56,7 @@ void addBench(CLI::App& app) {
   opt->contours.add(cmd);
   cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
-  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->add_flag("--no-quality", opt->noQuality, "Skip the oracle and the RMSE/FLIP columns");
   cmd->add_flag("--sequential", opt->sequential,
                 "All frames of one method, then the next, each freeing its buffers before the next starts "

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include "mfr/render.hpp"
@@ -36,6 +37,21 @@ inline constexpr const char* kFieldHelp =
 // or view fails at once; throws mfr::Error for an empty view list.
 std::vector<Scene> loadScenesWithViews(const std::vector<std::string>& paths, double opacity,
                                        const std::vector<std::string>& views);
+// CLI::Range lets NaN through (every comparison with it is false): a closed interval that refuses
+// it, for opacities and fractions.
+inline CLI::Validator finiteRange(double low, double high) {
+  std::ostringstream bounds;
+  bounds << "[" << low << ", " << high << "]";
+  return CLI::Validator(
+      [low, high, range = bounds.str()](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value) || !(value >= low && value <= high))
+          return "'" + text + "' is not a number in " + range;
+        return {};
+      },
+      bounds.str());
+}
+
 // --clip: "xmin,ymin,zmin,xmax,ymax,zmax" (world units) sets scene.clipBox, "none" removes the
 // scene's own; empty text leaves the scene as it is. Throws mfr::Error naming --clip.
 void applyClipOption(Scene& scene, const std::string& text);

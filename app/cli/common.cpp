@@ -257,7 +257,7 @@ void ContourOptions::add(CLI::App* cmd) {
                   "when the scene has several volumes (at most " +
                       std::to_string(kMaxContourValues) + "); the volume itself is hidden unless --keep-volume");
   cmd->add_option("--contour-opacity", opacity, "Opacity of the --contour parts (default: --opacity, else 0.5)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(finiteRange(0.0, 1.0));
   cmd->add_flag("--keep-volume", keepVolume, "With --contour: keep drawing the volume the isosurfaces come from");
 }
 

@@ -58,7 +58,7 @@ void addDataset(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--sample", opt->sample, "Fraction of the non-empty pixels written per frame")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(finiteRange(0.0, 1.0));
   cmd->add_option("--sample-by", opt->sampleBy,
                   "pixels: each non-empty pixel with probability --sample; deep: pixels deeper than the frame's "
                   "mean n(p) more often, in proportion to n(p)")
@@ -73,7 +73,7 @@ void addDataset(CLI::App& app) {
   cmd->add_flag("--skip-exact-budgets", opt->skipExact,
                 "Leave out a frame's budgets of at least sum max(1, n - 1) slots: there the exact-tail bound makes "
                 "every allocation exact, so their labels teach the network nothing");
-  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->callback([opt] {
     const std::vector<double> levels = parseBudgetLevels(opt->budgets);
     const std::vector<std::string> views = splitList(opt->views);

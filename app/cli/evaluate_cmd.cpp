@@ -125,7 +125,7 @@ void addEvaluate(CLI::App& app) {
   cmd->add_option("--repeat,-r", opt->repeat, "Timed frames per GPU method")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));
-  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->add_option("--json", opt->json, "Write all results as JSON");
   cmd->add_flag("--k-by-depth", opt->kByDepth,
                 "Also print (and write to the JSON) each method's mean k per depth-complexity class n(p)");

@@ -81,7 +81,7 @@ void addProbe(CLI::App& app) {
   opt->contours.add(cmd);
   cmd->add_option("--field", opt->field, kFieldHelp);
   cmd->add_option("--section", opt->section, kSectionHelp);
-  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->callback([opt, thicknessGiven] {
     const auto [w, h] = parseSize("--size", opt->size);
     validateImageSize("--size", w, h);

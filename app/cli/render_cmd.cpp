@@ -70,7 +70,7 @@ void addRender(CLI::App& app) {
   cmd->add_option("-o,--output", opt->output, "Output PNG")->required();
   cmd->add_option("--stats", opt->stats, "Write Stats as JSON to this file");
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1): see through opaque CAD parts")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(finiteRange(0.0, 1.0));
   cmd->callback([opt, thicknessGiven, stepOption] {
     const auto [w, h] = parseSize("--size", opt->size);
     // Both outputs checked before the work, so that a bad second path leaves no first file behind.

@@ -1,6 +1,7 @@
 #include "mfr/render.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <sstream>
 #include <cmath>
 #include <exception>
@@ -238,18 +239,24 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
   if (const std::string fields = fieldColorsNote(scene); !fields.empty())
     out.stats.notes.emplace_back("field colours", fields);
   const std::string operation = effectiveOperation(request.operation, nullptr, scene.hasVisibleVolume());
+  // Its one parameter, the core size of the exact hybrid image (--op hybrid -p k=N), checked before
+  // the cast; any other parameter is a mistake, not something to ignore.
+  std::uint32_t coreSize = 0;
+  for (const auto& [key, value] : request.params) {
+    const std::string what = "--param " + key + "=" + value;
+    if (key != "k" || operation != "hybrid")
+      throw Error(what, "the oracle takes no parameters but k=N (the core size) with --op hybrid");
+    const bool digits = !value.empty() && value.size() <= 9 &&
+                        std::all_of(value.begin(), value.end(), [](unsigned char c) { return std::isdigit(c) != 0; });
+    if (!digits) throw Error(what, "not a non-negative integer (below 10^9)");
+    coreSize = static_cast<std::uint32_t>(std::stoul(value));
+  }
+  if (operation == "hybrid" && request.params.count("k") == 0)
+    throw Error("--op hybrid", "the oracle needs --param k=N (core size)");
   const FragmentLists lists = castFragments(scene, camera, request.width, request.height);
   if (operation == "hybrid") {
     // The exact hybrid image for a uniform core size: --method oracle --op hybrid -p k=N.
-    const auto k = request.params.find("k");
-    if (k == request.params.end()) throw Error("--op hybrid", "the oracle needs --param k=N (core size)");
-    unsigned long value = 0;
-    try {
-      value = std::stoul(k->second);
-    } catch (const std::exception&) {
-      throw Error("--param k=" + k->second, "not a non-negative integer");
-    }
-    out.image = compositeHybrid(lists, static_cast<std::uint32_t>(value), scene.background);
+    out.image = compositeHybrid(lists, coreSize, scene.background);
   } else if (operation == "volume") {
     const std::vector<Volume> drawn = volumesAsRequested(request, scene);
     if (drawn.empty()) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");

@@ -88,6 +88,23 @@ TEST_F(Cli, BadMethodParameter) {
   expectCleanFailure("render @sample --method abuffer-ll -p colour=red", "--param colour");
 }
 
+// The oracle's one parameter is k with --op hybrid; anything else was silently ignored (found by
+// fuzzing), as was a NaN opacity (CLI11's range check lets NaN through).
+TEST_F(Cli, OracleParametersAndNanOpacitiesAreRefused) {
+  expectCleanFailure("render @sample --size 16x16 -p bogus=1", "--param bogus=1: the oracle takes no parameters");
+  expectCleanFailure("render @sample --size 16x16 -p k=3", "--param k=3: the oracle takes no parameters");
+  expectCleanFailure("render @sample --size 16x16 --op hybrid -p k=-1", "--param k=-1: not a non-negative integer");
+  expectCleanFailure("render @sample --size 16x16 --op hybrid -p k=99999999999", "--param k=99999999999");
+  expectCleanFailure("render @sample --size 16x16 --op hybrid", "the oracle needs --param k=N");
+  expectCleanFailure("render @sample --size 16x16 --opacity nan", "--opacity: 'nan' is not a number in [0, 1]");
+  expectCleanFailure("render @volume --size 16x16 --contour 0.5 --contour-opacity nan", "--contour-opacity");
+  expectCleanFailure("bench @sample --size 16x16 -m abuffer-ll --opacity 1.5", "--opacity: '1.5' is not a number");
+  const fs::path png = dir() / "k.png";
+  const CliResult r = runCli("render @sample --size 16x16 --op hybrid -p k=2 -o " + png.string());
+  EXPECT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_TRUE(fs::exists(png));
+}
+
 TEST_F(Cli, MissingOutputFolder) {
   const CliResult r = runCli("render @sample --size 16x16 -o " + (dir() / "no" / "such" / "dir.png").string());
   EXPECT_EQ(r.exitCode, 1) << r.out;
