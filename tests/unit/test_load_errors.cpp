@@ -296,6 +296,9 @@ TEST_F(LoadModel, ZeroTriangles) {
 TEST_F(LoadModel, GarbageOff) {
   expectLoadError(write("garbage.off", "this is not an off file\n"), "not an OFF file");
   expectLoadError(write("counts.off", "OFF\n300 100 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), "declares 300 vertices");
+  // A face's corner count beyond the file: CGAL sized the polygon from it (15 GB for 2·10⁹).
+  expectLoadError(write("corners.off", "OFF\n3 1 0\n0 0 0\n# a comment line\n1 0 0\n\n0 1 0\n2000000000 0 1 2\n"),
+                  "OFF face 0 declares 2000000000 corners but only 17 bytes follow");
   expectLoadError(write("badface.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 9\n"),
                   "malformed or truncated OFF");
 }
