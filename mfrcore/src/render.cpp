@@ -229,6 +229,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
   validateOperation(request.operation);
   if (request.method == "optimal-k") return renderOptimalK(scene, camera, request);
   if (request.method != "oracle") {
+    checkDrawable(scene, camera, request.width, request.height);  // what the oracle would refuse
     GpuRenderer& gpu = headlessRenderer();
     gpu.setScene(scene);
     RenderOutput out = gpu.render(camera, request);

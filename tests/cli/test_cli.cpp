@@ -105,6 +105,24 @@ TEST_F(Cli, OracleParametersAndNanOpacitiesAreRefused) {
   EXPECT_TRUE(fs::exists(png));
 }
 
+// The GPU methods refuse what the oracle refuses (they drew an empty or garbage image and exited 0,
+// found by fuzzing): only degenerate triangles, a zero transform, vertices at infinity.
+TEST_F(Cli, GpuMethodsRefuseWhatTheOracleRefuses) {
+  const fs::path degenerate = write("flat.obj", "v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n");
+  const fs::path zero = write("zero.mfrscene", R"({"objects": [{"name": "s", "primitive": {"type": "sphere"},
+      "transform": {"matrix": [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]}}]})");
+  const fs::path huge =
+      write("huge.mfrscene", R"({"objects": [{"name": "s", "primitive": {"type": "sphere", "radius": 1e300}}]})");
+  for (const auto& [file, reason] :
+       std::vector<std::pair<fs::path, std::string>>{{degenerate, "nothing to render (no visible triangles)"},
+                                                     {zero, "nothing to render (no visible triangles)"},
+                                                     {huge, "s: non-finite vertex coordinate"}})
+    for (const char* method : {"oracle", "abuffer-ll", "kplus-array"}) {
+      SCOPED_TRACE(file.filename().string() + " " + method);
+      expectCleanFailure("render " + file.string() + " --size 16x16 -m " + method, reason);
+    }
+}
+
 TEST_F(Cli, MissingOutputFolder) {
   const CliResult r = runCli("render @sample --size 16x16 -o " + (dir() / "no" / "such" / "dir.png").string());
   EXPECT_EQ(r.exitCode, 1) << r.out;

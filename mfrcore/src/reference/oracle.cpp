@@ -356,6 +356,24 @@ GeometryKey geometryKey(const Scene& scene) {
   return key;
 }
 
+// Zero world area (relative to the edge lengths): no plane, no fragments, no edges.
+bool hasArea(const glm::dvec3 (&p)[3]) {
+  const double area2 = glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
+  const double edge2 = std::max(
+      {glm::dot(p[1] - p[0], p[1] - p[0]), glm::dot(p[2] - p[1], p[2] - p[1]), glm::dot(p[0] - p[2], p[0] - p[2])});
+  return area2 > 1e-14 * edge2;
+}
+
+// The camera's inverse view-projection, refused when not finite.
+glm::dmat4 invertibleViewProjection(const Camera& camera, int width, int height, glm::dmat4& viewProj) {
+  viewProj = camera.projectionMatrix(static_cast<double>(width) / height) * camera.viewMatrix();
+  const glm::dmat4 inverse = glm::inverse(viewProj);
+  const double* m = glm::value_ptr(inverse);
+  if (!std::all_of(m, m + 16, [](double x) { return std::isfinite(x); }))
+    throw Error("camera", "projection is singular (check near/far planes, field of view and up vector)");
+  return inverse;
+}
+
 std::shared_ptr<const PreparedGeometry> buildGeometry(const Scene& scene, GeometryKey key) {
   auto geometry = std::make_shared<PreparedGeometry>();
   std::vector<WorldTriangle>& triangles = geometry->triangles;
@@ -371,12 +389,7 @@ std::shared_ptr<const PreparedGeometry> buildGeometry(const Scene& scene, Geomet
         tri.vertex[k] = mesh.indices[3 * t + k];
         tri.p[k] = world[tri.vertex[k]];
       }
-      // Zero world area (relative to the edge lengths): no plane, no fragments, no edges.
-      const double area2 = glm::length(glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]));
-      const double edge2 = std::max({glm::dot(tri.p[1] - tri.p[0], tri.p[1] - tri.p[0]),
-                                     glm::dot(tri.p[2] - tri.p[1], tri.p[2] - tri.p[1]),
-                                     glm::dot(tri.p[0] - tri.p[2], tri.p[0] - tri.p[2])});
-      if (!(area2 > 1e-14 * edge2)) continue;
+      if (!hasArea(tri.p)) continue;
       triangles.push_back(tri);
     }
   }
@@ -410,6 +423,27 @@ std::shared_ptr<const PreparedGeometry> preparedGeometry(const Scene& scene) {
 
 }  // namespace
 
+void checkDrawable(const Scene& scene, const Camera& camera, int width, int height) {
+  if (width <= 0 || height <= 0 || width > kMaxImageSize || height > kMaxImageSize)
+    throw Error("image size", std::to_string(width) + "x" + std::to_string(height) + " is not in 1.." +
+                                  std::to_string(kMaxImageSize) + " per side");
+  glm::dmat4 viewProj(1.0);
+  (void)invertibleViewProjection(camera, width, height, viewProj);
+  bool drawable = scene.hasVisibleVolume();
+  for (const Object& object : scene.objects) {
+    if (!object.visible || !object.mesh || object.mesh->triangleCount() == 0) continue;
+    object.mesh->validate(object.name);
+    const Mesh& mesh = *object.mesh;
+    for (std::size_t t = 0; !drawable && t < mesh.triangleCount(); ++t) {
+      glm::dvec3 p[3];
+      for (int k = 0; k < 3; ++k)
+        p[k] = transformPoint(object.transform, glm::dvec3(mesh.positions[mesh.indices[3 * t + k]]));
+      drawable = hasArea(p);
+    }
+  }
+  if (!drawable) throw Error("scene '" + scene.name + "'", "nothing to render (no visible triangles)");
+}
+
 FragmentLists castFragments(const Scene& scene, const Camera& camera, int width, int height,
                             const OracleOptions& options) {
   // A section plane is applied as geometry, as the GPU renderer does (scene/section.hpp).
@@ -420,14 +454,8 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
 
   const PixelRect region = regionInImage(options.region, width, height);
 
-  const glm::dmat4 viewProj =
-      camera.projectionMatrix(static_cast<double>(width) / height) * camera.viewMatrix();
-  const glm::dmat4 invViewProj = glm::inverse(viewProj);
-  {
-    const double* m = glm::value_ptr(invViewProj);
-    if (!std::all_of(m, m + 16, [](double x) { return std::isfinite(x); }))
-      throw Error("camera", "projection is singular (check near/far planes, field of view and up vector)");
-  }
+  glm::dmat4 viewProj(1.0);
+  const glm::dmat4 invViewProj = invertibleViewProjection(camera, width, height, viewProj);
 
   // Material and normal transform of every visible object (cheap, per call: colours change
   // without the geometry changing).

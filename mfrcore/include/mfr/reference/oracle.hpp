@@ -92,6 +92,12 @@ struct FragmentLists {
   [[nodiscard]] bool isAmbiguous(int x, int y) const { return flags[index(x, y)] != 0; }
 };
 
+// What castFragments refuses before it casts, for the GPU renderers to refuse the same (they drew
+// nothing, or garbage, and said nothing): a singular camera (a scene scaled to infinity), a visible
+// mesh that fails Mesh::validate (a non-finite vertex), no visible triangle of non-zero world
+// area and no visible volume. The scene as given (a section is not applied). Throws mfr::Error.
+void checkDrawable(const Scene& scene, const Camera& camera, int width, int height);
+
 // Throws mfr::Error for a zero-size image or an empty scene.
 FragmentLists castFragments(const Scene& scene, const Camera& camera, int width, int height,
                             const OracleOptions& options = {});
