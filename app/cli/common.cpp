@@ -205,6 +205,19 @@ void applyClipOption(Scene& scene, const std::string& text) {
   }
   if (!ok) throw Error("--clip " + text, "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax (or none)");
   if (!box.valid()) throw Error("--clip " + text, "min must not exceed max on any axis");
+  // A box that holds nothing of the scene draws an empty image, as a section plane that cuts away
+  // everything would: both are refused (found by fuzzing).
+  const Bounds b = scene.bounds();
+  bool holds = b.valid();
+  for (int a = 0; a < 3; ++a)
+    holds = holds && box.max[a] > box.min[a] && box.min[a] < b.max[a] && box.max[a] > b.min[a];
+  if (!holds) {
+    std::ostringstream bounds;
+    bounds << "[" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – [" << b.max.x << ", " << b.max.y << ", "
+           << b.max.z << "]";
+    throw Error("--clip " + text, "holds nothing of scene '" + scene.name +
+                                      "' (a flat box, or one outside its bounds " + bounds.str() + ")");
+  }
   scene.clipBox = box;
 }
 

@@ -59,6 +59,10 @@ TEST_F(CliClip, BadBoxesAndCsgAreRefused) {
   expectCleanFailure("render @sample --size 16x16 --clip 0,0,0,1,x,1", "expected six numbers");
   expectCleanFailure("render @sample --size 16x16 --clip 0,2,0,1,1,1", "min must not exceed max");
   expectCleanFailure("render @sample --size 16x16 --clip 0,0,0,1,1,inf", "expected six numbers");
+  // A box that holds nothing drew an empty image (found by fuzzing); a section plane that leaves
+  // nothing is refused too.
+  expectCleanFailure("render @sample --size 16x16 --clip 100,100,100,101,101,101", "holds nothing of scene 'sample'");
+  expectCleanFailure("render @sample --size 16x16 -m abuffer-ll --clip 0,0,0,0,0,0", "holds nothing of scene 'sample'");
   expectCleanFailure("render @csg --size 16x16 --op csg -m abuffer-ll --clip -1,-1,-1,1,1,1", "clip box");
   expectCleanFailure("render @csg --size 16x16 --op csg --clip -1,-1,-1,1,1,1", "clip box");
 }

@@ -561,6 +561,13 @@ TEST_F(VolumeLoading, BadVti) {
   expectVolumeError(
       write("zero.vti", vti("0 3 0 2 0 1", "0 0 0", "1 0 1", dataArray("Float32", "f", asciiValues(4, 3, 2)))),
       "spacing must be non-zero");
+  // VTK read what it could not parse as its default (spacing 1 1 1) without a word.
+  expectVolumeError(
+      write("nan.vti", vti("0 3 0 2 0 1", "0 0 0", "nan -1 1e309", dataArray("Float32", "f", asciiValues(4, 3, 2)))),
+      "ImageData Spacing 'nan -1 1e309' is not finite numbers");
+  expectVolumeError(
+      write("two.vti", vti("0 3 0 2 0 1", "0 0", "1 1 1", dataArray("Float32", "f", asciiValues(4, 3, 2)))),
+      "ImageData Origin '0 0' has 2 numbers");
 }
 
 // VTK 9.1's XML reader crashes on a String array: such arrays are skipped (the numbers beside them

@@ -470,7 +470,7 @@ SampleArray sampleArray(vtkImageData* image, const std::string& name, const std:
 // VTK 9.1's XML image reader crashes on a DataArray of type String in the point or cell data:
 // such arrays (text, never samples) are found in the XML, which comes before any appended binary
 // data, and left unread. (name, whether it is cell data); FieldData's are refused, as VTK cannot
-// be told to skip them.
+// be told to skip them. The ImageData's Origin, Spacing and Direction must be finite numbers.
 std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, const std::string& name) {
   std::ifstream in(path, std::ios::binary);
   std::string xml;
@@ -509,6 +509,25 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
              (tag.size() == element.size() || std::isspace(static_cast<unsigned char>(tag[element.size()])) ||
               tag[element.size()] == '/');
     };
+    if (is("ImageData"))
+      for (const char* key : {"Origin", "Spacing", "Direction"}) {
+        // VTK reads a value it cannot parse (nan, 1e309) as its default and says nothing.
+        const std::string text = attribute(tag, key);
+        if (text.empty()) continue;
+        std::istringstream numbers(text);
+        std::string number;
+        int count = 0;
+        while (numbers >> number) {
+          char* end = nullptr;
+          const double value = std::strtod(number.c_str(), &end);
+          if (end == number.c_str() || *end != '\0' || !std::isfinite(value))
+            throw Error(name, std::string("ImageData ") + key + " '" + text.substr(0, 64) + "' is not finite numbers");
+          ++count;
+        }
+        if (count != (std::string_view(key) == "Direction" ? 9 : 3))
+          throw Error(name, std::string("ImageData ") + key + " '" + text.substr(0, 64) + "' has " +
+                                std::to_string(count) + " numbers");
+      }
     if (is("PointData")) section = Section::kPoints;
     if (is("CellData")) section = Section::kCells;
     if (is("FieldData")) section = Section::kField;
