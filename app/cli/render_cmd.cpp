@@ -132,10 +132,7 @@ void addRender(CLI::App& app) {
       const bool depth = opt->dataView == "depth-complexity";
       std::vector<std::uint32_t> counts;
       if (depth && cpu) {
-        const FragmentLists lists = castFragments(scene, camera, w, h);
-        counts.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-        for (int y = 0; y < h; ++y)
-          for (int x = 0; x < w; ++x) counts[lists.index(x, y)] = lists.count(x, y);
+        counts = castFragments(scene, camera, w, h).counts();
       } else if (depth) {
         counts = headlessRenderer().depthComplexity(camera, w, h);
       } else {

@@ -472,15 +472,28 @@ SampleArray sampleArray(vtkImageData* image, const std::string& name, const std:
 // data, and left unread. (name, whether it is cell data); FieldData's are refused, as VTK cannot
 // be told to skip them. The ImageData's Origin, Spacing and Direction must be finite numbers.
 std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, const std::string& name) {
-  std::ifstream in(path, std::ios::binary);
-  std::string xml;
-  std::string chunk(1 << 16, '\0');
-  while (in) {
-    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
-    xml.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
-    if (const std::size_t appended = xml.find("<AppendedData"); appended != std::string::npos) {
-      xml.resize(appended);
-      break;
+  // The tags (the text between < and >) before <AppendedData, read in one pass: the samples
+  // between them are skipped, not kept.
+  std::vector<std::string> tags;
+  {
+    std::ifstream in(path, std::ios::binary);
+    std::string chunk(1 << 16, '\0'), tag;
+    bool inTag = false, appended = false;
+    while (!appended && in) {
+      in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+      for (std::size_t i = 0; i < static_cast<std::size_t>(in.gcount()) && !appended; ++i) {
+        const char c = chunk[i];
+        if (!inTag) {
+          inTag = c == '<';
+        } else if (c != '>') {
+          if (tag.size() < (1u << 16)) tag += c;
+        } else {
+          appended = tag.rfind("AppendedData", 0) == 0;
+          if (!appended) tags.push_back(std::move(tag));
+          tag.clear();
+          inTag = false;
+        }
+      }
     }
   }
   const auto attribute = [](std::string_view tag, std::string_view key) -> std::string {
@@ -500,10 +513,8 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
   };
   std::vector<std::pair<std::string, bool>> found;
   enum class Section { kNone, kPoints, kCells, kField } section = Section::kNone;
-  for (std::size_t open = xml.find('<'); open != std::string::npos; open = xml.find('<', open + 1)) {
-    const std::size_t close = xml.find('>', open);
-    if (close == std::string::npos) break;
-    const std::string_view tag(xml.data() + open + 1, close - open - 1);
+  for (const std::string& tagText : tags) {
+    const std::string_view tag(tagText);
     const auto is = [&](std::string_view element) {
       return tag.substr(0, element.size()) == element &&
              (tag.size() == element.size() || std::isspace(static_cast<unsigned char>(tag[element.size()])) ||

@@ -356,6 +356,12 @@ GeometryKey geometryKey(const Scene& scene) {
   return key;
 }
 
+void checkImageSize(int width, int height) {
+  if (width <= 0 || height <= 0 || width > kMaxImageSize || height > kMaxImageSize)
+    throw Error("image size", std::to_string(width) + "x" + std::to_string(height) + " is not in 1.." +
+                                  std::to_string(kMaxImageSize) + " per side");
+}
+
 // Zero world area (relative to the edge lengths): no plane, no fragments, no edges.
 bool hasArea(const glm::dvec3 (&p)[3]) {
   const double area2 = glm::length(glm::cross(p[1] - p[0], p[2] - p[0]));
@@ -424,9 +430,7 @@ std::shared_ptr<const PreparedGeometry> preparedGeometry(const Scene& scene) {
 }  // namespace
 
 void checkDrawable(const Scene& scene, const Camera& camera, int width, int height) {
-  if (width <= 0 || height <= 0 || width > kMaxImageSize || height > kMaxImageSize)
-    throw Error("image size", std::to_string(width) + "x" + std::to_string(height) + " is not in 1.." +
-                                  std::to_string(kMaxImageSize) + " per side");
+  checkImageSize(width, height);
   glm::dmat4 viewProj(1.0);
   (void)invertibleViewProjection(camera, width, height, viewProj);
   bool drawable = scene.hasVisibleVolume();
@@ -448,9 +452,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
                             const OracleOptions& options) {
   // A section plane is applied as geometry, as the GPU renderer does (scene/section.hpp).
   if (scene.section && !scene.sectionCut) return castFragments(sectionedScene(scene), camera, width, height, options);
-  if (width <= 0 || height <= 0 || width > kMaxImageSize || height > kMaxImageSize)
-    throw Error("image size", std::to_string(width) + "x" + std::to_string(height) + " is not in 1.." +
-                                  std::to_string(kMaxImageSize) + " per side");
+  checkImageSize(width, height);
 
   const PixelRect region = regionInImage(options.region, width, height);
 
