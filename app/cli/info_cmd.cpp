@@ -108,8 +108,8 @@ void addInfo(CLI::App& app) {
       const SectionPlane& plane = *scene.section;
       std::cout << "section    point " << plane.point.x << " " << plane.point.y << " " << plane.point.z << ", normal "
                 << plane.normal.x << " " << plane.normal.y << " " << plane.normal.z << ": " << section.cut
-                << " parts cut (" << section.capped << " capped), " << section.removed
-                << " removed; cross-section area " << section.totalCapArea() << "\n";
+                << (section.cut == 1 ? " part" : " parts") << " cut (" << section.capped << " capped), "
+                << section.removed << " removed; cross-section area " << section.totalCapArea() << "\n";
     }
     const std::size_t shown = std::min<std::size_t>(scene.objects.size(), 20);
     for (std::size_t i = 0; i < shown; ++i) {

@@ -289,7 +289,7 @@ TEST_F(Cli, InfoMeasuresPartsAsTheSectionCutsThem) {
   ASSERT_EQ(r.exitCode, 0) << r.out;
   // The brick is [-1, 1] × [-1, 1] × [-1.5, 1.5]; kept up to z = 0.5: 2 × 2 × 2 over a 2 × 2 cut.
   EXPECT_NE(r.out.find("area 24, closed, volume 8; cut, cross-section area 4\n"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("1 parts cut (1 capped), 1 removed; cross-section area 4\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("1 part cut (1 capped), 1 removed; cross-section area 4\n"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("    removed by the section\n"), std::string::npos) << r.out;
   std::ifstream in(json);
   const nlohmann::json j = nlohmann::json::parse(in);
