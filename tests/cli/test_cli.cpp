@@ -57,6 +57,23 @@ TEST_F(Cli, JsonSyntaxError) {
   expectCleanFailure("render " + p.string(), "broken.mfrscene: JSON syntax error at line 4");
 }
 
+// Wrong-typed flags and numbers beyond double precision were an "internal error" (exit 3) naming
+// neither the file nor the key (found by fuzzing).
+TEST_F(Cli, SceneFileFlagsAndHugeNumbersNameTheFileAndKey) {
+  const std::string sphere = R"({"primitive": {"type": "sphere"})";
+  for (const auto& [json, mention] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"sample": "yes"})", "top level.sample: expected true or false"},
+           {R"({"objects": [)" + sphere + R"(, "visible": 1}]})", "objects[0].visible: expected true or false"},
+           {R"({"objects": [)" + sphere +
+                R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "target": [0, 0, 0], "fit": null}]})",
+            "views[0].fit: expected true or false"},
+           {R"({"objects": [)" + sphere + R"(, "opacity": 1e400}]})", "JSON number out of range"}}) {
+    SCOPED_TRACE(json);
+    const fs::path p = write("flags.mfrscene", json);
+    expectCleanFailure("render " + p.string() + " --size 16x16", "flags.mfrscene: " + mention);
+  }
+}
+
 TEST_F(Cli, EmptyScene) {
   const fs::path p = write("empty.mfrscene", R"({"objects": []})");
   expectCleanFailure("render " + p.string(), "nothing to render");

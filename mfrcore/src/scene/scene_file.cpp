@@ -53,6 +53,11 @@ class Reader {
     if (v < lo || v > hi) fail(where + "." + key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return static_cast<int>(v);
   }
+  bool flag(const json& obj, const char* key, const std::string& where, bool fallback) const {
+    if (!obj.contains(key)) return fallback;
+    if (!obj[key].is_boolean()) fail(where + "." + key, "expected true or false");
+    return obj[key].get<bool>();
+  }
   glm::dvec3 vec3(const json& j, const std::string& where) const {
     if (!j.is_array() || j.size() != 3) fail(where, "expected an array of 3 numbers");
     return {number(j[0], where + "[0]"), number(j[1], where + "[1]"), number(j[2], where + "[2]")};
@@ -219,7 +224,8 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
   c.fovyDegrees = r.number(v, "fovy", where, c.fovyDegrees);
   if (c.fovyDegrees <= 0 || c.fovyDegrees >= 180) r.fail(where + ".fovy", "must be in (0, 180) degrees");
   c.orthoHeight = r.positive(v, "height", where, c.orthoHeight);
-  if (v.value("fit", false)) c = c.fittedTo(bounds, radius);
+  if (r.flag(v, "fit", where, false))
+    c = c.fittedTo(bounds, radius);
   else c.fitDepthRange(bounds, radius);
   if (v.contains("near") || v.contains("far")) {
     c.nearPlane = r.positive(v, "near", where, c.nearPlane);
@@ -307,8 +313,8 @@ Volume parseVolume(const Reader& r, const json& j, const std::string& where, con
   volume.name = r.string(v, "name", where, volume.name);
   volume.transform = xf * volume.transform;
   volume.sceneTransform = xf;
-  volume.visible = v.value("visible", true);
-  volume.shading = v.value("shading", false);
+  volume.visible = r.flag(v, "visible", where, true);
+  volume.shading = r.flag(v, "shading", where, false);
   // The defaults are relative to where the volume now is: its world diagonal.
   volume.transfer = defaultTransfer(*volume.grid, volume.bounds());
   if (v.contains("transfer")) volume.transfer = parseTransfer(r, v["transfer"], where + ".transfer", volume);
@@ -415,6 +421,8 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
   json doc;
   try {
     doc = json::parse(text);
+  } catch (const json::out_of_range&) {
+    throw Error(name, "JSON number out of range (beyond double precision)");
   } catch (const json::parse_error& e) {
     // Byte offset → line and column, which is what an editor shows.
     std::size_t line = 1, col = 1;
@@ -433,7 +441,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
   Scene scene;
   scene.name = r.string(doc, "name", "top level", std::filesystem::path(name).stem().string());
   if (doc.contains("background")) scene.background = glm::vec3(r.vec3(doc["background"], "background"));
-  if (doc.value("sample", false)) scene = makeSampleScene();
+  if (r.flag(doc, "sample", "top level", false)) scene = makeSampleScene();
   if (doc.contains("clip")) {
     const json& clip = r.object(doc["clip"], "clip");
     if (!clip.contains("min") || !clip.contains("max")) r.fail("clip", "expected \"min\" and \"max\" corners");
@@ -488,7 +496,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
       const json& o = r.object(objects[i], where);
       const std::string objName = r.string(o, "name", where, "object " + std::to_string(i));
       const glm::dmat4 xf = o.contains("transform") ? parseTransform(r, o["transform"], where + ".transform") : glm::dmat4(1.0);
-      const bool visible = o.value("visible", true);
+      const bool visible = r.flag(o, "visible", where, true);
       if (o.contains("file") == o.contains("primitive")) r.fail(where, "needs exactly one of 'file' or 'primitive'");
       if (o.contains("primitive")) {
         Object obj;
