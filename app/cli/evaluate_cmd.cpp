@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "mfr/budget/neural_importance.hpp"
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
@@ -134,13 +135,19 @@ void addEvaluate(CLI::App& app) {
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
     const std::vector<std::string> methods = splitList(opt->methods);
+    if (methods.empty()) throw Error("--methods", "names no method");
     const std::vector<std::string> known = availableMethods();
     std::map<std::string, RenderRequest> specs;  // each method spec's request, without size and budget
     std::size_t methodWidth = 11;
+    // A weights file that cannot be read is the user's mistake, not one row's failure: refused
+    // before anything runs (it was only a row's error, and exit 0).
+    if (!opt->weights.empty()) (void)loadNeuralImportance(opt->weights);
     for (const std::string& m : methods) {
       const RenderRequest spec = parseMethodSpec(m, w, h);
       if (std::find(known.begin(), known.end(), spec.method) == known.end() || spec.method == "oracle")
         throw Error("--methods " + m, "not a method (see mfr info --methods)");
+      if (const auto weights = spec.params.find("weights"); weights != spec.params.end())
+        (void)loadNeuralImportance(weights->second);
       specs[m] = spec;
       methodWidth = std::max(methodWidth, m.size() + 2);
     }

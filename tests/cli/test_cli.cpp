@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <iterator>
 #include <map>
 #include <sstream>
 #include <string>
@@ -519,6 +520,32 @@ TEST_F(Cli, BudgetCommandsBadInput) {
   expectCleanFailure("render @sample -s 16x16 -m vkb -p budget_mib=0", "--param budget_mib=0");
   expectCleanFailure("render @sample -s 16x16 -m fkb -p budget_mib=0.001", "--param budget_mib=0.001");
   expectCleanFailure("render @sample -s 16x16 -m optimal-k --op oit", "--op oit");
+  // Found by fuzzing: training options dlib cannot use (an assertion, or NaN weights), a dataset
+  // whose metadata is corrupt (refused after training, as an internal error), and evaluate with
+  // weights it cannot read (a row's error, exit 0).
+  {
+    const fs::path data = dir() / "small.bin", weights = dir() / "w.json";
+    ASSERT_EQ(runCli("dataset @sample --views front -s 24x18 --budgets 1,all -o " + data.string()).exitCode, 0);
+    expectCleanFailure("train " + data.string() + " --learning-rate 0", "--learning-rate: '0' is not a number");
+    expectCleanFailure("train " + data.string() + " --weight-decay nan", "--weight-decay: 'nan' is not a number");
+    expectCleanFailure("train " + data.string() + " --momentum inf", "--momentum: 'inf' is not a number");
+    std::ifstream in(data, std::ios::binary);
+    std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    bytes[24] = '\x01';  // the first byte of the JSON metadata (after the 24-byte header)
+    const fs::path corrupt = write("corrupt.bin", bytes);
+    expectCleanFailure("train " + corrupt.string() + " --epochs 1", "corrupt.bin: corrupt (its metadata is not JSON)");
+    const fs::path empty = write("empty.json", "");
+    const fs::path json = dir() / "e.json";
+    for (const std::string& args :
+         {"--weights " + empty.string(), std::string("-m dkb:weights=") + (dir() / "nope.json").string(),
+          std::string("-m ,")}) {
+      SCOPED_TRACE(args);
+      const CliResult r = runCli("evaluate @sample -s 24x18 --budgets k1 " + args + " --json " + json.string());
+      EXPECT_EQ(r.exitCode, 1) << r.out;
+      EXPECT_EQ(r.out.find("renderer:"), std::string::npos) << r.out;  // refused before any row
+      EXPECT_FALSE(fs::exists(json));
+    }
+  }
   // optimal-k's two refusals say what they need, and that much is enough: below the layout's fixed
   // part, then below a slot per non-empty pixel (after the cast), then it renders.
   {

@@ -6,6 +6,8 @@
 #include <cstring>
 #include <string_view>
 
+#include <nlohmann/json.hpp>
+
 #include "mfr/error.hpp"
 #include "mfr/io_util.hpp"
 
@@ -80,6 +82,8 @@ DkbDataset readDataset(const std::filesystem::path& path) {
                            " rows)");
   DkbDataset d;
   d.metadata = bytes.substr(header, metaLength);
+  if (!d.metadata.empty() && !nlohmann::json::accept(d.metadata))
+    throw Error(where, "corrupt (its metadata is not JSON)");
   d.rows.resize(rows * kDatasetColumns);
   std::memcpy(d.rows.data(), bytes.data() + header + metaLength, payload);
   for (float v : d.rows)
