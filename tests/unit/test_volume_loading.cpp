@@ -606,6 +606,29 @@ TEST_F(VolumeLoading, BadLegacyMetaImageAndNrrd) {
                           "DIMENSIONS 100000 100000 100000\nSPACING 1 1 1\nORIGIN 0 0 0\nPOINT_DATA 5\n"),
                     "larger than 2048 points per axis");
 
+  // FIELD counts VTK allocated before reading a value (12 GB and killed, or no end; found by
+  // fuzzing), and a message quoting bytes of the file (uninitialised garbage) kept printable.
+  const std::string points =
+      "# vtk DataFile Version 3.0\ng\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 3 3 3\nORIGIN 0 0 0\n"
+      "SPACING 1 1 1\nPOINT_DATA 27\n";
+  std::string values;
+  for (int v = 0; v < 27; ++v) values += std::to_string(v) + " ";
+  expectVolumeError(write("arrays.vtk", points + "FIELD FieldData 2147483647\nv 1 27 float\n" + values + "\n"),
+                    "FIELD 'FieldData' declares 2147483647 arrays (at most 4096)");
+  expectVolumeError(write("tuples.vtk", points + "FIELD FieldData 1\nnames 1 2000000000 string\ns0\ns1\n"),
+                    "array 'names' declares 1 components × 2000000000 values, more than the file's");
+  expectVolumeError(write("components.vtk", points + "FIELD FieldData 1\nv 2000000000 27 float\n" + values + "\n"),
+                    "array 'v' declares 2000000000 components");
+  const std::string unnamed = errorOf([&] {
+    (void)mfr::loadVolume(write("unnamed.vtk", points + "FIELD FieldData 1\n 1 27 float\n" + values + "\n"));
+  });
+  EXPECT_NE(unnamed, "(no error)");
+  for (const char c : unnamed) EXPECT_TRUE(static_cast<unsigned char>(c) >= 0x20) << unnamed;
+  expectVolumeError(write("ncomp.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1",
+                                           "<DataArray type=\"Float32\" Name=\"f\" NumberOfComponents=\"2147483647\" "
+                                           "format=\"ascii\">1 2 3</DataArray>")),
+                    "DataArray 'f' NumberOfComponents=\"2147483647\" is not a count in [1, 4096]");
+
   const std::string mhd =
       "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_FLOAT\n"
       "ElementSpacing = 1 1 1\nBinaryData = True\nElementDataFile = data.raw\n";

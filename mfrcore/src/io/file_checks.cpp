@@ -27,8 +27,24 @@ void checkReadable(const fs::path& path, const std::string& name, std::string_vi
 }
 
 std::string oneLine(std::string s) {
-  for (char& c : s)
-    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  // Libraries quote bytes of a corrupt file in their messages (VTK: "Unsupported data type: "
+  // and four bytes of garbage): control characters and bytes that are not UTF-8 become '?'.
+  for (std::size_t i = 0; i < s.size();) {
+    const auto lead = static_cast<unsigned char>(s[i]);
+    const std::size_t length = lead < 0x80           ? 1
+                               : (lead >> 5) == 0x6  ? 2
+                               : (lead >> 4) == 0xE  ? 3
+                               : (lead >> 3) == 0x1E ? 4
+                                                     : 0;
+    bool valid = length > 0 && i + length <= s.size();
+    for (std::size_t k = 1; valid && k < length; ++k) valid = (static_cast<unsigned char>(s[i + k]) >> 6) == 0x2;
+    if (!valid) {
+      s[i++] = '?';
+      continue;
+    }
+    if (length == 1 && (lead < 0x20 || lead == 0x7F)) s[i] = lead == '\n' || lead == '\r' || lead == '\t' ? ' ' : '?';
+    i += length;
+  }
   s.erase(std::unique(s.begin(), s.end(), [](char a, char b) { return a == ' ' && b == ' '; }), s.end());
   while (!s.empty() && s.back() == ' ') s.pop_back();
   return s;

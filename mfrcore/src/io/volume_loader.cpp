@@ -275,6 +275,63 @@ std::vector<std::optional<glm::dvec3>> nrrdDirections(const std::string& text, c
   return out;
 }
 
+// The most components an array of a volume file may declare: a 3×3 tensor has 9; a corrupt count
+// (2^31) made VTK's readers allocate without bound.
+constexpr long long kMaxComponents = 4096;
+
+// vtkStructuredPointsReader allocates a FIELD array of the size its header line declares before
+// reading it ("names 1 2000000000 string": killed at 12 GB; "FIELD FieldData 2147483647": no end;
+// found by fuzzing). Every line that looks like a FIELD header or a FIELD array's header (name,
+// components, tuples, type) is checked against the file's size (a value takes at least a byte).
+// Lines longer than a header are data and skipped.
+void checkLegacyVtkFieldCounts(const fs::path& path, const std::string& name) {
+  std::error_code ec;
+  const auto size = static_cast<long long>(fs::file_size(path, ec));
+  if (ec) return;  // the reader says what is wrong
+  std::ifstream in(path, std::ios::binary);
+  std::string chunk(1 << 16, '\0'), line;
+  bool longLine = false;
+  static const std::set<std::string> kTypes = {
+      "bit",  "unsigned_char", "char",   "unsigned_short", "short",     "unsigned_int", "int",          "unsigned_long",
+      "long", "float",         "double", "string",         "vtkIdType", "vtktypeint64", "vtktypeuint64"};
+  const auto check = [&](const std::string& text) {
+    std::istringstream words(text);
+    std::vector<std::string> w;
+    for (std::string word; words >> word && w.size() < 5;) w.push_back(word);
+    const auto count = [](const std::string& t) -> long long {
+      if (t.empty() || t.size() > 19 ||
+          !std::all_of(t.begin(), t.end(), [](unsigned char c) { return std::isdigit(c); }))
+        return -1;
+      return std::stoll(t);
+    };
+    if (w.size() == 3 && w[0] == "FIELD") {
+      const long long arrays = count(w[2]);
+      if (arrays < 0 || arrays > 4096 || arrays > size)
+        throw Error(name, "FIELD '" + w[1] + "' declares " + w[2].substr(0, 24) + " arrays (at most 4096)");
+    } else if (w.size() == 4 && kTypes.count(w[3]) > 0) {
+      const long long components = count(w[1]), tuples = count(w[2]);
+      if (components < 1 || components > kMaxComponents || tuples < 0 || tuples > size || components * tuples > size)
+        throw Error(name, "array '" + w[0].substr(0, 64) + "' declares " + w[1].substr(0, 24) + " components × " +
+                              w[2].substr(0, 24) + " values, more than the file's " + std::to_string(size) + " bytes");
+    }
+  };
+  while (in) {
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    for (std::size_t i = 0; i < static_cast<std::size_t>(in.gcount()); ++i) {
+      const char c = chunk[i];
+      if (c == '\n') {
+        if (!longLine) check(line);
+        line.clear();
+        longLine = false;
+      } else if (!longLine) {
+        line += c;
+        longLine = line.size() > 256;
+      }
+    }
+  }
+  if (!longLine) check(line);
+}
+
 // vtkMetaImageReader loops forever on a negative or huge NDims and reads zeros for 0 channels:
 // the header's keys are checked first (up to ElementDataFile, its last key).
 void checkMetaImageHeader(const fs::path& path, const std::string& name) {
@@ -543,6 +600,22 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
     if (is("CellData")) section = Section::kCells;
     if (is("FieldData")) section = Section::kField;
     if (is("/PointData") || is("/CellData") || is("/FieldData")) section = Section::kNone;
+    if (is("DataArray")) {
+      // VTK allocates what these declare before it reads a value (2^31 components: 12 GB, then
+      // killed; found by fuzzing).
+      for (const auto& [key, most] :
+           {std::pair<const char*, long long>{"NumberOfComponents", kMaxComponents},
+            std::pair<const char*, long long>{"NumberOfTuples", static_cast<long long>(VolumeGrid::kMaxPoints)}}) {
+        const std::string text = attribute(tag, key);
+        if (text.empty()) continue;
+        char* end = nullptr;
+        errno = 0;
+        const long long count = std::strtoll(text.c_str(), &end, 10);
+        if (errno != 0 || *end != '\0' || count < (std::string_view(key) == "NumberOfTuples" ? 0 : 1) || count > most)
+          throw Error(name, "DataArray '" + attribute(tag, "Name") + "' " + key + "=\"" + text.substr(0, 24) +
+                                "\" is not a count in [1, " + std::to_string(most) + "]");
+      }
+    }
     if (!is("DataArray") || attribute(tag, "type") != "String") continue;
     if (section == Section::kField)
       throw Error(name, "field data array '" + attribute(tag, "Name") + "' holds text, which VTK's reader cannot skip");
@@ -572,6 +645,7 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   NrrdOrientation nrrd;
   if (format == VolumeFormat::Nrrd) nrrd = checkNrrdHeader(path, name);
   if (format == VolumeFormat::MetaImage) checkMetaImageHeader(path, name);
+  if (format == VolumeFormat::LegacyVtk) checkLegacyVtkFieldCounts(path, name);
   VtkMessages messages;  // before the reader: VTK's output window goes quiet
   std::optional<CerrCapture> metaIo;
   if (format == VolumeFormat::MetaImage) metaIo.emplace();
