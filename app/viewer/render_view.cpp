@@ -633,6 +633,8 @@ mfr::ImageRGBA8 RenderView::renderImage(QSize size) {
   if (!model_.hasScene()) throw mfr::Error("export", "no scene loaded");
   const mfr::RenderRequest request = model_.renderRequest(0, size);
   if (model_.isCpuMethod(model_.method())) return mfr::render(model_.drawnScene(), model_.camera(), request).image;
+  // What mfr render refuses (a scene of degenerate triangles, a singular camera) is refused here too.
+  mfr::checkDrawable(model_.drawnScene(), model_.camera(), size.width(), size.height());
   const CurrentContext current = currentWithScene(0);
   try {
     return renderer(0).render(model_.camera(), request).image;

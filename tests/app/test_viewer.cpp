@@ -12,6 +12,7 @@
 #include <QListWidget>
 #include <QMessageBox>
 #include <QPlainTextEdit>
+#include <QFile>
 #include <QProcess>
 #include <QProgressBar>
 #include <QRegularExpression>
@@ -596,6 +597,21 @@ class ViewerTest : public QObject {
     }
     qInfo("viewer --screenshot vs mfr render: max channel difference %d over %lld cases", worst,
           static_cast<long long>(cases.size()));
+    // What mfr render refuses, the screenshot refuses too, writing nothing (a scene of degenerate
+    // triangles was an empty PNG and exit 0; found by fuzzing).
+    const QString flat = dir.filePath("flat.obj"), flatPng = dir.filePath("flat.png");
+    {
+      QFile file(flat);
+      QVERIFY(file.open(QIODevice::WriteOnly));
+      file.write("v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n");
+    }
+    QString out;
+    for (const char* method : {"abuffer-ll", "oracle"}) {
+      QCOMPARE(runProgram(MFRVIEW, {flat, "--screenshot", flatPng, "--size", "64x64", "--method", method}, &out), 1);
+      QVERIFY2(out.contains("nothing to render (no visible triangles)"), qPrintable(out));
+      QVERIFY(!QFile::exists(flatPng));
+      QCOMPARE(runProgram(MFR_CLI, {"render", flat, "-o", flatPng, "--size", "64x64", "--method", method}, &out), 1);
+    }
   }
 
   // Operation "csg" on the built-in CSG sample: the viewer's screenshot equals mfr render's, and
