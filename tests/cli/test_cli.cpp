@@ -253,7 +253,9 @@ TEST_F(Cli, BenchRowsAndOrders) {
   for (std::size_t i = 0; i < 2; ++i)
     for (const char* key : {"bytes_allocated", "fragments_stored", "rmse", "flip_mean"})
       EXPECT_EQ(runs["round-robin"]["results"][i][key], runs["sequential"]["results"][i][key]) << key;
-  expectCleanFailure("bench @sample --size 16x16 -m oracle", "--method oracle: the CPU reference, not a GPU method");
+  const CliResult oracle = runCli("bench @sample --size 16x16 -m oracle");
+  EXPECT_EQ(oracle.exitCode, 1) << oracle.out;
+  EXPECT_NE(oracle.out.find("--method oracle: the CPU reference, not a GPU method"), std::string::npos) << oracle.out;
   const fs::path json = dir() / "bad.json";
   const CliResult r = runCli("bench @sample -m abuffer-ll,magic --size 16x16 --json " + json.string());
   EXPECT_EQ(r.exitCode, 1) << r.out;
