@@ -282,7 +282,8 @@ constexpr long long kMaxComponents = 4096;
 // vtkStructuredPointsReader allocates a FIELD array of the size its header line declares before
 // reading it ("names 1 2000000000 string": killed at 12 GB; "FIELD FieldData 2147483647": no end;
 // found by fuzzing). Every line that looks like a FIELD header or a FIELD array's header (name,
-// components, tuples, type) is checked against the file's size (a value takes at least a byte).
+// components, tuples, type) is checked against the file's size (a value takes at least a byte, a
+// bit an eighth).
 // Lines longer than a header are data and skipped.
 void checkLegacyVtkFieldCounts(const fs::path& path, const std::string& name) {
   std::error_code ec;
@@ -310,7 +311,8 @@ void checkLegacyVtkFieldCounts(const fs::path& path, const std::string& name) {
         throw Error(name, "FIELD '" + w[1] + "' declares " + w[2].substr(0, 24) + " arrays (at most 4096)");
     } else if (w.size() == 4 && kTypes.count(w[3]) > 0) {
       const long long components = count(w[1]), tuples = count(w[2]);
-      if (components < 1 || components > kMaxComponents || tuples < 0 || tuples > size || components * tuples > size)
+      const long long room = w[3] == "bit" ? 8 * size : size;  // a bit array packs eight values a byte
+      if (components < 1 || components > kMaxComponents || tuples < 0 || tuples > room || components * tuples > room)
         throw Error(name, "array '" + w[0].substr(0, 64) + "' declares " + w[1].substr(0, 24) + " components × " +
                               w[2].substr(0, 24) + " values, more than the file's " + std::to_string(size) + " bytes");
     }
