@@ -164,14 +164,28 @@ constexpr int kMaxJsonDepth = 512;
 void checkGltfJsonDepth(const std::filesystem::path& path, const std::string* contents, const std::string& extension,
                         const std::string& name) {
   if (extension != ".gltf" && extension != ".glb") return;
+  // Only the JSON is read: an in-memory file is looked at, not copied; from disk a .glb's binary
+  // buffers after its JSON chunk are not read.
   std::string bytes;
+  std::string_view json;
   if (contents != nullptr) {
-    bytes = *contents;
+    json = *contents;
   } else {
     std::ifstream in(path, std::ios::binary);
-    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    bytes.resize(20);
+    in.read(bytes.data(), 20);
+    bytes.resize(static_cast<std::size_t>(in.gcount()));
+    if (bytes.size() == 20 && bytes.compare(0, 4, "glTF") == 0) {
+      std::uint32_t length = 0;
+      std::memcpy(&length, bytes.data() + 12, sizeof length);
+      bytes.resize(20 + std::min<std::uint32_t>(length, 1u << 30));
+      in.read(bytes.data() + 20, static_cast<std::streamsize>(bytes.size() - 20));
+      bytes.resize(20 + static_cast<std::size_t>(in.gcount()));
+    } else {
+      bytes.append(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    json = bytes;
   }
-  std::string_view json(bytes);
   if (extension == ".glb" || json.substr(0, 4) == "glTF") {
     if (json.size() < 20) return;  // assimp says what is wrong with it
     std::uint32_t length = 0;
