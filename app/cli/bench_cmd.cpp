@@ -33,7 +33,8 @@ void addBench(CLI::App& app) {
   struct Options {
     ColorByOptions colorBy;
     ContourOptions contours;
-    std::string scene, methods, size = "512x512", view = "fit", json, label, clip, section, field;
+    ReadOptions read;
+    std::string scene, methods, size = "512x512", view = "fit", json, label, clip, section;
     int repeat = 5, warmup = 1;
     double opacity = -1.0;
     bool noQuality = false;
@@ -54,7 +55,7 @@ void addBench(CLI::App& app) {
   cmd->add_option("--clip", opt->clip, kClipHelp);
   opt->colorBy.add(cmd);
   opt->contours.add(cmd);
-  cmd->add_option("--field", opt->field, kFieldHelp);
+  opt->read.add(cmd);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->add_flag("--no-quality", opt->noQuality, "Skip the oracle and the RMSE/FLIP columns");
@@ -67,7 +68,7 @@ void addBench(CLI::App& app) {
     std::vector<RenderRequest> requests;
     for (const std::string& spec : splitList(opt->methods)) requests.push_back(parseMethodSpec(spec, w, h));
     if (requests.empty()) throw Error("--methods", "no method given");
-    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
+    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->read);
     opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "mfr/io/load.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/scene.hpp"
 #include "mfr/scene/section.hpp"
@@ -27,12 +28,17 @@ void addProbe(CLI::App& app);
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);
 // A list separated by commas (or `separator`), empty items dropped.
 std::vector<std::string> splitList(const std::string& text, char separator = ',');
-// loadScene (with --field: the array or grid of a volume file), then every object's opacity set to
-// `opacity` unless it is negative (--opacity).
-Scene loadSceneWithOpacity(const std::string& path, double opacity, const std::string& field = {});
-inline constexpr const char* kFieldHelp =
-    "Volume file: the point-data array (.vti, .vtk) or grid (.vdb) to read instead of the default "
-    "(see mfr info for the file's fields)";
+// --field and --molecule: what to read of a file that holds several things.
+struct ReadOptions {
+  std::string field;                    // --field: the array or grid of a volume file
+  std::optional<std::string> molecule;  // --molecule: a molecule file's representations
+  void add(CLI::App* cmd);
+  // The options as mfr::LoadOptions; throws mfr::Error("--molecule", reason) for a bad list.
+  [[nodiscard]] LoadOptions load() const;
+};
+// loadScene with `read`, then every object's opacity set to `opacity` unless it is negative
+// (--opacity).
+Scene loadSceneWithOpacity(const std::string& path, double opacity, const ReadOptions& read = {});
 // Every scene loaded (with --opacity) and every view checked before any work, so that a bad file
 // or view fails at once; throws mfr::Error for an empty view list.
 std::vector<Scene> loadScenesWithViews(const std::vector<std::string>& paths, double opacity,

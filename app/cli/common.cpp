@@ -34,8 +34,23 @@ std::vector<std::string> splitList(const std::string& text, char separator) {
   return out;
 }
 
-Scene loadSceneWithOpacity(const std::string& path, double opacity, const std::string& field) {
-  Scene scene = loadScene(path, LoadOptions{field});
+void ReadOptions::add(CLI::App* cmd) {
+  cmd->add_option("--field", field,
+                  "Volume file: the point-data array (.vti, .vtk) or grid (.vdb) to read instead of the default "
+                  "(see mfr info for the file's fields)");
+  cmd->add_option("--molecule", molecule,
+                  "Molecule file (.pdb, .cif): how to draw it — spheres (default), sticks, ball-and-stick, surface "
+                  "(solvent-excluded, per chain), or several joined by ',' (surface,sticks)");
+}
+
+LoadOptions ReadOptions::load() const {
+  LoadOptions options(field);
+  if (molecule) options.molecule = MoleculeStyle::parse(*molecule, "--molecule " + *molecule);
+  return options;
+}
+
+Scene loadSceneWithOpacity(const std::string& path, double opacity, const ReadOptions& read) {
+  Scene scene = loadScene(path, read.load());
   if (opacity >= 0.0)
     for (Object& o : scene.objects) o.material.color.a = static_cast<float>(opacity);
   return scene;

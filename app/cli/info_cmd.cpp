@@ -17,7 +17,8 @@ namespace mfr::cli {
 
 void addInfo(CLI::App& app) {
   struct Options {
-    std::string scene, size = "256x256", view = "fit", json, field, section;
+    ReadOptions read;
+    std::string scene, size = "256x256", view = "fit", json, section;
     bool methods = false, noHistogram = false;
     ContourOptions contours;
   };
@@ -28,7 +29,7 @@ void addInfo(CLI::App& app) {
   cmd->add_option("--size,-s", opt->size, "Image size for the depth-complexity histogram")->capture_default_str();
   cmd->add_option("--view", opt->view, "View for the histogram")->capture_default_str();
   cmd->add_flag("--no-histogram", opt->noHistogram, "Skip the oracle pass");
-  cmd->add_option("--field", opt->field, kFieldHelp);
+  opt->read.add(cmd);
   opt->contours.add(cmd);
   cmd->add_option("--section", opt->section,
                   std::string(kSectionHelp) +
@@ -42,7 +43,7 @@ void addInfo(CLI::App& app) {
     }
     if (opt->scene.empty()) throw Error("info", "needs a scene (or --methods)");
     const auto [w, h] = parseSize("--size", opt->size);
-    Scene scene = loadScene(opt->scene, LoadOptions{opt->field});
+    Scene scene = loadScene(opt->scene, opt->read.load());
     opt->contours.apply(scene, -1.0);
     SectionReport section;
     applySectionOption(scene, opt->section, &section);

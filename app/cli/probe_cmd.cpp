@@ -54,7 +54,8 @@ void addProbe(CLI::App& app) {
   struct Options {
     ColorByOptions colorBy;
     ContourOptions contours;
-    std::string scene, pixel, size = "512x512", view = "fit", method, op = "auto", json, clip, section, field;
+    ReadOptions read;
+    std::string scene, pixel, size = "512x512", view = "fit", method, op = "auto", json, clip, section;
     std::vector<std::string> params;
     double opacity = -1.0;
     double thickness = 0.0;
@@ -79,7 +80,7 @@ void addProbe(CLI::App& app) {
   cmd->add_option("--clip", opt->clip, kClipHelp);
   opt->colorBy.add(cmd);
   opt->contours.add(cmd);
-  cmd->add_option("--field", opt->field, kFieldHelp);
+  opt->read.add(cmd);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->callback([opt, thicknessGiven] {
@@ -107,7 +108,7 @@ void addProbe(CLI::App& app) {
     validateOperation(opt->op);
     req.operation = opt->op;
     req.thickness = thicknessOption(*thicknessGiven, opt->thickness);
-    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
+    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->read);
     opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);

@@ -21,8 +21,9 @@ void addRender(CLI::App& app) {
   struct Options {
     ColorByOptions colorBy;
     ContourOptions contours;
+    ReadOptions read;
     std::string scene, method = "oracle", op = "auto", size = "512x512", view = "fit", output, stats, clip, section,
-                       field, dataView;
+                       dataView;
     std::vector<std::string> params;
     double opacity = -1.0;
     double thickness = 0.0;
@@ -62,7 +63,7 @@ void addRender(CLI::App& app) {
   cmd->add_option("--clip", opt->clip, kClipHelp);
   opt->colorBy.add(cmd);
   opt->contours.add(cmd);
-  cmd->add_option("--field", opt->field, kFieldHelp);
+  opt->read.add(cmd);
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view of the scene, or 'fit'")->capture_default_str();
@@ -90,7 +91,7 @@ void addRender(CLI::App& app) {
       if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");
       req.params[p.substr(0, eq)] = p.substr(eq + 1);
     }
-    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->field);
+    Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->read);
     const std::optional<ContourLegend> contourLegend = opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);

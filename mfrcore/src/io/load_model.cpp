@@ -20,6 +20,7 @@
 #include "file_checks.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "mfr/io/molecule.hpp"
 #include "molecule_loader.hpp"
 #include "obj_loader.hpp"
 #include "off_loader.hpp"
@@ -130,7 +131,8 @@ std::vector<Object> singleObject(Mesh mesh, const std::string& partName) {
   return {std::move(object)};
 }
 
-std::vector<Object> load(const fs::path& path, const std::string& name, const LoadProgress& progress) {
+std::vector<Object> load(const fs::path& path, const std::string& name, const LoadOptions& options,
+                         const LoadProgress& progress) {
   io::checkReadable(path, name, "model");
   if (isVolumeFile(path))
     throw Error(name,
@@ -197,7 +199,8 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
     case Family::Molecule: {
       if (!gz) data = readAll(path, name);
       const auto molecule = ext == ".pdb" || ext == ".ent" ? io::MoleculeFormat::Pdb : io::MoleculeFormat::Mmcif;
-      return io::readMolecule(data, molecule, name, progress.part(gz ? 0.3 : 0.0, 0.95));
+      return io::readMolecule(data, molecule, name, options.molecule.value_or(MoleculeStyle{}),
+                              progress.part(gz ? 0.3 : 0.0, 0.95));
     }
   }
   throw Error(name, "unsupported file type");
@@ -206,10 +209,40 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
 }  // namespace
 
 std::vector<Object> loadModel(const fs::path& path, const LoadProgress& progress) {
+  return loadModel(path, LoadOptions{}, progress);
+}
+
+bool isMoleculeFile(const fs::path& path) {
+  std::string fileName = lower(path.filename().string());
+  if (endsWith(fileName, ".gz")) fileName.resize(fileName.size() - 3);
+  const auto found = match(fileName);
+  return found && found->second.family == Family::Molecule;
+}
+
+MoleculeStructure readMoleculeStructure(const fs::path& path) {
   const std::string name = path.string();
   return io::withFileErrors(name, [&] {
+    io::checkReadable(path, name, "molecule");
+    if (!isMoleculeFile(path)) throw Error(name, "not a molecule file (.pdb .ent .cif .mmcif, optionally .gz)");
+    const std::string data =
+        endsWith(lower(path.filename().string()), ".gz") ? decompress(path, name) : readAll(path, name);
+    std::string fileName = lower(path.filename().string());
+    if (endsWith(fileName, ".gz")) fileName.resize(fileName.size() - 3);
+    const bool pdb = endsWith(fileName, ".pdb") || endsWith(fileName, ".ent");
+    return io::readMoleculeStructure(data, pdb ? io::MoleculeFormat::Pdb : io::MoleculeFormat::Mmcif, name);
+  });
+}
+
+std::vector<Object> loadModel(const fs::path& path, const LoadOptions& options, const LoadProgress& progress) {
+  const std::string name = path.string();
+  if (!options.field.empty())
+    throw Error(name, "field '" + options.field + "' can be chosen only for a volume file (this is not one)");
+  if (options.molecule && !isMoleculeFile(path))
+    throw Error(name, "a molecule representation (" + options.molecule->text() +
+                          ") can be chosen only for a molecule file (.pdb .ent .cif .mmcif)");
+  return io::withFileErrors(name, [&] {
     progress.step(0.0);
-    std::vector<Object> objects = load(path, name, progress);
+    std::vector<Object> objects = load(path, name, options, progress);
     if (objects.empty()) throw Error(name, "no triangles");
     // Every mesh once (assemblies share meshes between parts): the invariants renderers rely on.
     std::set<const Mesh*> checked;

@@ -34,6 +34,13 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
                                ? std::string("a scene file gives each volume its own 'field'")
                                : std::string("this is not one")) +
                           ")");
+  if (options.molecule && !isMoleculeFile(path))
+    throw Error(text, "a molecule representation (" + options.molecule->text() +
+                          ") can be chosen only for a molecule file (" +
+                          (path.extension() == ".mfrscene" || path.extension() == ".json"
+                               ? std::string("a scene file gives each molecule its own 'molecule'")
+                               : std::string(".pdb .ent .cif .mmcif; this is not one")) +
+                          ")");
   if (text == "@sample") return makeSampleScene();
   if (text == "@csg") return makeCsgSampleScene();
   if (text == "@intersect") return makeIntersectingSampleScene();
@@ -63,7 +70,7 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
       if (isVolumeFile(path))
         scene.volumes.push_back(loadVolume(path, options, progress));
       else
-        scene.objects = loadModel(path, progress);
+        scene.objects = loadModel(path, LoadOptions{{}, options.molecule}, progress);
     }
     Camera front;
     front.eye = {0.0, 0.0, 1.0};

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -19,8 +20,15 @@
 #include <gemmi/model.hpp>
 #include <gemmi/pdb.hpp>
 #include <gemmi/polyheur.hpp>
+#include <vtkIdList.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkStaticPointLocator.h>
 
 #include "mfr/error.hpp"
+#include "mfr/io/molecule.hpp"
+#include "mfr/scene/molecular_surface.hpp"
 
 namespace mfr::io {
 namespace {
@@ -218,16 +226,18 @@ std::string reason(std::string message, const std::string& name) {
 struct Atom {
   glm::dvec3 position;
   gemmi::El element;
-  // Colour-by fields (Mesh::fields) of its sphere: the B-factor (Å²), occupancy and residue
+  // Colour-by fields (Mesh::fields) of its geometry: the B-factor (Å²), occupancy and residue
   // sequence number as the file gives them (PyMOL's b, q and resi).
   float bFactor = 0.0f;
   float occupancy = 1.0f;
   float residue = 0.0f;
+  int serial = 0;
 };
 
 struct Part {
   std::string name;
   std::vector<Atom> atoms;
+  bool water = false;
 };
 
 // The atoms of the first model sorted into parts: polymer chains by name in order of appearance,
@@ -236,7 +246,7 @@ struct Part {
 std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
   std::vector<Part> chains;
   std::map<std::string, std::size_t> chainIndex;
-  Part ligands{"ligands", {}}, water{"water", {}};
+  Part ligands{"ligands", {}, false}, water{"water", {}, true};
   std::map<std::pair<std::string, gemmi::SeqId>, char> firstAltloc;
   std::size_t total = 0;
   for (const gemmi::Chain& chain : model.chains) {
@@ -261,14 +271,14 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
         Part* part = nullptr;
         if (residue.entity_type == gemmi::EntityType::Polymer) {
           const auto [it, isNew] = chainIndex.try_emplace(chain.name, chains.size());
-          if (isNew) chains.push_back({chain.name.empty() ? "chain (blank)" : "chain " + chain.name, {}});
+          if (isNew) chains.push_back({chain.name.empty() ? "chain (blank)" : "chain " + chain.name, {}, false});
           part = &chains[it->second];
         } else {
           part = residue.entity_type == gemmi::EntityType::Water ? &water : &ligands;
         }
         const float number = residue.seqid.num.has_value() ? static_cast<float>(*residue.seqid.num)
                                                            : std::numeric_limits<float>::quiet_NaN();
-        part->atoms.push_back({p, atom.element.elem, atom.b_iso, atom.occ, number});
+        part->atoms.push_back({p, atom.element.elem, atom.b_iso, atom.occ, number, atom.serial});
       }
     }
   }
@@ -277,45 +287,14 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
   return chains;
 }
 
-Mesh sphereMesh(const std::vector<Atom>& atoms, const UnitSphere& unit) {
-  Mesh mesh;
-  const std::size_t nv = unit.vertices.size();
-  mesh.positions.reserve(atoms.size() * nv);
-  mesh.normals.reserve(atoms.size() * nv);
-  mesh.colors.reserve(atoms.size() * nv);
-  mesh.indices.reserve(atoms.size() * unit.indices.size());
-  std::vector<glm::vec3> normals;
-  for (const glm::dvec3& u : unit.vertices) normals.push_back(glm::normalize(glm::vec3(u)));
-  MeshField bFactor{"b_factor", false, 1, {}}, occupancy{"occupancy", false, 1, {}}, residue{"residue", false, 1, {}};
-  for (MeshField* f : {&bFactor, &occupancy, &residue}) f->values.reserve(atoms.size() * nv);
-  for (const Atom& atom : atoms) {
-    bFactor.values.insert(bFactor.values.end(), nv, atom.bFactor);
-    occupancy.values.insert(occupancy.values.end(), nv, atom.occupancy);
-    residue.values.insert(residue.values.end(), nv, atom.residue);
-    const auto base = static_cast<std::uint32_t>(mesh.positions.size());
-    const double r = gemmi::vdw_radius(atom.element);
-    const glm::vec4 color = elementColor(atom.element);
-    for (std::size_t k = 0; k < nv; ++k) {
-      mesh.positions.emplace_back(atom.position + r * unit.vertices[k]);
-      mesh.normals.push_back(normals[k]);
-      mesh.colors.push_back(color);
-    }
-    for (const std::uint32_t i : unit.indices) mesh.indices.push_back(base + i);
-  }
-  mesh.fields = {std::move(bFactor), std::move(occupancy), std::move(residue)};
-  return mesh;
-}
+// The structure's first model, parsed, checked and sorted into parts.
+struct Parsed {
+  std::vector<Part> parts;
+  std::size_t models = 1;
+};
 
-}  // namespace
-
-int sphereSubdivisionLevel(std::size_t atoms) {
-  for (int level = 2; level > 0; --level)
-    if (atoms * (std::size_t{20} << (2 * level)) <= kMoleculeTriangleCap) return level;
-  return 0;
-}
-
-std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat format, const std::string& name,
-                                 const LoadProgress& progress) {
+Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const std::string& name,
+                     const LoadProgress& progress) {
   progress.step(0.0);
   gemmi::Structure st;
   try {
@@ -327,7 +306,7 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
   } catch (const std::exception& e) {
     throw Error(name, reason(e.what(), name));
   }
-  progress.step(0.6);
+  progress.step(0.5);
 
   const std::size_t models = st.models.size();
   if (models == 0 || std::none_of(st.models[0].chains.begin(), st.models[0].chains.end(), [](const gemmi::Chain& c) {
@@ -342,26 +321,398 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
   } catch (const std::exception& e) {
     throw Error(name, reason(e.what(), name));
   }
-  std::vector<Part> parts = partsOf(st.models[0], name);
-  progress.step(0.65);
+  Parsed parsed{partsOf(st.models[0], name), models};
+  progress.step(0.55);
+  return parsed;
+}
+
+int atomicNumber(gemmi::El element) {
+  return element == gemmi::El::D ? 1 : static_cast<int>(element);
+}
+
+MoleculeStructure structureOf(const Parsed& parsed) {
+  MoleculeStructure out;
+  out.models = parsed.models;
+  for (std::size_t p = 0; p < parsed.parts.size(); ++p) {
+    out.parts.push_back(parsed.parts[p].name);
+    for (const Atom& a : parsed.parts[p].atoms) out.atoms.push_back({a.serial, atomicNumber(a.element), a.position, p});
+  }
+  out.bonds = perceiveBonds(out.atoms);
+  return out;
+}
+
+// ---- geometry -----------------------------------------------------------------------------------
+
+// Per-vertex colour and colour-by fields of an atom's geometry, appended together.
+struct AtomMeshBuilder {
+  Mesh mesh;
+  MeshField bFactor{"b_factor", false, 1, {}}, occupancy{"occupancy", false, 1, {}}, residue{"residue", false, 1, {}};
+
+  void vertex(const Atom& atom, const glm::dvec3& position, const glm::vec3& normal) {
+    mesh.positions.emplace_back(position);
+    mesh.normals.push_back(normal);
+    mesh.colors.push_back(elementColor(atom.element));
+    bFactor.values.push_back(atom.bFactor);
+    occupancy.values.push_back(atom.occupancy);
+    residue.values.push_back(atom.residue);
+  }
+  [[nodiscard]] std::uint32_t next() const { return static_cast<std::uint32_t>(mesh.positions.size()); }
+
+  void sphere(const Atom& atom, double radius, const UnitSphere& unit) {
+    const std::uint32_t base = next();
+    for (const glm::dvec3& u : unit.vertices) vertex(atom, atom.position + radius * u, glm::normalize(glm::vec3(u)));
+    for (const std::uint32_t i : unit.indices) mesh.indices.push_back(base + i);
+  }
+
+  // An open tube of `sides` quads from `from` to `to` (the half of a bond on an atom's side).
+  void tube(const Atom& atom, const glm::dvec3& from, const glm::dvec3& to, double radius, int sides) {
+    const glm::dvec3 axis = glm::normalize(to - from);
+    const glm::dvec3 helper = std::abs(axis.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+    const glm::dvec3 u = glm::normalize(glm::cross(axis, helper)), v = glm::cross(axis, u);
+    const std::uint32_t base = next();
+    for (int s = 0; s < sides; ++s) {
+      const double angle = 2.0 * std::numbers::pi * s / sides;
+      const glm::dvec3 n = std::cos(angle) * u + std::sin(angle) * v;
+      vertex(atom, from + radius * n, glm::vec3(n));
+      vertex(atom, to + radius * n, glm::vec3(n));
+    }
+    for (int s = 0; s < sides; ++s) {
+      const auto a = base + static_cast<std::uint32_t>(2 * s),
+                 b = base + static_cast<std::uint32_t>(2 * ((s + 1) % sides));
+      // Counter-clockwise seen from outside: (u, v, axis) is right-handed.
+      mesh.indices.insert(mesh.indices.end(), {a, b, b + 1, a, b + 1, a + 1});
+    }
+  }
+
+  Mesh take() {
+    mesh.fields = {std::move(bFactor), std::move(occupancy), std::move(residue)};
+    return std::move(mesh);
+  }
+};
+
+// Stick and ball sizes: PyMOL's stick_radius (0.25 Å); Jmol's ball-and-stick default ("spacefill
+// 23%; wireframe 0.15").
+constexpr double kStickRadius = 0.25;
+constexpr double kBallAndStickRadius = 0.15;
+constexpr double kBallScale = 0.23;
+
+// Tube sides for the sphere tessellation level (16, 8, 6).
+int tubeSides(int level) {
+  return level >= 2 ? 16 : level == 1 ? 8 : 6;
+}
+
+Mesh spheresMesh(const Part& part, const UnitSphere& unit) {
+  AtomMeshBuilder b;
+  for (const Atom& atom : part.atoms) b.sphere(atom, gemmi::vdw_radius(atom.element), unit);
+  return b.take();
+}
+
+// Sticks (ballScale 0: joints of the stick radius at bonded atoms) or balls and sticks: each bond
+// drawn as two half tubes, each in its atom's colour and part; an atom without bonds as a ball of
+// 23 % of its van der Waals radius, so that ions and waters stay visible.
+Mesh sticksMesh(const Part& part, std::size_t firstAtom, const std::vector<Atom*>& all,
+                const std::vector<std::vector<std::uint32_t>>& bondedTo, double stickRadius, double ballScale,
+                const UnitSphere& unit, int sides) {
+  AtomMeshBuilder b;
+  for (std::size_t i = 0; i < part.atoms.size(); ++i) {
+    const Atom& atom = part.atoms[i];
+    const std::vector<std::uint32_t>& bonds = bondedTo[firstAtom + i];
+    const double ball = kBallScale * gemmi::vdw_radius(atom.element);
+    if (bonds.empty())
+      b.sphere(atom, std::max(stickRadius, ball), unit);
+    else
+      b.sphere(atom, ballScale > 0.0 ? std::max(stickRadius, ballScale * gemmi::vdw_radius(atom.element)) : stickRadius,
+               unit);
+    for (const std::uint32_t other : bonds)
+      b.tube(atom, atom.position, 0.5 * (atom.position + all[other]->position), stickRadius, sides);
+  }
+  return b.take();
+}
+
+// The part's solvent-excluded surface, each vertex coloured (and given the fields) of the atom
+// whose van der Waals sphere is nearest to it, as PyMOL colours a surface.
+Mesh surfaceMesh(const Part& part) {
+  std::vector<SurfaceAtom> spheres;
+  spheres.reserve(part.atoms.size());
+  double largest = 0.0;
+  for (const Atom& atom : part.atoms) {
+    spheres.push_back({atom.position, gemmi::vdw_radius(atom.element)});
+    largest = std::max(largest, spheres.back().radius);
+  }
+  const MolecularSurfaceOptions options;
+  const Mesh surface = solventExcludedSurface(spheres, options);
+  vtkNew<vtkPoints> centres;
+  centres->SetDataTypeToDouble();
+  for (const SurfaceAtom& s : spheres) centres->InsertNextPoint(s.centre.x, s.centre.y, s.centre.z);
+  vtkNew<vtkPolyData> centreSet;
+  centreSet->SetPoints(centres);
+  vtkNew<vtkStaticPointLocator> locator;
+  locator->SetDataSet(centreSet);
+  locator->BuildLocator();
+  vtkNew<vtkIdList> around;
+  // A surface point is at most the probe's diameter from its nearest sphere (it touches the probe,
+  // which touches an atom), plus the grid's error.
+  const double reach = largest + 2.0 * options.probeRadius + molecularSurfaceSpacing(spheres, options);
+  AtomMeshBuilder b;
+  for (std::size_t v = 0; v < surface.positions.size(); ++v) {
+    const glm::dvec3 p(surface.positions[v]);
+    double query[3] = {p.x, p.y, p.z};
+    locator->FindPointsWithinRadius(reach, query, around);
+    std::size_t best = 0;
+    double bestGap = std::numeric_limits<double>::infinity();
+    for (vtkIdType n = 0; n < around->GetNumberOfIds(); ++n) {
+      const auto a = static_cast<std::size_t>(around->GetId(n));
+      const double gap = glm::length(p - spheres[a].centre) - spheres[a].radius;
+      if (gap < bestGap) {
+        bestGap = gap;
+        best = a;
+      }
+    }
+    if (!std::isfinite(bestGap)) best = static_cast<std::size_t>(locator->FindClosestPoint(query));
+    b.vertex(part.atoms[best], p, surface.normals[v]);
+  }
+  b.mesh.indices = surface.indices;
+  return b.take();
+}
+
+}  // namespace
+
+int sphereSubdivisionLevel(std::size_t atoms) {
+  for (int level = 2; level > 0; --level)
+    if (atoms * (std::size_t{20} << (2 * level)) <= kMoleculeTriangleCap) return level;
+  return 0;
+}
+
+MoleculeStructure readMoleculeStructure(const std::string& contents, MoleculeFormat format, const std::string& name) {
+  return structureOf(parseMolecule(contents, format, name, {}));
+}
+
+std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat format, const std::string& name,
+                                 const MoleculeStyle& style, const LoadProgress& progress) {
+  Parsed parsed = parseMolecule(contents, format, name, progress);
+  std::vector<Part>& parts = parsed.parts;
 
   std::size_t atoms = 0;
   for (const Part& part : parts) atoms += part.atoms.size();
-  const UnitSphere& unit = icosphere(sphereSubdivisionLevel(atoms));
+  const int level = sphereSubdivisionLevel(atoms);
+  const UnitSphere& unit = icosphere(level);
+
+  // Bonds over the whole model (a disulphide joins two chains; a ligand binds to a residue), as
+  // lists per atom in the parts' order.
+  std::vector<Atom*> all;
+  std::vector<std::size_t> firstAtom;
+  std::vector<std::vector<std::uint32_t>> bondedTo;
+  if (style.sticks || style.ballAndStick) {
+    const MoleculeStructure structure = structureOf(parsed);
+    for (Part& part : parts) {
+      firstAtom.push_back(all.size());
+      for (Atom& atom : part.atoms) all.push_back(&atom);
+    }
+    bondedTo.resize(all.size());
+    for (const Bond& bond : structure.bonds) {
+      bondedTo[bond[0]].push_back(bond[1]);
+      bondedTo[bond[1]].push_back(bond[0]);
+    }
+  }
+  progress.step(0.6);
+
   // NMR ensembles: say which model is shown, in every part's name (the scene tree shows it).
-  const std::string modelNote = models > 1 ? " (model 1 of " + std::to_string(models) + ")" : "";
+  const std::string modelNote = parsed.models > 1 ? " (model 1 of " + std::to_string(parsed.models) + ")" : "";
+  const int representations = static_cast<int>(style.spheres) + static_cast<int>(style.ballAndStick) +
+                              static_cast<int>(style.sticks) + static_cast<int>(style.surface);
   std::vector<Object> objects;
-  for (std::size_t i = 0; i < parts.size(); ++i) {
+  const auto add = [&](const Part& part, const char* representation, Mesh mesh) {
+    if (mesh.indices.empty()) return;
     Object object;
-    object.name = parts[i].name + modelNote;
-    object.mesh = std::make_shared<const Mesh>(sphereMesh(parts[i].atoms, unit));
+    object.name = part.name + (representations > 1 ? std::string(" ") + representation : std::string()) + modelNote;
+    object.mesh = std::make_shared<const Mesh>(std::move(mesh));
     // White, so that the per-vertex element colours show as they are; the default opacity.
     object.material.color = glm::vec4(1.0f, 1.0f, 1.0f, Material{}.color.a);
     objects.push_back(std::move(object));
-    parts[i].atoms = {};
-    progress.step(0.65 + 0.35 * static_cast<double>(i + 1) / static_cast<double>(parts.size()));
+  };
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const Part& part = parts[i];
+    if (style.spheres) add(part, "spheres", spheresMesh(part, unit));
+    if (style.ballAndStick)
+      add(part, "ball-and-stick",
+          sticksMesh(part, firstAtom[i], all, bondedTo, kBallAndStickRadius, kBallScale, unit, tubeSides(level)));
+    if (style.sticks)
+      add(part, "sticks", sticksMesh(part, firstAtom[i], all, bondedTo, kStickRadius, 0.0, unit, tubeSides(level)));
+    // Water has no surface of its own (PyMOL leaves solvent out of surfaces too).
+    if (style.surface && !part.water) add(part, "surface", surfaceMesh(part));
+    progress.step(0.6 + 0.4 * static_cast<double>(i + 1) / static_cast<double>(parts.size()));
   }
+  if (objects.empty()) throw Error(name, "nothing to draw as " + style.text() + " (only water, which has no surface)");
   return objects;
 }
 
 }  // namespace mfr::io
+
+namespace mfr {
+
+namespace {
+
+// The most bonds an element makes, from the Blue Obelisk data Open Babel uses (its element table's
+// MaxBnd): 6 for the elements not listed.
+int maxBonds(int z) {
+  switch (z) {
+    case 1:
+    case 3:
+    case 9:
+    case 11:
+    case 17:
+    case 19:
+    case 35:
+    case 37:
+    case 53:
+    case 55:
+      return 1;  // H, alkali metals, halogens
+    case 4:
+    case 8:
+    case 12:
+    case 20:
+    case 34:
+    case 38:
+    case 56:
+      return 2;  // Be, O, Mg, Ca, Se, Sr, Ba
+    case 31:
+    case 33:
+    case 49:
+    case 51:
+      return 3;  // Ga, As, In, Sb
+    case 5:
+    case 6:
+    case 7:
+    case 32:
+    case 50:
+      return 4;  // B, C, N, Ge, Sn
+    case 15:
+      return 5;  // P
+    case 2:
+    case 10:
+    case 18:
+    case 36:
+    case 54:
+    case 86:
+      return 0;  // noble gases
+    default:
+      return 6;
+  }
+}
+
+}  // namespace
+
+std::vector<Bond> perceiveBonds(const std::vector<MoleculeAtom>& atoms) {
+  std::vector<Bond> bonds;
+  if (atoms.size() < 2) return bonds;
+  const auto covalent = [&](std::size_t i) {
+    const int z = atoms[i].atomicNumber;
+    return static_cast<double>(gemmi::covalent_radius(z >= 0 && z <= 118 ? static_cast<gemmi::El>(z) : gemmi::El::X));
+  };
+  double largest = 0.0;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  for (std::size_t i = 0; i < atoms.size(); ++i) {
+    largest = std::max(largest, covalent(i));
+    points->InsertNextPoint(atoms[i].position.x, atoms[i].position.y, atoms[i].position.z);
+  }
+  vtkNew<vtkPolyData> set;
+  set->SetPoints(points);
+  vtkNew<vtkStaticPointLocator> locator;
+  locator->SetDataSet(set);
+  locator->BuildLocator();
+  vtkNew<vtkIdList> around;
+  constexpr double kTolerance = 0.45, kShortest = 0.4;
+  std::vector<std::vector<std::uint32_t>> bondedTo(atoms.size());
+  for (std::size_t i = 0; i < atoms.size(); ++i) {
+    const double ri = covalent(i);
+    double query[3] = {atoms[i].position.x, atoms[i].position.y, atoms[i].position.z};
+    locator->FindPointsWithinRadius(ri + largest + kTolerance, query, around);
+    for (vtkIdType n = 0; n < around->GetNumberOfIds(); ++n) {
+      const auto j = static_cast<std::size_t>(around->GetId(n));
+      if (j <= i) continue;
+      const double d = glm::length(atoms[i].position - atoms[j].position);
+      if (d > kShortest && d < ri + covalent(j) + kTolerance) {
+        bondedTo[i].push_back(static_cast<std::uint32_t>(j));
+        bondedTo[j].push_back(static_cast<std::uint32_t>(i));
+      }
+    }
+  }
+  // Clean-up, atom by atom in order: too many bonds, or two bonds closer than 45°, lose the longest
+  // (a hydrogen its bond to another hydrogen first).
+  const auto length = [&](std::size_t a, std::size_t b) { return glm::length(atoms[a].position - atoms[b].position); };
+  const auto unbond = [&](std::size_t a, std::uint32_t b) {
+    std::erase(bondedTo[a], b);
+    std::erase(bondedTo[b], static_cast<std::uint32_t>(a));
+  };
+  const auto smallestAngle = [&](std::size_t a) {
+    double smallest = 180.0;
+    const std::vector<std::uint32_t>& n = bondedTo[a];
+    for (std::size_t x = 0; x < n.size(); ++x)
+      for (std::size_t y = x + 1; y < n.size(); ++y) {
+        const glm::dvec3 u = glm::normalize(atoms[n[x]].position - atoms[a].position),
+                         v = glm::normalize(atoms[n[y]].position - atoms[a].position);
+        smallest = std::min(smallest, glm::degrees(std::acos(std::clamp(glm::dot(u, v), -1.0, 1.0))));
+      }
+    return smallest;
+  };
+  for (std::size_t a = 0; a < atoms.size(); ++a) {
+    while (!bondedTo[a].empty() &&
+           (static_cast<int>(bondedTo[a].size()) > maxBonds(atoms[a].atomicNumber) || smallestAngle(a) < 45.0)) {
+      std::vector<std::uint32_t>& n = bondedTo[a];
+      if (atoms[a].atomicNumber == 1) {
+        const auto hh = std::find_if(n.begin(), n.end(), [&](std::uint32_t b) { return atoms[b].atomicNumber == 1; });
+        if (hh != n.end()) {
+          unbond(a, *hh);
+          continue;
+        }
+      }
+      const auto longest = std::max_element(
+          n.begin(), n.end(), [&](std::uint32_t x, std::uint32_t y) { return length(a, x) < length(a, y); });
+      unbond(a, *longest);
+    }
+  }
+  for (std::size_t a = 0; a < atoms.size(); ++a)
+    for (const std::uint32_t b : bondedTo[a])
+      if (a < b) bonds.push_back({static_cast<std::uint32_t>(a), b});
+  std::sort(bonds.begin(), bonds.end());
+  return bonds;
+}
+
+std::string MoleculeStyle::text() const {
+  std::string out;
+  for (const auto& [on, name] : {std::pair{spheres, "spheres"}, std::pair{ballAndStick, "ball-and-stick"},
+                                 std::pair{sticks, "sticks"}, std::pair{surface, "surface"}})
+    if (on) out += (out.empty() ? "" : ",") + std::string(name);
+  return out;
+}
+
+MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& what) {
+  MoleculeStyle style;
+  style.spheres = false;
+  bool any = false;
+  std::string item;
+  for (std::size_t i = 0; i <= text.size(); ++i) {
+    if (i < text.size() && text[i] != ',' && text[i] != '+') {
+      item += text[i];
+      continue;
+    }
+    if (item == "spheres")
+      style.spheres = true;
+    else if (item == "sticks")
+      style.sticks = true;
+    else if (item == "ball-and-stick")
+      style.ballAndStick = true;
+    else if (item == "surface")
+      style.surface = true;
+    else
+      throw Error(what, (item.empty() ? std::string("expected") : "unknown representation '" + item + "': expected") +
+                            " spheres, sticks, ball-and-stick or surface, or several joined by ',' (surface,sticks)");
+    any = true;
+    item.clear();
+  }
+  if (!any) throw Error(what, "expected spheres, sticks, ball-and-stick or surface");
+  return style;
+}
+
+}  // namespace mfr

@@ -514,7 +514,18 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
         scene.objects.push_back(std::move(obj));
       } else {
         const std::filesystem::path file = baseDir / r.string(o, "file", where, "");
-        std::vector<Object> parts = loadModel(file, objectProgress);  // its errors name the model file
+        LoadOptions options;
+        if (o.contains("molecule")) {
+          const std::string style = r.string(o, "molecule", where, "");
+          try {
+            options.molecule = MoleculeStyle::parse(style, "molecule");
+          } catch (const Error& e) {
+            r.fail(where + ".molecule", std::string(e.what()).substr(std::string("molecule: ").size()));
+          }
+          if (!isMoleculeFile(file))
+            r.fail(where + ".molecule", "only a molecule file (.pdb .ent .cif .mmcif) has representations");
+        }
+        std::vector<Object> parts = loadModel(file, options, objectProgress);  // its errors name the model file
         colorBy.push_back(
             {&o, where, scene.objects.size(), scene.objects.size() + parts.size(), file.filename().string()});
         for (Object& part : parts) {

@@ -3,7 +3,9 @@
 // material colour); .mfrscene files are parsed by scene/scene_file.
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mfr/error.hpp"
@@ -34,11 +36,34 @@ struct LoadProgress {
   [[nodiscard]] LoadProgress part(double from, double to) const;
 };
 
+// How a molecule (PDB, mmCIF) is drawn: any combination of these representations, each a part of
+// its own per chain (PyMOL's `show`).
+struct MoleculeStyle {
+  bool spheres = true;        // space-filling: van der Waals spheres (PyMOL's spheres, CPK)
+  bool sticks = false;        // bonds as sticks of radius 0.25 Å, joined by spheres (PyMOL's sticks)
+  bool ballAndStick = false;  // balls of 23 % of the van der Waals radius, sticks of 0.15 Å (Jmol's)
+  bool surface = false;       // the solvent-excluded surface of each part but water (probe 1.4 Å)
+
+  // "spheres", "surface,sticks": the names in the order spheres, ball-and-stick, sticks, surface.
+  [[nodiscard]] std::string text() const;
+  // One or more names separated by ',' or '+'. Throws mfr::Error(what, reason) for an unknown or
+  // missing name.
+  static MoleculeStyle parse(const std::string& text, const std::string& what);
+  bool operator==(const MoleculeStyle&) const = default;
+};
+
 // What to read of a file that holds several things.
 struct LoadOptions {
+  LoadOptions() = default;
+  explicit LoadOptions(std::string field_, std::optional<MoleculeStyle> molecule_ = {})
+      : field(std::move(field_)), molecule(std::move(molecule_)) {}
+
   // Volume files: the point-data array (.vti, legacy .vtk) or grid (.vdb) to read; empty: the
   // default (see loadVolume). Given for any other file, loading fails.
   std::string field;
+  // Molecule files: how to draw it; none: space-filling spheres. Given for any other file,
+  // loading fails.
+  std::optional<MoleculeStyle> molecule;
 };
 
 // Loads a model file — STL, PLY (also .ply.gz), OBJ, OFF, VTP, VTK legacy, STEP, glTF/GLB and the
@@ -46,6 +71,12 @@ struct LoadOptions {
 // part per chain plus ligands and water. Throws mfr::Error(path, reason) for a missing, unreadable,
 // truncated, corrupt or unsupported file, or one with no triangles; LoadCancelled when cancelled.
 std::vector<Object> loadModel(const std::filesystem::path& path, const LoadProgress& progress = {});
+// The same with options.molecule for a molecule file (options.field must be empty).
+std::vector<Object> loadModel(const std::filesystem::path& path, const LoadOptions& options,
+                              const LoadProgress& progress = {});
+
+// Whether `path` names a molecule file (.pdb, .ent, .cif, .mmcif, optionally .gz) by its name.
+bool isMoleculeFile(const std::filesystem::path& path);
 
 // File extensions loadModel accepts (lower case, with dot; ".ply.gz" included).
 std::vector<std::string> supportedModelExtensions();
@@ -70,8 +101,8 @@ bool isVolumeFile(const std::filesystem::path& path);
 
 // A scene from any supported file: .mfrscene → the scene it describes; a model → its parts with
 // default views ("front", "iso") fitted to them; a volume file → a scene of that one volume with
-// the same views. options.field is for a volume file only. Throws mfr::Error naming the file, or
-// LoadCancelled.
+// the same views. options.field is for a volume file only, options.molecule for a molecule file. Throws mfr::Error
+// naming the file, or LoadCancelled.
 Scene loadScene(const std::filesystem::path& path, const LoadProgress& progress = {});
 Scene loadScene(const std::filesystem::path& path, const LoadOptions& options, const LoadProgress& progress = {});
 

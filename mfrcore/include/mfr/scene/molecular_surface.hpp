@@ -1,0 +1,43 @@
+#pragma once
+// The solvent-excluded (molecular) surface of a set of atoms — PyMOL's `show surface`, Connolly's
+// surface (Richards 1977, Connolly 1983): the boundary of the space a probe sphere cannot enter when
+// it rolls over the atoms' van der Waals spheres. Where the probe touches one atom the surface is
+// that atom's sphere; where it touches two it is a concave torus; where three, a concave piece of
+// the probe's own sphere. Computed on a grid as the level set dist(p, A) = probe radius, A the
+// space of accessible probe centres (outside every atom's sphere grown by the probe radius), with
+// the distance measured to exact points of A's boundary — the solvent-accessible surface — and
+// extracted by VTK's flying edges.
+#include <cstddef>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/scene/mesh.hpp"
+
+namespace mfr {
+
+struct SurfaceAtom {
+  glm::dvec3 centre{0.0};
+  double radius = 0.0;  // van der Waals radius, > 0
+};
+
+struct MolecularSurfaceOptions {
+  double probeRadius = 1.4;  // water, as PyMOL's solvent_radius and every SES program
+  double spacing = 0.3;      // grid spacing (Å): the surface is within a small fraction of it
+  // The most grid points one surface may use; a larger structure gets a coarser grid (spacing
+  // grows until it fits), never a partial surface.
+  std::size_t maxGridPoints = std::size_t{1} << 25;
+};
+
+// The solvent-excluded surface of `atoms`, a closed mesh (one component per separate molecule or
+// cavity) whose normals point out of the excluded space and whose triangles wind counter-clockwise
+// seen from outside; positions and normals only (colours are the caller's). Empty for no atoms.
+// Throws mfr::Error for a non-finite centre, a radius that is not positive and finite, or options
+// out of range (probe radius not positive, spacing not positive).
+Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options = {});
+
+// The grid spacing solventExcludedSurface uses for `atoms`: options.spacing, or larger when the
+// grid would exceed options.maxGridPoints.
+double molecularSurfaceSpacing(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options = {});
+
+}  // namespace mfr

@@ -1,0 +1,242 @@
+// The solvent-excluded surface (Richards 1977; Connolly 1983) as a level set on a grid. A point p
+// is excluded when no probe sphere of radius r_p centred in the accessible space A touches it:
+// A = {c : |c − a_i| ≥ R_i for every atom i}, R_i = r_i + r_p, so p is excluded exactly when
+// dist(p, A) ≥ r_p. The grid holds f(p) = dist(p, A) − r_p and VTK's flying edges extracts f = 0.
+// dist(p, A) for p inside the solvent-accessible surface (SAS, ∂A) is the distance to ∂A, measured
+// to points that lie exactly on it: the projections of the grid points just outside it onto their
+// nearest grown sphere (the nearest point of a union of balls to an outside point is on the union's
+// boundary), plus points on every circle where two grown spheres meet and no third covers them —
+// the probe centres of the concave tori, which projections alone would only approach to within a
+// grid step. The probe's own concave patches (three atoms) are measured to the crease points
+// around them.
+#include "mfr/scene/molecular_surface.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <string>
+
+#include <vtkIdList.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkStaticPointLocator.h>
+
+#include "mfr/error.hpp"
+#include "mfr/scene/contour.hpp"
+#include "mfr/scene/volume.hpp"
+
+namespace mfr {
+namespace {
+
+constexpr const char* kWhat = "molecular surface";
+
+void check(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options) {
+  if (!(options.probeRadius > 0.0 && std::isfinite(options.probeRadius)))
+    throw Error(kWhat, "the probe radius must be positive and finite");
+  if (!(options.spacing > 0.0 && std::isfinite(options.spacing)))
+    throw Error(kWhat, "the grid spacing must be positive and finite");
+  if (options.maxGridPoints < 64) throw Error(kWhat, "at least 64 grid points are needed");
+  for (const SurfaceAtom& a : atoms) {
+    if (!std::isfinite(a.centre.x) || !std::isfinite(a.centre.y) || !std::isfinite(a.centre.z))
+      throw Error(kWhat, "an atom's centre is not finite");
+    if (!(a.radius > 0.0 && std::isfinite(a.radius))) throw Error(kWhat, "an atom's radius is not positive and finite");
+  }
+}
+
+// The box of the grown spheres.
+void grownBounds(const std::vector<SurfaceAtom>& atoms, double probe, glm::dvec3& lo, glm::dvec3& hi) {
+  lo = glm::dvec3(std::numeric_limits<double>::infinity());
+  hi = -lo;
+  for (const SurfaceAtom& a : atoms) {
+    lo = glm::min(lo, a.centre - (a.radius + probe));
+    hi = glm::max(hi, a.centre + (a.radius + probe));
+  }
+}
+
+// Grid points per axis for a box at spacing h: two points of margin on each side, so that every
+// point of the SAS has grid points outside it and the outermost layer is outside.
+glm::ivec3 gridDims(const glm::dvec3& lo, const glm::dvec3& hi, double h) {
+  const glm::dvec3 n = glm::ceil((hi - lo) / h) + 5.0;
+  return {static_cast<int>(n.x), static_cast<int>(n.y), static_cast<int>(n.z)};
+}
+
+double points(const glm::dvec3& lo, const glm::dvec3& hi, double h) {
+  const glm::dvec3 n = glm::ceil((hi - lo) / h) + 5.0;
+  return n.x * n.y * n.z;
+}
+
+}  // namespace
+
+double molecularSurfaceSpacing(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options) {
+  check(atoms, options);
+  if (atoms.empty()) return options.spacing;
+  glm::dvec3 lo, hi;
+  grownBounds(atoms, options.probeRadius, lo, hi);
+  double h = options.spacing;
+  const auto limit = static_cast<double>(options.maxGridPoints);
+  const auto perAxis = static_cast<double>(VolumeGrid::kMaxPointsPerAxis);
+  const auto fits = [&](double s) {
+    const glm::dvec3 n = glm::ceil((hi - lo) / s) + 5.0;
+    return points(lo, hi, s) <= limit && std::max({n.x, n.y, n.z}) <= perAxis;
+  };
+  while (!fits(h)) h *= 1.05;
+  return h;
+}
+
+Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options) {
+  check(atoms, options);
+  if (atoms.empty()) return {};
+  const double h = molecularSurfaceSpacing(atoms, options);
+  const double probe = options.probeRadius;
+  glm::dvec3 lo, hi;
+  grownBounds(atoms, probe, lo, hi);
+  const glm::dvec3 origin = lo - 2.0 * h;
+  const glm::ivec3 dims = gridDims(lo, hi, h);
+  const auto nx = static_cast<std::size_t>(dims.x), ny = static_cast<std::size_t>(dims.y),
+             nz = static_cast<std::size_t>(dims.z);
+  const auto at = [&](int i, int j, int k) {
+    return (static_cast<std::size_t>(k) * ny + static_cast<std::size_t>(j)) * nx + static_cast<std::size_t>(i);
+  };
+  const auto position = [&](int i, int j, int k) { return origin + h * glm::dvec3(i, j, k); };
+
+  // depth(p) = max_i (R_i − |p − a_i|): > 0 inside the SAS, a lower bound of the distance to its
+  // boundary there; outside, minus the distance to the nearest grown sphere, whose index is kept.
+  // Every grid point within 1.5 h of a grown sphere is visited, which covers every point next to
+  // the inside (those are within h of it).
+  std::vector<float> depth(nx * ny * nz, -std::numeric_limits<float>::infinity());
+  std::vector<std::int32_t> nearest(depth.size(), -1);
+  double largest = 0.0;
+  for (std::size_t a = 0; a < atoms.size(); ++a) {
+    const glm::dvec3 c = atoms[a].centre;
+    const double grown = atoms[a].radius + probe, reach = grown + 1.5 * h;
+    largest = std::max(largest, grown);
+    const glm::ivec3 from = glm::max(glm::ivec3(glm::floor((c - reach - origin) / h)), glm::ivec3(0));
+    const glm::ivec3 to = glm::min(glm::ivec3(glm::ceil((c + reach - origin) / h)), dims - 1);
+    for (int k = from.z; k <= to.z; ++k)
+      for (int j = from.y; j <= to.y; ++j)
+        for (int i = from.x; i <= to.x; ++i) {
+          const glm::dvec3 d = position(i, j, k) - c;
+          const double d2 = glm::dot(d, d);
+          if (d2 > reach * reach) continue;
+          const auto value = static_cast<float>(grown - std::sqrt(d2));
+          const std::size_t n = at(i, j, k);
+          if (value > depth[n]) {
+            depth[n] = value;
+            nearest[n] = static_cast<std::int32_t>(a);
+          }
+        }
+  }
+
+  // Points on the SAS: each grid point outside it next to one inside, projected onto its nearest
+  // grown sphere.
+  vtkNew<vtkPoints> samples;
+  samples->SetDataTypeToDouble();
+  for (int k = 1; k + 1 < dims.z; ++k)
+    for (int j = 1; j + 1 < dims.y; ++j)
+      for (int i = 1; i + 1 < dims.x; ++i) {
+        const std::size_t n = at(i, j, k);
+        if (depth[n] > 0.0f || nearest[n] < 0) continue;
+        const bool nextToInside = depth[at(i - 1, j, k)] > 0.0f || depth[at(i + 1, j, k)] > 0.0f ||
+                                  depth[at(i, j - 1, k)] > 0.0f || depth[at(i, j + 1, k)] > 0.0f ||
+                                  depth[at(i, j, k - 1)] > 0.0f || depth[at(i, j, k + 1)] > 0.0f;
+        if (!nextToInside) continue;
+        const SurfaceAtom& s = atoms[static_cast<std::size_t>(nearest[n])];
+        const glm::dvec3 d = position(i, j, k) - s.centre;
+        const double length = glm::length(d);
+        if (!(length > 0.0)) continue;
+        const glm::dvec3 q = s.centre + (s.radius + probe) / length * d;
+        samples->InsertNextPoint(q.x, q.y, q.z);
+      }
+
+  // Points on the circles where two grown spheres meet, where no third one covers them, every
+  // h/2 along the circle. Any sphere that covers a point of atom a's circle has its centre within
+  // R_a + R_max of a's.
+  vtkNew<vtkPoints> centres;
+  centres->SetDataTypeToDouble();
+  for (const SurfaceAtom& s : atoms) centres->InsertNextPoint(s.centre.x, s.centre.y, s.centre.z);
+  vtkNew<vtkPolyData> centreSet;
+  centreSet->SetPoints(centres);
+  vtkNew<vtkStaticPointLocator> atomLocator;
+  atomLocator->SetDataSet(centreSet);
+  atomLocator->BuildLocator();
+  vtkNew<vtkIdList> around;
+  std::vector<std::size_t> candidates;
+  for (std::size_t a = 0; a < atoms.size(); ++a) {
+    const glm::dvec3 ca = atoms[a].centre;
+    const double ra = atoms[a].radius + probe;
+    double centre[3] = {ca.x, ca.y, ca.z};
+    atomLocator->FindPointsWithinRadius(ra + largest, centre, around);
+    candidates.clear();
+    for (vtkIdType n = 0; n < around->GetNumberOfIds(); ++n) {
+      const auto b = static_cast<std::size_t>(around->GetId(n));
+      if (b != a) candidates.push_back(b);
+    }
+    for (const std::size_t b : candidates) {
+      if (b < a) continue;  // each pair once
+      const glm::dvec3 cb = atoms[b].centre;
+      const double rb = atoms[b].radius + probe;
+      const double d = glm::length(cb - ca);
+      if (!(d < ra + rb) || !(d > std::abs(ra - rb))) continue;  // apart, or one inside the other
+      const glm::dvec3 u = (cb - ca) / d;
+      const double x = (d * d + ra * ra - rb * rb) / (2.0 * d);
+      const double rho = std::sqrt(std::max(0.0, ra * ra - x * x));
+      const glm::dvec3 m = ca + x * u;
+      const glm::dvec3 helper = std::abs(u.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+      const glm::dvec3 v = glm::normalize(glm::cross(u, helper)), w = glm::cross(u, v);
+      const int count = std::max(8, static_cast<int>(std::ceil(2.0 * std::numbers::pi * rho / (0.5 * h))));
+      for (int t = 0; t < count; ++t) {
+        const double angle = 2.0 * std::numbers::pi * t / count;
+        const glm::dvec3 q = m + rho * (std::cos(angle) * v + std::sin(angle) * w);
+        const bool covered = std::any_of(candidates.begin(), candidates.end(), [&](std::size_t c) {
+          if (c == b) return false;
+          const double rc = atoms[c].radius + probe;
+          const glm::dvec3 e = q - atoms[c].centre;
+          return glm::dot(e, e) < rc * rc * (1.0 - 1e-12);
+        });
+        if (!covered) samples->InsertNextPoint(q.x, q.y, q.z);
+      }
+    }
+  }
+
+  auto grid = std::make_shared<VolumeGrid>();
+  grid->dims = dims;
+  grid->values.assign(depth.size(), static_cast<float>(-probe));
+  if (samples->GetNumberOfPoints() > 0) {
+    vtkNew<vtkPolyData> sampleSet;
+    sampleSet->SetPoints(samples);
+    vtkNew<vtkStaticPointLocator> sampleLocator;
+    sampleLocator->SetDataSet(sampleSet);
+    sampleLocator->BuildLocator();
+    // Deeper than r_p + 2h (depth is a lower bound of the distance), f > 2h: no crossing there.
+    const double near = probe + 2.0 * h, search = probe + 3.0 * h;
+    for (int k = 0; k < dims.z; ++k)
+      for (int j = 0; j < dims.y; ++j)
+        for (int i = 0; i < dims.x; ++i) {
+          const std::size_t n = at(i, j, k);
+          if (!(depth[n] > 0.0f)) continue;
+          float f = static_cast<float>(2.0 * h);
+          if (static_cast<double>(depth[n]) < near) {
+            const glm::dvec3 p = position(i, j, k);
+            double query[3] = {p.x, p.y, p.z}, d2 = 0.0;
+            if (sampleLocator->FindClosestPointWithinRadius(search, query, d2) >= 0)
+              f = static_cast<float>(std::min(std::sqrt(d2) - probe, 2.0 * h));
+          }
+          grid->values[n] = f;
+        }
+  }
+  depth = {};
+  nearest = {};
+
+  Volume volume;
+  volume.name = kWhat;
+  volume.origin = origin;
+  volume.spacing = glm::dvec3(h);
+  volume.grid = grid;
+  return contourVolume(volume, 0.0);
+}
+
+}  // namespace mfr

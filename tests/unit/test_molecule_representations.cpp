@@ -1,0 +1,258 @@
+// Molecules as sticks, balls and sticks and surfaces (mfr::MoleculeStyle) on a small structure
+// written here with textbook geometry — an alanine (N–CA 1.46, CA–C 1.52, C=O 1.23, CA–CB 1.53 Å),
+// a methane (C–H 1.09 Å, tetrahedral), a sodium ion and a water (O–H 0.96 Å, 104.5°) — whose 10
+// bonds are counted by hand; the bond rule (mfr::perceiveBonds) on hand-placed atoms, case by case;
+// the style's names; and every place a style can be given or refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "mfr/error.hpp"
+#include "mfr/io/load.hpp"
+#include "mfr/io/molecule.hpp"
+#include "mfr/scene/measure.hpp"
+#include "mfr/scene/scene_file.hpp"
+#include "test_files.hpp"
+
+namespace mfr::test {
+namespace {
+
+std::string record(const char* type, int serial, const char* name, const char* residue, char chain, int seq,
+                   const glm::dvec3& p, const char* element) {
+  char line[96];
+  std::snprintf(line, sizeof line, "%-6s%5d %-4s %3s %c%4d    %8.3f%8.3f%8.3f%6.2f%6.2f          %2s  \n", type, serial,
+                name, residue, chain, seq, p.x, p.y, p.z, 1.0, 20.0, element);
+  return line;
+}
+
+// Chain A: ALA 1 (N, CA, C, O, CB: 4 bonds); ligands: methane (4 bonds) and Na⁺ (none), 20 Å
+// away; water (2 bonds), 20 Å the other way.
+std::string smallStructure() {
+  std::string s;
+  const glm::dvec3 ca(0.0, 0.0, 0.0);
+  s += record("ATOM", 1, " N  ", "ALA", 'A', 1, ca + glm::dvec3(-1.46, 0.0, 0.0), "N");
+  s += record("ATOM", 2, " CA ", "ALA", 'A', 1, ca, "C");
+  const glm::dvec3 c = ca + 1.52 * glm::normalize(glm::dvec3(0.5, 0.866, 0.0));
+  s += record("ATOM", 3, " C  ", "ALA", 'A', 1, c, "C");
+  s += record("ATOM", 4, " O  ", "ALA", 'A', 1, c + glm::dvec3(1.23, 0.0, 0.0), "O");
+  s += record("ATOM", 5, " CB ", "ALA", 'A', 1, ca + 1.53 * glm::normalize(glm::dvec3(0.5, -0.5, 0.7)), "C");
+  s += "TER\n";
+  const glm::dvec3 m(20.0, 0.0, 0.0);
+  s += record("HETATM", 6, " C  ", "CH4", 'A', 101, m, "C");
+  const double t = 1.09 / std::sqrt(3.0);
+  int serial = 7;
+  for (const glm::dvec3& d : {glm::dvec3(1, 1, 1), glm::dvec3(1, -1, -1), glm::dvec3(-1, 1, -1), glm::dvec3(-1, -1, 1)})
+    s += record("HETATM", serial++, " H  ", "CH4", 'A', 101, m + t * d, "H");
+  s += record("HETATM", 11, "NA  ", " NA", 'A', 102, glm::dvec3(20.0, 10.0, 0.0), "NA");
+  const glm::dvec3 w(-20.0, 0.0, 0.0);
+  const double half = 0.5 * 104.5 * 3.14159265358979 / 180.0;
+  s += record("HETATM", 12, " O  ", "HOH", 'A', 201, w, "O");
+  s += record("HETATM", 13, " H1 ", "HOH", 'A', 201, w + 0.96 * glm::dvec3(std::sin(half), std::cos(half), 0.0), "H");
+  s += record("HETATM", 14, " H2 ", "HOH", 'A', 201, w + 0.96 * glm::dvec3(-std::sin(half), std::cos(half), 0.0), "H");
+  return s + "END\n";
+}
+
+// `load` must fail with one line that starts with the path and holds `reason`.
+template <class F>
+void expectFails(const std::filesystem::path& path, const std::string& reason, F load) {
+  expectFileError(path, reason, [&] {
+    load();
+    return std::string("loaded");
+  });
+}
+
+class MoleculeStyles : public TempDirTest {
+ protected:
+  std::vector<Object> load(const std::string& style) {
+    return loadModel(write("small.pdb", smallStructure()), LoadOptions({}, MoleculeStyle::parse(style, "test")));
+  }
+};
+
+std::map<std::string, std::size_t> trianglesPerPart(const std::vector<Object>& objects) {
+  std::map<std::string, std::size_t> out;
+  for (const Object& o : objects) out[o.name] = o.mesh->triangleCount();
+  return out;
+}
+
+// ---- the bond rule -------------------------------------------------------------------------------
+
+MoleculeAtom atom(int z, glm::dvec3 p) {
+  return {0, z, p, 0};
+}
+
+TEST(BondRule, CovalentRadiiPlusTolerance) {
+  // C–C: bonded below 0.73 + 0.73 + 0.45 = 1.91 Å (gemmi's carbon, Cordero's sp² radius).
+  EXPECT_EQ(perceiveBonds({atom(6, {0, 0, 0}), atom(6, {1.89, 0, 0})}).size(), 1u);
+  EXPECT_EQ(perceiveBonds({atom(6, {0, 0, 0}), atom(6, {1.93, 0, 0})}).size(), 0u);
+  // Closer than 0.4 Å: the same atom twice, or a corrupt file — not a bond.
+  EXPECT_EQ(perceiveBonds({atom(6, {0, 0, 0}), atom(6, {0.39, 0, 0})}).size(), 0u);
+  // Sulphur (1.05) reaches further: a disulphide at 2.05 Å.
+  EXPECT_EQ(perceiveBonds({atom(16, {0, 0, 0}), atom(16, {2.05, 0, 0})}).size(), 1u);
+}
+
+TEST(BondRule, AnAtomKeepsNoMoreBondsThanItsElementMakes) {
+  // A carbon with five hydrogens around it: its longest bond goes.
+  std::vector<MoleculeAtom> a = {atom(6, {0, 0, 0}),    atom(1, {1.00, 0, 0}),  atom(1, {-1.01, 0, 0}),
+                                 atom(1, {0, 1.02, 0}), atom(1, {0, -1.03, 0}), atom(1, {0, 0, 1.2})};
+  EXPECT_EQ(perceiveBonds(a), (std::vector<Bond>{{0, 1}, {0, 2}, {0, 3}, {0, 4}}));
+  // Two hydrogens 0.74 Å apart, each 0.93 Å from an oxygen of its own: the first hydrogen has two
+  // bonds, one too many, and drops the one to the other hydrogen although it is the shorter.
+  const std::vector<MoleculeAtom> hh = {atom(1, {0, 0.37, 0}), atom(1, {0, -0.37, 0}), atom(8, {0, 1.3, 0}),
+                                        atom(8, {0, -1.3, 0})};
+  EXPECT_EQ(perceiveBonds(hh), (std::vector<Bond>{{0, 2}, {1, 3}}));
+  // An oxygen makes two.
+  const std::vector<MoleculeAtom> o = {atom(8, {0, 0, 0}), atom(6, {1.40, 0, 0}), atom(6, {-1.41, 0, 0}),
+                                       atom(6, {0, 1.42, 0})};
+  EXPECT_EQ(perceiveBonds(o), (std::vector<Bond>{{0, 1}, {0, 2}}));
+}
+
+TEST(BondRule, TwoBondsCloserThan45DegreesLoseTheLonger) {
+  const double a = 30.0 * 3.14159265358979 / 180.0;
+  const std::vector<MoleculeAtom> atoms = {atom(6, {0, 0, 0}), atom(6, {1.5, 0, 0}),
+                                           atom(6, {1.6 * std::cos(a), 1.6 * std::sin(a), 0})};
+  // The two outer carbons are 0.8 Å apart: bonded to each other as well, by distance.
+  EXPECT_EQ(perceiveBonds(atoms), (std::vector<Bond>{{0, 1}, {1, 2}}));
+}
+
+// ---- drawing --------------------------------------------------------------------------------------
+
+TEST_F(MoleculeStyles, SticksAreTwoHalfTubesPerBondAndAJointPerAtom) {
+  const std::vector<Object> objects = load("sticks");
+  // Level 2 (320 triangles a sphere), 16-sided tubes (32 triangles a half bond).
+  EXPECT_EQ(trianglesPerPart(objects),
+            (std::map<std::string, std::size_t>{{"chain A", 5 * 320 + 2 * 4 * 32},
+                                                {"ligands", 6 * 320 + 2 * 4 * 32},  // methane, and Na⁺ as a ball
+                                                {"water", 3 * 320 + 2 * 2 * 32}}));
+  const Mesh& methane = *objects.at(1).mesh;
+  // Every tube vertex lies 0.25 Å from the axis of its bond, between the atom and the bond's middle.
+  const glm::dvec3 c(20.0, 0.0, 0.0);
+  std::size_t atMiddle = 0;
+  for (std::size_t v = 0; v < methane.positions.size(); ++v) {
+    const glm::dvec3 p(methane.positions[v]);
+    const double fromCarbon = glm::length(p - c);
+    // The file holds coordinates to 0.001 Å.
+    if (std::abs(fromCarbon - 0.25) < 2e-3) continue;  // the carbon's joint
+    // The sodium without bonds: a ball of 23 % of its van der Waals radius (Bondi's 2.27 Å).
+    if (std::abs(glm::length(p - glm::dvec3(20.0, 10.0, 0.0)) - 0.23 * 2.27) < 2e-3) continue;
+    bool found = false;
+    for (const glm::dvec3& d :
+         {glm::dvec3(1, 1, 1), glm::dvec3(1, -1, -1), glm::dvec3(-1, 1, -1), glm::dvec3(-1, -1, 1)}) {
+      const glm::dvec3 axis = glm::normalize(d), h = c + 1.09 * axis;
+      if (std::abs(glm::length(p - h) - 0.25) < 2e-3) found = true;  // a hydrogen's joint
+      const double along = glm::dot(p - c, axis);
+      const double off = glm::length(p - c - along * axis);
+      if (std::abs(off - 0.25) < 2e-3 && (std::abs(along) < 2e-3 || std::abs(along - 1.09) < 2e-3)) found = true;
+      if (std::abs(off - 0.25) < 2e-3 && std::abs(along - 0.545) < 2e-3) {
+        found = true;
+        ++atMiddle;
+      }
+    }
+    EXPECT_TRUE(found) << p.x << " " << p.y << " " << p.z;
+  }
+  EXPECT_EQ(atMiddle, 4u * 2u * 16u);  // each bond's two half tubes end in a ring of 16 at its middle
+  // Half bonds take their atom's colour: the carbon's half grey, the hydrogen's white.
+  std::size_t white = 0;
+  for (const glm::vec4& col : methane.colors) white += col == glm::vec4(1.0f) ? 1u : 0u;
+  EXPECT_EQ(white, 4u * (162u + 32u));  // four hydrogens: joint (162 vertices) and half tube
+}
+
+TEST_F(MoleculeStyles, BallAndStickBallsAre23PercentOfVanDerWaals) {
+  const std::vector<Object> objects = load("ball-and-stick");
+  ASSERT_EQ(objects.size(), 3u);
+  const Mesh& chain = *objects[0].mesh;
+  // Nitrogen (1.55 Å) at (−1.46, 0, 0): a ball of radius 0.23 · 1.55.
+  std::size_t onBall = 0;
+  for (const glm::vec3& p : chain.positions)
+    if (std::abs(glm::length(glm::dvec3(p) - glm::dvec3(-1.46, 0, 0)) - 0.23 * 1.55) < 1e-3) ++onBall;
+  EXPECT_GE(onBall, 162u);
+  EXPECT_EQ(chain.triangleCount(), 5u * 320u + 2u * 4u * 32u);
+}
+
+TEST_F(MoleculeStyles, SurfaceOfEachPartButWaterClosedAndColouredByTheNearestAtom) {
+  const std::vector<Object> objects = load("surface,sticks");
+  std::vector<std::string> names;
+  for (const Object& o : objects) names.push_back(o.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"chain A sticks", "chain A surface", "ligands sticks", "ligands surface",
+                                             "water sticks"}));
+  const Mesh& surface = *objects[1].mesh;
+  const SurfaceMeasures m = measureSurface(surface, glm::dmat4(1.0));
+  EXPECT_TRUE(m.closed());
+  EXPECT_GT(m.volume, 0.0);
+  // Coloured as the atom whose van der Waals sphere is nearest: left of x = −2.9 that is the
+  // nitrogen (at x = −1.46, radius 1.55 Å), Jmol's blue #3050F8.
+  std::size_t blue = 0;
+  for (std::size_t v = 0; v < surface.positions.size(); ++v) {
+    const glm::dvec3 p(surface.positions[v]);
+    if (p.x < -2.9) {
+      EXPECT_EQ(surface.colors[v], glm::vec4(0x30 / 255.0f, 0x50 / 255.0f, 0xF8 / 255.0f, 1.0f));
+      ++blue;
+    }
+  }
+  EXPECT_GT(blue, 0u);
+  ASSERT_EQ(surface.fields.size(), 3u);
+  EXPECT_EQ(surface.fields[0].name, "b_factor");
+  EXPECT_EQ(surface.fields[0].values.size(), surface.positions.size());
+}
+
+TEST_F(MoleculeStyles, OnlyWaterHasNoSurface) {
+  const auto water = write("water.pdb", record("HETATM", 1, " O  ", "HOH", 'A', 1, {0, 0, 0}, "O") + "END\n");
+  expectFails(water, "nothing to draw as surface (only water, which has no surface)",
+              [&] { (void)loadModel(water, LoadOptions({}, MoleculeStyle::parse("surface", "t"))); });
+}
+
+// ---- naming, and where a style may be given -------------------------------------------------------
+
+TEST(MoleculeStyleNames, ParseAndText) {
+  EXPECT_EQ(MoleculeStyle{}.text(), "spheres");
+  EXPECT_EQ(MoleculeStyle::parse("surface+sticks", "x").text(), "sticks,surface");
+  EXPECT_EQ(MoleculeStyle::parse("ball-and-stick,spheres", "x").text(), "spheres,ball-and-stick");
+  const auto reason = [](const std::string& text) {
+    try {
+      (void)MoleculeStyle::parse(text, "--molecule " + text);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(reason("cartoon"),
+            "--molecule cartoon: unknown representation 'cartoon': expected spheres, sticks, "
+            "ball-and-stick or surface, or several joined by ',' (surface,sticks)");
+  EXPECT_EQ(reason(""),
+            "--molecule : expected spheres, sticks, ball-and-stick or surface, or several joined by ',' "
+            "(surface,sticks)");
+  EXPECT_EQ(reason("sticks,"),
+            "--molecule sticks,: expected spheres, sticks, ball-and-stick or surface, or several "
+            "joined by ',' (surface,sticks)");
+}
+
+TEST_F(MoleculeStyles, OnlyForMoleculeFiles) {
+  const auto stl = write("part.stl", "solid x\nendsolid x\n");
+  const LoadOptions sticks({}, MoleculeStyle::parse("sticks", "t"));
+  expectFails(stl, "a molecule representation (sticks) can be chosen only for a molecule file (.pdb .ent .cif .mmcif)",
+              [&] { (void)loadModel(stl, sticks); });
+  const auto scene = write("s.mfrscene", R"({"objects": [{"file": "small.pdb"}]})");
+  write("small.pdb", smallStructure());
+  expectFails(scene,
+              "a molecule representation (sticks) can be chosen only for a molecule file (a scene file gives each "
+              "molecule its own 'molecule')",
+              [&] { (void)loadScene(scene, sticks); });
+  // A scene file's object says it itself.
+  const auto own = write("own.mfrscene", R"({"objects": [{"file": "small.pdb", "molecule": "sticks"}]})");
+  EXPECT_EQ(loadScene(own).objects.size(), 3u);
+  EXPECT_EQ(loadScene(own).objects[0].mesh->triangleCount(), 5u * 320u + 2u * 4u * 32u);
+  const auto bad = write("bad.mfrscene", R"({"objects": [{"file": "small.pdb", "molecule": "ribbon"}]})");
+  expectFails(bad,
+              "objects[0].molecule: unknown representation 'ribbon': expected spheres, sticks, ball-and-stick or "
+              "surface, or several joined by ',' (surface,sticks)",
+              [&] { (void)loadScene(bad); });
+  const auto notMolecule = write("nm.mfrscene", R"({"objects": [{"file": "part.stl", "molecule": "sticks"}]})");
+  expectFails(notMolecule, "objects[0].molecule: only a molecule file (.pdb .ent .cif .mmcif) has representations",
+              [&] { (void)loadScene(notMolecule); });
+}
+
+}  // namespace
+}  // namespace mfr::test
