@@ -6,6 +6,7 @@
 #include "commands.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "mfr/io/molecule.hpp"
 #include "mfr/io_util.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/oracle.hpp"
@@ -58,6 +59,15 @@ void addInfo(CLI::App& app) {
     j["triangles"] = scene.triangleCount();
     j["bounds"] = {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};
     j["views"] = scene.viewNames();
+    // A molecule: its atoms and bonds as drawn (the first model, the first alternative locations).
+    std::optional<MoleculeStructure> molecule;
+    if (isMoleculeFile(opt->scene)) {
+      molecule = readMoleculeStructure(opt->scene);
+      j["molecule"] = {{"atoms", molecule->atoms.size()},
+                       {"bonds", molecule->bonds.size()},
+                       {"models", molecule->models},
+                       {"representations", opt->read.load().molecule.value_or(MoleculeStyle{}).text()}};
+    }
     if (sectioned) {
       const SectionPlane& plane = *scene.section;
       j["section"] = {{"point", {plane.point.x, plane.point.y, plane.point.z}},
@@ -105,6 +115,10 @@ void addInfo(CLI::App& app) {
               << b.max.x << ", " << b.max.y << ", " << b.max.z << "]\nviews     ";
     for (const std::string& v : scene.viewNames()) std::cout << " " << v;
     std::cout << "\n";
+    if (molecule)
+      std::cout << "molecule   " << molecule->atoms.size() << " atoms, " << molecule->bonds.size() << " bonds"
+                << (molecule->models > 1 ? " (model 1 of " + std::to_string(molecule->models) + ")" : std::string())
+                << "; drawn as " << opt->read.load().molecule.value_or(MoleculeStyle{}).text() << "\n";
     if (sectioned) {
       const SectionPlane& plane = *scene.section;
       std::cout << "section    point " << plane.point.x << " " << plane.point.y << " " << plane.point.z << ", normal "

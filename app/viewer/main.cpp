@@ -27,6 +27,7 @@ struct CommandLine {
   QString scene = QStringLiteral("@sample");
   QString session, screenshot, windowScreenshot, view, method, op;
   QString field;                                  // --field: the array or grid of a volume file
+  std::optional<mfr::MoleculeStyle> molecule;     // --molecule: a molecule file's representations
   QString colorBy, colorMap;                      // --color-by, --color-map: surfaces coloured by a field
   std::optional<glm::dvec2> colorRange;           // --color-range
   std::vector<double> contour;                    // --contour: isosurfaces of the current volume
@@ -76,6 +77,12 @@ CommandLine parseCommandLine(const QApplication& app) {
       QStringLiteral("field"),
       QStringLiteral("Volume file: the point-data array (.vti, .vtk) or grid (.vdb) to read instead of the default."),
       QStringLiteral("name"));
+  const QCommandLineOption molecule(
+      QStringLiteral("molecule"),
+      QStringLiteral(
+          "Molecule file (.pdb, .cif): spheres (default), sticks, ball-and-stick, surface, or several joined "
+          "by ',' (as mfr render; the Scene panel's Molecule row)."),
+      QStringLiteral("representations"));
   const QCommandLineOption colorBy(
       QStringLiteral("color-by"),
       QStringLiteral("Colour every part that has this point-data or cell-data array by it (as mfr render)."),
@@ -103,8 +110,8 @@ CommandLine parseCommandLine(const QApplication& app) {
   const QCommandLineOption pluginSettings(QStringLiteral("plugin-settings"),
                                          QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
                                          QStringLiteral("id={json}"));
-  parser.addOptions({method, op, thickness, step, field, colorBy, colorMap, colorRange, contour, legend, param, view,
-                     size, screenshot, windowScreenshot, windowSize, pluginSettings});
+  parser.addOptions({method, op, thickness, step, field, molecule, colorBy, colorMap, colorRange, contour, legend,
+                     param, view, size, screenshot, windowScreenshot, windowSize, pluginSettings});
   parser.process(app);
 
   CommandLine cl;
@@ -130,6 +137,18 @@ CommandLine parseCommandLine(const QApplication& app) {
     fail(QStringLiteral("--field: expected the name of an array or grid"), 2);
   if (!cl.field.isEmpty() && !cl.session.isEmpty())
     fail(QStringLiteral("--field %1: a session keeps its volumes' own fields").arg(cl.field), 2);
+  if (parser.isSet(molecule)) {
+    if (!cl.session.isEmpty())
+      fail(QStringLiteral("--molecule %1: a session keeps its molecule's own representations")
+               .arg(parser.value(molecule)),
+           2);
+    try {
+      cl.molecule = mfr::MoleculeStyle::parse(parser.value(molecule).toStdString(),
+                                              "--molecule " + parser.value(molecule).toStdString());
+    } catch (const mfr::Error& e) {
+      fail(QString::fromUtf8(e.what()), 2);
+    }
+  }
   cl.colorBy = parser.value(colorBy);
   cl.colorMap = parser.value(colorMap);
   if ((parser.isSet(colorMap) || parser.isSet(colorRange)) && cl.colorBy.isEmpty())
@@ -280,7 +299,7 @@ int main(int argc, char** argv) {
     // A scripted run has no one to read the message box: a bad session file ends it.
     if (scripted && !window.lastError().isEmpty()) fail(window.lastError(), 1);
   } else {
-    window.openScene(cl.scene, cl.field);
+    window.openScene(cl.scene, cl.field, cl.molecule);
   }
   return QApplication::exec();
 }

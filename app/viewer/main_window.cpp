@@ -419,17 +419,18 @@ void MainWindow::open(const QString& path) {
     openScene(path);
 }
 
-void MainWindow::openScene(const QString& path, const QString& field) {
+void MainWindow::openScene(const QString& path, const QString& field,
+                           const std::optional<mfr::MoleculeStyle>& molecule) {
   pendingSession_.reset();
   // Built-ins stay as typed; files are remembered by absolute path.
-  model_->loadSceneAsync(path.startsWith('@') ? path : QFileInfo(path).absoluteFilePath(), field);
+  model_->loadSceneAsync(path.startsWith('@') ? path : QFileInfo(path).absoluteFilePath(), field, molecule);
 }
 
 void MainWindow::openSession(const QString& path) {
   try {
     Session session = readSessionFile(path);
     const QString scene = session.scenePath;
-    model_->loadSceneAsync(scene);
+    model_->loadSceneAsync(scene, {}, session.molecule);
     pendingSession_ = std::move(session);  // after loadSceneAsync, which cannot finish before we return
     pendingSessionFile_ = QFileInfo(path).absoluteFilePath();
   } catch (const std::exception& e) {

@@ -32,7 +32,9 @@ class MainWindow final : public QMainWindow {
   // Starts loading a model, .mfrscene, built-in (@sample) or .mfrsession file.
   void open(const QString& path);
   // `field`: the array or grid of a volume file (mfr::LoadOptions::field); empty: its default.
-  void openScene(const QString& path, const QString& field = {});
+  // `molecule`: a molecule file's representations (mfr::LoadOptions::molecule); none: spheres.
+  void openScene(const QString& path, const QString& field = {},
+                 const std::optional<mfr::MoleculeStyle>& molecule = {});
   void openSession(const QString& path);
   // Throws mfr::Error naming the file.
   void saveSession(const QString& path);

@@ -1,9 +1,11 @@
 #include "scene_tree_panel.hpp"
 
+#include <QCheckBox>
 #include <QColorDialog>
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QGridLayout>
+#include <QHBoxLayout>
 #include <QHeaderView>
 #include <QLabel>
 #include <QMenu>
@@ -16,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/measure.hpp"
@@ -90,6 +93,39 @@ QIcon swatch(const QColor& colour) {
 SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(parent), model_(model) {
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
+  // A molecule's representations (PyMOL's show): any combination, the file re-read with them.
+  moleculeRow_ = new QWidget;
+  moleculeRow_->setObjectName(QStringLiteral("moleculeRow"));
+  auto* molecule = new QHBoxLayout(moleculeRow_);
+  molecule->setContentsMargins(4, 4, 4, 0);
+  molecule->addWidget(new QLabel(tr("Molecule")));
+  const std::array<std::pair<const char*, QString>, 4> representations = {
+      std::pair{"moleculeSpheres", tr("Spheres")}, std::pair{"moleculeBallAndStick", tr("Ball and stick")},
+      std::pair{"moleculeSticks", tr("Sticks")}, std::pair{"moleculeSurface", tr("Surface")}};
+  for (std::size_t i = 0; i < molecule_.size(); ++i) {
+    molecule_[i] = new QCheckBox(representations[i].second);
+    molecule_[i]->setObjectName(QString::fromLatin1(representations[i].first));
+    molecule->addWidget(molecule_[i]);
+    connect(molecule_[i], &QCheckBox::toggled, this, [this] {
+      mfr::MoleculeStyle style;
+      style.spheres = molecule_[0]->isChecked();
+      style.ballAndStick = molecule_[1]->isChecked();
+      style.sticks = molecule_[2]->isChecked();
+      style.surface = molecule_[3]->isChecked();
+      if (!(style.spheres || style.ballAndStick || style.sticks || style.surface)) {
+        showMoleculeStyle();  // one at least
+        return;
+      }
+      model_.setMoleculeStyle(style);
+    });
+  }
+  molecule_[0]->setToolTip(tr("Van der Waals spheres (space-filling, CPK)"));
+  molecule_[1]->setToolTip(tr("Balls of 23 % of the van der Waals radius and sticks of 0.15 Å (Jmol's)"));
+  molecule_[2]->setToolTip(tr("Bonds as sticks of 0.25 Å (PyMOL's); bonds found from distances as Open Babel does"));
+  molecule_[3]->setToolTip(tr("The solvent-excluded surface of each chain and of the ligands (probe 1.4 Å)"));
+  molecule->addStretch(1);
+  moleculeRow_->setVisible(false);
+  layout->addWidget(moleculeRow_);
   // Colour by a field (mfr::colorObjectsByField): ParaView's "Color by", map and range.
   fieldRow_ = new QWidget;
   auto* fields = new QGridLayout(fieldRow_);
@@ -159,6 +195,7 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
     menu.exec(tree_->viewport()->mapToGlobal(at));
   });
   connect(&model_, &ViewerModel::sceneLoaded, this, &SceneTreePanel::rebuild);
+  connect(&model_, &ViewerModel::sceneLoaded, this, &SceneTreePanel::showMoleculeStyle);
   connect(&model_, &ViewerModel::partsChanged, this, &SceneTreePanel::rebuild);  // isosurfaces added or removed
   // Edits from elsewhere (a session's overrides, plugins) show up in the rows.
   connect(&model_, &ViewerModel::sceneChanged, this, &SceneTreePanel::showValues);
@@ -183,6 +220,17 @@ QString SceneTreePanel::volumeText(const mfr::Volume& volume, std::size_t index)
 QString SceneTreePanel::gridText(const mfr::Volume& volume) {
   const glm::ivec3 d = volume.grid ? volume.grid->dims : glm::ivec3(0);
   return QStringLiteral("%1×%2×%3").arg(d.x).arg(d.y).arg(d.z);
+}
+
+void SceneTreePanel::showMoleculeStyle() {
+  const std::optional<mfr::MoleculeStyle> style = model_.moleculeStyle();
+  moleculeRow_->setVisible(style.has_value());
+  if (!style) return;
+  const std::array<bool, 4> on = {style->spheres, style->ballAndStick, style->sticks, style->surface};
+  for (std::size_t i = 0; i < molecule_.size(); ++i) {
+    const QSignalBlocker block(molecule_[i]);
+    molecule_[i]->setChecked(on[i]);
+  }
 }
 
 void SceneTreePanel::showFieldColoring() {

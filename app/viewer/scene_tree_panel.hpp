@@ -1,14 +1,17 @@
 #pragma once
 // The scene dock: one row per object with a visibility check box, a colour swatch (click to
 // change) and an editable opacity, then one row per volume (name, grid size, visibility). Above
-// them, for parts with data arrays: Colour by (a field, or the parts' own colours), the colour map
-// and the range mapped to its ends.
+// them, for a molecule file: its representations (spheres, ball and stick, sticks, surface); for
+// parts with data arrays: Colour by (a field, or the parts' own colours), the colour map and the
+// range mapped to its ends.
 #include <QWidget>
 
+#include <array>
 #include <cstddef>
 
 #include "mfr/scene/volume.hpp"
 
+class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QLabel;
@@ -34,8 +37,12 @@ class SceneTreePanel final : public QWidget {
   void showFieldColoring();                 // the model's colouring in the Colour-by controls
   void applyFieldColoring(bool dataRange);  // the controls' colouring to the model
 
+  void showMoleculeStyle();  // the model's molecule representations in the Molecule row
+
   ViewerModel& model_;
   QTreeWidget* tree_ = nullptr;
+  QWidget* moleculeRow_ = nullptr;        // shown for a molecule file
+  std::array<QCheckBox*, 4> molecule_{};  // spheres, ball-and-stick, sticks, surface
   QWidget* fieldRow_ = nullptr;  // hidden when no part has a field
   QComboBox* colorBy_ = nullptr;
   QComboBox* colorMap_ = nullptr;

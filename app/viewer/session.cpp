@@ -97,6 +97,7 @@ class Reader {
 Session captureSession(const ViewerModel& model) {
   Session s;
   s.scenePath = model.scenePath();
+  s.molecule = model.moleculeStyle();
   s.camera = model.camera();
   s.method = model.method();
   s.operation = model.operation();
@@ -214,7 +215,7 @@ QJsonObject sessionToJson(const Session& s) {
                                {"color", QJsonArray{o.color.r, o.color.g, o.color.b}},
                                {"opacity", o.color.a},
                                {"vertex_colors", o.vertexColors}});
-  return {
+  QJsonObject json{
       {"format", "mfrview-session"},
       {"version", 1},
       {"scene", s.scenePath},
@@ -242,6 +243,8 @@ QJsonObject sessionToJson(const Session& s) {
                                                       {"map", QString::fromStdString(s.colorBy->map)},
                                                       {"range", QJsonArray{s.colorBy->range.x, s.colorBy->range.y}}})
                              : QJsonValue(QJsonValue::Null)}};
+  if (s.molecule) json.insert("molecule", QString::fromStdString(s.molecule->text()));
+  return json;
 }
 
 Session sessionFromJson(const QJsonObject& json, const QString& file) {
@@ -251,6 +254,15 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   Session s;
   s.scenePath = json.value("scene").toString();
   if (s.scenePath.isEmpty()) r.fail(QStringLiteral("scene"), QStringLiteral("missing scene path"));
+  if (json.contains("molecule")) {
+    if (!json.value("molecule").isString())
+      r.fail(QStringLiteral("molecule"), QStringLiteral("expected representations such as \"surface,sticks\""));
+    try {
+      s.molecule = mfr::MoleculeStyle::parse(json.value("molecule").toString().toStdString(), "molecule");
+    } catch (const mfr::Error& e) {
+      r.fail(QStringLiteral("molecule"), QString::fromUtf8(e.what()).mid(QStringLiteral("molecule: ").size()));
+    }
+  }
   const QJsonObject cam = json.value("camera").toObject();
   s.camera.eye = r.vec3(cam, "eye", "camera");
   s.camera.target = r.vec3(cam, "target", "camera");

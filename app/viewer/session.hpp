@@ -23,6 +23,8 @@ struct Session {
     bool vertexColors = true;  // Material::vertexColors: false once a colour was chosen for the part
   };
   QString scenePath;
+  // A molecule file's representations ("molecule": "surface,sticks"; absent: the default spheres).
+  std::optional<mfr::MoleculeStyle> molecule;
   mfr::Camera camera;
   QString method;
   QString operation;

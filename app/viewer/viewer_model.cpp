@@ -282,7 +282,7 @@ void ViewerModel::setVolumeFieldAt(int index, const QString& field,
         Read read;
         const mfr::LoadProgress progress{[state](double) { return !state->cancel; }};
         try {
-          read.volume = mfr::loadVolume(file, mfr::LoadOptions{name}, progress);
+          read.volume = mfr::loadVolume(file, mfr::LoadOptions(name), progress);
         } catch (const mfr::LoadCancelled&) {
           read.error = tr("reading stopped");
         } catch (const std::exception& e) {
@@ -691,7 +691,18 @@ void ViewerModel::setDataView(DataView view, bool overImage) {
 
 // ---- scene -------------------------------------------------------------------------------
 
-void ViewerModel::loadSceneAsync(const QString& path, const QString& field) {
+void ViewerModel::setMoleculeStyle(const mfr::MoleculeStyle& style) {
+  if (!moleculeStyle_ || style == *moleculeStyle_ ||
+      !(style.spheres || style.sticks || style.ballAndStick || style.surface))
+    return;
+  const mfr::Camera camera = camera_;
+  loadSceneAsync(scenePath_, {}, style);
+  keepCamera_ = camera;
+}
+
+void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
+                                 const std::optional<mfr::MoleculeStyle>& molecule) {
+  keepCamera_.reset();
   if (load_) {
     load_->cancel = true;  // superseded: stop the previous worker early
     ++abandonedLoads_;
@@ -710,14 +721,14 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field) {
   };
   runInBackground<Loaded>(
       this,
-      [path, field, state]() -> Loaded {
+      [path, field, molecule, state]() -> Loaded {
         Loaded loaded;
         const mfr::LoadProgress progress{[state](double fraction) {
           state->fraction = fraction;
           return !state->cancel;
         }};
         try {
-          loaded.scene = mfr::loadScene(path.toStdString(), mfr::LoadOptions{field.toStdString()}, progress);
+          loaded.scene = mfr::loadScene(path.toStdString(), mfr::LoadOptions(field.toStdString(), molecule), progress);
         } catch (const mfr::LoadCancelled&) {
           loaded.stopped = true;
         } catch (const std::exception& e) {
@@ -725,7 +736,7 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field) {
         }
         return loaded;
       },
-      [this, path, state](Loaded loaded) {
+      [this, path, molecule, state](Loaded loaded) {
         if (state != load_) {  // cancelled, or superseded by a newer load
           --abandonedLoads_;
           lastCancelStoppedLoader_ = loaded.stopped;
@@ -745,7 +756,13 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field) {
           emit loadFailed(path, QString::fromUtf8(e.what()));
           return;
         }
+        const std::optional<mfr::Camera> camera = keepCamera_;
+        keepCamera_.reset();
+        moleculeStyle_.reset();
+        if (!path.startsWith('@') && mfr::isMoleculeFile(path.toStdString()))
+          moleculeStyle_ = molecule.value_or(mfr::MoleculeStyle{});
         setScene(std::move(*loaded.scene), path);
+        if (camera) setCamera(*camera);
       });
 }
 

@@ -21,6 +21,7 @@
 
 #include "mfr/scene/section.hpp"
 #include "mfr/image.hpp"
+#include "mfr/io/load.hpp"
 #include "mfr/reference/metrics.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/scene.hpp"
@@ -203,7 +204,15 @@ class ViewerModel final : public ViewerContext {
   // Scene. loadSceneAsync reads the file on a worker thread, reporting loadProgressChanged; the
   // current scene stays until the new one has loaded (sceneLoaded) — a failure (loadFailed) or
   // cancelLoad() leaves it intact. cancelLoad also stops the loader at its next progress report.
-  void loadSceneAsync(const QString& path, const QString& field = {});
+  // `molecule`: the representations of a molecule file (mfr::LoadOptions::molecule).
+  void loadSceneAsync(const QString& path, const QString& field = {},
+                      const std::optional<mfr::MoleculeStyle>& molecule = {});
+  // A molecule file's representations (PyMOL's show): the scene's own (spheres unless it was
+  // loaded with others), none when the scene is not a molecule file. setMoleculeStyle re-reads
+  // the file in the background with `style`, keeping the camera (sceneLoaded follows; colours and
+  // opacities chosen for parts start again from the file's).
+  [[nodiscard]] std::optional<mfr::MoleculeStyle> moleculeStyle() const { return moleculeStyle_; }
+  void setMoleculeStyle(const mfr::MoleculeStyle& style);
   void cancelLoad();
   [[nodiscard]] bool isLoading() const { return loading_; }
   [[nodiscard]] double loadProgress() const { return loadProgress_; }  // of the current or last load
@@ -360,6 +369,8 @@ class ViewerModel final : public ViewerContext {
   QString fieldColoringError_;
   bool hasScene_ = false;
   QString scenePath_;
+  std::optional<mfr::MoleculeStyle> moleculeStyle_;
+  std::optional<mfr::Camera> keepCamera_;  // setMoleculeStyle's camera, for the scene it loads
   quint64 sceneRevision_ = 0;
   mfr::Bounds bounds_;
   double radius_ = 0.0;

@@ -3526,6 +3526,101 @@ class ViewerTest : public QObject {
     settle(m);
     QCOMPARE(maxChannelDifference(w->view().renderImage(size), sliced), 0);
   }
+  // A molecule's representations (the Scene dock's Molecule row): hidden for other scenes; a
+  // change re-reads the file with them and keeps the camera; the image equals mfr render's with
+  // --molecule and that camera; a session keeps them; mfrview --molecule too.
+  void moleculeRepresentations() {
+    const QString pept = QStringLiteral("/usr/share/pymol/data/demo/pept.pdb");
+    QVERIFY2(QFileInfo::exists(pept), "missing pept.pdb (Debian package pymol-data)");
+    auto w = openWindow();
+    QVERIFY(w);
+    auto* row = w->findChild<QWidget*>("moleculeRow");
+    auto* spheres = w->findChild<QCheckBox*>("moleculeSpheres");
+    auto* sticks = w->findChild<QCheckBox*>("moleculeSticks");
+    auto* surface = w->findChild<QCheckBox*>("moleculeSurface");
+    QVERIFY(row && spheres && sticks && surface);
+    QVERIFY(!row->isVisibleTo(w.get()));  // @sample is not a molecule
+    ViewerModel& m = w->model();
+    QVERIFY(!m.moleculeStyle());
+    w->openScene(pept);
+    QTRY_VERIFY_WITH_TIMEOUT(m.scenePath() == pept && m.framesRendered() > 0, kTimeoutMs);
+    QVERIFY(row->isVisibleTo(w.get()));
+    QVERIFY(spheres->isChecked() && !sticks->isChecked() && !surface->isChecked());
+    QCOMPARE(m.scene().objects.size(), std::size_t{1});
+    const QSize size(160, 120);
+    QVERIFY(showAbufferIso(*w, size));
+    const mfr::Camera camera = m.camera();
+    // Sticks and surface instead of spheres: the file is read again, the camera stays.
+    sticks->setChecked(true);
+    QTRY_VERIFY_WITH_TIMEOUT(m.moleculeStyle() && m.moleculeStyle()->sticks, kTimeoutMs);
+    surface->setChecked(true);
+    spheres->setChecked(false);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle() && m.moleculeStyle()->text() == "sticks,surface",
+                             kTimeoutMs);
+    QStringList names;
+    for (const mfr::Object& o : m.scene().objects) names << QString::fromStdString(o.name);
+    QCOMPARE(names, (QStringList{"chain E sticks", "chain E surface"}));
+    QCOMPARE(m.camera().eye, camera.eye);
+    QCOMPARE(m.camera().target, camera.target);
+    // None at all is not taken: the last one stays checked.
+    sticks->setChecked(false);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "surface", kTimeoutMs);
+    surface->setChecked(false);
+    QVERIFY(surface->isChecked());
+    QCOMPARE(m.moleculeStyle()->text(), std::string("surface"));
+    sticks->setChecked(true);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks,surface", kTimeoutMs);
+    settle(m);
+    const mfr::ImageRGBA8 shown = w->view().renderImage(size);
+    // mfr render with the same representations and camera draws the same image.
+    QTemporaryDir dir;
+    const QString scene = dir.filePath("pept.mfrscene"), cliPng = dir.filePath("cli.png");
+    {
+      const mfr::Camera c = m.camera();
+      const QJsonObject view{{"name", "here"},
+                             {"eye", QJsonArray{c.eye.x, c.eye.y, c.eye.z}},
+                             {"target", QJsonArray{c.target.x, c.target.y, c.target.z}},
+                             {"up", QJsonArray{c.up.x, c.up.y, c.up.z}},
+                             {"fovy", c.fovyDegrees},
+                             {"near", c.nearPlane},
+                             {"far", c.farPlane}};
+      const QJsonObject object{{"file", pept}, {"molecule", "surface,sticks"}};
+      QFile f(scene);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(QJsonDocument(QJsonObject{{"objects", QJsonArray{object}}, {"views", QJsonArray{view}}}).toJson());
+    }
+    QString out;
+    QCOMPARE(
+        runProgram(MFR_CLI, {"render", scene, "--view", "here", "-m", "abuffer-ll", "--size", "160x120", "-o", cliPng},
+                   &out),
+        0);
+    const int diff = maxChannelDifference(shown, mfr::readPng(cliPng.toStdString()));
+    qInfo("viewer sticks,surface vs mfr render: max channel difference %d", diff);
+    QVERIFY2(diff >= 0 && diff <= 1, qPrintable(out));
+    // A session keeps them.
+    const QString sessionPath = dir.filePath("pept.mfrsession");
+    w->saveSession(sessionPath);
+    QFile saved(sessionPath);
+    QVERIFY(saved.open(QIODevice::ReadOnly));
+    QCOMPARE(QJsonDocument::fromJson(saved.readAll()).object().value("molecule").toString(),
+             QStringLiteral("sticks,surface"));
+    auto again = reopenedSession(*w, sessionPath, size);
+    QVERIFY(again);
+    QTRY_VERIFY_WITH_TIMEOUT(again->model().hasScene() && again->model().framesRendered() > 0, kTimeoutMs);
+    QCOMPARE(again->model().moleculeStyle()->text(), std::string("sticks,surface"));
+    QCOMPARE(again->model().scene().objects.size(), std::size_t{2});
+    // mfrview --molecule: the same parts; a bad list or a file that is no molecule is refused.
+    const QString viewerPng = dir.filePath("viewer.png");
+    QCOMPARE(runProgram(MFRVIEW, {pept, "--molecule", "sticks", "--screenshot", viewerPng, "--size", "64x48"}, &out),
+             0);
+    QCOMPARE(runProgram(MFRVIEW, {pept, "--molecule", "cartoon", "--screenshot", viewerPng, "--size", "64x48"}, &out),
+             2);
+    QVERIFY2(out.contains("--molecule cartoon: unknown representation 'cartoon'"), qPrintable(out));
+    QCOMPARE(
+        runProgram(MFRVIEW, {"@sample", "--molecule", "sticks", "--screenshot", viewerPng, "--size", "64x48"}, &out),
+        1);
+    QVERIFY2(out.contains("can be chosen only for a molecule file"), qPrintable(out));
+  }
 };
 
 QTEST_MAIN(ViewerTest)

@@ -1,12 +1,16 @@
 // mfr on molecular structures (pymol-data, shared/DATA.md), end to end: info counts the parts and
-// triangles, the oracle draws the structure, a GPU method with --opacity agrees with the oracle on
-// the per-vertex element colours, and a damaged file is one line and a non-zero exit.
+// triangles, the atoms and bonds; the oracle draws the structure, a GPU method with --opacity agrees
+// with the oracle on the per-vertex element colours, in every representation (--molecule); a bad
+// representation and a damaged file are one line and a non-zero exit.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "mfr/image.hpp"
 #include "test_files.hpp"
@@ -74,6 +78,66 @@ TEST_F(CliMolecules, GpuAndOracleAgreeWithOpacity) {
             0);
   const CliResult d = runCli("compare " + a.string() + " " + c.string() + " --metric rmse");
   EXPECT_GT(std::stod(d.out.substr(d.out.find("rmse ") + 5)), 0.02) << d.out;
+}
+
+// 107 atoms (the file's ATOM records) and 112 bonds: the count Open Babel finds for the same atoms
+// (tests/data MoleculeBonds compares them bond for bond) and PyMOL's own (len(cmd.get_model().bond)).
+TEST_F(CliMolecules, InfoCountsAtomsAndBonds) {
+  const fs::path json = dir() / "info.json";
+  const CliResult r =
+      runCli("info " + kPept.string() + " --molecule sticks,surface --no-histogram --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("molecule   107 atoms, 112 bonds; drawn as sticks,surface\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("part 0: chain E sticks"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("part 1: chain E surface"), std::string::npos) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("molecule").at("atoms"), 107);
+  EXPECT_EQ(j.at("molecule").at("bonds"), 112);
+  EXPECT_EQ(j.at("molecule").at("representations"), "sticks,surface");
+  EXPECT_EQ(j.at("part_list").at(1).at("closed"), true);  // the surface
+}
+
+// Every representation reaches a GPU method as it reaches the oracle, and each draws differently.
+TEST_F(CliMolecules, RepresentationsGpuAndOracleAgree) {
+  std::vector<mfr::ImageRGBA8> oracles;
+  for (const std::string style : {"spheres", "sticks", "ball-and-stick", "surface,sticks"}) {
+    SCOPED_TRACE(style);
+    const fs::path a = dir() / "oracle.png", b = dir() / "gpu.png";
+    const std::string common = "render " + kPept.string() + " --molecule " + style + " --size 64x48 --view iso ";
+    const CliResult o = runCli(common + "--method oracle -o " + a.string());
+    ASSERT_EQ(o.exitCode, 0) << o.out;
+    const CliResult g = runCli(common + "--method abuffer-sbuffer -o " + b.string());
+    ASSERT_EQ(g.exitCode, 0) << g.out;
+    const CliResult r = runCli("compare " + a.string() + " " + b.string() + " --metric rmse");
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    EXPECT_LT(std::stod(r.out.substr(r.out.find("rmse ") + 5)), 0.02) << r.out;
+    oracles.push_back(mfr::readPng(a));
+  }
+  for (std::size_t i = 0; i < oracles.size(); ++i)
+    for (std::size_t k = i + 1; k < oracles.size(); ++k)
+      EXPECT_NE(oracles[i].pixels, oracles[k].pixels) << i << " " << k;
+}
+
+class CliMoleculeRefusals : public mfr::test::CliTest {};
+
+TEST_F(CliMoleculeRefusals, BadRepresentationOrNotAMolecule) {
+  expectCleanFailure("render " + kPept.string() + " --molecule cartoon",
+                     "--molecule cartoon: unknown representation 'cartoon'");
+  expectCleanFailure("render " + kPept.string() + " --molecule ,", "--molecule ,: expected spheres");
+  expectCleanFailure("render @sample --molecule sticks", "can be chosen only for a molecule file");
+  const CliResult info = runCli("info @sample --molecule sticks");
+  EXPECT_EQ(info.exitCode, 1) << info.out;
+  EXPECT_NE(info.out.find("@sample: a molecule representation (sticks) can be chosen only for a molecule file"),
+            std::string::npos)
+      << info.out;
+  // probe and bench read it too.
+  const CliResult probe = runCli("probe " + kPept.string() + " --molecule sticks --size 64x48 --pixel 32,24");
+  EXPECT_EQ(probe.exitCode, 0) << probe.out;
+  EXPECT_NE(probe.out.find("chain E"), std::string::npos) << probe.out;
+  const CliResult bench =
+      runCli("bench " + kPept.string() + " --molecule surface --size 32x24 --methods abuffer-ll --repeat 1");
+  EXPECT_EQ(bench.exitCode, 0) << bench.out;
 }
 
 TEST_F(CliMolecules, DamagedFileIsOneLine) {

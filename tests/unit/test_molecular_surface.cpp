@@ -214,5 +214,34 @@ TEST(MolecularSurface, VerticesLieOnTheExactSurface) {
   }
 }
 
+// A hollow ball of atoms — 162 carbons evenly on a sphere of radius 6 Å (a Fibonacci lattice,
+// about 1.8 Å apart: too close for the probe to pass) — holds a cavity the probe fits in. By
+// default (PyMOL, MSMS) only the outer surface is drawn; with cavities also the cavity's, a closed
+// component whose winding encloses a negative volume (its normals point into the cavity).
+TEST(MolecularSurface, BuriedCavitiesOnlyWhenAskedFor) {
+  std::vector<SurfaceAtom> shell;
+  const int n = 162;
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - (2.0 * i + 1.0) / n, r = std::sqrt(1.0 - z * z);
+    shell.push_back({6.0 * glm::dvec3(r * std::cos(golden * i), r * std::sin(golden * i), z), 1.7});
+  }
+  MolecularSurfaceOptions options;
+  const Mesh outer = solventExcludedSurface(shell, options);
+  options.cavities = true;
+  const Mesh both = solventExcludedSurface(shell, options);
+  const SurfaceMeasures o = measure(outer), b = measure(both);
+  ASSERT_TRUE(o.closed());
+  ASSERT_TRUE(b.closed());
+  EXPECT_GT(o.volume, 0.0);
+  // The cavity: a surface inside radius 6 − 1.7 = 4.3 Å, of negative enclosed volume.
+  EXPECT_LT(b.volume, o.volume);
+  EXPECT_GT(b.area, o.area + 4.0 * kPi * 2.0 * 2.0);
+  std::size_t inside = 0;
+  for (const glm::vec3& p : both.positions) inside += glm::length(p) < 4.31f ? 1u : 0u;
+  EXPECT_GT(inside, 100u);
+  for (const glm::vec3& p : outer.positions) EXPECT_GT(glm::length(p), 4.29f);
+}
+
 }  // namespace
 }  // namespace mfr::test

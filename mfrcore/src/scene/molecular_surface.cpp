@@ -18,6 +18,7 @@
 #include <memory>
 #include <numbers>
 #include <string>
+#include <thread>
 
 #include <vtkIdList.h>
 #include <vtkNew.h>
@@ -67,6 +68,45 @@ glm::ivec3 gridDims(const glm::dvec3& lo, const glm::dvec3& hi, double h) {
 double points(const glm::dvec3& lo, const glm::dvec3& hi, double h) {
   const glm::dvec3 n = glm::ceil((hi - lo) / h) + 5.0;
   return n.x * n.y * n.z;
+}
+
+// The mesh without its buried cavities. A cavity's surface is a closed component inside the
+// molecule's whose normals point into the cavity (out of the excluded space around it), so the
+// volume it encloses by its winding is negative; the outer surface of each molecule encloses a
+// positive one.
+Mesh withoutCavities(const Mesh& mesh) {
+  std::vector<std::uint32_t> parent(mesh.positions.size());
+  for (std::uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  const auto root = [&](std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const std::uint32_t a = root(mesh.indices[t]);
+    parent[root(mesh.indices[t + 1])] = a;
+    parent[root(mesh.indices[t + 2])] = a;
+  }
+  std::vector<double> volume(mesh.positions.size(), 0.0);  // per component, at its root
+  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const glm::dvec3 a(mesh.positions[mesh.indices[t]]), b(mesh.positions[mesh.indices[t + 1]]),
+        c(mesh.positions[mesh.indices[t + 2]]);
+    volume[root(mesh.indices[t])] += glm::dot(a, glm::cross(b, c)) / 6.0;
+  }
+  Mesh out;
+  std::vector<std::uint32_t> index(mesh.positions.size(), UINT32_MAX);
+  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    if (!(volume[root(mesh.indices[t])] > 0.0)) continue;
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t v = mesh.indices[t + static_cast<std::size_t>(k)];
+      if (index[v] == UINT32_MAX) {
+        index[v] = static_cast<std::uint32_t>(out.positions.size());
+        out.positions.push_back(mesh.positions[v]);
+        out.normals.push_back(mesh.normals[v]);
+      }
+      out.indices.push_back(index[v]);
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -212,21 +252,30 @@ Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const Molecul
     sampleLocator->SetDataSet(sampleSet);
     sampleLocator->BuildLocator();
     // Deeper than r_p + 2h (depth is a lower bound of the distance), f > 2h: no crossing there.
+    // The queries — most of the time — in slabs of z on every core (the locator's queries are
+    // thread-safe once it is built).
     const double near = probe + 2.0 * h, search = probe + 3.0 * h;
-    for (int k = 0; k < dims.z; ++k)
-      for (int j = 0; j < dims.y; ++j)
-        for (int i = 0; i < dims.x; ++i) {
-          const std::size_t n = at(i, j, k);
-          if (!(depth[n] > 0.0f)) continue;
-          float f = static_cast<float>(2.0 * h);
-          if (static_cast<double>(depth[n]) < near) {
-            const glm::dvec3 p = position(i, j, k);
-            double query[3] = {p.x, p.y, p.z}, d2 = 0.0;
-            if (sampleLocator->FindClosestPointWithinRadius(search, query, d2) >= 0)
-              f = static_cast<float>(std::min(std::sqrt(d2) - probe, 2.0 * h));
+    const auto slabs = [&](int kBegin, int kEnd) {
+      for (int k = kBegin; k < kEnd; ++k)
+        for (int j = 0; j < dims.y; ++j)
+          for (int i = 0; i < dims.x; ++i) {
+            const std::size_t n = at(i, j, k);
+            if (!(depth[n] > 0.0f)) continue;
+            float f = static_cast<float>(2.0 * h);
+            if (static_cast<double>(depth[n]) < near) {
+              const glm::dvec3 p = position(i, j, k);
+              double query[3] = {p.x, p.y, p.z}, d2 = 0.0;
+              if (sampleLocator->FindClosestPointWithinRadius(search, query, d2) >= 0)
+                f = static_cast<float>(std::min(std::sqrt(d2) - probe, 2.0 * h));
+            }
+            grid->values[n] = f;
           }
-          grid->values[n] = f;
-        }
+    };
+    const int threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, dims.z);
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(slabs, dims.z * t / threads, dims.z * (t + 1) / threads);
+    slabs(0, dims.z / threads);
+    for (std::thread& thread : pool) thread.join();
   }
   depth = {};
   nearest = {};
@@ -236,7 +285,8 @@ Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const Molecul
   volume.origin = origin;
   volume.spacing = glm::dvec3(h);
   volume.grid = grid;
-  return contourVolume(volume, 0.0);
+  Mesh mesh = contourVolume(volume, 0.0);
+  return options.cavities ? mesh : withoutCavities(mesh);
 }
 
 }  // namespace mfr

@@ -27,11 +27,14 @@ struct MolecularSurfaceOptions {
   // The most grid points one surface may use; a larger structure gets a coarser grid (spacing
   // grows until it fits), never a partial surface.
   std::size_t maxGridPoints = std::size_t{1} << 25;
+  // Also the surfaces of buried cavities — pockets inside that a probe fits in but cannot reach
+  // from outside. Off, as PyMOL (surface_cavity_mode 0) and MSMS draw a molecule by default.
+  bool cavities = false;
 };
 
-// The solvent-excluded surface of `atoms`, a closed mesh (one component per separate molecule or
-// cavity) whose normals point out of the excluded space and whose triangles wind counter-clockwise
-// seen from outside; positions and normals only (colours are the caller's). Empty for no atoms.
+// The solvent-excluded surface of `atoms`, a closed mesh (one component per separate molecule, and
+// per buried cavity with options.cavities) whose normals point out of the excluded space and whose triangles wind
+// counter-clockwise seen from outside; positions and normals only (colours are the caller's). Empty for no atoms.
 // Throws mfr::Error for a non-finite centre, a radius that is not positive and finite, or options
 // out of range (probe radius not positive, spacing not positive).
 Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options = {});
