@@ -83,8 +83,10 @@ void addInfo(CLI::App& app) {
       nlohmann::ordered_json fields = nlohmann::ordered_json::array();
       for (const std::string& f : fieldNames(*o.mesh)) {
         const FieldValues v = fieldValues(*o.mesh, f, o.name);
-        const glm::dvec2 r = fieldRange(v.values);
-        fields.push_back({{"name", f}, {"cell_data", v.cellData}, {"range", {r.x, r.y}}});
+        const std::optional<glm::dvec2> r = finiteSpan(v.values);
+        fields.push_back({{"name", f},
+                          {"cell_data", v.cellData},
+                          {"range", r ? nlohmann::ordered_json{r->x, r->y} : nlohmann::ordered_json()}});
       }
       const std::size_t i = static_cast<std::size_t>(&o - scene.objects.data());
       const SurfaceMeasures& m = measures[i];
@@ -144,8 +146,11 @@ void addInfo(CLI::App& app) {
         std::cout << "    fields:";
         for (const std::string& f : fieldNames(*o.mesh)) {
           const FieldValues v = fieldValues(*o.mesh, f, o.name);
-          const glm::dvec2 r = fieldRange(v.values);
-          std::cout << " " << f << (v.cellData ? " (cells)" : "") << " [" << r.x << ", " << r.y << "]";
+          std::cout << " " << f << (v.cellData ? " (cells)" : "");
+          if (const std::optional<glm::dvec2> r = finiteSpan(v.values))
+            std::cout << " [" << r->x << ", " << r->y << "]";
+          else
+            std::cout << " (no finite values)";
         }
         std::cout << "\n";
       }

@@ -196,6 +196,9 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   });
   connect(&model_, &ViewerModel::sceneLoaded, this, &SceneTreePanel::rebuild);
   connect(&model_, &ViewerModel::sceneLoaded, this, &SceneTreePanel::showMoleculeStyle);
+  // A re-read that fails or is cancelled leaves the representations drawn: the boxes show them.
+  connect(&model_, &ViewerModel::loadFailed, this, &SceneTreePanel::showMoleculeStyle);
+  connect(&model_, &ViewerModel::loadCancelled, this, &SceneTreePanel::showMoleculeStyle);
   connect(&model_, &ViewerModel::partsChanged, this, &SceneTreePanel::rebuild);  // isosurfaces added or removed
   // Edits from elsewhere (a session's overrides, plugins) show up in the rows.
   connect(&model_, &ViewerModel::sceneChanged, this, &SceneTreePanel::showValues);

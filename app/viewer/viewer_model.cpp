@@ -692,17 +692,19 @@ void ViewerModel::setDataView(DataView view, bool overImage) {
 // ---- scene -------------------------------------------------------------------------------
 
 void ViewerModel::setMoleculeStyle(const mfr::MoleculeStyle& style) {
-  if (!moleculeStyle_ || style == *moleculeStyle_ ||
-      !(style.spheres || style.sticks || style.ballAndStick || style.surface))
-    return;
-  const mfr::Camera camera = camera_;
+  if (!moleculeStyle_ || !(style.spheres || style.sticks || style.ballAndStick || style.surface)) return;
+  // Compared with what was asked last: a change undone before its read ends is a read of its own.
+  if (style == requestedMoleculeStyle_.value_or(*moleculeStyle_)) return;
+  const mfr::Camera camera = keepCamera_.value_or(camera_);
   loadSceneAsync(scenePath_, {}, style);
   keepCamera_ = camera;
+  requestedMoleculeStyle_ = style;
 }
 
 void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
                                  const std::optional<mfr::MoleculeStyle>& molecule) {
   keepCamera_.reset();
+  requestedMoleculeStyle_.reset();
   if (load_) {
     load_->cancel = true;  // superseded: stop the previous worker early
     ++abandonedLoads_;
@@ -747,6 +749,8 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
         load_.reset();
         loading_ = false;
         if (!loaded.error.isEmpty() || !loaded.scene) {
+          keepCamera_.reset();
+          requestedMoleculeStyle_.reset();
           emit loadFailed(path, loaded.error.isEmpty() ? tr("loading stopped") : loaded.error);
           return;
         }
@@ -758,6 +762,7 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
         }
         const std::optional<mfr::Camera> camera = keepCamera_;
         keepCamera_.reset();
+        requestedMoleculeStyle_.reset();
         moleculeStyle_.reset();
         if (!path.startsWith('@') && mfr::isMoleculeFile(path.toStdString()))
           moleculeStyle_ = molecule.value_or(mfr::MoleculeStyle{});
@@ -781,6 +786,8 @@ void ViewerModel::cancelLoad() {
   ++abandonedLoads_;
   loadPoll_->stop();
   loading_ = false;
+  keepCamera_.reset();
+  requestedMoleculeStyle_.reset();
   emit loadCancelled();
 }
 

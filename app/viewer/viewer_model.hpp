@@ -371,6 +371,7 @@ class ViewerModel final : public ViewerContext {
   QString scenePath_;
   std::optional<mfr::MoleculeStyle> moleculeStyle_;
   std::optional<mfr::Camera> keepCamera_;  // setMoleculeStyle's camera, for the scene it loads
+  std::optional<mfr::MoleculeStyle> requestedMoleculeStyle_;  // setMoleculeStyle's, while it loads
   quint64 sceneRevision_ = 0;
   mfr::Bounds bounds_;
   double radius_ = 0.0;

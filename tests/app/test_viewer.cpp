@@ -3568,6 +3568,13 @@ class ViewerTest : public QObject {
     surface->setChecked(false);
     QVERIFY(surface->isChecked());
     QCOMPARE(m.moleculeStyle()->text(), std::string("surface"));
+    // Ticked and unticked again before the re-read ends: what is drawn in the end is what is ticked.
+    sticks->setChecked(true);
+    sticks->setChecked(false);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading(), kTimeoutMs);
+    QCOMPARE(m.moleculeStyle()->text(), std::string("surface"));
+    QVERIFY(!sticks->isChecked());
+    QCOMPARE(m.scene().objects.size(), std::size_t{1});
     sticks->setChecked(true);
     QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks,surface", kTimeoutMs);
     settle(m);

@@ -1,11 +1,13 @@
-// Molecules drawn as sticks, balls and sticks, and surfaces, on real files (pymol-data,
-// python-biopython-doc), against independent programs:
-// * the bonds against Open Babel's (Debian openbabel): the same atoms written as XYZ — elements
-//   and coordinates only, so that Open Babel too must find the bonds from distances — and the
-//   bond table of the SD file it writes compared bond for bond;
-// * every bond drawn: two half tubes per bond, each in its atom's part and colour;
-// * the solvent-excluded surface: closed, outside every atom's van der Waals sphere, and coloured
-//   by the nearest atom. (Its area against PyMOL's own surface is tests/peer/pymol_surface_peer.py.)
+// Molecules drawn as sticks and surfaces, on real files (pymol-data, python-biopython-doc),
+// against independent programs and closed facts:
+// * the bonds against Open Babel's (Debian openbabel): the same atoms written as XYZ — elements and
+//   coordinates only, so that Open Babel too must find the bonds from distances — and the bond
+//   table of the MOL2 file it writes compared bond for bond;
+// * every one of those bonds drawn: the sticks' triangles are a joint per atom and two half tubes
+//   per bond, 112 bonds on pept.pdb (Open Babel's and PyMOL's count);
+// * the solvent-excluded surface of real chains: closed, outside every atom's van der Waals sphere
+//   and inside the solvent-accessible one. (Its area against PyMOL's own surface is
+//   tests/peer/pymol_surface_peer.py.)
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -114,6 +116,38 @@ TEST_F(MoleculeBonds, LigandsWaterAndAlternativeLocationsAsOpenBabel) {
   // Only the first alternative location is kept, and Open Babel is given the same atoms.
   const fs::path file = requireFile(kBiopython / "4CUP.cif.gz", "Debian package python-biopython-doc");
   expectSameBonds(file, readMoleculeStructure(file).atoms.size());
+}
+
+TEST(MoleculeDrawing, SticksDrawEveryBondAndSurfacesWrapTheAtoms) {
+  const fs::path pept = requireFile(kPymolDemo / "pept.pdb", "Debian package pymol-data");
+  const std::vector<Object> sticks = loadModel(pept, LoadOptions({}, MoleculeStyle::parse("sticks", "t")));
+  ASSERT_EQ(sticks.size(), 1u);
+  // 107 atoms: 320 triangles a joint; 16-sided half tubes, 32 triangles each, two per bond.
+  EXPECT_EQ(sticks[0].mesh->triangleCount(), 107u * 320u + 112u * 2u * 32u);
+
+  for (const fs::path& file : {pept, requireFile(kPymolDemo / "il2.pdb", "Debian package pymol-data")}) {
+    SCOPED_TRACE(file.string());
+    const MoleculeStructure m = readMoleculeStructure(file);
+    const std::vector<Object> parts = loadModel(file, LoadOptions({}, MoleculeStyle::parse("surface", "t")));
+    ASSERT_EQ(parts.size(), 1u);
+    const Mesh& surface = *parts[0].mesh;
+    EXPECT_TRUE(measureSurface(surface, glm::dmat4(1.0)).closed());
+    // Every vertex outside every atom (to within 5 % of the 0.3 Å grid) and inside some grown sphere.
+    double deepest = 1e30, farthest = -1e30;
+    for (const glm::vec3& vertex : surface.positions) {
+      const glm::dvec3 v(vertex);
+      double nearestGrown = 1e30;
+      for (const MoleculeAtom& a : m.atoms) {
+        const double r = gemmi::vdw_radius(static_cast<gemmi::El>(a.atomicNumber));
+        const double d = glm::length(v - a.position);
+        deepest = std::min(deepest, d - r);
+        nearestGrown = std::min(nearestGrown, d - r - 1.4);
+      }
+      farthest = std::max(farthest, nearestGrown);
+    }
+    EXPECT_GT(deepest, -0.015);
+    EXPECT_LT(farthest, 0.0);
+  }
 }
 
 }  // namespace

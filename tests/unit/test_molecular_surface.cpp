@@ -156,16 +156,34 @@ TEST(MolecularSurface, AnyStructureIsClosedOutsideTheAtomsAndInsideTheSas) {
 }
 
 TEST(MolecularSurface, ACoarserGridWhenTheFineOneIsTooLarge) {
-  const std::vector<SurfaceAtom> atoms = {{{0.0, 0.0, 0.0}, 1.7}, {{30.0, 0.0, 0.0}, 1.7}};
+  // Eleven overlapping carbons in a row, 30 Å long: one group, whose grid must be coarser to fit in
+  // 20,000 points.
+  std::vector<SurfaceAtom> row;
+  for (int i = 0; i <= 10; ++i) row.push_back({{3.0 * i, 0.0, 0.0}, 1.7});
   MolecularSurfaceOptions options;
   options.maxGridPoints = 20'000;
-  const double h = molecularSurfaceSpacing(atoms, options);
+  const double h = molecularSurfaceSpacing(row, options);
   EXPECT_GT(h, options.spacing);
-  const SurfaceMeasures m = measure(solventExcludedSurface(atoms, options));
+  const SurfaceMeasures m = measure(solventExcludedSurface(row, options));
   EXPECT_TRUE(m.closed());
-  EXPECT_NEAR(m.area, 2.0 * 4.0 * kPi * 1.7 * 1.7, 0.15 * 8.0 * kPi * 1.7 * 1.7);
-  options.maxGridPoints = 1u << 25;
-  EXPECT_DOUBLE_EQ(molecularSurfaceSpacing(atoms, options), options.spacing);
+  options.maxGridPoints = std::size_t{1} << 25;
+  EXPECT_DOUBLE_EQ(molecularSurfaceSpacing(row, options), options.spacing);
+  EXPECT_NEAR(measure(solventExcludedSurface(row, options)).area, m.area, 0.03 * m.area);
+  // Two atoms 10⁵ Å apart are two groups, each on a fine grid of its own: two exact spheres.
+  const std::vector<SurfaceAtom> apart = {{{-5e4, 0.0, 0.0}, 1.7}, {{5e4, 0.0, 0.0}, 1.7}};
+  EXPECT_DOUBLE_EQ(molecularSurfaceSpacing(apart, options), options.spacing);
+  EXPECT_NEAR(measure(solventExcludedSurface(apart, options)).area, 2.0 * 4.0 * kPi * 1.7 * 1.7,
+              0.01 * 8.0 * kPi * 1.7 * 1.7);
+  // A grid too coarse for the atoms is refused, not drawn as nothing.
+  options.maxGridPoints = 512;
+  try {
+    (void)solventExcludedSurface(row, options);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "molecular surface: 11 overlapping atoms span 36 Å: a grid of at most 512 points would be coarser than "
+              "their smallest atom");
+  }
 }
 
 TEST(MolecularSurface, BadInputIsRefused) {
@@ -187,6 +205,12 @@ TEST(MolecularSurface, BadInputIsRefused) {
   EXPECT_EQ(reason(one, bad), "molecular surface: the grid spacing must be positive and finite");
   EXPECT_EQ(reason({{{0.0, NAN, 0.0}, 1.7}}, {}), "molecular surface: an atom's centre is not finite");
   EXPECT_EQ(reason({{{0.0, 0.0, 0.0}, 0.0}}, {}), "molecular surface: an atom's radius is not positive and finite");
+  // Atoms packed denser than any molecule: refused before the crease search, which would be
+  // quadratic in them.
+  const std::vector<SurfaceAtom> pile(500, SurfaceAtom{{1.0, 2.0, 3.0}, 1.7});
+  EXPECT_EQ(reason(pile, {}),
+            "molecular surface: 499 atoms within 6 Å of one: packed denser than any molecule (a "
+            "protein's atoms have about 100)");
 }
 
 // Every vertex lies on the exact surface — one of the two spheres or the torus (the points at

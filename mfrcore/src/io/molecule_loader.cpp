@@ -20,15 +20,11 @@
 #include <gemmi/model.hpp>
 #include <gemmi/pdb.hpp>
 #include <gemmi/polyheur.hpp>
-#include <vtkIdList.h>
-#include <vtkNew.h>
-#include <vtkPoints.h>
-#include <vtkPolyData.h>
-#include <vtkStaticPointLocator.h>
 
 #include "mfr/error.hpp"
 #include "mfr/io/molecule.hpp"
 #include "mfr/scene/molecular_surface.hpp"
+#include "scene/point_grid.hpp"
 
 namespace mfr::io {
 namespace {
@@ -330,14 +326,18 @@ int atomicNumber(gemmi::El element) {
   return element == gemmi::El::D ? 1 : static_cast<int>(element);
 }
 
-MoleculeStructure structureOf(const Parsed& parsed) {
+MoleculeStructure structureOf(const Parsed& parsed, const std::string& name) {
   MoleculeStructure out;
   out.models = parsed.models;
   for (std::size_t p = 0; p < parsed.parts.size(); ++p) {
     out.parts.push_back(parsed.parts[p].name);
     for (const Atom& a : parsed.parts[p].atoms) out.atoms.push_back({a.serial, atomicNumber(a.element), a.position, p});
   }
-  out.bonds = perceiveBonds(out.atoms);
+  try {
+    out.bonds = perceiveBonds(out.atoms);
+  } catch (const Error& e) {
+    throw Error(name, e.what());
+  }
   return out;
 }
 
@@ -430,45 +430,43 @@ Mesh sticksMesh(const Part& part, std::size_t firstAtom, const std::vector<Atom*
 }
 
 // The part's solvent-excluded surface, each vertex coloured (and given the fields) of the atom
-// whose van der Waals sphere is nearest to it, as PyMOL colours a surface.
-Mesh surfaceMesh(const Part& part) {
+// whose van der Waals sphere is nearest to it, as PyMOL colours a surface. Its errors name the
+// file and the part.
+Mesh surfaceMesh(const Part& part, const std::string& name) {
   std::vector<SurfaceAtom> spheres;
+  std::vector<glm::dvec3> centres;
   spheres.reserve(part.atoms.size());
   double largest = 0.0;
   for (const Atom& atom : part.atoms) {
     spheres.push_back({atom.position, gemmi::vdw_radius(atom.element)});
+    centres.push_back(atom.position);
     largest = std::max(largest, spheres.back().radius);
   }
   const MolecularSurfaceOptions options;
-  const Mesh surface = solventExcludedSurface(spheres, options);
-  vtkNew<vtkPoints> centres;
-  centres->SetDataTypeToDouble();
-  for (const SurfaceAtom& s : spheres) centres->InsertNextPoint(s.centre.x, s.centre.y, s.centre.z);
-  vtkNew<vtkPolyData> centreSet;
-  centreSet->SetPoints(centres);
-  vtkNew<vtkStaticPointLocator> locator;
-  locator->SetDataSet(centreSet);
-  locator->BuildLocator();
-  vtkNew<vtkIdList> around;
+  Mesh surface;
+  double spacing = options.spacing;
+  try {
+    surface = solventExcludedSurface(spheres, options);
+    spacing = molecularSurfaceSpacing(spheres, options);
+  } catch (const Error& e) {
+    throw Error(name, "the surface of '" + part.name + "': " + e.what());
+  }
   // A surface point is at most the probe's diameter from its nearest sphere (it touches the probe,
   // which touches an atom), plus the grid's error.
-  const double reach = largest + 2.0 * options.probeRadius + molecularSurfaceSpacing(spheres, options);
+  const double reach = largest + 2.0 * options.probeRadius + spacing;
+  const PointGrid grid(centres, reach);
   AtomMeshBuilder b;
   for (std::size_t v = 0; v < surface.positions.size(); ++v) {
     const glm::dvec3 p(surface.positions[v]);
-    double query[3] = {p.x, p.y, p.z};
-    locator->FindPointsWithinRadius(reach, query, around);
     std::size_t best = 0;
     double bestGap = std::numeric_limits<double>::infinity();
-    for (vtkIdType n = 0; n < around->GetNumberOfIds(); ++n) {
-      const auto a = static_cast<std::size_t>(around->GetId(n));
-      const double gap = glm::length(p - spheres[a].centre) - spheres[a].radius;
-      if (gap < bestGap) {
+    grid.forEachWithin(p, reach, [&](std::uint32_t a, double d2) {
+      const double gap = std::sqrt(d2) - spheres[a].radius;
+      if (gap < bestGap || (gap == bestGap && a < best)) {
         bestGap = gap;
         best = a;
       }
-    }
-    if (!std::isfinite(bestGap)) best = static_cast<std::size_t>(locator->FindClosestPoint(query));
+    });
     b.vertex(part.atoms[best], p, surface.normals[v]);
   }
   b.mesh.indices = surface.indices;
@@ -484,7 +482,7 @@ int sphereSubdivisionLevel(std::size_t atoms) {
 }
 
 MoleculeStructure readMoleculeStructure(const std::string& contents, MoleculeFormat format, const std::string& name) {
-  return structureOf(parseMolecule(contents, format, name, {}));
+  return structureOf(parseMolecule(contents, format, name, {}), name);
 }
 
 std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat format, const std::string& name,
@@ -503,7 +501,7 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
   std::vector<std::size_t> firstAtom;
   std::vector<std::vector<std::uint32_t>> bondedTo;
   if (style.sticks || style.ballAndStick) {
-    const MoleculeStructure structure = structureOf(parsed);
+    const MoleculeStructure structure = structureOf(parsed, name);
     for (Part& part : parts) {
       firstAtom.push_back(all.size());
       for (Atom& atom : part.atoms) all.push_back(&atom);
@@ -539,7 +537,7 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
     if (style.sticks)
       add(part, "sticks", sticksMesh(part, firstAtom[i], all, bondedTo, kStickRadius, 0.0, unit, tubeSides(level)));
     // Water has no surface of its own (PyMOL leaves solvent out of surfaces too).
-    if (style.surface && !part.water) add(part, "surface", surfaceMesh(part));
+    if (style.surface && !part.water) add(part, "surface", surfaceMesh(part, name));
     progress.step(0.6 + 0.4 * static_cast<double>(i + 1) / static_cast<double>(parts.size()));
   }
   if (objects.empty()) throw Error(name, "nothing to draw as " + style.text() + " (only water, which has no surface)");
@@ -551,6 +549,9 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
 namespace mfr {
 
 namespace {
+
+// More atoms than this in one cube of the bond search (about 2 Å a side) is no molecule.
+constexpr std::size_t kMaxAtomsPerBondCell = 64;
 
 // The most bonds an element makes, from the Blue Obelisk data Open Babel uses (its element table's
 // MaxBnd): 6 for the elements not listed.
@@ -609,37 +610,39 @@ std::vector<Bond> perceiveBonds(const std::vector<MoleculeAtom>& atoms) {
     const int z = atoms[i].atomicNumber;
     return static_cast<double>(gemmi::covalent_radius(z >= 0 && z <= 118 ? static_cast<gemmi::El>(z) : gemmi::El::X));
   };
+  constexpr double kTolerance = 0.45, kShortest = 0.4;
   double largest = 0.0;
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
+  std::vector<glm::dvec3> positions;
+  positions.reserve(atoms.size());
   for (std::size_t i = 0; i < atoms.size(); ++i) {
     largest = std::max(largest, covalent(i));
-    points->InsertNextPoint(atoms[i].position.x, atoms[i].position.y, atoms[i].position.z);
+    positions.push_back(atoms[i].position);
   }
-  vtkNew<vtkPolyData> set;
-  set->SetPoints(points);
-  vtkNew<vtkStaticPointLocator> locator;
-  locator->SetDataSet(set);
-  locator->BuildLocator();
-  vtkNew<vtkIdList> around;
-  constexpr double kTolerance = 0.45, kShortest = 0.4;
+  // Cubes as large as the longest bond possible: each atom's candidates lie in the 27 around it.
+  const double reach = 2.0 * largest + kTolerance;
+  const PointGrid grid(positions, reach);
+  // No molecule packs atoms this densely (a protein has about 1 atom, or 2 with hydrogens, per
+  // 10 Å³; the cube is ~12–30 Å³): refused rather than searched pair by pair.
+  if (grid.largestCell() > kMaxAtomsPerBondCell)
+    throw Error("bonds", std::to_string(grid.largestCell()) + " atoms in one cube of " +
+                             std::to_string(static_cast<int>(std::lround(reach * 10.0)) / 10) + "." +
+                             std::to_string(static_cast<int>(std::lround(reach * 10.0)) % 10) +
+                             " Å: packed denser than any molecule");
   std::vector<std::vector<std::uint32_t>> bondedTo(atoms.size());
   for (std::size_t i = 0; i < atoms.size(); ++i) {
     const double ri = covalent(i);
-    double query[3] = {atoms[i].position.x, atoms[i].position.y, atoms[i].position.z};
-    locator->FindPointsWithinRadius(ri + largest + kTolerance, query, around);
-    for (vtkIdType n = 0; n < around->GetNumberOfIds(); ++n) {
-      const auto j = static_cast<std::size_t>(around->GetId(n));
-      if (j <= i) continue;
-      const double d = glm::length(atoms[i].position - atoms[j].position);
+    grid.forEachWithin(atoms[i].position, ri + largest + kTolerance, [&](std::uint32_t j, double d2) {
+      if (j <= i) return;
+      const double d = std::sqrt(d2);
       if (d > kShortest && d < ri + covalent(j) + kTolerance) {
-        bondedTo[i].push_back(static_cast<std::uint32_t>(j));
+        bondedTo[i].push_back(j);
         bondedTo[j].push_back(static_cast<std::uint32_t>(i));
       }
-    }
+    });
   }
   // Clean-up, atom by atom in order: too many bonds, or two bonds closer than 45°, lose the longest
-  // (a hydrogen its bond to another hydrogen first).
+  // (a hydrogen its bond to another hydrogen first). The angle is looked at only once the count is
+  // within the element's maximum, so a crowded atom costs its bonds squared, not cubed.
   const auto length = [&](std::size_t a, std::size_t b) { return glm::length(atoms[a].position - atoms[b].position); };
   const auto unbond = [&](std::size_t a, std::uint32_t b) {
     std::erase(bondedTo[a], b);
@@ -657,8 +660,8 @@ std::vector<Bond> perceiveBonds(const std::vector<MoleculeAtom>& atoms) {
     return smallest;
   };
   for (std::size_t a = 0; a < atoms.size(); ++a) {
-    while (!bondedTo[a].empty() &&
-           (static_cast<int>(bondedTo[a].size()) > maxBonds(atoms[a].atomicNumber) || smallestAngle(a) < 45.0)) {
+    while (!bondedTo[a].empty() && (static_cast<int>(bondedTo[a].size()) > maxBonds(atoms[a].atomicNumber) ||
+                                    (bondedTo[a].size() >= 2 && smallestAngle(a) < 45.0))) {
       std::vector<std::uint32_t>& n = bondedTo[a];
       if (atoms[a].atomicNumber == 1) {
         const auto hh = std::find_if(n.begin(), n.end(), [&](std::uint32_t b) { return atoms[b].atomicNumber == 1; });

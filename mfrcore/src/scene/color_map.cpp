@@ -70,18 +70,6 @@ const std::vector<ColorMap>& maps() {
   return all;
 }
 
-// The smallest and largest finite value, if there is one.
-std::optional<glm::dvec2> finiteSpan(const std::vector<float>& values) {
-  double low = std::numeric_limits<double>::infinity(), high = -low;
-  for (const float v : values)
-    if (std::isfinite(v)) {
-      low = std::min(low, double(v));
-      high = std::max(high, double(v));
-    }
-  if (!(low <= high)) return std::nullopt;
-  return glm::dvec2(low, high);
-}
-
 std::string list(const std::vector<std::string>& names) {
   std::string out;
   for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
@@ -178,6 +166,17 @@ FieldValues fieldValues(const Mesh& mesh, const std::string& field, const std::s
     }
   }
   return out;
+}
+
+std::optional<glm::dvec2> finiteSpan(const std::vector<float>& values) {
+  double low = std::numeric_limits<double>::infinity(), high = -low;
+  for (const float v : values)
+    if (std::isfinite(v)) {
+      low = std::min(low, double(v));
+      high = std::max(high, double(v));
+    }
+  if (!(low <= high)) return std::nullopt;
+  return glm::dvec2(low, high);
 }
 
 glm::dvec2 fieldRange(const std::vector<float>& values) {

@@ -20,7 +20,6 @@
 #include <string>
 #include <thread>
 
-#include <vtkIdList.h>
 #include <vtkNew.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -29,18 +28,21 @@
 #include "mfr/error.hpp"
 #include "mfr/scene/contour.hpp"
 #include "mfr/scene/volume.hpp"
+#include "scene/point_grid.hpp"
 
 namespace mfr {
 namespace {
 
 constexpr const char* kWhat = "molecular surface";
+// More atoms than this within reach of one grown sphere is no molecule (a protein's have about 100).
+constexpr std::size_t kMaxNeighbours = 400;
 
 void check(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options) {
   if (!(options.probeRadius > 0.0 && std::isfinite(options.probeRadius)))
     throw Error(kWhat, "the probe radius must be positive and finite");
   if (!(options.spacing > 0.0 && std::isfinite(options.spacing)))
     throw Error(kWhat, "the grid spacing must be positive and finite");
-  if (options.maxGridPoints < 64) throw Error(kWhat, "at least 64 grid points are needed");
+  if (options.maxGridPoints < 512) throw Error(kWhat, "at least 512 grid points are needed");
   for (const SurfaceAtom& a : atoms) {
     if (!std::isfinite(a.centre.x) || !std::isfinite(a.centre.y) || !std::isfinite(a.centre.z))
       throw Error(kWhat, "an atom's centre is not finite");
@@ -63,11 +65,6 @@ void grownBounds(const std::vector<SurfaceAtom>& atoms, double probe, glm::dvec3
 glm::ivec3 gridDims(const glm::dvec3& lo, const glm::dvec3& hi, double h) {
   const glm::dvec3 n = glm::ceil((hi - lo) / h) + 5.0;
   return {static_cast<int>(n.x), static_cast<int>(n.y), static_cast<int>(n.z)};
-}
-
-double points(const glm::dvec3& lo, const glm::dvec3& hi, double h) {
-  const glm::dvec3 n = glm::ceil((hi - lo) / h) + 5.0;
-  return n.x * n.y * n.z;
 }
 
 // The mesh without its buried cavities. A cavity's surface is a closed component inside the
@@ -109,28 +106,109 @@ Mesh withoutCavities(const Mesh& mesh) {
   return out;
 }
 
+// Atoms whose grown spheres overlap, transitively: groups whose surfaces are independent (no probe
+// touches two of them), each drawn on a grid of its own — so that a stray ion does not coarsen the
+// grid of a chain, nor a part's far-apart ligands make one large, empty grid. Throws when atoms
+// are packed denser than any molecule (which would make the crease search quadratic).
+std::vector<std::vector<SurfaceAtom>> groupsOf(const std::vector<SurfaceAtom>& atoms, double probe) {
+  std::vector<glm::dvec3> centres;
+  double largest = 0.0;
+  for (const SurfaceAtom& a : atoms) {
+    centres.push_back(a.centre);
+    largest = std::max(largest, a.radius + probe);
+  }
+  const PointGrid grid(centres, 2.0 * largest);
+  std::vector<std::uint32_t> parent(atoms.size());
+  for (std::uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+  const auto root = [&](std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (std::size_t a = 0; a < atoms.size(); ++a) {
+    const double grown = atoms[a].radius + probe;
+    std::size_t near = 0;
+    grid.forEachWithin(atoms[a].centre, grown + largest, [&](std::uint32_t b, double d2) {
+      ++near;
+      const double reach = grown + atoms[b].radius + probe;
+      if (d2 < reach * reach) parent[root(b)] = root(static_cast<std::uint32_t>(a));
+    });
+    if (near > kMaxNeighbours)
+      throw Error(kWhat, std::to_string(near - 1) + " atoms within " +
+                             std::to_string(static_cast<int>(grown + largest)) +
+                             " Å of one: packed denser than any molecule (a protein's atoms have about 100)");
+  }
+  std::vector<std::vector<SurfaceAtom>> groups;
+  std::vector<std::size_t> groupOf(atoms.size(), SIZE_MAX);
+  for (std::size_t a = 0; a < atoms.size(); ++a) {
+    std::size_t& g = groupOf[root(static_cast<std::uint32_t>(a))];
+    if (g == SIZE_MAX) {
+      g = groups.size();
+      groups.emplace_back();
+    }
+    groups[g].push_back(atoms[a]);
+  }
+  return groups;
+}
+
+// The grid spacing of one group: options.spacing, or the smallest larger one whose grid fits in
+// options.maxGridPoints and VolumeGrid's points per axis. Throws when that is coarser than the
+// group's smallest atom (its surface would fall between the grid points).
+double groupSpacing(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options) {
+  glm::dvec3 lo, hi;
+  grownBounds(atoms, options.probeRadius, lo, hi);
+  const glm::dvec3 extent = hi - lo;
+  if (!std::isfinite(extent.x) || !std::isfinite(extent.y) || !std::isfinite(extent.z))
+    throw Error(kWhat, "the atoms' coordinates are too large");
+  const auto limit = static_cast<double>(options.maxGridPoints);
+  const auto perAxis = static_cast<double>(VolumeGrid::kMaxPointsPerAxis);
+  const auto fits = [&](double s) {
+    const glm::dvec3 n = glm::ceil(extent / s) + 5.0;
+    return n.x * n.y * n.z <= limit && std::max({n.x, n.y, n.z}) <= perAxis;
+  };
+  // From below by the closed forms (points ≥ Π extent/h, per axis ≥ extent/h + 5), then up by 5 %
+  // steps: a few at most, since the margin's share is small once it does not fit.
+  double h = std::max({options.spacing, std::cbrt(extent.x * extent.y * extent.z / limit),
+                       std::max({extent.x, extent.y, extent.z}) / (perAxis - 6.0)});
+  for (int step = 0; step < 1000 && !fits(h); ++step) h *= 1.05;
+  double smallest = std::numeric_limits<double>::infinity();
+  for (const SurfaceAtom& a : atoms) smallest = std::min(smallest, a.radius);
+  if (!fits(h) || h > smallest)
+    throw Error(kWhat, std::to_string(atoms.size()) + " overlapping atoms span " +
+                           std::to_string(static_cast<long long>(std::max({extent.x, extent.y, extent.z}))) +
+                           " Å: a grid of at most " + std::to_string(options.maxGridPoints) +
+                           " points would be coarser than their smallest atom");
+  return h;
+}
+
+Mesh groupSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options);
+
 }  // namespace
 
 double molecularSurfaceSpacing(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options) {
   check(atoms, options);
-  if (atoms.empty()) return options.spacing;
-  glm::dvec3 lo, hi;
-  grownBounds(atoms, options.probeRadius, lo, hi);
   double h = options.spacing;
-  const auto limit = static_cast<double>(options.maxGridPoints);
-  const auto perAxis = static_cast<double>(VolumeGrid::kMaxPointsPerAxis);
-  const auto fits = [&](double s) {
-    const glm::dvec3 n = glm::ceil((hi - lo) / s) + 5.0;
-    return points(lo, hi, s) <= limit && std::max({n.x, n.y, n.z}) <= perAxis;
-  };
-  while (!fits(h)) h *= 1.05;
+  for (const std::vector<SurfaceAtom>& group : groupsOf(atoms, options.probeRadius))
+    h = std::max(h, groupSpacing(group, options));
   return h;
 }
 
 Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options) {
   check(atoms, options);
-  if (atoms.empty()) return {};
-  const double h = molecularSurfaceSpacing(atoms, options);
+  Mesh out;
+  for (const std::vector<SurfaceAtom>& group : groupsOf(atoms, options.probeRadius)) {
+    const Mesh mesh = groupSurface(group, options);
+    const auto base = static_cast<std::uint32_t>(out.positions.size());
+    out.positions.insert(out.positions.end(), mesh.positions.begin(), mesh.positions.end());
+    out.normals.insert(out.normals.end(), mesh.normals.begin(), mesh.normals.end());
+    for (const std::uint32_t i : mesh.indices) out.indices.push_back(base + i);
+  }
+  return out;
+}
+
+namespace {
+
+Mesh groupSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options) {
+  const double h = groupSpacing(atoms, options);
   const double probe = options.probeRadius;
   glm::dvec3 lo, hi;
   grownBounds(atoms, probe, lo, hi);
@@ -195,26 +273,17 @@ Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const Molecul
   // Points on the circles where two grown spheres meet, where no third one covers them, every
   // h/2 along the circle. Any sphere that covers a point of atom a's circle has its centre within
   // R_a + R_max of a's.
-  vtkNew<vtkPoints> centres;
-  centres->SetDataTypeToDouble();
-  for (const SurfaceAtom& s : atoms) centres->InsertNextPoint(s.centre.x, s.centre.y, s.centre.z);
-  vtkNew<vtkPolyData> centreSet;
-  centreSet->SetPoints(centres);
-  vtkNew<vtkStaticPointLocator> atomLocator;
-  atomLocator->SetDataSet(centreSet);
-  atomLocator->BuildLocator();
-  vtkNew<vtkIdList> around;
+  std::vector<glm::dvec3> centres;
+  for (const SurfaceAtom& a : atoms) centres.push_back(a.centre);
+  const PointGrid atomGrid(centres, 2.0 * largest);
   std::vector<std::size_t> candidates;
   for (std::size_t a = 0; a < atoms.size(); ++a) {
     const glm::dvec3 ca = atoms[a].centre;
     const double ra = atoms[a].radius + probe;
-    double centre[3] = {ca.x, ca.y, ca.z};
-    atomLocator->FindPointsWithinRadius(ra + largest, centre, around);
     candidates.clear();
-    for (vtkIdType n = 0; n < around->GetNumberOfIds(); ++n) {
-      const auto b = static_cast<std::size_t>(around->GetId(n));
+    atomGrid.forEachWithin(ca, ra + largest, [&](std::uint32_t b, double) {
       if (b != a) candidates.push_back(b);
-    }
+    });
     for (const std::size_t b : candidates) {
       if (b < a) continue;  // each pair once
       const glm::dvec3 cb = atoms[b].centre;
@@ -272,10 +341,11 @@ Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const Molecul
           }
     };
     const int threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, dims.z);
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(slabs, dims.z * t / threads, dims.z * (t + 1) / threads);
-    slabs(0, dims.z / threads);
-    for (std::thread& thread : pool) thread.join();
+    {
+      std::vector<std::jthread> pool;  // joined when it goes, also if starting one throws
+      for (int t = 1; t < threads; ++t) pool.emplace_back(slabs, dims.z * t / threads, dims.z * (t + 1) / threads);
+      slabs(0, dims.z / threads);
+    }
   }
   depth = {};
   nearest = {};
@@ -288,5 +358,7 @@ Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const Molecul
   Mesh mesh = contourVolume(volume, 0.0);
   return options.cavities ? mesh : withoutCavities(mesh);
 }
+
+}  // namespace
 
 }  // namespace mfr

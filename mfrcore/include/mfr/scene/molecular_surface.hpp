@@ -24,7 +24,7 @@ struct SurfaceAtom {
 struct MolecularSurfaceOptions {
   double probeRadius = 1.4;  // water, as PyMOL's solvent_radius and every SES program
   double spacing = 0.3;      // grid spacing (Å): the surface is within a small fraction of it
-  // The most grid points one surface may use; a larger structure gets a coarser grid (spacing
+  // The most grid points one group of atoms may use; a larger group gets a coarser grid (spacing
   // grows until it fits), never a partial surface.
   std::size_t maxGridPoints = std::size_t{1} << 25;
   // Also the surfaces of buried cavities — pockets inside that a probe fits in but cannot reach
@@ -33,14 +33,18 @@ struct MolecularSurfaceOptions {
 };
 
 // The solvent-excluded surface of `atoms`, a closed mesh (one component per separate molecule, and
-// per buried cavity with options.cavities) whose normals point out of the excluded space and whose triangles wind
-// counter-clockwise seen from outside; positions and normals only (colours are the caller's). Empty for no atoms.
-// Throws mfr::Error for a non-finite centre, a radius that is not positive and finite, or options
-// out of range (probe radius not positive, spacing not positive).
+// per buried cavity with options.cavities) whose normals point out of the excluded space and whose
+// triangles wind counter-clockwise seen from outside; positions and normals only (colours are the
+// caller's). Atoms whose grown spheres (radius + probe) overlap, transitively, form a group; no
+// probe touches two groups, so each is computed on a grid of its own. Empty for no atoms. Throws
+// mfr::Error("molecular surface", reason) for a non-finite centre, a radius that is not positive and
+// finite, options out of range (probe radius or spacing not positive and finite, fewer than 512
+// grid points), atoms packed denser than any molecule (more than 400 within reach of one), or a
+// group so large that its grid would be coarser than its smallest atom.
 Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options = {});
 
-// The grid spacing solventExcludedSurface uses for `atoms`: options.spacing, or larger when the
-// grid would exceed options.maxGridPoints.
+// The coarsest grid spacing solventExcludedSurface uses for a group of `atoms`: options.spacing,
+// or larger where a group's grid would exceed options.maxGridPoints.
 double molecularSurfaceSpacing(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options = {});
 
 }  // namespace mfr
