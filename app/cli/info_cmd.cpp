@@ -60,13 +60,21 @@ void addInfo(CLI::App& app) {
     j["bounds"] = {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};
     j["views"] = scene.viewNames();
     // A molecule: its atoms and bonds as drawn (the first model, the first alternative locations).
+    // A file whose bonds cannot be found (atoms packed denser than any molecule) still loads as
+    // spheres: its line says why the bonds are not counted.
     std::optional<MoleculeStructure> molecule;
+    std::string bondsError;
     if (isMoleculeFile(opt->scene)) {
-      molecule = readMoleculeStructure(opt->scene);
-      j["molecule"] = {{"atoms", molecule->atoms.size()},
-                       {"bonds", molecule->bonds.size()},
-                       {"models", molecule->models},
-                       {"representations", opt->read.load().molecule.value_or(MoleculeStyle{}).text()}};
+      try {
+        molecule = readMoleculeStructure(opt->scene);
+        j["molecule"] = {{"atoms", molecule->atoms.size()},
+                         {"bonds", molecule->bonds.size()},
+                         {"models", molecule->models},
+                         {"representations", opt->read.load().molecule.value_or(MoleculeStyle{}).text()}};
+      } catch (const Error& e) {
+        bondsError = e.what();
+        j["molecule"] = {{"error", bondsError}};
+      }
     }
     if (sectioned) {
       const SectionPlane& plane = *scene.section;
@@ -117,6 +125,7 @@ void addInfo(CLI::App& app) {
               << b.max.x << ", " << b.max.y << ", " << b.max.z << "]\nviews     ";
     for (const std::string& v : scene.viewNames()) std::cout << " " << v;
     std::cout << "\n";
+    if (!bondsError.empty()) std::cout << "molecule   atoms and bonds not counted: " << bondsError << "\n";
     if (molecule)
       std::cout << "molecule   " << molecule->atoms.size() << " atoms, " << molecule->bonds.size() << " bonds"
                 << (molecule->models > 1 ? " (model 1 of " + std::to_string(molecule->models) + ")" : std::string())

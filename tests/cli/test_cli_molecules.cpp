@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -131,6 +132,23 @@ TEST_F(CliMoleculeRefusals, BadRepresentationOrNotAMolecule) {
   EXPECT_NE(info.out.find("@sample: a molecule representation (sticks) can be chosen only for a molecule file"),
             std::string::npos)
       << info.out;
+  // Atoms piled up at one point: spheres still load, info says why it counts no bonds, sticks are
+  // refused (a surface is drawn: the pile's is one sphere).
+  std::string pile;
+  for (int i = 1; i <= 100; ++i) {
+    char line[96];
+    std::snprintf(line, sizeof line, "HETATM%5d  C   LIG A   1       1.000   2.000   3.000  1.00 20.00           C  \n",
+                  i);
+    pile += line;
+  }
+  const fs::path piled = write("pile.pdb", pile + "END\n");
+  const CliResult pileInfo = runCli("info " + piled.string() + " --no-histogram");
+  EXPECT_EQ(pileInfo.exitCode, 0) << pileInfo.out;
+  EXPECT_NE(pileInfo.out.find("molecule   atoms and bonds not counted: " + piled.string() +
+                              ": bonds: 100 atoms in one cube of 1.9 Å: packed denser than any molecule"),
+            std::string::npos)
+      << pileInfo.out;
+  expectCleanFailure("render " + piled.string() + " --molecule sticks", "packed denser than any molecule");
   // probe and bench read it too.
   const CliResult probe = runCli("probe " + kPept.string() + " --molecule sticks --size 64x48 --pixel 32,24");
   EXPECT_EQ(probe.exitCode, 0) << probe.out;

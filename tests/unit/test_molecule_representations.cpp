@@ -222,11 +222,18 @@ TEST(MoleculeStyleNames, ParseAndText) {
             "--molecule cartoon: unknown representation 'cartoon': expected spheres, sticks, "
             "ball-and-stick or surface, or several joined by ',' (surface,sticks)");
   EXPECT_EQ(reason(""),
-            "--molecule : expected spheres, sticks, ball-and-stick or surface, or several joined by ',' "
+            "--molecule: expected spheres, sticks, ball-and-stick or surface, or several joined by ',' "
             "(surface,sticks)");
   EXPECT_EQ(reason("sticks,"),
             "--molecule sticks,: expected spheres, sticks, ball-and-stick or surface, or several "
             "joined by ',' (surface,sticks)");
+  // Whatever was typed, the message is one short line.
+  const std::string multiLine = reason("surface\nsticks");
+  EXPECT_EQ(multiLine.find('\n'), std::string::npos) << multiLine;
+  EXPECT_EQ(multiLine,
+            "--molecule surface sticks: unknown representation 'surface sticks': expected spheres, "
+            "sticks, ball-and-stick or surface, or several joined by ',' (surface,sticks)");
+  EXPECT_LT(reason(std::string(100'000, 'x')).size(), 300u);
 }
 
 TEST_F(MoleculeStyles, OnlyForMoleculeFiles) {
@@ -249,6 +256,10 @@ TEST_F(MoleculeStyles, OnlyForMoleculeFiles) {
               "objects[0].molecule: unknown representation 'ribbon': expected spheres, sticks, ball-and-stick or "
               "surface, or several joined by ',' (surface,sticks)",
               [&] { (void)loadScene(bad); });
+  const auto primitive =
+      write("pr.mfrscene", R"({"objects": [{"primitive": {"type": "sphere", "radius": 1}, "molecule": "sticks"}]})");
+  expectFails(primitive, "objects[0].molecule: only a molecule file (.pdb .ent .cif .mmcif) has representations",
+              [&] { (void)loadScene(primitive); });
   const auto notMolecule = write("nm.mfrscene", R"({"objects": [{"file": "part.stl", "molecule": "sticks"}]})");
   expectFails(notMolecule, "objects[0].molecule: only a molecule file (.pdb .ent .cif .mmcif) has representations",
               [&] { (void)loadScene(notMolecule); });

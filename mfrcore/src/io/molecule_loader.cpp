@@ -1,5 +1,7 @@
 #include "molecule_loader.hpp"
 
+#include "file_checks.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -691,6 +693,12 @@ std::string MoleculeStyle::text() const {
 }
 
 MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& what) {
+  // Messages quote the option and the name as one short line, whatever was typed.
+  const auto quoted = [](const std::string& s) {
+    std::string line = io::oneLine(s);
+    if (line.size() > 48) line = line.substr(0, 45) + "...";
+    return line;
+  };
   MoleculeStyle style;
   style.spheres = false;
   bool any = false;
@@ -709,12 +717,13 @@ MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& w
     else if (item == "surface")
       style.surface = true;
     else
-      throw Error(what, (item.empty() ? std::string("expected") : "unknown representation '" + item + "': expected") +
-                            " spheres, sticks, ball-and-stick or surface, or several joined by ',' (surface,sticks)");
+      throw Error(quoted(what),
+                  (item.empty() ? std::string("expected") : "unknown representation '" + quoted(item) + "': expected") +
+                      " spheres, sticks, ball-and-stick or surface, or several joined by ',' (surface,sticks)");
     any = true;
     item.clear();
   }
-  if (!any) throw Error(what, "expected spheres, sticks, ball-and-stick or surface");
+  if (!any) throw Error(quoted(what), "expected spheres, sticks, ball-and-stick or surface");
   return style;
 }
 

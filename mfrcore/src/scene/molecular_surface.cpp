@@ -340,7 +340,10 @@ Mesh groupSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceO
             grid->values[n] = f;
           }
     };
-    const int threads = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, dims.z);
+    // Threads only where they pay: a lone ion's grid is done before they would have started.
+    const int threads = depth.size() < (std::size_t{1} << 20)
+                            ? 1
+                            : std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, dims.z);
     {
       std::vector<std::jthread> pool;  // joined when it goes, also if starting one throws
       for (int t = 1; t < threads; ++t) pool.emplace_back(slabs, dims.z * t / threads, dims.z * (t + 1) / threads);

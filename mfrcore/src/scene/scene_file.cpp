@@ -499,6 +499,8 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
       const bool visible = r.flag(o, "visible", where, true);
       if (o.contains("file") == o.contains("primitive")) r.fail(where, "needs exactly one of 'file' or 'primitive'");
       if (o.contains("primitive")) {
+        if (o.contains("molecule"))
+          r.fail(where + ".molecule", "only a molecule file (.pdb .ent .cif .mmcif) has representations");
         Object obj;
         obj.name = objName;
         try {
