@@ -67,21 +67,33 @@ glm::ivec3 gridDims(const glm::dvec3& lo, const glm::dvec3& hi, double h) {
   return {static_cast<int>(n.x), static_cast<int>(n.y), static_cast<int>(n.z)};
 }
 
+// Union-find over indices 0 … n − 1, with path halving: the connected components of a mesh, and
+// the groups of overlapping atoms.
+class DisjointSets {
+ public:
+  explicit DisjointSets(std::size_t n) : parent_(n) {
+    for (std::uint32_t i = 0; i < parent_.size(); ++i) parent_[i] = i;
+  }
+  std::uint32_t root(std::uint32_t x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  void join(std::uint32_t a, std::uint32_t b) { parent_[root(b)] = root(a); }
+
+ private:
+  std::vector<std::uint32_t> parent_;
+};
+
 // The mesh without its buried cavities. A cavity's surface is a closed component inside the
 // molecule's whose normals point into the cavity (out of the excluded space around it), so the
 // volume it encloses by its winding is negative; the outer surface of each molecule encloses a
 // positive one.
 Mesh withoutCavities(const Mesh& mesh) {
-  std::vector<std::uint32_t> parent(mesh.positions.size());
-  for (std::uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
-  const auto root = [&](std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  DisjointSets sets(mesh.positions.size());
+  const auto root = [&](std::uint32_t x) { return sets.root(x); };
   for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
-    const std::uint32_t a = root(mesh.indices[t]);
-    parent[root(mesh.indices[t + 1])] = a;
-    parent[root(mesh.indices[t + 2])] = a;
+    sets.join(mesh.indices[t], mesh.indices[t + 1]);
+    sets.join(mesh.indices[t], mesh.indices[t + 2]);
   }
   std::vector<double> volume(mesh.positions.size(), 0.0);  // per component, at its root
   for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
@@ -118,19 +130,14 @@ std::vector<std::vector<SurfaceAtom>> groupsOf(const std::vector<SurfaceAtom>& a
     largest = std::max(largest, a.radius + probe);
   }
   const PointGrid grid(centres, 2.0 * largest);
-  std::vector<std::uint32_t> parent(atoms.size());
-  for (std::uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
-  const auto root = [&](std::uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
+  DisjointSets sets(atoms.size());
   for (std::size_t a = 0; a < atoms.size(); ++a) {
     const double grown = atoms[a].radius + probe;
     std::size_t near = 0;
     grid.forEachWithin(atoms[a].centre, grown + largest, [&](std::uint32_t b, double d2) {
       ++near;
       const double reach = grown + atoms[b].radius + probe;
-      if (d2 < reach * reach) parent[root(b)] = root(static_cast<std::uint32_t>(a));
+      if (d2 < reach * reach) sets.join(static_cast<std::uint32_t>(a), b);
     });
     if (near > kMaxNeighbours)
       throw Error(kWhat, std::to_string(near - 1) + " atoms within " +
@@ -140,7 +147,7 @@ std::vector<std::vector<SurfaceAtom>> groupsOf(const std::vector<SurfaceAtom>& a
   std::vector<std::vector<SurfaceAtom>> groups;
   std::vector<std::size_t> groupOf(atoms.size(), SIZE_MAX);
   for (std::size_t a = 0; a < atoms.size(); ++a) {
-    std::size_t& g = groupOf[root(static_cast<std::uint32_t>(a))];
+    std::size_t& g = groupOf[sets.root(static_cast<std::uint32_t>(a))];
     if (g == SIZE_MAX) {
       g = groups.size();
       groups.emplace_back();
