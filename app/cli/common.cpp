@@ -39,8 +39,9 @@ void ReadOptions::add(CLI::App* cmd) {
                   "Volume file: the point-data array (.vti, .vtk) or grid (.vdb) to read instead of the default "
                   "(see mfr info for the file's fields)");
   cmd->add_option("--molecule", molecule,
-                  "Molecule file (.pdb, .cif): how to draw it — spheres (default), sticks, ball-and-stick, surface "
-                  "(solvent-excluded, per chain), or several joined by ',' (surface,sticks)");
+                  "Molecule file (.pdb, .cif): how to draw it — spheres (default), sticks, ball-and-stick, cartoon "
+                  "(helices, strands, loops), surface (solvent-excluded, per chain), or several joined by ',' "
+                  "(surface,sticks)");
 }
 
 LoadOptions ReadOptions::load() const {

@@ -71,6 +71,19 @@ void addInfo(CLI::App& app) {
                          {"bonds", molecule->bonds.size()},
                          {"models", molecule->models},
                          {"representations", opt->read.load().molecule.value_or(MoleculeStyle{}).text()}};
+        // Secondary structure, as the cartoon draws it: per chain one letter per residue (H helix,
+        // E strand, - loop), in file order.
+        std::vector<std::string> letters(molecule->parts.size());
+        for (const BackboneResidue& r : molecule->residues)
+          letters[r.part] += r.structure == SecondaryStructure::Helix    ? 'H'
+                             : r.structure == SecondaryStructure::Strand ? 'E'
+                                                                         : '-';
+        nlohmann::ordered_json chains = nlohmann::ordered_json::object();
+        for (std::size_t p = 0; p < letters.size(); ++p)
+          if (!letters[p].empty()) chains[molecule->parts[p]] = letters[p];
+        if (!molecule->residues.empty())
+          j["molecule"]["secondary_structure"] = {{"source", molecule->secondaryStructureFromFile ? "file" : "dssp"},
+                                                  {"chains", chains}};
       } catch (const Error& e) {
         bondsError = e.what();
         j["molecule"] = {{"error", bondsError}};
@@ -130,6 +143,17 @@ void addInfo(CLI::App& app) {
       std::cout << "molecule   " << molecule->atoms.size() << " atoms, " << molecule->bonds.size() << " bonds"
                 << (molecule->models > 1 ? " (model 1 of " + std::to_string(molecule->models) + ")" : std::string())
                 << "; drawn as " << opt->read.load().molecule.value_or(MoleculeStyle{}).text() << "\n";
+    if (molecule && !molecule->residues.empty()) {
+      std::size_t helix = 0, strand = 0;
+      for (const BackboneResidue& r : molecule->residues) {
+        helix += r.structure == SecondaryStructure::Helix ? 1 : 0;
+        strand += r.structure == SecondaryStructure::Strand ? 1 : 0;
+      }
+      std::cout << "           " << molecule->residues.size() << " polymer residues: " << helix << " helix, " << strand
+                << " strand ("
+                << (molecule->secondaryStructureFromFile ? "the file's HELIX/SHEET records" : "DSSP, from the backbone")
+                << ")\n";
+    }
     if (sectioned) {
       const SectionPlane& plane = *scene.section;
       std::cout << "section    point " << plane.point.x << " " << plane.point.y << " " << plane.point.z << ", normal "

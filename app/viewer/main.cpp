@@ -80,7 +80,7 @@ CommandLine parseCommandLine(const QApplication& app) {
   const QCommandLineOption molecule(
       QStringLiteral("molecule"),
       QStringLiteral(
-          "Molecule file (.pdb, .cif): spheres (default), sticks, ball-and-stick, surface, or several joined "
+          "Molecule file (.pdb, .cif): spheres (default), sticks, ball-and-stick, cartoon, surface, or several joined "
           "by ',' (as mfr render; the Scene panel's Molecule row)."),
       QStringLiteral("representations"));
   const QCommandLineOption colorBy(

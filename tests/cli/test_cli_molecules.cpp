@@ -97,12 +97,20 @@ TEST_F(CliMolecules, InfoCountsAtomsAndBonds) {
   EXPECT_EQ(j.at("molecule").at("bonds"), 112);
   EXPECT_EQ(j.at("molecule").at("representations"), "sticks,surface");
   EXPECT_EQ(j.at("part_list").at(1).at("closed"), true);  // the surface
+  // The β-hairpin's secondary structure by DSSP (no HELIX/SHEET records): mkdssp's 9 strand
+  // residues of 13 (tests/data SecondaryStructureAsMkdssp compares them residue by residue).
+  EXPECT_NE(r.out.find("13 polymer residues: 0 helix, 9 strand (DSSP, from the backbone)"), std::string::npos) << r.out;
+  const nlohmann::json& ss = j.at("molecule").at("secondary_structure");
+  EXPECT_EQ(ss.at("source"), "dssp");
+  const std::string letters = ss.at("chains").at("chain E");
+  EXPECT_EQ(letters.size(), 13u);
+  EXPECT_EQ(std::count(letters.begin(), letters.end(), 'E'), 9);
 }
 
 // Every representation reaches a GPU method as it reaches the oracle, and each draws differently.
 TEST_F(CliMolecules, RepresentationsGpuAndOracleAgree) {
   std::vector<mfr::ImageRGBA8> oracles;
-  for (const std::string style : {"spheres", "sticks", "ball-and-stick", "surface,sticks"}) {
+  for (const std::string style : {"spheres", "sticks", "ball-and-stick", "surface,sticks", "cartoon"}) {
     SCOPED_TRACE(style);
     const fs::path a = dir() / "oracle.png", b = dir() / "gpu.png";
     const std::string common = "render " + kPept.string() + " --molecule " + style + " --size 64x48 --view iso ";
@@ -123,8 +131,8 @@ TEST_F(CliMolecules, RepresentationsGpuAndOracleAgree) {
 class CliMoleculeRefusals : public mfr::test::CliTest {};
 
 TEST_F(CliMoleculeRefusals, BadRepresentationOrNotAMolecule) {
-  expectCleanFailure("render " + kPept.string() + " --molecule cartoon",
-                     "--molecule cartoon: unknown representation 'cartoon'");
+  expectCleanFailure("render " + kPept.string() + " --molecule ribbon",
+                     "--molecule ribbon: unknown representation 'ribbon'");
   expectCleanFailure("render " + kPept.string() + " --molecule ,", "--molecule ,: expected spheres");
   expectCleanFailure("render @sample --molecule sticks", "can be chosen only for a molecule file");
   const CliResult info = runCli("info @sample --molecule sticks");

@@ -198,10 +198,15 @@ TEST_F(MoleculeStyles, SurfaceOfEachPartButWaterClosedAndColouredByTheNearestAto
   EXPECT_EQ(surface.fields[0].values.size(), surface.positions.size());
 }
 
-TEST_F(MoleculeStyles, OnlyWaterHasNoSurface) {
+TEST_F(MoleculeStyles, OnlyWaterHasNoSurfaceAndNoCartoon) {
   const auto water = write("water.pdb", record("HETATM", 1, " O  ", "HOH", 'A', 1, {0, 0, 0}, "O") + "END\n");
   expectFails(water, "nothing to draw as surface (only water, which has no surface)",
               [&] { (void)loadModel(water, LoadOptions({}, MoleculeStyle::parse("surface", "t"))); });
+  expectFails(water,
+              "nothing to draw as cartoon,surface (no run of two polymer residues with Cα or P atoms for a cartoon; "
+              "only water, "
+              "which has no surface)",
+              [&] { (void)loadModel(water, LoadOptions({}, MoleculeStyle::parse("cartoon,surface", "t"))); });
 }
 
 // ---- naming, and where a style may be given -------------------------------------------------------
@@ -218,21 +223,22 @@ TEST(MoleculeStyleNames, ParseAndText) {
     }
     return std::string("no error");
   };
-  EXPECT_EQ(reason("cartoon"),
-            "--molecule cartoon: unknown representation 'cartoon': expected spheres, sticks, "
-            "ball-and-stick or surface, or several joined by ',' (surface,sticks)");
+  EXPECT_EQ(MoleculeStyle::parse("surface,cartoon,sticks", "x").text(), "sticks,cartoon,surface");
+  EXPECT_EQ(reason("ribbon"),
+            "--molecule ribbon: unknown representation 'ribbon': expected spheres, sticks, "
+            "ball-and-stick, cartoon or surface, or several joined by ',' (surface,sticks)");
   EXPECT_EQ(reason(""),
-            "--molecule: expected spheres, sticks, ball-and-stick or surface, or several joined by ',' "
+            "--molecule: expected spheres, sticks, ball-and-stick, cartoon or surface, or several joined by ',' "
             "(surface,sticks)");
   EXPECT_EQ(reason("sticks,"),
-            "--molecule sticks,: expected spheres, sticks, ball-and-stick or surface, or several "
+            "--molecule sticks,: expected spheres, sticks, ball-and-stick, cartoon or surface, or several "
             "joined by ',' (surface,sticks)");
   // Whatever was typed, the message is one short line.
   const std::string multiLine = reason("surface\nsticks");
   EXPECT_EQ(multiLine.find('\n'), std::string::npos) << multiLine;
   EXPECT_EQ(multiLine,
             "--molecule surface sticks: unknown representation 'surface sticks': expected spheres, "
-            "sticks, ball-and-stick or surface, or several joined by ',' (surface,sticks)");
+            "sticks, ball-and-stick, cartoon or surface, or several joined by ',' (surface,sticks)");
   EXPECT_LT(reason(std::string(100'000, 'x')).size(), 300u);
 }
 
@@ -253,8 +259,8 @@ TEST_F(MoleculeStyles, OnlyForMoleculeFiles) {
   EXPECT_EQ(loadScene(own).objects[0].mesh->triangleCount(), 5u * 320u + 2u * 4u * 32u);
   const auto bad = write("bad.mfrscene", R"({"objects": [{"file": "small.pdb", "molecule": "ribbon"}]})");
   expectFails(bad,
-              "objects[0].molecule: unknown representation 'ribbon': expected spheres, sticks, ball-and-stick or "
-              "surface, or several joined by ',' (surface,sticks)",
+              "objects[0].molecule: unknown representation 'ribbon': expected spheres, sticks, ball-and-stick, "
+              "cartoon or surface, or several joined by ',' (surface,sticks)",
               [&] { (void)loadScene(bad); });
   const auto primitive =
       write("pr.mfrscene", R"({"objects": [{"primitive": {"type": "sphere", "radius": 1}, "molecule": "sticks"}]})");

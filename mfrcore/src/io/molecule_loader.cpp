@@ -9,8 +9,9 @@
 #include <cstdint>
 #include <limits>
 #include <map>
-#include <numbers>
 #include <memory>
+#include <numbers>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
@@ -25,6 +26,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/io/molecule.hpp"
+#include "mfr/scene/cartoon.hpp"
 #include "mfr/scene/molecular_surface.hpp"
 #include "scene/point_grid.hpp"
 
@@ -236,6 +238,10 @@ struct Part {
   std::string name;
   std::vector<Atom> atoms;
   bool water = false;
+  // A polymer chain's residues in file order, and the trace atom (Cα, P) of each that has one:
+  // its fields are the cartoon's.
+  std::vector<BackboneResidue> residues;
+  std::vector<std::optional<Atom>> traceAtoms;
 };
 
 // The atoms of the first model sorted into parts: polymer chains by name in order of appearance,
@@ -244,12 +250,15 @@ struct Part {
 std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
   std::vector<Part> chains;
   std::map<std::string, std::size_t> chainIndex;
-  Part ligands{"ligands", {}, false}, water{"water", {}, true};
+  Part ligands{"ligands", {}, false, {}, {}}, water{"water", {}, true, {}, {}};
   std::map<std::pair<std::string, gemmi::SeqId>, char> firstAltloc;
   std::size_t total = 0;
   for (const gemmi::Chain& chain : model.chains) {
     for (const gemmi::Residue& residue : chain.residues) {
       char& chosen = firstAltloc[{chain.name, residue.seqid}];
+      BackboneResidue backbone;
+      std::optional<Atom> trace;
+      Part* polymer = nullptr;
       for (const gemmi::Atom& atom : residue.atoms) {
         if (atom.altloc != '\0') {
           if (chosen == '\0') chosen = atom.altloc;
@@ -269,7 +278,8 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
         Part* part = nullptr;
         if (residue.entity_type == gemmi::EntityType::Polymer) {
           const auto [it, isNew] = chainIndex.try_emplace(chain.name, chains.size());
-          if (isNew) chains.push_back({chain.name.empty() ? "chain (blank)" : "chain " + chain.name, {}, false});
+          if (isNew)
+            chains.push_back({chain.name.empty() ? "chain (blank)" : "chain " + chain.name, {}, false, {}, {}});
           part = &chains[it->second];
         } else {
           part = residue.entity_type == gemmi::EntityType::Water ? &water : &ligands;
@@ -277,6 +287,30 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
         const float number = residue.seqid.num.has_value() ? static_cast<float>(*residue.seqid.num)
                                                            : std::numeric_limits<float>::quiet_NaN();
         part->atoms.push_back({p, atom.element.elem, atom.b_iso, atom.occ, number, atom.serial});
+        if (residue.entity_type != gemmi::EntityType::Polymer) continue;
+        polymer = part;
+        // The backbone atoms by name: PDB's and mmCIF's (label_atom_id) are the same.
+        const bool carbon = atom.element.elem == gemmi::El::C;
+        if (atom.name == "N" && atom.element.elem == gemmi::El::N && !backbone.n) backbone.n = p;
+        if (atom.name == "CA" && carbon && !backbone.ca) {
+          backbone.ca = p;
+          trace = part->atoms.back();
+        }
+        if (atom.name == "C" && carbon && !backbone.c) backbone.c = p;
+        if (atom.name == "O" && atom.element.elem == gemmi::El::O && !backbone.o) backbone.o = p;
+        if (atom.name == "P" && atom.element.elem == gemmi::El::P && !backbone.phosphorus) {
+          backbone.phosphorus = p;
+          if (!backbone.ca) trace = part->atoms.back();
+        }
+      }
+      if (polymer != nullptr) {
+        backbone.part = static_cast<std::size_t>(polymer - chains.data());
+        backbone.chain = chain.name;
+        backbone.number = residue.seqid.num.has_value() ? *residue.seqid.num : 0;
+        backbone.insertion = residue.seqid.icode;
+        backbone.name = residue.name;
+        polymer->residues.push_back(std::move(backbone));
+        polymer->traceAtoms.push_back(trace);
       }
     }
   }
@@ -286,10 +320,54 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
 }
 
 // The structure's first model, parsed, checked and sorted into parts.
+// A helix or strand as the file records it: a range of residues in one chain.
+struct RecordedRange {
+  std::string chain;
+  gemmi::SeqId first, last;
+  SecondaryStructure structure;
+};
+
 struct Parsed {
   std::vector<Part> parts;
   std::size_t models = 1;
+  std::vector<RecordedRange> recorded;  // the file's HELIX/SHEET (mmCIF struct_conf/sheet_range)
 };
+
+// Each polymer residue's secondary structure: the file's records when it has any (every helix
+// class counts as helix, as PyMOL reads them), otherwise DSSP's over the whole model (sheets join
+// chains). Returns whether the records were used.
+bool assignStructure(Parsed& parsed, const std::string& name) {
+  std::vector<BackboneResidue*> all;
+  for (Part& part : parsed.parts)
+    for (BackboneResidue& r : part.residues) all.push_back(&r);
+  if (!parsed.recorded.empty()) {
+    for (const RecordedRange& range : parsed.recorded) {
+      // The residues from `first` to `last` in file order within the chain (insertion codes and
+      // numbering gaps as they come).
+      bool inside = false;
+      for (BackboneResidue* r : all) {
+        if (r->chain != range.chain) continue;
+        const gemmi::SeqId id(r->number, r->insertion);
+        if (id == range.first) inside = true;
+        if (inside && (r->structure == SecondaryStructure::Loop || range.structure == SecondaryStructure::Helix))
+          r->structure = range.structure;
+        if (id == range.last) inside = false;
+      }
+    }
+    return true;
+  }
+  std::vector<BackboneResidue> copy;
+  copy.reserve(all.size());
+  for (const BackboneResidue* r : all) copy.push_back(*r);
+  std::vector<SecondaryStructure> ss;
+  try {
+    ss = mfr::assignSecondaryStructure(copy);
+  } catch (const Error& e) {
+    throw Error(name, e.what());
+  }
+  for (std::size_t i = 0; i < all.size(); ++i) all[i]->structure = ss[i];
+  return false;
+}
 
 Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const std::string& name,
                      const LoadProgress& progress) {
@@ -319,7 +397,14 @@ Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const s
   } catch (const std::exception& e) {
     throw Error(name, reason(e.what(), name));
   }
-  Parsed parsed{partsOf(st.models[0], name), models};
+  Parsed parsed{partsOf(st.models[0], name), models, {}};
+  for (const gemmi::Helix& h : st.helices)
+    parsed.recorded.push_back(
+        {h.start.chain_name, h.start.res_id.seqid, h.end.res_id.seqid, SecondaryStructure::Helix});
+  for (const gemmi::Sheet& sheet : st.sheets)
+    for (const gemmi::Sheet::Strand& strand : sheet.strands)
+      parsed.recorded.push_back(
+          {strand.start.chain_name, strand.start.res_id.seqid, strand.end.res_id.seqid, SecondaryStructure::Strand});
   progress.step(0.55);
   return parsed;
 }
@@ -331,9 +416,11 @@ int atomicNumber(gemmi::El element) {
 MoleculeStructure structureOf(const Parsed& parsed, const std::string& name) {
   MoleculeStructure out;
   out.models = parsed.models;
+  out.secondaryStructureFromFile = !parsed.recorded.empty();
   for (std::size_t p = 0; p < parsed.parts.size(); ++p) {
     out.parts.push_back(parsed.parts[p].name);
     for (const Atom& a : parsed.parts[p].atoms) out.atoms.push_back({a.serial, atomicNumber(a.element), a.position, p});
+    out.residues.insert(out.residues.end(), parsed.parts[p].residues.begin(), parsed.parts[p].residues.end());
   }
   try {
     out.bonds = perceiveBonds(out.atoms);
@@ -431,6 +518,60 @@ Mesh sticksMesh(const Part& part, std::size_t firstAtom, const std::vector<Atom*
   return b.take();
 }
 
+// PyMOL's colours by secondary structure (util.cbss): helix red, strand yellow, loop green.
+glm::vec4 structureColor(SecondaryStructure s) {
+  switch (s) {
+    case SecondaryStructure::Helix:
+      return {1.0f, 0.0f, 0.0f, 1.0f};
+    case SecondaryStructure::Strand:
+      return {1.0f, 1.0f, 0.0f, 1.0f};
+    case SecondaryStructure::Loop:
+      break;
+  }
+  return {0.0f, 1.0f, 0.0f, 1.0f};
+}
+
+// Consecutive traces farther apart than this belong to different runs (missing residues): Cα–Cα
+// is 3.8 Å (2.9 Å in a cis peptide), P–P in a nucleic acid's backbone about 6–7.5 Å.
+constexpr double kMaxCaStep = 4.5;
+constexpr double kMaxPhosphorusStep = 8.0;
+
+// The chain's cartoon (cartoonMesh): runs of residues with a trace atom, split where the chain is
+// broken; protein residues coloured by secondary structure, nucleotides by their P's element
+// colour; the trace atoms' fields. As finely sampled as keeps `residues` within the triangle cap.
+Mesh cartoonOf(const Part& part, std::size_t residues) {
+  CartoonOptions options;
+  options.fieldNames = {"b_factor", "occupancy", "residue"};
+  for (const auto& [samples, sides] : {std::pair{8, 16}, std::pair{6, 12}, std::pair{4, 8}}) {
+    options.samplesPerResidue = samples;
+    options.sides = sides;
+    if (residues * static_cast<std::size_t>(2 * samples * sides) <= kMoleculeTriangleCap) break;
+  }
+  std::vector<std::vector<CartoonResidue>> segments(1);
+  const BackboneResidue* previous = nullptr;
+  for (std::size_t i = 0; i < part.residues.size(); ++i) {
+    const BackboneResidue& r = part.residues[i];
+    const std::optional<Atom>& atom = part.traceAtoms[i];
+    if (!atom) continue;
+    const bool amino = r.ca.has_value();
+    CartoonResidue c;
+    c.trace = atom->position;
+    if (r.c && r.o) c.guide = *r.o - *r.c;
+    c.structure = r.structure;
+    c.color = amino ? structureColor(r.structure) : elementColor(atom->element);
+    c.values = {atom->bFactor, atom->occupancy, atom->residue};
+    if (previous != nullptr) {
+      const bool previousAmino = previous->ca.has_value();
+      const double step = glm::distance(segments.back().back().trace, c.trace);
+      if (previous->chain != r.chain || amino != previousAmino || step > (amino ? kMaxCaStep : kMaxPhosphorusStep))
+        segments.emplace_back();
+    }
+    segments.back().push_back(std::move(c));
+    previous = &r;
+  }
+  return cartoonMesh(segments, options);
+}
+
 // The part's solvent-excluded surface, each vertex coloured (and given the fields) of the atom
 // whose van der Waals sphere is nearest to it, as PyMOL colours a surface. Its errors name the
 // file and the part.
@@ -484,7 +625,9 @@ int sphereSubdivisionLevel(std::size_t atoms) {
 }
 
 MoleculeStructure readMoleculeStructure(const std::string& contents, MoleculeFormat format, const std::string& name) {
-  return structureOf(parseMolecule(contents, format, name, {}), name);
+  Parsed parsed = parseMolecule(contents, format, name, {});
+  assignStructure(parsed, name);
+  return structureOf(parsed, name);
 }
 
 std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat format, const std::string& name,
@@ -519,7 +662,13 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
   // NMR ensembles: say which model is shown, in every part's name (the scene tree shows it).
   const std::string modelNote = parsed.models > 1 ? " (model 1 of " + std::to_string(parsed.models) + ")" : "";
   const int representations = static_cast<int>(style.spheres) + static_cast<int>(style.ballAndStick) +
-                              static_cast<int>(style.sticks) + static_cast<int>(style.surface);
+                              static_cast<int>(style.sticks) + static_cast<int>(style.cartoon) +
+                              static_cast<int>(style.surface);
+  std::size_t residues = 0;
+  if (style.cartoon) {
+    assignStructure(parsed, name);
+    for (const Part& part : parts) residues += part.residues.size();
+  }
   std::vector<Object> objects;
   const auto add = [&](const Part& part, const char* representation, Mesh mesh) {
     if (mesh.indices.empty()) return;
@@ -538,11 +687,18 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
           sticksMesh(part, firstAtom[i], all, bondedTo, kBallAndStickRadius, kBallScale, unit, tubeSides(level)));
     if (style.sticks)
       add(part, "sticks", sticksMesh(part, firstAtom[i], all, bondedTo, kStickRadius, 0.0, unit, tubeSides(level)));
+    if (style.cartoon && !part.residues.empty()) add(part, "cartoon", cartoonOf(part, residues));
     // Water has no surface of its own (PyMOL leaves solvent out of surfaces too).
     if (style.surface && !part.water) add(part, "surface", surfaceMesh(part, name));
     progress.step(0.6 + 0.4 * static_cast<double>(i + 1) / static_cast<double>(parts.size()));
   }
-  if (objects.empty()) throw Error(name, "nothing to draw as " + style.text() + " (only water, which has no surface)");
+  if (objects.empty()) {
+    // Only cartoons and surfaces can come out empty: say why for each asked for.
+    std::string why;
+    if (style.cartoon) why = "no run of two polymer residues with Cα or P atoms for a cartoon";
+    if (style.surface) why += std::string(why.empty() ? "" : "; ") + "only water, which has no surface";
+    throw Error(name, "nothing to draw as " + style.text() + " (" + why + ")");
+  }
   return objects;
 }
 
@@ -686,8 +842,9 @@ std::vector<Bond> perceiveBonds(const std::vector<MoleculeAtom>& atoms) {
 
 std::string MoleculeStyle::text() const {
   std::string out;
-  for (const auto& [on, name] : {std::pair{spheres, "spheres"}, std::pair{ballAndStick, "ball-and-stick"},
-                                 std::pair{sticks, "sticks"}, std::pair{surface, "surface"}})
+  for (const auto& [on, name] :
+       {std::pair{spheres, "spheres"}, std::pair{ballAndStick, "ball-and-stick"}, std::pair{sticks, "sticks"},
+        std::pair{cartoon, "cartoon"}, std::pair{surface, "surface"}})
     if (on) out += (out.empty() ? "" : ",") + std::string(name);
   return out;
 }
@@ -714,16 +871,19 @@ MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& w
       style.sticks = true;
     else if (item == "ball-and-stick")
       style.ballAndStick = true;
+    else if (item == "cartoon")
+      style.cartoon = true;
     else if (item == "surface")
       style.surface = true;
     else
-      throw Error(quoted(what),
-                  (item.empty() ? std::string("expected") : "unknown representation '" + quoted(item) + "': expected") +
-                      " spheres, sticks, ball-and-stick or surface, or several joined by ',' (surface,sticks)");
+      throw Error(
+          quoted(what),
+          (item.empty() ? std::string("expected") : "unknown representation '" + quoted(item) + "': expected") +
+              " spheres, sticks, ball-and-stick, cartoon or surface, or several joined by ',' (surface,sticks)");
     any = true;
     item.clear();
   }
-  if (!any) throw Error(quoted(what), "expected spheres, sticks, ball-and-stick or surface");
+  if (!any) throw Error(quoted(what), "expected spheres, sticks, ball-and-stick, cartoon or surface");
   return style;
 }
 

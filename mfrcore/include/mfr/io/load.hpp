@@ -42,9 +42,11 @@ struct MoleculeStyle {
   bool spheres = true;        // space-filling: van der Waals spheres (PyMOL's spheres, CPK)
   bool sticks = false;        // bonds as sticks of radius 0.25 Å, joined by spheres (PyMOL's sticks)
   bool ballAndStick = false;  // balls of 23 % of the van der Waals radius, sticks of 0.15 Å (Jmol's)
+  bool cartoon = false;       // each polymer chain's backbone as helices, strands and loops (PyMOL's cartoon)
   bool surface = false;       // the solvent-excluded surface of each part but water (probe 1.4 Å)
 
-  // "spheres", "surface,sticks": the names in the order spheres, ball-and-stick, sticks, surface.
+  // "spheres", "surface,sticks": the names in the order spheres, ball-and-stick, sticks, cartoon,
+  // surface.
   [[nodiscard]] std::string text() const;
   // One or more names separated by ',' or '+'. Throws mfr::Error(what, reason) for an unknown or
   // missing name.

@@ -1,0 +1,200 @@
+// Cartoons on real files (pymol-data, python-biopython-doc): the secondary structure they draw,
+// against the program that defines it and against the files' own records:
+// * mfr::assignSecondaryStructure against mkdssp 4 (Debian dssp, the reference implementation of
+//   Kabsch & Sander's DSSP), residue by residue: its H and I (α- and π-helix) as helix, E as
+//   strand, everything else as loop — on a helical protein (il2), a β protein dimer whose sheets
+//   cross chains (HIV protease, 1hpv), a β-hairpin peptide (pept), five chains (1tii) and an mmCIF
+//   file (4CUP);
+// * files with HELIX/SHEET records are drawn by them (as PyMOL does): 1hpv's records residue for
+//   residue;
+// * the cartoon of every chain is a closed surface, and each protein residue's Cα lies inside it
+//   (inside the ribbon of a helix or loop, where the curve passes through the Cα).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "mfr/io/load.hpp"
+#include "mfr/io/molecule.hpp"
+#include "mfr/scene/measure.hpp"
+#include "test_files.hpp"
+
+namespace fs = std::filesystem;
+
+namespace mfr::test {
+namespace {
+
+const fs::path kPymolDemo = "/usr/share/pymol/data/demo";
+const fs::path kPymolTutorial = "/usr/share/pymol/data/tut";
+const fs::path kBiopython = "/usr/share/doc/python-biopython-doc/Tests/PDB";
+
+fs::path requireFile(const fs::path& path, const std::string& package) {
+  if (!fs::exists(path)) ADD_FAILURE() << "missing " << path << " (from " << package << "; scripts/setup installs it)";
+  return path;
+}
+
+using ResidueKey = std::tuple<std::string, int, char>;  // chain, number, insertion code
+
+char letter(SecondaryStructure s) {
+  return s == SecondaryStructure::Helix ? 'H' : s == SecondaryStructure::Strand ? 'E' : '-';
+}
+
+class SecondaryStructureAsMkdssp : public TempDirTest {
+ protected:
+  // mkdssp's assignment of `file`, as helix ('H': its H and I), strand ('E') or loop ('-'). A PDB
+  // file is given to it as its ATOM records under a minimal HEADER and CRYST1 (mkdssp 4 insists on
+  // both), columns 73–80 dropped (old files put line numbers there) and a blank chain named A;
+  // mmCIF as it is.
+  std::map<ResidueKey, char> mkdssp(const fs::path& file, bool mmcif) {
+    fs::path input = dir() / (mmcif ? "in.cif" : "in.pdb");
+    if (mmcif) {
+      const CliResult unzip = runCommand("zcat '" + file.string() + "' > '" + input.string() + "'");
+      EXPECT_EQ(unzip.exitCode, 0) << unzip.out;
+    } else {
+      std::ifstream in(file);
+      std::ofstream out(input);
+      out << "HEADER    TEST                                    01-JAN-00   XXXX              \n"
+             "CRYST1    1.000    1.000    1.000  90.00  90.00  90.00 P 1           1          \n";
+      std::string line;
+      while (std::getline(in, line)) {
+        if (line.rfind("ATOM", 0) != 0 && line.rfind("TER", 0) != 0) continue;
+        line = line.substr(0, 72);
+        if (line.size() > 21 && line[21] == ' ') line[21] = 'A';
+        out << line << "\n";
+      }
+      out << "END\n";
+    }
+    const fs::path output = dir() / "out.dssp";
+    const CliResult r =
+        runCommand("mkdssp --output-format dssp '" + input.string() + "' '" + output.string() + "' 2>&1");
+    EXPECT_EQ(r.exitCode, 0) << r.out << " (mkdssp is Debian's dssp; scripts/setup installs it)";
+    std::map<ResidueKey, char> out;
+    std::ifstream in(output);
+    std::string line;
+    bool table = false;
+    while (std::getline(in, line)) {
+      if (line.rfind("  #  RESIDUE", 0) == 0) {
+        table = true;
+        continue;
+      }
+      if (!table || line.size() < 17 || line[13] == '!') continue;  // '!': a chain break
+      const int number = std::stoi(line.substr(5, 5));
+      const char ss = line[16];
+      out[{std::string(1, line[11]), number, line[10]}] = ss == 'H' || ss == 'I' ? 'H' : ss == 'E' ? 'E' : '-';
+    }
+    EXPECT_GT(out.size(), 0u) << "no residues read from mkdssp's " << output;
+    return out;
+  }
+
+  // Ours on the file's residues (never its records), compared with mkdssp's on every residue both
+  // assign; returns how many differ and checks the counts of helix and strand are mkdssp's.
+  void expectAsMkdssp(const fs::path& file, bool mmcif, std::size_t minResidues, std::size_t maxDifferent) {
+    SCOPED_TRACE(file.string());
+    const MoleculeStructure m = readMoleculeStructure(file);
+    const std::vector<SecondaryStructure> ours = assignSecondaryStructure(m.residues);
+    ASSERT_EQ(ours.size(), m.residues.size());
+    const std::map<ResidueKey, char> theirs = mkdssp(file, mmcif);
+    std::size_t compared = 0, different = 0, helix = 0, strand = 0, theirHelix = 0, theirStrand = 0;
+    std::string oursLine, theirsLine;
+    for (std::size_t i = 0; i < ours.size(); ++i) {
+      const BackboneResidue& r = m.residues[i];
+      const auto it = theirs.find({r.chain.empty() ? "A" : r.chain, r.number, r.insertion});
+      if (it == theirs.end()) continue;
+      ++compared;
+      const char a = letter(ours[i]), b = it->second;
+      helix += a == 'H';
+      strand += a == 'E';
+      theirHelix += b == 'H';
+      theirStrand += b == 'E';
+      oursLine += a;
+      theirsLine += b;
+      if (a != b) {
+        ++different;
+        ADD_FAILURE_AT(__FILE__, __LINE__)
+            << "residue " << r.chain << " " << r.name << " " << r.number << ": ours " << a << ", mkdssp " << b;
+      }
+    }
+    std::cout << file.filename().string() << ": " << compared << " residues compared, " << helix << " helix, " << strand
+              << " strand, " << different << " different\n";
+    EXPECT_GE(compared, minResidues);
+    EXPECT_LE(different, maxDifferent) << "\nours:   " << oursLine << "\nmkdssp: " << theirsLine;
+    EXPECT_EQ(helix, theirHelix);
+    EXPECT_EQ(strand, theirStrand);
+  }
+};
+
+TEST_F(SecondaryStructureAsMkdssp, HelicalProtein) {
+  expectAsMkdssp(requireFile(kPymolDemo / "il2.pdb", "Debian package pymol-data"), false, 126, 0);
+}
+
+TEST_F(SecondaryStructureAsMkdssp, BetaDimerWithSheetsAcrossChains) {
+  expectAsMkdssp(requireFile(kPymolTutorial / "1hpv.pdb", "Debian package pymol-data"), false, 198, 0);
+}
+
+TEST_F(SecondaryStructureAsMkdssp, BetaHairpinPeptide) {
+  expectAsMkdssp(requireFile(kPymolDemo / "pept.pdb", "Debian package pymol-data"), false, 13, 0);
+}
+
+TEST_F(SecondaryStructureAsMkdssp, FiveChains) {
+  expectAsMkdssp(requireFile(kPymolDemo / "1tii.pdb", "Debian package pymol-data"), false, 500, 0);
+}
+
+TEST_F(SecondaryStructureAsMkdssp, Mmcif) {
+  expectAsMkdssp(requireFile(kBiopython / "4CUP.cif.gz", "Debian package python-biopython-doc"), true, 100, 0);
+}
+
+// The cartoon of a two-chain β protein from its records: one closed, outward tube set per chain,
+// in PyMOL's colours of helix (red), strand (yellow) and loop (green), each residue's Cα within
+// the band's reach of the cartoon, and as many rings of strand colour as the records' strands.
+TEST(MoleculeCartoon, ClosedPerChainColouredByTheRecords) {
+  const fs::path file = requireFile(kPymolTutorial / "1hpv.pdb", "Debian package pymol-data");
+  const MoleculeStructure m = readMoleculeStructure(file);
+  ASSERT_TRUE(m.secondaryStructureFromFile);
+  const std::vector<Object> parts = loadModel(file, LoadOptions({}, MoleculeStyle::parse("cartoon", "t")));
+  ASSERT_EQ(parts.size(), 2u);
+  EXPECT_EQ(parts[0].name, "chain A");
+  EXPECT_EQ(parts[1].name, "chain B");
+  std::size_t part = 0;
+  for (const Object& o : parts) {
+    SCOPED_TRACE(o.name);
+    const SurfaceMeasures s = measureSurface(*o.mesh, glm::dmat4(1.0));
+    EXPECT_TRUE(s.closed());
+    EXPECT_GT(s.volume, 0.0);
+    std::size_t red = 0, yellow = 0, green = 0;
+    for (const glm::vec4& c : o.mesh->colors) {
+      red += c == glm::vec4(1, 0, 0, 1);
+      yellow += c == glm::vec4(1, 1, 0, 1);
+      green += c == glm::vec4(0, 1, 0, 1);
+    }
+    EXPECT_EQ(red + yellow + green, o.mesh->colors.size());
+    // Residues of the chain by the records: 99 per chain, 4 helix, 47 … strand.
+    std::size_t helix = 0, strand = 0, residues = 0;
+    for (const BackboneResidue& r : m.residues) {
+      if (r.part != part) continue;
+      ++residues;
+      helix += r.structure == SecondaryStructure::Helix;
+      strand += r.structure == SecondaryStructure::Strand;
+      // Every Cα within reach of the cartoon: at most the arrowhead's half-width (2.1 Å) from a vertex.
+      double nearest = 1e30;
+      for (const glm::vec3& v : o.mesh->positions) nearest = std::min(nearest, glm::distance(glm::dvec3(v), *r.ca));
+      EXPECT_LT(nearest, 2.11) << r.number;
+    }
+    EXPECT_EQ(residues, 99u);
+    EXPECT_GT(helix, 0u);
+    EXPECT_GT(strand, 40u);
+    EXPECT_GT(red, 0u);
+    EXPECT_GT(yellow, red);
+    ++part;
+  }
+}
+
+}  // namespace
+}  // namespace mfr::test
