@@ -99,9 +99,10 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   auto* molecule = new QHBoxLayout(moleculeRow_);
   molecule->setContentsMargins(4, 4, 4, 0);
   molecule->addWidget(new QLabel(tr("Molecule")));
-  const std::array<std::pair<const char*, QString>, 4> representations = {
+  const std::array<std::pair<const char*, QString>, 5> representations = {
       std::pair{"moleculeSpheres", tr("Spheres")}, std::pair{"moleculeBallAndStick", tr("Ball and stick")},
-      std::pair{"moleculeSticks", tr("Sticks")}, std::pair{"moleculeSurface", tr("Surface")}};
+      std::pair{"moleculeSticks", tr("Sticks")}, std::pair{"moleculeCartoon", tr("Cartoon")},
+      std::pair{"moleculeSurface", tr("Surface")}};
   for (std::size_t i = 0; i < molecule_.size(); ++i) {
     molecule_[i] = new QCheckBox(representations[i].second);
     molecule_[i]->setObjectName(QString::fromLatin1(representations[i].first));
@@ -111,8 +112,9 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
       style.spheres = molecule_[0]->isChecked();
       style.ballAndStick = molecule_[1]->isChecked();
       style.sticks = molecule_[2]->isChecked();
-      style.surface = molecule_[3]->isChecked();
-      if (!(style.spheres || style.ballAndStick || style.sticks || style.surface)) {
+      style.cartoon = molecule_[3]->isChecked();
+      style.surface = molecule_[4]->isChecked();
+      if (!(style.spheres || style.ballAndStick || style.sticks || style.cartoon || style.surface)) {
         showMoleculeStyle();  // one at least
         return;
       }
@@ -122,7 +124,10 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   molecule_[0]->setToolTip(tr("Van der Waals spheres (space-filling, CPK)"));
   molecule_[1]->setToolTip(tr("Balls of 23 % of the van der Waals radius and sticks of 0.15 Å (Jmol's)"));
   molecule_[2]->setToolTip(tr("Bonds as sticks of 0.25 Å (PyMOL's); bonds found from distances as Open Babel does"));
-  molecule_[3]->setToolTip(tr("The solvent-excluded surface of each chain and of the ligands (probe 1.4 Å)"));
+  molecule_[3]->setToolTip(
+      tr("Each chain's backbone: helices, strands with arrows and loops, coloured red, yellow "
+         "and green (PyMOL's cartoon); from the file's HELIX/SHEET records, or DSSP"));
+  molecule_[4]->setToolTip(tr("The solvent-excluded surface of each chain and of the ligands (probe 1.4 Å)"));
   molecule->addStretch(1);
   moleculeRow_->setVisible(false);
   layout->addWidget(moleculeRow_);
@@ -229,7 +234,7 @@ void SceneTreePanel::showMoleculeStyle() {
   const std::optional<mfr::MoleculeStyle> style = model_.moleculeStyle();
   moleculeRow_->setVisible(style.has_value());
   if (!style) return;
-  const std::array<bool, 4> on = {style->spheres, style->ballAndStick, style->sticks, style->surface};
+  const std::array<bool, 5> on = {style->spheres, style->ballAndStick, style->sticks, style->cartoon, style->surface};
   for (std::size_t i = 0; i < molecule_.size(); ++i) {
     const QSignalBlocker block(molecule_[i]);
     molecule_[i]->setChecked(on[i]);

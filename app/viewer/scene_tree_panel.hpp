@@ -42,7 +42,7 @@ class SceneTreePanel final : public QWidget {
   ViewerModel& model_;
   QTreeWidget* tree_ = nullptr;
   QWidget* moleculeRow_ = nullptr;        // shown for a molecule file
-  std::array<QCheckBox*, 4> molecule_{};  // spheres, ball-and-stick, sticks, surface
+  std::array<QCheckBox*, 5> molecule_{};  // spheres, ball-and-stick, sticks, cartoon, surface
   QWidget* fieldRow_ = nullptr;  // hidden when no part has a field
   QComboBox* colorBy_ = nullptr;
   QComboBox* colorMap_ = nullptr;

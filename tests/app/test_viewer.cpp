@@ -3562,6 +3562,16 @@ class ViewerTest : public QObject {
     QCOMPARE(names, (QStringList{"chain E sticks", "chain E surface"}));
     QCOMPARE(m.camera().eye, camera.eye);
     QCOMPARE(m.camera().target, camera.target);
+    // The cartoon: a part of its own between the sticks and the surface; untick it again.
+    auto* cartoon = w->findChild<QCheckBox*>("moleculeCartoon");
+    QVERIFY(cartoon && !cartoon->isChecked());
+    cartoon->setChecked(true);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks,cartoon,surface", kTimeoutMs);
+    names.clear();
+    for (const mfr::Object& o : m.scene().objects) names << QString::fromStdString(o.name);
+    QCOMPARE(names, (QStringList{"chain E sticks", "chain E cartoon", "chain E surface"}));
+    cartoon->setChecked(false);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks,surface", kTimeoutMs);
     // None at all is not taken: the last one stays checked.
     sticks->setChecked(false);
     QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "surface", kTimeoutMs);
@@ -3621,8 +3631,10 @@ class ViewerTest : public QObject {
     QCOMPARE(runProgram(MFRVIEW, {pept, "--molecule", "sticks", "--screenshot", viewerPng, "--size", "64x48"}, &out),
              0);
     QCOMPARE(runProgram(MFRVIEW, {pept, "--molecule", "cartoon", "--screenshot", viewerPng, "--size", "64x48"}, &out),
+             0);
+    QCOMPARE(runProgram(MFRVIEW, {pept, "--molecule", "ribbon", "--screenshot", viewerPng, "--size", "64x48"}, &out),
              2);
-    QVERIFY2(out.contains("--molecule cartoon: unknown representation 'cartoon'"), qPrintable(out));
+    QVERIFY2(out.contains("--molecule ribbon: unknown representation 'ribbon'"), qPrintable(out));
     QCOMPARE(
         runProgram(MFRVIEW, {"@sample", "--molecule", "sticks", "--screenshot", viewerPng, "--size", "64x48"}, &out),
         1);
