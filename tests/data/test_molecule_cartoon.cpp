@@ -3,8 +3,8 @@
 // * mfr::assignSecondaryStructure against mkdssp 4 (Debian dssp, the reference implementation of
 //   Kabsch & Sander's DSSP), residue by residue: its H and I (α- and π-helix) as helix, E as
 //   strand, everything else as loop — on a helical protein (il2), a β protein dimer whose sheets
-//   cross chains (HIV protease, 1hpv), a β-hairpin peptide (pept), five chains (1tii) and an mmCIF
-//   file (4CUP);
+//   cross chains (HIV protease, 1hpv), a β-hairpin peptide (pept), five chains (1tii), an mmCIF
+//   file (4CUP) and eight more of Biopython's test files: 2,668 of 2,669 residues alike;
 // * files with HELIX/SHEET records are drawn by them (as PyMOL does): 1hpv's records residue for
 //   residue;
 // * the cartoon of every chain is a closed surface, and each protein residue's Cα lies inside it
@@ -59,7 +59,13 @@ class SecondaryStructureAsMkdssp : public TempDirTest {
       const CliResult unzip = runCommand("zcat '" + file.string() + "' > '" + input.string() + "'");
       EXPECT_EQ(unzip.exitCode, 0) << unzip.out;
     } else {
-      std::ifstream in(file);
+      fs::path plain = file;
+      if (file.extension() == ".gz") {
+        plain = dir() / "plain.pdb";
+        const CliResult unzip = runCommand("zcat '" + file.string() + "' > '" + plain.string() + "'");
+        EXPECT_EQ(unzip.exitCode, 0) << unzip.out;
+      }
+      std::ifstream in(plain);
       std::ofstream out(input);
       out << "HEADER    TEST                                    01-JAN-00   XXXX              \n"
              "CRYST1    1.000    1.000    1.000  90.00  90.00  90.00 P 1           1          \n";
@@ -103,7 +109,7 @@ class SecondaryStructureAsMkdssp : public TempDirTest {
     ASSERT_EQ(ours.size(), m.residues.size());
     const std::map<ResidueKey, char> theirs = mkdssp(file, mmcif);
     std::size_t compared = 0, different = 0, helix = 0, strand = 0, theirHelix = 0, theirStrand = 0;
-    std::string oursLine, theirsLine;
+    std::string oursLine, theirsLine, differences;
     for (std::size_t i = 0; i < ours.size(); ++i) {
       const BackboneResidue& r = m.residues[i];
       const auto it = theirs.find({r.chain.empty() ? "A" : r.chain, r.number, r.insertion});
@@ -118,16 +124,17 @@ class SecondaryStructureAsMkdssp : public TempDirTest {
       theirsLine += b;
       if (a != b) {
         ++different;
-        ADD_FAILURE_AT(__FILE__, __LINE__)
-            << "residue " << r.chain << " " << r.name << " " << r.number << ": ours " << a << ", mkdssp " << b;
+        differences += " " + r.chain + ":" + r.name + std::to_string(r.number) + " ours " + a + ", mkdssp " + b + ";";
       }
     }
     std::cout << file.filename().string() << ": " << compared << " residues compared, " << helix << " helix, " << strand
               << " strand, " << different << " different\n";
     EXPECT_GE(compared, minResidues);
-    EXPECT_LE(different, maxDifferent) << "\nours:   " << oursLine << "\nmkdssp: " << theirsLine;
-    EXPECT_EQ(helix, theirHelix);
-    EXPECT_EQ(strand, theirStrand);
+    EXPECT_LE(different, maxDifferent) << differences << "\nours:   " << oursLine << "\nmkdssp: " << theirsLine;
+    if (maxDifferent == 0) {
+      EXPECT_EQ(helix, theirHelix);
+      EXPECT_EQ(strand, theirStrand);
+    }
   }
 };
 
@@ -149,6 +156,25 @@ TEST_F(SecondaryStructureAsMkdssp, FiveChains) {
 
 TEST_F(SecondaryStructureAsMkdssp, Mmcif) {
   expectAsMkdssp(requireFile(kBiopython / "4CUP.cif.gz", "Debian package python-biopython-doc"), true, 100, 0);
+}
+
+// Eight more files of Biopython's test set: an amyloid fibril whose parallel sheets run across
+// five chains (2BEG), large α/β proteins (2XHE, 4ZHL), a protein–DNA complex (1LCD), NMR models
+// (2OFG, 1LCD) and selenomethionine (1A8O). 3JQH has two residues at one position (ARG and GLN
+// at 15, alternative locations of different residues): mkdssp keeps both, with a chain break
+// between them, mfr the first — one residue differs there, as that explains.
+TEST_F(SecondaryStructureAsMkdssp, MoreFiles) {
+  struct Case {
+    const char* file;
+    std::size_t residues, different;
+  };
+  for (const Case& c : {Case{"2BEG.pdb.gz", 130, 0}, Case{"2XHE.cif.gz", 786, 0}, Case{"4ZHL.cif.gz", 257, 0},
+                        Case{"1A7G.cif.gz", 82, 0}, Case{"2OFG.cif.gz", 106, 0}, Case{"1LCD.cif.gz", 51, 0},
+                        Case{"1A8O.cif.gz", 70, 0}, Case{"3JQH.cif.gz", 23, 1}}) {
+    const std::string name = c.file;
+    expectAsMkdssp(requireFile(kBiopython / name, "Debian package python-biopython-doc"),
+                   name.find(".cif") != std::string::npos, c.residues, c.different);
+  }
 }
 
 // The cartoon of a two-chain β protein from its records: one closed, outward tube set per chain,
