@@ -40,8 +40,8 @@ void ReadOptions::add(CLI::App* cmd) {
                   "(see mfr info for the file's fields)");
   cmd->add_option("--molecule", molecule,
                   "Molecule file (.pdb, .cif): how to draw it — spheres (default), sticks, ball-and-stick, cartoon "
-                  "(helices, strands, loops), surface (solvent-excluded, per chain), or several joined by ',' "
-                  "(surface,sticks)");
+                  "(helices, strands, loops), surface (solvent-excluded, per chain), or several joined by ',', each on "
+                  "all parts or on @polymer, @ligands or @water (cartoon,sticks@ligands)");
 }
 
 LoadOptions ReadOptions::load() const {

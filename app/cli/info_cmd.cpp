@@ -74,10 +74,7 @@ void addInfo(CLI::App& app) {
         // Secondary structure, as the cartoon draws it: per chain one letter per residue (H helix,
         // E strand, - loop), in file order.
         std::vector<std::string> letters(molecule->parts.size());
-        for (const BackboneResidue& r : molecule->residues)
-          letters[r.part] += r.structure == SecondaryStructure::Helix    ? 'H'
-                             : r.structure == SecondaryStructure::Strand ? 'E'
-                                                                         : '-';
+        for (const BackboneResidue& r : molecule->residues) letters[r.part] += secondaryStructureLetter(r.structure);
         nlohmann::ordered_json chains = nlohmann::ordered_json::object();
         for (std::size_t p = 0; p < letters.size(); ++p)
           if (!letters[p].empty()) chains[molecule->parts[p]] = letters[p];

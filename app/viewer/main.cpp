@@ -81,7 +81,8 @@ CommandLine parseCommandLine(const QApplication& app) {
       QStringLiteral("molecule"),
       QStringLiteral(
           "Molecule file (.pdb, .cif): spheres (default), sticks, ball-and-stick, cartoon, surface, or several joined "
-          "by ',' (as mfr render; the Scene panel's Molecule row)."),
+          "by ',', each on all parts or on @polymer, @ligands or @water (as mfr render; the Scene panel's "
+          "Molecule row)."),
       QStringLiteral("representations"));
   const QCommandLineOption colorBy(
       QStringLiteral("color-by"),

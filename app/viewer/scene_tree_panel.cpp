@@ -88,6 +88,11 @@ QIcon swatch(const QColor& colour) {
   return QIcon(pixmap);
 }
 
+// The Molecule row's check boxes, in order.
+constexpr std::array<mfr::MoleculeParts mfr::MoleculeStyle::*, 5> kMoleculeRepresentations = {
+    &mfr::MoleculeStyle::spheres, &mfr::MoleculeStyle::ballAndStick, &mfr::MoleculeStyle::sticks,
+    &mfr::MoleculeStyle::cartoon, &mfr::MoleculeStyle::surface};
+
 }  // namespace
 
 SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(parent), model_(model) {
@@ -107,14 +112,18 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
     molecule_[i] = new QCheckBox(representations[i].second);
     molecule_[i]->setObjectName(QString::fromLatin1(representations[i].first));
     molecule->addWidget(molecule_[i]);
-    connect(molecule_[i], &QCheckBox::toggled, this, [this] {
-      mfr::MoleculeStyle style;
-      style.spheres = molecule_[0]->isChecked();
-      style.ballAndStick = molecule_[1]->isChecked();
-      style.sticks = molecule_[2]->isChecked();
-      style.cartoon = molecule_[3]->isChecked();
-      style.surface = molecule_[4]->isChecked();
-      if (!(style.spheres || style.ballAndStick || style.sticks || style.cartoon || style.surface)) {
+    // Checked: the representation on every part; unchecked: on none. A representation the style
+    // draws on some parts only (sticks@ligands) shows partly checked, and a click makes it all.
+    connect(molecule_[i], &QCheckBox::stateChanged, this, [this](int state) {
+      const std::optional<mfr::MoleculeStyle> loaded = model_.moleculeStyle();
+      if (!loaded || state == Qt::PartiallyChecked) return;
+      // From all the boxes, so that quick clicks add up while the file is read again.
+      mfr::MoleculeStyle style = *loaded;
+      for (std::size_t k = 0; k < molecule_.size(); ++k)
+        if (molecule_[k]->checkState() != Qt::PartiallyChecked)
+          style.*kMoleculeRepresentations[k] =
+              molecule_[k]->checkState() == Qt::Checked ? mfr::MoleculeParts::all() : mfr::MoleculeParts{};
+      if (!style.any()) {
         showMoleculeStyle();  // one at least
         return;
       }
@@ -234,10 +243,12 @@ void SceneTreePanel::showMoleculeStyle() {
   const std::optional<mfr::MoleculeStyle> style = model_.moleculeStyle();
   moleculeRow_->setVisible(style.has_value());
   if (!style) return;
-  const std::array<bool, 5> on = {style->spheres, style->ballAndStick, style->sticks, style->cartoon, style->surface};
   for (std::size_t i = 0; i < molecule_.size(); ++i) {
     const QSignalBlocker block(molecule_[i]);
-    molecule_[i]->setChecked(on[i]);
+    const mfr::MoleculeParts& parts = (*style).*kMoleculeRepresentations[i];
+    const bool some = static_cast<bool>(parts) && parts != mfr::MoleculeParts::all();
+    molecule_[i]->setTristate(some);
+    molecule_[i]->setCheckState(some ? Qt::PartiallyChecked : parts ? Qt::Checked : Qt::Unchecked);
   }
 }
 

@@ -692,7 +692,7 @@ void ViewerModel::setDataView(DataView view, bool overImage) {
 // ---- scene -------------------------------------------------------------------------------
 
 void ViewerModel::setMoleculeStyle(const mfr::MoleculeStyle& style) {
-  if (!moleculeStyle_ || !(style.spheres || style.sticks || style.ballAndStick || style.surface)) return;
+  if (!moleculeStyle_ || !style.any()) return;
   // Compared with what was asked last: a change undone before its read ends is a read of its own.
   if (style == requestedMoleculeStyle_.value_or(*moleculeStyle_)) return;
   const mfr::Camera camera = keepCamera_.value_or(camera_);

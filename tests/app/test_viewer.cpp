@@ -3572,6 +3572,14 @@ class ViewerTest : public QObject {
     QCOMPARE(names, (QStringList{"chain E sticks", "chain E cartoon", "chain E surface"}));
     cartoon->setChecked(false);
     QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks,surface", kTimeoutMs);
+    // Sticks on the chain only (--molecule sticks@polymer): partly checked; a click draws them on all.
+    m.setMoleculeStyle(mfr::MoleculeStyle::parse("sticks@polymer,surface", "test"));
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks@polymer,surface", kTimeoutMs);
+    QCOMPARE(sticks->checkState(), Qt::PartiallyChecked);
+    QCOMPARE(surface->checkState(), Qt::Checked);
+    sticks->setCheckState(Qt::Checked);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks,surface", kTimeoutMs);
+    QVERIFY(!sticks->isTristate());
     // None at all is not taken: the last one stays checked.
     sticks->setChecked(false);
     QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "surface", kTimeoutMs);

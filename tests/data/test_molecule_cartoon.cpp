@@ -5,10 +5,11 @@
 //   strand, everything else as loop — on a helical protein (il2), a β protein dimer whose sheets
 //   cross chains (HIV protease, 1hpv), a β-hairpin peptide (pept), five chains (1tii), an mmCIF
 //   file (4CUP) and eight more of Biopython's test files: 2,668 of 2,669 residues alike;
-// * files with HELIX/SHEET records are drawn by them (as PyMOL does): 1hpv's records residue for
-//   residue;
-// * the cartoon of every chain is a closed surface, and each protein residue's Cα lies inside it
-//   (inside the ribbon of a helix or loop, where the curve passes through the Cα).
+// * files with HELIX/SHEET records are drawn by them (as PyMOL does; PyMOL's reading of 1hpv's and
+//   1tii's records is compared residue for residue in tests/peer/pymol_secondary_structure_peer.py);
+// * the cartoons of 1hpv's chains are closed and outward, in the three colours, each Cα near its
+//   cartoon; and the cartoon of real backbones (1hpv, 1tii, il2) never turns a ring round against
+//   the one before it (no pinched or twisted tube).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -24,6 +25,7 @@
 
 #include "mfr/io/load.hpp"
 #include "mfr/io/molecule.hpp"
+#include "mfr/scene/cartoon.hpp"
 #include "mfr/scene/measure.hpp"
 #include "test_files.hpp"
 
@@ -42,10 +44,6 @@ fs::path requireFile(const fs::path& path, const std::string& package) {
 }
 
 using ResidueKey = std::tuple<std::string, int, char>;  // chain, number, insertion code
-
-char letter(SecondaryStructure s) {
-  return s == SecondaryStructure::Helix ? 'H' : s == SecondaryStructure::Strand ? 'E' : '-';
-}
 
 class SecondaryStructureAsMkdssp : public TempDirTest {
  protected:
@@ -101,25 +99,23 @@ class SecondaryStructureAsMkdssp : public TempDirTest {
   }
 
   // Ours on the file's residues (never its records), compared with mkdssp's on every residue both
-  // assign; returns how many differ and checks the counts of helix and strand are mkdssp's.
+  // assign: at least `minResidues` compared, at most `maxDifferent` differing.
   void expectAsMkdssp(const fs::path& file, bool mmcif, std::size_t minResidues, std::size_t maxDifferent) {
     SCOPED_TRACE(file.string());
     const MoleculeStructure m = readMoleculeStructure(file);
     const std::vector<SecondaryStructure> ours = assignSecondaryStructure(m.residues);
     ASSERT_EQ(ours.size(), m.residues.size());
     const std::map<ResidueKey, char> theirs = mkdssp(file, mmcif);
-    std::size_t compared = 0, different = 0, helix = 0, strand = 0, theirHelix = 0, theirStrand = 0;
+    std::size_t compared = 0, different = 0, helix = 0, strand = 0;
     std::string oursLine, theirsLine, differences;
     for (std::size_t i = 0; i < ours.size(); ++i) {
       const BackboneResidue& r = m.residues[i];
       const auto it = theirs.find({r.chain.empty() ? "A" : r.chain, r.number, r.insertion});
       if (it == theirs.end()) continue;
       ++compared;
-      const char a = letter(ours[i]), b = it->second;
+      const char a = secondaryStructureLetter(ours[i]), b = it->second;
       helix += a == 'H';
       strand += a == 'E';
-      theirHelix += b == 'H';
-      theirStrand += b == 'E';
       oursLine += a;
       theirsLine += b;
       if (a != b) {
@@ -131,10 +127,6 @@ class SecondaryStructureAsMkdssp : public TempDirTest {
               << " strand, " << different << " different\n";
     EXPECT_GE(compared, minResidues);
     EXPECT_LE(different, maxDifferent) << differences << "\nours:   " << oursLine << "\nmkdssp: " << theirsLine;
-    if (maxDifferent == 0) {
-      EXPECT_EQ(helix, theirHelix);
-      EXPECT_EQ(strand, theirStrand);
-    }
   }
 };
 
@@ -179,7 +171,7 @@ TEST_F(SecondaryStructureAsMkdssp, MoreFiles) {
 
 // The cartoon of a two-chain β protein from its records: one closed, outward tube set per chain,
 // in PyMOL's colours of helix (red), strand (yellow) and loop (green), each residue's Cα within
-// the band's reach of the cartoon, and as many rings of strand colour as the records' strands.
+// the band's reach (2.1 Å) of some vertex, helix and strand residues as the records have them.
 TEST(MoleculeCartoon, ClosedPerChainColouredByTheRecords) {
   const fs::path file = requireFile(kPymolTutorial / "1hpv.pdb", "Debian package pymol-data");
   const MoleculeStructure m = readMoleculeStructure(file);
@@ -219,6 +211,58 @@ TEST(MoleculeCartoon, ClosedPerChainColouredByTheRecords) {
     EXPECT_GT(red, 0u);
     EXPECT_GT(yellow, red);
     ++part;
+  }
+}
+
+// Real backbones, each chain's runs as the loader splits them: between consecutive rings the band's
+// width direction (ring vertex 0 from the ring's centre) never turns by more than 90° — a guide
+// projected onto a ring's plane can point against the previous one where the curve bends across
+// it, and the tube would pinch there (1hpv, 1tii and il2 all have such places).
+TEST(MoleculeCartoon, RingsNeverTurnRound) {
+  for (const fs::path& file : {requireFile(kPymolTutorial / "1hpv.pdb", "Debian package pymol-data"),
+                               requireFile(kPymolDemo / "1tii.pdb", "Debian package pymol-data"),
+                               requireFile(kPymolDemo / "il2.pdb", "Debian package pymol-data")}) {
+    SCOPED_TRACE(file.string());
+    const MoleculeStructure m = readMoleculeStructure(file);
+    std::vector<std::vector<CartoonResidue>> segments(1);
+    const BackboneResidue* previous = nullptr;
+    for (const BackboneResidue& r : m.residues) {
+      if (!r.ca) continue;
+      if (previous != nullptr && (previous->part != r.part || glm::distance(*previous->ca, *r.ca) > 4.5))
+        segments.emplace_back();
+      CartoonResidue c;
+      c.trace = *r.ca;
+      if (r.c && r.o) c.guide = *r.o - *r.c;
+      c.structure = r.structure;
+      segments.back().push_back(c);
+      previous = &r;
+    }
+    const CartoonOptions options;
+    const Mesh mesh = cartoonMesh(segments, options);
+    const auto sides = static_cast<std::size_t>(options.sides);
+    std::size_t base = 0, rings = 0, worst = 0;
+    double smallest = 1.0;
+    for (const std::vector<CartoonResidue>& segment : segments) {
+      if (segment.size() < 2) continue;
+      const std::size_t count = (segment.size() - 1) * static_cast<std::size_t>(options.samplesPerResidue) + 1;
+      glm::dvec3 before(0.0);
+      for (std::size_t k = 0; k < count; ++k) {
+        glm::dvec3 centre(0.0);
+        for (std::size_t v = 0; v < sides; ++v) centre += glm::dvec3(mesh.positions[base + k * sides + v]);
+        centre /= static_cast<double>(sides);
+        const glm::dvec3 width = glm::normalize(glm::dvec3(mesh.positions[base + k * sides]) - centre);
+        if (k > 0) {
+          const double d = glm::dot(width, before);
+          if (d < 0.0) ++worst;
+          smallest = std::min(smallest, d);
+        }
+        before = width;
+      }
+      rings += count;
+      base += count * sides + 2 * (sides + 1);  // the rings, then two caps (centre and rim)
+    }
+    ASSERT_EQ(base, mesh.positions.size());
+    EXPECT_EQ(worst, 0u) << "of " << rings << " rings; smallest cosine " << smallest;
   }
 }
 

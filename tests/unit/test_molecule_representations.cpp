@@ -200,13 +200,59 @@ TEST_F(MoleculeStyles, SurfaceOfEachPartButWaterClosedAndColouredByTheNearestAto
 
 TEST_F(MoleculeStyles, OnlyWaterHasNoSurfaceAndNoCartoon) {
   const auto water = write("water.pdb", record("HETATM", 1, " O  ", "HOH", 'A', 1, {0, 0, 0}, "O") + "END\n");
-  expectFails(water, "nothing to draw as surface (only water, which has no surface)",
+  expectFails(water, "nothing to draw as surface (the structure has water only; water has no surface)",
               [&] { (void)loadModel(water, LoadOptions({}, MoleculeStyle::parse("surface", "t"))); });
   expectFails(water,
-              "nothing to draw as cartoon,surface (no run of two polymer residues with Cα or P atoms for a cartoon; "
-              "only water, "
-              "which has no surface)",
+              "nothing to draw as cartoon,surface (the structure has water only; a cartoon needs a run of two "
+              "polymer residues with Cα or P atoms; water has no surface)",
               [&] { (void)loadModel(water, LoadOptions({}, MoleculeStyle::parse("cartoon,surface", "t"))); });
+}
+
+// Representations limited to some parts: the small structure's water as spheres and its ligands
+// as sticks, nothing for its chain; and a part the structure lacks draws nothing.
+TEST_F(MoleculeStyles, RepresentationsOnSomePartsOnly) {
+  const std::vector<Object> parts = load("spheres@water,sticks@ligands");
+  ASSERT_EQ(parts.size(), 2u);
+  EXPECT_EQ(parts[0].name, "ligands sticks");
+  EXPECT_EQ(parts[1].name, "water spheres");
+  // Ligands: methane's joint spheres and 4 bonds, the ion's ball; water: three van der Waals spheres.
+  EXPECT_EQ(parts[0].mesh->triangleCount(), 6u * 320u + 4u * 2u * 32u);
+  EXPECT_EQ(parts[1].mesh->triangleCount(), 3u * 320u);
+  const std::vector<Object> chainOnly = load("sticks@polymer");
+  ASSERT_EQ(chainOnly.size(), 1u);
+  EXPECT_EQ(chainOnly[0].name, "chain A");
+  const auto protein = write("protein.pdb", record("ATOM", 1, " CA ", "ALA", 'A', 1, {0, 0, 0}, "C") + "END\n");
+  expectFails(protein, "nothing to draw as sticks@ligands (the structure has polymer chains only)",
+              [&] { (void)loadModel(protein, LoadOptions({}, MoleculeStyle::parse("sticks@ligands", "t"))); });
+}
+
+// A file's HELIX/SHEET ranges hold the residues whose numbers lie between their ends, also when an
+// end residue is missing from the file (as PyMOL reads them); helix wins where both claim one.
+TEST_F(MoleculeStyles, RecordedRangesByResidueNumber) {
+  const auto helix = [](int from, int to) {
+    char line[96];
+    std::snprintf(line, sizeof line, "HELIX  %3d %3s %3s %c %4d%c %3s %c %4d%c%2d\n", 1, "1", "ALA", 'A', from, ' ',
+                  "ALA", 'A', to, ' ', 1);
+    return std::string(line);
+  };
+  const auto sheet = [](int from, int to) {
+    char line[96];
+    std::snprintf(line, sizeof line, "SHEET  %3d %3s%2d %3s %c%4d%c %3s %c%4d%c%2d\n", 1, "S", 1, "ALA", 'A', from, ' ',
+                  "ALA", 'A', to, ' ', 0);
+    return std::string(line);
+  };
+  // Residues 1–14 but 5 and 8, Cα only, 3.8 Å apart; helix 2–5 (5 missing), strand 8–10 (8
+  // missing), strand 12–13 inside helix 11–13 (helix wins).
+  std::string pdb = helix(2, 5) + helix(11, 13) + sheet(8, 10) + sheet(12, 13);
+  int serial = 1;
+  for (int n = 1; n <= 14; ++n)
+    if (n != 5 && n != 8) pdb += record("ATOM", serial++, " CA ", "ALA", 'A', n, {3.8 * n, 0.0, 0.0}, "C");
+  const MoleculeStructure m = readMoleculeStructure(write("ranges.pdb", pdb + "END\n"));
+  ASSERT_TRUE(m.secondaryStructureFromFile);
+  std::string letters;
+  for (const BackboneResidue& r : m.residues) letters += secondaryStructureLetter(r.structure);
+  // 1 2 3 4 6 7 9 10 11 12 13 14
+  EXPECT_EQ(letters, "-HHH--EEHHH-");
 }
 
 // ---- naming, and where a style may be given -------------------------------------------------------
@@ -224,21 +270,36 @@ TEST(MoleculeStyleNames, ParseAndText) {
     return std::string("no error");
   };
   EXPECT_EQ(MoleculeStyle::parse("surface,cartoon,sticks", "x").text(), "sticks,cartoon,surface");
+  // Limited to some parts: one item per part, in the order polymer, ligands, water; all three is
+  // the plain name.
+  const MoleculeStyle scoped = MoleculeStyle::parse("cartoon@polymer,sticks@water+sticks@ligands", "x");
+  EXPECT_EQ(scoped.text(), "sticks@ligands,sticks@water,cartoon@polymer");
+  EXPECT_TRUE(scoped.sticks && !scoped.sticks.polymer && scoped.sticks.ligands && scoped.sticks.water);
+  EXPECT_FALSE(scoped.spheres);
+  EXPECT_EQ(MoleculeStyle::parse(scoped.text(), "x"), scoped);
+  EXPECT_EQ(MoleculeStyle::parse("surface@polymer,surface@ligands,surface@water", "x").text(), "surface");
+  EXPECT_EQ(MoleculeStyle::parse("sticks@water,sticks", "x").text(), "sticks");
+  EXPECT_EQ(reason("sticks@protein"),
+            "--molecule sticks@protein: unknown part 'protein' after 'sticks@': expected polymer, ligands or water");
+  EXPECT_EQ(reason("ribbon@ligands"),
+            "--molecule ribbon@ligands: unknown representation 'ribbon': expected spheres, sticks, ball-and-stick, "
+            "cartoon or surface, joined by ',' (cartoon,sticks@ligands: '@' limits one to polymer, ligands or water)");
   EXPECT_EQ(reason("ribbon"),
-            "--molecule ribbon: unknown representation 'ribbon': expected spheres, sticks, "
-            "ball-and-stick, cartoon or surface, or several joined by ',' (surface,sticks)");
+            "--molecule ribbon: unknown representation 'ribbon': expected spheres, sticks, ball-and-stick, "
+            "cartoon or surface, joined by ',' (cartoon,sticks@ligands: '@' limits one to polymer, ligands or water)");
   EXPECT_EQ(reason(""),
-            "--molecule: expected spheres, sticks, ball-and-stick, cartoon or surface, or several joined by ',' "
-            "(surface,sticks)");
+            "--molecule: expected spheres, sticks, ball-and-stick, cartoon or surface, joined by ',' "
+            "(cartoon,sticks@ligands: '@' limits one to polymer, ligands or water)");
   EXPECT_EQ(reason("sticks,"),
-            "--molecule sticks,: expected spheres, sticks, ball-and-stick, cartoon or surface, or several "
-            "joined by ',' (surface,sticks)");
+            "--molecule sticks,: expected spheres, sticks, ball-and-stick, cartoon or surface, joined by ',' "
+            "(cartoon,sticks@ligands: '@' limits one to polymer, ligands or water)");
   // Whatever was typed, the message is one short line.
   const std::string multiLine = reason("surface\nsticks");
   EXPECT_EQ(multiLine.find('\n'), std::string::npos) << multiLine;
   EXPECT_EQ(multiLine,
             "--molecule surface sticks: unknown representation 'surface sticks': expected spheres, "
-            "sticks, ball-and-stick, cartoon or surface, or several joined by ',' (surface,sticks)");
+            "sticks, ball-and-stick, cartoon or surface, joined by ',' (cartoon,sticks@ligands: '@' limits one to "
+            "polymer, ligands or water)");
   EXPECT_LT(reason(std::string(100'000, 'x')).size(), 300u);
 }
 
@@ -260,7 +321,8 @@ TEST_F(MoleculeStyles, OnlyForMoleculeFiles) {
   const auto bad = write("bad.mfrscene", R"({"objects": [{"file": "small.pdb", "molecule": "ribbon"}]})");
   expectFails(bad,
               "objects[0].molecule: unknown representation 'ribbon': expected spheres, sticks, ball-and-stick, "
-              "cartoon or surface, or several joined by ',' (surface,sticks)",
+              "cartoon or surface, joined by ',' (cartoon,sticks@ligands: '@' limits one to polymer, ligands or "
+              "water)",
               [&] { (void)loadScene(bad); });
   const auto primitive =
       write("pr.mfrscene", R"({"objects": [{"primitive": {"type": "sphere", "radius": 1}, "molecule": "sticks"}]})");

@@ -28,6 +28,7 @@
 #include "mfr/io/molecule.hpp"
 #include "mfr/scene/cartoon.hpp"
 #include "mfr/scene/molecular_surface.hpp"
+#include "scene/perpendicular.hpp"
 #include "scene/point_grid.hpp"
 
 namespace mfr::io {
@@ -234,10 +235,12 @@ struct Atom {
   int serial = 0;
 };
 
+enum class PartKind { Polymer, Ligands, Water };
+
 struct Part {
   std::string name;
   std::vector<Atom> atoms;
-  bool water = false;
+  PartKind kind = PartKind::Polymer;
   // A polymer chain's residues in file order, and the trace atom (Cα, P) of each that has one:
   // its fields are the cartoon's.
   std::vector<BackboneResidue> residues;
@@ -250,7 +253,7 @@ struct Part {
 std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
   std::vector<Part> chains;
   std::map<std::string, std::size_t> chainIndex;
-  Part ligands{"ligands", {}, false, {}, {}}, water{"water", {}, true, {}, {}};
+  Part ligands{"ligands", {}, PartKind::Ligands, {}, {}}, water{"water", {}, PartKind::Water, {}, {}};
   std::map<std::pair<std::string, gemmi::SeqId>, char> firstAltloc;
   std::size_t total = 0;
   for (const gemmi::Chain& chain : model.chains) {
@@ -279,7 +282,8 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
         if (residue.entity_type == gemmi::EntityType::Polymer) {
           const auto [it, isNew] = chainIndex.try_emplace(chain.name, chains.size());
           if (isNew)
-            chains.push_back({chain.name.empty() ? "chain (blank)" : "chain " + chain.name, {}, false, {}, {}});
+            chains.push_back(
+                {chain.name.empty() ? "chain (blank)" : "chain " + chain.name, {}, PartKind::Polymer, {}, {}});
           part = &chains[it->second];
         } else {
           part = residue.entity_type == gemmi::EntityType::Water ? &water : &ligands;
@@ -319,7 +323,6 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
   return chains;
 }
 
-// The structure's first model, parsed, checked and sorted into parts.
 // A helix or strand as the file records it: a range of residues in one chain.
 struct RecordedRange {
   std::string chain;
@@ -327,6 +330,7 @@ struct RecordedRange {
   SecondaryStructure structure;
 };
 
+// The structure's first model, parsed, checked and sorted into parts.
 struct Parsed {
   std::vector<Part> parts;
   std::size_t models = 1;
@@ -334,27 +338,58 @@ struct Parsed {
 };
 
 // Each polymer residue's secondary structure: the file's records when it has any (every helix
-// class counts as helix, as PyMOL reads them), otherwise DSSP's over the whole model (sheets join
-// chains). Returns whether the records were used.
-bool assignStructure(Parsed& parsed, const std::string& name) {
+// class counts as helix, and helix wins where a strand overlaps it, as PyMOL reads them),
+// otherwise DSSP's over the whole model (sheets join chains).
+void assignStructure(Parsed& parsed, const std::string& name) {
   std::vector<BackboneResidue*> all;
   for (Part& part : parsed.parts)
     for (BackboneResidue& r : part.residues) all.push_back(&r);
   if (!parsed.recorded.empty()) {
+    // A range holds the chain's residues whose (number, insertion code) lies between its ends —
+    // by value, so a range whose end residue is missing still ends there. Per chain, residues
+    // sorted by that key, and each range adds one at its first residue and takes one off after
+    // its last: a running sum says how many helices (strands) hold a residue.
+    const auto key = [](int number, char insertion) {
+      return static_cast<std::int64_t>(number) * 256 + static_cast<unsigned char>(insertion);
+    };
+    struct Chain {
+      std::vector<std::pair<std::int64_t, BackboneResidue*>> residues;
+      std::vector<int> helix, strand;  // the ranges' starts (+1) and ends (−1), per position
+    };
+    std::map<std::string, Chain> chains;
+    for (BackboneResidue* r : all) chains[r->chain].residues.emplace_back(key(r->number, r->insertion), r);
+    for (auto& [chainName, chain] : chains) {
+      std::stable_sort(chain.residues.begin(), chain.residues.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
+      chain.helix.assign(chain.residues.size() + 1, 0);
+      chain.strand.assign(chain.residues.size() + 1, 0);
+    }
     for (const RecordedRange& range : parsed.recorded) {
-      // The residues from `first` to `last` in file order within the chain (insertion codes and
-      // numbering gaps as they come).
-      bool inside = false;
-      for (BackboneResidue* r : all) {
-        if (r->chain != range.chain) continue;
-        const gemmi::SeqId id(r->number, r->insertion);
-        if (id == range.first) inside = true;
-        if (inside && (r->structure == SecondaryStructure::Loop || range.structure == SecondaryStructure::Helix))
-          r->structure = range.structure;
-        if (id == range.last) inside = false;
+      const auto it = chains.find(range.chain);
+      if (it == chains.end() || !range.first.num || !range.last.num) continue;
+      Chain& chain = it->second;
+      const std::int64_t first = key(*range.first.num, range.first.icode),
+                         last = key(*range.last.num, range.last.icode);
+      const auto lo = std::lower_bound(chain.residues.begin(), chain.residues.end(), first,
+                                       [](const auto& r, std::int64_t k) { return r.first < k; });
+      const auto hi = std::upper_bound(chain.residues.begin(), chain.residues.end(), last,
+                                       [](std::int64_t k, const auto& r) { return k < r.first; });
+      if (lo >= hi) continue;
+      std::vector<int>& counts = range.structure == SecondaryStructure::Helix ? chain.helix : chain.strand;
+      ++counts[static_cast<std::size_t>(lo - chain.residues.begin())];
+      --counts[static_cast<std::size_t>(hi - chain.residues.begin())];
+    }
+    for (auto& [chainName, chain] : chains) {
+      int helix = 0, strand = 0;
+      for (std::size_t k = 0; k < chain.residues.size(); ++k) {
+        helix += chain.helix[k];
+        strand += chain.strand[k];
+        chain.residues[k].second->structure = helix > 0    ? SecondaryStructure::Helix
+                                              : strand > 0 ? SecondaryStructure::Strand
+                                                           : SecondaryStructure::Loop;
       }
     }
-    return true;
+    return;
   }
   std::vector<BackboneResidue> copy;
   copy.reserve(all.size());
@@ -366,7 +401,6 @@ bool assignStructure(Parsed& parsed, const std::string& name) {
     throw Error(name, e.what());
   }
   for (std::size_t i = 0; i < all.size(); ++i) all[i]->structure = ss[i];
-  return false;
 }
 
 Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const std::string& name,
@@ -456,8 +490,7 @@ struct AtomMeshBuilder {
   // An open tube of `sides` quads from `from` to `to` (the half of a bond on an atom's side).
   void tube(const Atom& atom, const glm::dvec3& from, const glm::dvec3& to, double radius, int sides) {
     const glm::dvec3 axis = glm::normalize(to - from);
-    const glm::dvec3 helper = std::abs(axis.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-    const glm::dvec3 u = glm::normalize(glm::cross(axis, helper)), v = glm::cross(axis, u);
+    const glm::dvec3 u = anyPerpendicular(axis), v = glm::cross(axis, u);
     const std::uint32_t base = next();
     for (int s = 0; s < sides; ++s) {
       const double angle = 2.0 * std::numbers::pi * s / sides;
@@ -661,9 +694,9 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
 
   // NMR ensembles: say which model is shown, in every part's name (the scene tree shows it).
   const std::string modelNote = parsed.models > 1 ? " (model 1 of " + std::to_string(parsed.models) + ")" : "";
-  const int representations = static_cast<int>(style.spheres) + static_cast<int>(style.ballAndStick) +
-                              static_cast<int>(style.sticks) + static_cast<int>(style.cartoon) +
-                              static_cast<int>(style.surface);
+  int representations = 0;
+  for (const MoleculeParts& r : {style.spheres, style.ballAndStick, style.sticks, style.cartoon, style.surface})
+    representations += r ? 1 : 0;
   std::size_t residues = 0;
   if (style.cartoon) {
     assignStructure(parsed, name);
@@ -679,24 +712,42 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
     object.material.color = glm::vec4(1.0f, 1.0f, 1.0f, Material{}.color.a);
     objects.push_back(std::move(object));
   };
+  // Whether a representation is drawn on this part.
+  const auto on = [](const MoleculeParts& drawnOn, const Part& part) {
+    switch (part.kind) {
+      case PartKind::Polymer:
+        return drawnOn.polymer;
+      case PartKind::Ligands:
+        return drawnOn.ligands;
+      case PartKind::Water:
+        break;
+    }
+    return drawnOn.water;
+  };
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const Part& part = parts[i];
-    if (style.spheres) add(part, "spheres", spheresMesh(part, unit));
-    if (style.ballAndStick)
+    if (on(style.spheres, part)) add(part, "spheres", spheresMesh(part, unit));
+    if (on(style.ballAndStick, part))
       add(part, "ball-and-stick",
           sticksMesh(part, firstAtom[i], all, bondedTo, kBallAndStickRadius, kBallScale, unit, tubeSides(level)));
-    if (style.sticks)
+    if (on(style.sticks, part))
       add(part, "sticks", sticksMesh(part, firstAtom[i], all, bondedTo, kStickRadius, 0.0, unit, tubeSides(level)));
-    if (style.cartoon && !part.residues.empty()) add(part, "cartoon", cartoonOf(part, residues));
+    if (on(style.cartoon, part) && !part.residues.empty()) add(part, "cartoon", cartoonOf(part, residues));
     // Water has no surface of its own (PyMOL leaves solvent out of surfaces too).
-    if (style.surface && !part.water) add(part, "surface", surfaceMesh(part, name));
+    if (on(style.surface, part) && part.kind != PartKind::Water) add(part, "surface", surfaceMesh(part, name));
     progress.step(0.6 + 0.4 * static_cast<double>(i + 1) / static_cast<double>(parts.size()));
   }
   if (objects.empty()) {
-    // Only cartoons and surfaces can come out empty: say why for each asked for.
-    std::string why;
-    if (style.cartoon) why = "no run of two polymer residues with Cα or P atoms for a cartoon";
-    if (style.surface) why += std::string(why.empty() ? "" : "; ") + "only water, which has no surface";
+    // What the structure has, and what cartoons and surfaces need.
+    std::vector<std::string> kinds;
+    for (const auto& [kind, what] : {std::pair{PartKind::Polymer, "polymer chains"},
+                                     std::pair{PartKind::Ligands, "ligands"}, std::pair{PartKind::Water, "water"}})
+      if (std::any_of(parts.begin(), parts.end(), [&](const Part& p) { return p.kind == kind; })) kinds.push_back(what);
+    std::string why = "the structure has " + kinds[0];
+    for (std::size_t k = 1; k < kinds.size(); ++k) why += (k + 1 == kinds.size() ? " and " : ", ") + kinds[k];
+    if (kinds.size() < 3) why += " only";
+    if (style.cartoon) why += "; a cartoon needs a run of two polymer residues with Cα or P atoms";
+    if (style.surface) why += "; water has no surface";
     throw Error(name, "nothing to draw as " + style.text() + " (" + why + ")");
   }
   return objects;
@@ -840,12 +891,30 @@ std::vector<Bond> perceiveBonds(const std::vector<MoleculeAtom>& atoms) {
   return bonds;
 }
 
+namespace {
+
+// The representations in the order text() names them.
+constexpr std::array<std::pair<MoleculeParts MoleculeStyle::*, const char*>, 5> kRepresentations = {
+    std::pair{&MoleculeStyle::spheres, "spheres"}, std::pair{&MoleculeStyle::ballAndStick, "ball-and-stick"},
+    std::pair{&MoleculeStyle::sticks, "sticks"}, std::pair{&MoleculeStyle::cartoon, "cartoon"},
+    std::pair{&MoleculeStyle::surface, "surface"}};
+constexpr std::array<std::pair<bool MoleculeParts::*, const char*>, 3> kPartKinds = {
+    std::pair{&MoleculeParts::polymer, "polymer"}, std::pair{&MoleculeParts::ligands, "ligands"},
+    std::pair{&MoleculeParts::water, "water"}};
+
+}  // namespace
+
 std::string MoleculeStyle::text() const {
   std::string out;
-  for (const auto& [on, name] :
-       {std::pair{spheres, "spheres"}, std::pair{ballAndStick, "ball-and-stick"}, std::pair{sticks, "sticks"},
-        std::pair{cartoon, "cartoon"}, std::pair{surface, "surface"}})
-    if (on) out += (out.empty() ? "" : ",") + std::string(name);
+  const auto item = [&](const std::string& s) { out += (out.empty() ? "" : ",") + s; };
+  for (const auto& [member, name] : kRepresentations) {
+    const MoleculeParts& parts = this->*member;
+    if (parts == MoleculeParts::all())
+      item(name);
+    else
+      for (const auto& [kind, kindName] : kPartKinds)
+        if (parts.*kind) item(std::string(name) + "@" + kindName);
+  }
   return out;
 }
 
@@ -856,8 +925,11 @@ MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& w
     if (line.size() > 48) line = line.substr(0, 45) + "...";
     return line;
   };
+  constexpr const char* kExpected =
+      " spheres, sticks, ball-and-stick, cartoon or surface, joined by ',' (cartoon,sticks@ligands: '@' "
+      "limits one to polymer, ligands or water)";
   MoleculeStyle style;
-  style.spheres = false;
+  style.spheres = {};
   bool any = false;
   std::string item;
   for (std::size_t i = 0; i <= text.size(); ++i) {
@@ -865,25 +937,30 @@ MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& w
       item += text[i];
       continue;
     }
-    if (item == "spheres")
-      style.spheres = true;
-    else if (item == "sticks")
-      style.sticks = true;
-    else if (item == "ball-and-stick")
-      style.ballAndStick = true;
-    else if (item == "cartoon")
-      style.cartoon = true;
-    else if (item == "surface")
-      style.surface = true;
-    else
-      throw Error(
-          quoted(what),
-          (item.empty() ? std::string("expected") : "unknown representation '" + quoted(item) + "': expected") +
-              " spheres, sticks, ball-and-stick, cartoon or surface, or several joined by ',' (surface,sticks)");
+    const std::size_t at = item.find('@');
+    const std::string name = item.substr(0, at);
+    const auto representation =
+        std::find_if(kRepresentations.begin(), kRepresentations.end(), [&](const auto& r) { return name == r.second; });
+    if (representation == kRepresentations.end())
+      throw Error(quoted(what),
+                  (item.empty() ? std::string("expected") : "unknown representation '" + quoted(name) + "': expected") +
+                      kExpected);
+    MoleculeParts& parts = style.*(representation->first);
+    if (at == std::string::npos) {
+      parts = MoleculeParts::all();
+    } else {
+      const std::string kind = item.substr(at + 1);
+      const auto k =
+          std::find_if(kPartKinds.begin(), kPartKinds.end(), [&](const auto& p) { return kind == p.second; });
+      if (k == kPartKinds.end())
+        throw Error(quoted(what), "unknown part '" + quoted(kind) + "' after '" + quoted(name) +
+                                      "@': expected polymer, ligands or water");
+      parts.*(k->first) = true;
+    }
     any = true;
     item.clear();
   }
-  if (!any) throw Error(quoted(what), "expected spheres, sticks, ball-and-stick, cartoon or surface");
+  if (!any) throw Error(quoted(what), std::string("expected") + kExpected);
   return style;
 }
 

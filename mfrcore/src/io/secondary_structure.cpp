@@ -7,7 +7,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "mfr/error.hpp"
@@ -99,7 +102,9 @@ std::vector<SecondaryStructure> assignSecondaryStructure(const std::vector<Backb
   const auto count = static_cast<std::int64_t>(r.size());
   if (count < 2) return out;
 
-  // Hydrogen bonds between residues whose Cα lie within 9 Å.
+  // Pairs whose Cα lie within 9 Å (mkdssp's "near" list): the only ones tried for hydrogen bonds
+  // and for bridges. Each residue's later neighbours, ascending, so that everything below runs in
+  // mkdssp's order (i, then j) — which decides ties between equal bond energies.
   std::vector<glm::dvec3> cas;
   cas.reserve(r.size());
   for (const Residue& x : r) cas.push_back(x.ca);
@@ -107,14 +112,20 @@ std::vector<SecondaryStructure> assignSecondaryStructure(const std::vector<Backb
   if (grid.largestCell() > kMaxResiduesPerCell)
     throw Error("secondary structure",
                 std::to_string(grid.largestCell()) + " residues in one cube of 9 Å: packed denser than any protein");
+  std::vector<std::vector<std::int64_t>> near(r.size());
+  for (std::int64_t i = 0; i < count; ++i) {
+    std::vector<std::int64_t>& n = near[static_cast<std::size_t>(i)];
+    grid.forEachWithin(r[static_cast<std::size_t>(i)].ca, kMinimalCADistance, [&](std::uint32_t j, double) {
+      if (static_cast<std::int64_t>(j) > i) n.push_back(j);
+    });
+    std::sort(n.begin(), n.end());
+  }
   for (std::int64_t i = 0; i < count; ++i)
-    grid.forEachWithin(r[static_cast<std::size_t>(i)].ca, kMinimalCADistance, [&](std::uint32_t jj, double d2) {
-      const auto j = static_cast<std::int64_t>(jj);
-      if (j <= i || d2 >= kMinimalCADistance * kMinimalCADistance) return;
+    for (const std::int64_t j : near[static_cast<std::size_t>(i)]) {
       Residue &a = r[static_cast<std::size_t>(i)], &b = r[static_cast<std::size_t>(j)];
       keepBest(a.acceptor, a.acceptorEnergy, j, hbondEnergy(a, b));
       if (j != i + 1) keepBest(b.acceptor, b.acceptorEnergy, i, hbondEnergy(b, a));
-    });
+    }
   // bond(d, a): the N–H of d bonds to the C=O of a (Kabsch & Sander's Hbond(a, d)).
   const auto bond = [&](std::int64_t d, std::int64_t a) {
     if (d < 0 || a < 0 || d >= count || a >= count) return false;
@@ -129,13 +140,19 @@ std::vector<SecondaryStructure> assignSecondaryStructure(const std::vector<Backb
     return from >= 0 && to < count && from <= to &&
            r[static_cast<std::size_t>(from)].chainRun == r[static_cast<std::size_t>(to)].chainRun;
   };
-  std::vector<SecondaryStructure> ss(r.size(), SecondaryStructure::Loop);
-  const auto at = [&](std::int64_t i) -> SecondaryStructure& { return ss[static_cast<std::size_t>(i)]; };
+  // DSSP's classes as far as they decide helix and strand: 3₁₀ helices (G) and isolated bridges (B)
+  // are drawn as loop but keep a π-helix off their residues, as in mkdssp.
+  enum class Assigned : std::uint8_t { Loop, Alpha, Strand, Bridge, Helix310, Pi };
+  std::vector<Assigned> ss(r.size(), Assigned::Loop);
+  const auto at = [&](std::int64_t i) -> Assigned& { return ss[static_cast<std::size_t>(i)]; };
 
-  // β-bridges, then ladders: consecutive bridges of one type, joined across bulges.
+  // β-bridges over the near pairs, then ladders: consecutive bridges of one type. A ladder that
+  // the next bridge (i + 1, j ± 1) would continue is found by that bridge's key.
   std::vector<Ladder> ladders;
+  std::map<std::tuple<Bridge, std::int64_t, std::int64_t>, std::size_t> continuedBy;
   for (std::int64_t i = 1; i + 4 < count; ++i)
-    for (std::int64_t j = i + 3; j + 1 < count; ++j) {
+    for (const std::int64_t j : near[static_cast<std::size_t>(i)]) {
+      if (j < i + 3 || j + 1 >= count) continue;
       if (!unbroken(i - 1, i + 1) || !unbroken(j - 1, j + 1)) continue;
       Bridge type;
       if ((bond(i + 1, j) && bond(j, i - 1)) || (bond(j + 1, i) && bond(i, j - 1)))
@@ -144,32 +161,35 @@ std::vector<SecondaryStructure> assignSecondaryStructure(const std::vector<Backb
         type = Bridge::Antiparallel;
       else
         continue;
-      bool joined = false;
-      for (Ladder& l : ladders) {
-        if (l.type != type || i != l.i.back() + 1) continue;
-        if (type == Bridge::Parallel && l.j.back() + 1 == j) {
-          l.i.push_back(i);
-          l.j.push_back(j);
-          joined = true;
-          break;
-        }
-        if (type == Bridge::Antiparallel && l.j.front() - 1 == j) {
-          l.i.push_back(i);
-          l.j.push_front(j);
-          joined = true;
-          break;
-        }
+      const auto it = continuedBy.find({type, i, j});
+      std::size_t l = ladders.size();
+      if (it != continuedBy.end()) {
+        l = it->second;
+        continuedBy.erase(it);
+        ladders[l].i.push_back(i);
+        if (type == Bridge::Parallel)
+          ladders[l].j.push_back(j);
+        else
+          ladders[l].j.push_front(j);
+      } else {
+        ladders.push_back({type, {i}, {j}});
       }
-      if (!joined) ladders.push_back({type, {i}, {j}});
+      continuedBy[{type, i + 1, type == Bridge::Parallel ? j + 1 : j - 1}] = l;
     }
   // Bulges: two ladders of one type whose strands are at most 1 (then 4 on the other strand) or
   // 2 residues apart become one. mkdssp compares unsigned differences: a negative one never links.
+  // Ladders are in order of their first i, so the search for a's partners ends at the first b
+  // that starts 6 or more after a ends.
   const auto within = [](std::int64_t d, std::int64_t limit) { return d >= 0 && d < limit; };
-  for (std::size_t a = 0; a < ladders.size(); ++a)
+  std::vector<bool> merged(ladders.size(), false);
+  for (std::size_t a = 0; a < ladders.size(); ++a) {
+    if (merged[a]) continue;
     for (std::size_t b = a + 1; b < ladders.size(); ++b) {
+      if (merged[b]) continue;
       Ladder &la = ladders[a], &lb = ladders[b];
       const std::int64_t ibi = la.i.front(), iei = la.i.back(), jbi = la.j.front(), jei = la.j.back();
       const std::int64_t ibj = lb.i.front(), iej = lb.i.back(), jbj = lb.j.front(), jej = lb.j.back();
+      if (ibj - iei >= 6) break;
       if (la.type != lb.type || !unbroken(std::min(ibi, ibj), std::max(iei, iej)) ||
           !unbroken(std::min(jbi, jbj), std::max(jei, jej)) || !within(ibj - iei, 6) || (iei >= ibj && ibi <= iej))
         continue;
@@ -182,30 +202,45 @@ std::vector<SecondaryStructure> assignSecondaryStructure(const std::vector<Backb
         la.j.insert(la.j.end(), lb.j.begin(), lb.j.end());
       else
         la.j.insert(la.j.begin(), lb.j.begin(), lb.j.end());
-      ladders.erase(ladders.begin() + static_cast<std::ptrdiff_t>(b));
-      b = a;  // look again from the start: the longer ladder may now reach another
+      merged[b] = true;
     }
-  for (const Ladder& l : ladders) {
-    if (l.i.size() < 2) continue;  // an isolated bridge (DSSP's B) is drawn as loop
-    for (std::int64_t k = l.i.front(); k <= l.i.back(); ++k) at(k) = SecondaryStructure::Strand;
-    for (std::int64_t k = l.j.front(); k <= l.j.back(); ++k) at(k) = SecondaryStructure::Strand;
+  }
+  for (std::size_t l = 0; l < ladders.size(); ++l) {
+    if (merged[l]) continue;
+    const Ladder& ladder = ladders[l];
+    const Assigned kind = ladder.i.size() > 1 ? Assigned::Strand : Assigned::Bridge;
+    for (const auto& [from, to] :
+         {std::pair{ladder.i.front(), ladder.i.back()}, std::pair{ladder.j.front(), ladder.j.back()}})
+      for (std::int64_t k = from; k <= to; ++k)
+        if (at(k) != Assigned::Strand) at(k) = kind;
   }
 
-  // n-turns at i: the C=O of i bonds to the N–H of i + n, within one unbroken run.
+  // n-turns at i: the C=O of i bonds to the N–H of i + n, within one unbroken run. Helices from two
+  // consecutive n-turns, in mkdssp's order: α (n = 4) over anything; 3₁₀ (n = 3) over loop only;
+  // π (n = 5, which mkdssp 4 prefers to α) over loop, α and π only.
   const auto turn = [&](std::int64_t i, std::int64_t n) { return i >= 0 && unbroken(i, i + n) && bond(i + n, i); };
-  // α-helices: two consecutive 4-turns; they win over strands. Then π-helices (5-turns, which
-  // mkdssp 4 prefers over α) over loop and helix only.
   for (std::int64_t i = 1; i + 4 < count; ++i)
     if (turn(i, 4) && turn(i - 1, 4))
-      for (std::int64_t k = i; k <= i + 3; ++k) at(k) = SecondaryStructure::Helix;
+      for (std::int64_t k = i; k <= i + 3; ++k) at(k) = Assigned::Alpha;
+  for (std::int64_t i = 1; i + 3 < count; ++i)
+    if (turn(i, 3) && turn(i - 1, 3)) {
+      bool free = true;
+      for (std::int64_t k = i; k <= i + 2; ++k) free = free && (at(k) == Assigned::Loop || at(k) == Assigned::Helix310);
+      if (free)
+        for (std::int64_t k = i; k <= i + 2; ++k) at(k) = Assigned::Helix310;
+    }
   for (std::int64_t i = 1; i + 5 < count; ++i)
     if (turn(i, 5) && turn(i - 1, 5)) {
       bool free = true;
-      for (std::int64_t k = i; k <= i + 4; ++k) free = free && at(k) != SecondaryStructure::Strand;
+      for (std::int64_t k = i; k <= i + 4; ++k)
+        free = free && (at(k) == Assigned::Loop || at(k) == Assigned::Alpha || at(k) == Assigned::Pi);
       if (free)
-        for (std::int64_t k = i; k <= i + 4; ++k) at(k) = SecondaryStructure::Helix;
+        for (std::int64_t k = i; k <= i + 4; ++k) at(k) = Assigned::Pi;
     }
-  for (std::size_t k = 0; k < r.size(); ++k) out[index[k]] = ss[k];
+  for (std::size_t k = 0; k < r.size(); ++k)
+    out[index[k]] = ss[k] == Assigned::Alpha || ss[k] == Assigned::Pi ? SecondaryStructure::Helix
+                    : ss[k] == Assigned::Strand                       ? SecondaryStructure::Strand
+                                                                      : SecondaryStructure::Loop;
   return out;
 }
 

@@ -8,18 +8,13 @@
 #include <string>
 
 #include "mfr/error.hpp"
+#include "scene/perpendicular.hpp"
 
 namespace mfr {
 namespace {
 
 bool finite(const glm::dvec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-// A unit vector perpendicular to `t`.
-glm::dvec3 anyPerpendicular(const glm::dvec3& t) {
-  const glm::dvec3 helper = std::abs(t.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-  return glm::normalize(glm::cross(t, helper));
 }
 
 // The cross-section at a point of the curve: semi-axes along the band's width (a) and thickness
@@ -154,7 +149,7 @@ Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const
       if (glm::length(tangent) < 0.5) tangent = glm::dvec3(0, 0, 1);  // coincident traces: any direction
       // The band's width: the guides interpolated and made perpendicular to the curve; where
       // there is none (nucleic acids) or it runs along the curve, the previous width carried on
-      // (parallel transport), so the tube never twists.
+      // (parallel transport).
       const auto i = static_cast<std::size_t>(std::clamp(std::floor(u), 0.0, static_cast<double>(m - 2)));
       const double t = u - static_cast<double>(i);
       glm::dvec3 g = (1.0 - t) * seg.guides[i] + t * seg.guides[i + 1];
@@ -166,6 +161,10 @@ Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const
         if (glm::length(w) < 1e-9) w = anyPerpendicular(tangent);
       }
       w = glm::normalize(w);
+      // Projected onto the ring's plane, consecutive guides can still point apart (where the curve
+      // bends across them); every section is symmetric about its centre, so turning w round keeps
+      // the shape and stops the tube pinching there.
+      if (k > 0 && glm::dot(w, width) < 0.0) w = -w;
       const glm::dvec3 n = glm::cross(tangent, w);  // (w, n, tangent) right-handed
       width = w;
       previousTangent = tangent;

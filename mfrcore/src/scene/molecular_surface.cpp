@@ -28,6 +28,7 @@
 #include "mfr/error.hpp"
 #include "mfr/scene/contour.hpp"
 #include "mfr/scene/volume.hpp"
+#include "scene/perpendicular.hpp"
 #include "scene/point_grid.hpp"
 
 namespace mfr {
@@ -301,8 +302,7 @@ Mesh groupSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceO
       const double x = (d * d + ra * ra - rb * rb) / (2.0 * d);
       const double rho = std::sqrt(std::max(0.0, ra * ra - x * x));
       const glm::dvec3 m = ca + x * u;
-      const glm::dvec3 helper = std::abs(u.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-      const glm::dvec3 v = glm::normalize(glm::cross(u, helper)), w = glm::cross(u, v);
+      const glm::dvec3 v = anyPerpendicular(u), w = glm::cross(u, v);
       const int count = std::max(8, static_cast<int>(std::ceil(2.0 * std::numbers::pi * rho / (0.5 * h))));
       for (int t = 0; t < count; ++t) {
         const double angle = 2.0 * std::numbers::pi * t / count;

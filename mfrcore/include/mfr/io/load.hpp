@@ -36,20 +36,35 @@ struct LoadProgress {
   [[nodiscard]] LoadProgress part(double from, double to) const;
 };
 
-// How a molecule (PDB, mmCIF) is drawn: any combination of these representations, each a part of
-// its own per chain (PyMOL's `show`).
-struct MoleculeStyle {
-  bool spheres = true;        // space-filling: van der Waals spheres (PyMOL's spheres, CPK)
-  bool sticks = false;        // bonds as sticks of radius 0.25 Å, joined by spheres (PyMOL's sticks)
-  bool ballAndStick = false;  // balls of 23 % of the van der Waals radius, sticks of 0.15 Å (Jmol's)
-  bool cartoon = false;       // each polymer chain's backbone as helices, strands and loops (PyMOL's cartoon)
-  bool surface = false;       // the solvent-excluded surface of each part but water (probe 1.4 Å)
+// Which of a molecule's parts a representation draws: its polymer chains ("chain A", …), its
+// ligands, its water (PyMOL's polymer, organic + inorganic, solvent).
+struct MoleculeParts {
+  bool polymer = false, ligands = false, water = false;
 
-  // "spheres", "surface,sticks": the names in the order spheres, ball-and-stick, sticks, cartoon,
-  // surface.
+  static constexpr MoleculeParts all() { return {true, true, true}; }
+  // Drawn on some part.
+  explicit operator bool() const { return polymer || ligands || water; }
+  bool operator==(const MoleculeParts&) const = default;
+};
+
+// How a molecule (PDB, mmCIF) is drawn: any combination of these representations, each on all
+// parts or on some (PyMOL's `show sticks, organic`), each a part of its own per chain.
+struct MoleculeStyle {
+  MoleculeParts spheres = MoleculeParts::all();  // space-filling: van der Waals spheres (PyMOL's spheres, CPK)
+  MoleculeParts ballAndStick;  // balls of 23 % of the van der Waals radius, sticks of 0.15 Å (Jmol's)
+  MoleculeParts sticks;        // bonds as sticks of radius 0.25 Å, joined by spheres (PyMOL's sticks)
+  MoleculeParts cartoon;       // each polymer chain's backbone as helices, strands and loops (PyMOL's cartoon)
+  MoleculeParts surface;       // the solvent-excluded surface of each part but water (probe 1.4 Å)
+
+  // Some representation on some part.
+  [[nodiscard]] bool any() const { return spheres || ballAndStick || sticks || cartoon || surface; }
+  // "spheres", "surface,sticks", "cartoon,sticks@ligands": the names in the order spheres,
+  // ball-and-stick, sticks, cartoon, surface; one drawn on some parts only is followed by '@' and
+  // each of them (polymer, ligands, water), one item each.
   [[nodiscard]] std::string text() const;
-  // One or more names separated by ',' or '+'. Throws mfr::Error(what, reason) for an unknown or
-  // missing name.
+  // One or more names separated by ',' or '+', each on all parts or, followed by '@polymer',
+  // '@ligands' or '@water', on those (several items of one name add up). Throws
+  // mfr::Error(what, reason) for an unknown or missing name or part.
   static MoleculeStyle parse(const std::string& text, const std::string& what);
   bool operator==(const MoleculeStyle&) const = default;
 };

@@ -27,6 +27,11 @@ using Bond = std::array<std::uint32_t, 2>;  // indices of two atoms, the smaller
 // isolated bridges, coil) is loop.
 enum class SecondaryStructure : std::uint8_t { Loop, Helix, Strand };
 
+// DSSP's letter for it: 'H', 'E', or '-' for loop (as mfr info lists them).
+constexpr char secondaryStructureLetter(SecondaryStructure s) {
+  return s == SecondaryStructure::Helix ? 'H' : s == SecondaryStructure::Strand ? 'E' : '-';
+}
+
 // A residue of a polymer chain with the atoms its backbone is traced and assigned by.
 struct BackboneResidue {
   std::size_t part = 0;  // index into MoleculeStructure::parts
@@ -70,10 +75,10 @@ std::vector<Bond> perceiveBonds(const std::vector<MoleculeAtom>& atoms);
 // electrostatic energy E = 0.084·332·(1/r_ON + 1/r_CH − 1/r_OH − 1/r_CN) kcal/mol < −0.5 (H placed
 // 1 Å from N opposite the previous C=O; each N–H keeps its two best bonds), between residues whose
 // Cα are within 9 Å, in any chain; two consecutive 4-turns make an α-helix (5-turns, π-helices,
-// count as helix as well), ladders of two or more β-bridges (joined across bulges) make strands,
-// and helix wins over strand. Residues lacking N, CA, C or O take part in nothing and are loop; a
-// peptide bond longer than 2.5 Å breaks the chain. Returns one value per residue. Throws
-// mfr::Error("secondary structure", reason) for backbones packed denser than any protein.
+// count as helix as well, where no 3₁₀ helix, strand or isolated bridge is), ladders of two or
+// more β-bridges (joined across bulges) make strands, and α-helix wins over strand. Residues lacking N, CA, C or O take
+// part in nothing and are loop; a peptide bond longer than 2.5 Å breaks the chain. Returns one value per residue.
+// Throws mfr::Error("secondary structure", reason) for backbones packed denser than any protein.
 std::vector<SecondaryStructure> assignSecondaryStructure(const std::vector<BackboneResidue>& residues);
 
 }  // namespace mfr
