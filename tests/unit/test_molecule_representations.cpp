@@ -255,6 +255,22 @@ TEST_F(MoleculeStyles, RecordedRangesByResidueNumber) {
   EXPECT_EQ(letters, "-HHH--EEHHH-");
 }
 
+// A trace that repeats a point or turns straight back is no backbone: the repeated point is left
+// out and the run ends at the reversal, so every cartoon tube stays closed.
+TEST_F(MoleculeStyles, CartoonSkipsRepeatedPointsAndEndsRunsAtReversals) {
+  std::string pdb;
+  int serial = 1, number = 1;
+  for (const double x : {0.0, 3.8, 3.8, 7.6, 3.8})
+    pdb += record("ATOM", serial++, " CA ", "ALA", 'A', number++, {x, 0.0, 0.0}, "C");
+  const std::vector<Object> parts =
+      loadModel(write("trace.pdb", pdb + "END\n"), LoadOptions({}, MoleculeStyle::parse("cartoon", "t")));
+  ASSERT_EQ(parts.size(), 1u);
+  // One run of three residues (0, 3.8, 7.6): 17 rings of 16, two caps; the residue after the
+  // reversal alone draws nothing.
+  EXPECT_EQ(parts[0].mesh->triangleCount(), 16u * 16u * 2u + 2u * 16u);
+  EXPECT_TRUE(measureSurface(*parts[0].mesh, glm::dmat4(1.0)).closed());
+}
+
 // ---- naming, and where a style may be given -------------------------------------------------------
 
 TEST(MoleculeStyleNames, ParseAndText) {

@@ -568,14 +568,21 @@ glm::vec4 structureColor(SecondaryStructure s) {
 // is 3.8 Å (2.9 Å in a cis peptide), P–P in a nucleic acid's backbone about 6–7.5 Å.
 constexpr double kMaxCaStep = 4.5;
 constexpr double kMaxPhosphorusStep = 8.0;
+// Traces closer than this are one point; a turn sharper than 160° (virtual Cα angle under 20°; a
+// protein's are 80–150°) is no backbone either: both are left out of the curve, which could not be
+// a closed tube through them.
+constexpr double kMinTraceStep = 0.01;
+constexpr double kMaxReversal = -0.9397;  // cos 160°
 
 // The chain's cartoon (cartoonMesh): runs of residues with a trace atom, split where the chain is
 // broken; protein residues coloured by secondary structure, nucleotides by their P's element
-// colour; the trace atoms' fields. As finely sampled as keeps `residues` within the triangle cap.
+// colour; the trace atoms' fields. As finely sampled as keeps `residues` within the triangle cap
+// (down to 24 triangles a residue; 83,000 residues and more exceed it rather than lose residues).
 Mesh cartoonOf(const Part& part, std::size_t residues) {
   CartoonOptions options;
   options.fieldNames = {"b_factor", "occupancy", "residue"};
-  for (const auto& [samples, sides] : {std::pair{8, 16}, std::pair{6, 12}, std::pair{4, 8}}) {
+  for (const auto& [samples, sides] :
+       {std::pair{8, 16}, std::pair{6, 12}, std::pair{4, 8}, std::pair{3, 6}, std::pair{2, 6}}) {
     options.samplesPerResidue = samples;
     options.sides = sides;
     if (residues * static_cast<std::size_t>(2 * samples * sides) <= kMoleculeTriangleCap) break;
@@ -595,9 +602,16 @@ Mesh cartoonOf(const Part& part, std::size_t residues) {
     c.values = {atom->bFactor, atom->occupancy, atom->residue};
     if (previous != nullptr) {
       const bool previousAmino = previous->ca.has_value();
-      const double step = glm::distance(segments.back().back().trace, c.trace);
-      if (previous->chain != r.chain || amino != previousAmino || step > (amino ? kMaxCaStep : kMaxPhosphorusStep))
+      const std::vector<CartoonResidue>& run = segments.back();
+      const double step = glm::distance(run.back().trace, c.trace);
+      if (previous->chain != r.chain || amino != previousAmino || step > (amino ? kMaxCaStep : kMaxPhosphorusStep)) {
         segments.emplace_back();
+      } else if (step < kMinTraceStep) {
+        continue;  // the same point again: no backbone; the tube would fold onto itself
+      } else if (run.size() >= 2 && glm::dot(glm::normalize(run.back().trace - run[run.size() - 2].trace),
+                                             glm::normalize(c.trace - run.back().trace)) < kMaxReversal) {
+        segments.emplace_back();  // the trace turns back on itself: a new run (no backbone does)
+      }
     }
     segments.back().push_back(std::move(c));
     previous = &r;
