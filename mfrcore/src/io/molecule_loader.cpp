@@ -466,10 +466,15 @@ MoleculeStructure structureOf(const Parsed& parsed, const std::string& name) {
 
 // ---- geometry -----------------------------------------------------------------------------------
 
+// The colour-by fields every representation carries: each atom's B-factor, occupancy and residue
+// number (PyMOL's b, q and resi).
+constexpr std::array<const char*, 3> kAtomFieldNames = {"b_factor", "occupancy", "residue"};
+
 // Per-vertex colour and colour-by fields of an atom's geometry, appended together.
 struct AtomMeshBuilder {
   Mesh mesh;
-  MeshField bFactor{"b_factor", false, 1, {}}, occupancy{"occupancy", false, 1, {}}, residue{"residue", false, 1, {}};
+  MeshField bFactor{kAtomFieldNames[0], false, 1, {}}, occupancy{kAtomFieldNames[1], false, 1, {}},
+      residue{kAtomFieldNames[2], false, 1, {}};
 
   void vertex(const Atom& atom, const glm::dvec3& position, const glm::vec3& normal) {
     mesh.positions.emplace_back(position);
@@ -580,7 +585,7 @@ constexpr double kMaxReversal = -0.9397;  // cos 160°
 // (down to 24 triangles a residue; 83,000 residues and more exceed it rather than lose residues).
 Mesh cartoonOf(const Part& part, std::size_t residues) {
   CartoonOptions options;
-  options.fieldNames = {"b_factor", "occupancy", "residue"};
+  options.fieldNames.assign(kAtomFieldNames.begin(), kAtomFieldNames.end());
   for (const auto& [samples, sides] :
        {std::pair{8, 16}, std::pair{6, 12}, std::pair{4, 8}, std::pair{3, 6}, std::pair{2, 6}}) {
     options.samplesPerResidue = samples;

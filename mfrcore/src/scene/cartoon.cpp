@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <numbers>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "mfr/error.hpp"
 #include "scene/perpendicular.hpp"
@@ -91,7 +93,12 @@ Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const
   Mesh mesh;
   std::vector<MeshField> fields;
   for (const std::string& name : o.fieldNames) fields.push_back({name, false, 1, {}});
-  const double pi = std::numbers::pi;
+  // The ring's directions (cos, sin), the same for every ring.
+  std::vector<std::pair<double, double>> unitRing;
+  for (int v = 0; v < o.sides; ++v) {
+    const double angle = 2.0 * std::numbers::pi * v / o.sides;
+    unitRing.emplace_back(std::cos(angle), std::sin(angle));
+  }
 
   for (const std::vector<CartoonResidue>& residues : segments) {
     const std::size_t m = residues.size();
@@ -133,13 +140,16 @@ Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const
     const auto base = static_cast<std::uint32_t>(mesh.positions.size());
     glm::dvec3 width = glm::dvec3(0.0), firstCentre(0.0), lastCentre(0.0);
     glm::dvec3 previousTangent(0.0);
-    const auto pushValues = [&](double u) {
+    // The residues' values at parameter u, once, for `copies` vertices.
+    const auto pushValues = [&](double u, std::size_t copies) {
       const double lo = std::floor(u);
       const auto i = static_cast<std::size_t>(std::clamp(lo, 0.0, static_cast<double>(m - 1)));
       const std::size_t j = std::min(i + 1, m - 1);
       const double t = u - static_cast<double>(i);
-      for (std::size_t f = 0; f < fields.size(); ++f)
-        fields[f].values.push_back(static_cast<float>((1.0 - t) * residues[i].values[f] + t * residues[j].values[f]));
+      for (std::size_t f = 0; f < fields.size(); ++f) {
+        const auto value = static_cast<float>((1.0 - t) * residues[i].values[f] + t * residues[j].values[f]);
+        fields[f].values.insert(fields[f].values.end(), copies, value);
+      }
     };
     for (std::size_t k = 0; k < rings; ++k) {
       const double u = static_cast<double>(k) / o.samplesPerResidue;
@@ -173,15 +183,14 @@ Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const
 
       const Section s = sectionAt(u);
       const auto r = static_cast<std::size_t>(std::clamp(std::lround(u), 0L, static_cast<long>(m - 1)));
-      for (std::size_t v = 0; v < sides; ++v) {
-        const double angle = 2.0 * pi * static_cast<double>(v) / static_cast<double>(sides);
-        const double c = std::cos(angle), sn = std::sin(angle), e = 2.0 / s.exponent;
+      const double e = 2.0 / s.exponent;
+      for (const auto& [c, sn] : unitRing) {
         const double x = s.a * std::copysign(std::pow(std::abs(c), e), c);
         const double y = s.b * std::copysign(std::pow(std::abs(sn), e), sn);
         mesh.positions.emplace_back(centre + x * w + y * n);
-        mesh.colors.push_back(residues[r].color);
-        pushValues(u);
       }
+      mesh.colors.insert(mesh.colors.end(), sides, residues[r].color);
+      pushValues(u, sides);
     }
     // Quads between consecutive rings, counter-clockwise seen from outside.
     for (std::size_t k = 0; k + 1 < rings; ++k)
@@ -199,13 +208,9 @@ Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const
       const std::size_t r = atEnd ? m - 1 : 0;
       const auto centreIndex = static_cast<std::uint32_t>(mesh.positions.size());
       mesh.positions.emplace_back(atEnd ? lastCentre : firstCentre);
-      mesh.colors.push_back(residues[r].color);
-      pushValues(u);
-      for (std::size_t v = 0; v < sides; ++v) {
-        mesh.positions.push_back(mesh.positions[base + ring * sides + v]);
-        mesh.colors.push_back(residues[r].color);
-        pushValues(u);
-      }
+      for (std::size_t v = 0; v < sides; ++v) mesh.positions.push_back(mesh.positions[base + ring * sides + v]);
+      mesh.colors.insert(mesh.colors.end(), sides + 1, residues[r].color);
+      pushValues(u, sides + 1);
       for (std::size_t v = 0; v < sides; ++v) {
         const auto a = centreIndex + 1 + static_cast<std::uint32_t>(v);
         const auto b = centreIndex + 1 + static_cast<std::uint32_t>((v + 1) % sides);
