@@ -170,6 +170,65 @@ TEST(Section, OnlyTheCutLineMustBeClosed) {
   EXPECT_NEAR(capArea(cut), 1.0, 1e-6);
 }
 
+// Meshes of several shells, in one part: `b` joined to `a`, moved by `offset`, wound inside out if
+// `inverted`, its vertices coloured `colour`.
+Mesh joined(const Mesh& a, const Mesh& b, const glm::vec3& offset, bool inverted, const glm::vec4& colour) {
+  Mesh m = a;
+  if (m.colors.empty()) m.colors.assign(m.positions.size(), glm::vec4(1.0f));
+  const auto base = static_cast<std::uint32_t>(m.positions.size());
+  for (std::size_t i = 0; i < b.positions.size(); ++i) {
+    m.positions.push_back(b.positions[i] + offset);
+    m.normals.push_back(inverted ? -b.normals[i] : b.normals[i]);
+    m.colors.push_back(colour);
+  }
+  for (std::size_t t = 0; t < b.triangleCount(); ++t)
+    for (const int k : {0, inverted ? 2 : 1, inverted ? 1 : 2}) m.indices.push_back(base + b.indices[3 * t + k]);
+  return m;
+}
+
+// A self-intersecting part (a cartoon folding over at a tight bend, two tubes of one chain
+// overlapping): its cut line crosses itself, and the cap fills what the loops wind around, once —
+// the union of the overlapping sections — with a vertex at each crossing. A cavity wound inward
+// stays open, as before.
+TEST(Section, OverlappingShellsOfOnePartAreCappedByTheirUnion) {
+  const Mesh unit = makeBox({1.0, 1.0, 1.0});
+  const glm::vec4 red(1.0f, 0.0f, 0.0f, 1.0f);
+  const Mesh overlapping = joined(unit, unit, {0.5f, 0.5f, 0.0f}, false, red);
+  const SectionedMesh cut = sectionMesh(overlapping, {0.0, 0.0, 1.0, -0.2}, true);
+  EXPECT_TRUE(cut.closed);
+  ASSERT_EQ(cut.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(cut), 1.0 + 1.0 - 0.25, 1e-6);  // the union of the two unit squares
+  const Mesh& m = cut.mesh;
+  const std::size_t capStart = m.positions.size() - 3 * cut.capTriangles;
+  std::size_t atCrossings = 0;
+  for (std::size_t i = capStart; i < m.positions.size(); ++i) {
+    EXPECT_NEAR(m.positions[i].z, 0.2f, 1e-6f);
+    EXPECT_EQ(m.normals[i], glm::vec3(0.0f, 0.0f, -1.0f));
+    // The squares' edges cross at (0.5, 0) and (0, 0.5); a crossing takes the colour beside it.
+    const glm::vec2 p(m.positions[i]);
+    if (glm::distance(p, glm::vec2(0.5f, 0.0f)) < 1e-6f || glm::distance(p, glm::vec2(0.0f, 0.5f)) < 1e-6f) {
+      ++atCrossings;
+      EXPECT_TRUE(m.colors[i] == red || m.colors[i] == glm::vec4(1.0f));
+    }
+  }
+  EXPECT_GT(atCrossings, 0u);
+  // Both inside out, the loops wind the other way round: the same union.
+  const Mesh insideOut = joined(joined(Mesh{}, unit, {}, true, glm::vec4(1.0f)), unit, {0.5f, 0.5f, 0.0f}, true, red);
+  const SectionedMesh mirrored = sectionMesh(insideOut, {0.0, 0.0, 1.0, -0.2}, true);
+  ASSERT_EQ(mirrored.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(mirrored), 1.75, 1e-6);
+  // Shells wound against each other wind 0 around their overlap, which stays open.
+  const SectionedMesh opposed =
+      sectionMesh(joined(unit, unit, {0.5f, 0.5f, 0.0f}, true, red), {0.0, 0.0, 1.0, -0.2}, true);
+  ASSERT_EQ(opposed.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(opposed), 0.75 + 0.75, 1e-6);
+  // A cavity wound inward stays open.
+  const Mesh hollow = joined(makeBox({2.0, 2.0, 2.0}), unit, {}, true, red);
+  const SectionedMesh ring = sectionMesh(hollow, {0.0, 0.0, 1.0, -0.2}, true);
+  ASSERT_EQ(ring.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(ring), 4.0 - 1.0, 1e-6);
+}
+
 // A box whose +x face is moved out by `gap` (its edges no longer meet the neighbouring faces'):
 // a gap below 1e-3 of the size (the box's diagonal, 1.73) is joined and capped, a visible one is not.
 TEST(Section, TinyGapsAlongTheCutAreJoined) {

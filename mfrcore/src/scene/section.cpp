@@ -13,6 +13,7 @@
 #include <utility>
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Constrained_triangulation_plus_2.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
@@ -33,49 +34,59 @@ constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
 // joined, never points that close already, and the cap's area check stays the last word.
 constexpr double kCapWeld = 1e-3;
 
-// Faces of the cap's triangulation: how many constrained edges (cut-line segments) separate them
-// from the outside; odd is inside the section.
+// The cap's triangulation. Each cut-line segment is its own constraint, so that where segments
+// cross (a self-intersecting surface: a cartoon folding over at a tight bend, two tubes of one part
+// overlapping) CGAL splits them at the crossing and still tells which segments, in which direction,
+// run along each piece: the faces' winding numbers follow from that.
+constexpr std::size_t kCrossing = std::numeric_limits<std::size_t>::max();
+struct CapPoint {
+  std::size_t id = kCrossing;  // the cut-line point; kCrossing where two segments cross
+};
 struct CapFace {
-  int nesting = -1;
+  int winding = 0;
+  bool reached = false;
 };
 using CapKernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using CapTds =
-    CGAL::Triangulation_data_structure_2<CGAL::Triangulation_vertex_base_with_info_2<std::size_t, CapKernel>,
+    CGAL::Triangulation_data_structure_2<CGAL::Triangulation_vertex_base_with_info_2<CapPoint, CapKernel>,
                                          CGAL::Constrained_triangulation_face_base_2<
                                              CapKernel, CGAL::Triangulation_face_base_with_info_2<CapFace, CapKernel>>>;
-// Crossing segments (a self-intersecting cut line) throw instead of inventing points.
-using CapTriangulation =
-    CGAL::Constrained_Delaunay_triangulation_2<CapKernel, CapTds, CGAL::No_constraint_intersection_tag>;
+using CapTriangulation = CGAL::Constrained_triangulation_plus_2<
+    CGAL::Constrained_Delaunay_triangulation_2<CapKernel, CapTds, CGAL::Exact_predicates_tag>>;
 
-// Breadth-first from the infinite face: each region bounded by constrained edges gets one more
-// than the region it was reached from.
-void markNesting(CapTriangulation& cdt) {
-  for (const CapTriangulation::Face_handle f : cdt.all_face_handles()) f->info().nesting = -1;
-  std::vector<CapTriangulation::Edge> border;
-  const auto flood = [&](CapTriangulation::Face_handle start, int nesting) {
-    std::vector<CapTriangulation::Face_handle> queue{start};
-    while (!queue.empty()) {
-      const CapTriangulation::Face_handle f = queue.back();
-      queue.pop_back();
-      if (f->info().nesting != -1) continue;
-      f->info().nesting = nesting;
-      for (int i = 0; i < 3; ++i) {
-        const CapTriangulation::Face_handle next = f->neighbor(i);
-        if (next->info().nesting != -1) continue;
-        if (cdt.is_constrained({f, i}))
-          border.emplace_back(f, i);
-        else
-          queue.push_back(next);
-      }
-    }
+// The winding number of every face about the cut line (the plane's 2D frame, counter-clockwise
+// positive), breadth-first from the infinite face (0): crossing a piece of constraint a → b from
+// its left side lowers it by one per segment running a → b and raises it by one per segment
+// running b → a. False if two paths to a face disagree (never for closed loops; kept as a check).
+bool markWinding(CapTriangulation& cdt) {
+  for (const CapTriangulation::Face_handle f : cdt.all_face_handles()) f->info() = CapFace{};
+  const auto across = [&](CapTriangulation::Face_handle f, int i) {
+    if (!f->is_constrained(i)) return 0;
+    // Face f lies left of its edge i run from vertex ccw(i) to vertex cw(i).
+    const CapTriangulation::Vertex_handle a = f->vertex(CapTriangulation::ccw(i));
+    const CapTriangulation::Vertex_handle b = f->vertex(CapTriangulation::cw(i));
+    int change = 0;
+    for (auto context = cdt.contexts_begin(a, b); context != cdt.contexts_end(a, b); ++context)
+      change += *context->current() == a ? -1 : 1;
+    return change;
   };
-  flood(cdt.infinite_face(), 0);
-  while (!border.empty()) {
-    const CapTriangulation::Edge e = border.back();
-    border.pop_back();
-    const CapTriangulation::Face_handle next = e.first->neighbor(e.second);
-    if (next->info().nesting == -1) flood(next, e.first->info().nesting + 1);
+  std::vector<CapTriangulation::Face_handle> queue{cdt.infinite_face()};
+  cdt.infinite_face()->info().reached = true;
+  while (!queue.empty()) {
+    const CapTriangulation::Face_handle f = queue.back();
+    queue.pop_back();
+    for (int i = 0; i < 3; ++i) {
+      const CapTriangulation::Face_handle next = f->neighbor(i);
+      const int winding = f->info().winding + across(f, i);
+      if (next->info().reached) {
+        if (next->info().winding != winding) return false;
+        continue;
+      }
+      next->info() = {winding, true};
+      queue.push_back(next);
+    }
   }
+  return true;
 }
 
 // A cut line welded into loops: the segments exit → entry (vertex indices into `positions`) where
@@ -154,16 +165,25 @@ WeldedCutLine weldCutLine(const std::vector<glm::vec3>& positions,
   return w;
 }
 
-// The cap of a closed cut line: CGAL's constrained Delaunay triangulation fills the loops (inside:
-// an odd number of loops around), keeping every cut point as a vertex, so the cap meets the cut
-// surface edge to edge (watertight). The cap is kept only if its area equals the area the loops
-// enclose, to 0.1 %: a failed fill is dropped, never drawn. `corners` gets the cap's triangles as
-// vertex indices into `positions`, counter-clockwise seen from `outward`; empty when there is no cap.
-void fillCap(const std::vector<glm::vec3>& positions, const WeldedCutLine& line, const glm::dvec3& outward,
-             std::vector<std::uint32_t>& corners) {
-  corners.clear();
+// The cap of a closed cut line. CGAL's constrained Delaunay triangulation fills the loops by the
+// nonzero winding rule — inside where the loops wind around a point at all, so overlapping loops
+// are filled once and a hole wound the other way stays open — keeping every cut point as a vertex,
+// so the cap meets the cut surface edge to edge (watertight; where two segments cross, the cap gets
+// a vertex at the crossing). The cap is kept only if the areas of its faces, each times its winding
+// number, add up to the signed area the loops enclose, to 0.1 %: a failed fill is dropped, never
+// drawn.
+struct Cap {
+  // The cap's triangles, counter-clockwise seen from `outward`: indices into `positions`, then
+  // into `crossings` from positions.size() on. Empty when there is no cap.
+  std::vector<std::uint32_t> corners;
+  std::vector<glm::dvec3> crossings;  // where two segments of the cut line cross
+  std::vector<std::size_t> beside;    // per crossing: the vertex of `positions` nearest to it on the line
+};
+
+Cap fillCap(const std::vector<glm::vec3>& positions, const WeldedCutLine& line, const glm::dvec3& outward) {
+  Cap cap;
   const auto position = [&](std::size_t id) { return glm::dvec3(positions[line.source[id]]); };
-  // The plane's own 2D frame, about the cut line's centre.
+  // The plane's own 2D frame (u × v = outward), about the cut line's centre.
   glm::dvec3 centre(0.0);
   for (std::size_t id = 0; id < line.source.size(); ++id) centre += position(id);
   centre /= static_cast<double>(line.source.size());
@@ -172,41 +192,70 @@ void fillCap(const std::vector<glm::vec3>& positions, const WeldedCutLine& line,
   const glm::dvec3 v = glm::cross(outward, u);
   CapTriangulation cdt;
   std::vector<CapTriangulation::Vertex_handle> handle(line.source.size());
-  double enclosed = 0.0;  // about `centre`, along -outward (the cut line's own winding)
-  try {
-    for (std::size_t id = 0; id < line.source.size(); ++id) {
-      if (line.root[id] != id) continue;  // joined to its representative
-      const glm::dvec3 p = position(id) - centre;
-      handle[id] = cdt.insert(CapKernel::Point_2(glm::dot(p, u), glm::dot(p, v)));
-      handle[id]->info() = id;
-    }
-    for (const auto& [a, b] : line.segments) {
-      if (handle[a] == handle[b]) return;  // two points in one: no cap
-      cdt.insert_constraint(handle[a], handle[b]);
-      enclosed -= 0.5 * glm::dot(glm::cross(position(a) - centre, position(b) - centre), outward);
-    }
-  } catch (const CapTriangulation::Intersection_of_constraints_exception&) {
-    return;  // the cut line crosses itself: closed, but no cap
+  double enclosed = 0.0;  // about `centre`, along outward
+  for (std::size_t id = 0; id < line.source.size(); ++id) {
+    if (line.root[id] != id) continue;  // joined to its representative
+    const glm::dvec3 p = position(id) - centre;
+    handle[id] = cdt.insert(CapKernel::Point_2(glm::dot(p, u), glm::dot(p, v)));
+    if (handle[id]->info().id != kCrossing) return cap;  // two points in one: no cap
+    handle[id]->info().id = id;
   }
-  markNesting(cdt);
+  for (const auto& [a, b] : line.segments) {
+    cdt.insert_constraint(handle[a], handle[b]);
+    enclosed += 0.5 * glm::dot(glm::cross(position(a) - centre, position(b) - centre), outward);
+  }
+  if (!markWinding(cdt)) return cap;
+
+  // Crossings become points of the cap, in the plane.
+  std::vector<std::uint32_t> index(line.source.size());
+  for (std::size_t id = 0; id < line.source.size(); ++id) index[id] = line.source[id];
+  for (const CapTriangulation::Vertex_handle vertex : cdt.finite_vertex_handles()) {
+    if (vertex->info().id != kCrossing) continue;
+    const CapKernel::Point_2& q = vertex->point();
+    const glm::dvec3 at = centre + q.x() * u + q.y() * v;
+    std::size_t nearest = kCrossing;
+    double distance = std::numeric_limits<double>::infinity();
+    auto around = cdt.incident_vertices(vertex), first = around;
+    do {
+      if (!cdt.is_infinite(around) && around->info().id < line.source.size())  // a cut point, not a crossing
+        if (const double d = glm::distance(at, position(around->info().id)); d < distance) {
+          distance = d;
+          nearest = around->info().id;
+        }
+    } while (++around != first);
+    if (nearest == kCrossing) return cap;  // crossings all round: no colour to give it
+    vertex->info().id = index.size();
+    index.push_back(static_cast<std::uint32_t>(positions.size() + cap.crossings.size()));
+    cap.crossings.push_back(at);
+    cap.beside.push_back(line.source[nearest]);
+  }
+  const auto pointOf = [&](std::size_t id) {
+    return id < line.source.size() ? position(id) : cap.crossings[id - line.source.size()];
+  };
 
   std::vector<std::uint32_t> filled;
-  double area = 0.0;
+  double area = 0.0, wound = 0.0;
   for (const CapTriangulation::Face_handle f : cdt.finite_face_handles()) {
-    if (f->info().nesting % 2 != 1) continue;
+    const int winding = f->info().winding;
+    if (winding == 0) continue;
     std::size_t ids[3];
     glm::dvec3 p[3];
     for (int k = 0; k < 3; ++k) {
-      ids[k] = f->vertex(k)->info();
-      p[k] = position(ids[k]);
+      ids[k] = f->vertex(k)->info().id;
+      p[k] = pointOf(ids[k]);
     }
     const double facing = glm::dot(glm::cross(p[1] - p[0], p[2] - p[0]), outward);
     if (facing == 0.0) continue;
     area += 0.5 * std::abs(facing);
+    wound += 0.5 * facing * winding;
     const int order[3] = {0, facing > 0.0 ? 1 : 2, facing > 0.0 ? 2 : 1};
-    for (const int k : order) filled.push_back(line.source[ids[k]]);
+    for (const int k : order) filled.push_back(index[ids[k]]);
   }
-  if (area > 0.0 && std::abs(area - enclosed) <= 1e-3 * area) corners = std::move(filled);
+  if (area > 0.0 && std::abs(wound - enclosed) <= 1e-3 * area)
+    cap.corners = std::move(filled);
+  else
+    cap.crossings.clear(), cap.beside.clear();
+  return cap;
 }
 
 }  // namespace
@@ -318,23 +367,26 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
     const double weldDistance = std::max(kCapWeld * glm::length(box.max - box.min), 1e-30);
     WeldedCutLine line = weldCutLine(m.positions, cutLine, weldDistance);
     out.closed = line.closed();
-    std::vector<std::uint32_t> corners;
-    if (out.closed) fillCap(m.positions, line, -glm::normalize(n), corners);
-    if (!corners.empty()) {
-      out.capTriangles = corners.size() / 3;
+    const Cap cap = out.closed ? fillCap(m.positions, line, -glm::normalize(n)) : Cap{};
+    if (!cap.corners.empty()) {
+      out.capTriangles = cap.corners.size() / 3;
       const glm::vec3 outward(-glm::normalize(n));
-      for (const std::uint32_t c : corners) {
-        const glm::vec3 position = m.positions[c];
+      const std::size_t cutVertices = m.positions.size();
+      for (const std::uint32_t c : cap.corners) {
+        // A crossing takes its colour and value from the cut point beside it.
+        const bool crossing = c >= cutVertices;
+        const std::uint32_t from = crossing ? static_cast<std::uint32_t>(cap.beside[c - cutVertices]) : c;
+        const glm::vec3 position = crossing ? glm::vec3(cap.crossings[c - cutVertices]) : m.positions[c];
         m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
         m.positions.push_back(position);
         if (hasNormals) m.normals.push_back(outward);
         if (hasColors) {
-          const glm::vec4 colour = m.colors[c];
+          const glm::vec4 colour = m.colors[from];
           m.colors.push_back(colour);
         }
         // The cap is coloured by the field where the surface meets the plane, along its rim.
         if (hasScalars) {
-          const float value = m.scalars[c];
+          const float value = m.scalars[from];
           m.scalars.push_back(value);
         }
       }
@@ -426,8 +478,8 @@ std::vector<bool> capJointly(std::vector<Object>& objects, std::vector<OpenCut>&
     }
     const WeldedCutLine line = weldCutLine(positions, cutLine, kCapWeld * glm::length(box.max - box.min));
     if (!line.closed()) continue;
-    std::vector<std::uint32_t> corners;
-    fillCap(positions, line, outward, corners);
+    const Cap cap = fillCap(positions, line, outward);
+    const std::vector<std::uint32_t>& corners = cap.corners;
     if (corners.empty()) continue;
 
     // The cap goes to the owner, in its object space.
@@ -441,10 +493,14 @@ std::vector<bool> capJointly(std::vector<Object>& objects, std::vector<OpenCut>&
     for (std::size_t c = 0; c < corners.size(); c += 3) {
       const std::uint32_t triangle[3] = {corners[c], corners[c + (mirrored ? 2 : 1)], corners[c + (mirrored ? 1 : 2)]};
       for (const std::uint32_t corner : triangle) {
-        const auto [part, v] = from[corner];
+        // A crossing of two cut lines takes its colour and value from the cut point beside it.
+        const bool crossing = corner >= positions.size();
+        const auto [part, v] = from[crossing ? cap.beside[corner - positions.size()] : corner];
         const Mesh& source = open[part].cut.mesh;
-        const glm::vec3 position =
-            part == owner ? source.positions[v] : glm::vec3(toOwner * glm::dvec4(open[part].world[v], 1.0));
+        const glm::vec3 position = crossing
+                                       ? glm::vec3(toOwner * glm::dvec4(cap.crossings[corner - positions.size()], 1.0))
+                                   : part == owner ? source.positions[v]
+                                                   : glm::vec3(toOwner * glm::dvec4(open[part].world[v], 1.0));
         const glm::vec4 colour = source.colors.empty() ? glm::vec4(1.0f) : source.colors[v];
         const float value = source.scalars.empty() ? 0.0f : source.scalars[v];
         m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));

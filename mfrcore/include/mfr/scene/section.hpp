@@ -44,9 +44,12 @@ struct SectionedMesh {
 // line — the segments where triangles cross the plane, repeats counted once, a segment and its
 // reverse cancelled, chains ending within 1e-3 of the bounding box's diagonal of another's start
 // joined — must form closed loops (the surface is closed where the plane cuts it; holes elsewhere do
-// not matter); the loops are filled, and the cap is kept only if its area equals the area they
-// enclose (0.1 %): a failed triangulation is dropped, never drawn. Caps get the normal -plane.xyz
-// (outward) and, when the mesh has vertex colours, the colours of the cut.
+// not matter); the loops are filled by the nonzero winding rule (overlapping loops of a
+// self-intersecting surface once, a cavity wound the other way not at all; where the line crosses
+// itself the cap gets a vertex), and the cap is kept only if its faces' areas times their winding
+// numbers add up to the area the loops enclose (0.1 %): a failed triangulation is dropped, never
+// drawn. Caps get the normal -plane.xyz (outward) and, when the mesh has vertex colours, the
+// colours of the cut.
 SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps);
 
 struct SectionReport {
