@@ -1,4 +1,5 @@
 #include <iostream>
+#include <map>
 #include <memory>
 
 #include <nlohmann/json.hpp>
@@ -71,6 +72,18 @@ void addInfo(CLI::App& app) {
                          {"bonds", molecule->bonds.size()},
                          {"models", molecule->models},
                          {"representations", opt->read.load().molecule.value_or(MoleculeStyle{}).text()}};
+        // Atoms per element (PyMOL's count_atoms elem X), in the order of the periodic table.
+        std::map<int, std::size_t> perElement;
+        for (const MoleculeAtom& a : molecule->atoms) ++perElement[a.atomicNumber];
+        nlohmann::ordered_json elements = nlohmann::ordered_json::object();
+        for (const auto& [number, count] : perElement) elements[elementSymbol(number)] = count;
+        j["molecule"]["elements"] = elements;
+        // Atoms per part, as drawn.
+        std::vector<std::size_t> perPart(molecule->parts.size(), 0);
+        for (const MoleculeAtom& a : molecule->atoms) ++perPart[a.part];
+        nlohmann::ordered_json atomParts = nlohmann::ordered_json::object();
+        for (std::size_t p = 0; p < perPart.size(); ++p) atomParts[molecule->parts[p]] = perPart[p];
+        j["molecule"]["parts"] = atomParts;
         // Secondary structure, as the cartoon draws it: per chain one letter per residue (H helix,
         // E strand, - loop), in file order.
         std::vector<std::string> letters(molecule->parts.size());

@@ -9,11 +9,13 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
 
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "mfr/io/molecule.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "test_files.hpp"
 
@@ -273,6 +275,75 @@ TEST_F(MoleculeLoader, BlankChainHydrogensAndNoTer) {
   const auto objects = mfr::loadModel(write("blank.pdb", s));
   EXPECT_EQ(atomsPerPart(objects),
             (std::map<std::string, std::size_t>{{"chain (blank)", 19}, {"ligands", 1}, {"water", 1}}));
+}
+
+// Residues sorted into parts by their kind and bonds, whatever the TER records and residue order
+// (as MD programs write files: no TER, no element columns, atom names from column 13, where gemmi
+// reads Cα "CA  " as calcium). gemmi's guess took a chain's polymer to end at its first residue
+// not of the chain's type: a chain starting with an acetyl cap was all ligands, and a chain of
+// protein then DNA lost its DNA.
+TEST_F(MoleculeLoader, ResiduesSortedByKindAndBonds) {
+  std::string s;
+  int serial = 1;
+  const auto atom = [&](const char* record, const char* name, const char* residue, char chain, int seq,
+                        const glm::dvec3& p) {
+    s += atomRecord(record, serial++, name, ' ', residue, chain, seq, p.x, p.y, p.z, "");
+  };
+  // A peptide along x, 3.8 Å per residue, each C bonded to the next N (1.33 Å).
+  const auto peptide = [&](const char* record, const char* residue, char chain, int seq, double x, bool selenium) {
+    atom(record, "N   ", residue, chain, seq, {x, 0.0, 0.0});
+    atom(record, "CA  ", residue, chain, seq, {x + 1.45, 0.3, 0.0});
+    atom(record, "C   ", residue, chain, seq, {x + 2.47, 0.0, 0.0});
+    atom(record, "O   ", residue, chain, seq, {x + 2.47, 1.23, 0.0});
+    atom(record, "CB  ", residue, chain, seq, {x + 1.45, -0.5, 1.3});
+    if (selenium) {
+      atom(record, "CG  ", residue, chain, seq, {x + 1.45, -0.5, 2.8});
+      atom(record, "SE  ", residue, chain, seq, {x + 1.45, -0.5, 4.7});
+      atom(record, "CE  ", residue, chain, seq, {x + 1.45, -0.5, 6.6});
+    }
+  };
+  // Chain A: ACE, ALA, ALA, MSE (HETATM, bonded into the chain), ALA, NME; then a free glutamate
+  // (HETATM, bonded to nothing), a ligand whose names read as chlorine, and GROMACS water (SOL).
+  atom("ATOM", "CH3 ", "ACE", 'A', 0, {-2.8, 0.0, 0.0});
+  atom("ATOM", "C   ", "ACE", 'A', 0, {-1.33, 0.0, 0.0});
+  atom("ATOM", "O   ", "ACE", 'A', 0, {-1.33, 1.23, 0.0});
+  peptide("ATOM", "ALA", 'A', 1, 0.0, false);
+  peptide("ATOM", "ALA", 'A', 2, 3.8, false);
+  peptide("HETATM", "MSE", 'A', 3, 7.6, true);
+  peptide("ATOM", "ALA", 'A', 4, 11.4, false);
+  atom("ATOM", "N   ", "NME", 'A', 5, {15.2, 0.0, 0.0});
+  atom("ATOM", "CH3 ", "NME", 'A', 5, {16.65, 0.3, 0.0});
+  peptide("HETATM", "GLU", 'A', 6, 30.0, false);
+  atom("HETATM", "CL1 ", "LIG", 'A', 7, {40.0, 0.0, 0.0});
+  atom("HETATM", "CL2 ", "LIG", 'A', 7, {41.8, 0.0, 0.0});
+  atom("ATOM", "OW  ", "SOL", 'A', 8, {50.0, 0.0, 0.0});
+  atom("ATOM", "HW1 ", "SOL", 'A', 8, {50.96, 0.0, 0.0});
+  atom("ATOM", "HW2 ", "SOL", 'A', 8, {49.76, 0.93, 0.0});
+  // Chain B: two alanines, then two DNA nucleotides, each O3' bonded to the next P (1.6 Å).
+  peptide("ATOM", "ALA", 'B', 1, 0.0, false);
+  peptide("ATOM", "ALA", 'B', 2, 3.8, false);
+  for (int k = 0; k < 2; ++k) {
+    const double x = 10.0 + 5.0 * k;
+    atom("ATOM", "P   ", " DA", 'B', 3 + k, {x, 5.0, 0.0});
+    atom("ATOM", "O5' ", " DA", 'B', 3 + k, {x + 1.0, 6.2, 0.0});
+    atom("ATOM", "C5' ", " DA", 'B', 3 + k, {x + 2.0, 7.3, 0.0});
+    atom("ATOM", "C4' ", " DA", 'B', 3 + k, {x + 3.0, 6.2, 0.0});
+    atom("ATOM", "C3' ", " DA", 'B', 3 + k, {x + 2.9, 4.8, 0.0});
+    atom("ATOM", "O3' ", " DA", 'B', 3 + k, {x + 3.4, 5.0, 0.0});  // 1.6 Å from the next P
+  }
+  const fs::path file = write("md.pdb", s + "END\n");
+  // 3 + 5 + 5 + 8 + 5 + 2 in chain A, 5 + 5 + 6 + 6 in chain B, 5 + 2 ligand atoms, 3 water.
+  EXPECT_EQ(atomsPerPart(mfr::loadModel(file)),
+            (std::map<std::string, std::size_t>{{"chain A", 28}, {"chain B", 22}, {"ligands", 7}, {"water", 3}}));
+  const mfr::MoleculeStructure m = mfr::readMoleculeStructure(file);
+  std::map<int, std::size_t> elements;
+  for (const mfr::MoleculeAtom& a : m.atoms) ++elements[a.atomicNumber];
+  // Cα carbon, not calcium (also the free glutamate's); water's OW and HW1 oxygen and hydrogen; the
+  // selenium stays; the ligand's chlorines are left as gemmi reads them.
+  EXPECT_EQ(elements, (std::map<int, std::size_t>{{1, 2}, {6, 32}, {7, 8}, {8, 13}, {15, 2}, {17, 2}, {34, 1}}));
+  std::string residues;
+  for (const mfr::BackboneResidue& r : m.residues) residues += r.chain + r.name + " ";
+  EXPECT_EQ(residues, "AACE AALA AALA AMSE AALA ANME BALA BALA BDA BDA ");
 }
 
 // The tessellation rule: 320 triangles per sphere while the structure stays within 2,000,000

@@ -403,6 +403,122 @@ void assignStructure(Parsed& parsed, const std::string& name) {
   for (std::size_t i = 0; i < all.size(); ++i) all[i]->structure = ss[i];
 }
 
+// Solvent residue names: gemmi's waters and those of MD programs (GROMACS SOL, CHARMM TIP3, …),
+// PyMOL's solvent.
+bool isWater(const gemmi::Residue& residue) {
+  static const std::array<std::string_view, 9> kSolvent = {"SOL", "TIP", "TIP3", "TIP4", "TIP5",
+                                                           "T3P", "T4P", "T5P",  "SPC"};
+  return residue.is_water() || std::find(kSolvent.begin(), kSolvent.end(), residue.name) != kSolvent.end();
+}
+
+// Whether `residue` is a link of a chain: an amino acid or a nucleotide by gemmi's table, or an
+// untabulated residue with the backbone of one (N, Cα, C; or P).
+bool isChainResidue(const gemmi::Residue& residue) {
+  const gemmi::ResidueInfo info = gemmi::find_tabulated_residue(residue.name);
+  if (info.found()) return info.is_amino_acid() || info.is_nucleic_acid();
+  // By atom names only: MD files' names start in column 13, where gemmi reads " CA" as calcium.
+  const auto has = [&](const char* atom) { return residue.find_atom(atom, '*') != nullptr; };
+  return (has("N") && has("CA") && has("C")) || (has("P") && (has("O3'") || has("O5'")));
+}
+
+// Whether two residues in a row are bonded as a chain is: a peptide bond (C of the first to N of
+// the next) or a phosphodiester bond (O3' to P), at most 2 Å long (1.33 and 1.61 Å in proteins and
+// nucleic acids).
+bool linked(const gemmi::Residue& first, const gemmi::Residue& next) {
+  const auto near = [](const gemmi::Atom* a, const gemmi::Atom* b) {
+    return a != nullptr && b != nullptr && a->pos.dist(b->pos) <= 2.0;
+  };
+  const gemmi::Atom* o3 = first.find_atom("O3'", '*');
+  if (o3 == nullptr) o3 = first.find_atom("O3*", '*');
+  return near(first.find_atom("C", '*'), next.find_atom("N", '*')) || near(o3, next.find_atom("P", '*'));
+}
+
+// Whether every ATOM/HETATM record of a PDB file names its element (columns 77–78). Files written
+// by MD programs (AMBER, CHARMM) often do not, and start atom names in column 13, so that gemmi
+// takes Cα ("CA  ") for calcium and γ-hydrogens ("HG1 ") for mercury.
+bool pdbGivesElements(const std::string& data) {
+  if (hasLineNumbersInColumns73To80(data)) return false;  // read as 72 columns
+  for (std::size_t start = 0; start < data.size();) {
+    std::size_t end = data.find('\n', start);
+    if (end == std::string::npos) end = data.size();
+    const std::string_view line = withoutLineEnd(std::string_view(data).substr(start, end - start));
+    if (isAtomRecord(line) && (line.size() < 78 || (line[76] == ' ' && line[77] == ' '))) return false;
+    start = end + 1;
+  }
+  return true;
+}
+
+// Elements of the atoms of a chain residue (polymer or free), its caps and water, where the file
+// does not give them: those hold only H, C, N, O, S, P and Se, so an atom gemmi guessed as anything
+// else from its name (or not at all: water's "OW", "HW1") is the element of its name's first
+// letter (PyMOL reads AMBER and GROMACS files so too).
+void fixChainElements(gemmi::Residue& residue) {
+  for (gemmi::Atom& atom : residue.atoms) {
+    const gemmi::El e = atom.element.elem;
+    if (e == gemmi::El::H || e == gemmi::El::D || e == gemmi::El::C || e == gemmi::El::N || e == gemmi::El::O ||
+        e == gemmi::El::S || e == gemmi::El::P || e == gemmi::El::Se)
+      continue;
+    const std::size_t letter = atom.name.find_first_not_of("0123456789 ");
+    if (letter == std::string::npos) continue;
+    switch (atom.name[letter]) {
+      case 'H':
+        atom.element = gemmi::Element(gemmi::El::H);
+        break;
+      case 'C':
+        atom.element = gemmi::Element(gemmi::El::C);
+        break;
+      case 'N':
+        atom.element = gemmi::Element(gemmi::El::N);
+        break;
+      case 'O':
+        atom.element = gemmi::Element(gemmi::El::O);
+        break;
+      case 'S':
+        atom.element = gemmi::Element(gemmi::El::S);
+        break;
+      case 'P':
+        atom.element = gemmi::Element(gemmi::El::P);
+        break;
+      default:
+        break;
+    }
+  }
+}
+
+// Entity types where the file does not give them (`given` false: a PDB file, whose TER records
+// MD programs put anywhere, or an mmCIF file without _entity), residue by residue as PyMOL sorts
+// them, not as gemmi's guess (the chain's residues up to the first one that is not of the chain's
+// polymer type, so that a chain starting with an acetyl cap, or mixing protein and DNA, lost its
+// polymer):
+// * water and MD solvent: water;
+// * amino acids and nucleotides: polymer if ATOM records or bonded to the residue before or after
+//   (HETATM MSE inside a chain); a lone HETATM one (a free amino acid, ATP) is a ligand;
+// * anything else is a ligand unless it is bonded into the chain (ACE and NME caps).
+void classifyResidues(gemmi::Chain& chain, const std::vector<bool>& given) {
+  std::vector<gemmi::Residue>& residues = chain.residues;
+  std::vector<bool> link(residues.size(), false);  // link[i]: residue i is bonded to i + 1
+  std::vector<bool> inChain(residues.size(), false);
+  for (std::size_t i = 0; i < residues.size(); ++i) {
+    inChain[i] = !isWater(residues[i]) && isChainResidue(residues[i]);
+    if (i + 1 < residues.size()) link[i] = linked(residues[i], residues[i + 1]);
+  }
+  for (std::size_t i = 0; i < residues.size(); ++i) {
+    if (given[i]) continue;
+    gemmi::Residue& residue = residues[i];
+    const bool before = i > 0 && link[i - 1], after = link[i];
+    bool polymer = false;
+    if (isWater(residue))
+      polymer = false;
+    else if (inChain[i])
+      polymer = residue.het_flag != 'H' || before || after;
+    else
+      polymer = (before && inChain[i - 1]) || (after && inChain[i + 1]);
+    residue.entity_type = polymer            ? gemmi::EntityType::Polymer
+                          : isWater(residue) ? gemmi::EntityType::Water
+                                             : gemmi::EntityType::NonPolymer;
+  }
+}
+
 Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const std::string& name,
                      const LoadProgress& progress) {
   progress.step(0.0);
@@ -426,11 +542,18 @@ Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const s
     throw Error(name, format == MoleculeFormat::Pdb ? "no atoms (no ATOM or HETATM records in the first model)"
                                                     : "no atoms (the _atom_site table of the first model is empty)");
   st.models.erase(st.models.begin() + 1, st.models.end());  // first model only: NMR ensembles hold many
-  try {
-    gemmi::setup_entities(st);  // entity types (polymer, non-polymer, water) where the file lacks them
-  } catch (const std::exception& e) {
-    throw Error(name, reason(e.what(), name));
+  // Entity types an mmCIF file gives (_entity.type) are kept; the others are sorted here.
+  std::vector<std::vector<bool>> given;
+  for (const gemmi::Chain& chain : st.models[0].chains) {
+    given.emplace_back();
+    for (const gemmi::Residue& residue : chain.residues)
+      given.back().push_back(format == MoleculeFormat::Mmcif && residue.entity_type != gemmi::EntityType::Unknown);
   }
+  for (std::size_t c = 0; c < st.models[0].chains.size(); ++c) classifyResidues(st.models[0].chains[c], given[c]);
+  if (format == MoleculeFormat::Pdb && !pdbGivesElements(contents))
+    for (gemmi::Chain& chain : st.models[0].chains)
+      for (gemmi::Residue& residue : chain.residues)
+        if (residue.entity_type != gemmi::EntityType::NonPolymer || isChainResidue(residue)) fixChainElements(residue);
   Parsed parsed{partsOf(st.models[0], name), models, {}};
   for (const gemmi::Helix& h : st.helices)
     parsed.recorded.push_back(
@@ -981,6 +1104,11 @@ MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& w
   }
   if (!any) throw Error(quoted(what), std::string("expected") + kExpected);
   return style;
+}
+
+std::string elementSymbol(int atomicNumber) {
+  if (atomicNumber <= 0 || atomicNumber > static_cast<int>(gemmi::El::Og)) return "X";
+  return gemmi::element_name(static_cast<gemmi::El>(atomicNumber));
 }
 
 }  // namespace mfr

@@ -62,6 +62,9 @@ struct MoleculeStructure {
 // loadModel does.
 MoleculeStructure readMoleculeStructure(const std::filesystem::path& path);
 
+// The chemical symbol of an element ("C", "Se"); "X" for 0 (unknown) and numbers beyond the table.
+std::string elementSymbol(int atomicNumber);
+
 // Covalent bonds from distances alone, the rule of Open Babel's ConnectTheDots and Jmol (the Blue
 // Obelisk's rebondFrom3DCoordinates): atoms a and b are bonded when 0.4 Å < |a − b| <
 // r_a + r_b + 0.45 Å, r the covalent radius (Cordero et al. 2008, as gemmi tabulates it); then,
