@@ -52,6 +52,7 @@ LoadOptions ReadOptions::load() const {
 
 Scene loadSceneWithOpacity(const std::string& path, double opacity, const ReadOptions& read) {
   Scene scene = loadScene(path, read.load());
+  for (const std::string& note : scene.notes) std::cerr << "note: " << note << "\n";
   if (opacity >= 0.0)
     for (Object& o : scene.objects) o.material.color.a = static_cast<float>(opacity);
   return scene;

@@ -46,6 +46,7 @@ void addInfo(CLI::App& app) {
     if (opt->scene.empty()) throw Error("info", "needs a scene (or --methods)");
     const auto [w, h] = parseSize("--size", opt->size);
     Scene scene = loadScene(opt->scene, opt->read.load());
+    for (const std::string& note : scene.notes) std::cerr << "note: " << note << "\n";
     opt->contours.apply(scene, -1.0);
     SectionReport section;
     applySectionOption(scene, opt->section, &section);
@@ -92,8 +93,10 @@ void addInfo(CLI::App& app) {
         for (std::size_t p = 0; p < letters.size(); ++p)
           if (!letters[p].empty()) chains[molecule->parts[p]] = letters[p];
         if (!molecule->residues.empty())
-          j["molecule"]["secondary_structure"] = {{"source", molecule->secondaryStructureFromFile ? "file" : "dssp"},
-                                                  {"chains", chains}};
+          j["molecule"]["secondary_structure"] = {
+              {"source", molecule->secondaryStructureFromFile ? "file" : "dssp"},
+              {"file_records_unmatched", molecule->secondaryStructureRecordsUnmatched},
+              {"chains", chains}};
       } catch (const Error& e) {
         bondsError = e.what();
         j["molecule"] = {{"error", bondsError}};
@@ -161,7 +164,10 @@ void addInfo(CLI::App& app) {
       }
       std::cout << "           " << molecule->residues.size() << " polymer residues: " << helix << " helix, " << strand
                 << " strand ("
-                << (molecule->secondaryStructureFromFile ? "the file's HELIX/SHEET records" : "DSSP, from the backbone")
+                << (molecule->secondaryStructureFromFile ? "the file's HELIX/SHEET records"
+                    : molecule->secondaryStructureRecordsUnmatched
+                        ? "DSSP, from the backbone: the file's HELIX/SHEET records hold none of its residues"
+                        : "DSSP, from the backbone")
                 << ")\n";
     }
     if (sectioned) {

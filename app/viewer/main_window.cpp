@@ -96,11 +96,14 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
   connect(model_, &ViewerModel::sceneLoaded, this, [this, loadEnded] {
     loadEnded();
     lastError_.clear();
-    statusBar()->showMessage(tr("Loaded %1 — %2 objects, %3 triangles")
-                                 .arg(model_->scenePath())
-                                 .arg(model_->scene().objects.size())
-                                 .arg(model_->scene().triangleCount()),
-                             8000);
+    // What loading could not do as asked (a cartoon of a structure without chains) follows.
+    QString message = tr("Loaded %1 — %2 objects, %3 triangles")
+                          .arg(model_->scenePath())
+                          .arg(model_->scene().objects.size())
+                          .arg(model_->scene().triangleCount());
+    for (const std::string& note : model_->scene().notes)
+      message += QStringLiteral("; ") + QString::fromStdString(note);
+    statusBar()->showMessage(message, model_->scene().notes.empty() ? 8000 : 20000);
     addRecentFile(model_->scenePath());
     rebuildNamedViews();
     updateTitle();

@@ -128,6 +128,22 @@ TEST_F(CliMolecules, RepresentationsGpuAndOracleAgree) {
       EXPECT_NE(oracles[i].pixels, oracles[k].pixels) << i << " " << k;
 }
 
+// A representation drawn on no part (pept.pdb has no ligands) is a note on stderr, the render goes
+// on and its output is written; one drawn on nothing at all fails.
+TEST_F(CliMolecules, ARepresentationDrawnOnNoPartIsANote) {
+  const fs::path out = dir() / "note.png";
+  const CliResult r = runCli("render " + kPept.string() +
+                             " --molecule cartoon,sticks@ligands --size 32x24 --method oracle -o " + out.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("note: " + kPept.string() + ": no sticks drawn (the structure has no ligands)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_TRUE(fs::exists(out));
+  const CliResult none = runCli("render " + kPept.string() + " --molecule sticks@ligands -o " + out.string());
+  EXPECT_EQ(none.exitCode, 1) << none.out;
+  EXPECT_NE(none.out.find("nothing to draw as sticks@ligands"), std::string::npos) << none.out;
+}
+
 class CliMoleculeRefusals : public mfr::test::CliTest {};
 
 TEST_F(CliMoleculeRefusals, BadRepresentationOrNotAMolecule) {

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "mfr/error.hpp"
@@ -16,6 +17,7 @@
 #include "mfr/io/molecule.hpp"
 #include "mfr/scene/measure.hpp"
 #include "mfr/scene/scene_file.hpp"
+#include "poly_alanine.hpp"
 #include "test_files.hpp"
 
 namespace mfr::test {
@@ -226,6 +228,40 @@ TEST_F(MoleculeStyles, RepresentationsOnSomePartsOnly) {
               [&] { (void)loadModel(protein, LoadOptions({}, MoleculeStyle::parse("sticks@ligands", "t"))); });
 }
 
+// A representation that draws on no part, while others do, is no error but a note naming the file
+// and the reason; the scene keeps the notes.
+TEST_F(MoleculeStyles, ARepresentationDrawnOnNoPartIsANote) {
+  const auto file = write("small.pdb", smallStructure());
+  std::vector<std::string> notes;
+  LoadOptions options({}, MoleculeStyle::parse("cartoon,sticks@ligands,spheres@water,surface@water", "t"));
+  options.notes = &notes;
+  const std::vector<Object> parts = loadModel(file, options);
+  ASSERT_EQ(parts.size(), 2u);  // the ligands' sticks, the water's spheres
+  const std::string path = file.string();
+  EXPECT_EQ(notes, (std::vector<std::string>{
+                       path + ": no cartoon drawn (no chain has a run of two residues with Cα or P atoms)",
+                       path + ": no surface drawn (water has no surface)"}));
+  notes.clear();
+  options.molecule = MoleculeStyle::parse("spheres,cartoon@ligands,ball-and-stick@water", "t");
+  (void)loadModel(write("ligands.pdb", record("HETATM", 1, " C  ", "CH4", 'A', 1, {0, 0, 0}, "C") + "END\n"), options);
+  ASSERT_EQ(notes.size(), 2u);
+  EXPECT_NE(notes[0].find("no ball-and-stick drawn (the structure has no water)"), std::string::npos) << notes[0];
+  EXPECT_NE(notes[1].find("no cartoon drawn (ligands and water have no cartoon)"), std::string::npos) << notes[1];
+  notes.clear();
+  options.molecule = MoleculeStyle::parse("spheres,cartoon", "t");
+  (void)loadModel(write("ligands.pdb", record("HETATM", 1, " C  ", "CH4", 'A', 1, {0, 0, 0}, "C") + "END\n"), options);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("no cartoon drawn (the structure has no polymer chains)"), std::string::npos) << notes[0];
+  // Everything drawn: no note. And through loadScene, the scene's notes.
+  notes.clear();
+  options.molecule = MoleculeStyle::parse("sticks", "t");
+  (void)loadModel(file, options);
+  EXPECT_TRUE(notes.empty());
+  const Scene scene = loadScene(file, LoadOptions({}, MoleculeStyle::parse("cartoon,spheres", "t")));
+  ASSERT_EQ(scene.notes.size(), 1u);
+  EXPECT_NE(scene.notes[0].find("no cartoon drawn"), std::string::npos);
+}
+
 // A file's HELIX/SHEET ranges hold the residues whose numbers lie between their ends, also when an
 // end residue is missing from the file (as PyMOL reads them); helix wins where both claim one.
 TEST_F(MoleculeStyles, RecordedRangesByResidueNumber) {
@@ -253,6 +289,37 @@ TEST_F(MoleculeStyles, RecordedRangesByResidueNumber) {
   for (const BackboneResidue& r : m.residues) letters += secondaryStructureLetter(r.structure);
   // 1 2 3 4 6 7 9 10 11 12 13 14
   EXPECT_EQ(letters, "-HHH--EEHHH-");
+}
+
+// Records that hold no residue of the structure (a chain renamed after the header was written)
+// are not read as "all loop": DSSP's structure is drawn, and the structure says so. A record that
+// holds a residue is taken, and DSSP not run.
+TEST_F(MoleculeStyles, RecordsThatHoldNoResidueGiveWayToDssp) {
+  std::string atoms;
+  int serial = 1;
+  for (const BackboneResidue& r : polyAlanine(12, -57.0, -47.0))  // an ideal α-helix
+    for (const auto& [name, p, element] : {std::tuple{" N  ", *r.n, "N"}, std::tuple{" CA ", *r.ca, "C"},
+                                           std::tuple{" C  ", *r.c, "C"}, std::tuple{" O  ", *r.o, "O"}})
+      atoms += record("ATOM", serial++, name, "ALA", 'A', r.number, p, element);
+  const auto helixRecord = [](char chain, int from, int to) {
+    char line[96];
+    std::snprintf(line, sizeof line, "HELIX  %3d %3s %3s %c %4d%c %3s %c %4d%c%2d\n", 1, "1", "ALA", chain, from, ' ',
+                  "ALA", chain, to, ' ', 1);
+    return std::string(line);
+  };
+  const auto letters = [](const MoleculeStructure& m) {
+    std::string out;
+    for (const BackboneResidue& r : m.residues) out += secondaryStructureLetter(r.structure);
+    return out;
+  };
+  const MoleculeStructure renamed = readMoleculeStructure(write("renamed.pdb", helixRecord('Z', 1, 12) + atoms));
+  EXPECT_FALSE(renamed.secondaryStructureFromFile);
+  EXPECT_TRUE(renamed.secondaryStructureRecordsUnmatched);
+  EXPECT_EQ(letters(renamed), "-HHHHHHHHHH-");
+  const MoleculeStructure recorded = readMoleculeStructure(write("recorded.pdb", helixRecord('A', 3, 5) + atoms));
+  EXPECT_TRUE(recorded.secondaryStructureFromFile);
+  EXPECT_FALSE(recorded.secondaryStructureRecordsUnmatched);
+  EXPECT_EQ(letters(recorded), "--HHH-------");
 }
 
 // A trace that repeats a point or turns straight back is no backbone: the repeated point is left

@@ -200,7 +200,7 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
       if (!gz) data = readAll(path, name);
       const auto molecule = ext == ".pdb" || ext == ".ent" ? io::MoleculeFormat::Pdb : io::MoleculeFormat::Mmcif;
       return io::readMolecule(data, molecule, name, options.molecule.value_or(MoleculeStyle{}),
-                              progress.part(gz ? 0.3 : 0.0, 0.95));
+                              progress.part(gz ? 0.3 : 0.0, 0.95), options.notes);
     }
   }
   throw Error(name, "unsupported file type");

@@ -69,8 +69,11 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
       scene.name = path.filename().string();
       if (isVolumeFile(path))
         scene.volumes.push_back(loadVolume(path, options, progress));
-      else
-        scene.objects = loadModel(path, LoadOptions{{}, options.molecule}, progress);
+      else {
+        LoadOptions model{{}, options.molecule};
+        model.notes = &scene.notes;
+        scene.objects = loadModel(path, model, progress);
+      }
     }
     Camera front;
     front.eye = {0.0, 0.0, 1.0};

@@ -335,15 +335,19 @@ struct Parsed {
   std::vector<Part> parts;
   std::size_t models = 1;
   std::vector<RecordedRange> recorded;  // the file's HELIX/SHEET (mmCIF struct_conf/sheet_range)
+  bool structureFromFile = false;       // assignStructure took the records
 };
 
-// Each polymer residue's secondary structure: the file's records when it has any (every helix
-// class counts as helix, and helix wins where a strand overlaps it, as PyMOL reads them),
-// otherwise DSSP's over the whole model (sheets join chains).
+// Each polymer residue's secondary structure: the file's records when it has any that hold a
+// residue (every helix class counts as helix, and helix wins where a strand overlaps it, as PyMOL
+// reads them), otherwise DSSP's over the whole model (sheets join chains). Records that hold no
+// residue at all (chains renamed or residues renumbered after the header was written) are not
+// taken as "all loop", as PyMOL takes them, but as no records.
 void assignStructure(Parsed& parsed, const std::string& name) {
   std::vector<BackboneResidue*> all;
   for (Part& part : parsed.parts)
     for (BackboneResidue& r : part.residues) all.push_back(&r);
+  parsed.structureFromFile = false;
   if (!parsed.recorded.empty()) {
     // A range holds the chain's residues whose (number, insertion code) lies between its ends —
     // by value, so a range whose end residue is missing still ends there. Per chain, residues
@@ -375,11 +379,13 @@ void assignStructure(Parsed& parsed, const std::string& name) {
       const auto hi = std::upper_bound(chain.residues.begin(), chain.residues.end(), last,
                                        [](std::int64_t k, const auto& r) { return k < r.first; });
       if (lo >= hi) continue;
+      parsed.structureFromFile = true;
       std::vector<int>& counts = range.structure == SecondaryStructure::Helix ? chain.helix : chain.strand;
       ++counts[static_cast<std::size_t>(lo - chain.residues.begin())];
       --counts[static_cast<std::size_t>(hi - chain.residues.begin())];
     }
     for (auto& [chainName, chain] : chains) {
+      if (!parsed.structureFromFile) break;
       int helix = 0, strand = 0;
       for (std::size_t k = 0; k < chain.residues.size(); ++k) {
         helix += chain.helix[k];
@@ -389,7 +395,7 @@ void assignStructure(Parsed& parsed, const std::string& name) {
                                                            : SecondaryStructure::Loop;
       }
     }
-    return;
+    if (parsed.structureFromFile) return;
   }
   std::vector<BackboneResidue> copy;
   copy.reserve(all.size());
@@ -573,7 +579,8 @@ int atomicNumber(gemmi::El element) {
 MoleculeStructure structureOf(const Parsed& parsed, const std::string& name) {
   MoleculeStructure out;
   out.models = parsed.models;
-  out.secondaryStructureFromFile = !parsed.recorded.empty();
+  out.secondaryStructureFromFile = parsed.structureFromFile;
+  out.secondaryStructureRecordsUnmatched = !parsed.recorded.empty() && !parsed.structureFromFile;
   for (std::size_t p = 0; p < parsed.parts.size(); ++p) {
     out.parts.push_back(parsed.parts[p].name);
     for (const Atom& a : parsed.parts[p].atoms) out.atoms.push_back({a.serial, atomicNumber(a.element), a.position, p});
@@ -806,7 +813,8 @@ MoleculeStructure readMoleculeStructure(const std::string& contents, MoleculeFor
 }
 
 std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat format, const std::string& name,
-                                 const MoleculeStyle& style, const LoadProgress& progress) {
+                                 const MoleculeStyle& style, const LoadProgress& progress,
+                                 std::vector<std::string>* notes) {
   Parsed parsed = parseMolecule(contents, format, name, progress);
   std::vector<Part>& parts = parsed.parts;
 
@@ -845,6 +853,7 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
     for (const Part& part : parts) residues += part.residues.size();
   }
   std::vector<Object> objects;
+  std::map<std::string, std::size_t> drawn;  // parts per representation
   const auto add = [&](const Part& part, const char* representation, Mesh mesh) {
     if (mesh.indices.empty()) return;
     Object object;
@@ -853,6 +862,7 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
     // White, so that the per-vertex element colours show as they are; the default opacity.
     object.material.color = glm::vec4(1.0f, 1.0f, 1.0f, Material{}.color.a);
     objects.push_back(std::move(object));
+    ++drawn[representation];
   };
   // Whether a representation is drawn on this part.
   const auto on = [](const MoleculeParts& drawnOn, const Part& part) {
@@ -879,12 +889,33 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
     if (on(style.surface, part) && part.kind != PartKind::Water) add(part, "surface", surfaceMesh(part, name));
     progress.step(0.6 + 0.4 * static_cast<double>(i + 1) / static_cast<double>(parts.size()));
   }
+  // What the structure has, and why a representation can draw nothing on it.
+  const auto has = [&](PartKind kind) {
+    return std::any_of(parts.begin(), parts.end(), [&](const Part& p) { return p.kind == kind; });
+  };
+  const auto whyNot = [&](MoleculeParts asked, std::string_view representation) {
+    // The parts it can draw on: a cartoon only chains, a surface all but water.
+    if (representation == "cartoon") asked.ligands = asked.water = false;
+    if (representation == "surface") asked.water = false;
+    if (!asked)
+      return std::string(representation == "cartoon" ? "ligands and water have no cartoon" : "water has no surface");
+    std::vector<std::string> missing;
+    if (asked.polymer && !has(PartKind::Polymer)) missing.emplace_back("polymer chains");
+    if (asked.ligands && !has(PartKind::Ligands)) missing.emplace_back("ligands");
+    if (asked.water && !has(PartKind::Water)) missing.emplace_back("water");
+    if (static_cast<int>(missing.size()) == int(asked.polymer) + int(asked.ligands) + int(asked.water)) {
+      std::string text = "the structure has no " + missing[0];
+      for (std::size_t k = 1; k < missing.size(); ++k) text += (k + 1 == missing.size() ? " or " : ", ") + missing[k];
+      return text;
+    }
+    if (representation == "cartoon") return std::string("no chain has a run of two residues with Cα or P atoms");
+    return std::string("no atoms to draw");
+  };
   if (objects.empty()) {
-    // What the structure has, and what cartoons and surfaces need.
     std::vector<std::string> kinds;
     for (const auto& [kind, what] : {std::pair{PartKind::Polymer, "polymer chains"},
                                      std::pair{PartKind::Ligands, "ligands"}, std::pair{PartKind::Water, "water"}})
-      if (std::any_of(parts.begin(), parts.end(), [&](const Part& p) { return p.kind == kind; })) kinds.push_back(what);
+      if (has(kind)) kinds.push_back(what);
     std::string why = "the structure has " + kinds[0];
     for (std::size_t k = 1; k < kinds.size(); ++k) why += (k + 1 == kinds.size() ? " and " : ", ") + kinds[k];
     if (kinds.size() < 3) why += " only";
@@ -892,6 +923,12 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
     if (style.surface) why += "; water has no surface";
     throw Error(name, "nothing to draw as " + style.text() + " (" + why + ")");
   }
+  if (notes != nullptr)
+    for (const auto& [representation, asked] :
+         {std::pair{"spheres", style.spheres}, std::pair{"ball-and-stick", style.ballAndStick},
+          std::pair{"sticks", style.sticks}, std::pair{"cartoon", style.cartoon}, std::pair{"surface", style.surface}})
+      if (asked && drawn[representation] == 0)
+        notes->push_back(name + ": no " + representation + " drawn (" + whyNot(asked, representation) + ")");
   return objects;
 }
 

@@ -19,9 +19,11 @@ enum class MoleculeFormat { Pdb, Mmcif };
 // file order), then "ligands" (every other non-water residue) and "water", each drawn in every
 // representation of `style` — one mesh per part and representation, named "chain A sticks" when
 // there are several — with per-vertex element colours and a white material. Reports progress
-// after parsing and per part; throws mfr::Error(name, reason) or LoadCancelled.
+// after parsing and per part; throws mfr::Error(name, reason) or LoadCancelled. A representation
+// drawn on no part while others are drawn is no error: `notes`, when given, gets a line saying so.
 std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat format, const std::string& name,
-                                 const MoleculeStyle& style = {}, const LoadProgress& progress = {});
+                                 const MoleculeStyle& style = {}, const LoadProgress& progress = {},
+                                 std::vector<std::string>* notes = nullptr);
 
 // The atoms readMolecule draws and their bonds.
 MoleculeStructure readMoleculeStructure(const std::string& contents, MoleculeFormat format, const std::string& name);

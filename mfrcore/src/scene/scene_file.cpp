@@ -527,6 +527,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
           if (!isMoleculeFile(file))
             r.fail(where + ".molecule", "only a molecule file (.pdb .ent .cif .mmcif) has representations");
         }
+        options.notes = &scene.notes;
         std::vector<Object> parts = loadModel(file, options, objectProgress);  // its errors name the model file
         colorBy.push_back(
             {&o, where, scene.objects.size(), scene.objects.size() + parts.size(), file.filename().string()});

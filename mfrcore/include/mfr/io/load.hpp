@@ -81,6 +81,10 @@ struct LoadOptions {
   // Molecule files: how to draw it; none: space-filling spheres. Given for any other file,
   // loading fails.
   std::optional<MoleculeStyle> molecule;
+  // Where loading adds a line, naming the file, for each thing it could not do as asked but that
+  // is no error (a molecule representation drawn on no part: `cartoon,sticks` of a structure
+  // without a chain to draw a cartoon of); none: not kept.
+  std::vector<std::string>* notes = nullptr;
 };
 
 // Loads a model file — STL, PLY (also .ply.gz), OBJ, OFF, VTP, VTK legacy, STEP, glTF/GLB and the

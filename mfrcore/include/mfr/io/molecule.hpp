@@ -55,6 +55,9 @@ struct MoleculeStructure {
   // takes it, otherwise assignSecondaryStructure's.
   std::vector<BackboneResidue> residues;
   bool secondaryStructureFromFile = false;
+  // The file has HELIX/SHEET records, but none holds a residue of the structure (chains renamed or
+  // residues renumbered after the header was written): DSSP's is drawn instead.
+  bool secondaryStructureRecordsUnmatched = false;
 };
 
 // The first model of a PDB or mmCIF file (also .gz), as loadModel draws it: the first alternative

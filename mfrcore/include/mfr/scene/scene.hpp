@@ -86,6 +86,8 @@ struct Scene {
   // fit() ignore it, like the clip box.
   std::optional<SectionPlane> section;
   bool sectionCut = false;  // the meshes are sectionedScene's: already cut by `section`
+  // What loading could not do as asked but is no error (LoadOptions::notes), one line each.
+  std::vector<std::string> notes;
 
   [[nodiscard]] Bounds bounds() const;  // world bounds of visible objects and volumes
   // Radius of the smallest sphere around bounds().center() holding every visible vertex and
