@@ -222,6 +222,29 @@ TEST(Section, OverlappingShellsOfOnePartAreCappedByTheirUnion) {
       sectionMesh(joined(unit, unit, {0.5f, 0.5f, 0.0f}, true, red), {0.0, 0.0, 1.0, -0.2}, true);
   ASSERT_EQ(opposed.outcome, SectionOutcome::kCapped);
   EXPECT_NEAR(capArea(opposed), 0.75 + 0.75, 1e-6);
+  // Shells whose cut lines overlap along a line (boxes side by side, half overlapping): the
+  // segments are collinear, and the crossings exact, so no constraint takes a detour.
+  const SectionedMesh collinear =
+      sectionMesh(joined(unit, unit, {0.5f, 0.0f, 0.0f}, false, red), {0.0, 0.0, 1.0, -0.2}, true);
+  ASSERT_EQ(collinear.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(collinear), 1.5, 1e-6);
+  // A surface wound inside out gets a cap that faces as it does: inward, and the cut box is again
+  // closed and consistently wound (volume negative). Where shells overlap, each region's cap faces
+  // as the shells winding around it.
+  const SectionedMesh inverted = sectionMesh(joined(Mesh{}, unit, {}, true, red), {0.0, 0.0, 1.0, -0.2}, true);
+  ASSERT_EQ(inverted.outcome, SectionOutcome::kCapped);
+  EXPECT_TRUE(closedAndConsistent(inverted.mesh));
+  EXPECT_NEAR(signedVolume(inverted.mesh), -0.3, 1e-6);
+  for (std::size_t i = inverted.mesh.positions.size() - 3 * inverted.capTriangles; i < inverted.mesh.positions.size();
+       ++i)
+    EXPECT_EQ(inverted.mesh.normals[i], glm::vec3(0.0f, 0.0f, 1.0f));
+  // A closed surface flattened into a plane: its cut points lie on one line and enclose nothing.
+  Mesh flat;
+  flat.positions = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, {1.0f, 0.0f, 1.0f}};
+  flat.indices = {0, 1, 2, 0, 2, 3, 0, 3, 1, 1, 3, 2};
+  const SectionedMesh line = sectionMesh(flat, {0.0, 0.0, 1.0, -0.3}, true);
+  EXPECT_EQ(line.outcome, SectionOutcome::kCut);
+  EXPECT_EQ(line.capTriangles, 0u);
   // A cavity wound inward stays open.
   const Mesh hollow = joined(makeBox({2.0, 2.0, 2.0}), unit, {}, true, red);
   const SectionedMesh ring = sectionMesh(hollow, {0.0, 0.0, 1.0, -0.2}, true);

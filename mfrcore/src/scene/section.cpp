@@ -10,10 +10,12 @@
 #include <sstream>
 #include <tuple>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 #include <CGAL/Constrained_Delaunay_triangulation_2.h>
 #include <CGAL/Constrained_triangulation_plus_2.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
@@ -34,10 +36,14 @@ constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
 // joined, never points that close already, and the cap's area check stays the last word.
 constexpr double kCapWeld = 1e-3;
 
-// The cap's triangulation. Each cut-line segment is its own constraint, so that where segments
-// cross (a self-intersecting surface: a cartoon folding over at a tight bend, two tubes of one part
-// overlapping) CGAL splits them at the crossing and still tells which segments, in which direction,
-// run along each piece: the faces' winding numbers follow from that.
+// The cap's triangulation, in two kinds. Most cut lines are simple loops: CGAL's constrained
+// Delaunay triangulation with inexact constructions fills them, and refuses (throws) where two
+// segments cross or a point lies on a segment. Then — a self-intersecting surface: a cartoon
+// folding over at a tight bend, two tubes of one part overlapping, shells meeting along a face —
+// the cut line is triangulated again with exact constructions, each segment its own constraint of
+// a Constrained_triangulation_plus_2, so that CGAL splits segments where they cross and still tells
+// which segments, in which direction, run along each piece (inexact crossings could send a
+// constraint on a detour through a nearby crossing).
 constexpr std::size_t kCrossing = std::numeric_limits<std::size_t>::max();
 struct CapPoint {
   std::size_t id = kCrossing;  // the cut-line point; kCrossing where two segments cross
@@ -46,38 +52,35 @@ struct CapFace {
   int winding = 0;
   bool reached = false;
 };
-using CapKernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using CapTds =
-    CGAL::Triangulation_data_structure_2<CGAL::Triangulation_vertex_base_with_info_2<CapPoint, CapKernel>,
-                                         CGAL::Constrained_triangulation_face_base_2<
-                                             CapKernel, CGAL::Triangulation_face_base_with_info_2<CapFace, CapKernel>>>;
-using CapTriangulation = CGAL::Constrained_triangulation_plus_2<
-    CGAL::Constrained_Delaunay_triangulation_2<CapKernel, CapTds, CGAL::Exact_predicates_tag>>;
+template <class Kernel>
+using CapTds = CGAL::Triangulation_data_structure_2<
+    CGAL::Triangulation_vertex_base_with_info_2<CapPoint, Kernel>,
+    CGAL::Constrained_triangulation_face_base_2<Kernel, CGAL::Triangulation_face_base_with_info_2<CapFace, Kernel>>>;
+using SimpleKernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using SimpleCapTriangulation = CGAL::Constrained_Delaunay_triangulation_2<SimpleKernel, CapTds<SimpleKernel>,
+                                                                          CGAL::No_constraint_intersection_tag>;
+using CrossingKernel = CGAL::Exact_predicates_exact_constructions_kernel;
+using CrossingCapTriangulation = CGAL::Constrained_triangulation_plus_2<
+    CGAL::Constrained_Delaunay_triangulation_2<CrossingKernel, CapTds<CrossingKernel>, CGAL::Exact_intersections_tag>>;
 
 // The winding number of every face about the cut line (the plane's 2D frame, counter-clockwise
-// positive), breadth-first from the infinite face (0): crossing a piece of constraint a → b from
-// its left side lowers it by one per segment running a → b and raises it by one per segment
+// positive), breadth-first from the infinite face (0): crossing a constrained edge a → b from its
+// left side changes it by across(a, b) — minus one per segment running a → b, plus one per segment
 // running b → a. False if two paths to a face disagree (never for closed loops; kept as a check).
-bool markWinding(CapTriangulation& cdt) {
-  for (const CapTriangulation::Face_handle f : cdt.all_face_handles()) f->info() = CapFace{};
-  const auto across = [&](CapTriangulation::Face_handle f, int i) {
-    if (!f->is_constrained(i)) return 0;
-    // Face f lies left of its edge i run from vertex ccw(i) to vertex cw(i).
-    const CapTriangulation::Vertex_handle a = f->vertex(CapTriangulation::ccw(i));
-    const CapTriangulation::Vertex_handle b = f->vertex(CapTriangulation::cw(i));
-    int change = 0;
-    for (auto context = cdt.contexts_begin(a, b); context != cdt.contexts_end(a, b); ++context)
-      change += *context->current() == a ? -1 : 1;
-    return change;
-  };
-  std::vector<CapTriangulation::Face_handle> queue{cdt.infinite_face()};
+template <class Triangulation, class Across>
+bool markWinding(Triangulation& cdt, const Across& across) {
+  for (const typename Triangulation::Face_handle f : cdt.all_face_handles()) f->info() = CapFace{};
+  std::vector<typename Triangulation::Face_handle> queue{cdt.infinite_face()};
   cdt.infinite_face()->info().reached = true;
   while (!queue.empty()) {
-    const CapTriangulation::Face_handle f = queue.back();
+    const typename Triangulation::Face_handle f = queue.back();
     queue.pop_back();
     for (int i = 0; i < 3; ++i) {
-      const CapTriangulation::Face_handle next = f->neighbor(i);
-      const int winding = f->info().winding + across(f, i);
+      const typename Triangulation::Face_handle next = f->neighbor(i);
+      // Face f lies left of its edge i run from vertex ccw(i) to vertex cw(i).
+      const int winding =
+          f->info().winding +
+          (f->is_constrained(i) ? across(f->vertex(Triangulation::ccw(i)), f->vertex(Triangulation::cw(i))) : 0);
       if (next->info().reached) {
         if (next->info().winding != winding) return false;
         continue;
@@ -169,73 +172,118 @@ WeldedCutLine weldCutLine(const std::vector<glm::vec3>& positions,
 // nonzero winding rule — inside where the loops wind around a point at all, so overlapping loops
 // are filled once and a hole wound the other way stays open — keeping every cut point as a vertex,
 // so the cap meets the cut surface edge to edge (watertight; where two segments cross, the cap gets
-// a vertex at the crossing). The cap is kept only if the areas of its faces, each times its winding
-// number, add up to the signed area the loops enclose, to 0.1 %: a failed fill is dropped, never
-// drawn.
+// a vertex at the crossing). A region the loops wind around the wrong way (an inside-out surface)
+// is capped facing the other way, as that surface faces. The cap is kept only if the areas of its
+// faces, each times its winding number, add up to the signed area the loops enclose, to 0.1 %: a
+// failed fill is dropped, never drawn.
 struct Cap {
-  // The cap's triangles, counter-clockwise seen from `outward`: indices into `positions`, then
-  // into `crossings` from positions.size() on. Empty when there is no cap.
+  // The cap's triangles, counter-clockwise seen from `outward` (or from −outward where `inward`):
+  // indices into `positions`, then into `crossings` from positions.size() on. Empty: no cap.
   std::vector<std::uint32_t> corners;
+  std::vector<bool> inward;           // per triangle: faces −outward (an inside-out surface's cap)
   std::vector<glm::dvec3> crossings;  // where two segments of the cut line cross
   std::vector<std::size_t> beside;    // per crossing: the vertex of `positions` nearest to it on the line
 };
 
-Cap fillCap(const std::vector<glm::vec3>& positions, const WeldedCutLine& line, const glm::dvec3& outward) {
-  Cap cap;
+// fillCap with one kind of triangulation; false when the simple kind refuses crossing segments.
+template <class Triangulation>
+bool fillCapWith(const std::vector<glm::vec3>& positions, const WeldedCutLine& line, const glm::dvec3& outward,
+                 Cap& cap) {
+  using Kernel = typename Triangulation::Geom_traits;
+  using Vertex = typename Triangulation::Vertex_handle;
+  constexpr bool crossings = requires(Triangulation t, Vertex a) {
+    t.contexts_begin(a, a);
+  };
+  cap = Cap{};
   const auto position = [&](std::size_t id) { return glm::dvec3(positions[line.source[id]]); };
-  // The plane's own 2D frame (u × v = outward), about the cut line's centre.
+  // The plane's own 2D frame (u × v = outward), about the cut line's centre. Outward solids wind
+  // −1 around their cap in it (their cut line runs clockwise seen from outside).
   glm::dvec3 centre(0.0);
   for (std::size_t id = 0; id < line.source.size(); ++id) centre += position(id);
   centre /= static_cast<double>(line.source.size());
   const glm::dvec3 u = glm::normalize(glm::abs(outward.x) < 0.9 ? glm::cross(outward, glm::dvec3(1.0, 0.0, 0.0))
                                                                 : glm::cross(outward, glm::dvec3(0.0, 1.0, 0.0)));
   const glm::dvec3 v = glm::cross(outward, u);
-  CapTriangulation cdt;
-  std::vector<CapTriangulation::Vertex_handle> handle(line.source.size());
+  Triangulation cdt;
+  std::vector<Vertex> handle(line.source.size());
   double enclosed = 0.0;  // about `centre`, along outward
   for (std::size_t id = 0; id < line.source.size(); ++id) {
     if (line.root[id] != id) continue;  // joined to its representative
     const glm::dvec3 p = position(id) - centre;
-    handle[id] = cdt.insert(CapKernel::Point_2(glm::dot(p, u), glm::dot(p, v)));
-    if (handle[id]->info().id != kCrossing) return cap;  // two points in one: no cap
+    handle[id] = cdt.insert(typename Kernel::Point_2(glm::dot(p, u), glm::dot(p, v)));
+    if (handle[id]->info().id != kCrossing) return true;  // two points in one: no cap
     handle[id]->info().id = id;
   }
-  for (const auto& [a, b] : line.segments) {
-    cdt.insert_constraint(handle[a], handle[b]);
-    enclosed += 0.5 * glm::dot(glm::cross(position(a) - centre, position(b) - centre), outward);
+  // The simple kind: each constrained edge is one segment, whose direction is kept here.
+  std::unordered_set<std::uint64_t> direction;  // (a, b) as a << 32 | b, point ids
+  const auto key = [](Vertex a, Vertex b) {
+    return static_cast<std::uint64_t>(a->info().id) << 32 | static_cast<std::uint64_t>(b->info().id);
+  };
+  try {
+    for (const auto& [a, b] : line.segments) {
+      cdt.insert_constraint(handle[a], handle[b]);
+      if constexpr (!crossings) direction.insert(key(handle[a], handle[b]));
+      enclosed += 0.5 * glm::dot(glm::cross(position(a) - centre, position(b) - centre), outward);
+    }
+  } catch (const typename SimpleCapTriangulation::Intersection_of_constraints_exception&) {
+    return false;
   }
-  if (!markWinding(cdt)) return cap;
+  if (cdt.dimension() < 2) return true;  // every point on one line: nothing enclosed
+  const auto across = [&](Vertex a, Vertex b) {
+    int change = 0;
+    if constexpr (crossings) {
+      for (auto context = cdt.contexts_begin(a, b); context != cdt.contexts_end(a, b); ++context)
+        change += *context->current() == a ? -1 : 1;
+    } else {
+      if (direction.contains(key(a, b))) --change;
+      if (direction.contains(key(b, a))) ++change;
+    }
+    return change;
+  };
+  if (!markWinding(cdt, across)) return true;
 
-  // Crossings become points of the cap, in the plane.
+  // Crossings become points of the cap, in the plane, coloured as the nearer end of a segment
+  // through them.
   std::vector<std::uint32_t> index(line.source.size());
   for (std::size_t id = 0; id < line.source.size(); ++id) index[id] = line.source[id];
-  for (const CapTriangulation::Vertex_handle vertex : cdt.finite_vertex_handles()) {
-    if (vertex->info().id != kCrossing) continue;
-    const CapKernel::Point_2& q = vertex->point();
-    const glm::dvec3 at = centre + q.x() * u + q.y() * v;
-    std::size_t nearest = kCrossing;
-    double distance = std::numeric_limits<double>::infinity();
-    auto around = cdt.incident_vertices(vertex), first = around;
-    do {
-      if (!cdt.is_infinite(around) && around->info().id < line.source.size())  // a cut point, not a crossing
-        if (const double d = glm::distance(at, position(around->info().id)); d < distance) {
-          distance = d;
-          nearest = around->info().id;
+  if constexpr (crossings) {
+    for (const Vertex vertex : cdt.finite_vertex_handles()) {
+      if (vertex->info().id != kCrossing) continue;
+      const auto& q = vertex->point();
+      const glm::dvec3 at = centre + CGAL::to_double(q.x()) * u + CGAL::to_double(q.y()) * v;
+      std::size_t nearest = kCrossing;
+      double distance = std::numeric_limits<double>::infinity();
+      auto around = cdt.incident_vertices(vertex), first = around;
+      do {
+        if (cdt.is_infinite(around) || !cdt.is_subconstraint(vertex, around)) continue;
+        // The segment's ends: the first and last vertices of its constraint.
+        for (auto context = cdt.contexts_begin(vertex, around); context != cdt.contexts_end(vertex, around);
+             ++context) {
+          Vertex last = *context->vertices_begin();
+          for (auto it = context->vertices_begin(); it != context->vertices_end(); ++it) last = *it;
+          for (const Vertex end : {*context->vertices_begin(), last})
+            if (end->info().id < line.source.size())
+              if (const double d = glm::distance(at, position(end->info().id)); d < distance) {
+                distance = d;
+                nearest = end->info().id;
+              }
         }
-    } while (++around != first);
-    if (nearest == kCrossing) return cap;  // crossings all round: no colour to give it
-    vertex->info().id = index.size();
-    index.push_back(static_cast<std::uint32_t>(positions.size() + cap.crossings.size()));
-    cap.crossings.push_back(at);
-    cap.beside.push_back(line.source[nearest]);
+      } while (++around != first);
+      if (nearest == kCrossing) return true;  // never: a crossing lies on segments between cut points
+      vertex->info().id = index.size();
+      index.push_back(static_cast<std::uint32_t>(positions.size() + cap.crossings.size()));
+      cap.crossings.push_back(at);
+      cap.beside.push_back(line.source[nearest]);
+    }
   }
   const auto pointOf = [&](std::size_t id) {
     return id < line.source.size() ? position(id) : cap.crossings[id - line.source.size()];
   };
 
   std::vector<std::uint32_t> filled;
+  std::vector<bool> inward;
   double area = 0.0, wound = 0.0;
-  for (const CapTriangulation::Face_handle f : cdt.finite_face_handles()) {
+  for (const typename Triangulation::Face_handle f : cdt.finite_face_handles()) {
     const int winding = f->info().winding;
     if (winding == 0) continue;
     std::size_t ids[3];
@@ -248,13 +296,26 @@ Cap fillCap(const std::vector<glm::vec3>& positions, const WeldedCutLine& line, 
     if (facing == 0.0) continue;
     area += 0.5 * std::abs(facing);
     wound += 0.5 * facing * winding;
-    const int order[3] = {0, facing > 0.0 ? 1 : 2, facing > 0.0 ? 2 : 1};
+    // Counter-clockwise seen from outward where the loops wind as an outward solid's (negative),
+    // from −outward where they wind the other way.
+    const bool flip = (facing > 0.0) == (winding > 0);
+    const int order[3] = {0, flip ? 2 : 1, flip ? 1 : 2};
     for (const int k : order) filled.push_back(index[ids[k]]);
+    inward.push_back(winding > 0);
   }
-  if (area > 0.0 && std::abs(wound - enclosed) <= 1e-3 * area)
+  if (area > 0.0 && std::abs(wound - enclosed) <= 1e-3 * area) {
     cap.corners = std::move(filled);
-  else
-    cap.crossings.clear(), cap.beside.clear();
+    cap.inward = std::move(inward);
+  } else {
+    cap = Cap{};
+  }
+  return true;
+}
+
+Cap fillCap(const std::vector<glm::vec3>& positions, const WeldedCutLine& line, const glm::dvec3& outward) {
+  Cap cap;
+  if (!fillCapWith<SimpleCapTriangulation>(positions, line, outward, cap))
+    fillCapWith<CrossingCapTriangulation>(positions, line, outward, cap);
   return cap;
 }
 
@@ -372,14 +433,15 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
       out.capTriangles = cap.corners.size() / 3;
       const glm::vec3 outward(-glm::normalize(n));
       const std::size_t cutVertices = m.positions.size();
-      for (const std::uint32_t c : cap.corners) {
+      for (std::size_t k = 0; k < cap.corners.size(); ++k) {
+        const std::uint32_t c = cap.corners[k];
         // A crossing takes its colour and value from the cut point beside it.
         const bool crossing = c >= cutVertices;
         const std::uint32_t from = crossing ? static_cast<std::uint32_t>(cap.beside[c - cutVertices]) : c;
         const glm::vec3 position = crossing ? glm::vec3(cap.crossings[c - cutVertices]) : m.positions[c];
         m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
         m.positions.push_back(position);
-        if (hasNormals) m.normals.push_back(outward);
+        if (hasNormals) m.normals.push_back(cap.inward[k / 3] ? -outward : outward);
         if (hasColors) {
           const glm::vec4 colour = m.colors[from];
           m.colors.push_back(colour);
@@ -505,7 +567,7 @@ std::vector<bool> capJointly(std::vector<Object>& objects, std::vector<OpenCut>&
         const float value = source.scalars.empty() ? 0.0f : source.scalars[v];
         m.indices.push_back(static_cast<std::uint32_t>(m.positions.size()));
         m.positions.push_back(position);
-        if (!m.normals.empty()) m.normals.push_back(normal);
+        if (!m.normals.empty()) m.normals.push_back(cap.inward[c / 3] ? -normal : normal);
         if (!m.colors.empty()) m.colors.push_back(colour);
         if (!m.scalars.empty()) m.scalars.push_back(value);
       }
