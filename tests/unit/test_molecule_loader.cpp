@@ -492,6 +492,16 @@ TEST_F(MoleculeLoader, AbsurdCoordinates) {
   std::string pdb = tinyPdb();
   pdb.replace(pdb.find("ATOM      1") + 30, 8, "99999999");  // x of the first atom
   expectLoadError(write("huge.pdb", pdb), "atom 1 (N of ALA 1, chain 'A') has coordinates (1e+08, 0, ");
+  // Not numbers (gemmi read "1.0x0" as 1 and a blank as 0): refused, naming the line and columns.
+  for (const auto& [text, reason] :
+       {std::pair{"   1.0x0", "line 4: the y coordinate (columns 39–46) is not a number: '1.0x0'"},
+        std::pair{"        ", "line 4: the y coordinate (columns 39–46) is blank"},
+        std::pair{"   -.   ", "line 4: the y coordinate (columns 39–46) is not a number: '-.'"},
+        std::pair{"  1.2.3 ", "line 4: the y coordinate (columns 39–46) is not a number: '1.2.3'"}}) {
+    std::string bad = tinyPdb();
+    bad.replace(bad.find("ATOM      2") + 38, 8, text);  // y of the second atom, on line 4
+    expectLoadError(write("nan.pdb", bad), reason);
+  }
 }
 
 TEST_F(MoleculeLoader, BrokenMmcifSyntax) {

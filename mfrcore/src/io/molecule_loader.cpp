@@ -150,6 +150,48 @@ void checkPdbNotCut(const std::string& data, const std::string& name) {
                           " (the one before has " + std::to_string(previous.size()) + ")");
 }
 
+// Coordinates that are not numbers: gemmi reads "2.0x0" as 2 and a blank field as 0, which would
+// put the atom somewhere it is not. Each of columns 31–38, 39–46 and 47–54 of an ATOM/HETATM
+// record must hold one decimal number, spaces around it.
+void checkPdbCoordinates(const std::string& data, const std::string& name) {
+  std::size_t lineNumber = 0;
+  for (std::size_t start = 0; start < data.size();) {
+    std::size_t end = data.find('\n', start);
+    if (end == std::string::npos) end = data.size();
+    ++lineNumber;
+    const std::string_view line = withoutLineEnd(std::string_view(data).substr(start, end - start));
+    start = end + 1;
+    if (!isAtomRecord(line) || line.size() < 54) continue;  // a short record: gemmi's and checkPdbNotCut's
+    for (const auto& [axis, from] : {std::pair{'x', 30}, std::pair{'y', 38}, std::pair{'z', 46}}) {
+      const std::string_view field = line.substr(static_cast<std::size_t>(from), 8);
+      const std::size_t first = field.find_first_not_of(' ');
+      const std::size_t last = field.find_last_not_of(' ');
+      std::size_t digits = 0;
+      bool number = first != std::string_view::npos;
+      if (number) {
+        const std::string_view value = field.substr(first, last - first + 1);
+        std::size_t i = value[0] == '-' || value[0] == '+' ? 1 : 0;
+        bool point = false;
+        for (; i < value.size() && number; ++i) {
+          if (std::isdigit(static_cast<unsigned char>(value[i])) != 0)
+            ++digits;
+          else if (value[i] == '.' && !point)
+            point = true;
+          else
+            number = false;
+        }
+      }
+      if (!number || digits == 0)
+        throw Error(name,
+                    "line " + std::to_string(lineNumber) + ": the " + std::string(1, axis) + " coordinate (columns " +
+                        std::to_string(from + 1) + "–" + std::to_string(from + 8) +
+                        (first == std::string_view::npos
+                             ? ") is blank"
+                             : ") is not a number: '" + std::string(field.substr(first, last - first + 1)) + "'"));
+    }
+  }
+}
+
 // Whether a CIF block looks like a small-molecule (coreCIF) structure rather than mmCIF.
 bool isSmallMoleculeCif(const gemmi::cif::Block& block) {
   for (const char* tag : {"_atom_site_fract_x", "_atom_site_label", "_atom_site_Cartn_x", "_cell_length_a"})
@@ -179,7 +221,9 @@ gemmi::Structure parse(const std::string& data, MoleculeFormat format, const std
     gemmi::PdbReadOptions options;
     // Columns 73–80 ignored: elements then come from the atom names, as in those files' time.
     if (hasLineNumbersInColumns73To80(data)) options.max_line_length = 72;
-    return gemmi::read_pdb_from_memory(data.data(), data.size(), name, options);
+    gemmi::Structure st = gemmi::read_pdb_from_memory(data.data(), data.size(), name, options);
+    checkPdbCoordinates(data, name);  // after gemmi's own checks (an mmCIF file named .pdb)
+    return st;
   }
   const gemmi::cif::Document doc = gemmi::cif::read_memory(data.data(), data.size(), name.c_str());
   if (doc.blocks.empty()) throw Error(name, "no CIF data block (data_...) in the file");
