@@ -271,6 +271,29 @@ TEST(MoleculeCartoon, RingsNeverTurnRound) {
   }
 }
 
+// 1LCD's DNA (two chains of the lac repressor's operator): each nucleotide with its phosphorus
+// and base drawn, as PyMOL draws them, with a ladder rod reaching its base's N1 or N3; the DNA
+// chains' cartoons closed.
+TEST(MoleculeCartoon, DnaLaddersReachTheirBases) {
+  const fs::path file = requireFile(kBiopython / "1LCD.pdb.gz", "Debian package python-biopython-doc");
+  const MoleculeStructure m = readMoleculeStructure(file);
+  const std::vector<Object> parts = loadModel(file, LoadOptions({}, MoleculeStyle::parse("cartoon", "t")));
+  std::size_t bases = 0;
+  for (const BackboneResidue& r : m.residues) {
+    if (!r.phosphorus || !r.base) continue;
+    ++bases;
+    const std::string name = m.parts[r.part];
+    const auto part =
+        std::find_if(parts.begin(), parts.end(), [&](const Object& o) { return o.name.rfind(name, 0) == 0; });
+    ASSERT_NE(part, parts.end()) << name;
+    EXPECT_TRUE(measureSurface(*part->mesh, glm::dmat4(1.0)).closed()) << name;
+    double nearest = 1e30;
+    for (const glm::vec3& v : part->mesh->positions) nearest = std::min(nearest, glm::distance(glm::dvec3(v), *r.base));
+    EXPECT_LT(nearest, 1e-3) << name << " " << r.number;  // the rod's end cap is centred on the base atom
+  }
+  EXPECT_GE(bases, 20u);  // 2 × 11 nucleotides, less the 5' ends without a phosphorus
+}
+
 // How many times `mesh` winds around point p: its triangles' signed crossings of a ray from p
 // (+1 leaving through an outward face). Nonzero inside the union of outward closed shells, also
 // where they overlap.

@@ -145,6 +145,44 @@ TEST(Cartoon, SegmentsAreSeparateTubesAndShortOnesDrawNothing) {
   EXPECT_TRUE(measureSurface(cartoonMesh({unguided}, o), glm::dmat4(1.0)).closed());
 }
 
+// A nucleic acid's backbone (P trace, no guide): PyMOL's 0.5 Å tube, and from the curve at each
+// nucleotide a closed 0.25 Å rod to its base atom, in the nucleotide's colour and values.
+TEST(Cartoon, NucleicAcidsAreHalfAngstromTubesWithLaddersToTheirBases) {
+  const CartoonOptions o = withField();
+  std::vector<CartoonResidue> run = straightRun(3, SecondaryStructure::Loop, glm::dvec3(0, 1, 0));
+  for (CartoonResidue& r : run) {
+    r.guide.reset();
+    r.nucleic = true;
+    r.ladder = r.trace + glm::dvec3(0.0, 6.0, 0.0);  // straight out sideways, 6 Å
+  }
+  run[2].ladder.reset();  // a nucleotide without its base atoms: no rod
+  const Mesh mesh = cartoonMesh({run}, o);
+  EXPECT_TRUE(measureSurface(mesh, glm::dmat4(1.0)).closed());
+  // The tube: 17 rings of 16 and two caps; each rod: 8 sides, capped (makeTube's 4·8 triangles).
+  EXPECT_EQ(mesh.triangleCount(), (16u * 16u * 2u + 2u * 16u) + 2u * (4u * 8u));
+  std::size_t onTube = 0, atBase = 0;
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    const glm::dvec3 p(mesh.positions[v]);
+    if (p.y < 1.0) {  // the backbone: 0.5 Å about the x axis (the rods start inside it)
+      const double r = std::hypot(p.y, p.z);
+      if (p.x > 0.0 && p.x < 7.6) {
+        EXPECT_LE(r, 0.5 + 1e-5);
+        onTube += std::abs(r - 0.5) < 1e-5 ? 1 : 0;
+      }
+      continue;
+    }
+    // A rod: 0.25 Å about its axis, reaching y = 6 at its base; residue 0's or 1's colour and value.
+    const std::size_t i = p.x < 1.9 ? 0 : 1;
+    EXPECT_LE(std::hypot(p.x - run[i].trace.x, p.z), 0.25 + 1e-5);
+    EXPECT_LE(p.y, 6.0 + 1e-5);
+    atBase += std::abs(p.y - 6.0) < 1e-5 ? 1 : 0;
+    EXPECT_EQ(mesh.colors[v], run[i].color);
+    EXPECT_EQ(mesh.fields[0].values[v], run[i].values[0]);
+  }
+  EXPECT_GT(onTube, 100u);
+  EXPECT_GT(atBase, 2u * 8u);
+}
+
 TEST(Cartoon, BadInputIsRefused) {
   std::vector<CartoonResidue> run = straightRun(3, SecondaryStructure::Loop, glm::dvec3(0, 1, 0));
   run[1].trace.x = std::numeric_limits<double>::quiet_NaN();

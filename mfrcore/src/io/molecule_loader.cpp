@@ -305,6 +305,8 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
       char& chosen = firstAltloc[{chain.name, residue.seqid}];
       BackboneResidue backbone;
       std::optional<Atom> trace;
+      std::optional<glm::dvec3> n1, n3;
+      bool purine = false;
       Part* polymer = nullptr;
       for (const gemmi::Atom& atom : residue.atoms) {
         if (atom.altloc != '\0') {
@@ -346,12 +348,17 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
         }
         if (atom.name == "C" && carbon && !backbone.c) backbone.c = p;
         if (atom.name == "O" && atom.element.elem == gemmi::El::O && !backbone.o) backbone.o = p;
+        // The ladder's end: N1 of a purine (which has N9), N3 of a pyrimidine.
+        if (atom.name == "N1" && !n1) n1 = p;
+        if (atom.name == "N3" && !n3) n3 = p;
+        if (atom.name == "N9") purine = true;
         if (atom.name == "P" && atom.element.elem == gemmi::El::P && !backbone.phosphorus) {
           backbone.phosphorus = p;
           if (!backbone.ca) trace = part->atoms.back();
         }
       }
       if (polymer != nullptr) {
+        if (backbone.phosphorus && !backbone.ca) backbone.base = purine ? n1 : n3;
         backbone.part = static_cast<std::size_t>(polymer - chains.data());
         backbone.chain = chain.name;
         backbone.number = residue.seqid.num.has_value() ? *residue.seqid.num : 0;
@@ -764,7 +771,9 @@ Mesh cartoonOf(const Part& part, std::size_t residues) {
        {std::pair{8, 16}, std::pair{6, 12}, std::pair{4, 8}, std::pair{3, 6}, std::pair{2, 6}}) {
     options.samplesPerResidue = samples;
     options.sides = sides;
-    if (residues * static_cast<std::size_t>(2 * samples * sides) <= kMoleculeTriangleCap) break;
+    // Per residue: its stretch of tube, and a nucleotide's ladder rod (4 triangles per side).
+    if (residues * static_cast<std::size_t>(2 * samples * sides + 4 * std::max(sides / 2, 6)) <= kMoleculeTriangleCap)
+      break;
   }
   std::vector<std::vector<CartoonResidue>> segments(1);
   const BackboneResidue* previous = nullptr;
@@ -779,6 +788,8 @@ Mesh cartoonOf(const Part& part, std::size_t residues) {
     c.structure = r.structure;
     c.color = amino ? structureColor(r.structure) : elementColor(atom->element);
     c.values = {atom->bFactor, atom->occupancy, atom->residue};
+    c.nucleic = !amino;
+    if (!amino) c.ladder = r.base;
     if (previous != nullptr) {
       const bool previousAmino = previous->ca.has_value();
       const std::vector<CartoonResidue>& run = segments.back();

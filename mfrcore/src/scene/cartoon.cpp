@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "mfr/error.hpp"
+#include "mfr/scene/primitives.hpp"
 #include "scene/perpendicular.hpp"
 
 namespace mfr {
@@ -88,7 +89,7 @@ void evaluate(const std::vector<glm::dvec3>& p, double u, glm::dvec3& position, 
 Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const CartoonOptions& o) {
   if (o.samplesPerResidue < 1 || o.sides < 3 || !(o.loopRadius > 0.0) || !(o.helixHalfWidth > 0.0) ||
       !(o.helixHalfThickness > 0.0) || !(o.strandHalfWidth > 0.0) || !(o.strandHalfThickness > 0.0) ||
-      !(o.arrowScale > 0.0))
+      !(o.arrowScale > 0.0) || !(o.nucleicRadius > 0.0) || !(o.ladderRadius > 0.0))
     throw Error("cartoon", "samples ≥ 1, sides ≥ 3 and positive sizes expected");
   Mesh mesh;
   std::vector<MeshField> fields;
@@ -104,7 +105,8 @@ Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const
     const std::size_t m = residues.size();
     if (m < 2) continue;
     for (const CartoonResidue& r : residues) {
-      if (!finite(r.trace)) throw Error("cartoon", "a residue's trace point is not finite");
+      if (!finite(r.trace) || (r.ladder && !finite(*r.ladder)))
+        throw Error("cartoon", "a residue's trace point is not finite");
       if (r.values.size() != o.fieldNames.size())
         throw Error("cartoon", "a residue has " + std::to_string(r.values.size()) + " values for " +
                                    std::to_string(o.fieldNames.size()) + " fields");
@@ -132,7 +134,12 @@ Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const
         case SecondaryStructure::Loop:
           break;
       }
-      return {o.loopRadius, o.loopRadius, 2.0};
+      const double radius =
+          residues[static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(r, 0, static_cast<std::ptrdiff_t>(m) - 1))]
+                  .nucleic
+              ? o.nucleicRadius
+              : o.loopRadius;
+      return {radius, radius, 2.0};
     };
 
     const std::size_t rings = (m - 1) * static_cast<std::size_t>(o.samplesPerResidue) + 1;
@@ -219,6 +226,19 @@ Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const
         else
           mesh.indices.insert(mesh.indices.end(), {centreIndex, b, a});
       }
+    }
+    // Ladders: a capped rod from the curve at each nucleotide to its base atom.
+    for (std::size_t i = 0; i < m; ++i) {
+      if (!residues[i].ladder) continue;
+      glm::dvec3 centre, d;
+      evaluate(seg.points, static_cast<double>(i), centre, d);
+      if (glm::distance(centre, *residues[i].ladder) < 1e-6) continue;
+      const Mesh rod = makeTube({centre, *residues[i].ladder}, o.ladderRadius, std::max(o.sides / 2, 6));
+      const auto first = static_cast<std::uint32_t>(mesh.positions.size());
+      mesh.positions.insert(mesh.positions.end(), rod.positions.begin(), rod.positions.end());
+      mesh.colors.insert(mesh.colors.end(), rod.positions.size(), residues[i].color);
+      pushValues(static_cast<double>(i), rod.positions.size());
+      for (const std::uint32_t index : rod.indices) mesh.indices.push_back(first + index);
     }
   }
   mesh.computeSmoothNormals();

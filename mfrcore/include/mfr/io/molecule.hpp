@@ -39,9 +39,10 @@ struct BackboneResidue {
   int number = 0;        // sequence number and insertion code (' ' for none)
   char insertion = ' ';
   std::string name;  // residue name, "ALA"
-  // Amino acids: the backbone's N, CA, C and O; nucleotides: the phosphorus. Absent atoms are
+  // Amino acids: the backbone's N, CA, C and O; nucleotides: the phosphorus, and the base atom a
+  // cartoon's ladder reaches (N1 of a purine, N3 of a pyrimidine, as PyMOL's). Absent atoms are
   // empty (first alternative location otherwise, as drawn).
-  std::optional<glm::dvec3> n, ca, c, o, phosphorus;
+  std::optional<glm::dvec3> n, ca, c, o, phosphorus, base;
   SecondaryStructure structure = SecondaryStructure::Loop;
 };
 

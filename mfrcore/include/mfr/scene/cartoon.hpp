@@ -20,6 +20,10 @@ struct CartoonResidue {
   SecondaryStructure structure = SecondaryStructure::Loop;
   glm::vec4 color{1.0f};
   std::vector<float> values;  // one per CartoonOptions::fieldNames, interpolated along the curve
+  // Nucleotides: the backbone is a tube of nucleicRadius, and a rod of ladderRadius runs from the
+  // curve at this residue to `ladder` (its base's N1 or N3: PyMOL's cartoon_ladder_mode 1).
+  bool nucleic = false;
+  std::optional<glm::dvec3> ladder;
 };
 
 // Sizes in Å are PyMOL's defaults, as semi-axes: cartoon_oval_length/width (helix),
@@ -31,6 +35,7 @@ struct CartoonOptions {
   double helixHalfWidth = 1.35, helixHalfThickness = 0.25;
   double strandHalfWidth = 1.4, strandHalfThickness = 0.4;
   double arrowScale = 1.5;  // the arrowhead's base, as a multiple of the strand's width
+  double nucleicRadius = 0.5, ladderRadius = 0.25;  // PyMOL's cartoon_tube_radius, cartoon_ladder_radius
   std::vector<std::string> fieldNames;
 };
 
@@ -40,7 +45,8 @@ struct CartoonOptions {
 // to the next) and the residues' values as point-data fields (Mesh::fields). The curve is the
 // Catmull–Rom spline through the traces; along a strand's interior the traces are first averaged
 // with their neighbours (¼, ½, ¼) and so are the guides, which flattens the pleat as PyMOL's
-// flat sheets do. Throws mfr::Error("cartoon", reason) for a non-finite trace or bad options.
+// flat sheets do. A nucleotide's ladder is a closed rod of its own, in its residue's colour and
+// values. Throws mfr::Error("cartoon", reason) for a non-finite trace or bad options.
 Mesh cartoonMesh(const std::vector<std::vector<CartoonResidue>>& segments, const CartoonOptions& options = {});
 
 }  // namespace mfr
