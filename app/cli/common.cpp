@@ -212,16 +212,7 @@ void applyClipOption(Scene& scene, const std::string& text) {
     scene.clipBox.reset();
     return;
   }
-  const std::vector<std::string> items = splitList(text);
-  Bounds box;
-  bool ok = items.size() == 6;
-  for (std::size_t i = 0; ok && i < 6; ++i) {
-    const std::optional<double> v = parseNumber(items[i]);
-    ok = v.has_value();
-    if (ok) (i < 3 ? box.min : box.max)[static_cast<int>(i % 3)] = *v;
-  }
-  if (!ok) throw Error("--clip " + text, "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax (or none)");
-  if (!box.valid()) throw Error("--clip " + text, "min must not exceed max on any axis");
+  const Bounds box = parseClipBox(text, "--clip " + text);
   // A box that holds nothing of the scene draws an empty image, as a section plane that cuts away
   // everything would: both are refused (found by fuzzing).
   const Bounds b = scene.bounds();
@@ -370,42 +361,7 @@ void applySectionOption(Scene& scene, const std::string& text, SectionReport* re
     return;
   }
   const std::string what = "--section " + text;
-  std::string plane = text;
-  SectionPlane section;
-  if (const std::size_t colon = text.find(':'); colon != std::string::npos) {
-    for (const std::string& suffix : splitList(text.substr(colon + 1), ':')) {
-      if (suffix == "nocaps")
-        section.caps = false;
-      else if (suffix == "slice")
-        section.slice = true;
-      else
-        throw Error(what, "the suffixes are :nocaps and :slice");
-    }
-    plane = text.substr(0, colon);
-  }
-  if (const std::size_t eq = plane.find('='); eq != std::string::npos) {
-    const std::string axis = plane.substr(0, eq);
-    static const char* const kAxes[] = {"x", "y", "z", "-x", "-y", "-z"};
-    int index = -1;
-    for (int a = 0; a < 6; ++a)
-      if (axis == kAxes[a]) index = a;
-    const std::optional<double> value = parseNumber(plane.substr(eq + 1));
-    if (index < 0 || !value) throw Error(what, "expected AXIS=VALUE with AXIS one of x, y, z, -x, -y, -z and a number");
-    section.normal = glm::dvec3(0.0);
-    section.normal[index % 3] = index < 3 ? 1.0 : -1.0;
-    section.point = glm::dvec3(0.0);
-    section.point[index % 3] = *value;
-  } else {
-    const std::vector<std::string> items = splitList(plane);
-    bool ok = items.size() == 6;
-    for (std::size_t i = 0; ok && i < 6; ++i) {
-      const std::optional<double> v = parseNumber(items[i]);
-      ok = v.has_value();
-      if (ok) (i < 3 ? section.point : section.normal)[static_cast<int>(i % 3)] = *v;
-    }
-    if (!ok) throw Error(what, "expected AXIS=VALUE or six numbers px,py,pz,nx,ny,nz (or none)");
-    if (!(glm::length(section.normal) > 0.0)) throw Error(what, "the normal must not be zero");
-  }
+  const SectionPlane section = parseSectionPlane(text, what);
   scene.section = section;
   cutBySection(scene, out, what);
 }

@@ -18,6 +18,7 @@
 
 #include "main_window.hpp"
 #include "mfr/scene/scene.hpp"
+#include "mfr/scene/section.hpp"
 #include "render_view.hpp"
 #include "viewer_model.hpp"
 
@@ -37,6 +38,9 @@ struct CommandLine {
   std::map<std::string, std::string> params;
   double thickness = 0.0;  // --thickness (operation zthickness); 0: the scene's default
   double step = 0.0;       // --step (operation volume); 0: the volume's default
+  // --clip, --section: as mfr render's; "none" removes the scene's own.
+  std::optional<std::optional<mfr::Bounds>> clip;
+  std::optional<std::optional<mfr::SectionPlane>> section;
 };
 
 [[noreturn]] void fail(const QString& message, int code) {
@@ -108,11 +112,22 @@ CommandLine parseCommandLine(const QApplication& app) {
   const QCommandLineOption screenshot(QStringLiteral("screenshot"), QStringLiteral("Render the view at --size, write this PNG and quit."), QStringLiteral("file.png"));
   const QCommandLineOption windowScreenshot(QStringLiteral("window-screenshot"), QStringLiteral("Grab the whole window once drawn, write this PNG and quit."), QStringLiteral("file.png"));
   const QCommandLineOption windowSize(QStringLiteral("window-size"), QStringLiteral("Window size."), QStringLiteral("WxH"));
+  const QCommandLineOption clip(
+      QStringLiteral("clip"),
+      QStringLiteral(
+          "Clip box: only what lies inside is drawn (the Clip panel's box); 'none' removes the scene's own."),
+      QStringLiteral("xmin,ymin,zmin,xmax,ymax,zmax"));
+  const QCommandLineOption section(
+      QStringLiteral("section"),
+      QStringLiteral("Section plane, as mfr render's: AXIS=VALUE (x, y, z, -x, -y, -z; keeps the side the axis points "
+                     "to) or px,py,pz,nx,ny,nz, optionally :nocaps and/or :slice; 'none' removes the scene's own."),
+      QStringLiteral("plane"));
   const QCommandLineOption pluginSettings(QStringLiteral("plugin-settings"),
                                          QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
                                          QStringLiteral("id={json}"));
-  parser.addOptions({method, op, thickness, step, field, molecule, colorBy, colorMap, colorRange, contour, legend,
-                     param, view, size, screenshot, windowScreenshot, windowSize, pluginSettings});
+  parser.addOptions({method,     op,      thickness, step,          field, molecule, colorBy,    colorMap,
+                     colorRange, contour, legend,    param,         view,  size,     screenshot, windowScreenshot,
+                     windowSize, clip,    section,   pluginSettings});
   parser.process(app);
 
   CommandLine cl;
@@ -173,6 +188,19 @@ CommandLine parseCommandLine(const QApplication& app) {
       cl.contour.push_back(v);
     }
   }
+  try {
+    if (parser.isSet(clip)) {
+      const std::string text = parser.value(clip).toStdString();
+      cl.clip = text == "none" ? std::optional<mfr::Bounds>() : mfr::parseClipBox(text, "--clip " + text);
+    }
+    if (parser.isSet(section)) {
+      const std::string text = parser.value(section).toStdString();
+      cl.section =
+          text == "none" ? std::optional<mfr::SectionPlane>() : mfr::parseSectionPlane(text, "--section " + text);
+    }
+  } catch (const mfr::Error& e) {
+    fail(QString::fromUtf8(e.what()), 2);
+  }
   cl.view = parser.value(view);
   cl.screenshot = parser.value(screenshot);
   cl.windowScreenshot = parser.value(windowScreenshot);
@@ -229,6 +257,8 @@ int main(int argc, char** argv) {
     // A new scene starts at the default thickness (scene units): --thickness applies to this one.
     if (cl.thickness > 0.0) model.setZThickness(cl.thickness);
     if (cl.step > 0.0) model.setVolumeStep(cl.step);  // likewise the volume step
+    if (cl.clip) model.setClipBox(*cl.clip);
+    if (cl.section) model.setSection(*cl.section);
     if (!cl.contour.empty()) {
       // Before --color-by, which then colours them too.
       QStringList texts;

@@ -316,12 +316,20 @@ TEST_F(MoleculeLoader, ResiduesSortedByKindAndBonds) {
   peptide("HETATM", "GLU", 'A', 6, 30.0, false);
   atom("HETATM", "CL1 ", "LIG", 'A', 7, {40.0, 0.0, 0.0});
   atom("HETATM", "CL2 ", "LIG", 'A', 7, {41.8, 0.0, 0.0});
+  // MD programs write ligands as ATOM records: an untabulated cofactor with N, CA and C atoms bonded
+  // to nothing, and an iodide (gemmi's table reads "I" as inosine), are ligands.
+  atom("ATOM", "N   ", "SAM", 'A', 9, {60.0, 0.0, 0.0});
+  atom("ATOM", "CA  ", "SAM", 'A', 9, {61.45, 0.3, 0.0});
+  atom("ATOM", "C   ", "SAM", 'A', 9, {62.47, 0.0, 0.0});
+  atom("ATOM", "I   ", "  I", 'A', 10, {70.0, 0.0, 0.0});
   atom("ATOM", "OW  ", "SOL", 'A', 8, {50.0, 0.0, 0.0});
   atom("ATOM", "HW1 ", "SOL", 'A', 8, {50.96, 0.0, 0.0});
   atom("ATOM", "HW2 ", "SOL", 'A', 8, {49.76, 0.93, 0.0});
   // Chain B: two alanines, then two DNA nucleotides, each O3' bonded to the next P (1.6 Å).
   peptide("ATOM", "ALA", 'B', 1, 0.0, false);
   peptide("ATOM", "ALA", 'B', 2, 3.8, false);
+  // An element the record states is kept, though other records leave theirs blank.
+  s += atomRecord("ATOM", serial++, "HG  ", ' ', "ALA", 'B', 2, 5.0, -1.5, 2.0, "HG");
   for (int k = 0; k < 2; ++k) {
     const double x = 10.0 + 5.0 * k;
     atom("ATOM", "P   ", " DA", 'B', 3 + k, {x, 5.0, 0.0});
@@ -332,18 +340,43 @@ TEST_F(MoleculeLoader, ResiduesSortedByKindAndBonds) {
     atom("ATOM", "O3' ", " DA", 'B', 3 + k, {x + 3.4, 5.0, 0.0});  // 1.6 Å from the next P
   }
   const fs::path file = write("md.pdb", s + "END\n");
-  // 3 + 5 + 5 + 8 + 5 + 2 in chain A, 5 + 5 + 6 + 6 in chain B, 5 + 2 ligand atoms, 3 water.
+  // 3 + 5 + 5 + 8 + 5 + 2 in chain A, 5 + 6 + 6 + 6 in chain B, 5 + 2 + 3 + 1 ligand atoms, 3 water.
   EXPECT_EQ(atomsPerPart(mfr::loadModel(file)),
-            (std::map<std::string, std::size_t>{{"chain A", 28}, {"chain B", 22}, {"ligands", 7}, {"water", 3}}));
+            (std::map<std::string, std::size_t>{{"chain A", 28}, {"chain B", 23}, {"ligands", 11}, {"water", 3}}));
   const mfr::MoleculeStructure m = mfr::readMoleculeStructure(file);
   std::map<int, std::size_t> elements;
   for (const mfr::MoleculeAtom& a : m.atoms) ++elements[a.atomicNumber];
   // Cα carbon, not calcium (also the free glutamate's); water's OW and HW1 oxygen and hydrogen; the
   // selenium stays; the ligand's chlorines are left as gemmi reads them.
-  EXPECT_EQ(elements, (std::map<int, std::size_t>{{1, 2}, {6, 32}, {7, 8}, {8, 13}, {15, 2}, {17, 2}, {34, 1}}));
+  EXPECT_EQ(elements, (std::map<int, std::size_t>{
+                          {1, 2}, {6, 34}, {7, 9}, {8, 13}, {15, 2}, {17, 2}, {34, 1}, {53, 1}, {80, 1}}));
   std::string residues;
   for (const mfr::BackboneResidue& r : m.residues) residues += r.chain + r.name + " ";
   EXPECT_EQ(residues, "AACE AALA AALA AMSE AALA ANME BALA BALA BDA BDA ");
+}
+
+// An mmCIF file without _entity: gemmi guesses from the subchains (a one-residue ALA subchain a
+// ligand, two SOL residues a polymer); the residues are sorted by kind and bonds instead.
+TEST_F(MoleculeLoader, MmcifWithoutEntitiesIsSortedByKind) {
+  std::string cif =
+      "data_X\nloop_\n_atom_site.group_PDB\n_atom_site.id\n_atom_site.type_symbol\n_atom_site.label_atom_id\n"
+      "_atom_site.label_alt_id\n_atom_site.label_comp_id\n_atom_site.label_asym_id\n_atom_site.label_entity_id\n"
+      "_atom_site.label_seq_id\n_atom_site.Cartn_x\n_atom_site.Cartn_y\n_atom_site.Cartn_z\n_atom_site.occupancy\n"
+      "_atom_site.B_iso_or_equiv\n_atom_site.auth_seq_id\n_atom_site.auth_asym_id\n_atom_site.pdbx_PDB_model_num\n"
+      "ATOM 1 N N . ALA A 1 1 -1.649 0.885 0.183 1 0 1 A 1\nATOM 2 C CA . ALA A 1 1 -0.244 1.035 -0.187 1 0 1 A 1\n"
+      "ATOM 3 C C . ALA A 1 1 0.221 2.456 0.023 1 0 1 A 1\nATOM 4 O O . ALA A 1 1 -0.530 3.334 0.466 1 0 1 A 1\n";
+  for (int w = 0; w < 2; ++w) {
+    const double x = 40.0 + 3.0 * w;
+    char rows[400];
+    std::snprintf(
+        rows, sizeof rows,
+        "HETATM %d O OW . SOL B 2 . %.2f 60 60 1 0 %d A 1\nHETATM %d H HW1 . SOL B 2 . %.2f 60 60 1 0 %d A 1\n"
+        "HETATM %d H HW2 . SOL B 2 . %.2f 60.93 60 1 0 %d A 1\n",
+        5 + 3 * w, x, 2 + w, 6 + 3 * w, x + 0.96, 2 + w, 7 + 3 * w, x - 0.24, 2 + w);
+    cif += rows;
+  }
+  EXPECT_EQ(atomsPerPart(mfr::loadModel(write("noentity.cif", cif))),
+            (std::map<std::string, std::size_t>{{"chain A", 4}, {"water", 6}}));
 }
 
 // The tessellation rule: 320 triangles per sphere while the structure stays within 2,000,000

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -15,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
+#include <unordered_set>
 #include <utility>
 
 #include <gemmi/cif.hpp>
@@ -469,8 +471,14 @@ bool isWater(const gemmi::Residue& residue) {
 }
 
 // Whether `residue` is a link of a chain: an amino acid or a nucleotide by gemmi's table, or an
-// untabulated residue with the backbone of one (N, Cα, C; or P).
+// untabulated residue with the backbone of one (N, Cα, C; or P) — but never a lone atom other than
+// a Cα or P (a trace-only model): GROMACS's iodide "I" is inosine by the table.
+bool isTabulatedChainResidue(const gemmi::Residue& residue) {
+  const gemmi::ResidueInfo info = gemmi::find_tabulated_residue(residue.name);
+  return info.found() && (info.is_amino_acid() || info.is_nucleic_acid());
+}
 bool isChainResidue(const gemmi::Residue& residue) {
+  if (residue.atoms.size() == 1 && residue.atoms[0].name != "CA" && residue.atoms[0].name != "P") return false;
   const gemmi::ResidueInfo info = gemmi::find_tabulated_residue(residue.name);
   if (info.found()) return info.is_amino_acid() || info.is_nucleic_acid();
   // By atom names only: MD files' names start in column 13, where gemmi reads " CA" as calcium.
@@ -490,27 +498,40 @@ bool linked(const gemmi::Residue& first, const gemmi::Residue& next) {
   return near(first.find_atom("C", '*'), next.find_atom("N", '*')) || near(o3, next.find_atom("P", '*'));
 }
 
-// Whether every ATOM/HETATM record of a PDB file names its element (columns 77–78). Files written
-// by MD programs (AMBER, CHARMM) often do not, and start atom names in column 13, so that gemmi
-// takes Cα ("CA  ") for calcium and γ-hydrogens ("HG1 ") for mercury.
-bool pdbGivesElements(const std::string& data) {
-  if (hasLineNumbersInColumns73To80(data)) return false;  // read as 72 columns
+// The serial numbers of a PDB file's ATOM/HETATM records that leave the element (columns 77–78)
+// blank and start the atom name in column 13. Files written by MD programs (AMBER, CHARMM) do, and
+// gemmi then takes Cα ("CA  ") for calcium and γ-hydrogens ("HG1 ") for mercury. A serial that
+// also names a record with an element is left out.
+std::unordered_set<int> pdbAtomsWithoutElements(const std::string& data) {
+  const bool columns72 = hasLineNumbersInColumns73To80(data);  // read as 72 columns: no elements
+  std::unordered_set<int> without, with;
   for (std::size_t start = 0; start < data.size();) {
     std::size_t end = data.find('\n', start);
     if (end == std::string::npos) end = data.size();
     const std::string_view line = withoutLineEnd(std::string_view(data).substr(start, end - start));
-    if (isAtomRecord(line) && (line.size() < 78 || (line[76] == ' ' && line[77] == ' '))) return false;
     start = end + 1;
+    if (!isAtomRecord(line) || line.size() < 16) continue;
+    int serial = 0;
+    const std::string_view digits = line.substr(6, 5);
+    const std::size_t first = digits.find_first_not_of(' ');
+    if (first == std::string_view::npos ||
+        std::from_chars(digits.data() + first, digits.data() + digits.size(), serial).ptr !=
+            digits.data() + digits.size())
+      continue;  // hybrid-36 or garbage: no guess
+    const bool blank = columns72 || line.size() < 78 || (line[76] == ' ' && line[77] == ' ');
+    (blank && line[12] != ' ' ? without : with).insert(serial);
   }
-  return true;
+  for (const int serial : with) without.erase(serial);
+  return without;
 }
 
 // Elements of the atoms of a chain residue (polymer or free), its caps and water, where the file
-// does not give them: those hold only H, C, N, O, S, P and Se, so an atom gemmi guessed as anything
-// else from its name (or not at all: water's "OW", "HW1") is the element of its name's first
-// letter (PyMOL reads AMBER and GROMACS files so too).
-void fixChainElements(gemmi::Residue& residue) {
+// does not give them (`unstated`: pdbAtomsWithoutElements): those hold only H (D), C, N, O, S, P
+// and Se, so an atom gemmi guessed as anything else from its name (or not at all: water's "OW",
+// "HW1") is the element of its name's first letter (PyMOL reads AMBER and GROMACS files so too).
+void fixChainElements(gemmi::Residue& residue, const std::unordered_set<int>& unstated) {
   for (gemmi::Atom& atom : residue.atoms) {
+    if (!unstated.contains(atom.serial)) continue;
     const gemmi::El e = atom.element.elem;
     if (e == gemmi::El::H || e == gemmi::El::D || e == gemmi::El::C || e == gemmi::El::N || e == gemmi::El::O ||
         e == gemmi::El::S || e == gemmi::El::P || e == gemmi::El::Se)
@@ -520,6 +541,9 @@ void fixChainElements(gemmi::Residue& residue) {
     switch (atom.name[letter]) {
       case 'H':
         atom.element = gemmi::Element(gemmi::El::H);
+        break;
+      case 'D':
+        atom.element = gemmi::Element(gemmi::El::D);
         break;
       case 'C':
         atom.element = gemmi::Element(gemmi::El::C);
@@ -548,8 +572,9 @@ void fixChainElements(gemmi::Residue& residue) {
 // polymer type, so that a chain starting with an acetyl cap, or mixing protein and DNA, lost its
 // polymer):
 // * water and MD solvent: water;
-// * amino acids and nucleotides: polymer if ATOM records or bonded to the residue before or after
-//   (HETATM MSE inside a chain); a lone HETATM one (a free amino acid, ATP) is a ligand;
+// * amino acids and nucleotides: polymer if bonded to the residue before or after (a HETATM MSE
+//   inside a chain) or, for those in gemmi's table, ATOM records (chain breaks); a lone HETATM one
+//   (a free amino acid, ATP) and an unbonded untabulated one (an MD file's cofactor) are ligands;
 // * anything else is a ligand unless it is bonded into the chain (ACE and NME caps).
 void classifyResidues(gemmi::Chain& chain, const std::vector<bool>& given) {
   std::vector<gemmi::Residue>& residues = chain.residues;
@@ -567,7 +592,9 @@ void classifyResidues(gemmi::Chain& chain, const std::vector<bool>& given) {
     if (isWater(residue))
       polymer = false;
     else if (inChain[i])
-      polymer = residue.het_flag != 'H' || before || after;
+      // An untabulated one (a cofactor with N, CA and C atoms: SAM, AMP) only when bonded into the
+      // chain: MD programs write ligands as ATOM records too.
+      polymer = before || after || (residue.het_flag != 'H' && isTabulatedChainResidue(residue));
     else
       polymer = (before && inChain[i - 1]) || (after && inChain[i + 1]);
     residue.entity_type = polymer            ? gemmi::EntityType::Polymer
@@ -599,18 +626,28 @@ Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const s
     throw Error(name, format == MoleculeFormat::Pdb ? "no atoms (no ATOM or HETATM records in the first model)"
                                                     : "no atoms (the _atom_site table of the first model is empty)");
   st.models.erase(st.models.begin() + 1, st.models.end());  // first model only: NMR ensembles hold many
-  // Entity types an mmCIF file gives (_entity.type) are kept; the others are sorted here.
+  // Entity types an mmCIF file gives (_entity.type of the residue's label_entity_id) are kept; the
+  // others are sorted here (gemmi fills them from the subchains when _entity is missing: a water
+  // first is all water, one residue a ligand, more a polymer).
+  std::map<std::string, bool> typedEntity;
+  if (format == MoleculeFormat::Mmcif)
+    for (const gemmi::Entity& entity : st.entities)
+      typedEntity[entity.name] = entity.entity_type != gemmi::EntityType::Unknown;
   std::vector<std::vector<bool>> given;
   for (const gemmi::Chain& chain : st.models[0].chains) {
     given.emplace_back();
-    for (const gemmi::Residue& residue : chain.residues)
-      given.back().push_back(format == MoleculeFormat::Mmcif && residue.entity_type != gemmi::EntityType::Unknown);
+    for (const gemmi::Residue& residue : chain.residues) {
+      const auto it = typedEntity.find(residue.entity_id);
+      given.back().push_back(it != typedEntity.end() && it->second);
+    }
   }
   for (std::size_t c = 0; c < st.models[0].chains.size(); ++c) classifyResidues(st.models[0].chains[c], given[c]);
-  if (format == MoleculeFormat::Pdb && !pdbGivesElements(contents))
-    for (gemmi::Chain& chain : st.models[0].chains)
-      for (gemmi::Residue& residue : chain.residues)
-        if (residue.entity_type != gemmi::EntityType::NonPolymer || isChainResidue(residue)) fixChainElements(residue);
+  if (format == MoleculeFormat::Pdb)
+    if (const std::unordered_set<int> unstated = pdbAtomsWithoutElements(contents); !unstated.empty())
+      for (gemmi::Chain& chain : st.models[0].chains)
+        for (gemmi::Residue& residue : chain.residues)
+          if (residue.entity_type != gemmi::EntityType::NonPolymer || isChainResidue(residue))
+            fixChainElements(residue, unstated);
   Parsed parsed{partsOf(st.models[0], name), models, {}};
   for (const gemmi::Helix& h : st.helices)
     parsed.recorded.push_back(

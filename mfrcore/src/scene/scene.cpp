@@ -7,6 +7,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "mfr/error.hpp"
+#include "scene/list_text.hpp"
 
 namespace mfr {
 
@@ -141,6 +142,20 @@ Camera Scene::view(const std::string& viewName) const {
   for (const std::string& n : viewNames()) list += (list.empty() ? "" : ", ") + n;
   throw Error("view '" + viewName + "'",
               "not in scene '" + name + "' (available: " + list + ", or orbit:AZIMUTH:ELEVATION)");
+}
+
+Bounds parseClipBox(const std::string& text, const std::string& what) {
+  const std::vector<std::string> items = text::splitList(text);
+  Bounds box;
+  bool ok = items.size() == 6;
+  for (std::size_t i = 0; ok && i < 6; ++i) {
+    const std::optional<double> v = text::parseNumber(items[i]);
+    ok = v.has_value();
+    if (ok) (i < 3 ? box.min : box.max)[static_cast<int>(i % 3)] = *v;
+  }
+  if (!ok) throw Error(what, "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax (or none)");
+  if (!box.valid()) throw Error(what, "min must not exceed max on any axis");
+  return box;
 }
 
 }  // namespace mfr

@@ -22,6 +22,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/scene/color_map.hpp"
+#include "scene/list_text.hpp"
 
 namespace mfr {
 namespace {
@@ -774,6 +775,46 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
     throw Error("section plane", "cuts away every visible surface of scene '" + scene.name + "'");
   if (report) *report = std::move(local);
   return out;
+}
+
+SectionPlane parseSectionPlane(const std::string& textIn, const std::string& what) {
+  std::string plane = textIn;
+  SectionPlane section;
+  if (const std::size_t colon = textIn.find(':'); colon != std::string::npos) {
+    for (const std::string& suffix : text::splitList(textIn.substr(colon + 1), ':')) {
+      if (suffix == "nocaps")
+        section.caps = false;
+      else if (suffix == "slice")
+        section.slice = true;
+      else
+        throw Error(what, "the suffixes are :nocaps and :slice");
+    }
+    plane = textIn.substr(0, colon);
+  }
+  if (const std::size_t eq = plane.find('='); eq != std::string::npos) {
+    const std::string axis = plane.substr(0, eq);
+    static const char* const kAxes[] = {"x", "y", "z", "-x", "-y", "-z"};
+    int index = -1;
+    for (int a = 0; a < 6; ++a)
+      if (axis == kAxes[a]) index = a;
+    const std::optional<double> value = text::parseNumber(plane.substr(eq + 1));
+    if (index < 0 || !value) throw Error(what, "expected AXIS=VALUE with AXIS one of x, y, z, -x, -y, -z and a number");
+    section.normal = glm::dvec3(0.0);
+    section.normal[index % 3] = index < 3 ? 1.0 : -1.0;
+    section.point = glm::dvec3(0.0);
+    section.point[index % 3] = *value;
+    return section;
+  }
+  const std::vector<std::string> items = text::splitList(plane);
+  bool ok = items.size() == 6;
+  for (std::size_t i = 0; ok && i < 6; ++i) {
+    const std::optional<double> v = text::parseNumber(items[i]);
+    ok = v.has_value();
+    if (ok) (i < 3 ? section.point : section.normal)[static_cast<int>(i % 3)] = *v;
+  }
+  if (!ok) throw Error(what, "expected AXIS=VALUE or six numbers px,py,pz,nx,ny,nz (or none)");
+  if (!(glm::length(section.normal) > 0.0)) throw Error(what, "the normal must not be zero");
+  return section;
 }
 
 }  // namespace mfr

@@ -109,6 +109,9 @@ struct Scene {
   [[nodiscard]] std::vector<std::string> viewNames() const;
 };
 
+// A clip box as `mfr render --clip` and `mfrview --clip` take it: six numbers
+// xmin,ymin,zmin,xmax,ymax,zmax. Throws mfr::Error(what, reason) for anything else or min > max.
+Bounds parseClipBox(const std::string& text, const std::string& what);
 // Throws mfr::Error(what, …) for a clip box with a non-finite corner or min > max on an axis.
 void validateClipBox(const std::optional<Bounds>& box, const std::string& what);
 // Throws mfr::Error(what, …) for a section plane with a non-finite point or normal or a zero normal.

@@ -52,6 +52,12 @@ struct SectionedMesh {
 // colours of the cut.
 SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps);
 
+// A section plane as `mfr render --section` and `mfrview --section` take it: AXIS=VALUE (x, y, z,
+// -x, -y, -z: the plane across that axis at VALUE, keeping the side the axis points to) or six
+// numbers px,py,pz,nx,ny,nz (a point and the kept side's normal), optionally followed by :nocaps
+// and/or :slice. Throws mfr::Error(what, reason) for anything else or a zero normal.
+SectionPlane parseSectionPlane(const std::string& text, const std::string& what);
+
 struct SectionReport {
   std::size_t cut = 0;     // objects cut (capped or not)
   std::size_t capped = 0;  // of those, capped (alone or together with the other parts of their solid)
