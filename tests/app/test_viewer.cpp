@@ -579,9 +579,16 @@ class ViewerTest : public QObject {
   void viewerScreenshotEqualsCli() {
     QTemporaryDir dir;
     const QList<QStringList> cases{
-        {"--method", "abuffer-ll", "--view", "iso"},         {"--method", "kbuffer", "-p", "k=6", "--view", "front"},
-        {"--method", "kplus-dynamic", "-p", "budget_mib=2"}, {"--method", "wboit", "--view", "iso"},
-        {"--method", "peel-dual", "--view", "iso"},          {"--method", "oracle", "--view", "iso"},
+        {"--method", "abuffer-ll", "--view", "iso"},
+        {"--method", "kbuffer", "-p", "k=6", "--view", "front"},
+        {"--method", "kplus-dynamic", "-p", "budget_mib=2"},
+        {"--method", "wboit", "--view", "iso"},
+        {"--method", "peel-dual", "--view", "iso"},
+        {"--method", "oracle", "--view", "iso"},
+        // The clip box and section plane as the command lines give them.
+        {"--method", "abuffer-ll", "--view", "iso", "--clip", "-2,-2,-2,0.3,2,0.5"},
+        {"--method", "abuffer-ll", "--view", "iso", "--section", "0.1,0,0,1,0.5,0.2"},
+        {"--method", "oracle", "--view", "iso", "--section", "-y=0.2:nocaps"},
     };
     int worst = 0;
     for (const QStringList& c : cases) {
@@ -606,6 +613,13 @@ class ViewerTest : public QObject {
       file.write("v 0 0 0\nv 1 1 1\nv 2 2 2\nf 1 2 3\n");
     }
     QString out;
+    // A plane or box the command line cannot read: the same one line as mfr's, exit 2.
+    QCOMPARE(runProgram(MFRVIEW, {"@sample", "--screenshot", flatPng, "--section", "w=1"}, &out), 2);
+    QVERIFY2(out.contains("--section w=1: expected AXIS=VALUE with AXIS one of x, y, z, -x, -y, -z and a number"),
+             qPrintable(out));
+    QCOMPARE(runProgram(MFRVIEW, {"@sample", "--screenshot", flatPng, "--clip", "1,1,1,0,0,0"}, &out), 2);
+    QVERIFY2(out.contains("--clip 1,1,1,0,0,0: min must not exceed max on any axis"), qPrintable(out));
+    QVERIFY(!QFile::exists(flatPng));
     for (const char* method : {"abuffer-ll", "oracle"}) {
       QCOMPARE(runProgram(MFRVIEW, {flat, "--screenshot", flatPng, "--size", "64x64", "--method", method}, &out), 1);
       QVERIFY2(out.contains("nothing to render (no visible triangles)"), qPrintable(out));
