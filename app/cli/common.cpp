@@ -11,6 +11,7 @@
 #include "mfr/render.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/contour.hpp"
+#include "mfr/list_text.hpp"
 #include "mfr/scene/section.hpp"
 
 namespace mfr::cli {
@@ -26,12 +27,7 @@ std::pair<int, int> parseSize(const std::string& option, const std::string& text
 }
 
 std::vector<std::string> splitList(const std::string& text, char separator) {
-  std::vector<std::string> out;
-  std::string item;
-  std::istringstream in(text);
-  while (std::getline(in, item, separator))
-    if (!item.empty()) out.push_back(item);
-  return out;
+  return mfr::text::splitList(text, separator);
 }
 
 void ReadOptions::add(CLI::App* cmd) {
@@ -76,15 +72,7 @@ double thicknessOption(const CLI::Option& option, double value) {
 }
 
 std::optional<double> parseNumber(const std::string& text) {
-  std::size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-  if (used != text.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
+  return mfr::text::parseNumber(text);
 }
 
 double median(std::vector<double> values) {

@@ -7,7 +7,7 @@
 #include <glm/trigonometric.hpp>
 
 #include "mfr/error.hpp"
-#include "scene/list_text.hpp"
+#include "mfr/list_text.hpp"
 
 namespace mfr {
 

@@ -22,7 +22,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/scene/color_map.hpp"
-#include "scene/list_text.hpp"
+#include "mfr/list_text.hpp"
 
 namespace mfr {
 namespace {

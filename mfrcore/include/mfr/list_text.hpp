@@ -1,6 +1,6 @@
 #pragma once
-// Comma-separated numbers as the command lines give them (--clip, --section): shared by the
-// parsers of mfr and mfrview, so both read the same text the same way.
+// Comma-separated numbers as the command lines give them (--clip, --section, budgets, sizes):
+// shared by mfr's options and mfrcore's parsers, so both read the same text the same way.
 #include <cmath>
 #include <cstddef>
 #include <optional>
