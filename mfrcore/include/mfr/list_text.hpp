@@ -6,6 +6,7 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mfr::text {
@@ -31,6 +32,20 @@ inline std::optional<double> parseNumber(const std::string& text) {
   }
   if (used != text.size() || !std::isfinite(v)) return std::nullopt;
   return v;
+}
+
+// Six numbers a,b,c,d,e,f as two vectors (a,b,c) and (d,e,f), or none.
+template <class Vec3>
+std::optional<std::pair<Vec3, Vec3>> parseTwoVectors(const std::string& text) {
+  const std::vector<std::string> items = splitList(text);
+  if (items.size() != 6) return std::nullopt;
+  std::pair<Vec3, Vec3> out;
+  for (std::size_t i = 0; i < 6; ++i) {
+    const std::optional<double> v = parseNumber(items[i]);
+    if (!v) return std::nullopt;
+    (i < 3 ? out.first : out.second)[static_cast<int>(i % 3)] = *v;
+  }
+  return out;
 }
 
 }  // namespace mfr::text

@@ -538,31 +538,9 @@ void fixChainElements(gemmi::Residue& residue, const std::unordered_set<int>& un
       continue;
     const std::size_t letter = atom.name.find_first_not_of("0123456789 ");
     if (letter == std::string::npos) continue;
-    switch (atom.name[letter]) {
-      case 'H':
-        atom.element = gemmi::Element(gemmi::El::H);
-        break;
-      case 'D':
-        atom.element = gemmi::Element(gemmi::El::D);
-        break;
-      case 'C':
-        atom.element = gemmi::Element(gemmi::El::C);
-        break;
-      case 'N':
-        atom.element = gemmi::Element(gemmi::El::N);
-        break;
-      case 'O':
-        atom.element = gemmi::Element(gemmi::El::O);
-        break;
-      case 'S':
-        atom.element = gemmi::Element(gemmi::El::S);
-        break;
-      case 'P':
-        atom.element = gemmi::Element(gemmi::El::P);
-        break;
-      default:
-        break;
-    }
+    // Only those elements; gemmi's Element reads the one-letter symbol.
+    if (std::string_view("HDCNOSP").find(atom.name[letter]) != std::string_view::npos)
+      atom.element = gemmi::Element(std::string(1, atom.name[letter]));
   }
 }
 
@@ -579,9 +557,10 @@ void fixChainElements(gemmi::Residue& residue, const std::unordered_set<int>& un
 void classifyResidues(gemmi::Chain& chain, const std::vector<bool>& given) {
   std::vector<gemmi::Residue>& residues = chain.residues;
   std::vector<bool> link(residues.size(), false);  // link[i]: residue i is bonded to i + 1
-  std::vector<bool> inChain(residues.size(), false);
+  std::vector<bool> inChain(residues.size(), false), water(residues.size(), false);
   for (std::size_t i = 0; i < residues.size(); ++i) {
-    inChain[i] = !isWater(residues[i]) && isChainResidue(residues[i]);
+    water[i] = isWater(residues[i]);
+    inChain[i] = !water[i] && isChainResidue(residues[i]);
     if (i + 1 < residues.size()) link[i] = linked(residues[i], residues[i + 1]);
   }
   for (std::size_t i = 0; i < residues.size(); ++i) {
@@ -589,7 +568,7 @@ void classifyResidues(gemmi::Chain& chain, const std::vector<bool>& given) {
     gemmi::Residue& residue = residues[i];
     const bool before = i > 0 && link[i - 1], after = link[i];
     bool polymer = false;
-    if (isWater(residue))
+    if (water[i])
       polymer = false;
     else if (inChain[i])
       // An untabulated one (a cofactor with N, CA and C atoms: SAM, AMP) only when bonded into the
@@ -597,9 +576,9 @@ void classifyResidues(gemmi::Chain& chain, const std::vector<bool>& given) {
       polymer = before || after || (residue.het_flag != 'H' && isTabulatedChainResidue(residue));
     else
       polymer = (before && inChain[i - 1]) || (after && inChain[i + 1]);
-    residue.entity_type = polymer            ? gemmi::EntityType::Polymer
-                          : isWater(residue) ? gemmi::EntityType::Water
-                                             : gemmi::EntityType::NonPolymer;
+    residue.entity_type = polymer    ? gemmi::EntityType::Polymer
+                          : water[i] ? gemmi::EntityType::Water
+                                     : gemmi::EntityType::NonPolymer;
   }
 }
 

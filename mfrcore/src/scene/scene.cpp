@@ -145,15 +145,11 @@ Camera Scene::view(const std::string& viewName) const {
 }
 
 Bounds parseClipBox(const std::string& text, const std::string& what) {
-  const std::vector<std::string> items = text::splitList(text);
+  const auto corners = text::parseTwoVectors<glm::dvec3>(text);
+  if (!corners) throw Error(what, "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax (or none)");
   Bounds box;
-  bool ok = items.size() == 6;
-  for (std::size_t i = 0; ok && i < 6; ++i) {
-    const std::optional<double> v = text::parseNumber(items[i]);
-    ok = v.has_value();
-    if (ok) (i < 3 ? box.min : box.max)[static_cast<int>(i % 3)] = *v;
-  }
-  if (!ok) throw Error(what, "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax (or none)");
+  box.min = corners->first;
+  box.max = corners->second;
   if (!box.valid()) throw Error(what, "min must not exceed max on any axis");
   return box;
 }

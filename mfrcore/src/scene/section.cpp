@@ -805,14 +805,10 @@ SectionPlane parseSectionPlane(const std::string& textIn, const std::string& wha
     section.point[index % 3] = *value;
     return section;
   }
-  const std::vector<std::string> items = text::splitList(plane);
-  bool ok = items.size() == 6;
-  for (std::size_t i = 0; ok && i < 6; ++i) {
-    const std::optional<double> v = text::parseNumber(items[i]);
-    ok = v.has_value();
-    if (ok) (i < 3 ? section.point : section.normal)[static_cast<int>(i % 3)] = *v;
-  }
-  if (!ok) throw Error(what, "expected AXIS=VALUE or six numbers px,py,pz,nx,ny,nz (or none)");
+  const auto pointAndNormal = text::parseTwoVectors<glm::dvec3>(plane);
+  if (!pointAndNormal) throw Error(what, "expected AXIS=VALUE or six numbers px,py,pz,nx,ny,nz (or none)");
+  section.point = pointAndNormal->first;
+  section.normal = pointAndNormal->second;
   if (!(glm::length(section.normal) > 0.0)) throw Error(what, "the normal must not be zero");
   return section;
 }
