@@ -27,7 +27,6 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkPolyDataNormals.h>
 #include <vtkPolygon.h>
 #include <vtkSTLReader.h>
 #include <vtkSmartPointer.h>
@@ -35,6 +34,7 @@
 #include <vtkXMLPolyDataReader.h>
 
 #include "mfr/error.hpp"
+#include "mfr/scene/feature_normals.hpp"
 
 namespace mfr::io {
 namespace {
@@ -321,26 +321,27 @@ vtkSmartPointer<vtkPolyData> triangulate(vtkPolyData* in) {
 }
 
 // The numeric arrays of a file's point and cell data as Mesh::fields (what a surface can be
-// coloured by), except the normals and the colours read as colours. Point data comes from `out`
-// (whose points the normals filter may have split: each copy keeps its values); cell data from the
-// input, one tuple per triangle of `out` by its kSourceCellArray.
-void readFields(vtkPolyData* input, vtkPolyData* out, Mesh& mesh) {
-  vtkPointData* pd = out->GetPointData();
-  const vtkDataArray* colors = colorArray(out);
+// coloured by), except the normals and the colours read as colours. Point data comes from the
+// triangulated `triangles`, one tuple per mesh vertex by `source` (a vertex split at a crease keeps
+// its values); cell data from the input, one tuple per triangle of `triangles` by its
+// kSourceCellArray.
+void readFields(vtkPolyData* input, vtkPolyData* triangles, const std::vector<std::uint32_t>& source, Mesh& mesh) {
+  vtkPointData* pd = triangles->GetPointData();
+  const vtkDataArray* colors = colorArray(triangles);
   for (int i = 0; i < pd->GetNumberOfArrays(); ++i) {
     vtkDataArray* a = pd->GetArray(i);
     if (a == nullptr || a->GetName() == nullptr || a == pd->GetNormals() || a == colors ||
-        std::strcmp(a->GetName(), kSoupColorArray) == 0 || a->GetNumberOfTuples() != out->GetNumberOfPoints())
+        std::strcmp(a->GetName(), kSoupColorArray) == 0 || a->GetNumberOfTuples() != triangles->GetNumberOfPoints())
       continue;
     MeshField f{a->GetName(), false, a->GetNumberOfComponents(), {}};
-    f.values.reserve(static_cast<std::size_t>(a->GetNumberOfTuples() * f.components));
-    for (vtkIdType t = 0; t < a->GetNumberOfTuples(); ++t)
+    f.values.reserve(source.size() * static_cast<std::size_t>(f.components));
+    for (const std::uint32_t t : source)
       for (int c = 0; c < f.components; ++c) f.values.push_back(static_cast<float>(a->GetComponent(t, c)));
     mesh.fields.push_back(std::move(f));
   }
   vtkCellData* cd = input->GetCellData();
-  vtkDataArray* source = out->GetCellData()->GetArray(kSourceCellArray);
-  if (source == nullptr || source->GetNumberOfTuples() != static_cast<vtkIdType>(mesh.triangleCount())) return;
+  vtkDataArray* cellSource = triangles->GetCellData()->GetArray(kSourceCellArray);
+  if (cellSource == nullptr || cellSource->GetNumberOfTuples() != static_cast<vtkIdType>(mesh.triangleCount())) return;
   for (int i = 0; i < cd->GetNumberOfArrays(); ++i) {
     vtkDataArray* a = cd->GetArray(i);
     if (a == nullptr || a->GetName() == nullptr || a == cd->GetNormals() ||
@@ -348,77 +349,73 @@ void readFields(vtkPolyData* input, vtkPolyData* out, Mesh& mesh) {
       continue;
     MeshField f{a->GetName(), true, a->GetNumberOfComponents(), {}};
     f.values.reserve(mesh.triangleCount() * static_cast<std::size_t>(f.components));
-    for (vtkIdType t = 0; t < source->GetNumberOfTuples(); ++t) {
-      const auto cell = static_cast<vtkIdType>(source->GetComponent(t, 0));
+    for (vtkIdType t = 0; t < cellSource->GetNumberOfTuples(); ++t) {
+      const auto cell = static_cast<vtkIdType>(cellSource->GetComponent(t, 0));
       for (int c = 0; c < f.components; ++c) f.values.push_back(static_cast<float>(a->GetComponent(cell, c)));
     }
     mesh.fields.push_back(std::move(f));
   }
 }
 
-// Triangulates, adds feature-angle normals when missing, and converts to a Mesh.
+// Triangulates, adds feature-angle normals when missing (orientAndSplitAtFeatures: consistent
+// winding, creases split), and converts to a Mesh.
 Mesh finish(vtkPolyData* input, const std::string& name) {
   checkPolyData(input, name);
   const bool keepNormals = usableNormals(input);
   if (!keepNormals) input->GetPointData()->SetNormals(nullptr);
 
   vtkSmartPointer<vtkPolyData> triangles = triangulate(input);
-  vtkNew<vtkPolyDataNormals> normals;
-  vtkPolyData* out = triangles;
-  if (!keepNormals) {
-    normals->SetInputData(triangles);
-    normals->SetFeatureAngle(kFeatureAngleDegrees);
-    normals->SplittingOn();
-    normals->ConsistencyOn();  // STL exports often mix windings; CSG needs them consistent
-    normals->AutoOrientNormalsOff();
-    normals->ComputePointNormalsOn();
-    normals->ComputeCellNormalsOff();
-    normals->Update();
-    out = normals->GetOutput();
-  }
-  if (out == nullptr || out->GetPoints() == nullptr || out->GetNumberOfPolys() == 0)
+  if (triangles->GetPoints() == nullptr || triangles->GetNumberOfPolys() == 0)
     throw Error(name, "no triangles after triangulation");
-
-  Mesh mesh;
-  const vtkIdType np = out->GetNumberOfPoints();
-  mesh.positions.resize(static_cast<std::size_t>(np));
-  for (vtkIdType i = 0; i < np; ++i) {
-    double p[3];
-    out->GetPoint(i, p);
-    mesh.positions[static_cast<std::size_t>(i)] = glm::vec3(p[0], p[1], p[2]);
-  }
-  if (vtkDataArray* n = out->GetPointData()->GetNormals(); n != nullptr && n->GetNumberOfTuples() == np) {
-    mesh.normals.resize(static_cast<std::size_t>(np));
-    for (vtkIdType i = 0; i < np; ++i) {
-      double v[3];
-      n->GetTuple(i, v);
-      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-      // Degenerate triangles get zero normals; shaders would normalise them into NaN.
-      mesh.normals[static_cast<std::size_t>(i)] =
-          len > 0.0 && std::isfinite(len) ? glm::vec3(v[0] / len, v[1] / len, v[2] / len) : glm::vec3(0, 0, 1);
-    }
-  }
-  if (vtkDataArray* c = colorArray(out); c != nullptr && c->GetNumberOfTuples() == np) {
-    const int comps = c->GetNumberOfComponents();
-    const double scale = c->GetDataType() == VTK_UNSIGNED_CHAR ? 1.0 / 255.0 : 1.0;
-    mesh.colors.resize(static_cast<std::size_t>(np));
-    for (vtkIdType i = 0; i < np; ++i) {
-      double v[4] = {0.0, 0.0, 0.0, 1.0 / scale};
-      for (int k = 0; k < comps && k < 4; ++k) v[k] = c->GetComponent(i, k);
-      glm::vec4 rgba(v[0] * scale, v[1] * scale, v[2] * scale, v[3] * scale);
-      mesh.colors[static_cast<std::size_t>(i)] = glm::clamp(rgba, 0.0f, 1.0f);
-    }
-  }
-  vtkCellArray* polys = out->GetPolys();
-  mesh.indices.reserve(static_cast<std::size_t>(polys->GetNumberOfConnectivityIds()));
+  const vtkIdType np = triangles->GetNumberOfPoints();
+  std::vector<glm::dvec3> points(static_cast<std::size_t>(np));
+  for (vtkIdType i = 0; i < np; ++i) triangles->GetPoint(i, &points[static_cast<std::size_t>(i)].x);
+  std::vector<std::uint32_t> indices;
+  vtkCellArray* polys = triangles->GetPolys();
+  indices.reserve(static_cast<std::size_t>(polys->GetNumberOfConnectivityIds()));
   vtkIdType n = 0;
   const vtkIdType* ids = nullptr;
-  for (polys->InitTraversal(); polys->GetNextCell(n, ids) != 0;) {
-    if (n != 3) continue;  // the triangle filter leaves none, but never trust a size
-    for (vtkIdType k = 0; k < 3; ++k) mesh.indices.push_back(static_cast<std::uint32_t>(ids[k]));
+  for (polys->InitTraversal(); polys->GetNextCell(n, ids) != 0;)
+    for (vtkIdType k = 0; k < 3; ++k) indices.push_back(static_cast<std::uint32_t>(ids[k]));  // triangulate's
+
+  Mesh mesh;
+  std::vector<std::uint32_t> source;
+  if (keepNormals) {
+    mesh.indices = std::move(indices);
+    source.resize(points.size());
+    for (std::size_t i = 0; i < source.size(); ++i) source[i] = static_cast<std::uint32_t>(i);
+    vtkDataArray* normals = triangles->GetPointData()->GetNormals();
+    mesh.normals.resize(source.size());
+    for (std::size_t i = 0; i < source.size(); ++i) {
+      double v[3];
+      normals->GetTuple(static_cast<vtkIdType>(i), v);
+      mesh.normals[i] = glm::vec3(v[0], v[1], v[2]);
+    }
+  } else {
+    FeatureSplit split = orientAndSplitAtFeatures(points, std::move(indices), kFeatureAngleDegrees);
+    mesh.indices = std::move(split.indices);
+    source = std::move(split.source);
+    mesh.normals = std::move(split.normals);
   }
-  if (mesh.normals.empty()) mesh.computeSmoothNormals();
-  readFields(input, out, mesh);
+  mesh.positions.resize(source.size());
+  for (std::size_t i = 0; i < source.size(); ++i) mesh.positions[i] = glm::vec3(points[source[i]]);
+  for (glm::vec3& v : mesh.normals) {
+    const float len = glm::length(v);
+    // Degenerate triangles get zero normals; shaders would normalise them into NaN.
+    v = len > 0.0f && std::isfinite(len) ? v / len : glm::vec3(0, 0, 1);
+  }
+  if (vtkDataArray* c = colorArray(triangles); c != nullptr && c->GetNumberOfTuples() == np) {
+    const int comps = c->GetNumberOfComponents();
+    const double scale = c->GetDataType() == VTK_UNSIGNED_CHAR ? 1.0 / 255.0 : 1.0;
+    mesh.colors.resize(source.size());
+    for (std::size_t i = 0; i < source.size(); ++i) {
+      double v[4] = {0.0, 0.0, 0.0, 1.0 / scale};
+      for (int k = 0; k < comps && k < 4; ++k) v[k] = c->GetComponent(source[i], k);
+      glm::vec4 rgba(v[0] * scale, v[1] * scale, v[2] * scale, v[3] * scale);
+      mesh.colors[i] = glm::clamp(rgba, 0.0f, 1.0f);
+    }
+  }
+  readFields(input, triangles, source, mesh);
   return mesh;
 }
 
