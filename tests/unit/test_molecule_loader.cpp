@@ -4,6 +4,7 @@
 // names the file. The expected numbers are counted by hand from the files written here.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -353,6 +354,47 @@ TEST_F(MoleculeLoader, ResiduesSortedByKindAndBonds) {
   std::string residues;
   for (const mfr::BackboneResidue& r : m.residues) residues += r.chain + r.name + " ";
   EXPECT_EQ(residues, "AACE AALA AALA AMSE AALA ANME BALA BALA BDA BDA ");
+}
+
+// Elements where an MD or old file gives none and the atom name alone is ambiguous: CHARMM's ions
+// are named after their residue (gemmi read SOD as no element and POT as polonium), and "HG" from
+// column 13 is a serine's γ-hydrogen in an AMBER file but the mercury of S-(methylmercury)cysteine
+// (CMH) in an old PDB file — told apart by the distance to the nearest atom of the residue.
+TEST_F(MoleculeLoader, IonsAndMercuryWithoutElementColumns) {
+  std::string s;
+  int serial = 1;
+  const auto atom = [&](const char* name, const char* residue, int seq, const glm::dvec3& p) {
+    s += atomRecord("ATOM", serial++, name, ' ', residue, 'A', seq, p.x, p.y, p.z, "");
+  };
+  const auto backbone = [&](const char* residue, int seq, double x) {
+    atom("N   ", residue, seq, {x, 0.0, 0.0});
+    atom("CA  ", residue, seq, {x + 1.45, 0.3, 0.0});
+    atom("C   ", residue, seq, {x + 2.47, 0.0, 0.0});
+    atom("O   ", residue, seq, {x + 2.47, 1.23, 0.0});
+    atom("CB  ", residue, seq, {x + 1.45, -0.5, 1.45});
+  };
+  backbone("SER", 1, 0.0);
+  atom("OG  ", "SER", 1, {1.45, -0.5, 2.88});
+  atom("HG  ", "SER", 1, {1.45, 0.46, 2.88});  // 0.96 Å from OG
+  backbone("CMH", 2, 3.8);
+  atom("SG  ", "CMH", 2, {5.25, -0.5, 3.27});  // 1.82 Å from CB
+  atom("HG  ", "CMH", 2, {5.25, -0.5, 5.67});  // 2.40 Å from SG
+  atom("CM  ", "CMH", 2, {5.25, -0.5, 7.77});  // 2.10 Å from HG
+  const std::array<const char*, 6> ions = {"SOD", "POT", "CLA", "CAL", "CES", "ZN2"};
+  for (std::size_t i = 0; i < ions.size(); ++i)
+    atom(i == 5 ? "ZN  " : (std::string(ions[i]) + " ").c_str(), ions[i], 10 + static_cast<int>(i),
+         {20.0 + 5.0 * static_cast<double>(i), 0.0, 0.0});
+  const mfr::MoleculeStructure m = mfr::readMoleculeStructure(write("md-ions.pdb", s + "END\n"));
+  std::map<int, int> elementOf;  // serial → atomic number
+  for (const mfr::MoleculeAtom& a : m.atoms) elementOf[a.serial] = a.atomicNumber;
+  EXPECT_EQ(elementOf[7], 1) << "serine's HG";
+  EXPECT_EQ(elementOf[13], 16) << "CMH's SG";
+  EXPECT_EQ(elementOf[14], 80) << "CMH's HG";
+  EXPECT_EQ(elementOf[15], 6) << "CMH's CM";
+  EXPECT_EQ(
+      (std::vector<int>{elementOf[16], elementOf[17], elementOf[18], elementOf[19], elementOf[20], elementOf[21]}),
+      (std::vector<int>{11, 19, 17, 20, 55, 30}))
+      << "SOD POT CLA CAL CES ZN2";
 }
 
 // An mmCIF file without _entity: gemmi guesses from the subchains (a one-residue ALA subchain a

@@ -238,9 +238,8 @@ TEST_F(MoleculeStyles, ARepresentationDrawnOnNoPartIsANote) {
   const std::vector<Object> parts = loadModel(file, options);
   ASSERT_EQ(parts.size(), 2u);  // the ligands' sticks, the water's spheres
   const std::string path = file.string();
-  EXPECT_EQ(notes, (std::vector<std::string>{
-                       path + ": no cartoon drawn (no chain has a run of two residues with Cα or P atoms)",
-                       path + ": no surface drawn (water has no surface)"}));
+  EXPECT_EQ(notes, (std::vector<std::string>{path + ": no cartoon drawn (no chain has two residues with Cα or P atoms)",
+                                             path + ": no surface drawn (water has no surface)"}));
   notes.clear();
   options.molecule = MoleculeStyle::parse("spheres,cartoon@ligands,ball-and-stick@water", "t");
   (void)loadModel(write("ligands.pdb", record("HETATM", 1, " C  ", "CH4", 'A', 1, {0, 0, 0}, "C") + "END\n"), options);
@@ -252,6 +251,24 @@ TEST_F(MoleculeStyles, ARepresentationDrawnOnNoPartIsANote) {
   (void)loadModel(write("ligands.pdb", record("HETATM", 1, " C  ", "CH4", 'A', 1, {0, 0, 0}, "C") + "END\n"), options);
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes[0].find("no cartoon drawn (the structure has no polymer chains)"), std::string::npos) << notes[0];
+  // Residues with Cα atoms, but none in a row close enough to be bonded; residues without any.
+  notes.clear();
+  options.molecule = MoleculeStyle::parse("cartoon,spheres", "t");
+  (void)loadModel(write("broken.pdb", record("ATOM", 1, " CA ", "ALA", 'A', 1, {0, 0, 0}, "C") +
+                                          record("ATOM", 2, " CA ", "ALA", 'A', 2, {10, 0, 0}, "C") +
+                                          record("ATOM", 3, " CA ", "ALA", 'A', 3, {20, 0, 0}, "C") + "END\n"),
+                  options);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("no cartoon drawn (no chain has two residues in a row that make a backbone (Cα atoms "
+                          "0.01 to 4.5 Å apart, P atoms 0.01 to 8 Å))"),
+            std::string::npos)
+      << notes[0];
+  notes.clear();
+  (void)loadModel(write("no-trace.pdb", record("ATOM", 1, " N  ", "ALA", 'A', 1, {0, 0, 0}, "N") +
+                                            record("ATOM", 2, " C  ", "ALA", 'A', 1, {1.4, 0, 0}, "C") + "END\n"),
+                  options);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("no cartoon drawn (no polymer residue has a Cα or P atom)"), std::string::npos) << notes[0];
   // Everything drawn: no note. And through loadScene, the scene's notes.
   notes.clear();
   options.molecule = MoleculeStyle::parse("sticks", "t");

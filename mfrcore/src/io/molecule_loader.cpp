@@ -529,6 +529,10 @@ std::unordered_set<int> pdbAtomsWithoutElements(const std::string& data) {
 // does not give them (`unstated`: pdbAtomsWithoutElements): those hold only H (D), C, N, O, S, P
 // and Se, so an atom gemmi guessed as anything else from its name (or not at all: water's "OW",
 // "HW1") is the element of its name's first letter (PyMOL reads AMBER and GROMACS files so too).
+// The exception is a metal in a modified residue whose name starts with H: "HG" is serine's
+// γ-hydrogen in an AMBER file and the mercury of S-(methylmercury)cysteine (CMH) in an old one.
+// A hydrogen is bonded to an atom of its residue within 1.45 Å (S–H, the longest usual bond to
+// hydrogen, is 1.34 Å); the mercury's nearest atoms are 2.1 Å (C) and 2.4 Å (S) away.
 void fixChainElements(gemmi::Residue& residue, const std::unordered_set<int>& unstated) {
   for (gemmi::Atom& atom : residue.atoms) {
     if (!unstated.contains(atom.serial)) continue;
@@ -538,10 +542,34 @@ void fixChainElements(gemmi::Residue& residue, const std::unordered_set<int>& un
       continue;
     const std::size_t letter = atom.name.find_first_not_of("0123456789 ");
     if (letter == std::string::npos) continue;
+    const char first = atom.name[letter];
+    if (first == 'H' && e != gemmi::El::X &&
+        std::none_of(residue.atoms.begin(), residue.atoms.end(),
+                     [&](const gemmi::Atom& other) { return &other != &atom && other.pos.dist(atom.pos) <= 1.45; }))
+      continue;
     // Only those elements; gemmi's Element reads the one-letter symbol.
-    if (std::string_view("HDCNOSP").find(atom.name[letter]) != std::string_view::npos)
-      atom.element = gemmi::Element(std::string(1, atom.name[letter]));
+    if (std::string_view("HDCNOSP").find(first) != std::string_view::npos)
+      atom.element = gemmi::Element(std::string(1, first));
   }
+}
+
+// The element of a lone ion by its residue name in CHARMM's force field (SOD, POT, CLA, …), where
+// the file does not give it: gemmi reads the atom names (also SOD, POT) as no element and polonium.
+void fixCharmmIon(gemmi::Residue& residue, const std::unordered_set<int>& unstated) {
+  static const std::array<std::pair<std::string_view, std::string_view>, 11> kIons = {{{"SOD", "Na"},
+                                                                                       {"POT", "K"},
+                                                                                       {"CLA", "Cl"},
+                                                                                       {"CAL", "Ca"},
+                                                                                       {"CES", "Cs"},
+                                                                                       {"LIT", "Li"},
+                                                                                       {"RUB", "Rb"},
+                                                                                       {"BAR", "Ba"},
+                                                                                       {"ZN2", "Zn"},
+                                                                                       {"CD2", "Cd"},
+                                                                                       {"MG", "Mg"}}};
+  if (residue.atoms.size() != 1 || !unstated.contains(residue.atoms[0].serial)) return;
+  for (const auto& [name, element] : kIons)
+    if (residue.name == name) residue.atoms[0].element = gemmi::Element(std::string(element));
 }
 
 // Entity types where the file does not give them (`given` false: a PDB file, whose TER records
@@ -621,12 +649,17 @@ Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const s
     }
   }
   for (std::size_t c = 0; c < st.models[0].chains.size(); ++c) classifyResidues(st.models[0].chains[c], given[c]);
-  if (format == MoleculeFormat::Pdb)
-    if (const std::unordered_set<int> unstated = pdbAtomsWithoutElements(contents); !unstated.empty())
+  if (format == MoleculeFormat::Pdb) {
+    if (const std::unordered_set<int> unstated = pdbAtomsWithoutElements(contents); !unstated.empty()) {
       for (gemmi::Chain& chain : st.models[0].chains)
-        for (gemmi::Residue& residue : chain.residues)
+        for (gemmi::Residue& residue : chain.residues) {
           if (residue.entity_type != gemmi::EntityType::NonPolymer || isChainResidue(residue))
             fixChainElements(residue, unstated);
+          else
+            fixCharmmIon(residue, unstated);
+        }
+    }
+  }
   Parsed parsed{partsOf(st.models[0], name), models, {}};
   for (const gemmi::Helix& h : st.helices)
     parsed.recorded.push_back(
@@ -979,7 +1012,20 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
       for (std::size_t k = 1; k < missing.size(); ++k) text += (k + 1 == missing.size() ? " or " : ", ") + missing[k];
       return text;
     }
-    if (representation == "cartoon") return std::string("no chain has a run of two residues with Cα or P atoms");
+    if (representation == "cartoon") {
+      // Why cartoonOf made no run of two: too few trace atoms, or none of them in a row close enough.
+      std::size_t mostTraces = 0;
+      for (const Part& p : parts)
+        if (p.kind == PartKind::Polymer)
+          mostTraces = std::max<std::size_t>(mostTraces, std::count_if(p.traceAtoms.begin(), p.traceAtoms.end(),
+                                                                       [](const auto& a) { return a.has_value(); }));
+      if (mostTraces == 0) return std::string("no polymer residue has a Cα or P atom");
+      if (mostTraces == 1) return std::string("no chain has two residues with Cα or P atoms");
+      const auto number = [](double v) { return (std::ostringstream() << v).str(); };
+      return "no chain has two residues in a row that make a backbone (Cα atoms " + number(kMinTraceStep) + " to " +
+             number(kMaxCaStep) + " Å apart, P atoms " + number(kMinTraceStep) + " to " + number(kMaxPhosphorusStep) +
+             " Å)";
+    }
     return std::string("no atoms to draw");
   };
   if (objects.empty()) {
