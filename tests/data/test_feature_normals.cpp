@@ -195,3 +195,18 @@ TEST(FeatureNormals, SameAsVtkOnTheStanfordDragon) {
   TempDir dir;
   checkBoth(readPlyGz(path, dir), "dragon_vrip_res3");
 }
+
+// Where only VTK's exact arithmetic decides (found by fuzzing against VTK): a crease of exactly 30°
+// on integer coordinates (VTK compares the dot product in double: joined), and a collinear sliver
+// whose normal is zero or a unit vector of rounding noise depending on the corner the cross product
+// is taken at (VTK's: (c − b) × (a − b)).
+TEST(FeatureNormals, SameAsVtkOnExactCreasesAndSlivers) {
+  const Triangles crease{{{1, 6, -1}, {2, 6, 1}, {1, 7, -1}, {2, 7, 0}}, {0, 1, 3, 3, 2, 0}};
+  expectSameAsVtk(crease, "30° crease");
+  const Triangles sliver{{{2, 1, -0.071293419737075189},
+                          {2, 2, 0.118756996395249},
+                          {2, 1.5, 0.023731788329086914},
+                          {2, 1.5, -0.97626821167091304}},
+                         {0, 2, 1, 0, 1, 3}};
+  expectSameAsVtk(sliver, "collinear sliver");
+}

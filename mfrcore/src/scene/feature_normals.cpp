@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <stdexcept>
 
 namespace mfr {
 namespace {
@@ -61,6 +63,10 @@ EdgeMap buildEdgeMap(const std::vector<std::uint32_t>& indices) {
 FeatureSplit orientAndSplitAtFeatures(const std::vector<glm::dvec3>& positions, std::vector<std::uint32_t> indices,
                                       double featureAngleDegrees) {
   FeatureSplit out;
+  // Corner slots, edge groups and vertex ids are 32-bit (as Mesh::indices are).
+  if (indices.size() >= std::numeric_limits<std::uint32_t>::max() ||
+      positions.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw std::length_error("orientAndSplitAtFeatures: more than 2^32 - 1 corners or vertices");
   const std::size_t triangles = indices.size() / 3;
   indices.resize(3 * triangles);
   const std::vector<std::uint32_t> input = indices;
@@ -112,11 +118,13 @@ FeatureSplit orientAndSplitAtFeatures(const std::vector<glm::dvec3>& positions, 
     }
   }
 
-  // Unit triangle normals, in single precision as VTK keeps them (the feature test compares them).
+  // Unit triangle normals as VTK makes them: (c − b) × (a − b) in double, kept in single precision
+  // (the choice of corner decides which nearly collinear triangles get a zero normal and which a
+  // unit one of rounding noise).
   std::vector<glm::vec3> faceNormals(triangles);
   for (std::size_t t = 0; t < triangles; ++t) {
-    const glm::dvec3& a = positions[indices[3 * t]];
-    const glm::dvec3 n = glm::cross(positions[indices[3 * t + 1]] - a, positions[indices[3 * t + 2]] - a);
+    const glm::dvec3& b = positions[indices[3 * t + 1]];
+    const glm::dvec3 n = glm::cross(positions[indices[3 * t + 2]] - b, positions[indices[3 * t]] - b);
     const double length = glm::length(n);
     faceNormals[t] = glm::vec3(length > 0.0 ? n / length : n);
   }
@@ -164,7 +172,10 @@ FeatureSplit orientAndSplitAtFeatures(const std::vector<glm::dvec3>& positions, 
           if (g == kNoEdge || edges.size(g) != 2) continue;  // boundary or non-manifold: a crease
           const std::uint32_t y =
               edges.members[edges.start[g]] == x ? edges.members[edges.start[g] + 1] : edges.members[edges.start[g]];
-          if (region[y] >= 0 || glm::dot(faceNormals[x], faceNormals[y]) <= cosFeature) continue;
+          // The dot product in double, as VTK takes it (creases of exactly 30° on grid data are
+          // decided by it); a NaN normal joins nothing.
+          if (region[y] >= 0 || !(glm::dot(glm::dvec3(faceNormals[x]), glm::dvec3(faceNormals[y])) > cosFeature))
+            continue;
           region[y] = regions;
           stack.push_back(y);
         }

@@ -32,7 +32,9 @@ struct FeatureSplit {
 // Splitting: around each vertex, triangles joined by a manifold edge (two triangles) whose normals
 // are less than `featureAngleDegrees` apart form one region; each region after the first (in
 // triangle order) gets its own copy of the vertex. Indices must be < positions.size() (the loaders
-// check); triangles that repeat a vertex have no edge between the repeated corners.
+// check); a last incomplete triangle is ignored; triangles that repeat a vertex have no edge
+// between the repeated corners (where VTK's filter does odd things). Throws std::length_error past
+// 2^32 − 1 corners or vertices.
 [[nodiscard]] FeatureSplit orientAndSplitAtFeatures(const std::vector<glm::dvec3>& positions,
                                                     std::vector<std::uint32_t> indices, double featureAngleDegrees);
 
