@@ -228,6 +228,17 @@ TEST(Section, OverlappingShellsOfOnePartAreCappedByTheirUnion) {
       sectionMesh(joined(unit, unit, {0.5f, 0.0f, 0.0f}, false, red), {0.0, 0.0, 1.0, -0.2}, true);
   ASSERT_EQ(collinear.outcome, SectionOutcome::kCapped);
   EXPECT_NEAR(capArea(collinear), 1.5, 1e-6);
+  // Shells whose cut lines share a stretch exactly, point for point: a 2 × 1 × 1 box holding the
+  // unit box against its end face (the two x = −0.5 faces are one). The stretch counts for both
+  // loops (as a doubled triangle's it would count once, and neither loop would close).
+  const SectionedMesh shared =
+      sectionMesh(joined(unit, makeBox({2.0, 1.0, 1.0}), {0.5f, 0.0f, 0.0f}, false, red), {0.0, 0.0, 1.0, -0.2}, true);
+  ASSERT_EQ(shared.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(shared), 2.0, 1e-6);
+  // Two copies of one box: every segment twice. Either reading closes the loops; the cap is one.
+  const SectionedMesh copies = sectionMesh(joined(unit, unit, {}, false, red), {0.0, 0.0, 1.0, -0.2}, true);
+  ASSERT_EQ(copies.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(copies), 1.0, 1e-6);
   // A surface wound inside out gets a cap that faces as it does: inward, and the cut box is again
   // closed and consistently wound (volume negative). Where shells overlap, each region's cap faces
   // as the shells winding around it.
@@ -567,6 +578,21 @@ TEST(Section, CutSolidsAreWatertightForCsg) {
     EXPECT_EQ(report.capped, report.cut);
     EXPECT_NO_THROW(validateCsg(cut));
   }
+}
+
+// A plane between two shells of one part removes one whole and crosses no triangle: nothing was
+// opened, so the part counts as capped (with no cap) and no note calls it open.
+TEST(Section, RemovingWholeShellsOpensNothing) {
+  const Mesh twoBoxes = joined(makeBox({1.0, 1.0, 1.0}), makeBox({1.0, 1.0, 1.0}), {3.0f, 0.0f, 0.0f}, false,
+                               glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
+  const SectionedMesh cut = sectionMesh(twoBoxes, {1.0, 0.0, 0.0, -1.5}, true);
+  EXPECT_EQ(cut.outcome, SectionOutcome::kCapped);
+  EXPECT_TRUE(cut.closed);
+  EXPECT_EQ(cut.capTriangles, 0u);
+  EXPECT_EQ(cut.mesh.triangleCount(), 12u);
+  EXPECT_TRUE(closedAndConsistent(cut.mesh));
+  // Without caps asked for, it is reported as cut, as any part the plane changes.
+  EXPECT_EQ(sectionMesh(twoBoxes, {1.0, 0.0, 0.0, -1.5}, false).outcome, SectionOutcome::kCut);
 }
 
 TEST(Section, OpenPartsAreReportedAndCapsCanBeTurnedOff) {

@@ -96,8 +96,11 @@ bool markWinding(Triangulation& cdt, const Across& across) {
 // A cut line welded into loops: the segments exit → entry (vertex indices into `positions`) where
 // a surface's triangles cross the plane, in the surface's winding.
 //
-// Points at the same position are one; a segment repeated (a doubled triangle) counts once and a
-// segment with its reverse (a two-sided sheet) cancels; a chain that ends within `weldDistance` of
+// Points at the same position are one; a segment with its reverse (a two-sided sheet) cancels. A
+// segment repeated in one direction is either two shells' shared stretch (two boxes of one part
+// side by side with a common face, or a copy of a sphere): it counts for each, so that both loops
+// close; or a doubled triangle's: it counts once. Each whole cut line is read the first way if that
+// leaves no fewer open ends than the second. A chain that ends within `weldDistance` of
 // where another starts is joined to it (a CAD face's edge nodes, evaluated on each of its surfaces,
 // differ by rounding), the nearest pairs first. Points that close already are never moved, so a
 // fine tessellation keeps every cut point.
@@ -133,22 +136,34 @@ WeldedCutLine weldCutLine(const std::vector<glm::vec3>& positions,
 
   w.root.resize(w.source.size());
   for (std::size_t i = 0; i < w.root.size(); ++i) w.root[i] = i;
-  const auto collect = [&] {
-    std::map<std::pair<std::size_t, std::size_t>, bool> segments;
+  // The segments between representatives, each as often as it is used more than its reverse
+  // (`repeated`), or once.
+  const auto collect = [&](bool repeated) {
+    std::map<std::pair<std::size_t, std::size_t>, int> uses;  // (i < j): uses of i → j minus j → i
+    std::map<std::pair<std::size_t, std::size_t>, bool> present;
     for (const auto& [a, b] : raw)
-      if (const std::size_t i = w.find(a), j = w.find(b); i != j) segments[{i, j}] = true;
-    for (auto& [segment, keep] : segments)
-      if (segments.contains({segment.second, segment.first})) keep = false;
+      if (const std::size_t i = w.find(a), j = w.find(b); i != j) {
+        uses[{std::min(i, j), std::max(i, j)}] += i < j ? 1 : -1;
+        present[{i, j}] = true;
+      }
     w.segments.clear();
     w.balance.assign(w.source.size(), 0);
-    for (const auto& [segment, keep] : segments)
-      if (keep) {
+    for (const auto& [pair, net] : uses) {
+      const auto [i, j] = pair;
+      // Once: as before repeated segments counted, a segment and its reverse cancel outright.
+      const int times = repeated ? std::abs(net) : (present.contains({i, j}) && present.contains({j, i}) ? 0 : 1);
+      for (int k = 0; k < times; ++k) {
+        const auto segment = net > 0 ? std::pair{i, j} : std::pair{j, i};
         w.segments.push_back(segment);
         ++w.balance[segment.first];
         --w.balance[segment.second];
       }
+    }
+    return static_cast<std::size_t>(std::count_if(w.balance.begin(), w.balance.end(), [](int b) { return b != 0; }));
   };
-  collect();
+  const std::size_t openOnce = collect(false);
+  const bool repeated = collect(true) <= openOnce;
+  if (!repeated) collect(false);
   std::vector<std::tuple<double, std::size_t, std::size_t>> gaps;
   for (std::size_t e = 0; e < w.balance.size(); ++e)
     if (w.balance[e] < 0)
@@ -164,7 +179,7 @@ WeldedCutLine weldCutLine(const std::vector<glm::vec3>& positions,
       --open[b];
       w.root[w.find(b)] = w.find(e);
     }
-    collect();
+    collect(repeated);
   }
   return w;
 }
@@ -215,15 +230,16 @@ bool fillCapWith(const std::vector<glm::vec3>& positions, const WeldedCutLine& l
     if (handle[id]->info().id != kCrossing) return true;  // two points in one: no cap
     handle[id]->info().id = id;
   }
-  // The simple kind: each constrained edge is one segment, whose direction is kept here.
-  std::unordered_set<std::uint64_t> direction;  // (a, b) as a << 32 | b, point ids
+  // The simple kind: each constrained edge is one segment (or a repeated one), whose direction and
+  // number of uses are kept here.
+  std::unordered_map<std::uint64_t, int> direction;  // (a, b) as a << 32 | b, point ids
   const auto key = [](Vertex a, Vertex b) {
     return static_cast<std::uint64_t>(a->info().id) << 32 | static_cast<std::uint64_t>(b->info().id);
   };
   try {
     for (const auto& [a, b] : line.segments) {
       cdt.insert_constraint(handle[a], handle[b]);
-      if constexpr (!crossings) direction.insert(key(handle[a], handle[b]));
+      if constexpr (!crossings) ++direction[key(handle[a], handle[b])];
       enclosed += 0.5 * glm::dot(glm::cross(position(a) - centre, position(b) - centre), outward);
     }
   } catch (const typename SimpleCapTriangulation::Intersection_of_constraints_exception&) {
@@ -236,8 +252,8 @@ bool fillCapWith(const std::vector<glm::vec3>& positions, const WeldedCutLine& l
       for (auto context = cdt.contexts_begin(a, b); context != cdt.contexts_end(a, b); ++context)
         change += *context->current() == a ? -1 : 1;
     } else {
-      if (direction.contains(key(a, b))) --change;
-      if (direction.contains(key(b, a))) ++change;
+      if (const auto it = direction.find(key(a, b)); it != direction.end()) change -= it->second;
+      if (const auto it = direction.find(key(b, a)); it != direction.end()) change += it->second;
     }
     return change;
   };
@@ -425,7 +441,12 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
     }
   }
   out.outcome = SectionOutcome::kCut;
-  if (caps && !m.indices.empty()) {
+  if (caps && !m.indices.empty() && cutLine.empty()) {
+    // Only whole shells were removed (no triangle crosses the plane): nothing was opened, so
+    // nothing needs a cap.
+    out.closed = true;
+    out.outcome = SectionOutcome::kCapped;
+  } else if (caps && !m.indices.empty()) {
     const double weldDistance = std::max(kCapWeld * glm::length(box.max - box.min), 1e-30);
     WeldedCutLine line = weldCutLine(m.positions, cutLine, weldDistance);
     out.closed = line.closed();
