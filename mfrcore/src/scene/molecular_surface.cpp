@@ -190,6 +190,39 @@ double groupSpacing(const std::vector<SurfaceAtom>& atoms, const MolecularSurfac
 
 Mesh groupSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options);
 
+// A lone atom's solvent-excluded surface: its van der Waals sphere (no probe touches it and another
+// atom), made directly as a latitude–longitude sphere with edges of about h along the equator
+// (area 0.6 % short at the default 0.3 Å, 0.07 % at 0.1 Å), every vertex shared as on the grid's
+// surfaces (one vertex per pole, no seam). On grids, 10,000 lone ions took 127 s.
+Mesh loneAtomSurface(const SurfaceAtom& atom, double h) {
+  const int slices = std::max(12, static_cast<int>(std::ceil(2.0 * std::numbers::pi * atom.radius / h)));
+  const int stacks = std::max(6, slices / 2);
+  Mesh m;
+  const auto add = [&](double phi, double theta) {
+    // Around +y, counter-clockwise seen from outside, from the south pole (φ = −π/2) up.
+    const glm::dvec3 n(std::cos(phi) * std::sin(theta), std::sin(phi), std::cos(phi) * std::cos(theta));
+    m.positions.emplace_back(atom.centre + atom.radius * n);
+    m.normals.emplace_back(n);
+  };
+  add(-0.5 * std::numbers::pi, 0.0);
+  for (int r = 1; r < stacks; ++r)
+    for (int c = 0; c < slices; ++c)
+      add(std::numbers::pi * (static_cast<double>(r) / stacks - 0.5), 2.0 * std::numbers::pi * c / slices);
+  add(0.5 * std::numbers::pi, 0.0);
+  const auto north = static_cast<std::uint32_t>(m.positions.size() - 1);
+  const auto at = [&](int r, int c) {  // ring r in 1 .. stacks − 1
+    return static_cast<std::uint32_t>(1 + (r - 1) * slices + c % slices);
+  };
+  for (int c = 0; c < slices; ++c) {
+    m.indices.insert(m.indices.end(), {0, at(1, c + 1), at(1, c)});
+    for (int r = 1; r + 1 < stacks; ++r)
+      m.indices.insert(m.indices.end(),
+                       {at(r, c), at(r, c + 1), at(r + 1, c + 1), at(r, c), at(r + 1, c + 1), at(r + 1, c)});
+    m.indices.insert(m.indices.end(), {at(stacks - 1, c), at(stacks - 1, c + 1), north});
+  }
+  return m;
+}
+
 }  // namespace
 
 double molecularSurfaceSpacing(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options) {
@@ -204,7 +237,8 @@ Mesh solventExcludedSurface(const std::vector<SurfaceAtom>& atoms, const Molecul
   check(atoms, options);
   Mesh out;
   for (const std::vector<SurfaceAtom>& group : groupsOf(atoms, options.probeRadius)) {
-    const Mesh mesh = groupSurface(group, options);
+    const Mesh mesh =
+        group.size() == 1 ? loneAtomSurface(group[0], groupSpacing(group, options)) : groupSurface(group, options);
     const auto base = static_cast<std::uint32_t>(out.positions.size());
     out.positions.insert(out.positions.end(), mesh.positions.begin(), mesh.positions.end());
     out.normals.insert(out.normals.end(), mesh.normals.begin(), mesh.normals.end());
