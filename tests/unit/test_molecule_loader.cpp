@@ -384,6 +384,19 @@ TEST_F(MoleculeLoader, IonsAndMercuryWithoutElementColumns) {
   for (std::size_t i = 0; i < ions.size(); ++i)
     atom(i == 5 ? "ZN  " : (std::string(ions[i]) + " ").c_str(), ions[i], 10 + static_cast<int>(i),
          {20.0 + 5.0 * static_cast<double>(i), 0.0, 0.0});
+  // Review cases: the mercury in two alternative locations 0.8 Å apart (each other's no bonding
+  // partner); two SOD ions numbered as one residue; ions named from column 14 (" SOD", as MDTraj
+  // and OpenMM write them; gemmi read S and P); a leucine's HG moved 30 Å away (a periodic box):
+  // in a residue of gemmi's table, still a hydrogen.
+  s += atomRecord("ATOM", serial++, "HG  ", 'B', "CMH", 'A', 2, 5.25, 0.3, 5.67, "");  // 22
+  atom("SOD ", "SOD", 20, {60.0, 0.0, 0.0});                                           // 23
+  atom("SOD ", "SOD", 20, {65.0, 0.0, 0.0});                                           // 24
+  atom(" SOD", "SOD", 21, {70.0, 0.0, 0.0});                                           // 25
+  atom(" POT", "POT", 22, {75.0, 0.0, 0.0});                                           // 26
+  atom("N   ", "LEU", 30, {100.0, 0.0, 0.0});                                          // 27
+  atom("CA  ", "LEU", 30, {101.45, 0.3, 0.0});                                         // 28
+  atom("C   ", "LEU", 30, {102.47, 0.0, 0.0});                                         // 29
+  atom("HG  ", "LEU", 30, {130.0, 0.0, 0.0});                                          // 30
   const mfr::MoleculeStructure m = mfr::readMoleculeStructure(write("md-ions.pdb", s + "END\n"));
   std::map<int, int> elementOf;  // serial → atomic number
   for (const mfr::MoleculeAtom& a : m.atoms) elementOf[a.serial] = a.atomicNumber;
@@ -395,6 +408,10 @@ TEST_F(MoleculeLoader, IonsAndMercuryWithoutElementColumns) {
       (std::vector<int>{elementOf[16], elementOf[17], elementOf[18], elementOf[19], elementOf[20], elementOf[21]}),
       (std::vector<int>{11, 19, 17, 20, 55, 30}))
       << "SOD POT CLA CAL CES ZN2";
+  EXPECT_EQ(elementOf[14], 80) << "CMH's HG beside its other location";
+  EXPECT_EQ((std::vector<int>{elementOf[23], elementOf[24], elementOf[25], elementOf[26], elementOf[30]}),
+            (std::vector<int>{11, 11, 11, 19, 1}))
+      << "SOD SOD (one residue), SOD POT (from column 14), LEU's far HG";
 }
 
 // An mmCIF file without _entity: gemmi guesses from the subchains (a one-residue ALA subchain a

@@ -259,8 +259,8 @@ TEST_F(MoleculeStyles, ARepresentationDrawnOnNoPartIsANote) {
                                           record("ATOM", 3, " CA ", "ALA", 'A', 3, {20, 0, 0}, "C") + "END\n"),
                   options);
   ASSERT_EQ(notes.size(), 1u);
-  EXPECT_NE(notes[0].find("no cartoon drawn (no chain has two residues in a row that make a backbone (Cα atoms "
-                          "0.01 to 4.5 Å apart, P atoms 0.01 to 8 Å))"),
+  EXPECT_NE(notes[0].find("no cartoon drawn (no chain has two residues in a row that make a backbone: Cα atoms at "
+                          "most 4.5 Å apart, or P atoms at most 8 Å apart)"),
             std::string::npos)
       << notes[0];
   notes.clear();

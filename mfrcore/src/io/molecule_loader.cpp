@@ -499,10 +499,10 @@ bool linked(const gemmi::Residue& first, const gemmi::Residue& next) {
 }
 
 // The serial numbers of a PDB file's ATOM/HETATM records that leave the element (columns 77–78)
-// blank and start the atom name in column 13. Files written by MD programs (AMBER, CHARMM) do, and
+// blank and (`fromColumn13`) start the atom name in column 13. Files written by MD programs (AMBER, CHARMM) do, and
 // gemmi then takes Cα ("CA  ") for calcium and γ-hydrogens ("HG1 ") for mercury. A serial that
 // also names a record with an element is left out.
-std::unordered_set<int> pdbAtomsWithoutElements(const std::string& data) {
+std::unordered_set<int> pdbAtomsWithoutElements(const std::string& data, bool fromColumn13 = true) {
   const bool columns72 = hasLineNumbersInColumns73To80(data);  // read as 72 columns: no elements
   std::unordered_set<int> without, with;
   for (std::size_t start = 0; start < data.size();) {
@@ -519,7 +519,7 @@ std::unordered_set<int> pdbAtomsWithoutElements(const std::string& data) {
             digits.data() + digits.size())
       continue;  // hybrid-36 or garbage: no guess
     const bool blank = columns72 || line.size() < 78 || (line[76] == ' ' && line[77] == ' ');
-    (blank && line[12] != ' ' ? without : with).insert(serial);
+    (blank && (line[12] != ' ' || !fromColumn13) ? without : with).insert(serial);
   }
   for (const int serial : with) without.erase(serial);
   return without;
@@ -543,9 +543,14 @@ void fixChainElements(gemmi::Residue& residue, const std::unordered_set<int>& un
     const std::size_t letter = atom.name.find_first_not_of("0123456789 ");
     if (letter == std::string::npos) continue;
     const char first = atom.name[letter];
-    if (first == 'H' && e != gemmi::El::X &&
-        std::none_of(residue.atoms.begin(), residue.atoms.end(),
-                     [&](const gemmi::Atom& other) { return &other != &atom && other.pos.dist(atom.pos) <= 1.45; }))
+    // Not in residues of gemmi's table (their H-named atoms are hydrogens, wherever a periodic box
+    // put them); another location of the same atom, or another hydrogen, is no bonding partner.
+    if (first == 'H' && e != gemmi::El::X && !gemmi::find_tabulated_residue(residue.name).found() &&
+        std::none_of(residue.atoms.begin(), residue.atoms.end(), [&](const gemmi::Atom& other) {
+          const std::size_t o = other.name.find_first_not_of("0123456789 ");
+          return other.name != atom.name && o != std::string::npos && other.name[o] != 'H' && other.name[o] != 'D' &&
+                 other.pos.dist(atom.pos) <= 1.45;
+        }))
       continue;
     // Only those elements; gemmi's Element reads the one-letter symbol.
     if (std::string_view("HDCNOSP").find(first) != std::string_view::npos)
@@ -553,23 +558,31 @@ void fixChainElements(gemmi::Residue& residue, const std::unordered_set<int>& un
   }
 }
 
-// The element of a lone ion by its residue name in CHARMM's force field (SOD, POT, CLA, …), where
-// the file does not give it: gemmi reads the atom names (also SOD, POT) as no element and polonium.
+// The element of an ion by its residue name in CHARMM's force field (SOD, POT, CLA, …), where the
+// file does not give it (`unstated`: names from column 13 or 14): gemmi reads the atom names (also
+// SOD, POT) as no element and polonium, or from column 14 as S and P.
 void fixCharmmIon(gemmi::Residue& residue, const std::unordered_set<int>& unstated) {
-  static const std::array<std::pair<std::string_view, std::string_view>, 11> kIons = {{{"SOD", "Na"},
-                                                                                       {"POT", "K"},
-                                                                                       {"CLA", "Cl"},
-                                                                                       {"CAL", "Ca"},
-                                                                                       {"CES", "Cs"},
-                                                                                       {"LIT", "Li"},
-                                                                                       {"RUB", "Rb"},
-                                                                                       {"BAR", "Ba"},
-                                                                                       {"ZN2", "Zn"},
-                                                                                       {"CD2", "Cd"},
-                                                                                       {"MG", "Mg"}}};
-  if (residue.atoms.size() != 1 || !unstated.contains(residue.atoms[0].serial)) return;
-  for (const auto& [name, element] : kIons)
-    if (residue.name == name) residue.atoms[0].element = gemmi::Element(std::string(element));
+  struct Ion {
+    std::string_view residue, atom, element;
+  };
+  static const std::array<Ion, 11> kIons = {{{"SOD", "SOD", "Na"},
+                                             {"POT", "POT", "K"},
+                                             {"CLA", "CLA", "Cl"},
+                                             {"CAL", "CAL", "Ca"},
+                                             {"CES", "CES", "Cs"},
+                                             {"LIT", "LIT", "Li"},
+                                             {"RUB", "RUB", "Rb"},
+                                             {"BAR", "BAR", "Ba"},
+                                             {"ZN2", "ZN", "Zn"},
+                                             {"CD2", "CD", "Cd"},
+                                             {"MG", "MG", "Mg"}}};
+  for (const Ion& ion : kIons) {
+    if (residue.name != ion.residue) continue;
+    // Each of its atoms named as the ion (several where a program numbered the ions as one residue).
+    for (gemmi::Atom& atom : residue.atoms)
+      if (atom.name == ion.atom && unstated.contains(atom.serial))
+        atom.element = gemmi::Element(std::string(ion.element));
+  }
 }
 
 // Entity types where the file does not give them (`given` false: a PDB file, whose TER records
@@ -650,13 +663,15 @@ Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const s
   }
   for (std::size_t c = 0; c < st.models[0].chains.size(); ++c) classifyResidues(st.models[0].chains[c], given[c]);
   if (format == MoleculeFormat::Pdb) {
-    if (const std::unordered_set<int> unstated = pdbAtomsWithoutElements(contents); !unstated.empty()) {
+    const std::unordered_set<int> unstated = pdbAtomsWithoutElements(contents);
+    const std::unordered_set<int> blank = pdbAtomsWithoutElements(contents, false);
+    if (!blank.empty()) {
       for (gemmi::Chain& chain : st.models[0].chains)
         for (gemmi::Residue& residue : chain.residues) {
           if (residue.entity_type != gemmi::EntityType::NonPolymer || isChainResidue(residue))
             fixChainElements(residue, unstated);
           else
-            fixCharmmIon(residue, unstated);
+            fixCharmmIon(residue, blank);
         }
     }
   }
@@ -1022,9 +1037,8 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
       if (mostTraces == 0) return std::string("no polymer residue has a Cα or P atom");
       if (mostTraces == 1) return std::string("no chain has two residues with Cα or P atoms");
       const auto number = [](double v) { return (std::ostringstream() << v).str(); };
-      return "no chain has two residues in a row that make a backbone (Cα atoms " + number(kMinTraceStep) + " to " +
-             number(kMaxCaStep) + " Å apart, P atoms " + number(kMinTraceStep) + " to " + number(kMaxPhosphorusStep) +
-             " Å)";
+      return "no chain has two residues in a row that make a backbone: Cα atoms at most " + number(kMaxCaStep) +
+             " Å apart, or P atoms at most " + number(kMaxPhosphorusStep) + " Å apart";
     }
     return std::string("no atoms to draw");
   };

@@ -191,11 +191,11 @@ double groupSpacing(const std::vector<SurfaceAtom>& atoms, const MolecularSurfac
 Mesh groupSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceOptions& options);
 
 // A lone atom's solvent-excluded surface: its van der Waals sphere (no probe touches it and another
-// atom), made directly as a latitude–longitude sphere with edges of about h along the equator
-// (area 0.6 % short at the default 0.3 Å, 0.07 % at 0.1 Å), every vertex shared as on the grid's
+// atom), made directly as a latitude–longitude sphere with edges of about h along the equator and
+// at least 36 around (so at most 0.63 % short in area), every vertex shared as on the grid's
 // surfaces (one vertex per pole, no seam). On grids, 10,000 lone ions took 127 s.
 Mesh loneAtomSurface(const SurfaceAtom& atom, double h) {
-  const int slices = std::max(12, static_cast<int>(std::ceil(2.0 * std::numbers::pi * atom.radius / h)));
+  const int slices = std::max(36, static_cast<int>(std::ceil(2.0 * std::numbers::pi * atom.radius / h)));
   const int stacks = std::max(6, slices / 2);
   Mesh m;
   const auto add = [&](double phi, double theta) {
