@@ -397,6 +397,13 @@ TEST_F(MoleculeLoader, IonsAndMercuryWithoutElementColumns) {
   atom("CA  ", "LEU", 30, {101.45, 0.3, 0.0});                                         // 28
   atom("C   ", "LEU", 30, {102.47, 0.0, 0.0});                                         // 29
   atom("HG  ", "LEU", 30, {130.0, 0.0, 0.0});                                          // 30
+  // Serials past 99,999 (where MD files put their ions): hybrid-36, and VMD's "*****".
+  for (const auto& [text, residue] : {std::pair{"A0000", "SOD"}, std::pair{"*****", "POT"}}) {
+    std::string line = atomRecord("HETATM", 0, (std::string(residue) + " ").c_str(), ' ', residue, 'A', 40, 90.0,
+                                  residue[0] == 'S' ? 0.0 : 5.0, 0.0, "");
+    line.replace(6, 5, text);
+    s += line;
+  }
   const mfr::MoleculeStructure m = mfr::readMoleculeStructure(write("md-ions.pdb", s + "END\n"));
   std::map<int, int> elementOf;  // serial → atomic number
   for (const mfr::MoleculeAtom& a : m.atoms) elementOf[a.serial] = a.atomicNumber;
@@ -412,6 +419,8 @@ TEST_F(MoleculeLoader, IonsAndMercuryWithoutElementColumns) {
   EXPECT_EQ((std::vector<int>{elementOf[23], elementOf[24], elementOf[25], elementOf[26], elementOf[30]}),
             (std::vector<int>{11, 11, 11, 19, 1}))
       << "SOD SOD (one residue), SOD POT (from column 14), LEU's far HG";
+  EXPECT_EQ(elementOf[100000], 11) << "SOD with a hybrid-36 serial";
+  EXPECT_EQ(elementOf[0], 19) << "POT with the serial *****";
 }
 
 // An mmCIF file without _entity: gemmi guesses from the subchains (a one-residue ALA subchain a

@@ -511,13 +511,9 @@ std::unordered_set<int> pdbAtomsWithoutElements(const std::string& data, bool fr
     const std::string_view line = withoutLineEnd(std::string_view(data).substr(start, end - start));
     start = end + 1;
     if (!isAtomRecord(line) || line.size() < 16) continue;
-    int serial = 0;
-    const std::string_view digits = line.substr(6, 5);
-    const std::size_t first = digits.find_first_not_of(' ');
-    if (first == std::string_view::npos ||
-        std::from_chars(digits.data() + first, digits.data() + digits.size(), serial).ptr !=
-            digits.data() + digits.size())
-      continue;  // hybrid-36 or garbage: no guess
+    // As gemmi reads it into Atom::serial: also hybrid-36 ("A0000" is 100000) and the "*****" of
+    // programs past 99,999 atoms (0), where MD files put their ions.
+    const int serial = gemmi::pdb_impl::read_serial(line.data() + 6);
     const bool blank = columns72 || line.size() < 78 || (line[76] == ' ' && line[77] == ' ');
     (blank && (line[12] != ' ' || !fromColumn13) ? without : with).insert(serial);
   }
