@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -239,6 +240,24 @@ TEST(Section, OverlappingShellsOfOnePartAreCappedByTheirUnion) {
   const SectionedMesh copies = sectionMesh(joined(unit, unit, {}, false, red), {0.0, 0.0, 1.0, -0.2}, true);
   ASSERT_EQ(copies.outcome, SectionOutcome::kCapped);
   EXPECT_NEAR(capArea(copies), 1.0, 1e-6);
+  // A cavity listed twice is one cavity: both readings close, and counting once leaves it open
+  // (counting each use would wind −1 in it and fill it with an inward cap).
+  const Mesh doubleCavity = joined(joined(makeBox({2.0, 2.0, 2.0}), unit, {}, true, red), unit, {}, true, red);
+  const SectionedMesh cavity = sectionMesh(doubleCavity, {0.0, 0.0, 1.0, -0.2}, true);
+  ASSERT_EQ(cavity.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(cavity), 4.0 - 1.0, 1e-6);
+  // Both a doubled triangle and a stretch shared by two shells (about 10⁻⁶ long, where the plane
+  // passes through a corner): counting repeats once leaves two open ends the weld joins, counting
+  // each use two it cannot join. The reading is chosen after welding (a fuzzer's case).
+  const std::vector<Object> boxes =
+      loadModel(std::filesystem::path(MFR_TEST_DATA_DIR) / "sections" / "offset_boxes_doubled_triangle.off");
+  ASSERT_EQ(boxes.size(), 1u);
+  const SectionedMesh oblique = sectionMesh(
+      *boxes[0].mesh,
+      sectionPlaneEquation({{1.0, 0.5, 1.0}, {-0.39272011989098476, 1.151924692572371, -0.7241083188228018}, true}),
+      true);
+  EXPECT_EQ(oblique.outcome, SectionOutcome::kCapped);
+  EXPECT_NEAR(capArea(oblique), 0.644486, 1e-5);
   // A surface wound inside out gets a cap that faces as it does: inward, and the cut box is again
   // closed and consistently wound (volume negative). Where shells overlap, each region's cap faces
   // as the shells winding around it.
@@ -593,6 +612,13 @@ TEST(Section, RemovingWholeShellsOpensNothing) {
   EXPECT_TRUE(closedAndConsistent(cut.mesh));
   // Without caps asked for, it is reported as cut, as any part the plane changes.
   EXPECT_EQ(sectionMesh(twoBoxes, {1.0, 0.0, 0.0, -1.5}, false).outcome, SectionOutcome::kCut);
+  // What is kept is open (a sheet kept, the box removed): reported as cut without a cap.
+  const Mesh sheetAndBox =
+      joined(makeBox({1.0, 1.0, 1.0}), makePlane(1.0, 1.0), {3.0f, 0.0f, 0.0f}, false, glm::vec4(1.0f));
+  const SectionedMesh sheet = sectionMesh(sheetAndBox, {1.0, 0.0, 0.0, -1.5}, true);
+  EXPECT_EQ(sheet.outcome, SectionOutcome::kCut);
+  EXPECT_EQ(sheet.mesh.triangleCount(), 2u);
+  EXPECT_EQ(describeCut(SectionOutcome::kCapped, 0.0), "; cut, closed without a cap of its own");
 }
 
 TEST(Section, OpenPartsAreReportedAndCapsCanBeTurnedOff) {

@@ -22,6 +22,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/scene/color_map.hpp"
+#include "mfr/scene/measure.hpp"
 #include "mfr/list_text.hpp"
 
 namespace mfr {
@@ -97,10 +98,10 @@ bool markWinding(Triangulation& cdt, const Across& across) {
 // a surface's triangles cross the plane, in the surface's winding.
 //
 // Points at the same position are one; a segment with its reverse (a two-sided sheet) cancels. A
-// segment repeated in one direction is either two shells' shared stretch (two boxes of one part
-// side by side with a common face, or a copy of a sphere): it counts for each, so that both loops
-// close; or a doubled triangle's: it counts once. Each whole cut line is read the first way if that
-// leaves no fewer open ends than the second. A chain that ends within `weldDistance` of
+// segment repeated in one direction is either a doubled triangle's (or a shell listed twice): it
+// counts once; or two shells' shared stretch (two boxes of one part side by side with a common
+// face): it counts for each, so that both loops close. Each whole cut line is read the second way
+// only if that leaves fewer open ends after welding. A chain that ends within `weldDistance` of
 // where another starts is joined to it (a CAD face's edge nodes, evaluated on each of its surfaces,
 // differ by rounding), the nearest pairs first. Points that close already are never moved, so a
 // fine tessellation keeps every cut point.
@@ -134,54 +135,64 @@ WeldedCutLine weldCutLine(const std::vector<glm::vec3>& positions,
   for (const auto& [a, b] : cutLine) raw.emplace_back(pointOf(a), pointOf(b));
   const auto position = [&](std::size_t id) { return glm::dvec3(positions[w.source[id]]); };
 
-  w.root.resize(w.source.size());
-  for (std::size_t i = 0; i < w.root.size(); ++i) w.root[i] = i;
-  // The segments between representatives, each as often as it is used more than its reverse
-  // (`repeated`), or once.
-  const auto collect = [&](bool repeated) {
-    std::map<std::pair<std::size_t, std::size_t>, int> uses;  // (i < j): uses of i → j minus j → i
-    std::map<std::pair<std::size_t, std::size_t>, bool> present;
-    for (const auto& [a, b] : raw)
-      if (const std::size_t i = w.find(a), j = w.find(b); i != j) {
-        uses[{std::min(i, j), std::max(i, j)}] += i < j ? 1 : -1;
-        present[{i, j}] = true;
+  // The cut line under one reading of repeated segments: its segments between representatives,
+  // each as often as it is used more than its reverse (`repeated`), or once; then chains that end
+  // near where another starts joined.
+  const auto weld = [&](bool repeated) {
+    WeldedCutLine line = w;
+    line.root.resize(line.source.size());
+    for (std::size_t i = 0; i < line.root.size(); ++i) line.root[i] = i;
+    const auto collect = [&] {
+      std::map<std::pair<std::size_t, std::size_t>, int> uses;  // (i < j): uses of i → j minus j → i
+      std::map<std::pair<std::size_t, std::size_t>, bool> present;
+      for (const auto& [a, b] : raw)
+        if (const std::size_t i = line.find(a), j = line.find(b); i != j) {
+          uses[{std::min(i, j), std::max(i, j)}] += i < j ? 1 : -1;
+          present[{i, j}] = true;
+        }
+      line.segments.clear();
+      line.balance.assign(line.source.size(), 0);
+      for (const auto& [pair, net] : uses) {
+        const auto [i, j] = pair;
+        // Once: a segment and its reverse cancel outright, however often each is used.
+        const int times = repeated ? std::abs(net) : (present.contains({i, j}) && present.contains({j, i}) ? 0 : 1);
+        for (int k = 0; k < times; ++k) {
+          const auto segment = net > 0 ? std::pair{i, j} : std::pair{j, i};
+          line.segments.push_back(segment);
+          ++line.balance[segment.first];
+          --line.balance[segment.second];
+        }
       }
-    w.segments.clear();
-    w.balance.assign(w.source.size(), 0);
-    for (const auto& [pair, net] : uses) {
-      const auto [i, j] = pair;
-      // Once: as before repeated segments counted, a segment and its reverse cancel outright.
-      const int times = repeated ? std::abs(net) : (present.contains({i, j}) && present.contains({j, i}) ? 0 : 1);
-      for (int k = 0; k < times; ++k) {
-        const auto segment = net > 0 ? std::pair{i, j} : std::pair{j, i};
-        w.segments.push_back(segment);
-        ++w.balance[segment.first];
-        --w.balance[segment.second];
+    };
+    collect();
+    std::vector<std::tuple<double, std::size_t, std::size_t>> gaps;
+    for (std::size_t e = 0; e < line.balance.size(); ++e)
+      if (line.balance[e] < 0)
+        for (std::size_t b = 0; b < line.balance.size(); ++b)
+          if (line.balance[b] > 0)
+            if (const double d = glm::distance(position(e), position(b)); d <= weldDistance) gaps.emplace_back(d, e, b);
+    if (!gaps.empty()) {
+      std::sort(gaps.begin(), gaps.end());
+      std::vector<int> open = line.balance;
+      for (const auto& [d, e, b] : gaps) {
+        if (open[e] >= 0 || open[b] <= 0 || line.find(e) == line.find(b)) continue;
+        ++open[e];
+        --open[b];
+        line.root[line.find(b)] = line.find(e);
       }
+      collect();
     }
-    return static_cast<std::size_t>(std::count_if(w.balance.begin(), w.balance.end(), [](int b) { return b != 0; }));
+    return line;
   };
-  const std::size_t openOnce = collect(false);
-  const bool repeated = collect(true) <= openOnce;
-  if (!repeated) collect(false);
-  std::vector<std::tuple<double, std::size_t, std::size_t>> gaps;
-  for (std::size_t e = 0; e < w.balance.size(); ++e)
-    if (w.balance[e] < 0)
-      for (std::size_t b = 0; b < w.balance.size(); ++b)
-        if (w.balance[b] > 0)
-          if (const double d = glm::distance(position(e), position(b)); d <= weldDistance) gaps.emplace_back(d, e, b);
-  if (!gaps.empty()) {
-    std::sort(gaps.begin(), gaps.end());
-    std::vector<int> open = w.balance;
-    for (const auto& [d, e, b] : gaps) {
-      if (open[e] >= 0 || open[b] <= 0 || w.find(e) == w.find(b)) continue;
-      ++open[e];
-      --open[b];
-      w.root[w.find(b)] = w.find(e);
-    }
-    collect(repeated);
-  }
-  return w;
+  const auto openEnds = [](const WeldedCutLine& line) {
+    return std::count_if(line.balance.begin(), line.balance.end(), [](int b) { return b != 0; });
+  };
+  // Counting repeats for each use only where that leaves fewer open ends: a shell listed twice
+  // closes either way and means one shell.
+  WeldedCutLine once = weld(false);
+  if (openEnds(once) == 0) return once;
+  WeldedCutLine each = weld(true);
+  return openEnds(each) < openEnds(once) ? each : once;
 }
 
 // The cap of a closed cut line. CGAL's constrained Delaunay triangulation fills the loops by the
@@ -442,10 +453,10 @@ SectionedMesh sectionMesh(const Mesh& mesh, const glm::dvec4& plane, bool caps) 
   }
   out.outcome = SectionOutcome::kCut;
   if (caps && !m.indices.empty() && cutLine.empty()) {
-    // Only whole shells were removed (no triangle crosses the plane): nothing was opened, so
-    // nothing needs a cap.
+    // Only whole shells were removed (no triangle crosses the plane): nothing was opened. What is
+    // kept needs no cap if it is closed (an open sheet kept stays reported as open).
     out.closed = true;
-    out.outcome = SectionOutcome::kCapped;
+    if (measureSurface(m, glm::dmat4(1.0)).closed()) out.outcome = SectionOutcome::kCapped;
   } else if (caps && !m.indices.empty()) {
     const double weldDistance = std::max(kCapWeld * glm::length(box.max - box.min), 1e-30);
     WeldedCutLine line = weldCutLine(m.positions, cutLine, weldDistance);
@@ -629,7 +640,8 @@ std::string describeCut(SectionOutcome outcome, double capArea) {
     case SectionOutcome::kCapped:
       break;
   }
-  if (!(capArea > 0.0)) return "; cut, capped with another part";
+  // Capped by a group with other parts, or closed with nothing to cap (whole shells removed).
+  if (!(capArea > 0.0)) return "; cut, closed without a cap of its own";
   std::ostringstream text;  // describeSurface's format: six significant digits
   text << "; cut, cross-section area " << capArea;
   return text.str();
