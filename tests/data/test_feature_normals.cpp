@@ -30,6 +30,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
+using mfr::test::extractCgalMesh;
 using mfr::test::TempDir;
 
 struct Triangles {
@@ -92,14 +93,6 @@ Triangles readPlyGz(const fs::path& path, const TempDir& dir) {
   reader->SetFileName(ply.c_str());
   reader->Update();
   return fromPolyData(reader->GetOutput());
-}
-
-fs::path extractCgalMesh(const TempDir& dir, const std::string& file) {
-  const fs::path tarball = "/usr/share/doc/libcgal-dev/data.tar.gz";
-  const std::string member = "data/meshes/" + file;
-  const std::string command = "tar -xzf '" + tarball.string() + "' -C '" + dir.path().string() + "' '" + member + "'";
-  EXPECT_EQ(std::system(command.c_str()), 0) << command << " (Debian package libcgal-demo)";
-  return dir.path() / member;
 }
 
 // Both implementations on the same triangles; returns how many triangles each reversed (VTK's

@@ -55,20 +55,8 @@ fs::path requireFile(const fs::path& path, const std::string& package) {
   return path;
 }
 
+using mfr::test::extractCgalMesh;
 using mfr::test::TempDir;
-
-// CGAL's demo meshes ship inside one tarball; the test extracts just the file it needs.
-fs::path extractCgalMesh(const TempDir& dir, const std::string& file) {
-  const fs::path tarball = "/usr/share/doc/libcgal-dev/data.tar.gz";
-  if (!fs::exists(requireFile(tarball, "Debian package libcgal-demo"))) return {};
-  const std::string member = "data/meshes/" + file;
-  const std::string command = "tar -xzf '" + tarball.string() + "' -C '" + dir.path().string() + "' '" + member + "'";
-  if (std::system(command.c_str()) != 0) {
-    ADD_FAILURE() << "could not extract " << member << " from " << tarball;
-    return {};
-  }
-  return dir.path() / member;
-}
 
 // ---- STL (occt-misc) ----------------------------------------------------------------------------
 

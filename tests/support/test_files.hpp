@@ -11,6 +11,7 @@
 #include <array>
 #include <cctype>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -102,6 +103,23 @@ class TempDirTest : public ::testing::Test {
  private:
   std::optional<TempDir> tmp_;
 };
+
+// CGAL's demo meshes ship inside one tarball (Debian package libcgal-demo): extracts the one named
+// `file` (data/meshes/FILE) into `dir` and returns its path, or an empty path after a failure.
+inline std::filesystem::path extractCgalMesh(const TempDir& dir, const std::string& file) {
+  const std::filesystem::path tarball = "/usr/share/doc/libcgal-dev/data.tar.gz";
+  if (!std::filesystem::exists(tarball)) {
+    ADD_FAILURE() << "missing " << tarball << " (from Debian package libcgal-demo; scripts/setup installs it)";
+    return {};
+  }
+  const std::string member = "data/meshes/" + file;
+  const std::string command = "tar -xzf '" + tarball.string() + "' -C '" + dir.path().string() + "' '" + member + "'";
+  if (std::system(command.c_str()) != 0) {
+    ADD_FAILURE() << "could not extract " << member << " from " << tarball;
+    return {};
+  }
+  return dir.path() / member;
+}
 
 // Expects loadModel(path) to throw one mfr::Error whose message is one line that starts with
 // "<path>: " and contains `reason`. Loading, LoadCancelled and any other exception are failures.

@@ -499,12 +499,16 @@ bool linked(const gemmi::Residue& first, const gemmi::Residue& next) {
 }
 
 // The serial numbers of a PDB file's ATOM/HETATM records that leave the element (columns 77–78)
-// blank and (`fromColumn13`) start the atom name in column 13. Files written by MD programs (AMBER, CHARMM) do, and
-// gemmi then takes Cα ("CA  ") for calcium and γ-hydrogens ("HG1 ") for mercury. A serial that
-// also names a record with an element is left out.
-std::unordered_set<int> pdbAtomsWithoutElements(const std::string& data, bool fromColumn13 = true) {
+// blank: `anyColumn` all of them, `fromColumn13` those that also start the atom name in column 13.
+// Files written by MD programs (AMBER, CHARMM) do, and gemmi then takes Cα ("CA  ") for calcium and
+// γ-hydrogens ("HG1 ") for mercury. A serial that also names a record that is not in a set is left
+// out of it.
+struct AtomsWithoutElements {
+  std::unordered_set<int> fromColumn13, anyColumn;
+};
+AtomsWithoutElements pdbAtomsWithoutElements(const std::string& data) {
   const bool columns72 = hasLineNumbersInColumns73To80(data);  // read as 72 columns: no elements
-  std::unordered_set<int> without, with;
+  AtomsWithoutElements without, with;
   for (std::size_t start = 0; start < data.size();) {
     std::size_t end = data.find('\n', start);
     if (end == std::string::npos) end = data.size();
@@ -515,14 +519,16 @@ std::unordered_set<int> pdbAtomsWithoutElements(const std::string& data, bool fr
     // programs past 99,999 atoms (0), where MD files put their ions.
     const int serial = gemmi::pdb_impl::read_serial(line.data() + 6);
     const bool blank = columns72 || line.size() < 78 || (line[76] == ' ' && line[77] == ' ');
-    (blank && (line[12] != ' ' || !fromColumn13) ? without : with).insert(serial);
+    (blank ? without : with).anyColumn.insert(serial);
+    (blank && line[12] != ' ' ? without : with).fromColumn13.insert(serial);
   }
-  for (const int serial : with) without.erase(serial);
+  for (const int serial : with.anyColumn) without.anyColumn.erase(serial);
+  for (const int serial : with.fromColumn13) without.fromColumn13.erase(serial);
   return without;
 }
 
 // Elements of the atoms of a chain residue (polymer or free), its caps and water, where the file
-// does not give them (`unstated`: pdbAtomsWithoutElements): those hold only H (D), C, N, O, S, P
+// does not give them (`unstated`: pdbAtomsWithoutElements' fromColumn13): those hold only H (D), C, N, O, S, P
 // and Se, so an atom gemmi guessed as anything else from its name (or not at all: water's "OW",
 // "HW1") is the element of its name's first letter (PyMOL reads AMBER and GROMACS files so too).
 // The exception is a metal in a modified residue whose name starts with H: "HG" is serine's
@@ -659,15 +665,13 @@ Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const s
   }
   for (std::size_t c = 0; c < st.models[0].chains.size(); ++c) classifyResidues(st.models[0].chains[c], given[c]);
   if (format == MoleculeFormat::Pdb) {
-    const std::unordered_set<int> unstated = pdbAtomsWithoutElements(contents);
-    const std::unordered_set<int> blank = pdbAtomsWithoutElements(contents, false);
-    if (!blank.empty()) {
+    if (const AtomsWithoutElements unstated = pdbAtomsWithoutElements(contents); !unstated.anyColumn.empty()) {
       for (gemmi::Chain& chain : st.models[0].chains)
         for (gemmi::Residue& residue : chain.residues) {
           if (residue.entity_type != gemmi::EntityType::NonPolymer || isChainResidue(residue))
-            fixChainElements(residue, unstated);
+            fixChainElements(residue, unstated.fromColumn13);
           else
-            fixCharmmIon(residue, blank);
+            fixCharmmIon(residue, unstated.anyColumn);
         }
     }
   }
