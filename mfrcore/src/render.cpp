@@ -202,7 +202,7 @@ RenderOutput renderOptimalK(const Scene& scene, const Camera& camera, const Rend
   s.notes.emplace_back("F(M)", std::to_string(layout.slotBudget(budgetBytes)) + " slots");
   s.notes.emplace_back("solver", solver);
   s.notes.emplace_back("error", std::to_string(best.error));
-  s.notes.emplace_back("device", "CPU ray casting (CGAL AABB tree)");
+  s.notes.emplace_back("device", "CPU ray casting (double precision)");
   out.kMap = best.k;
   return out;
 }
@@ -290,7 +290,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
   out.stats.bytesAllocated = lists.fragments.size() * sizeof(Fragment) + lists.offsets.size() * sizeof(std::uint32_t);
   out.stats.bytesUsed = out.stats.bytesAllocated;
   out.stats.kMax = lists.maxCount();
-  out.stats.notes.emplace_back("device", "CPU ray casting (CGAL AABB tree)");
+  out.stats.notes.emplace_back("device", "CPU ray casting (double precision)");
   return out;
 }
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <memory>
 #include <numeric>
 #include <string>
@@ -454,7 +455,110 @@ TEST(OracleThreads, ResultDoesNotDependOnThreadCount) {
   }
 }
 
-// The oracle keeps the last scene's AABB tree between calls; a changed scene must never be
+// The broad phase bins each triangle to the pixels near its window polygon; testing every
+// triangle against every ray must give the same lists, bit for bit, and the same flags. The
+// scenes are the cases a bin could miss: a fan of slivers (each a fraction of a pixel wide),
+// triangles reaching behind the eye and past the far plane, a camera inside nested spheres,
+// quads lying in the near and far planes, edge-on triangles, a random soup with huge triangles,
+// a 170° field of view, an orthographic view and a region of the image.
+TEST(OracleBroadPhase, BinsGiveTheListsOfTestingEveryTriangle) {
+  const auto expectSameLists = [](const FragmentLists& a, const FragmentLists& b) {
+    ASSERT_EQ(a.offsets, b.offsets);
+    ASSERT_EQ(a.flags, b.flags);
+    ASSERT_EQ(a.fragments.size(), b.fragments.size());
+    for (std::size_t i = 0; i < a.fragments.size(); ++i) {
+      SCOPED_TRACE("fragment " + std::to_string(i));
+      ASSERT_EQ(a.fragments[i].depth, b.fragments[i].depth);
+      ASSERT_EQ(a.fragments[i].color, b.fragments[i].color);
+      ASSERT_EQ(a.fragments[i].objectId, b.fragments[i].objectId);
+      ASSERT_EQ(a.fragments[i].frontFacing, b.fragments[i].frontFacing);
+      ASSERT_EQ(a.fragments[i].depthSlope, b.fragments[i].depthSlope);
+    }
+  };
+  const auto check = [&](const std::string& what, const Scene& scene, const Camera& camera, int width, int height,
+                         PixelRect region = {}) {
+    SCOPED_TRACE(what);
+    OracleOptions binned;
+    binned.region = region;
+    OracleOptions everyTriangle = binned;
+    everyTriangle.everyTriangleACandidate = true;
+    const FragmentLists a = castFragments(scene, camera, width, height, binned);
+    const FragmentLists b = castFragments(scene, camera, width, height, everyTriangle);
+    expectSameLists(a, b);
+    return a.fragments.size();
+  };
+
+  // Two fans of 3,000 slivers about their hubs, one tilted, as a CAD tessellator writes a disc.
+  Mesh fan;
+  const int spokes = 3000;
+  fan.positions.push_back({0.0f, 0.0f, 0.0f});
+  for (int i = 0; i < spokes; ++i) {
+    const double a = 2.0 * 3.14159265358979323846 * i / spokes;
+    fan.positions.push_back({static_cast<float>(3.0 * std::cos(a)), static_cast<float>(3.0 * std::sin(a)), 0.0f});
+  }
+  for (int i = 0; i < spokes; ++i)
+    fan.indices.insert(fan.indices.end(),
+                       {0u, 1u + static_cast<std::uint32_t>(i), 1u + static_cast<std::uint32_t>((i + 1) % spokes)});
+  fan.normals.assign(fan.positions.size(), glm::vec3(0, 0, 1));
+  Scene fans;
+  fans.name = "fans";
+  addObject(fans, fan, translate(0.4, -0.3, 0.0), {0.8f, 0.2f, 0.2f, 0.5f});
+  addObject(fans, fan, glm::rotate(glm::dmat4(1.0), glm::radians(70.0), glm::dvec3(1.0, 0.2, 0.0)),
+            {0.2f, 0.2f, 0.8f, 0.5f});
+  EXPECT_GT(check("fans, perspective", fans, frontCamera(Projection::Perspective), 61, 47), 2000u);
+  EXPECT_GT(check("fans, orthographic", fans, frontCamera(Projection::Orthographic), 61, 47), 2000u);
+  EXPECT_GT(check("fans, a region", fans, frontCamera(Projection::Perspective), 61, 47, PixelRect{20, 10, 17, 9}),
+            100u);
+
+  // A ground plane from behind the eye to past the far plane; quads in the near plane (z = 9) and
+  // the far one (z = −10) of the front camera; an edge-on plane.
+  Scene planes;
+  planes.name = "planes";
+  addObject(planes, makePlane(200.0, 200.0),
+            translate(0.0, -1.0, 0.0) * glm::rotate(glm::dmat4(1.0), glm::radians(-90.0), glm::dvec3(1.0, 0.0, 0.0)),
+            {1.0f, 1.0f, 1.0f, 0.5f});
+  addObject(planes, makePlane(0.3, 0.3), translate(0.05, 0.1, 9.0), {1.0f, 0.0f, 0.0f, 0.5f});
+  addObject(planes, makePlane(12.0, 12.0), translate(0.0, 2.0, -10.0), {0.0f, 1.0f, 0.0f, 0.5f});
+  addObject(planes, makePlane(4.0, 4.0), glm::rotate(glm::dmat4(1.0), glm::radians(90.0), glm::dvec3(0.0, 1.0, 0.0)),
+            {0.0f, 0.0f, 1.0f, 0.5f});
+  EXPECT_GT(check("planes", planes, frontCamera(Projection::Perspective), 64, 64), 1000u);
+
+  // Inside nested spheres: the near plane cuts every one of them.
+  Camera inside = frontCamera(Projection::Perspective);
+  inside.eye = {0.3, 0.2, 0.5};
+  inside.target = {0.0, -0.5, -3.0};
+  inside.nearPlane = 0.05;
+  inside.farPlane = 4.0;
+  EXPECT_GT(check("inside", nestedSpheres(), inside, 48, 40), 1000u);
+  Camera wide = inside;
+  wide.fovyDegrees = 170.0;
+  EXPECT_GT(check("inside, 170 degrees", nestedSpheres(), wide, 40, 48), 1000u);
+
+  // 400 random triangles, a tenth of them a hundred times larger (through the eye, off screen).
+  Mesh soup;
+  std::uint32_t state = 12345;
+  const auto random = [&state](double lo, double hi) {
+    state = state * 1664525u + 1013904223u;
+    return lo + (hi - lo) * (state >> 8) / 16777216.0;
+  };
+  for (int t = 0; t < 400; ++t) {
+    const double scale = t % 10 == 0 ? 100.0 : 1.0;
+    const glm::dvec3 centre(random(-4, 4), random(-4, 4), random(-12, 12));
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec3 p = centre + scale * glm::dvec3(random(-1, 1), random(-1, 1), random(-1, 1));
+      soup.positions.push_back(glm::vec3(p));
+      soup.indices.push_back(static_cast<std::uint32_t>(soup.positions.size() - 1));
+    }
+  }
+  soup.normals.assign(soup.positions.size(), glm::vec3(0, 0, 1));
+  Scene soupScene;
+  soupScene.name = "soup";
+  addObject(soupScene, soup, glm::dmat4(1.0), {0.5f, 0.5f, 0.5f, 0.3f});
+  EXPECT_GT(check("soup", soupScene, frontCamera(Projection::Perspective), 53, 64), 2000u);
+  EXPECT_GT(check("soup, orthographic", soupScene, frontCamera(Projection::Orthographic), 53, 64), 2000u);
+}
+
+// The oracle keeps the last scene's world triangles between calls; a changed scene must never be
 // served the old geometry: moving, hiding or editing a part in place (same Mesh object, same
 // sizes) each changes the lists as the geometry says.
 TEST(OracleCache, ChangedScenesNeverGetTheLastGeometry) {

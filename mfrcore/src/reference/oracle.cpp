@@ -1,5 +1,12 @@
-// The CPU fragment oracle: exact per-pixel fragment lists by ray casting through a CGAL AABB tree
-// (double precision), independent of any GPU code.
+// The CPU fragment oracle: exact per-pixel fragment lists by ray casting (double precision),
+// independent of any GPU code.
+//
+// Candidates (the broad phase): each triangle's window polygon, clipped to slightly widened near
+// and far planes, is binned to every pixel centre of the region within kBinPad pixels of it; a
+// pixel's rays are tested only against its bin. A ray that hits a triangle at a depth in [0, 1]
+// passes through that polygon, so the bins miss no hit, and each holds what covers the pixel (the
+// fragments, plus a sliver of pad) — unlike a world-space box tree, whose boxes of long thin
+// triangles (a fan's slivers around its hub) each hold thousands of pixels they do not cover.
 //
 // Rays: one per pixel centre. Pixel (x, y) of the image (y = 0 is the top row) is the GL window
 // point (x + 0.5, height − 1 − y + 0.5); its ray runs from the unprojected near-plane point to the
@@ -27,15 +34,13 @@
 #include <cstring>
 #include <exception>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <string>
 #include <thread>
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Simple_cartesian.h>
 #include <glm/gtc/packing.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
@@ -51,15 +56,18 @@ using namespace glm;
 namespace mfr {
 namespace {
 
-using K = CGAL::Simple_cartesian<double>;
-using CgalTriangle = K::Triangle_3;
-using TriangleIterator = std::vector<CgalTriangle>::const_iterator;
-using Primitive = CGAL::AABB_triangle_primitive<K, TriangleIterator>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
-
 constexpr int kMaxImageSize = 16384;
 // Below this window-space area (px²) GL rasterises a triangle as nothing (edge-on).
 constexpr double kMinScreenArea = 1e-6;
+// Broad phase: a pixel centre within this many pixels of a triangle's window polygon (plus a
+// relative kBinPadRelative of the polygon's largest coordinate) is a candidate. The ray through a
+// centre and the projection of the triangle agree to rounding (about 1e-9 px here), so the pad
+// only has to be safe; each pixel it adds costs one more exact test.
+constexpr double kBinPad = 0.05;
+constexpr double kBinPadRelative = 1e-9;
+// The bins' near and far planes are widened by this (relative to w): a hit whose double-precision
+// depth lands in [0, 1] by rounding is still binned.
+constexpr double kBinDepthSlack = 1e-6;
 
 // A visible, non-degenerate triangle in world space plus what shading needs.
 struct WorldTriangle {
@@ -108,19 +116,96 @@ std::vector<glm::dvec4> clipPolygon(const std::vector<glm::dvec4>& in, const glm
   return out;
 }
 
-// The triangle's footprint in window coordinates after clipping to the near and far planes.
-std::vector<glm::dvec2> windowPolygon(const WorldTriangle& t, const glm::dmat4& viewProj, int width, int height) {
+// The triangle's footprint in window coordinates after clipping to the near and far planes
+// (z ≥ −(1 + slack)·w, z ≤ (1 + slack)·w). `inFront` is false when a clipped point still is not
+// in front of the eye (w ≤ 0) or not finite, which our cameras never give: the footprint is then
+// empty.
+std::vector<glm::dvec2> windowPolygon(const WorldTriangle& t, const glm::dmat4& viewProj, int width, int height,
+                                      double slack = 0.0, bool* inFront = nullptr) {
+  if (inFront != nullptr) *inFront = true;
   std::vector<glm::dvec4> poly;
   for (const glm::dvec3& p : t.p) poly.push_back(viewProj * glm::dvec4(p, 1.0));
-  poly = clipPolygon(poly, glm::dvec4(0.0, 0.0, 1.0, 1.0));  // near: z ≥ −w
-  if (!poly.empty()) poly = clipPolygon(poly, glm::dvec4(0.0, 0.0, -1.0, 1.0));  // far: z ≤ w
+  poly = clipPolygon(poly, glm::dvec4(0.0, 0.0, 1.0, 1.0 + slack));                      // near
+  if (!poly.empty()) poly = clipPolygon(poly, glm::dvec4(0.0, 0.0, -1.0, 1.0 + slack));  // far
   std::vector<glm::dvec2> window;
   for (const glm::dvec4& c : poly) {
-    // After near clipping w ≥ near > 0 for our cameras; skip a point that still is not in front.
-    if (!(c.w > 0.0)) return {};
-    window.emplace_back((0.5 * c.x / c.w + 0.5) * width, (0.5 * c.y / c.w + 0.5) * height);
+    const glm::dvec2 w((0.5 * c.x / c.w + 0.5) * width, (0.5 * c.y / c.w + 0.5) * height);
+    if (!(c.w > 0.0) || !std::isfinite(w.x) || !std::isfinite(w.y)) {
+      if (inFront != nullptr) *inFront = false;
+      return {};
+    }
+    window.push_back(w);
   }
   return window;
+}
+
+// Calls visit(pixel index) for every pixel of `region` whose centre lies within `pad` of the
+// convex window polygon `poly` (any number of points; as a closed loop). A row's x range is that
+// of the polygon's sides inside the band of rows within pad of its centre line, widened by pad:
+// the extent of the band's slice of a convex polygon lies on its sides.
+template <class Visit>
+void forPixelsNearPolygon(const std::vector<glm::dvec2>& poly, double pad, int height, const PixelRect& region,
+                          int width, Visit&& visit) {
+  if (poly.empty()) return;
+  double ymin = poly[0].y;
+  double ymax = poly[0].y;
+  for (const glm::dvec2& p : poly) {
+    ymin = std::min(ymin, p.y);
+    ymax = std::max(ymax, p.y);
+  }
+  // Window row r has its centre at r + 0.5; image row y is window row height - 1 - y.
+  const double rowLo = std::max(static_cast<double>(height - region.y - region.height), std::ceil(ymin - pad - 0.5));
+  const double rowHi = std::min(static_cast<double>(height - 1 - region.y), std::floor(ymax + pad - 0.5));
+  if (!(rowLo <= rowHi)) return;
+  const std::size_t n = poly.size();
+  for (int row = static_cast<int>(rowLo); row <= static_cast<int>(rowHi); ++row) {
+    const double yc = row + 0.5;
+    double xmin = std::numeric_limits<double>::infinity();
+    double xmax = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < n; ++i) {
+      const glm::dvec2& a = poly[i];
+      const glm::dvec2& b = poly[(i + 1) % n];
+      const glm::dvec2 d = b - a;
+      double t0 = 0.0;
+      double t1 = 1.0;
+      if (d.y != 0.0) {
+        t0 = (yc - pad - a.y) / d.y;
+        t1 = (yc + pad - a.y) / d.y;
+        if (t0 > t1) std::swap(t0, t1);
+        t0 = std::max(t0, 0.0);
+        t1 = std::min(t1, 1.0);
+        if (t0 > t1) continue;
+      } else if (std::abs(a.y - yc) > pad) {
+        continue;
+      }
+      const double x0 = a.x + t0 * d.x;
+      const double x1 = a.x + t1 * d.x;
+      xmin = std::min({xmin, x0, x1});
+      xmax = std::max({xmax, x0, x1});
+    }
+    const double xLo = std::max(static_cast<double>(region.x), std::ceil(xmin - pad - 0.5));
+    const double xHi = std::min(static_cast<double>(region.x + region.width - 1), std::floor(xmax + pad - 0.5));
+    if (!(xLo <= xHi)) continue;
+    const std::size_t rowBase = static_cast<std::size_t>(height - 1 - row) * width;  // image rows top-down
+    for (int col = static_cast<int>(xLo); col <= static_cast<int>(xHi); ++col) visit(rowBase + col);
+  }
+}
+
+// Calls visit(pixel index) for every pixel of `region` whose ray may hit the triangle at a depth
+// in [0, 1]: those near its widened window polygon, or, should the projection fail, all of them.
+template <class Visit>
+void forCandidatePixels(const WorldTriangle& t, const glm::dmat4& viewProj, int width, int height,
+                        const PixelRect& region, Visit&& visit) {
+  bool inFront = true;
+  const std::vector<glm::dvec2> poly = windowPolygon(t, viewProj, width, height, kBinDepthSlack, &inFront);
+  if (!inFront) {
+    for (int y = region.y; y < region.y + region.height; ++y)
+      for (int x = region.x; x < region.x + region.width; ++x) visit(static_cast<std::size_t>(y) * width + x);
+    return;
+  }
+  double largest = 0.0;
+  for (const glm::dvec2& p : poly) largest = std::max({largest, std::abs(p.x), std::abs(p.y)});
+  forPixelsNearPolygon(poly, kBinPad + kBinPadRelative * largest, height, region, width, visit);
 }
 
 double polygonArea(const std::vector<glm::dvec2>& poly) {
@@ -258,58 +343,9 @@ std::uint32_t shade(const WorldTriangle& tri, const ObjectShading& obj, double u
   return glm::packUnorm4x8(shading::mfrShade(base, glm::vec3(normal), viewDir));
 }
 
-// Broad phase of one ray: collects every triangle whose tree boxes the segment origin + t·dir,
-// t in [tMin, tMax], passes through (a slab test in double on boxes padded by a relative 1e-9, so
-// rounding never drops a box a hit lies in). The exact test is the Möller–Trumbore one in
-// castRow, so CGAL's own segment–triangle predicate would only test each candidate twice.
-// (AABB_tree::traversal with user traits, CGAL's documented-internal traversal interface.)
-class SegmentCandidates {
- public:
-  SegmentCandidates(const glm::dvec3& origin, const glm::dvec3& dir, double tMin, double tMax, TriangleIterator first,
-                    std::vector<std::uint32_t>& out)
-      : origin_(origin), dir_(dir), tMin_(tMin), tMax_(tMax), first_(first), out_(out) {}
-
-  [[nodiscard]] bool go_further() const { return true; }
-  template <class Query>
-  void intersection(const Query& /*query*/, const Primitive& primitive) {
-    out_.push_back(static_cast<std::uint32_t>(primitive.id() - first_));
-  }
-  template <class Query, class Node>
-  [[nodiscard]] bool do_intersect(const Query& /*query*/, const Node& node) const {
-    const CGAL::Bbox_3& box = node.bbox();
-    double t0 = tMin_;
-    double t1 = tMax_;
-    for (int a = 0; a < 3; ++a) {
-      const double pad = 1e-9 * (std::abs(box.min(a)) + std::abs(box.max(a))) + 1e-300;
-      const double lo = box.min(a) - pad;
-      const double hi = box.max(a) + pad;
-      if (dir_[a] == 0.0) {
-        if (origin_[a] < lo || origin_[a] > hi) return false;
-        continue;
-      }
-      double ta = (lo - origin_[a]) / dir_[a];
-      double tb = (hi - origin_[a]) / dir_[a];
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-      if (t0 > t1) return false;
-    }
-    return true;
-  }
-
- private:
-  glm::dvec3 origin_;
-  glm::dvec3 dir_;
-  double tMin_;
-  double tMax_;
-  TriangleIterator first_;
-  std::vector<std::uint32_t>& out_;
-};
-
-// The camera-independent part of the oracle: world-space triangles of the visible objects and
-// the AABB tree over them. Building them takes 0.9–1.2 s of a 3.6 s call on 1.8 M triangles (1tii
-// at 512²), and the viewer, mfr evaluate and mfr dataset cast many images of one scene, so the
-// last geometry is kept and reused while its key matches.
+// The camera-independent part of the oracle: world-space triangles of the visible objects (with
+// zero-area ones dropped). The viewer, mfr evaluate and mfr dataset cast many images of one
+// scene, so the last geometry is kept and reused while its key matches.
 struct GeometryKey {
   struct Part {
     std::size_t object = 0;  // becomes the fragments' objectId
@@ -326,12 +362,9 @@ struct GeometryKey {
 struct PreparedGeometry {
   GeometryKey key;
   std::vector<WorldTriangle> triangles;
-  std::vector<CgalTriangle> cgalTriangles;
-  Tree tree;  // over cgalTriangles: the object is never moved (held by shared_ptr)
 };
 
-// FNV-1a over 32-bit words: a few milliseconds for millions of vertices, against seconds for a
-// tree build.
+// FNV-1a over 32-bit words: a few milliseconds for millions of vertices.
 std::uint64_t hashWords(const void* data, std::size_t bytes, std::uint64_t h) {
   const auto* p = static_cast<const unsigned char*>(data);
   std::uint32_t word = 0;
@@ -398,15 +431,6 @@ std::shared_ptr<const PreparedGeometry> buildGeometry(const Scene& scene, Geomet
       if (!hasArea(tri.p)) continue;
       triangles.push_back(tri);
     }
-  }
-  geometry->cgalTriangles.reserve(triangles.size());
-  for (const WorldTriangle& t : triangles)
-    geometry->cgalTriangles.emplace_back(K::Point_3(t.p[0].x, t.p[0].y, t.p[0].z),
-                                         K::Point_3(t.p[1].x, t.p[1].y, t.p[1].z),
-                                         K::Point_3(t.p[2].x, t.p[2].y, t.p[2].z));
-  if (!triangles.empty()) {
-    geometry->tree.insert(geometry->cgalTriangles.cbegin(), geometry->cgalTriangles.cend());
-    geometry->tree.build();  // explicitly, before threads query it (lazy construction is not thread-safe)
   }
   geometry->key = std::move(key);
   return geometry;
@@ -480,8 +504,6 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   }
   const std::shared_ptr<const PreparedGeometry> geometry = preparedGeometry(scene);
   const std::vector<WorldTriangle>& triangles = geometry->triangles;
-  const std::vector<CgalTriangle>& cgalTriangles = geometry->cgalTriangles;
-  const Tree& tree = geometry->tree;
   FragmentLists lists;
   lists.width = width;
   lists.height = height;
@@ -499,14 +521,47 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
       options.threads > 0 ? static_cast<unsigned>(options.threads) : std::thread::hardware_concurrency();
   threadCount = std::max(threadCount, 1u);
 
-  // Edge pass (2D, window space) — also decides which triangles GL would draw as nothing.
+  // Edge pass (2D, window space) — also decides which triangles GL would draw as nothing — and
+  // the broad phase's bin sizes. Several threads count into one pixel at once.
   std::vector<std::uint8_t> screenDegenerate(triangles.size(), 0);
+  std::vector<std::uint32_t> binCounts(options.everyTriangleACandidate ? 0 : pixelCount, 0);
   runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
     const std::vector<glm::dvec2> poly = windowPolygon(triangles[t], viewProj, width, height);
     screenDegenerate[t] = polygonArea(poly) < kMinScreenArea ? 1 : 0;
     for (std::size_t i = 0; i < poly.size(); ++i)
       markSegment(poly[i], poly[(i + 1) % poly.size()], options.edgeEpsilon, width, height, region, lists.flags);
+    if (!options.everyTriangleACandidate)
+      forCandidatePixels(triangles[t], viewProj, width, height, region, [&](std::size_t pixel) {
+        std::atomic_ref<std::uint32_t>(binCounts[pixel]).fetch_add(1, std::memory_order_relaxed);
+      });
   });
+  // The bins, filled in any order: each ray's hits are sorted by a total order below.
+  std::vector<std::size_t> binOffsets;
+  std::vector<std::uint32_t> bins;
+  if (!options.everyTriangleACandidate) {
+    binOffsets.resize(pixelCount + 1);
+    std::size_t total = 0;
+    for (std::size_t i = 0; i < pixelCount; ++i) {
+      binOffsets[i] = total;
+      total += binCounts[i];
+      binCounts[i] = 0;  // from here: the fill cursor
+    }
+    binOffsets[pixelCount] = total;
+    if (total > UINT32_MAX) throw Error("oracle", "more than 2^32 candidate fragments in one image");
+    bins.resize(total);
+    runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
+      forCandidatePixels(triangles[t], viewProj, width, height, region, [&](std::size_t pixel) {
+        const std::uint32_t slot =
+            std::atomic_ref<std::uint32_t>(binCounts[pixel]).fetch_add(1, std::memory_order_relaxed);
+        bins[binOffsets[pixel] + slot] = static_cast<std::uint32_t>(t);
+      });
+    });
+  }
+  std::vector<std::uint32_t> everyTriangle;
+  if (options.everyTriangleACandidate) {
+    everyTriangle.resize(triangles.size());
+    for (std::size_t t = 0; t < triangles.size(); ++t) everyTriangle[t] = static_cast<std::uint32_t>(t);
+  }
 
   const glm::vec3 viewDir(camera.forward());
   std::vector<std::vector<Fragment>> rowFragments(static_cast<std::size_t>(height));
@@ -567,17 +622,17 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     return false;
   };
 
-  const auto castRow = [&](int y, std::vector<std::uint32_t>& candidates, std::vector<Hit>& hits) {
+  const auto castRow = [&](int y, std::vector<Hit>& hits) {
     std::vector<Fragment>& out = rowFragments[static_cast<std::size_t>(y)];
     const double wy = (height - 1 - y) + 0.5;
     for (int x = region.x; x < region.x + region.width; ++x) {
       const std::size_t pixel = static_cast<std::size_t>(y) * width + x;
       glm::dvec3 origin, dir;
       windowRay(x + 0.5, wy, origin, dir);
-      // The broad phase takes a slightly longer segment; the exact depth test below decides.
-      candidates.clear();
-      SegmentCandidates collect(origin, dir, -1e-6, 1.0 + 1e-6, cgalTriangles.cbegin(), candidates);
-      tree.traversal(0, collect);
+      const std::span<const std::uint32_t> candidates =
+          options.everyTriangleACandidate
+              ? std::span<const std::uint32_t>(everyTriangle)
+              : std::span<const std::uint32_t>(bins.data() + binOffsets[pixel], bins.data() + binOffsets[pixel + 1]);
       hits.clear();
       for (const std::uint32_t index : candidates) {
         const WorldTriangle& tri = triangles[index];
@@ -625,9 +680,8 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
 
   runParallel(std::min(threadCount, static_cast<unsigned>(region.height)), static_cast<std::size_t>(region.height), 1,
               [&](std::size_t row) {
-                thread_local std::vector<std::uint32_t> candidates;
                 thread_local std::vector<Hit> hits;
-                castRow(region.y + static_cast<int>(row), candidates, hits);
+                castRow(region.y + static_cast<int>(row), hits);
               });
 
   lists.offsets.resize(pixelCount + 1);

@@ -1,5 +1,5 @@
 #pragma once
-// The CPU oracle: exact per-pixel fragment lists by ray casting (CGAL AABB tree), independent of
+// The CPU oracle: exact per-pixel fragment lists by ray casting in double precision, independent of
 // any GPU code. One ray through each pixel centre — the sample point the rasteriser uses — and
 // every intersection with every visible triangle between the near and far planes, shaded with the
 // shared shading function (shaders/common/shading.h), sorted front to back.
@@ -56,6 +56,9 @@ struct OracleOptions {
   // Cast only these pixels (a probe of one pixel, a zoomed-in check); the others get empty lists
   // and no flags. Empty: the whole image. A rectangle not inside the image throws mfr::Error.
   PixelRect region;
+  // Test every triangle against every ray instead of each pixel's bin of the triangles near it:
+  // the reference that the broad phase's tests compare with (pixels × triangles exact tests).
+  bool everyTriangleACandidate = false;
 };
 
 // Exact fragment lists of one image. Pixel (x, y) uses image coordinates: y = 0 is the top row.
