@@ -536,18 +536,18 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
       });
   });
   // The bins, filled in any order: each ray's hits are sorted by a total order below.
-  std::vector<std::size_t> binOffsets;
+  std::vector<std::uint32_t> binOffsets;
   std::vector<std::uint32_t> bins;
   if (!options.everyTriangleACandidate) {
     binOffsets.resize(pixelCount + 1);
     std::size_t total = 0;
     for (std::size_t i = 0; i < pixelCount; ++i) {
-      binOffsets[i] = total;
+      binOffsets[i] = static_cast<std::uint32_t>(total);
       total += binCounts[i];
+      if (total > UINT32_MAX) throw Error("oracle", "more than 2^32 candidate fragments in one image");
       binCounts[i] = 0;  // from here: the fill cursor
     }
-    binOffsets[pixelCount] = total;
-    if (total > UINT32_MAX) throw Error("oracle", "more than 2^32 candidate fragments in one image");
+    binOffsets[pixelCount] = static_cast<std::uint32_t>(total);
     bins.resize(total);
     runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
       forCandidatePixels(triangles[t], viewProj, width, height, region, [&](std::size_t pixel) {
