@@ -460,7 +460,8 @@ TEST(OracleThreads, ResultDoesNotDependOnThreadCount) {
 // scenes are the cases a bin could miss: a fan of slivers (each a fraction of a pixel wide),
 // triangles reaching behind the eye and past the far plane, a camera inside nested spheres,
 // quads lying in the near and far planes, edge-on triangles, a random soup with huge triangles,
-// a 170° field of view, an orthographic view and a region of the image.
+// a 170° field of view, an orthographic view, a region of the image, and rays that stray from
+// their pixel centres.
 TEST(OracleBroadPhase, BinsGiveTheListsOfTestingEveryTriangle) {
   const auto expectSameLists = [](const FragmentLists& a, const FragmentLists& b) {
     ASSERT_EQ(a.offsets, b.offsets);
@@ -556,6 +557,22 @@ TEST(OracleBroadPhase, BinsGiveTheListsOfTestingEveryTriangle) {
   addObject(soupScene, soup, glm::dmat4(1.0), {0.5f, 0.5f, 0.5f, 0.3f});
   EXPECT_GT(check("soup", soupScene, frontCamera(Projection::Perspective), 53, 64), 2000u);
   EXPECT_GT(check("soup, orthographic", soupScene, frontCamera(Projection::Orthographic), 53, 64), 2000u);
+
+  // An eye 3·10⁶ from the origin with a near plane at 10⁻⁹: the rays as cast stray pixels from
+  // their centres (a fuzzer's case), so the bins must widen by the measured stray.
+  Mesh far;
+  far.positions = {{2999999.0f, -0.2f, -0.2f}, {2999999.0f, 0.2f, -0.15f}, {2999999.0f, 0.03f, 0.25f}};
+  far.normals.assign(3, glm::vec3(1, 0, 0));
+  far.indices = {0, 1, 2};
+  Scene farScene;
+  farScene.name = "far from the origin";
+  addObject(farScene, far, glm::dmat4(1.0), {1.0f, 1.0f, 1.0f, 0.5f});
+  Camera closeNear = frontCamera(Projection::Perspective);
+  closeNear.eye = {3e6, 0.0, 0.0};
+  closeNear.target = {2999999.0, 0.0, 0.0};
+  closeNear.nearPlane = 1e-9;
+  closeNear.farPlane = 10.0;
+  EXPECT_GT(check("near plane 1e-9 at 3e6", farScene, closeNear, 16, 16), 20u);
 }
 
 // The oracle keeps the last scene's world triangles between calls; a changed scene must never be

@@ -60,9 +60,10 @@ constexpr int kMaxImageSize = 16384;
 // Below this window-space area (px²) GL rasterises a triangle as nothing (edge-on).
 constexpr double kMinScreenArea = 1e-6;
 // Broad phase: a pixel centre within this many pixels of a triangle's window polygon (plus a
-// relative kBinPadRelative of the polygon's largest coordinate) is a candidate. The ray through a
-// centre and the projection of the triangle agree to rounding (about 1e-9 px here), so the pad
-// only has to be safe; each pixel it adds costs one more exact test.
+// relative kBinPadRelative of the polygon's largest coordinate, plus twice the measured stray of
+// the cast rays) is a candidate. The ray through a centre and the projection of the triangle
+// agree to rounding (about 1e-9 px here), so the pad only has to be safe; each pixel it adds
+// costs one more exact test.
 constexpr double kBinPad = 0.05;
 constexpr double kBinPadRelative = 1e-9;
 // The bins' near and far planes are widened by this (relative to w): a hit whose double-precision
@@ -192,20 +193,21 @@ void forPixelsNearPolygon(const std::vector<glm::dvec2>& poly, double pad, int h
 }
 
 // Calls visit(pixel index) for every pixel of `region` whose ray may hit the triangle at a depth
-// in [0, 1]: those near its widened window polygon, or, should the projection fail, all of them.
+// in [0, 1]: those within `pad` of its widened window polygon, or, should the projection fail,
+// all of them.
 template <class Visit>
 void forCandidatePixels(const WorldTriangle& t, const glm::dmat4& viewProj, int width, int height,
-                        const PixelRect& region, Visit&& visit) {
+                        const PixelRect& region, double pad, Visit&& visit) {
   bool inFront = true;
   const std::vector<glm::dvec2> poly = windowPolygon(t, viewProj, width, height, kBinDepthSlack, &inFront);
-  if (!inFront) {
+  if (!inFront || !std::isfinite(pad)) {
     for (int y = region.y; y < region.y + region.height; ++y)
       for (int x = region.x; x < region.x + region.width; ++x) visit(static_cast<std::size_t>(y) * width + x);
     return;
   }
   double largest = 0.0;
   for (const glm::dvec2& p : poly) largest = std::max({largest, std::abs(p.x), std::abs(p.y)});
-  forPixelsNearPolygon(poly, kBinPad + kBinPadRelative * largest, height, region, width, visit);
+  forPixelsNearPolygon(poly, pad + kBinPadRelative * largest, height, region, width, visit);
 }
 
 double polygonArea(const std::vector<glm::dvec2>& poly) {
@@ -521,6 +523,35 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
       options.threads > 0 ? static_cast<unsigned>(options.threads) : std::thread::hardware_concurrency();
   threadCount = std::max(threadCount, 1u);
 
+  // The ray through window point (wx, wy): origin on the near plane, dir to the far plane.
+  const auto windowRay = [&](double wx, double wy, glm::dvec3& origin, glm::dvec3& dir) {
+    const double ndcX = 2.0 * wx / width - 1.0;
+    const double ndcY = 2.0 * wy / height - 1.0;
+    const glm::dvec4 n4 = invViewProj * glm::dvec4(ndcX, ndcY, -1.0, 1.0);
+    const glm::dvec4 f4 = invViewProj * glm::dvec4(ndcX, ndcY, 1.0, 1.0);
+    origin = glm::dvec3(n4) / n4.w;
+    dir = glm::dvec3(f4) / f4.w - origin;
+  };
+  // How far the rays as cast stray from their pixel centres, in window pixels: the largest distance
+  // of a ray's projected ends from its centre, over the region. A point of the segment projects
+  // between its ends, so the bins widened by this hold every triangle the cast rays can hit. It is
+  // about 1e-9 px; only absurd cameras (near plane 1e-9 at 3e6 from the origin) make it matter.
+  double rayDrift = 0.0;
+  if (!options.everyTriangleACandidate)
+    for (int y = region.y; y < region.y + region.height; ++y)
+      for (int x = region.x; x < region.x + region.width; ++x) {
+        const glm::dvec2 centre(x + 0.5, (height - 1 - y) + 0.5);
+        glm::dvec3 origin, dir;
+        windowRay(centre.x, centre.y, origin, dir);
+        for (const glm::dvec3& end : {origin, origin + dir}) {
+          const glm::dvec4 c = viewProj * glm::dvec4(end, 1.0);
+          const glm::dvec2 w((0.5 * c.x / c.w + 0.5) * width, (0.5 * c.y / c.w + 0.5) * height);
+          const double d = glm::length(w - centre);
+          rayDrift = std::isfinite(d) ? std::max(rayDrift, d) : std::numeric_limits<double>::infinity();
+        }
+      }
+  const double binPad = kBinPad + 2.0 * rayDrift;
+
   // Edge pass (2D, window space) — also decides which triangles GL would draw as nothing — and
   // the broad phase's bin sizes. Several threads count into one pixel at once.
   std::vector<std::uint8_t> screenDegenerate(triangles.size(), 0);
@@ -531,7 +562,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     for (std::size_t i = 0; i < poly.size(); ++i)
       markSegment(poly[i], poly[(i + 1) % poly.size()], options.edgeEpsilon, width, height, region, lists.flags);
     if (!options.everyTriangleACandidate)
-      forCandidatePixels(triangles[t], viewProj, width, height, region, [&](std::size_t pixel) {
+      forCandidatePixels(triangles[t], viewProj, width, height, region, binPad, [&](std::size_t pixel) {
         std::atomic_ref<std::uint32_t>(binCounts[pixel]).fetch_add(1, std::memory_order_relaxed);
       });
   });
@@ -550,7 +581,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     binOffsets[pixelCount] = static_cast<std::uint32_t>(total);
     bins.resize(total);
     runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
-      forCandidatePixels(triangles[t], viewProj, width, height, region, [&](std::size_t pixel) {
+      forCandidatePixels(triangles[t], viewProj, width, height, region, binPad, [&](std::size_t pixel) {
         const std::uint32_t slot =
             std::atomic_ref<std::uint32_t>(binCounts[pixel]).fetch_add(1, std::memory_order_relaxed);
         bins[binOffsets[pixel] + slot] = static_cast<std::uint32_t>(t);
@@ -568,15 +599,6 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   std::vector<std::uint32_t> counts(pixelCount, 0);
   std::vector<std::uint8_t> rayFlags(pixelCount, 0);
 
-  // The ray through window point (wx, wy): origin on the near plane, dir to the far plane.
-  const auto windowRay = [&](double wx, double wy, glm::dvec3& origin, glm::dvec3& dir) {
-    const double ndcX = 2.0 * wx / width - 1.0;
-    const double ndcY = 2.0 * wy / height - 1.0;
-    const glm::dvec4 n4 = invViewProj * glm::dvec4(ndcX, ndcY, -1.0, 1.0);
-    const glm::dvec4 f4 = invViewProj * glm::dvec4(ndcX, ndcY, 1.0, 1.0);
-    origin = glm::dvec3(n4) / n4.w;
-    dir = glm::dvec3(f4) / f4.w - origin;
-  };
   // Where the rays through the next pixel centres right of and above window point (wx, wy) meet
   // the plane of a triangle with this normal; false when one of them runs in the plane (edge-on).
   const auto neighbourPlanePoints = [&](const WorldTriangle& tri, const glm::dvec3& normal, double wx, double wy,
