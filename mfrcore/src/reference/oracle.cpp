@@ -140,6 +140,27 @@ std::vector<glm::dvec2> windowPolygon(const WorldTriangle& t, const glm::dmat4& 
   return window;
 }
 
+// The x values at the ends of segment ab's part inside the band |y − yc| ≤ eps (in any order);
+// false when no part of it lies in the band.
+bool segmentInBand(const glm::dvec2& a, const glm::dvec2& b, double yc, double eps, double& x0, double& x1) {
+  const glm::dvec2 d = b - a;
+  double t0 = 0.0;
+  double t1 = 1.0;
+  if (d.y != 0.0) {
+    t0 = (yc - eps - a.y) / d.y;
+    t1 = (yc + eps - a.y) / d.y;
+    if (t0 > t1) std::swap(t0, t1);
+    t0 = std::max(t0, 0.0);
+    t1 = std::min(t1, 1.0);
+    if (t0 > t1) return false;
+  } else if (std::abs(a.y - yc) > eps) {
+    return false;
+  }
+  x0 = a.x + t0 * d.x;
+  x1 = a.x + t1 * d.x;
+  return true;
+}
+
 // Calls visit(pixel index) for every pixel of `region` whose centre lies within `pad` of the
 // convex window polygon `poly` (any number of points; as a closed loop). A row's x range is that
 // of the polygon's sides inside the band of rows within pad of its centre line, widened by pad:
@@ -164,23 +185,9 @@ void forPixelsNearPolygon(const std::vector<glm::dvec2>& poly, double pad, int h
     double xmin = std::numeric_limits<double>::infinity();
     double xmax = -std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < n; ++i) {
-      const glm::dvec2& a = poly[i];
-      const glm::dvec2& b = poly[(i + 1) % n];
-      const glm::dvec2 d = b - a;
-      double t0 = 0.0;
-      double t1 = 1.0;
-      if (d.y != 0.0) {
-        t0 = (yc - pad - a.y) / d.y;
-        t1 = (yc + pad - a.y) / d.y;
-        if (t0 > t1) std::swap(t0, t1);
-        t0 = std::max(t0, 0.0);
-        t1 = std::min(t1, 1.0);
-        if (t0 > t1) continue;
-      } else if (std::abs(a.y - yc) > pad) {
-        continue;
-      }
-      const double x0 = a.x + t0 * d.x;
-      const double x1 = a.x + t1 * d.x;
+      double x0 = 0.0;
+      double x1 = 0.0;
+      if (!segmentInBand(poly[i], poly[(i + 1) % n], yc, pad, x0, x1)) continue;
       xmin = std::min({xmin, x0, x1});
       xmax = std::max({xmax, x0, x1});
     }
@@ -239,23 +246,11 @@ void markSegment(const glm::dvec2& a, const glm::dvec2& b, double eps, int width
   const double rowLo = std::max(static_cast<double>(height - region.y - region.height), std::ceil(ymin - 0.5));
   const double rowHi = std::min(static_cast<double>(height - 1 - region.y), std::floor(ymax - 0.5));
   if (!(rowLo <= rowHi)) return;
-  const glm::dvec2 d = b - a;
   for (int row = static_cast<int>(rowLo); row <= static_cast<int>(rowHi); ++row) {
     const double yc = row + 0.5;
-    double t0 = 0.0;
-    double t1 = 1.0;
-    if (d.y != 0.0) {
-      t0 = (yc - eps - a.y) / d.y;
-      t1 = (yc + eps - a.y) / d.y;
-      if (t0 > t1) std::swap(t0, t1);
-      t0 = std::max(t0, 0.0);
-      t1 = std::min(t1, 1.0);
-      if (t0 > t1) continue;
-    } else if (std::abs(a.y - yc) > eps) {
-      continue;
-    }
-    const double x0 = a.x + t0 * d.x;
-    const double x1 = a.x + t1 * d.x;
+    double x0 = 0.0;
+    double x1 = 0.0;
+    if (!segmentInBand(a, b, yc, eps, x0, x1)) continue;
     const double xLo = std::max(static_cast<double>(region.x), std::ceil(std::min(x0, x1) - eps - 0.5));
     const double xHi =
         std::min(static_cast<double>(region.x + region.width - 1), std::floor(std::max(x0, x1) + eps - 0.5));
