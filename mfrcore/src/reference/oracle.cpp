@@ -29,6 +29,7 @@
 #include "reference/pixel_region.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -102,9 +103,26 @@ glm::dvec3 transformPoint(const glm::dmat4& m, const glm::dvec3& p) {
   return glm::dvec3(h) / h.w;
 }
 
+// A polygon of at most 12 points, on the stack: a triangle clipped by two planes. Each of its
+// sides adds at most two points per clip, so 3 → 6 → 12 holds even when rounding makes a clipped
+// polygon not quite convex. (The oracle computes millions of these per image, three times each.)
+template <class Point>
+struct SmallPolygon {
+  std::array<Point, 12> points{};
+  std::size_t count = 0;
+  void push_back(const Point& p) { points[count++] = p; }
+  [[nodiscard]] std::size_t size() const { return count; }
+  [[nodiscard]] bool empty() const { return count == 0; }
+  const Point& operator[](std::size_t i) const { return points[i]; }
+  [[nodiscard]] const Point* begin() const { return points.data(); }
+  [[nodiscard]] const Point* end() const { return points.data() + count; }
+};
+using ClipPolygon = SmallPolygon<glm::dvec4>;
+using WindowPolygon = SmallPolygon<glm::dvec2>;
+
 // Sutherland–Hodgman against one clip-space plane dot(plane, v) ≥ 0.
-std::vector<glm::dvec4> clipPolygon(const std::vector<glm::dvec4>& in, const glm::dvec4& plane) {
-  std::vector<glm::dvec4> out;
+ClipPolygon clipPolygon(const ClipPolygon& in, const glm::dvec4& plane) {
+  ClipPolygon out;
   const std::size_t n = in.size();
   for (std::size_t i = 0; i < n; ++i) {
     const glm::dvec4& a = in[i];
@@ -121,14 +139,14 @@ std::vector<glm::dvec4> clipPolygon(const std::vector<glm::dvec4>& in, const glm
 // (z ≥ −(1 + slack)·w, z ≤ (1 + slack)·w). `inFront` is false when a clipped point still is not
 // in front of the eye (w ≤ 0) or not finite, which our cameras never give: the footprint is then
 // empty.
-std::vector<glm::dvec2> windowPolygon(const WorldTriangle& t, const glm::dmat4& viewProj, int width, int height,
-                                      double slack = 0.0, bool* inFront = nullptr) {
+WindowPolygon windowPolygon(const WorldTriangle& t, const glm::dmat4& viewProj, int width, int height,
+                            double slack = 0.0, bool* inFront = nullptr) {
   if (inFront != nullptr) *inFront = true;
-  std::vector<glm::dvec4> poly;
+  ClipPolygon poly;
   for (const glm::dvec3& p : t.p) poly.push_back(viewProj * glm::dvec4(p, 1.0));
   poly = clipPolygon(poly, glm::dvec4(0.0, 0.0, 1.0, 1.0 + slack));                      // near
   if (!poly.empty()) poly = clipPolygon(poly, glm::dvec4(0.0, 0.0, -1.0, 1.0 + slack));  // far
-  std::vector<glm::dvec2> window;
+  WindowPolygon window;
   for (const glm::dvec4& c : poly) {
     const glm::dvec2 w((0.5 * c.x / c.w + 0.5) * width, (0.5 * c.y / c.w + 0.5) * height);
     if (!(c.w > 0.0) || !std::isfinite(w.x) || !std::isfinite(w.y)) {
@@ -166,8 +184,8 @@ bool segmentInBand(const glm::dvec2& a, const glm::dvec2& b, double yc, double e
 // of the polygon's sides inside the band of rows within pad of its centre line, widened by pad:
 // the extent of the band's slice of a convex polygon lies on its sides.
 template <class Visit>
-void forPixelsNearPolygon(const std::vector<glm::dvec2>& poly, double pad, int height, const PixelRect& region,
-                          int width, Visit&& visit) {
+void forPixelsNearPolygon(const WindowPolygon& poly, double pad, int height, const PixelRect& region, int width,
+                          Visit&& visit) {
   if (poly.empty()) return;
   double ymin = poly[0].y;
   double ymax = poly[0].y;
@@ -206,7 +224,7 @@ template <class Visit>
 void forCandidatePixels(const WorldTriangle& t, const glm::dmat4& viewProj, int width, int height,
                         const PixelRect& region, double pad, Visit&& visit) {
   bool inFront = true;
-  const std::vector<glm::dvec2> poly = windowPolygon(t, viewProj, width, height, kBinDepthSlack, &inFront);
+  const WindowPolygon poly = windowPolygon(t, viewProj, width, height, kBinDepthSlack, &inFront);
   if (!inFront || !std::isfinite(pad)) {
     for (int y = region.y; y < region.y + region.height; ++y)
       for (int x = region.x; x < region.x + region.width; ++x) visit(static_cast<std::size_t>(y) * width + x);
@@ -217,7 +235,7 @@ void forCandidatePixels(const WorldTriangle& t, const glm::dmat4& viewProj, int 
   forPixelsNearPolygon(poly, pad + kBinPadRelative * largest, height, region, width, visit);
 }
 
-double polygonArea(const std::vector<glm::dvec2>& poly) {
+double polygonArea(const WindowPolygon& poly) {
   double a = 0.0;
   for (std::size_t i = 0; i < poly.size(); ++i) {
     const glm::dvec2& p = poly[i];
@@ -551,14 +569,16 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   // the broad phase's bin sizes. Several threads count into one pixel at once.
   std::vector<std::uint8_t> screenDegenerate(triangles.size(), 0);
   std::vector<std::uint32_t> binCounts(options.everyTriangleACandidate ? 0 : pixelCount, 0);
+  std::vector<std::uint8_t> inSomeBin(options.everyTriangleACandidate ? 0 : triangles.size(), 0);
   runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
-    const std::vector<glm::dvec2> poly = windowPolygon(triangles[t], viewProj, width, height);
+    const WindowPolygon poly = windowPolygon(triangles[t], viewProj, width, height);
     screenDegenerate[t] = polygonArea(poly) < kMinScreenArea ? 1 : 0;
     for (std::size_t i = 0; i < poly.size(); ++i)
       markSegment(poly[i], poly[(i + 1) % poly.size()], options.edgeEpsilon, width, height, region, lists.flags);
     if (!options.everyTriangleACandidate)
       forCandidatePixels(triangles[t], viewProj, width, height, region, binPad, [&](std::size_t pixel) {
         std::atomic_ref<std::uint32_t>(binCounts[pixel]).fetch_add(1, std::memory_order_relaxed);
+        inSomeBin[t] = 1;
       });
   });
   // The bins, filled in any order: each ray's hits are sorted by a total order below.
@@ -576,6 +596,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     binOffsets[pixelCount] = static_cast<std::uint32_t>(total);
     bins.resize(total);
     runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
+      if (inSomeBin[t] == 0) return;  // off the region (a probe's one pixel: nearly all of them)
       forCandidatePixels(triangles[t], viewProj, width, height, region, binPad, [&](std::size_t pixel) {
         const std::uint32_t slot =
             std::atomic_ref<std::uint32_t>(binCounts[pixel]).fetch_add(1, std::memory_order_relaxed);
