@@ -2,11 +2,11 @@
 // independent of any GPU code.
 //
 // Candidates (the broad phase): each triangle's window polygon, clipped to slightly widened near
-// and far planes, is binned to every pixel centre of the region within kBinPad pixels of it; a
-// pixel's rays are tested only against its bin. A ray that hits a triangle at a depth in [0, 1]
-// passes through that polygon, so the bins miss no hit, and each holds what covers the pixel (the
-// fragments, plus a sliver of pad) — unlike a world-space box tree, whose boxes of long thin
-// triangles (a fan's slivers around its hub) each hold thousands of pixels they do not cover.
+// and far planes, is binned to every pixel centre of the region within a pad of it (kBinPad plus
+// the cast rays' measured stray); a pixel's rays are tested only against its bin. A ray that hits a triangle at a depth
+// in [0, 1] passes through that polygon, so the bins miss no hit, and each holds what covers the pixel (the fragments,
+// plus a sliver of pad) — unlike a world-space box tree, whose boxes of long thin triangles (a fan's slivers around its
+// hub) each hold thousands of pixels they do not cover.
 //
 // Rays: one per pixel centre. Pixel (x, y) of the image (y = 0 is the top row) is the GL window
 // point (x + 0.5, height − 1 − y + 0.5); its ray runs from the unprojected near-plane point to the
@@ -135,6 +135,11 @@ ClipPolygon clipPolygon(const ClipPolygon& in, const glm::dvec4& plane) {
   return out;
 }
 
+// Window coordinates of a clip-space point.
+glm::dvec2 toWindow(const glm::dvec4& c, int width, int height) {
+  return {(0.5 * c.x / c.w + 0.5) * width, (0.5 * c.y / c.w + 0.5) * height};
+}
+
 // The triangle's footprint in window coordinates after clipping to the near and far planes
 // (z ≥ −(1 + slack)·w, z ≤ (1 + slack)·w). `inFront` is false when a clipped point still is not
 // in front of the eye (w ≤ 0) or not finite, which our cameras never give: the footprint is then
@@ -148,7 +153,7 @@ WindowPolygon windowPolygon(const WorldTriangle& t, const glm::dmat4& viewProj, 
   if (!poly.empty()) poly = clipPolygon(poly, glm::dvec4(0.0, 0.0, -1.0, 1.0 + slack));  // far
   WindowPolygon window;
   for (const glm::dvec4& c : poly) {
-    const glm::dvec2 w((0.5 * c.x / c.w + 0.5) * width, (0.5 * c.y / c.w + 0.5) * height);
+    const glm::dvec2 w = toWindow(c, width, height);
     if (!(c.w > 0.0) || !std::isfinite(w.x) || !std::isfinite(w.y)) {
       if (inFront != nullptr) *inFront = false;
       return {};
@@ -550,65 +555,54 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   // between its ends, so the bins widened by this hold every triangle the cast rays can hit. It is
   // about 1e-9 px; only absurd cameras (near plane 1e-9 at 3e6 from the origin) make it matter.
   double rayDrift = 0.0;
-  if (!options.everyTriangleACandidate)
-    for (int y = region.y; y < region.y + region.height; ++y)
-      for (int x = region.x; x < region.x + region.width; ++x) {
-        const glm::dvec2 centre(x + 0.5, (height - 1 - y) + 0.5);
-        glm::dvec3 origin, dir;
-        windowRay(centre.x, centre.y, origin, dir);
-        for (const glm::dvec3& end : {origin, origin + dir}) {
-          const glm::dvec4 c = viewProj * glm::dvec4(end, 1.0);
-          const glm::dvec2 w((0.5 * c.x / c.w + 0.5) * width, (0.5 * c.y / c.w + 0.5) * height);
-          const double d = glm::length(w - centre);
-          rayDrift = std::isfinite(d) ? std::max(rayDrift, d) : std::numeric_limits<double>::infinity();
-        }
+  for (int y = region.y; y < region.y + region.height; ++y)
+    for (int x = region.x; x < region.x + region.width; ++x) {
+      const glm::dvec2 centre(x + 0.5, (height - 1 - y) + 0.5);
+      glm::dvec3 origin, dir;
+      windowRay(centre.x, centre.y, origin, dir);
+      for (const glm::dvec3& end : {origin, origin + dir}) {
+        const double d = glm::length(toWindow(viewProj * glm::dvec4(end, 1.0), width, height) - centre);
+        rayDrift = std::isfinite(d) ? std::max(rayDrift, d) : std::numeric_limits<double>::infinity();
       }
-  const double binPad = kBinPad + 2.0 * rayDrift;
+    }
+  // An infinite pad bins every triangle to every pixel (everyTriangleACandidate, the tests' reference).
+  const double binPad =
+      options.everyTriangleACandidate ? std::numeric_limits<double>::infinity() : kBinPad + 2.0 * rayDrift;
 
   // Edge pass (2D, window space) — also decides which triangles GL would draw as nothing — and
   // the broad phase's bin sizes. Several threads count into one pixel at once.
   std::vector<std::uint8_t> screenDegenerate(triangles.size(), 0);
-  std::vector<std::uint32_t> binCounts(options.everyTriangleACandidate ? 0 : pixelCount, 0);
-  std::vector<std::uint8_t> inSomeBin(options.everyTriangleACandidate ? 0 : triangles.size(), 0);
+  std::vector<std::uint32_t> binCounts(pixelCount, 0);
+  std::vector<std::uint8_t> inSomeBin(triangles.size(), 0);
   runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
     const WindowPolygon poly = windowPolygon(triangles[t], viewProj, width, height);
     screenDegenerate[t] = polygonArea(poly) < kMinScreenArea ? 1 : 0;
     for (std::size_t i = 0; i < poly.size(); ++i)
       markSegment(poly[i], poly[(i + 1) % poly.size()], options.edgeEpsilon, width, height, region, lists.flags);
-    if (!options.everyTriangleACandidate)
-      forCandidatePixels(triangles[t], viewProj, width, height, region, binPad, [&](std::size_t pixel) {
-        std::atomic_ref<std::uint32_t>(binCounts[pixel]).fetch_add(1, std::memory_order_relaxed);
-        inSomeBin[t] = 1;
-      });
+    forCandidatePixels(triangles[t], viewProj, width, height, region, binPad, [&](std::size_t pixel) {
+      std::atomic_ref<std::uint32_t>(binCounts[pixel]).fetch_add(1, std::memory_order_relaxed);
+      inSomeBin[t] = 1;
+    });
   });
   // The bins, filled in any order: each ray's hits are sorted by a total order below.
-  std::vector<std::uint32_t> binOffsets;
-  std::vector<std::uint32_t> bins;
-  if (!options.everyTriangleACandidate) {
-    binOffsets.resize(pixelCount + 1);
-    std::size_t total = 0;
-    for (std::size_t i = 0; i < pixelCount; ++i) {
-      binOffsets[i] = static_cast<std::uint32_t>(total);
-      total += binCounts[i];
-      if (total > UINT32_MAX) throw Error("oracle", "more than 2^32 candidate fragments in one image");
-      binCounts[i] = 0;  // from here: the fill cursor
-    }
-    binOffsets[pixelCount] = static_cast<std::uint32_t>(total);
-    bins.resize(total);
-    runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
-      if (inSomeBin[t] == 0) return;  // off the region (a probe's one pixel: nearly all of them)
-      forCandidatePixels(triangles[t], viewProj, width, height, region, binPad, [&](std::size_t pixel) {
-        const std::uint32_t slot =
-            std::atomic_ref<std::uint32_t>(binCounts[pixel]).fetch_add(1, std::memory_order_relaxed);
-        bins[binOffsets[pixel] + slot] = static_cast<std::uint32_t>(t);
-      });
+  std::vector<std::uint32_t> binOffsets(pixelCount + 1);
+  std::size_t candidateCount = 0;
+  for (std::size_t i = 0; i < pixelCount; ++i) {
+    binOffsets[i] = static_cast<std::uint32_t>(candidateCount);
+    candidateCount += binCounts[i];
+    if (candidateCount > UINT32_MAX) throw Error("oracle", "more than 2^32 candidate fragments in one image");
+    binCounts[i] = 0;  // from here: the fill cursor
+  }
+  binOffsets[pixelCount] = static_cast<std::uint32_t>(candidateCount);
+  std::vector<std::uint32_t> bins(candidateCount);
+  runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
+    if (inSomeBin[t] == 0) return;  // off the region (a probe's one pixel: nearly all of them)
+    forCandidatePixels(triangles[t], viewProj, width, height, region, binPad, [&](std::size_t pixel) {
+      const std::uint32_t slot =
+          std::atomic_ref<std::uint32_t>(binCounts[pixel]).fetch_add(1, std::memory_order_relaxed);
+      bins[binOffsets[pixel] + slot] = static_cast<std::uint32_t>(t);
     });
-  }
-  std::vector<std::uint32_t> everyTriangle;
-  if (options.everyTriangleACandidate) {
-    everyTriangle.resize(triangles.size());
-    for (std::size_t t = 0; t < triangles.size(); ++t) everyTriangle[t] = static_cast<std::uint32_t>(t);
-  }
+  });
 
   const glm::vec3 viewDir(camera.forward());
   std::vector<std::vector<Fragment>> rowFragments(static_cast<std::size_t>(height));
@@ -667,10 +661,8 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
       const std::size_t pixel = static_cast<std::size_t>(y) * width + x;
       glm::dvec3 origin, dir;
       windowRay(x + 0.5, wy, origin, dir);
-      const std::span<const std::uint32_t> candidates =
-          options.everyTriangleACandidate
-              ? std::span<const std::uint32_t>(everyTriangle)
-              : std::span<const std::uint32_t>(bins.data() + binOffsets[pixel], bins.data() + binOffsets[pixel + 1]);
+      const std::span<const std::uint32_t> candidates(bins.data() + binOffsets[pixel],
+                                                      bins.data() + binOffsets[pixel + 1]);
       hits.clear();
       for (const std::uint32_t index : candidates) {
         const WorldTriangle& tri = triangles[index];
