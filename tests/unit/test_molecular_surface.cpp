@@ -6,6 +6,7 @@
 // the solvent-accessible one; and bad input is refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -102,6 +103,26 @@ TEST(MolecularSurface, OneAtomIsItsVanDerWaalsSphere) {
   // Normals point out, and the triangles wind counter-clockwise seen from outside (volume > 0).
   for (std::size_t i = 0; i < mesh.positions.size(); ++i)
     EXPECT_GT(glm::dot(glm::dvec3(mesh.normals[i]), glm::dvec3(mesh.positions[i]) - atoms[0].centre), 0.0);
+  // No slivers at either spacing: every triangle nearly equilateral (a latitude–longitude sphere's
+  // pole triangles have an aspect ratio of 6–17 here), none longer than about the spacing.
+  for (const double spacing : {0.1, 0.3}) {
+    options.spacing = spacing;
+    const Mesh sphere = solventExcludedSurface(atoms, options);
+    double worstRatio = 0.0, longest = 0.0;
+    for (std::size_t t = 0; t < sphere.indices.size(); t += 3) {
+      double lo = 1e30, hi = 0.0;
+      for (std::size_t e = 0; e < 3; ++e) {
+        const double length = glm::length(glm::dvec3(sphere.positions[sphere.indices[t + e]]) -
+                                          glm::dvec3(sphere.positions[sphere.indices[t + (e + 1) % 3]]));
+        lo = std::min(lo, length);
+        hi = std::max(hi, length);
+      }
+      worstRatio = std::max(worstRatio, hi / lo);
+      longest = std::max(longest, hi);
+    }
+    EXPECT_LT(worstRatio, 1.25) << spacing;
+    EXPECT_LT(longest, 1.05 * spacing) << spacing;
+  }
 }
 
 TEST(MolecularSurface, TwoAtomsAreTwoCapsAndAConcaveTorus) {

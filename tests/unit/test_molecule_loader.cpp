@@ -186,7 +186,7 @@ TEST_F(MoleculeLoader, SpheresSitOnTheAtomsWithRadiusAndColourOfTheElement) {
         const glm::dvec3 offset = glm::dvec3(mesh.positions[k]) - centre;
         ASSERT_NEAR(glm::length(offset), radius, 1e-5) << o.name << " sphere " << s;
         ASSERT_NEAR(glm::length(mesh.normals[k]), 1.0f, 1e-6f);
-        ASSERT_GT(glm::dot(glm::dvec3(mesh.normals[k]), offset / radius), 1.0 - 1e-6) << "normal not radial";
+        ASSERT_GT(glm::dot(glm::dvec3(mesh.normals[k]), glm::normalize(offset)), 1.0 - 1e-6) << "normal not radial";
         ASSERT_EQ(mesh.colors[k], colour) << o.name << " sphere " << s << " (" << tinyAtoms()[atoms[s]].element << ")";
       }
     }

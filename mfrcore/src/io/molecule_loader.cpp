@@ -30,6 +30,7 @@
 #include "mfr/io/molecule.hpp"
 #include "mfr/scene/cartoon.hpp"
 #include "mfr/scene/molecular_surface.hpp"
+#include "scene/geodesic_sphere.hpp"
 #include "scene/perpendicular.hpp"
 #include "scene/point_grid.hpp"
 
@@ -75,52 +76,10 @@ glm::vec4 elementColor(gemmi::El el) {
 
 // ---- icospheres ---------------------------------------------------------------------------------
 
-struct UnitSphere {
-  std::vector<glm::dvec3> vertices;  // unit length
-  std::vector<std::uint32_t> indices;
-};
-
-// The icosahedron subdivided `level` times, every new vertex pushed out to the unit sphere;
-// triangles counter-clockwise seen from outside. 10·4^level + 2 vertices, 20·4^level triangles.
-// At level ≥ 1 the six points (±1, 0, 0), (0, ±1, 0), (0, 0, ±1) are vertices (midpoints of the
-// icosahedron's edges along the axes), so a sphere's bounding box is its centre ± radius.
-UnitSphere makeIcosphere(int level) {
-  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  UnitSphere s;
-  for (const glm::dvec3& v : {glm::dvec3(-1, t, 0), glm::dvec3(1, t, 0), glm::dvec3(-1, -t, 0), glm::dvec3(1, -t, 0),
-                              glm::dvec3(0, -1, t), glm::dvec3(0, 1, t), glm::dvec3(0, -1, -t), glm::dvec3(0, 1, -t),
-                              glm::dvec3(t, 0, -1), glm::dvec3(t, 0, 1), glm::dvec3(-t, 0, -1), glm::dvec3(-t, 0, 1)})
-    s.vertices.push_back(glm::normalize(v));
-  s.indices = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4,  11, 10, 2,  10, 7, 6, 7, 1, 8,
-               3, 9,  4, 3, 4, 2, 3, 2, 6, 3, 6, 8,  3, 8,  9,  4, 9, 5, 2, 4,  11, 6,  2,  10, 8,  6, 7, 9, 8, 1};
-  for (int l = 0; l < level; ++l) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> midpoints;
-    const auto midpoint = [&](std::uint32_t a, std::uint32_t b) {
-      const auto key = std::minmax(a, b);
-      const auto [it, isNew] = midpoints.try_emplace(key, static_cast<std::uint32_t>(s.vertices.size()));
-      if (isNew) s.vertices.push_back(glm::normalize(s.vertices[a] + s.vertices[b]));
-      return it->second;
-    };
-    std::vector<std::uint32_t> finer;
-    finer.reserve(4 * s.indices.size());
-    for (std::size_t i = 0; i < s.indices.size(); i += 3) {
-      const std::uint32_t a = s.indices[i], b = s.indices[i + 1], c = s.indices[i + 2];
-      const std::uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-      finer.insert(finer.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
-    }
-    s.indices = std::move(finer);
-  }
-  // Orientation made certain rather than trusted to the table: outward normals.
-  for (std::size_t i = 0; i < s.indices.size(); i += 3) {
-    const glm::dvec3 &a = s.vertices[s.indices[i]], &b = s.vertices[s.indices[i + 1]],
-                     &c = s.vertices[s.indices[i + 2]];
-    if (glm::dot(glm::cross(b - a, c - a), a + b + c) < 0.0) std::swap(s.indices[i + 1], s.indices[i + 2]);
-  }
-  return s;
-}
-
+// Level l: the geodesic sphere of frequency 2^l (20·4^l triangles; at level ≥ 1 a sphere's bounding
+// box is its centre ± radius).
 const UnitSphere& icosphere(int level) {
-  static const std::array<UnitSphere, 3> spheres = {makeIcosphere(0), makeIcosphere(1), makeIcosphere(2)};
+  static const std::array<UnitSphere, 3> spheres = {geodesicSphere(1), geodesicSphere(2), geodesicSphere(4)};
   return spheres[static_cast<std::size_t>(std::clamp(level, 0, 2))];
 }
 
