@@ -31,7 +31,7 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
         // Keep min ≤ max: the other face gives way.
         if (s == low_[a] && high_[a]->value() < s->value()) high_[a]->setValue(s->value());
         if (s == high_[a] && low_[a]->value() > s->value()) low_[a]->setValue(s->value());
-        apply();
+        applyBox(a);
       });
       return s;
     };
@@ -95,12 +95,19 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
   section->setColumnStretch(0, 1);
   layout->addLayout(section);
   layout->addStretch(1);
-  connect(sectionEnabled_, &QCheckBox::toggled, this, [this] { apply(); });
-  connect(sectionAxis_, &QComboBox::currentIndexChanged, this, [this] { apply(); });
-  connect(sectionFlip_, &QCheckBox::toggled, this, [this] { apply(); });
-  connect(sectionCaps_, &QCheckBox::toggled, this, [this] { apply(); });
-  connect(sectionSlice_, &QCheckBox::toggled, this, [this] { apply(); });
-  connect(sectionOffset_, &QSlider::valueChanged, this, [this] { apply(); });
+  // Each control changes only what it shows: a flag or the side keeps the plane where it is (a
+  // file's plane need not sit on a slider step), the offset and the axis move it.
+  connect(sectionEnabled_, &QCheckBox::toggled, this, [this] { placeSection(); });
+  connect(sectionAxis_, &QComboBox::currentIndexChanged, this, [this] { placeSection(); });
+  connect(sectionOffset_, &QSlider::valueChanged, this, [this] { placeSection(); });
+  // The other side: the normal turned round (the box follows the model: flipped is a normal
+  // against its axis).
+  connect(sectionFlip_, &QCheckBox::toggled, this,
+          [this] { editSection([](mfr::SectionPlane& plane) { plane.normal = -plane.normal; }); });
+  connect(sectionCaps_, &QCheckBox::toggled, this,
+          [this](bool on) { editSection([on](mfr::SectionPlane& plane) { plane.caps = on; }); });
+  connect(sectionSlice_, &QCheckBox::toggled, this,
+          [this](bool on) { editSection([on](mfr::SectionPlane& plane) { plane.slice = on; }); });
   connect(sectionAlign_, &QPushButton::clicked, this, [this] {
     const mfr::Camera& camera = model_.camera();
     model_.setSection(
@@ -108,7 +115,7 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
     showModel();
   });
 
-  connect(enabled_, &QCheckBox::toggled, this, [this] { apply(); });
+  connect(enabled_, &QCheckBox::toggled, this, [this] { applyBox(-1); });
   connect(reset_, &QPushButton::clicked, this, [this] {
     showing_ = true;
     for (int a = 0; a < 3; ++a) {
@@ -116,7 +123,7 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
       high_[a]->setValue(kSteps);
     }
     showing_ = false;
-    apply();
+    applyBox(-1);
   });
   connect(&model_, &ViewerModel::sceneChanged, this, &ClipPanel::showModel);
   showModel();  // an unchanged model emits nothing: the controls still follow the switches
@@ -249,19 +256,35 @@ void ClipPanel::showModel() {
   showing_ = false;
 }
 
-void ClipPanel::apply() {
+void ClipPanel::applyBox(int axis) {
   if (showing_) return;
-  if (enabled_->isChecked()) {
+  if (!enabled_->isChecked()) {
+    model_.setClipBox(std::nullopt);
+  } else {
     std::array<int, 3> low{}, high{};
     for (int a = 0; a < 3; ++a) {
       low[static_cast<std::size_t>(a)] = low_[a]->value();
       high[static_cast<std::size_t>(a)] = high_[a]->value();
     }
-    model_.setClipBox(boxFromPositions(model_.scene().bounds(), low, high));
-  } else {
-    model_.setClipBox(std::nullopt);
+    mfr::Bounds box = boxFromPositions(model_.scene().bounds(), low, high);
+    // One axis moved: the others keep the model's faces (a file's box need not sit on slider
+    // steps, and may reach past the bounds).
+    if (const std::optional<mfr::Bounds>& current = model_.clipBox(); current && axis >= 0) {
+      const mfr::Bounds moved = box;
+      box = *current;
+      box.min[axis] = moved.min[axis];
+      box.max[axis] = moved.max[axis];
+    }
+    model_.setClipBox(box);
   }
-  if (sectionEnabled_->isChecked()) {
+  showModel();  // an unchanged model emits nothing: the controls still follow the switches
+}
+
+void ClipPanel::placeSection() {
+  if (showing_) return;
+  if (!sectionEnabled_->isChecked()) {
+    model_.setSection(std::nullopt);
+  } else {
     const int index = sectionAxis_->currentIndex();
     glm::dvec3 axis = customNormal_;
     if (index >= 0 && index < 3) {
@@ -271,8 +294,15 @@ void ClipPanel::apply() {
     model_.setSection(sectionFromPosition(model_.scene().bounds(), axis, sectionOffset_->value(),
                                           sectionFlip_->isChecked(), sectionCaps_->isChecked(),
                                           sectionSlice_->isChecked()));
-  } else {
-    model_.setSection(std::nullopt);
   }
-  showModel();  // an unchanged model emits nothing: the controls still follow the switches
+  showModel();
+}
+
+void ClipPanel::editSection(const std::function<void(mfr::SectionPlane&)>& edit) {
+  if (showing_) return;
+  if (std::optional<mfr::SectionPlane> plane = model_.section()) {
+    edit(*plane);
+    model_.setSection(*plane);
+  }
+  showModel();
 }

@@ -14,6 +14,7 @@
 #include <QWidget>
 
 #include <array>
+#include <functional>
 #include <optional>
 
 #include "mfr/scene/mesh.hpp"
@@ -43,7 +44,11 @@ class ClipPanel final : public QWidget {
 
  private:
   void showModel();  // controls from the model's clip box
-  void apply();      // the model's clip box from the controls
+  // The model's clip box from the sliders: all axes, or only `axis` (the others keep the model's).
+  void applyBox(int axis);
+  void placeSection();  // the model's plane from the axis, offset, side and flags shown
+  // The model's plane with one property changed, the rest (its point) as it is.
+  void editSection(const std::function<void(mfr::SectionPlane&)>& edit);
 
   ViewerModel& model_;
   QCheckBox* enabled_ = nullptr;

@@ -8,6 +8,7 @@
 #include <QLabel>
 #include <QSignalBlocker>
 #include <QSlider>
+#include <QScrollBar>
 #include <QTableWidget>
 #include <QVBoxLayout>
 
@@ -54,7 +55,11 @@ ComparePanel::ComparePanel(ViewerModel& model, QWidget* parent) : QWidget(parent
   metrics_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   metrics_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   metrics_->horizontalHeader()->setStretchLastSection(true);
-  metrics_->setMaximumHeight(metrics_->horizontalHeader()->sizeHint().height() * 3 + 8);
+  // Both rows always in sight, with room kept for the scroll bar a narrow dock gives the columns.
+  metrics_->setVerticalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  metrics_->setFixedHeight(metrics_->horizontalHeader()->sizeHint().height() +
+                           2 * metrics_->verticalHeader()->defaultSectionSize() +
+                           metrics_->horizontalScrollBar()->sizeHint().height() + 2 * metrics_->frameWidth());
   layout->addWidget(metrics_);
   auto* note =
       new QLabel(tr("Against the exact image of the same size (the oracle's “over” of every fragment). "

@@ -1,11 +1,15 @@
 // mfrview: the Qt 6 viewer. Besides the interactive window, command-line options make it
 // scriptable: --screenshot renders the view at --size through mfrcore (the `mfr render` path),
 // writes a PNG and quits; --window-screenshot grabs the whole window once everything is drawn.
+// libepoxy's header before any of Qt's OpenGL ones (QOpenGLContext), which would bring GL/gl.h.
+#include <epoxy/gl.h>
+
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QElapsedTimer>
 #include <QJsonDocument>
 #include <QJsonObject>
+#include <QOpenGLContext>
 #include <QStatusBar>
 #include <QSurfaceFormat>
 #include <QTimer>
@@ -236,6 +240,16 @@ int main(int argc, char** argv) {
   QApplication::setApplicationVersion(QStringLiteral(MFR_VERSION));
   const CommandLine cl = parseCommandLine(app);
   const bool scripted = !cl.screenshot.isEmpty() || !cl.windowScreenshot.isEmpty();
+  {
+    // The view is a QOpenGLWidget: on a platform without OpenGL windows (offscreen, minimal, vnc)
+    // Qt would crash at the first paint instead of saying so.
+    QOpenGLContext probe;
+    if (!probe.create())
+      fail(QStringLiteral("cannot create an OpenGL context on the Qt platform '%1' (mfrview needs a display with "
+                          "OpenGL: X11 or Wayland, or xvfb-run; mfr render needs none)")
+               .arg(QGuiApplication::platformName()),
+           1);
+  }
 
   // Scripted runs must not depend on (or change) what the last interactive session left behind.
   MainWindow window(MainWindow::Options{.restoreSettings = !scripted, .loadPlugins = true});

@@ -17,7 +17,11 @@
 #include <QMimeData>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QAbstractSlider>
+#include <QAbstractSpinBox>
+#include <QComboBox>
 #include <QScrollArea>
+#include <QScrollBar>
 #include <QSettings>
 #include <QStatusBar>
 #include <QTableWidget>
@@ -25,6 +29,7 @@
 #include <QToolBar>
 #include <QVBoxLayout>
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 
@@ -62,6 +67,85 @@ QString sceneFileFilter() {
 
 }  // namespace
 
+namespace {
+
+// A panel that scrolls vertically in its dock: the panels' combined heights (the method panel's
+// parameter rows, the budget panel's histogram) then no longer set the window's minimum height or
+// squeeze the image. Never sideways: the dock stays as wide as the panel needs, so no row is cut.
+class VerticalScroll final : public QScrollArea {
+ public:
+  explicit VerticalScroll(QWidget* panel) {
+    setWidgetResizable(true);
+    setFrameShape(QFrame::NoFrame);
+    setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+    setWidget(panel);
+  }
+  // A panel that rebuilds its rows (the method panel, per method) may need another width: the
+  // dock must ask again, which a scroll area does not do by itself.
+  bool eventFilter(QObject* watched, QEvent* event) override {
+    if (watched == widget() && event->type() == QEvent::LayoutRequest) updateGeometry();
+    return QScrollArea::eventFilter(watched, event);
+  }
+  [[nodiscard]] QSize minimumSizeHint() const override {
+    const QSize least = QScrollArea::minimumSizeHint();
+    const int panelWidth = widget() ? widget()->minimumSizeHint().width() : 0;
+    return {std::max(least.width(), panelWidth + verticalScrollBar()->sizeHint().width()), least.height()};
+  }
+};
+
+// Spin boxes size themselves to the longest number their range allows (±1e30 with six decimals:
+// about 300 px) and combo boxes to their longest entry; in a dock either sets the window's minimum
+// width. Capped here for every panel, plugins' included.
+void narrowControls(QWidget* panel) {
+  constexpr int kWidestSpinBox = 120;
+  for (QAbstractSpinBox* box : panel->findChildren<QAbstractSpinBox*>())
+    if (box->minimumSizeHint().width() > kWidestSpinBox) box->setMinimumWidth(kWidestSpinBox);
+  constexpr int kWidestComboBox = 160;
+  for (QComboBox* combo : panel->findChildren<QComboBox*>())
+    if (combo->minimumSizeHint().width() > kWidestComboBox) {
+      combo->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
+      combo->setMinimumWidth(kWidestComboBox);
+    }
+}
+
+// The wheel over a dock scrolls the dock, unless the control under it has the focus (clicked or
+// tabbed to): a slider, spin box or combo box in a panel must not change the scene because the
+// wheel passed over it on the way down. Such controls take the focus by click or tab only.
+class DockWheelGuard final : public QObject {
+ public:
+  using QObject::QObject;
+
+ protected:
+  bool eventFilter(QObject* watched, QEvent* event) override {
+    const bool control = qobject_cast<QAbstractSlider*>(watched) || qobject_cast<QAbstractSpinBox*>(watched) ||
+                         qobject_cast<QComboBox*>(watched);
+    if (!control || (event->type() != QEvent::Wheel && event->type() != QEvent::Polish)) return false;
+    auto* widget = static_cast<QWidget*>(watched);
+    if (!inDock(widget)) return false;
+    if (event->type() == QEvent::Polish) {
+      if (widget->focusPolicy() == Qt::WheelFocus) widget->setFocusPolicy(Qt::StrongFocus);
+      return false;
+    }
+    if (widget->hasFocus()) return false;
+    event->ignore();  // on to the parents: the dock's scroll area scrolls
+    return true;
+  }
+
+ private:
+  static bool inDock(const QWidget* widget) {
+    for (const QWidget* w = widget->parentWidget(); w; w = w->parentWidget())
+      if (dynamic_cast<const VerticalScroll*>(w)) return true;
+    return false;
+  }
+};
+
+QWidget* scrolled(QWidget* panel) {
+  narrowControls(panel);
+  return new VerticalScroll(panel);
+}
+
+}  // namespace
+
 MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), options_(options) {
   setObjectName(QStringLiteral("mfrviewMainWindow"));
   model_ = new ViewerModel(this);
@@ -73,6 +157,7 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
   setCorner(Qt::BottomLeftCorner, Qt::LeftDockWidgetArea);
   setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
 
+  qApp->installEventFilter(new DockWheelGuard(this));
   buildMenus();
   buildDocks();
   if (options_.loadPlugins) {
@@ -311,20 +396,14 @@ void MainWindow::buildDocks() {
   const auto dock = [this](const QString& title, const QString& name, QWidget* panel, Qt::DockWidgetArea area) {
     auto* d = new QDockWidget(title, this);
     d->setObjectName(name);
-    d->setWidget(panel);
+    d->setWidget(scrolled(panel));
     addDockWidget(area, d);
     panelsMenu_->addAction(d->toggleViewAction());
     return d;
   };
   QDockWidget* scene =
       dock(tr("Scene"), QStringLiteral("sceneDock"), new SceneTreePanel(*model_), Qt::LeftDockWidgetArea);
-  // Scrolled: the box's and the section's controls are taller than the scene tree they share the
-  // left side with, and would otherwise set the window's minimum height.
-  auto* clipScroll = new QScrollArea;
-  clipScroll->setWidgetResizable(true);
-  clipScroll->setFrameShape(QFrame::NoFrame);
-  clipScroll->setWidget(new ClipPanel(*model_));
-  QDockWidget* clip = dock(tr("Clip"), QStringLiteral("clipDock"), clipScroll, Qt::LeftDockWidgetArea);
+  QDockWidget* clip = dock(tr("Clip"), QStringLiteral("clipDock"), new ClipPanel(*model_), Qt::LeftDockWidgetArea);
   tabifyDockWidget(scene, clip);
   scene->raise();
   QDockWidget* method =
@@ -358,7 +437,7 @@ void MainWindow::buildPluginDocks() {
     if (!r.plugin) continue;
     auto* d = new QDockWidget(r.name, this);
     d->setObjectName(QStringLiteral("plugin-") + r.id);
-    d->setWidget(r.plugin->createPanel(*model_, d));
+    d->setWidget(scrolled(r.plugin->createPanel(*model_, d)));
     addDockWidget(Qt::RightDockWidgetArea, d);
     if (first)
       tabifyDockWidget(first, d);
@@ -560,7 +639,7 @@ void MainWindow::updateTitle() {
 
 void MainWindow::updateFrameInfo() {
   const mfr::Stats& s = model_->stats();
-  const QSize size = model_->renderSize();
+  const QSize size = model_->paneSize();  // the image the statistics describe
   frameInfo_->setText(tr("%1  ·  %2×%3  ·  %4 ms  ·  %5")
                           .arg(QString::fromStdString(s.method))
                           .arg(size.width())

@@ -69,6 +69,14 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
     if (lastReduction_ > 1) update();  // the full frame of where the motion stopped
   });
 
+  errorNote_ = new QLabel(this);
+  errorNote_->setObjectName(QStringLiteral("renderErrorNote"));
+  errorNote_->setWordWrap(true);
+  errorNote_->setAlignment(Qt::AlignCenter);
+  errorNote_->setTextInteractionFlags(Qt::TextSelectableByMouse);  // copied into a bug report
+  errorNote_->setStyleSheet(QStringLiteral(
+      "QLabel { background: rgba(255, 255, 255, 230); color: #202020; border: 1px solid #c04030; padding: 10px; }"));
+  errorNote_->hide();
   splitHandle_ = new SplitHandle(this);
   splitHandle_->setObjectName(QStringLiteral("splitHandle"));
   splitHandle_->hide();
@@ -351,7 +359,7 @@ const std::vector<std::uint32_t>& RenderView::depthCounts(QSize size) {
 
 void RenderView::reportDepthComplexity() {
   if (!renderers_[0] || !model_.hasScene()) return;
-  const QSize size = pixelSize();
+  const QSize size = model_.paneSize();  // the image of the statistics (half the view side by side)
   QVector<quint64> histogram;
   makeCurrent();
   try {
@@ -513,8 +521,40 @@ void RenderView::endNavigation(int settleMs) {
 
 // ---- overlays ------------------------------------------------------------------------------
 
+// " k=4 tail=true": the parameters in which this pane's method differs from the other pane's, when
+// both panes run the same method (what a same-method comparison is about); values as set or default.
+QString RenderView::differingParams(int side) const {
+  const QString method = model_.methodOf(side);
+  const mfr::MethodInfo* info = model_.methodInfo(method);
+  if (!info || model_.methodOf(1 - side) != method) return {};
+  const std::map<std::string, std::string> mine = model_.paramsOf(side), other = model_.paramsOf(1 - side);
+  const auto value = [](const std::map<std::string, std::string>& set, const mfr::ParamSpec& spec) {
+    const auto it = set.find(spec.name);
+    return it == set.end() ? spec.defaultValue : it->second;
+  };
+  QString text;
+  for (const mfr::ParamSpec& spec : info->params)
+    if (value(mine, spec) != value(other, spec))
+      text +=
+          QStringLiteral(" %1=%2").arg(QString::fromStdString(spec.name), QString::fromStdString(value(mine, spec)));
+  return text;
+}
+
 void RenderView::updateOverlays() {
   const double ratio = devicePixelRatioF();
+  // A frame that cannot be rendered leaves the view empty: say why there, not only in the status
+  // bar, whose next message would hide it.
+  if (!model_.compareEnabled() && model_.hasScene() && !model_.renderError().isEmpty()) {
+    errorNote_->setText(tr("Cannot render:\n%1").arg(model_.renderError()));
+    errorNote_->setFixedWidth(std::clamp(width() - 24, 80, 520));
+    errorNote_->adjustSize();
+    errorNote_->move(std::max(0, (width() - errorNote_->width()) / 2),
+                     std::max(0, (height() - errorNote_->height()) / 2));
+    errorNote_->show();
+    errorNote_->raise();
+  } else {
+    errorNote_->hide();
+  }
   const auto logical = [ratio](const QRect& r) {
     return QRect(static_cast<int>(r.x() / ratio), static_cast<int>(r.y() / ratio), static_cast<int>(r.width() / ratio),
                  static_cast<int>(r.height() / ratio));
@@ -539,7 +579,8 @@ void RenderView::updateOverlays() {
         operation += QStringLiteral(", step %1")
                          .arg(model_.volumeStep() > 0.0 ? model_.volumeStep() : model_.volumeStepDefault(), 0, 'g', 4);
       QStringList lines{
-          QStringLiteral("%1 · %2 (%3)").arg(QLatin1String(sideName(side)), model_.methodOf(side), operation)};
+          QStringLiteral("%1 · %2 (%3)")
+              .arg(QLatin1String(sideName(side)), model_.methodOf(side) + differingParams(side), operation)};
       if (paneFailed_[side])
         lines << tr("cannot render (see the status bar)");
       else if (!model_.metricsCurrent(side))

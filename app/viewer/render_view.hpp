@@ -15,6 +15,7 @@
 #include <epoxy/gl.h>
 
 #include <QColor>
+#include <QLabel>
 #include <QOpenGLWidget>
 #include <QPoint>
 
@@ -172,6 +173,7 @@ class RenderView final : public QOpenGLWidget {
   void clearToBackground();
   void releaseGl();
   void updateOverlays();
+  [[nodiscard]] QString differingParams(int side) const;  // a compare caption's " k=4"
 
   ViewerModel& model_;
   std::array<std::unique_ptr<mfr::GpuRenderer>, kSides> renderers_;
@@ -186,6 +188,7 @@ class RenderView final : public QOpenGLWidget {
   std::array<PaneTarget, kSides> reducedTargets_;  // navigation previews, at 1/f of the pane size
   std::array<DataMap, kSides> maps_;
   std::array<bool, kSides> paneFailed_{false, false};  // the pane's last paint had an error
+  QLabel* errorNote_ = nullptr;  // over an image that cannot be rendered: why (compare panes have captions)
   // n(p) of the last view (both panes share it when their sizes agree).
   struct DepthCache {
     quint64 scene = 0, view = 0;

@@ -101,9 +101,10 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   // A molecule's representations (PyMOL's show): any combination, the file re-read with them.
   moleculeRow_ = new QWidget;
   moleculeRow_->setObjectName(QStringLiteral("moleculeRow"));
-  auto* molecule = new QHBoxLayout(moleculeRow_);
+  // Two rows of boxes, so that the row does not set the dock's width.
+  auto* molecule = new QGridLayout(moleculeRow_);
   molecule->setContentsMargins(4, 4, 4, 0);
-  molecule->addWidget(new QLabel(tr("Molecule")));
+  molecule->addWidget(new QLabel(tr("Molecule")), 0, 0);
   const std::array<std::pair<const char*, QString>, 5> representations = {
       std::pair{"moleculeSpheres", tr("Spheres")}, std::pair{"moleculeBallAndStick", tr("Ball and stick")},
       std::pair{"moleculeSticks", tr("Sticks")}, std::pair{"moleculeCartoon", tr("Cartoon")},
@@ -111,7 +112,7 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   for (std::size_t i = 0; i < molecule_.size(); ++i) {
     molecule_[i] = new QCheckBox(representations[i].second);
     molecule_[i]->setObjectName(QString::fromLatin1(representations[i].first));
-    molecule->addWidget(molecule_[i]);
+    molecule->addWidget(molecule_[i], static_cast<int>(i / 3), static_cast<int>(i % 3) + 1);
     // Checked: the representation on every part; unchecked: on none. A representation the style
     // draws on some parts only (sticks@ligands) shows partly checked, and a click makes it all.
     connect(molecule_[i], &QCheckBox::stateChanged, this, [this](int state) {
@@ -137,7 +138,7 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
       tr("Each chain's backbone: helices, strands with arrows and loops, coloured red, yellow "
          "and green (PyMOL's cartoon); from the file's HELIX/SHEET records, or DSSP"));
   molecule_[4]->setToolTip(tr("The solvent-excluded surface of each chain and of the ligands (probe 1.4 Å)"));
-  molecule->addStretch(1);
+  molecule->setColumnStretch(4, 1);
   moleculeRow_->setVisible(false);
   layout->addWidget(moleculeRow_);
   // Colour by a field (mfr::colorObjectsByField): ParaView's "Color by", map and range.
@@ -166,14 +167,15 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   fieldNote_ = new QLabel;
   fieldNote_->setObjectName(QStringLiteral("colorByNote"));
   fieldNote_->setWordWrap(true);
+  // Three columns at most, so that the rows do not set the dock's width.
   fields->addWidget(new QLabel(tr("Colour by")), 0, 0);
   fields->addWidget(colorBy_, 0, 1);
-  fields->addWidget(colorMap_, 0, 2, 1, 2);
+  fields->addWidget(colorMap_, 0, 2);
   fields->addWidget(new QLabel(tr("Range")), 1, 0);
   fields->addWidget(rangeLow_, 1, 1);
   fields->addWidget(rangeHigh_, 1, 2);
-  fields->addWidget(dataRange_, 1, 3);
-  fields->addWidget(fieldNote_, 2, 0, 1, 4);
+  fields->addWidget(dataRange_, 2, 2);
+  fields->addWidget(fieldNote_, 3, 0, 1, 3);
   fields->setColumnStretch(1, 1);
   fields->setColumnStretch(2, 1);
   layout->addWidget(fieldRow_);

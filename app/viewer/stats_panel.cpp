@@ -49,7 +49,7 @@ void StatsPanel::showStats() {
   QTreeWidgetItem* frame = group(tr("Frame"));
   row(frame, tr("Method"), QString::fromStdString(s.method));
   row(frame, tr("Operation"), QString::fromStdString(s.operation));
-  row(frame, tr("Image"), QStringLiteral("%1 × %2").arg(model_.renderSize().width()).arg(model_.renderSize().height()));
+  row(frame, tr("Image"), QStringLiteral("%1 × %2").arg(model_.paneSize().width()).arg(model_.paneSize().height()));
   row(frame, tr("Synchronisation"), QString::fromStdString(s.sync));
   row(frame, tr("Geometry passes"), QString::number(s.passes));
   if (s.kMax > 0) row(frame, tr("k range"), s.kMin == s.kMax ? QString::number(s.kMax) : QStringLiteral("%1 … %2").arg(s.kMin).arg(s.kMax));

@@ -86,7 +86,8 @@ class ViewerModel final : public ViewerContext {
   void setParams(const std::map<std::string, std::string>& changes) override { setParamsOf(0, changes); }
   [[nodiscard]] bool hasScene() const override { return hasScene_; }
   [[nodiscard]] const mfr::Stats& stats() const override { return stats_[0]; }
-  [[nodiscard]] QSize renderSize() const override { return renderSize_; }
+  [[nodiscard]] QSize renderSize() const { return renderSize_; }  // the whole view's pixels
+  [[nodiscard]] QSize imageSize() const override { return paneSize(); }
   void requestDepthComplexity() override;
   void requestFrameQuality() override;
   [[nodiscard]] FrameQuality frameQuality() const override;

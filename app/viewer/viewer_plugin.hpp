@@ -72,8 +72,9 @@ class ViewerContext : public QObject {
   [[nodiscard]] virtual bool hasScene() const = 0;
   // Stats of the last frame drawn in the view (empty before the first).
   [[nodiscard]] virtual const mfr::Stats& stats() const = 0;
-  // Pixels of the live image.
-  [[nodiscard]] virtual QSize renderSize() const = 0;
+  // Pixels of the image stats() describes: the view's, or in compare mode side by side the first
+  // pane's (half the view's width).
+  [[nodiscard]] virtual QSize imageSize() const = 0;
   // Asks for the per-pixel fragment counts n(p) of the current view at the image's size, counted
   // by the GPU's rasterisation (one count pass: what the GPU methods capture; equal to the
   // oracle's counts on every pixel whose centre is off triangle edges); depthComplexityReady
@@ -244,5 +245,7 @@ class MfrViewerPlugin {
 // 1.7: a volume file's fields: volumeFields, volumeField, setVolumeField, volumeFieldLoading,
 //      volumeFieldError.
 // 1.8: isosurfaces of a volume: isosurfaceValues, isosurfaceOpacity, setIsosurfaces.
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.8"
+// 1.9: imageSize (the image stats() describes) instead of renderSize (the whole view's, which
+//      side by side is two images).
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.9"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -35,6 +35,7 @@ struct GpuRenderer::GpuVolume {
   std::shared_ptr<gl::Texture> grid;  // R32F, dims; shared by volumes with the same samples
   gl::Texture transfer;               // RGBA32F, MFR_VOLUME_TF_SIZE: (rgb, σ)
   std::size_t bytes = 0;              // the transfer table's, and the grid's unless an earlier volume holds it
+  std::size_t sceneGridBytes = 0;     // the grid's when the scene holds it (surfaces coloured by it: a slice)
 };
 
 GpuRenderer::~GpuRenderer() = default;
@@ -70,6 +71,7 @@ void GpuRenderer::uploadVolumes(const Scene& scene) {
     gpu->transfer = gl::createTexture1D(GL_RGBA32F, MFR_VOLUME_TF_SIZE);
     glTextureSubImage1D(gpu->transfer.id(), 0, 0, MFR_VOLUME_TF_SIZE, GL_RGBA, GL_FLOAT, table.data());
     gpu->bytes = (earlier || inScene ? 0 : v.grid->values.size() * sizeof(float)) + table.size() * sizeof(glm::vec4);
+    gpu->sceneGridBytes = !earlier && inScene ? v.grid->values.size() * sizeof(float) : 0;
     volumes_.push_back(std::move(gpu));
   }
 }
@@ -240,10 +242,16 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   if (operation_ == "zthickness") stats.notes.emplace_back("z-thickness", std::to_string(thickness_));
   if (operation_ == "volume") {
     stats.notes.emplace_back("volume step", std::to_string(volumeStep_));
-    std::size_t bytes = 0;
-    for (const auto& v : volumes_) bytes += v->bytes;
+    std::size_t bytes = 0, shared = 0;
+    for (const auto& v : volumes_) {
+      bytes += v->bytes;
+      shared += v->sceneGridBytes;
+    }
     stats.notes.emplace_back("volumes", std::to_string(volumes_.size()));
     stats.notes.emplace_back("volume (bytes)", std::to_string(bytes));
+    // Grids that surfaces coloured by the volume hold (a section's slice): counted with the scene,
+    // not above, but on the GPU all the same.
+    if (shared > 0) stats.notes.emplace_back("volume grid held by the scene (bytes)", std::to_string(shared));
     stats.notes.emplace_back("volume shading", volumeShadingNote(drawnVolumes_));
     if (const std::string fields = volumeFieldsNote(drawnVolumes_); !fields.empty())
       stats.notes.emplace_back("volume fields", fields);

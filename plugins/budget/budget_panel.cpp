@@ -125,7 +125,7 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   exactLabel_->setObjectName(QStringLiteral("budgetExactAt"));
   exactLabel_->setToolTip(
       tr("The least budget at which this frame's image is exact (vkb, dkb: a one-fragment "
-         "tail is exact, so Σ max(1, n − 1) slots suffice)"));
+         "tail, and a final run of one colour, are exact: Σ max(1, n − m) slots suffice)"));
   frameForm->addRow(tr("Memory"), memoryBar_);
   frameForm->addRow(tr("Holding data"), memoryLabel_);
   frameForm->addRow(tr("Captured"), capturedLabel_);
@@ -235,6 +235,7 @@ void BudgetPanel::setBudget(int mib) {
   }
   driving_ = true;
   corrections_ = 0;
+  showKnob();
   applyBudget();
 }
 
@@ -244,17 +245,36 @@ void BudgetPanel::methodChanged() {
     const QSignalBlocker block(methodCombo_);
     methodCombo_->setCurrentIndex(methodCombo_->findData(ctx_.method()));
   }
-  switch (d.knob) {
-    case Knob::None: knobLabel_->setText(tr("nothing: %1 has no memory parameter").arg(ctx_.method())); break;
-    case Knob::Budget: knobLabel_->setText(tr("budget_mib — the method picks k per frame within the budget")); break;
-    case Knob::Pool: knobLabel_->setText(tr("pool = fixed, pool_mib = budget − per-pixel heads")); break;
-    case Knob::Slots:
-      knobLabel_->setText(tr("%1 — the largest that fits (%2 … %3)").arg(QString::fromStdString(d.param)).arg(d.minValue).arg(d.maxValue));
-      break;
-  }
+  showKnob();
   corrections_ = 0;
   showRobustness();
   if (driving_) applyBudget();
+}
+
+void BudgetPanel::showKnob() {
+  const Driver d = driverFor(ctx_.method());
+  QString text;
+  switch (d.knob) {
+    case Knob::None:
+      text = tr("nothing: %1 has no memory parameter").arg(ctx_.method());
+      break;
+    case Knob::Budget:
+      text = tr("budget_mib — the method picks k per frame within the budget");
+      break;
+    case Knob::Pool:
+      text = tr("pool = fixed, pool_mib = budget − per-pixel heads");
+      break;
+    case Knob::Slots:
+      text = tr("%1 — the largest that fits (%2 … %3)")
+                 .arg(QString::fromStdString(d.param))
+                 .arg(d.minValue)
+                 .arg(d.maxValue);
+      break;
+  }
+  // Until the budget is moved (or a session says so) the method keeps its own parameters and the
+  // bar below is only a reference line.
+  if (d.knob != Knob::None && !driving_) text += tr("; not applied until you set a budget");
+  knobLabel_->setText(text);
 }
 
 void BudgetPanel::showRobustness() {
@@ -284,7 +304,7 @@ void BudgetPanel::showQuality() {
 void BudgetPanel::applyBudget() {
   const Driver d = driverFor(ctx_.method());
   const double budget = budgetMiB() * kMiB;
-  const double pixels = static_cast<double>(ctx_.renderSize().width()) * ctx_.renderSize().height();
+  const double pixels = static_cast<double>(ctx_.imageSize().width()) * ctx_.imageSize().height();
   switch (d.knob) {
     case Knob::None: return;
     case Knob::Budget: ctx_.setParams({{"budget_mib", std::to_string(budgetMiB())}}); return;
@@ -319,7 +339,7 @@ void BudgetPanel::applyBudget() {
 void BudgetPanel::frameRendered() {
   const mfr::Stats& s = ctx_.stats();
   if (QString::fromStdString(s.method) != ctx_.method()) return;
-  const QSize size = ctx_.renderSize();
+  const QSize size = ctx_.imageSize();
   const std::string key = s.method + "@" + std::to_string(size.width()) + "x" + std::to_string(size.height());
   if (key != fit_.key) fit_ = Fit{key, {}, -1};
   const Driver d = driverFor(ctx_.method());
@@ -352,19 +372,26 @@ void BudgetPanel::showFrame() {
   memoryBar_->setValue(static_cast<int>(std::min(1000.0, 1000.0 * allocated / budget)));
   memoryBar_->setFormat(tr("%1 of %2 MiB (%3 %)").arg(mib(allocated)).arg(budgetMiB()).arg(100.0 * allocated / budget, 0, 'f', 0));
   // Red only when the budget is in force: before the slider is used it is a reference line.
-  memoryBar_->setStyleSheet(driving_ && allocated > budget ? QStringLiteral("QProgressBar::chunk { background: #d04030; }") : QString());
-  if (!driving_) memoryBar_->setFormat(memoryBar_->format() + tr(" — budget not applied"));
+  memoryBar_->setStyleSheet(
+      driving_ && allocated > budget ? QStringLiteral("QProgressBar::chunk { background: #d04030; }") : QString());
   memoryLabel_->setText(tr("%1 MiB of %2 MiB allocated").arg(mib(static_cast<double>(s.bytesUsed)), mib(allocated)));
-  capturedLabel_->setText(s.fragmentsGenerated
-                              ? tr("%1 % (%2 of %3 fragments)")
-                                    .arg(100.0 * static_cast<double>(s.fragmentsStored) / static_cast<double>(s.fragmentsGenerated), 0, 'f', 1)
-                                    .arg(locale.toString(s.fragmentsStored), locale.toString(s.fragmentsGenerated))
-                              : tr("—"));
+  // Blending methods (wboit, mboit) keep no fragment but use every one: not "0 % captured".
+  const bool blendsAll = s.kMax == 0 && s.fragmentsStored == 0 && s.fragmentsDropped == 0;
+  capturedLabel_->setText(
+      blendsAll && s.fragmentsGenerated
+          ? tr("all %1 fragments blended, none stored").arg(locale.toString(s.fragmentsGenerated))
+      : s.fragmentsGenerated
+          ? tr("%1 % (%2 of %3 fragments)")
+                .arg(100.0 * static_cast<double>(s.fragmentsStored) / static_cast<double>(s.fragmentsGenerated), 0, 'f',
+                     1)
+                .arg(locale.toString(s.fragmentsStored), locale.toString(s.fragmentsGenerated))
+          : tr("—"));
   kLabel_->setText(s.kMax == 0 ? tr("— (no per-pixel capacity)")
                    : s.kMin == s.kMax ? QString::number(s.kMax)
                                       : QStringLiteral("%1 … %2").arg(s.kMin).arg(s.kMax));
   const std::string* exactAt = s.note("exact at");
-  exactLabel_->setText(exactAt ? QString::fromStdString(*exactAt) : tr("—"));
+  exactLabel_->setText(exactAt ? QString::fromStdString(*exactAt).replace(QStringLiteral(">= "), QStringLiteral("≥ "))
+                               : tr("—"));
   histogram_->setMarker(driverFor(ctx_.method()).knob == Knob::Pool ? 0 : static_cast<int>(s.kMax), s.kMin != s.kMax);
 }
 
@@ -376,6 +403,7 @@ void BudgetPanel::loadSettings(const QJsonObject& settings) {
   slider_->setValue(mib);
   spin_->setValue(mib);
   driving_ = settings.value("driving").toBool(false);
+  showKnob();
   corrections_ = 0;
   if (driving_) applyBudget();  // same parameters as saved for the same image size
 }

@@ -58,6 +58,7 @@ class BudgetPanel final : public QWidget {
   void frameRendered();
   void showFrame();
   void methodChanged();
+  void showKnob();  // what the budget drives, and whether it does yet
   void showRobustness();
   void showQuality();
 

@@ -33,7 +33,9 @@ void HistogramWidget::paintEvent(QPaintEvent*) {
   quint64 largest = 1;
   for (qsizetype n = 1; n < histogram_.size(); ++n) largest = std::max(largest, histogram_[n]);
   const QRect plot =
-      rect().adjusted(fm.horizontalAdvance(QString::number(largest)) + 10, fm.height() + 8, -10, -2 * fm.height() - 8);
+      // Room above for the title and half the top value's label, which is centred on the top.
+      rect().adjusted(fm.horizontalAdvance(QString::number(largest)) + 10, 2 * fm.height() + 4, -10,
+                      -2 * fm.height() - 8);
   p.setPen(pal.color(QPalette::Text));
   p.drawText(QRect(4, 2, width() - 8, fm.height() + 4), Qt::AlignLeft | Qt::AlignVCenter,
              histogram_.isEmpty()
@@ -70,13 +72,20 @@ void HistogramWidget::paintEvent(QPaintEvent*) {
   p.drawText(QRect(0, plot.bottom() - fm.height() / 2, plot.left() - 4, fm.height()), Qt::AlignRight | Qt::AlignVCenter,
              QStringLiteral("0"));
   p.drawText(QRect(plot.left(), plot.bottom() + fm.height() + 4, plot.width(), fm.height()),
-             Qt::AlignHCenter | Qt::AlignTop, tr("fragments per pixel n (pixels, log scale)"));
+             Qt::AlignHCenter | Qt::AlignTop, tr("fragments per pixel n; bars: pixels (log scale)"));
   if (marker_ > 0 && marker_ <= maxN) {
     const int x = static_cast<int>(plot.left() + marker_ * barWidth);
     p.setPen(QPen(QColor(200, 30, 30), 2, Qt::DashLine));
     p.drawLine(x, plot.top(), x, plot.bottom());
     const QString label = variable_ ? tr("max k(p) = %1").arg(marker_) : QStringLiteral("k = %1").arg(marker_);
-    p.drawText(QRect(x + 4, plot.top(), fm.horizontalAdvance(label) + 8, fm.height()), Qt::AlignLeft | Qt::AlignTop,
-               label);
+    // Right of the line, or left of it where the plot ends; on the background colour, so that it
+    // reads over the bars.
+    const int labelWidth = fm.horizontalAdvance(label) + 8;
+    const int left = x + 4 + labelWidth <= plot.right() ? x + 4 : std::max(plot.left(), x - 4 - labelWidth);
+    const QRect box(left, plot.top(), labelWidth, fm.height());
+    QColor backing = pal.color(QPalette::Base);
+    backing.setAlpha(220);
+    p.fillRect(box, backing);
+    p.drawText(box, Qt::AlignHCenter | Qt::AlignVCenter, label);
   }
 }

@@ -430,6 +430,10 @@ void HybridVolumePanel::showIsosurfaces() {
     isoOpacity_->setValue(context_.isosurfaceOpacity());
   }
   const glm::dvec2 range = context_.volumeValueRange();
+  // An example from this volume's values (a third and two thirds of the way), not a fixed one.
+  isoValues_->setPlaceholderText(tr("values, e.g. %1, %2")
+                                     .arg(range.x + (range.y - range.x) / 3.0, 0, 'g', 3)
+                                     .arg(range.x + 2.0 * (range.y - range.x) / 3.0, 0, 'g', 3));
   isoNote_->setStyleSheet(isoError_.isEmpty() ? QString() : QStringLiteral("color: #b00020;"));
   isoNote_->setText(!isoError_.isEmpty() ? isoError_
                     : values.empty()
@@ -707,14 +711,17 @@ void HybridVolumePanel::showInfo() {
   if (const QStringList fields = context_.volumeFields(); !fields.isEmpty())
     lines << tr("field %1 (of %2)").arg(context_.volumeField(), fields.join(QStringLiteral(", ")));
   lines << tr("values %1 … %2").arg(r.x, 0, 'g', 5).arg(r.y, 0, 'g', 5);
-  QString step, bytes;
+  QString step, bytes, sharedBytes;
   for (const auto& [name, value] : context_.stats().notes) {
     if (name == "volume step") step = QString::fromStdString(value);
     if (name == "volume (bytes)") bytes = QString::fromStdString(value);
+    if (name == "volume grid held by the scene (bytes)") sharedBytes = QString::fromStdString(value);
   }
   if (!step.isEmpty()) {
     QString line = tr("last frame: step %1").arg(step.toDouble(), 0, 'g', 5);
     if (!bytes.isEmpty()) line += tr(", %1 on the GPU").arg(bytesText(bytes.toDouble()));
+    if (!sharedBytes.isEmpty())
+      line += tr(" (+ its grid, %1, held by the surfaces it colours)").arg(bytesText(sharedBytes.toDouble()));
     lines << line;
   } else {
     lines << tr("last frame: volume not drawn (step %1)")
