@@ -66,13 +66,22 @@ void addBench(CLI::App& app) {
   cmd->callback([opt] {
     const auto [w, h] = parseSize("--size", opt->size);
     std::vector<RenderRequest> requests;
-    for (const std::string& spec : splitList(opt->methods)) requests.push_back(parseMethodSpec(spec, w, h));
+    for (const std::string& spec : splitList(opt->methods)) {
+      requests.push_back(parseMethodSpec(spec, w, h));
+      // The oracle's refusal comes from the registry; optimal-k, a CPU method too, would be refused
+      // there as an unknown method.
+      if (requests.back().method == "optimal-k")
+        throw Error("--methods " + spec,
+                    "a CPU method, not a GPU one: bench times the GPU methods (optimal-k "
+                    "runs in mfr evaluate and mfr render)");
+    }
     if (requests.empty()) throw Error("--methods", "no method given");
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->read);
     opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
+    refuseEmptyView(scene);
     const Camera camera = scene.view(opt->view);
 
     ImageRGBA8 reference;

@@ -32,6 +32,7 @@ void addCompare(CLI::App& app) {
       else if (m == "flip") wantFlip = true;
       else throw Error("--metric " + m, "unknown metric (rmse, flip)");
     }
+    if (!wantRmse && !wantFlip) throw Error("--metric " + opt->metrics, "names no metric (rmse, flip)");
     if (!(opt->ppd > 0) || opt->ppd > 1e4) throw Error("--ppd", "must be in (0, 10000]");
     const ImageRGBA8 ref = readPng(opt->reference);
     const ImageRGBA8 test = readPng(opt->test);

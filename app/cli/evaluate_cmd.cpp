@@ -148,6 +148,19 @@ void addEvaluate(CLI::App& app) {
         throw Error("--methods " + m, "not a method (see mfr info --methods)");
       if (const auto weights = spec.params.find("weights"); weights != spec.params.end())
         (void)loadNeuralImportance(weights->second);
+      // The rest of the spec too, before anything renders: a bad parameter or operation is the
+      // user's mistake, which every row would only repeat (with exit 0).
+      const MethodInfo* methodInfo = findMethodInfo(spec.method);
+      if (!methodInfo) throw Error("--methods " + m, "not a method (see mfr info --methods)");
+      if (std::none_of(methodInfo->params.begin(), methodInfo->params.end(),
+                       [](const ParamSpec& p) { return p.name == "budget_mib"; }))
+        throw Error("--methods " + m, "has no memory budget (budget_mib): evaluate compares methods under --budgets");
+      if (spec.params.contains("budget_mib"))
+        throw Error("--methods " + m, "budget_mib is set by --budgets, not in the method spec");
+      std::map<std::string, std::string> values = spec.params;
+      values["budget_mib"] = "1";
+      (void)Params(methodInfo->params, values, spec.method);
+      if (spec.operation != "auto") validateOperation(spec.operation);
       specs[m] = spec;
       methodWidth = std::max(methodWidth, m.size() + 2);
     }

@@ -1,3 +1,4 @@
+#include <optional>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -50,6 +51,9 @@ void addInfo(CLI::App& app) {
     opt->contours.apply(scene, -1.0);
     SectionReport section;
     applySectionOption(scene, opt->section, &section);
+    // The histogram's view, checked before anything is printed: a bad --view is one line.
+    const std::optional<Camera> histogramView =
+        opt->noHistogram ? std::nullopt : std::optional<Camera>(scene.view(opt->view));
     const bool sectioned = !section.outcomes.empty();
     const auto outcome = [&](std::size_t i) { return sectioned ? section.outcomes[i] : SectionOutcome::kKept; };
     std::vector<SurfaceMeasures> measures;
@@ -234,7 +238,7 @@ void addInfo(CLI::App& app) {
     }
     j["volumes"] = volumes;
     if (!opt->noHistogram) {
-      const FragmentLists lists = castFragments(scene, scene.view(opt->view), w, h);
+      const FragmentLists lists = castFragments(scene, *histogramView, w, h);
       const std::vector<std::uint64_t> hist = depthComplexityHistogram(lists);
       j["depth_complexity"] = {{"size", opt->size}, {"view", opt->view}, {"max", lists.maxCount()},
                                {"fragments", lists.fragments.size()}, {"histogram", hist}};

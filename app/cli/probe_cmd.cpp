@@ -113,6 +113,7 @@ void addProbe(CLI::App& app) {
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
+    refuseEmptyView(scene);
     const Camera camera = scene.view(opt->view);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);
     // What the method (or, without one, the oracle) does with the lists: hybrid and volume are taken apart.

@@ -1,3 +1,4 @@
+#include <filesystem>
 #include <algorithm>
 #include <cmath>
 #include <iostream>
@@ -77,6 +78,10 @@ void addRender(CLI::App& app) {
     // Both outputs checked before the work, so that a bad second path leaves no first file behind.
     checkOutputPath(opt->output);
     if (!opt->stats.empty()) checkOutputPath(opt->stats);
+    // One file cannot be both: the JSON would replace the image just written.
+    if (!opt->stats.empty() &&
+        std::filesystem::weakly_canonical(opt->stats) == std::filesystem::weakly_canonical(opt->output))
+      throw Error("--stats " + opt->stats, "is the output image's file too (-o)");
     RenderRequest req;
     req.method = opt->method;
     req.operation = opt->op;
@@ -96,6 +101,7 @@ void addRender(CLI::App& app) {
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     applySectionOption(scene, opt->section);
+    refuseEmptyView(scene);
     if (opt->shade) {
       if (scene.volumes.empty()) throw Error("--shade", "scene '" + scene.name + "' has no volume");
       req.volumeShading = true;

@@ -133,7 +133,9 @@ TEST_F(Cli, GpuMethodsRefuseWhatTheOracleRefuses) {
       write("huge.mfrscene", R"({"objects": [{"name": "s", "primitive": {"type": "sphere", "radius": 1e300}}]})");
   for (const auto& [file, reason] :
        std::vector<std::pair<fs::path, std::string>>{{degenerate, "nothing to render (no visible triangles)"},
-                                                     {zero, "nothing to render (no visible triangles)"},
+                                                     // Refused where it is written (the loader, since
+                                                     // this round), for every method alike.
+                                                     {zero, "objects[0].transform.matrix: singular"},
                                                      {huge, "s: non-finite vertex coordinate"}})
     for (const char* method : {"oracle", "abuffer-ll", "kplus-array"}) {
       SCOPED_TRACE(file.filename().string() + " " + method);
@@ -511,6 +513,42 @@ TEST_F(Cli, EvaluateBudgetsRelativeToTheExactThresholds) {
   }
 }
 
+// Found by a bug hunt: what left an empty image with exit 0, or its own output overwritten, or
+// printed half a report before the error.
+TEST_F(Cli, NothingToDrawAndOtherLateRefusals) {
+  expectCleanFailure("render @sample -s 32x32 --clip 0.9,0.9,0.9,1.06,1,1.06", "nothing to draw inside the clip box");
+  expectCleanFailure("render @sample -s 32x32 --section z=0.5 --clip -5,-5,-5,5,5,0",
+                     "nothing to draw inside the clip box on the kept side of the section plane");
+  for (const std::string& command :
+       {std::string("probe @sample -s 32x32 --pixel 16,16 --clip 0.9,0.9,0.9,1.06,1,1.06"),
+        std::string("bench @sample -s 16x16 --methods abuffer-ll --clip 0.9,0.9,0.9,1.06,1,1.06")}) {
+    const CliResult r = runCli(command);
+    EXPECT_EQ(r.exitCode, 1) << command << ": " << r.out;
+    EXPECT_NE(r.out.find("nothing to draw"), std::string::npos) << r.out;
+  }
+  const fs::path clipped =
+      write("clipped.mfrscene",
+            R"({"objects": [{"primitive": {"type": "box"}}], "clip": {"min": [5, 5, 5], "max": [6, 6, 6]}})");
+  expectCleanFailure("render " + clipped.string() + " -s 32x32", "nothing to draw inside the clip box");
+  // The same box drawn through the other corner is a scene that draws: not refused.
+  const fs::path png = dir() / "ok.png";
+  EXPECT_EQ(runCli("render @sample -s 32x32 --clip 0,0,0,1.06,1,1.06 -o " + png.string()).exitCode, 0);
+  const fs::path same = dir() / "same.png";
+  const CliResult r = runCli("render @sample -s 32x32 -o " + same.string() + " --stats " + same.string());
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find("is the output image's file too"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(same));
+  const CliResult info = runCli("info @sample --view orbit:inf:0");
+  EXPECT_EQ(info.exitCode, 1) << info.out;
+  EXPECT_EQ(std::count(info.out.begin(), info.out.end(), '\n'), 1) << info.out;
+  const CliResult bench = runCli("bench @sample -s 16x16 --methods optimal-k");
+  EXPECT_EQ(bench.exitCode, 1) << bench.out;
+  EXPECT_NE(bench.out.find("a CPU method"), std::string::npos) << bench.out;
+  const CliResult metric = runCli("compare " + png.string() + " " + png.string() + " --metric ,");
+  EXPECT_EQ(metric.exitCode, 1) << metric.out;
+  EXPECT_NE(metric.out.find("names no metric"), std::string::npos) << metric.out;
+}
+
 TEST_F(Cli, BudgetCommandsBadInput) {
   // A corrupt dataset, a missing dataset, bad budgets, a bad weights file.
   const fs::path junk = write("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");
@@ -585,7 +623,16 @@ TEST_F(Cli, BudgetCommandsBadInput) {
                                                         {"--budgets e0", "--budgets e0"},
                                                         {"--budgets x101", "--budgets x101"},
                                                         {"-m vkb:exact_tail", "--methods vkb:exact_tail"},
-                                                        {"-m vkb,nosuch:k=1", "--methods nosuch:k=1"}}) {
+                                                        {"-m vkb,nosuch:k=1", "--methods nosuch:k=1"},
+                                                        // Each was only every row's error, with exit 0:
+                                                        {"-m fkb:k=0", "--param k"},
+                                                        {"-m vkb:exact_tail=maybe", "--param exact_tail"},
+                                                        {"-m fkb:op=bogus", "--op bogus"},
+                                                        {"-m abuffer-ll", "--methods abuffer-ll"},
+                                                        {"-m fkb:budget_mib=5", "--methods fkb:budget_mib=5"},
+                                                        // 1e14 MiB overflowed to a budget of 0 bytes.
+                                                        {"--budgets 1e14", "--budgets 1e14"},
+                                                        {"--budgets 0x10", "--budgets 0x10"}}) {
     const CliResult r = runCli("evaluate @sample -s 16x16 " + args + " --json " + json.string());
     EXPECT_EQ(r.exitCode, 1) << r.out;
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;

@@ -127,6 +127,25 @@ TEST(Flip, ErrorIsLocalAndBounded) {
   EXPECT_GE(r.stats.min, 0.0);
 }
 
+// mfr compare accepts any ppd in (0, 10000]: at one pixel per degree and below the feature
+// detectors' off-centre weights underflow, which gave 0 / 0 = NaN everywhere. The error stays a
+// number in [0, 1], zero for identical images and above zero where colours differ.
+TEST(Flip, LowPixelsPerDegreeGiveNumbers) {
+  const mfr::ImageRGBA8 reference = noiseImage(24, 16, 3);
+  const mfr::ImageRGBA8 test = noiseImage(24, 16, 4);
+  for (const double ppd : {0.01, 0.5, 1.0, 1.5}) {
+    const mfr::FlipResult same = mfr::flip(reference, reference, ppd);
+    EXPECT_EQ(same.stats.mean, 0.0) << ppd;
+    const mfr::FlipResult r = mfr::flip(reference, test, ppd);
+    EXPECT_TRUE(std::isfinite(r.stats.mean)) << ppd;
+    EXPECT_GT(r.stats.mean, 0.0) << ppd;
+    EXPECT_LE(r.stats.max, 1.0) << ppd;
+    EXPECT_TRUE(std::all_of(r.errorMap.data.begin(), r.errorMap.data.end(), [](float v) {
+      return std::isfinite(v) && v >= 0.0f && v <= 1.0f;
+    })) << ppd;
+  }
+}
+
 TEST(Flip, SizeMismatchThrows) {
   EXPECT_THROW(mfr::flip(flatImage(4, 4, 0, 0, 0), flatImage(4, 5, 0, 0, 0)), mfr::Error);
 }

@@ -894,6 +894,19 @@ TEST_F(SceneVolumes, ErrorsNameTheJsonPath) {
               "exactly one of 'preset' or 'points'");
   expectError(R"({"volumes": [{"file": "cube.vti", "transform": {"scale": 0}}]})", "volumes[0].transform.scale",
               "zero scale");
+  // Placements no renderer can draw: refused where they are written, not as an empty image.
+  expectError(R"({"volumes": [{"file": "cube.vti", "transform": {"translate": [1e300, 0, 0]}}]})",
+              "volumes[0].transform", "beyond ±1e15");
+  expectError(R"({"objects": [{"primitive": {"type": "box"}, "transform": {"scale": 1e308}}]})", "objects[0].transform",
+              "beyond ±1e15");
+  expectError(R"({"objects": [{"primitive": {"type": "box"}, "transform": {"scale": 1e-200}}]})",
+              "objects[0].transform", "singular");
+  expectError(R"({"objects": [{"primitive": {"type": "box"},
+                  "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,1,0]}}]})",
+              "objects[0].transform.matrix", "projective");
+  expectError(R"({"objects": [{"primitive": {"type": "box"},
+                  "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,0,0, 0,0,0,1]}}]})",
+              "objects[0].transform.matrix", "singular");
   expectError(R"({"volumes": [{"file": "cube.vti", "visible": "yes"}]})", "volumes[0].visible",
               "expected true or false");
   expectError(R"({"volumes": [{"file": "cube.vti", "field": "mass"}]})", "volumes[0].field",

@@ -338,10 +338,17 @@ FeatureKernels featureKernels(float ppd) {
     (dg > 0 ? dgPos : dgNeg) += std::fabs(dg);
     (ddg > 0 ? ddgPos : ddgNeg) += std::fabs(ddg);
   }
+  // At a few pixels per degree or less σ is a small fraction of a pixel and the off-centre weights
+  // underflow to 0: a part with no weight stays 0 (the detector sees nothing at that scale)
+  // instead of 0 / 0 = NaN.
+  const auto share = [](float v, float positive, float negative) {
+    const float part = v > 0 ? positive : negative;
+    return part > 0 ? v / part : 0.0f;
+  };
   for (std::size_t i = 0; i < k.g.size(); ++i) {
     k.g[i] /= gSum;
-    k.dg[i] /= k.dg[i] > 0 ? dgPos : dgNeg;
-    k.ddg[i] /= k.ddg[i] > 0 ? ddgPos : ddgNeg;
+    k.dg[i] = share(k.dg[i], dgPos, dgNeg);
+    k.ddg[i] = share(k.ddg[i], ddgPos, ddgNeg);
   }
   return k;
 }

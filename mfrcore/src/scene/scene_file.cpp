@@ -76,6 +76,21 @@ class Reader {
   std::string file_;
 };
 
+// A placement every renderer can draw: affine (a projective last row would send points through
+// infinity, which no renderer here divides by), not flattening (a zero determinant leaves no
+// surface facing anywhere), and within ±1e15 (beyond, the view's projection degenerates and the
+// image comes out empty).
+void checkTransform(const Reader& r, const glm::dmat4& m, const std::string& where) {
+  constexpr double kLargest = 1e15;
+  for (int col = 0; col < 4; ++col)
+    for (int row = 0; row < 4; ++row)
+      if (!(std::abs(m[col][row]) <= kLargest)) r.fail(where, "entries beyond ±1e15 cannot be drawn");
+  const double det = glm::determinant(glm::dmat3(m));
+  if (!(std::abs(det) > 1e-300) || !std::isfinite(det)) r.fail(where, "singular: it flattens the object");
+  if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0)
+    r.fail(where, "projective: the last row must be 0, 0, 0, 1");
+}
+
 glm::dmat4 parseTransform(const Reader& r, const json& t, const std::string& where) {
   r.object(t, where);
   if (t.contains("matrix")) {
@@ -85,6 +100,7 @@ glm::dmat4 parseTransform(const Reader& r, const json& t, const std::string& whe
     for (int row = 0; row < 4; ++row)
       for (int col = 0; col < 4; ++col)
         out[col][row] = r.number(m[static_cast<std::size_t>(row * 4 + col)], where + ".matrix");
+    checkTransform(r, out, where + ".matrix");
     return out;
   }
   glm::dmat4 out(1.0);
@@ -110,6 +126,7 @@ glm::dmat4 parseTransform(const Reader& r, const json& t, const std::string& whe
     if (v.x == 0 || v.y == 0 || v.z == 0) r.fail(where + ".scale", "zero scale");
     out = glm::scale(out, v);
   }
+  checkTransform(r, out, where);
   return out;
 }
 
