@@ -154,6 +154,10 @@ BudgetSpec parseBudgetSpec(const std::string& item, std::uint64_t pixels) {
         std::ceil(static_cast<double>(m.pixels) * (8.0 * *k + static_cast<double>(m.bytesPerPixel)) +
                   static_cast<double>(m.fixedBytes)));
     b.mib = static_cast<double>(b.bytes) / (1024.0 * 1024.0);
+    if (b.mib > kLargestBudgetMiB)
+      throw Error("--budgets " + item, "is " + std::to_string(static_cast<long long>(b.mib)) +
+                                           " MiB at this size: at most " +
+                                           std::to_string(static_cast<int>(kLargestBudgetMiB)) + " MiB");
     return b;
   }
   const std::optional<double> mib = parseNumber(item);

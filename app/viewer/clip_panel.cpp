@@ -31,7 +31,7 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
         // Keep min ≤ max: the other face gives way.
         if (s == low_[a] && high_[a]->value() < s->value()) high_[a]->setValue(s->value());
         if (s == high_[a] && low_[a]->value() > s->value()) low_[a]->setValue(s->value());
-        applyBox(a);
+        applyBox(a, s == low_[a]);
       });
       return s;
     };
@@ -115,7 +115,7 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
     showModel();
   });
 
-  connect(enabled_, &QCheckBox::toggled, this, [this] { applyBox(-1); });
+  connect(enabled_, &QCheckBox::toggled, this, [this] { applyBox(-1, false); });
   connect(reset_, &QPushButton::clicked, this, [this] {
     showing_ = true;
     for (int a = 0; a < 3; ++a) {
@@ -123,7 +123,7 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
       high_[a]->setValue(kSteps);
     }
     showing_ = false;
-    applyBox(-1);
+    applyBox(-1, false);
   });
   connect(&model_, &ViewerModel::sceneChanged, this, &ClipPanel::showModel);
   showModel();  // an unchanged model emits nothing: the controls still follow the switches
@@ -209,7 +209,11 @@ void ClipPanel::showModel() {
       if (sectionAxis_->count() > 3) sectionAxis_->removeItem(3);
       sectionAxis_->setCurrentIndex(axis);
     } else {
-      customNormal_ = n;
+      // A plane of its own normal: Custom is that normal (kept when the plane is only flipped, so
+      // Flip shows which way round it is).
+      if (std::abs(std::abs(glm::dot(n, customNormal_)) - 1.0) > 1e-12) customNormal_ = n;
+      flip = glm::dot(n, customNormal_) < 0.0;
+      base = customNormal_;
       if (sectionAxis_->count() == 3) sectionAxis_->addItem(tr("Custom"));
       sectionAxis_->setCurrentIndex(3);
     }
@@ -256,7 +260,7 @@ void ClipPanel::showModel() {
   showing_ = false;
 }
 
-void ClipPanel::applyBox(int axis) {
+void ClipPanel::applyBox(int axis, bool lowFace) {
   if (showing_) return;
   if (!enabled_->isChecked()) {
     model_.setClipBox(std::nullopt);
@@ -267,13 +271,15 @@ void ClipPanel::applyBox(int axis) {
       high[static_cast<std::size_t>(a)] = high_[a]->value();
     }
     mfr::Bounds box = boxFromPositions(model_.scene().bounds(), low, high);
-    // One axis moved: the others keep the model's faces (a file's box need not sit on slider
-    // steps, and may reach past the bounds).
+    // One face moved: every other face keeps the model's value (a file's box need not sit on
+    // slider steps, and may reach past the bounds). A face it pushed has moved itself already.
     if (const std::optional<mfr::Bounds>& current = model_.clipBox(); current && axis >= 0) {
       const mfr::Bounds moved = box;
       box = *current;
-      box.min[axis] = moved.min[axis];
-      box.max[axis] = moved.max[axis];
+      if (lowFace)
+        box.min[axis] = moved.min[axis];
+      else
+        box.max[axis] = moved.max[axis];
     }
     model_.setClipBox(box);
   }

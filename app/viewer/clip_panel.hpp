@@ -44,8 +44,9 @@ class ClipPanel final : public QWidget {
 
  private:
   void showModel();  // controls from the model's clip box
-  // The model's clip box from the sliders: all axes, or only `axis` (the others keep the model's).
-  void applyBox(int axis);
+  // The model's clip box from the sliders: all faces (axis −1), or only `axis`'s low or high face
+  // (the others keep the model's).
+  void applyBox(int axis, bool lowFace);
   void placeSection();  // the model's plane from the axis, offset, side and flags shown
   // The model's plane with one property changed, the rest (its point) as it is.
   void editSection(const std::function<void(mfr::SectionPlane&)>& edit);

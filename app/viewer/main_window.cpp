@@ -86,6 +86,13 @@ class VerticalScroll final : public QScrollArea {
     if (watched == widget() && event->type() == QEvent::LayoutRequest) updateGeometry();
     return QScrollArea::eventFilter(watched, event);
   }
+  // The panel's own wish, not QScrollArea's (capped at 24 lines): docks laid out by resizeDocks
+  // give a panel the height it asks for when there is room.
+  [[nodiscard]] QSize sizeHint() const override {
+    if (!widget()) return QScrollArea::sizeHint();
+    const QSize panel = widget()->sizeHint();
+    return {panel.width() + verticalScrollBar()->sizeHint().width(), panel.height()};
+  }
   [[nodiscard]] QSize minimumSizeHint() const override {
     const QSize least = QScrollArea::minimumSizeHint();
     const int panelWidth = widget() ? widget()->minimumSizeHint().width() : 0;
@@ -108,22 +115,34 @@ void narrowControls(QWidget* panel) {
     }
 }
 
+// Controls whose value the wheel changes: sliders, spin boxes and combo boxes — not scroll bars,
+// which is how scroll areas (the dock's own, a tree's, a table's) take the wheel.
+bool wheelChangesValue(QObject* object) {
+  if (qobject_cast<QScrollBar*>(object)) return false;
+  return qobject_cast<QAbstractSlider*>(object) || qobject_cast<QAbstractSpinBox*>(object) ||
+         qobject_cast<QComboBox*>(object);
+}
+
+// Such a control takes the focus by click or tab only, not by the wheel passing over it.
+void noWheelFocus(QWidget* widget) {
+  if (widget->focusPolicy() == Qt::WheelFocus) widget->setFocusPolicy(Qt::StrongFocus);
+}
+
 // The wheel over a dock scrolls the dock, unless the control under it has the focus (clicked or
 // tabbed to): a slider, spin box or combo box in a panel must not change the scene because the
-// wheel passed over it on the way down. Such controls take the focus by click or tab only.
+// wheel passed over it on the way down.
 class DockWheelGuard final : public QObject {
  public:
   using QObject::QObject;
 
  protected:
   bool eventFilter(QObject* watched, QEvent* event) override {
-    const bool control = qobject_cast<QAbstractSlider*>(watched) || qobject_cast<QAbstractSpinBox*>(watched) ||
-                         qobject_cast<QComboBox*>(watched);
-    if (!control || (event->type() != QEvent::Wheel && event->type() != QEvent::Polish)) return false;
+    if (event->type() != QEvent::Wheel && event->type() != QEvent::Polish) return false;
+    if (!wheelChangesValue(watched)) return false;
     auto* widget = static_cast<QWidget*>(watched);
     if (!inDock(widget)) return false;
-    if (event->type() == QEvent::Polish) {
-      if (widget->focusPolicy() == Qt::WheelFocus) widget->setFocusPolicy(Qt::StrongFocus);
+    if (event->type() == QEvent::Polish) {  // rows a panel adds later (the method panel's, per method)
+      noWheelFocus(widget);
       return false;
     }
     if (widget->hasFocus()) return false;
@@ -140,8 +159,13 @@ class DockWheelGuard final : public QObject {
 };
 
 QWidget* scrolled(QWidget* panel) {
+  auto* scroll = new VerticalScroll(panel);
   narrowControls(panel);
-  return new VerticalScroll(panel);
+  // The controls there already: narrowControls' size queries polished them before they were in a
+  // dock, so the guard's Polish handler saw them outside one.
+  for (QWidget* child : panel->findChildren<QWidget*>())
+    if (wheelChangesValue(child)) noWheelFocus(child);
+  return scroll;
 }
 
 }  // namespace
@@ -186,6 +210,8 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
                           .arg(model_->scenePath())
                           .arg(model_->scene().objects.size())
                           .arg(model_->scene().triangleCount());
+    if (const std::size_t volumes = model_->scene().volumes.size(); volumes > 0)
+      message += volumes == 1 ? tr(", 1 volume") : tr(", %1 volumes").arg(volumes);
     for (const std::string& note : model_->scene().notes)
       message += QStringLiteral("; ") + QString::fromStdString(note);
     statusBar()->showMessage(message, model_->scene().notes.empty() ? 8000 : 20000);
@@ -425,7 +451,17 @@ void MainWindow::buildDocks() {
   // The image gets most of the window; panels start narrow (users widen them as they like).
   // Deferred until the window has its size, or the layout overrides it.
   QTimer::singleShot(0, this, [this, scene, stats] {
-    if (!restoredLayout_) resizeDocks({scene, stats}, {330, 360}, Qt::Horizontal);
+    if (restoredLayout_) return;
+    resizeDocks({scene, stats}, {330, 360}, Qt::Horizontal);
+    // The plugin panels scroll, so nothing makes room for them any more: the one in front gets the
+    // height its panel asks for (the budget panel's histogram in sight), the statistics the rest.
+    for (QDockWidget* d : findChildren<QDockWidget*>())
+      if (d->objectName().startsWith(QStringLiteral("plugin-")) && !d->visibleRegion().isEmpty()) {
+        const int total = stats->height() + d->height();
+        const int wanted = std::clamp(d->widget()->sizeHint().height() + 40, total / 2, total - 200);
+        resizeDocks({stats, d}, {total - wanted, wanted}, Qt::Vertical);
+        break;
+      }
   });
 }
 

@@ -73,7 +73,7 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
   errorNote_->setObjectName(QStringLiteral("renderErrorNote"));
   errorNote_->setWordWrap(true);
   errorNote_->setAlignment(Qt::AlignCenter);
-  errorNote_->setTextInteractionFlags(Qt::TextSelectableByMouse);  // copied into a bug report
+  errorNote_->setAttribute(Qt::WA_TransparentForMouseEvents);  // the view still orbits under it
   errorNote_->setStyleSheet(QStringLiteral(
       "QLabel { background: rgba(255, 255, 255, 230); color: #202020; border: 1px solid #c04030; padding: 10px; }"));
   errorNote_->hide();

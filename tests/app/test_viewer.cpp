@@ -16,6 +16,8 @@
 #include <QProcess>
 #include <QProgressBar>
 #include <QRegularExpression>
+#include <QScrollArea>
+#include <QScrollBar>
 #include <QPushButton>
 #include <QSignalSpy>
 #include <QSlider>
@@ -3380,13 +3382,24 @@ class ViewerTest : public QObject {
     QCOMPARE(m.section()->point, plane.point);
     QCOMPARE(m.section()->normal, -plane.normal);
     QCOMPARE(m.clipBox()->max, box.max);
-    // One face moved: the other axes keep theirs.
+    // One face moved: every other face keeps its value, the same axis's other face included.
     minY->setValue(500);
     const mfr::Bounds b = m.scene().bounds();
     QCOMPARE(m.clipBox()->min.y, b.min.y + (b.max.y - b.min.y) * 500 / 1000);
+    QCOMPARE(m.clipBox()->max.y, box.max.y);
     QCOMPARE(m.clipBox()->min.x, box.min.x);
     QCOMPARE(m.clipBox()->max.z, box.max.z);
     QCOMPARE(m.section()->point, plane.point);
+    // A plane of its own normal (Custom): Flip turns it round and shows it, and back.
+    const glm::dvec3 tilted = glm::normalize(glm::dvec3(1.0, 1.0, 0.0));
+    m.setSection(mfr::SectionPlane{plane.point, tilted, true, false});
+    QVERIFY(!flip->isChecked());
+    flip->setChecked(true);
+    QCOMPARE(m.section()->normal, -tilted);
+    QCOMPARE(m.section()->point, plane.point);
+    QVERIFY(flip->isChecked());
+    flip->setChecked(false);
+    QCOMPARE(m.section()->normal, tilted);
     // The wheel over an unfocused slider: nothing moves.
     const mfr::Bounds before = *m.clipBox();
     const int position = minX->value();
@@ -3398,6 +3411,22 @@ class ViewerTest : public QObject {
     QCOMPARE(minX->value(), position);
     QCOMPARE(m.clipBox()->min, before.min);
     QCOMPARE(m.clipBox()->max, before.max);
+    // ... while the wheel over the dock still scrolls it (its scroll area hands the wheel to its
+    // scroll bar, a slider the guard must let through).
+    auto* dock = w->findChild<QDockWidget*>("clipDock");
+    QVERIFY(dock);
+    dock->raise();
+    w->resize(1000, 600);
+    QScrollArea* scroll = nullptr;
+    for (QWidget* p = minX->parentWidget(); p && !scroll; p = p->parentWidget()) scroll = qobject_cast<QScrollArea*>(p);
+    QVERIFY(scroll);
+    QTRY_VERIFY_WITH_TIMEOUT(scroll->verticalScrollBar()->maximum() > 0, 10000);
+    QCOMPARE(scroll->verticalScrollBar()->value(), 0);
+    const QPointF middle(scroll->viewport()->width() / 2.0, scroll->viewport()->height() / 2.0);
+    QWheelEvent down(middle, scroll->viewport()->mapToGlobal(middle), QPoint(), QPoint(0, -120), Qt::NoButton,
+                     Qt::NoModifier, Qt::NoScrollPhase, false);
+    QApplication::sendEvent(scroll->viewport(), &down);
+    QVERIFY(scroll->verticalScrollBar()->value() > 0);
   }
 
   void sectionPlane() {

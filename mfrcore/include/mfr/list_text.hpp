@@ -24,7 +24,7 @@ inline std::vector<std::string> splitList(const std::string& text, char separato
 // The whole of `text` (after leading blanks) as one finite decimal number, or none (std::stod
 // alone would also take hexadecimal, "0x10").
 inline std::optional<double> parseNumber(const std::string& text) {
-  if (text.find_first_not_of("0123456789+-.eE \t") != std::string::npos) return std::nullopt;
+  if (text.find_first_not_of("0123456789+-.eE \t\n\r\v\f") != std::string::npos) return std::nullopt;
   std::size_t used = 0;
   double v = 0;
   try {

@@ -11,7 +11,7 @@
 namespace mfr {
 
 UnitSphere geodesicSphere(int frequency) {
-  // Far more than any caller needs (a lone atom of radius 3 Å at a 0.05 Å spacing asks for 72).
+  // Far more than any caller needs (a lone atom of radius 3 Å at a 0.05 Å spacing asks for 80).
   if (frequency < 1 || frequency > 4096) throw Error("geodesic sphere", "frequency must be in [1, 4096]");
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   const std::array<glm::dvec3, 12> corners = {glm::dvec3(-1, t, 0),  glm::dvec3(1, t, 0),   glm::dvec3(-1, -t, 0),
