@@ -5,6 +5,7 @@
 #include <QGridLayout>
 #include <QLabel>
 #include <QPushButton>
+#include <QSignalBlocker>
 #include <QSlider>
 #include <QVBoxLayout>
 
@@ -28,10 +29,15 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
       s->setRange(0, kSteps);
       s->setValue(value);
       connect(s, &QSlider::valueChanged, this, [this, s, a](int) {
-        // Keep min ≤ max: the other face gives way.
-        if (s == low_[a] && high_[a]->value() < s->value()) high_[a]->setValue(s->value());
-        if (s == high_[a] && low_[a]->value() > s->value()) low_[a]->setValue(s->value());
-        applyBox(a, s == low_[a]);
+        // Keep min ≤ max: the other face gives way, moved here without a signal of its own (its
+        // own apply would show the model's old face back on this slider before it was applied).
+        QSlider* other = s == low_[a] ? high_[a] : low_[a];
+        const bool pushed = s == low_[a] ? other->value() < s->value() : other->value() > s->value();
+        if (pushed) {
+          const QSignalBlocker block(other);
+          other->setValue(s->value());
+        }
+        applyBox(a, pushed ? Face::Both : s == low_[a] ? Face::Low : Face::High);
       });
       return s;
     };
@@ -115,7 +121,7 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
     showModel();
   });
 
-  connect(enabled_, &QCheckBox::toggled, this, [this] { applyBox(-1, false); });
+  connect(enabled_, &QCheckBox::toggled, this, [this] { applyBox(-1, Face::Both); });
   connect(reset_, &QPushButton::clicked, this, [this] {
     showing_ = true;
     for (int a = 0; a < 3; ++a) {
@@ -123,7 +129,7 @@ ClipPanel::ClipPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), mod
       high_[a]->setValue(kSteps);
     }
     showing_ = false;
-    applyBox(-1, false);
+    applyBox(-1, Face::Both);
   });
   connect(&model_, &ViewerModel::sceneChanged, this, &ClipPanel::showModel);
   showModel();  // an unchanged model emits nothing: the controls still follow the switches
@@ -260,7 +266,7 @@ void ClipPanel::showModel() {
   showing_ = false;
 }
 
-void ClipPanel::applyBox(int axis, bool lowFace) {
+void ClipPanel::applyBox(int axis, Face face) {
   if (showing_) return;
   if (!enabled_->isChecked()) {
     model_.setClipBox(std::nullopt);
@@ -271,15 +277,13 @@ void ClipPanel::applyBox(int axis, bool lowFace) {
       high[static_cast<std::size_t>(a)] = high_[a]->value();
     }
     mfr::Bounds box = boxFromPositions(model_.scene().bounds(), low, high);
-    // One face moved: every other face keeps the model's value (a file's box need not sit on
-    // slider steps, and may reach past the bounds). A face it pushed has moved itself already.
+    // One axis's face (or both, one pushing the other) moved: every other face keeps the model's
+    // value (a file's box need not sit on slider steps, and may reach past the bounds).
     if (const std::optional<mfr::Bounds>& current = model_.clipBox(); current && axis >= 0) {
       const mfr::Bounds moved = box;
       box = *current;
-      if (lowFace)
-        box.min[axis] = moved.min[axis];
-      else
-        box.max[axis] = moved.max[axis];
+      if (face != Face::High) box.min[axis] = moved.min[axis];
+      if (face != Face::Low) box.max[axis] = moved.max[axis];
     }
     model_.setClipBox(box);
   }

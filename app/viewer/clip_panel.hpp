@@ -44,9 +44,10 @@ class ClipPanel final : public QWidget {
 
  private:
   void showModel();  // controls from the model's clip box
-  // The model's clip box from the sliders: all faces (axis −1), or only `axis`'s low or high face
-  // (the others keep the model's).
-  void applyBox(int axis, bool lowFace);
+  // The model's clip box from the sliders: all faces (axis −1), or only `axis`'s low, high or both
+  // faces (the others keep the model's).
+  enum class Face { Low, High, Both };
+  void applyBox(int axis, Face face);
   void placeSection();  // the model's plane from the axis, offset, side and flags shown
   // The model's plane with one property changed, the rest (its point) as it is.
   void editSection(const std::function<void(mfr::SectionPlane&)>& edit);

@@ -3390,6 +3390,14 @@ class ViewerTest : public QObject {
     QCOMPARE(m.clipBox()->min.x, box.min.x);
     QCOMPARE(m.clipBox()->max.z, box.max.z);
     QCOMPARE(m.section()->point, plane.point);
+    // A face pushed by the other: both at the slider's place.
+    auto* maxY = w->findChild<QSlider*>("clipMaxY");
+    QVERIFY(maxY);
+    maxY->setValue(300);
+    QCOMPARE(minY->value(), 300);
+    QCOMPARE(m.clipBox()->min.y, b.min.y + (b.max.y - b.min.y) * 300 / 1000);
+    QCOMPARE(m.clipBox()->max.y, m.clipBox()->min.y);
+    QCOMPARE(m.clipBox()->min.x, box.min.x);
     // A plane of its own normal (Custom): Flip turns it round and shows it, and back.
     const glm::dvec3 tilted = glm::normalize(glm::dvec3(1.0, 1.0, 0.0));
     m.setSection(mfr::SectionPlane{plane.point, tilted, true, false});
