@@ -136,7 +136,6 @@ void addEvaluate(CLI::App& app) {
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
     const std::vector<std::string> methods = splitList(opt->methods);
     if (methods.empty()) throw Error("--methods", "names no method");
-    const std::vector<std::string> known = availableMethods();
     std::map<std::string, RenderRequest> specs;  // each method spec's request, without size and budget
     std::size_t methodWidth = 11;
     // A weights file that cannot be read is the user's mistake, not one row's failure: refused
@@ -144,14 +143,13 @@ void addEvaluate(CLI::App& app) {
     if (!opt->weights.empty()) (void)loadNeuralImportance(opt->weights);
     for (const std::string& m : methods) {
       const RenderRequest spec = parseMethodSpec(m, w, h);
-      if (std::find(known.begin(), known.end(), spec.method) == known.end() || spec.method == "oracle")
-        throw Error("--methods " + m, "not a method (see mfr info --methods)");
+      // The registry's methods and optimal-k have a description; the oracle (no budget) has none.
+      const MethodInfo* methodInfo = findMethodInfo(spec.method);
+      if (!methodInfo) throw Error("--methods " + m, "not a method (see mfr info --methods)");
       if (const auto weights = spec.params.find("weights"); weights != spec.params.end())
         (void)loadNeuralImportance(weights->second);
       // The rest of the spec too, before anything renders: a bad parameter or operation is the
       // user's mistake, which every row would only repeat (with exit 0).
-      const MethodInfo* methodInfo = findMethodInfo(spec.method);
-      if (!methodInfo) throw Error("--methods " + m, "not a method (see mfr info --methods)");
       if (std::none_of(methodInfo->params.begin(), methodInfo->params.end(),
                        [](const ParamSpec& p) { return p.name == "budget_mib"; }))
         throw Error("--methods " + m, "has no memory budget (budget_mib): evaluate compares methods under --budgets");
