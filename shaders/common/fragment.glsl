@@ -34,9 +34,18 @@ float mfrFieldValue() {
   return isnan(value) ? value : clamp(value, uColorMapRange.x - band, uColorMapRange.y + band);
 }
 
+// The material's colour, and whether the mesh's vertex colours multiply it (then in vColor).
+uniform vec4 uColor;
+uniform int uVertexColors;
+
 vec4 mfrShadedColor() {
-  // A field-coloured surface: the map's colour, the material's opacity (vColor.a is uColor.a then).
-  vec4 base = uColorMapRow >= 0 ? vec4(mfrMapFieldValue(mfrFieldValue()), vColor.a) : vColor;
+  // One colour per object is read from the uniform, not interpolated: perspective interpolation
+  // of a constant can move it by an ulp, which flips a colour on an 8-bit rounding tie (0.3·255 =
+  // 76.5) on some fragments only, so that one part's faces no longer match each other or the
+  // oracle's, which uses the material's colour as it is.
+  vec4 material = uVertexColors != 0 ? vColor : uColor;
+  // A field-coloured surface: the map's colour, the material's opacity.
+  vec4 base = uColorMapRow >= 0 ? vec4(mfrMapFieldValue(mfrFieldValue()), uColor.a) : material;
   return mfrShade(base, vNormal, uViewDir);
 }
 

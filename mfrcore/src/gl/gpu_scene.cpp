@@ -79,8 +79,11 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
     // A field colouring needs the field's values on the mesh (colorByField puts them there).
     const std::optional<FieldColors>& field = o.material.fieldColors;
     const bool mapped = field && o.mesh->scalars.size() == o.mesh->positions.size();
+    // Vertex colours only where the mesh has them (else white ones were uploaded): the shader then
+    // reads the material's colour exactly, as the oracle does (common/fragment.glsl says why).
+    const bool vertexColors = o.material.vertexColors && o.mesh->colors.size() == o.mesh->positions.size();
     items_.push_back({it->second, model, glm::mat3(glm::transpose(glm::inverse(o.transform))), o.material.color,
-                      o.material.vertexColors, static_cast<std::uint32_t>(i), mapped ? colorMapIndex(field->map) : -1,
+                      vertexColors, static_cast<std::uint32_t>(i), mapped ? colorMapIndex(field->map) : -1,
                       mapped ? glm::vec2(field->range) : glm::vec2(0.0f, 1.0f)});
     if (const std::optional<VolumeFieldSampler> sampler = volumeFieldSampler(scene, o)) {
       DrawItem& item = items_.back();
