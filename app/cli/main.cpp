@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"mfr: multifragment rendering — capture, sort and operate on many fragments per pixel", "mfr"};
@@ -23,6 +24,7 @@ int main(int argc, char** argv) {
   mfr::cli::addAllocations(app);
   mfr::cli::addProbe(app);
   try {
+    (void)mfr::availableHostMemory();  // a malformed MFR_MEMORY_LIMIT_MIB is refused before any work
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);

@@ -21,6 +21,8 @@
 #include <optional>
 
 #include "main_window.hpp"
+#include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 #include "mfr/scene/scene.hpp"
 #include "mfr/scene/section.hpp"
 #include "render_view.hpp"
@@ -240,6 +242,11 @@ int main(int argc, char** argv) {
   QApplication::setApplicationVersion(QStringLiteral(MFR_VERSION));
   const CommandLine cl = parseCommandLine(app);
   const bool scripted = !cl.screenshot.isEmpty() || !cl.windowScreenshot.isEmpty();
+  try {
+    (void)mfr::availableHostMemory();  // a malformed MFR_MEMORY_LIMIT_MIB is refused before any work
+  } catch (const mfr::Error& e) {
+    fail(QString::fromStdString(e.what()), 1);
+  }
   {
     // The view is a QOpenGLWidget: on a platform without OpenGL windows (offscreen, minimal, vnc)
     // Qt would crash at the first paint instead of saying so.

@@ -549,6 +549,48 @@ TEST_F(Cli, NothingToDrawAndOtherLateRefusals) {
   EXPECT_NE(metric.out.find("names no metric"), std::string::npos) << metric.out;
 }
 
+// Linux overcommits, so an image too large for the machine's memory (the oracle's lists, FLIP's
+// planes, llvmpipe's buffers) used to end in the OOM killer; now in one line that says how much is
+// needed. MFR_MEMORY_LIMIT_MIB stands in for a small machine.
+TEST_F(Cli, MoreMemoryThanThereIsIsRefused) {
+  const std::string limit = "MFR_MEMORY_LIMIT_MIB=200 ";
+  const auto refused = [&](const std::string& command, const std::string& mention) {
+    const fs::path out = dir() / "big.png";
+    const CliResult r = mfr::test::runCommand(limit + MFR_CLI + " " + command);
+    EXPECT_EQ(r.exitCode, 1) << command << ": " << r.out;
+    EXPECT_NE(r.out.find(mention), std::string::npos) << command << ": " << r.out;
+    EXPECT_NE(r.out.find("under MFR_MEMORY_LIMIT_MIB=200"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(out));
+    return r;
+  };
+  const fs::path out = dir() / "big.png";
+  refused("render @sample -m oracle -s 4096x4096 -o " + out.string(),
+          "mfr: oracle: the exact fragment lists of 4096x4096 pixels would take ");
+  // FLIP of two images of that size (mfr compare; bench and evaluate run the same code).
+  const fs::path blankA = dir() / "a.png", blankB = dir() / "b.png";
+  mfr::ImageRGBA8 blank(4096, 2048);
+  mfr::writePng(blankA, blank);
+  mfr::writePng(blankB, blank);
+  refused("compare " + blankA.string() + " " + blankB.string() + " --metric flip",
+          "flip: FLIP of 4096x2048 pixels would take 480 MiB more memory");
+  // llvmpipe's buffers are main memory; a hardware driver answers GL_OUT_OF_MEMORY itself.
+  const CliResult bench =
+      mfr::test::runCommand(limit + MFR_CLI + " bench @sample -m abuffer-ll -s 4096x4096 --no-quality -r 1 --warmup 0");
+  if (bench.out.find("renderer: llvmpipe") != std::string::npos) {
+    EXPECT_EQ(bench.exitCode, 1) << bench.out;
+    EXPECT_NE(bench.out.find("mfr: OpenGL: a GPU buffer of the software rasteriser (in main memory) would take"),
+              std::string::npos)
+        << bench.out;
+  }
+  // Not a guard that refuses everything: the same commands at a size that fits.
+  EXPECT_EQ(mfr::test::runCommand(limit + MFR_CLI + " render @sample -m oracle -s 128x128 -o " + out.string()).exitCode,
+            0);
+  const CliResult bad = mfr::test::runCommand("MFR_MEMORY_LIMIT_MIB=-5 " + std::string(MFR_CLI) + " info @sample");
+  EXPECT_EQ(bad.exitCode, 1) << bad.out;
+  EXPECT_NE(bad.out.find("MFR_MEMORY_LIMIT_MIB: '-5' is not a positive whole number of MiB"), std::string::npos)
+      << bad.out;
+}
+
 TEST_F(Cli, BudgetCommandsBadInput) {
   // A corrupt dataset, a missing dataset, bad budgets, a bad weights file.
   const fs::path junk = write("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");

@@ -46,6 +46,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/section.hpp"
 
@@ -528,6 +529,10 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   lists.width = width;
   lists.height = height;
   const std::size_t pixelCount = static_cast<std::size_t>(width) * height;
+  const std::string listsOfSize =
+      "the exact fragment lists of " + std::to_string(width) + "x" + std::to_string(height) + " pixels";
+  // Per pixel: flags, bin counts and offsets, hit counts, ray flags and the lists' offsets.
+  requireHostMemory("oracle", listsOfSize, pixelCount * 18);
   lists.flags.assign(pixelCount, 0);
   if (triangles.empty()) {
     // A scene of volumes only: every list is empty.
@@ -594,6 +599,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     binCounts[i] = 0;  // from here: the fill cursor
   }
   binOffsets[pixelCount] = static_cast<std::uint32_t>(candidateCount);
+  requireHostMemory("oracle", listsOfSize, candidateCount * sizeof(std::uint32_t));
   std::vector<std::uint32_t> bins(candidateCount);
   runParallel(threadCount, triangles.size(), 4096, [&](std::size_t t) {
     if (inSomeBin[t] == 0) return;  // off the region (a probe's one pixel: nearly all of them)
@@ -654,6 +660,8 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     return false;
   };
 
+  std::atomic<std::size_t> castBytes{0};
+  std::atomic<std::size_t> uncheckedBytes{0};
   const auto castRow = [&](int y, std::vector<Hit>& hits) {
     std::vector<Fragment>& out = rowFragments[static_cast<std::size_t>(y)];
     const double wy = (height - 1 - y) + 0.5;
@@ -706,6 +714,15 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
       }
       counts[pixel] = static_cast<std::uint32_t>(hits.size());
     }
+    // Every 64 MiB of rows, ask whether the lists cast so far could still be copied into one
+    // array at the end (below); if not, stop now rather than after casting the rest.
+    constexpr std::size_t kCheckEvery = std::size_t{64} << 20;
+    const std::size_t rowBytes = out.capacity() * sizeof(Fragment);
+    const std::size_t cast = castBytes.fetch_add(rowBytes) + rowBytes;
+    if (uncheckedBytes.fetch_add(rowBytes) + rowBytes >= kCheckEvery) {
+      uncheckedBytes = 0;
+      requireHostMemory("oracle", listsOfSize, cast);
+    }
   };
 
   runParallel(std::min(threadCount, static_cast<unsigned>(region.height)), static_cast<std::size_t>(region.height), 1,
@@ -723,6 +740,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   }
   if (total > UINT32_MAX) throw Error("oracle", "more than 2^32 fragments in one image");
   lists.offsets[pixelCount] = static_cast<std::uint32_t>(total);
+  requireHostMemory("oracle", listsOfSize, total * sizeof(Fragment));
   lists.fragments.reserve(total);
   for (std::vector<Fragment>& row : rowFragments) {
     lists.fragments.insert(lists.fragments.end(), row.begin(), row.end());

@@ -1,0 +1,101 @@
+#include "mfr/host_memory.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "mfr/error.hpp"
+
+namespace mfr {
+
+namespace {
+
+// MemAvailable from /proc/meminfo, in bytes.
+std::optional<std::uint64_t> memAvailable() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  std::uint64_t kib = 0;
+  std::string unit;
+  while (in >> key >> kib >> unit)
+    if (key == "MemAvailable:") return kib * 1024;
+  return std::nullopt;
+}
+
+// This process's resident memory (second field of /proc/self/statm, in pages).
+std::optional<std::uint64_t> residentBytes() {
+  std::ifstream in("/proc/self/statm");
+  std::uint64_t size = 0, resident = 0;
+  if (!(in >> size >> resident)) return std::nullopt;
+  const long page = sysconf(_SC_PAGESIZE);
+  return resident * static_cast<std::uint64_t>(page > 0 ? page : 4096);
+}
+
+// MFR_MEMORY_LIMIT_MIB as bytes; nullopt when unset. A value that is not a positive whole number
+// is refused rather than ignored: a limit that silently does nothing is worse than none.
+std::optional<std::uint64_t> environmentLimit() {
+  const char* text = std::getenv("MFR_MEMORY_LIMIT_MIB");
+  if (text == nullptr || *text == '\0') return std::nullopt;
+  const auto refuse = [&] {
+    return Error("MFR_MEMORY_LIMIT_MIB", "'" + std::string(text) + "' is not a positive whole number of MiB");
+  };
+  if (*text < '0' || *text > '9') throw refuse();  // strtoull would take a sign or blanks
+  errno = 0;
+  char* end = nullptr;
+  const unsigned long long mib = std::strtoull(text, &end, 10);
+  if (errno != 0 || *end != '\0' || mib == 0 || mib > (UINT64_MAX >> 20)) throw refuse();
+  return static_cast<std::uint64_t>(mib) << 20;
+}
+
+}  // namespace
+
+namespace {
+
+struct Available {
+  std::optional<std::uint64_t> bytes;
+  bool byLimit = false;  // MFR_MEMORY_LIMIT_MIB, not the machine, decides
+};
+
+Available available() {
+  Available a{memAvailable()};
+  if (const std::optional<std::uint64_t> limit = environmentLimit()) {
+    const std::uint64_t used = residentBytes().value_or(0);
+    const std::uint64_t left = limit > used ? *limit - used : 0;
+    a.byLimit = !a.bytes || left < *a.bytes;
+    a.bytes = a.byLimit ? left : a.bytes;
+  }
+  return a;
+}
+
+}  // namespace
+
+std::optional<std::uint64_t> availableHostMemory() {
+  return available().bytes;
+}
+
+std::string formatMemory(std::uint64_t bytes) {
+  char text[64];
+  if (bytes >= (std::uint64_t{1} << 30))
+    std::snprintf(text, sizeof text, "%.2f GiB", static_cast<double>(bytes) / static_cast<double>(1u << 30));
+  else if (bytes >= (std::uint64_t{1} << 20))
+    std::snprintf(text, sizeof text, "%.0f MiB", static_cast<double>(bytes) / static_cast<double>(1u << 20));
+  else
+    std::snprintf(text, sizeof text, "%llu bytes", static_cast<unsigned long long>(bytes));
+  return text;
+}
+
+void requireHostMemory(const std::string& what, const std::string& purpose, std::uint64_t bytes) {
+  const Available a = available();
+  if (!a.bytes || bytes <= *a.bytes) return;
+  throw Error(what, purpose + " would take " + formatMemory(bytes) + " more memory; only " + formatMemory(*a.bytes) +
+                        " is available" +
+                        (a.byLimit ? " under MFR_MEMORY_LIMIT_MIB=" + std::string(std::getenv("MFR_MEMORY_LIMIT_MIB"))
+                                   : std::string()));
+}
+
+}  // namespace mfr
