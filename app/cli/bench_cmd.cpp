@@ -13,6 +13,7 @@
 #include "mfr/gpu_renderer.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
+#include "mfr/methods/method.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/metrics.hpp"
 #include "mfr/reference/oracle.hpp"
@@ -70,19 +71,32 @@ void addBench(CLI::App& app) {
       requests.push_back(parseMethodSpec(spec, w, h));
       // The oracle's refusal comes from the registry; optimal-k, a CPU method too, would be refused
       // there as an unknown method.
-      if (requests.back().method == "optimal-k")
+      const RenderRequest& req = requests.back();
+      if (req.method == "optimal-k")
         throw Error("--methods " + spec,
                     "a CPU method, not a GPU one: bench times the GPU methods (optimal-k "
                     "runs in mfr evaluate and mfr render)");
+      if (req.method == "oracle")
+        throw Error("--methods " + spec, "the CPU reference, not a GPU method: bench measures every row against it");
+      // The whole spec before any work, so that a typo costs no oracle and prints no half table.
+      const MethodInfo* info = findMethodInfo(req.method);
+      if (!info) {
+        std::string gpuMethods;
+        for (const std::string& m : availableMethods())
+          if (m != "oracle" && m != "optimal-k") gpuMethods += (gpuMethods.empty() ? "" : ", ") + m;
+        throw Error("--methods " + spec, "unknown method (available: " + gpuMethods + ")");
+      }
+      (void)Params(info->params, req.params, req.method);
+      validateOperation(req.operation);
     }
     if (requests.empty()) throw Error("--methods", "no method given");
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->read);
     opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
+    const Camera camera = scene.view(opt->view);  // before the cut: fit frames the whole scene
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
-    const Camera camera = scene.view(opt->view);
 
     ImageRGBA8 reference;
     ImageRGBA8 csgReference;  // the oracle's CSG image, for rows with op=csg
@@ -116,13 +130,6 @@ void addBench(CLI::App& app) {
     out["oracle_ms"] = oracleMs;
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
 
-    std::cout << "scene " << scene.name << ", " << opt->size << ", view " << opt->view << ", " << opt->repeat
-              << " frames each (" << (opt->sequential ? "sequential" : "round-robin")
-              << "), renderer: " << info.renderer << "\n";
-    std::cout << std::left << std::setw(34) << "method" << std::right << std::setw(11) << "total ms" << std::setw(11)
-              << "MiB alloc" << std::setw(10) << "MiB used" << std::setw(11) << "frags" << std::setw(11) << "stored"
-              << std::setw(9) << "RMSE" << std::setw(9) << "FLIP"
-              << "  passes (median ms)\n";
     // One renderer per method (sharing the scene), frames interleaved round-robin: a slow spell
     // of the machine then falls on every method alike, so the ratios between rows hold better
     // than with one method's frames after another's. The price is every method's buffers at once;
@@ -165,6 +172,15 @@ void addBench(CLI::App& app) {
       for (int i = 0; i < opt->repeat; ++i)
         for (Run& run : runs) frame(run);
     }
+    // The table's head once every frame has rendered: a method that fails leaves one line, not a
+    // head without rows.
+    std::cout << "scene " << scene.name << ", " << opt->size << ", view " << opt->view << ", " << opt->repeat
+              << " frames each (" << (opt->sequential ? "sequential" : "round-robin")
+              << "), renderer: " << info.renderer << "\n";
+    std::cout << std::left << std::setw(34) << "method" << std::right << std::setw(11) << "total ms" << std::setw(11)
+              << "MiB alloc" << std::setw(10) << "MiB used" << std::setw(11) << "frags" << std::setw(11) << "stored"
+              << std::setw(9) << "RMSE" << std::setw(9) << "FLIP"
+              << "  passes (median ms)\n";
     for (Run& run : runs) {
       const RenderRequest& req = *run.req;
       const std::vector<double>& totals = run.totals;

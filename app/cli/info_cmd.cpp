@@ -1,5 +1,7 @@
-#include <optional>
 #include <iostream>
+#include <optional>
+#include <sstream>
+#include <string>
 #include <map>
 #include <memory>
 
@@ -10,6 +12,7 @@
 #include "mfr/io/load.hpp"
 #include "mfr/io/molecule.hpp"
 #include "mfr/io_util.hpp"
+#include "mfr/methods/method.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "mfr/render.hpp"
@@ -17,6 +20,64 @@
 #include "mfr/scene/measure.hpp"
 
 namespace mfr::cli {
+
+namespace {
+
+// Every method render() accepts, where it runs, what it is and its parameters (name, type,
+// default, range or choices): what -m and -p take.
+nlohmann::ordered_json methodsJson() {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const std::string& name : availableMethods()) {
+    const MethodInfo* info = findMethodInfo(name);
+    nlohmann::ordered_json params = nlohmann::ordered_json::array();
+    if (info)
+      for (const ParamSpec& p : info->params) {
+        static const char* const kTypes[] = {"int", "float", "bool", "choice", "text"};
+        nlohmann::ordered_json param = {{"name", p.name},
+                                        {"type", kTypes[static_cast<int>(p.type)]},
+                                        {"default", p.defaultValue},
+                                        {"help", p.help.empty() ? p.label : p.help}};
+        if (p.type == ParamSpec::Type::Int || p.type == ParamSpec::Type::Float) param["range"] = {p.min, p.max};
+        if (p.type == ParamSpec::Type::Choice) param["choices"] = p.choices;
+        params.push_back(param);
+      }
+    const bool gpu = info && name != "optimal-k";
+    list.push_back({{"name", name},
+                    {"runs_on", gpu ? "gpu" : "cpu"},
+                    {"title", info ? info->title : "Exact reference: ray-cast per-pixel fragment lists (the oracle)"},
+                    {"operation", info ? info->preferredOperation : "oit"},
+                    {"params", params}});
+  }
+  return list;
+}
+
+std::string numberText(double v) {
+  std::ostringstream text;
+  text << v;
+  return text.str();
+}
+
+void printMethods(const nlohmann::ordered_json& methods) {
+  for (const auto& m : methods) {
+    std::cout << m["name"].get<std::string>() << "  (" << m["runs_on"].get<std::string>() << ") "
+              << m["title"].get<std::string>() << "\n";
+    std::string line;
+    for (const auto& p : m["params"]) {
+      std::string values;
+      if (p.contains("choices"))
+        for (const auto& c : p["choices"]) values += (values.empty() ? "" : "|") + c.get<std::string>();
+      else if (p.contains("range"))
+        values = numberText(p["range"][0].get<double>()) + ".." + numberText(p["range"][1].get<double>());
+      else if (p["type"] == "bool")
+        values = "true|false";
+      line += (line.empty() ? "" : ", ") + p["name"].get<std::string>() + "=" + p["default"].get<std::string>() +
+              (values.empty() ? "" : " (" + values + ")");
+    }
+    if (!line.empty()) std::cout << "    -p " << line << "\n";
+  }
+}
+
+}  // namespace
 
 void addInfo(CLI::App& app) {
   struct Options {
@@ -41,26 +102,36 @@ void addInfo(CLI::App& app) {
   cmd->add_option("--json", opt->json, "Also write the information as JSON");
   cmd->callback([opt] {
     if (opt->methods) {
-      for (const std::string& m : availableMethods()) std::cout << m << "\n";
-      if (opt->scene.empty()) return;
+      const nlohmann::ordered_json methods = methodsJson();
+      printMethods(methods);
+      if (opt->scene.empty()) {
+        if (!opt->json.empty())
+          writeFileAtomically(opt->json, nlohmann::ordered_json{{"methods", methods}}.dump(2) + "\n");
+        return;
+      }
     }
     if (opt->scene.empty()) throw Error("info", "needs a scene (or --methods)");
     const auto [w, h] = parseSize("--size", opt->size);
     Scene scene = loadScene(opt->scene, opt->read.load());
     for (const std::string& note : scene.notes) std::cerr << "note: " << note << "\n";
     opt->contours.apply(scene, -1.0);
-    SectionReport section;
-    applySectionOption(scene, opt->section, &section);
-    // The histogram's view, checked before anything is printed: a bad --view is one line.
+    // The scene's bounds ignore the section (Scene::bounds, like the clip box): the whole scene's, as
+    // without --section and as mfrview's Clip dock spans them. After the cut they would be the boxes
+    // of the cut meshes transformed corner by corner — reaching past the plane (z >= 0 gave -0.675).
+    const Bounds b = scene.bounds();
+    // The histogram's view, checked before anything is printed: a bad --view is one line. Taken
+    // before the cut, so that fit frames the whole scene (Scene::fit ignores the section).
     const std::optional<Camera> histogramView =
         opt->noHistogram ? std::nullopt : std::optional<Camera>(scene.view(opt->view));
+    SectionReport section;
+    applySectionOption(scene, opt->section, &section);
     const bool sectioned = !section.outcomes.empty();
     const auto outcome = [&](std::size_t i) { return sectioned ? section.outcomes[i] : SectionOutcome::kKept; };
     std::vector<SurfaceMeasures> measures;
     for (const Object& o : scene.objects) measures.push_back(measureSurface(*o.mesh, o.transform));
     nlohmann::ordered_json j;
-    const Bounds b = scene.bounds();
     j["scene"] = scene.name;
+    if (opt->methods) j["methods"] = methodsJson();
     j["parts"] = scene.objects.size();
     j["triangles"] = scene.triangleCount();
     j["bounds"] = {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};

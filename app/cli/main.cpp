@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <string>
 
 #include "commands.hpp"
 #include "mfr/error.hpp"
@@ -23,6 +24,20 @@ int main(int argc, char** argv) {
   mfr::cli::addEvaluate(app);
   mfr::cli::addAllocations(app);
   mfr::cli::addProbe(app);
+  // A first word that is no command ("mfr rendr") — CLI11 would only say that a subcommand is
+  // required, without naming the word.
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string commands;
+    bool known = false;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) {
+      commands += (commands.empty() ? "" : ", ") + sub->get_name();
+      known = known || sub->get_name() == argv[1];
+    }
+    if (!known) {
+      std::cerr << "mfr: " << argv[1] << ": unknown command (" << commands << "; see mfr --help)\n";
+      return 2;
+    }
+  }
   try {
     (void)mfr::availableHostMemory();  // a malformed MFR_MEMORY_LIMIT_MIB is refused before any work
     app.parse(argc, argv);

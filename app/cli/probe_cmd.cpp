@@ -70,7 +70,8 @@ void addProbe(CLI::App& app) {
   cmd->add_option("--method,-m", opt->method, "Also a GPU method: which fragments it holds, the colour it draws");
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
   cmd->add_option("--op", opt->op,
-                  "The method's operation, as for render (auto: hybrid for fkb, vkb, dkb, else oit). With hybrid, "
+                  "The method's operation, as for render (auto: hybrid for fkb, vkb, dkb; zthickness for "
+                  "kbuffer-zmerge; else oit). With hybrid, "
                   "each fragment's share under the method's split: the held ones the core, the rest the tail")
       ->capture_default_str();
   CLI::Option* thicknessGiven =
@@ -112,9 +113,9 @@ void addProbe(CLI::App& app) {
     opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
+    const Camera camera = scene.view(opt->view);  // before the cut: fit frames the whole scene
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
-    const Camera camera = scene.view(opt->view);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);
     // What the method (or, without one, the oracle) does with the lists: hybrid and volume are taken apart.
     const std::string operation = effectiveOperation(req.operation, info, scene.hasVisibleVolume());

@@ -38,7 +38,8 @@ void addRender(CLI::App& app) {
   cmd->add_option("scene", opt->scene, "Scene: model file, .mfrscene, or @sample")->required();
   cmd->add_option("--method,-m", opt->method, "Construction method (see mfr info --methods)")->capture_default_str();
   cmd->add_option("--op", opt->op,
-                  "Operation on the sorted lists: auto (the method's own: hybrid for fkb, vkb, dkb, optimal-k; else "
+                  "Operation on the sorted lists: auto (the method's own: hybrid for fkb, vkb, dkb, optimal-k; "
+                  "zthickness for kbuffer-zmerge; else "
                   "oit), oit, hybrid, csg (the scene's CSG tree, opaque; oracle and the A-buffers), zthickness "
                   "(z-thickness blending: surfaces closer than --thickness blend; oracle, A-buffers, k-buffers), "
                   "volume (the scene's volume ray-marched between the sorted surfaces; auto picks it for a scene "
@@ -100,6 +101,9 @@ void addRender(CLI::App& app) {
     const std::optional<ContourLegend> contourLegend = opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
+    // The view before the cut: fit and orbit:… frame the whole scene (Scene::fit ignores the section),
+    // as mfrview's camera does; sectionedScene's meshes would frame the kept part only.
+    const Camera camera = scene.view(opt->view);
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
     if (opt->shade) {
@@ -130,7 +134,6 @@ void addRender(CLI::App& app) {
         throw Error("--legend", "the image " + opt->size + " is too small for one: at least " +
                                     std::to_string(kMinLegendImageSize) + " pixels a side");
     }
-    const Camera camera = scene.view(opt->view);
     RenderOutput out = render(scene, camera, req);
     if (!opt->dataView.empty()) {
       // n(p): the GPU's count pass for a GPU method, the oracle's lists for the CPU ones; k(p): the

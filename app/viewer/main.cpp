@@ -261,6 +261,15 @@ int main(int argc, char** argv) {
   // Scripted runs must not depend on (or change) what the last interactive session left behind.
   MainWindow window(MainWindow::Options{.restoreSettings = !scripted, .loadPlugins = true});
   ViewerModel& model = window.model();
+  for (const auto& [id, settings] : cl.pluginSettings) {
+    QStringList loaded;
+    for (const PluginRecord& r : window.plugins().records())
+      if (r.plugin) loaded << r.id;
+    if (!loaded.contains(id))
+      fail(QStringLiteral("--plugin-settings %1: no plugin of that id is loaded (loaded: %2)")
+               .arg(id, loaded.isEmpty() ? QStringLiteral("none") : loaded.join(QStringLiteral(", "))),
+           2);
+  }
   if (!cl.windowSize.isEmpty()) window.resize(cl.windowSize);
   if (!cl.method.isEmpty()) {
     if (!model.methodNames().contains(cl.method))

@@ -593,6 +593,9 @@ class ViewerTest : public QObject {
         {"--method", "abuffer-ll", "--view", "iso", "--clip", "-2,-2,-2,0.3,2,0.5"},
         {"--method", "abuffer-ll", "--view", "iso", "--section", "0.1,0,0,1,0.5,0.2"},
         {"--method", "oracle", "--view", "iso", "--section", "-y=0.2:nocaps"},
+        // fit and orbit:… frame the whole scene, cut or not (mfr render framed the kept half).
+        {"--method", "abuffer-ll", "--section", "z=0"},
+        {"--method", "abuffer-ll", "--view", "orbit:30:20", "--section", "z=0"},
     };
     int worst = 0;
     for (const QStringList& c : cases) {
@@ -623,6 +626,9 @@ class ViewerTest : public QObject {
              qPrintable(out));
     QCOMPARE(runProgram(MFRVIEW, {"@sample", "--screenshot", flatPng, "--clip", "1,1,1,0,0,0"}, &out), 2);
     QVERIFY2(out.contains("--clip 1,1,1,0,0,0: min must not exceed max on any axis"), qPrintable(out));
+    // Settings for a plugin that is not there were dropped without a word.
+    QCOMPARE(runProgram(MFRVIEW, {"@sample", "--screenshot", flatPng, "--plugin-settings", "nope={}"}, &out), 2);
+    QVERIFY2(out.contains("--plugin-settings nope: no plugin of that id is loaded (loaded: "), qPrintable(out));
     QVERIFY(!QFile::exists(flatPng));
     for (const char* method : {"abuffer-ll", "oracle"}) {
       QCOMPARE(runProgram(MFRVIEW, {flat, "--screenshot", flatPng, "--size", "64x64", "--method", method}, &out), 1);
@@ -1143,8 +1149,9 @@ class ViewerTest : public QObject {
     const mfr::ImageRGBA8 fire = w->view().renderImage(m.renderSize());
     qInfo("fire: frame quality RMSE %.6f (against the old transfer function's oracle %.6f)", m.frameQuality().rmse,
           mfr::rmse(oldOracle, fire));
+    // Measured against the new oracle: against the old one the same frame is > 0.01 off (both
+    // values are the surfaces' edge pixels alone, so they may equal the first frame's).
     QVERIFY(m.frameQuality().rmse < 0.002);
-    QVERIFY(m.frameQuality().rmse != quality);
     QVERIFY(std::abs(m.frameQuality().rmse - mfr::rmse(oracle("volume", m.renderSize()), fire)) < 1e-9);
     QVERIFY(mfr::rmse(oldOracle, fire) > 0.01);
 

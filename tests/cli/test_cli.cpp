@@ -75,6 +75,52 @@ TEST_F(Cli, SceneFileFlagsAndHugeNumbersNameTheFileAndKey) {
   }
 }
 
+// A misspelt key was dropped without a word: "colour" drew the part in the default colour, a
+// view's "fovy_degrees" at 45°, a transform's "translate" beside "matrix" nowhere.
+TEST_F(Cli, SceneFileKeysThatMeanNothingAreRefused) {
+  const std::string sphere = R"({"primitive": {"type": "sphere"})";
+  for (const auto& [json, mention] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"objects": [)" + sphere + R"(, "colour": [1, 0, 0]}]})",
+            "objects[0].colour: unknown key (expected name, file, primitive, transform, color, opacity, visible, "
+            "molecule, color_by)"},
+           {R"({"objetcs": [)" + sphere + "}]}", "objetcs: unknown key (expected name, background, sample,"},
+           {R"({"objects": [{"primitive": {"type": "sphere", "radious": 2}}]})",
+            "objects[0].primitive.radious: unknown key (expected type, radius, slices, stacks)"},
+           {R"({"objects": [{"primitive": {"type": "box", "radius": 2}}]})",
+            "objects[0].primitive.radius: unknown key (expected type, size)"},
+           {R"({"objects": [)" + sphere + R"(, "transform": {"translate": [1, 0, 0], "rotation": [0, 90, 0]}}]})",
+            "objects[0].transform.rotation: unknown key"},
+           {R"({"objects": [)" + sphere +
+                R"(, "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], "translate": [1, 0, 0]}}]})",
+            "objects[0].transform.translate: not with 'matrix'"},
+           {R"({"objects": [)" + sphere + R"(, "transform": {"rotate": {"axis": [0, 1, 0], "angle": 90}}}]})",
+            "objects[0].transform.rotate.angle: unknown key (expected axis, degrees)"},
+           {R"({"objects": [)" + sphere + R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "fovy_degrees": 20}]})",
+            "views[0].fovy_degrees: unknown key"},
+           {R"({"objects": [)" + sphere + R"(}], "clip": {"min": [0, 0, 0], "max": [1, 1, 1], "caps": true}})",
+            "clip.caps: unknown key (expected min, max)"},
+           {R"({"objects": [)" + sphere + R"(}], "section": {"point": [0, 0, 0], "normal": [0, 0, 1], "cap": false}})",
+            "section.cap: unknown key (expected point, normal, caps, slice)"},
+           {R"({"objects": [)" + sphere + R"(, "color_by": {"field": "x", "colormap": "magma"}}]})",
+            "objects[0].color_by.colormap: unknown key (expected field, map, range)"}}) {
+    SCOPED_TRACE(json);
+    const fs::path p = write("keys.mfrscene", json);
+    expectCleanFailure("render " + p.string() + " --size 16x16", "keys.mfrscene: " + mention);
+  }
+  // Every key the format documents still reads (docs/scene-format.md).
+  const fs::path ok = write("ok.mfrscene", R"({"name": "n", "background": [1, 1, 1], "objects": [
+      {"name": "s", "primitive": {"type": "sphere", "radius": 1, "slices": 16, "stacks": 8}, "color": [1, 0, 0],
+       "opacity": 0.5, "visible": true, "transform": {"translate": [0, 0, 0], "rotate": {"axis": [0, 1, 0],
+       "degrees": 10}, "scale": 1}},
+      {"primitive": {"type": "torus", "major_radius": 1, "minor_radius": 0.2, "major_segments": 16,
+       "minor_segments": 8}, "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}}],
+    "views": [{"name": "v", "eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "projection": "perspective",
+               "fovy": 40, "fit": true}],
+    "clip": {"min": [-5, -5, -5], "max": [5, 5, 5]},
+    "section": {"point": [0, 0, 0], "normal": [0, 0, 1], "caps": true, "slice": false}})");
+  EXPECT_EQ(runCli("render " + ok.string() + " --size 16x16 -o " + (dir() / "ok.png").string()).exitCode, 0);
+}
+
 TEST_F(Cli, EmptyScene) {
   const fs::path p = write("empty.mfrscene", R"({"objects": []})");
   expectCleanFailure("render " + p.string(), "nothing to render");
@@ -87,6 +133,12 @@ TEST_F(Cli, UnknownPrimitiveNamesTheJsonPath) {
 
 TEST_F(Cli, UnknownMethod) {
   expectCleanFailure("render @sample --method magic", "--method magic: unknown method");
+  // An unknown command is named (CLI11 said only that a subcommand is required).
+  const CliResult r = runCli("rendr @sample");
+  EXPECT_EQ(r.exitCode, 2) << r.out;
+  EXPECT_EQ(r.out,
+            "mfr: rendr: unknown command (render, compare, info, bench, dataset, train, evaluate, allocations, "
+            "probe; see mfr --help)\n");
 }
 
 TEST_F(Cli, ZeroSizeImage) {
@@ -265,12 +317,54 @@ TEST_F(Cli, BenchRowsAndOrders) {
   EXPECT_FALSE(fs::exists(json));
 }
 
+// A bad spec anywhere in --methods is one line before any work: it used to come after the
+// oracle's image and the table's head.
+TEST_F(Cli, BenchRefusesBadSpecsBeforeAnyWork) {
+  for (const auto& [methods, mention] : std::vector<std::pair<std::string, std::string>>{
+           {"abuffer-ll,bogus", "mfr: --methods bogus: unknown method (available: abuffer-ll, "},
+           {"abuffer-ll,kplus-array:kk=3", "mfr: --param kk: not a parameter of kplus-array"},
+           {"abuffer-ll:op=magic", "mfr: --op magic: unknown operation"},
+           {"oracle", "mfr: --methods oracle: the CPU reference, not a GPU method"}}) {
+    const CliResult r = runCli("bench @sample -s 16x16 -r 1 --methods " + methods);
+    EXPECT_EQ(r.exitCode, 1) << methods << ": " << r.out;
+    EXPECT_EQ(r.out, r.out.substr(0, r.out.find('\n') + 1)) << "more than one line: " << r.out;
+    EXPECT_NE(r.out.find(mention), std::string::npos) << r.out;
+  }
+}
+
 TEST_F(Cli, InfoReportsTrianglesAndHistogram) {
   const CliResult r = runCli("info @quads:7 --size 32x32 --view front");
   ASSERT_EQ(r.exitCode, 0) << r.out;
   EXPECT_NE(r.out.find("parts      7"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("triangles  28"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("n=7: 1024 pixels"), std::string::npos) << r.out;  // every pixel has 7 layers
+}
+
+// `info --methods`: every method -m takes, where it runs and its parameters, as text and JSON
+// (--json wrote nothing without a scene; the text was bare names).
+TEST_F(Cli, InfoListsMethodsWithTheirParameters) {
+  const fs::path json = dir() / "methods.json";
+  const CliResult r = runCli("info --methods --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("oracle  (cpu) "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("kplus-array  (gpu) "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("    -p k=8 (1..256), sync=spinlock (spinlock|interlock)"), std::string::npos) << r.out;
+  ASSERT_TRUE(fs::exists(json));
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  std::map<std::string, nlohmann::json> byName;
+  for (const auto& m : j.at("methods")) byName[m.at("name").get<std::string>()] = m;
+  for (const char* name : {"oracle", "abuffer-ll", "kplus-array", "fkb", "vkb", "dkb", "optimal-k", "wboit"})
+    EXPECT_TRUE(byName.contains(name)) << name;
+  EXPECT_EQ(byName["oracle"]["runs_on"], "cpu");
+  EXPECT_EQ(byName["optimal-k"]["runs_on"], "cpu");
+  EXPECT_EQ(byName["abuffer-ll"]["runs_on"], "gpu");
+  EXPECT_EQ(byName["vkb"]["operation"], "hybrid");
+  const nlohmann::json& k = byName["kplus-array"]["params"][0];
+  EXPECT_EQ(k["name"], "k");
+  EXPECT_EQ(k["default"], "8");
+  EXPECT_EQ(k["range"], nlohmann::json::array({1.0, 256.0}));
+  EXPECT_EQ(byName["wboit"]["params"][1]["choices"], nlohmann::json::array({"r8", "r16f"}));
 }
 
 // Each part's area and, when it is closed, the volume it encloses — in the world (the transform's
@@ -328,6 +422,10 @@ TEST_F(Cli, InfoMeasuresPartsAsTheSectionCutsThem) {
   EXPECT_EQ(j["part_list"][2]["section"], "removed");
   EXPECT_TRUE(j["part_list"][2]["area"].is_null());
   EXPECT_TRUE(j["part_list"][2]["volume"].is_null());
+  // The scene's bounds, as without the section (they were the cut meshes': the removed box gone,
+  // max z 0.5), which is what --clip and the viewer's Clip dock take.
+  EXPECT_EQ(j["bounds"]["max"][2], 10.5);
+  EXPECT_EQ(j["bounds"]["min"][2], -1.5);
 
   // The scene file's own section, and "none" to measure the whole parts.
   const fs::path sectioned =
@@ -574,9 +672,11 @@ TEST_F(Cli, MoreMemoryThanThereIsIsRefused) {
   refused("compare " + blankA.string() + " " + blankB.string() + " --metric flip",
           "flip: FLIP of 4096x2048 pixels would take 480 MiB more memory");
   // llvmpipe's buffers are main memory; a hardware driver answers GL_OUT_OF_MEMORY itself.
+  const CliResult small = runCli("bench @sample -m abuffer-ll -s 8x8 --no-quality -r 1 --warmup 0");
+  ASSERT_EQ(small.exitCode, 0) << small.out;
   const CliResult bench =
       mfr::test::runCommand(limit + MFR_CLI + " bench @sample -m abuffer-ll -s 4096x4096 --no-quality -r 1 --warmup 0");
-  if (bench.out.find("renderer: llvmpipe") != std::string::npos) {
+  if (small.out.find("renderer: llvmpipe") != std::string::npos) {
     EXPECT_EQ(bench.exitCode, 1) << bench.out;
     EXPECT_NE(bench.out.find("mfr: OpenGL: a GPU buffer of the software rasteriser (in main memory) would take"),
               std::string::npos)

@@ -335,6 +335,20 @@ TEST_F(LoadModel, GarbageGlb) {
   expectLoadError(write("garbage.glb", "glTF but not really, just text\n"), "cannot read glb");
 }
 
+// A binary glTF cut short (a broken download): assimp said only "no suitable reader found".
+TEST_F(LoadModel, TruncatedGlbSaysSo) {
+  std::string glb = "glTF";
+  const auto word = [&](std::uint32_t v) { glb.append(reinterpret_cast<const char*>(&v), 4); };
+  word(2);
+  word(1000);  // total length
+  const std::string json = R"({"asset": {"version": "2.0"}})";
+  word(static_cast<std::uint32_t>(json.size()));
+  word(0x4E4F534Au);  // "JSON"
+  glb += json;
+  expectLoadError(write("cut.glb", glb), "cut.glb: truncated binary glTF (" + std::to_string(glb.size()) +
+                                             " of the 1000 bytes its header gives)");
+}
+
 // assimp parses glTF's JSON recursively: 200,000 nested arrays overflowed the stack (signal 11).
 // Refused before the import, as .gltf and as a .glb's JSON chunk; brackets inside strings do not count.
 TEST_F(LoadModel, DeeplyNestedGltfJsonIsRefusedNotACrash) {

@@ -5,10 +5,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <mutex>
+#include <system_error>
 #include <iterator>
 #include <streambuf>
 #include <set>
@@ -188,6 +190,16 @@ void checkGltfJsonDepth(const std::filesystem::path& path, const std::string* co
   }
   if (extension == ".glb" || json.substr(0, 4) == "glTF") {
     if (json.size() < 20) return;  // assimp says what is wrong with it
+    // The header's total length against the file's: a cut-off download, which assimp reports only
+    // as "no suitable reader found".
+    std::uint32_t version = 0, total = 0;
+    std::memcpy(&version, json.data() + 4, sizeof version);
+    std::memcpy(&total, json.data() + 8, sizeof total);
+    std::error_code error;
+    const std::uintmax_t size = contents != nullptr ? contents->size() : std::filesystem::file_size(path, error);
+    if (json.substr(0, 4) == "glTF" && version == 2 && !error && size < total)
+      throw Error(name, "truncated binary glTF (" + std::to_string(size) + " of the " + std::to_string(total) +
+                            " bytes its header gives)");
     std::uint32_t length = 0;
     std::memcpy(&length, json.data() + 12, sizeof length);  // little-endian, as every host mfr builds on
     json = json.substr(20, length);

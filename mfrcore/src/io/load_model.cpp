@@ -146,9 +146,12 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
     const std::string ext = path.extension().string();
     if (gz)
       throw Error(name, "unsupported compressed file type: name it after its contents, e.g. model.ply.gz");
-    throw Error(name, "unsupported file type '" + (ext.empty() ? path.filename().string() : lower(ext)) +
-                          "' (supported: .stl .ply .obj .off .vtp .vtk .step .stp .glb .gltf and the other formats "
-                          "assimp reads, .pdb .ent .cif .mmcif molecules, optionally gzip-compressed as .gz)");
+    throw Error(
+        name,
+        "unsupported file type '" + (ext.empty() ? path.filename().string() : lower(ext)) +
+            "' (supported: .stl .ply .obj .off .vtp .vtk .step .stp .glb .gltf and the other formats "
+            "assimp reads, .pdb .ent .cif .mmcif molecules, optionally gzip-compressed as .gz; volumes: .vti .vtk "
+            ".mha .mhd .nrrd .nhdr .inr(.gz) .vdb, InVesalius .inv3; scenes: .mfrscene)");
   }
   const auto& [ext, format] = *found;
   // The part name of single-object formats: the file name without its extension(s).

@@ -73,7 +73,7 @@ void DepthPeelingFrontToBack::capture(const FrameContext&) { stats_ = Stats{}; }
 void DepthPeelingFrontToBack::resolve(const FrameContext& ctx, const Operation& op) {
   const bool dump = op.name == "dump";
   if (!dump && op.name != "oit")
-    throw Error("--op " + op.name, "peel-f2b composites while it peels: it supports the operations oit and dump only");
+    throw Error("--op " + op.name, "peel-f2b composites while it peels: it supports only the operation oit");
   const gl::Program* dumpProgram = nullptr;
   if (dump) {
     dumpProgram = &dumpPrograms_.get("peel-f2b", op, {}, "dump.screen.frag");

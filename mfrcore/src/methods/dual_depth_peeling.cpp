@@ -90,7 +90,7 @@ void DualDepthPeeling::capture(const FrameContext&) { stats_ = Stats{}; }
 void DualDepthPeeling::resolve(const FrameContext& ctx, const Operation& op) {
   const bool dump = op.name == "dump";
   if (!dump && op.name != "oit")
-    throw Error("--op " + op.name, "peel-dual composites while it peels: it supports the operations oit and dump only");
+    throw Error("--op " + op.name, "peel-dual composites while it peels: it supports only the operation oit");
   const gl::Program* dumpProgram = nullptr;
   if (dump) {
     dumpProgram = &dumpPrograms_.get("peel-dual", op, {}, "dump.screen.frag");

@@ -1,6 +1,7 @@
 #include "k_peeling.hpp"
 
 #include <algorithm>
+#include <vector>
 
 #include "common/bindings.h"
 #include "mfr/error.hpp"
@@ -97,13 +98,23 @@ void KPeeling::capture(const FrameContext& ctx) {
   stats_.fragmentsGenerated = c[0];
   maxCount_ = c[1];
   stats_.passes = 1;
+  // Pixels deeper than max_iterations · k keep only their nearest fragments: count them now, before
+  // the resolve reuses the count image as its semaphores.
+  const std::uint64_t reach = static_cast<std::uint64_t>(k_) * maxIterations_;
+  if (maxCount_ > reach) {
+    std::vector<std::uint32_t> counts(static_cast<std::size_t>(width_) * height_);
+    glGetTextureImage(counts_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, static_cast<GLsizei>(4 * counts.size()),
+                      counts.data());
+    stats_.overflowPixels = static_cast<std::uint64_t>(
+        std::count_if(counts.begin(), counts.end(), [&](std::uint32_t n) { return n > reach; }));
+  }
 }
 
 void KPeeling::resolve(const FrameContext& ctx, const Operation& op) {
   const bool carry = op.name == "oit";
   if (!carry && op.name != "dump")
-    throw Error("--op " + op.name, "kpeel composites between its peeling iterations and supports the oit and dump "
-                                   "operations only");
+    throw Error("--op " + op.name,
+                "kpeel composites between its peeling iterations: it supports only the operation oit");
   const std::uint64_t pixels = static_cast<std::uint64_t>(width_) * height_;
   // Fresh frame state: empty slots; pixel state all zero (no threshold yet, nothing composited,
   // OIT colour 0 and opacity 0); semaphores 0 (the count image is reused as the semaphore image).

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
@@ -71,6 +72,18 @@ class Reader {
     if (!j.is_object()) fail(where, "expected an object");
     return j;
   }
+  // An object with only these keys: a misspelt one ("colour") would otherwise be dropped without a
+  // word and the scene drawn without it.
+  const json& object(const json& j, const std::string& where, std::initializer_list<const char*> keys) const {
+    object(j, where);
+    for (const auto& item : j.items()) {
+      if (std::any_of(keys.begin(), keys.end(), [&](const char* k) { return item.key() == k; })) continue;
+      std::string list;
+      for (const char* k : keys) list += (list.empty() ? "" : ", ") + std::string(k);
+      fail(where == "top level" ? item.key() : where + "." + item.key(), "unknown key (expected " + list + ")");
+    }
+    return j;
+  }
 
  private:
   std::string file_;
@@ -92,8 +105,10 @@ void checkTransform(const Reader& r, const glm::dmat4& m, const std::string& whe
 }
 
 glm::dmat4 parseTransform(const Reader& r, const json& t, const std::string& where) {
-  r.object(t, where);
+  r.object(t, where, {"matrix", "translate", "rotate", "scale"});
   if (t.contains("matrix")) {
+    for (const char* other : {"translate", "rotate", "scale"})
+      if (t.contains(other)) r.fail(where + "." + other, "not with 'matrix' (the matrix is the whole transform)");
     const json& m = t["matrix"];
     if (!m.is_array() || m.size() != 16) r.fail(where + ".matrix", "expected 16 numbers (row-major)");
     glm::dmat4 out(1.0);
@@ -108,6 +123,7 @@ glm::dmat4 parseTransform(const Reader& r, const json& t, const std::string& whe
   if (t.contains("rotate")) {
     const json& rot = t["rotate"];
     if (rot.is_object()) {
+      r.object(rot, where + ".rotate", {"axis", "degrees"});
       const glm::dvec3 axis = r.vec3(rot.value("axis", json::array({0, 0, 1})), where + ".rotate.axis");
       if (glm::length(axis) == 0.0) r.fail(where + ".rotate.axis", "zero axis");
       out = glm::rotate(out, glm::radians(r.number(rot.value("degrees", json(0.0)), where + ".rotate.degrees")),
@@ -133,6 +149,13 @@ glm::dmat4 parseTransform(const Reader& r, const json& t, const std::string& whe
 Mesh parsePrimitive(const Reader& r, const json& p, const std::string& where) {
   r.object(p, where);
   const std::string type = r.string(p, "type", where, "");
+  if (type == "sphere") r.object(p, where, {"type", "radius", "slices", "stacks"});
+  if (type == "box") r.object(p, where, {"type", "size"});
+  if (type == "cylinder") r.object(p, where, {"type", "radius", "height", "slices"});
+  if (type == "torus") r.object(p, where, {"type", "major_radius", "minor_radius", "major_segments", "minor_segments"});
+  if (type == "plane") r.object(p, where, {"type", "width", "height"});
+  if (type == "tube") r.object(p, where, {"type", "path", "radius", "sides"});
+  if (type == "hairball") r.object(p, where, {"type", "radius", "tube_radius", "count", "seed", "segments", "sides"});
   if (type == "sphere")
     return makeSphere(r.positive(p, "radius", where, 1.0), r.integer(p, "slices", where, 48, 3, 4096),
                       r.integer(p, "stacks", where, 24, 2, 4096));
@@ -203,7 +226,7 @@ void parseColorBy(const Reader& r, const json& o, const std::string& where, cons
   if (c.is_string()) {
     field = c.get<std::string>();
   } else {
-    r.object(c, at);
+    r.object(c, at, {"field", "map", "range"});
     field = r.string(c, "field", at, "");
     map = r.string(c, "map", at, map);
     if (c.contains("range")) {
@@ -228,7 +251,7 @@ void parseColorBy(const Reader& r, const json& o, const std::string& where, cons
 }
 
 Camera parseView(const Reader& r, const json& v, const std::string& where, const Bounds& bounds, double radius) {
-  r.object(v, where);
+  r.object(v, where, {"name", "eye", "target", "up", "projection", "fovy", "height", "fit", "near", "far"});
   Camera c;
   if (v.contains("eye")) c.eye = r.vec3(v["eye"], where + ".eye");
   if (v.contains("target")) c.target = r.vec3(v["target"], where + ".target");
@@ -255,7 +278,7 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
 // A volume's "transfer": {"preset", "range", "unit_distance"} or {"points", "unit_distance"}; the
 // defaults (data range, diagonal / 50) come from the loaded volume's defaultTransfer().
 TransferFunction parseTransfer(const Reader& r, const json& t, const std::string& where, const Volume& volume) {
-  r.object(t, where);
+  r.object(t, where, {"preset", "points", "range", "unit_distance"});
   const TransferFunction fallback = volume.transfer;
   const double unitDistance = r.positive(t, "unit_distance", where, fallback.unitDistance);
   if (t.contains("preset") == t.contains("points")) r.fail(where, "needs exactly one of 'preset' or 'points'");
@@ -305,7 +328,8 @@ TransferFunction parseTransfer(const Reader& r, const json& t, const std::string
 
 Volume parseVolume(const Reader& r, const json& j, const std::string& where, const std::filesystem::path& baseDir,
                    const LoadProgress& progress) {
-  const json& v = r.object(j, where);
+  const json& v =
+      r.object(j, where, {"file", "name", "transform", "visible", "shading", "field", "transfer", "contours"});
   if (!v.contains("file")) r.fail(where, "needs 'file' (a volume file)");
   const std::string file = r.string(v, "file", where, "");
   const glm::dmat4 xf =
@@ -454,13 +478,13 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     throw Error(name, "JSON syntax error at line " + std::to_string(line) + ", column " + std::to_string(col));
   }
   const Reader r(name);
-  r.object(doc, "top level");
+  r.object(doc, "top level", {"name", "background", "sample", "objects", "volumes", "views", "csg", "clip", "section"});
   Scene scene;
   scene.name = r.string(doc, "name", "top level", std::filesystem::path(name).stem().string());
   if (doc.contains("background")) scene.background = glm::vec3(r.vec3(doc["background"], "background"));
   if (r.flag(doc, "sample", "top level", false)) scene = makeSampleScene();
   if (doc.contains("clip")) {
-    const json& clip = r.object(doc["clip"], "clip");
+    const json& clip = r.object(doc["clip"], "clip", {"min", "max"});
     if (!clip.contains("min") || !clip.contains("max")) r.fail("clip", "expected \"min\" and \"max\" corners");
     Bounds box;
     box.min = r.vec3(clip["min"], "clip.min");
@@ -469,7 +493,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     scene.clipBox = box;
   }
   if (doc.contains("section")) {
-    const json& section = r.object(doc["section"], "section");
+    const json& section = r.object(doc["section"], "section", {"point", "normal", "caps", "slice"});
     if (!section.contains("point") || !section.contains("normal"))
       r.fail("section", "expected \"point\" and \"normal\"");
     SectionPlane plane;
@@ -510,7 +534,9 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
       const LoadProgress objectProgress = itemProgress(i);
       objectProgress.step(0.0);
       const std::string where = "objects[" + std::to_string(i) + "]";
-      const json& o = r.object(objects[i], where);
+      const json& o =
+          r.object(objects[i], where,
+                   {"name", "file", "primitive", "transform", "color", "opacity", "visible", "molecule", "color_by"});
       const std::string objName = r.string(o, "name", where, "object " + std::to_string(i));
       const glm::dmat4 xf = o.contains("transform") ? parseTransform(r, o["transform"], where + ".transform") : glm::dmat4(1.0);
       const bool visible = r.flag(o, "visible", where, true);
