@@ -113,7 +113,7 @@ void addProbe(CLI::App& app) {
     opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
-    const Camera camera = scene.view(opt->view);  // before the cut: fit frames the whole scene
+    const Camera camera = scene.view(opt->view);  // fit frames the whole scene, cut or not
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);

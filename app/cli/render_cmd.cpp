@@ -101,8 +101,8 @@ void addRender(CLI::App& app) {
     const std::optional<ContourLegend> contourLegend = opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
-    // The view before the cut: fit and orbit:… frame the whole scene (Scene::fit ignores the section),
-    // as mfrview's camera does; sectionedScene's meshes would frame the kept part only.
+    // fit and orbit:… frame the whole scene, cut or not (Scene::fit ignores the section), as
+    // mfrview's camera does.
     const Camera camera = scene.view(opt->view);
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);

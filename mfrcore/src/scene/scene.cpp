@@ -12,6 +12,7 @@
 namespace mfr {
 
 Bounds Scene::bounds() const {
+  if (uncutExtent) return uncutExtent->first;
   Bounds b;
   for (const Object& o : objects) {
     if (!o.visible || !o.mesh) continue;
@@ -30,6 +31,7 @@ Bounds Scene::bounds() const {
 }
 
 double Scene::boundingRadius() const {
+  if (uncutExtent) return uncutExtent->second;
   const glm::dvec3 c = bounds().center();
   double r2 = 0.0;
   for (const Object& o : objects) {

@@ -736,6 +736,7 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
   const glm::dvec3 n(world);
   Scene out = scene;
   out.sectionCut = true;
+  out.uncutExtent = std::pair{scene.bounds(), scene.boundingRadius()};
   SectionReport local;
   local.outcomes.assign(out.objects.size(), SectionOutcome::kKept);
   local.capAreas.assign(out.objects.size(), 0.0);

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -86,6 +87,10 @@ struct Scene {
   // fit() ignore it, like the clip box.
   std::optional<SectionPlane> section;
   bool sectionCut = false;  // the meshes are sectionedScene's: already cut by `section`
+  // sectionedScene's copy keeps the whole scene's bounds() and boundingRadius(), so that its fit,
+  // orbit views and default z-thickness are the uncut scene's, as said above (its cut meshes would
+  // frame the kept part and give a thinner default slab).
+  std::optional<std::pair<Bounds, double>> uncutExtent;
   // What loading could not do as asked but is no error (LoadOptions::notes), one line each.
   std::vector<std::string> notes;
 
