@@ -94,7 +94,7 @@ void addBench(CLI::App& app) {
     opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
-    const Camera camera = scene.view(opt->view);  // before the cut: fit frames the whole scene
+    const Camera camera = scene.view(opt->view);  // fit frames the whole scene, cut or not
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
 

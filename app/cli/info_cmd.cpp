@@ -115,12 +115,10 @@ void addInfo(CLI::App& app) {
     Scene scene = loadScene(opt->scene, opt->read.load());
     for (const std::string& note : scene.notes) std::cerr << "note: " << note << "\n";
     opt->contours.apply(scene, -1.0);
-    // The scene's bounds ignore the section (Scene::bounds, like the clip box): the whole scene's, as
-    // without --section and as mfrview's Clip dock spans them. After the cut they would be the boxes
-    // of the cut meshes transformed corner by corner — reaching past the plane (z >= 0 gave -0.675).
+    // The scene's bounds and the histogram's view ignore the section (Scene::bounds and fit, like
+    // the clip box): the whole scene's, as without --section and as mfrview's Clip dock spans them.
     const Bounds b = scene.bounds();
-    // The histogram's view, checked before anything is printed: a bad --view is one line. Taken
-    // before the cut, so that fit frames the whole scene (Scene::fit ignores the section).
+    // The histogram's view, checked before anything is printed: a bad --view is one line.
     const std::optional<Camera> histogramView =
         opt->noHistogram ? std::nullopt : std::optional<Camera>(scene.view(opt->view));
     SectionReport section;

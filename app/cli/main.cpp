@@ -39,7 +39,12 @@ int main(int argc, char** argv) {
     }
   }
   try {
-    (void)mfr::availableHostMemory();  // a malformed MFR_MEMORY_LIMIT_MIB is refused before any work
+    // A malformed MFR_MEMORY_LIMIT_MIB is refused before any work (not before --help or --version).
+    bool helpOrVersion = false;
+    for (int i = 1; i < argc; ++i)
+      helpOrVersion = helpOrVersion || std::string(argv[i]) == "-h" || std::string(argv[i]) == "--help" ||
+                      std::string(argv[i]) == "--version";
+    if (!helpOrVersion) (void)mfr::availableHostMemory();
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);

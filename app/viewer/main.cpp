@@ -4,6 +4,8 @@
 // libepoxy's header before any of Qt's OpenGL ones (QOpenGLContext), which would bring GL/gl.h.
 #include <epoxy/gl.h>
 
+#include <clocale>
+
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QElapsedTimer>
@@ -237,6 +239,10 @@ int main(int argc, char** argv) {
   QSurfaceFormat::setDefaultFormat(format);
 
   QApplication app(argc, argv);
+  // QApplication takes the user's locale for all of C's categories; mfrcore reads parameters and
+  // scene numbers with std::stod, which under a comma-decimal locale (de_DE) read "0.9" as 0.
+  // Qt's own widgets format numbers by QLocale, which this does not touch.
+  std::setlocale(LC_NUMERIC, "C");
   QApplication::setApplicationName(QStringLiteral("mfrview"));
   QApplication::setOrganizationName(QStringLiteral("mfr"));
   QApplication::setApplicationVersion(QStringLiteral(MFR_VERSION));

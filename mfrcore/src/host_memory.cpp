@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "mfr/error.hpp"
 
@@ -24,6 +25,44 @@ std::optional<std::uint64_t> memAvailable() {
   std::string unit;
   while (in >> key >> kib >> unit)
     if (key == "MemAvailable:") return kib * 1024;
+  return std::nullopt;
+}
+
+// What a container's memory limit leaves (cgroup v2 memory.max − memory.current, or v1's
+// limit_in_bytes − usage_in_bytes, as seen from inside it); nullopt without a limit. MemAvailable is
+// the whole machine's and would let a limited container be killed all the same.
+std::optional<std::uint64_t> cgroupLeft() {
+  const auto read = [](const char* path) -> std::optional<std::uint64_t> {
+    std::ifstream in(path);
+    std::string text;
+    if (!(in >> text) || text.empty() || text[0] < '0' || text[0] > '9') return std::nullopt;  // "max": none
+    return std::strtoull(text.c_str(), nullptr, 10);
+  };
+  // The usage counts the page cache; its inactive part is given back before anything is killed
+  // (what `docker stats` subtracts too).
+  const auto inactiveFile = [](const char* path, const char* key) -> std::uint64_t {
+    std::ifstream in(path);
+    std::string name;
+    std::uint64_t value = 0;
+    while (in >> name >> value)
+      if (name == key) return value;
+    return 0;
+  };
+  struct Files {
+    const char *limit, *usage, *stat, *inactive;
+  };
+  for (const Files& f :
+       {Files{"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current", "/sys/fs/cgroup/memory.stat",
+              "inactive_file"},
+        Files{"/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes",
+              "/sys/fs/cgroup/memory/memory.stat", "total_inactive_file"}}) {
+    const std::optional<std::uint64_t> limit = read(f.limit), usage = read(f.usage);
+    // v1 writes "no limit" as a page-rounded 2^63.
+    if (!limit || !usage || *limit >= (std::uint64_t{1} << 62)) continue;
+    const std::uint64_t inactive = inactiveFile(f.stat, f.inactive);
+    const std::uint64_t used = *usage > inactive ? *usage - inactive : 0;
+    return *limit > used ? *limit - used : 0;
+  }
   return std::nullopt;
 }
 
@@ -63,6 +102,7 @@ struct Available {
 
 Available available() {
   Available a{memAvailable()};
+  if (const std::optional<std::uint64_t> left = cgroupLeft()) a.bytes = a.bytes ? std::min(*a.bytes, *left) : *left;
   if (const std::optional<std::uint64_t> limit = environmentLimit()) {
     const std::uint64_t used = residentBytes().value_or(0);
     const std::uint64_t left = limit > used ? *limit - used : 0;

@@ -638,6 +638,34 @@ class ViewerTest : public QObject {
     }
   }
 
+  // Under a comma-decimal locale (de_DE), QApplication's setlocale made mfrcore's std::stod read
+  // "0.9" as 0: mboit's overestimation=0.9 bias=0.3 drew the image of 0 and 0 (RMSE 0.054 from
+  // mfr render's). The locale is built with localedef into a temporary folder (LOCPATH).
+  void viewerReadsNumbersInAnyLocale() {
+    QTemporaryDir dir;
+    QString out;
+    QCOMPARE(runProgram(QStringLiteral("localedef"), {"-i", "de_DE", "-f", "UTF-8", dir.filePath("de_DE.UTF-8")}, &out),
+             0);
+    const QStringList common{"--size", "96x72", "--method", "mboit", "-p", "overestimation=0.9", "-p", "bias=0.3"};
+    const QString viewerPng = dir.filePath("viewer.png"), cliPng = dir.filePath("cli.png"),
+                  plainPng = dir.filePath("plain.png");
+    QProcess viewer;
+    QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+    env.insert("LOCPATH", dir.path());
+    env.insert("LC_ALL", "de_DE.UTF-8");
+    viewer.setProcessEnvironment(env);
+    viewer.setProcessChannelMode(QProcess::MergedChannels);
+    viewer.start(MFRVIEW, QStringList{"@sample", "--screenshot", viewerPng} + common);
+    QVERIFY(viewer.waitForFinished(kTimeoutMs));
+    QVERIFY2(viewer.exitCode() == 0, viewer.readAll().constData());
+    QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@sample", "-o", cliPng} + common, &out), 0);
+    QCOMPARE(runProgram(MFR_CLI, {"render", "@sample", "-o", plainPng, "--size", "96x72", "--method", "mboit"}, &out),
+             0);
+    const mfr::ImageRGBA8 v = mfr::readPng(viewerPng.toStdString()), c = mfr::readPng(cliPng.toStdString());
+    QVERIFY(maxChannelDifference(v, c) >= 0 && maxChannelDifference(v, c) <= 1);
+    QVERIFY(maxChannelDifference(c, mfr::readPng(plainPng.toStdString())) > 8);  // the parameters show
+  }
+
   // Operation "csg" on the built-in CSG sample: the viewer's screenshot equals mfr render's, and
   // the frame's quality is measured against the oracle's CSG image (against its "over" image the
   // opaque drilled block would be far off).

@@ -108,17 +108,35 @@ TEST_F(Cli, SceneFileKeysThatMeanNothingAreRefused) {
     expectCleanFailure("render " + p.string() + " --size 16x16", "keys.mfrscene: " + mention);
   }
   // Every key the format documents still reads (docs/scene-format.md).
-  const fs::path ok = write("ok.mfrscene", R"({"name": "n", "background": [1, 1, 1], "objects": [
+  {
+    std::ofstream grid(dir() / "ramp.vtk");
+    grid << "# vtk DataFile Version 3.0\nramp\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 5 5 5\n"
+            "ORIGIN -1 -1 -1\nSPACING 0.5 0.5 0.5\nPOINT_DATA 125\nSCALARS ramp float 1\nLOOKUP_TABLE default\n";
+    for (int i = 0; i < 125; ++i) grid << i % 5 << "\n";
+  }
+  const fs::path ok = write("ok.mfrscene", R"({"name": "n", "background": [1, 1, 1], "sample": false, "objects": [
       {"name": "s", "primitive": {"type": "sphere", "radius": 1, "slices": 16, "stacks": 8}, "color": [1, 0, 0],
        "opacity": 0.5, "visible": true, "transform": {"translate": [0, 0, 0], "rotate": {"axis": [0, 1, 0],
-       "degrees": 10}, "scale": 1}},
+       "degrees": 10}, "scale": 1}, "color_by": {"field": "@v", "map": "magma", "range": [0, 4]}},
       {"primitive": {"type": "torus", "major_radius": 1, "minor_radius": 0.2, "major_segments": 16,
-       "minor_segments": 8}, "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}}],
+       "minor_segments": 8}, "transform": {"matrix": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}},
+      {"primitive": {"type": "tube", "path": [[0, 0, 0], [1, 1, 1]], "radius": 0.1, "sides": 8}}],
+    "volumes": [{"file": "ramp.vtk", "name": "v", "field": "ramp", "visible": true, "shading": false,
+                 "transform": {"scale": 1}, "transfer": {"preset": "fire", "range": [0, 4], "unit_distance": 1},
+                 "contours": {"values": [2], "opacity": 0.4}}],
     "views": [{"name": "v", "eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "projection": "perspective",
-               "fovy": 40, "fit": true}],
+               "fovy": 40, "fit": true},
+              {"name": "o", "eye": [0, 5, 0], "up": [0, 0, -1], "projection": "orthographic", "height": 3,
+               "near": 0.1, "far": 20}],
     "clip": {"min": [-5, -5, -5], "max": [5, 5, 5]},
     "section": {"point": [0, 0, 0], "normal": [0, 0, 1], "caps": true, "slice": false}})");
   EXPECT_EQ(runCli("render " + ok.string() + " --size 16x16 -o " + (dir() / "ok.png").string()).exitCode, 0);
+  // "sample": true no longer replaces the file's own name and background.
+  const fs::path sample = write("mine.mfrscene", R"({"name": "mine", "background": [0, 0, 0], "sample": true})");
+  const mfr::ImageRGBA8 image = renderedPng("render " + sample.string() + " --size 16x16", "mine.png");
+  ASSERT_FALSE(image.empty());
+  EXPECT_EQ(image.at(0, 0)[0], 0);  // a corner of the background: black, not the sample's white
+  EXPECT_NE(runCli("info " + sample.string() + " --no-histogram").out.find("scene      mine\n"), std::string::npos);
 }
 
 TEST_F(Cli, EmptyScene) {
@@ -670,7 +688,7 @@ TEST_F(Cli, MoreMemoryThanThereIsIsRefused) {
   mfr::writePng(blankA, blank);
   mfr::writePng(blankB, blank);
   refused("compare " + blankA.string() + " " + blankB.string() + " --metric flip",
-          "flip: FLIP of 4096x2048 pixels would take 480 MiB more memory");
+          "flip: FLIP of 4096x2048 pixels would take 512 MiB more memory");
   // llvmpipe's buffers are main memory; a hardware driver answers GL_OUT_OF_MEMORY itself.
   const CliResult small = runCli("bench @sample -m abuffer-ll -s 8x8 --no-quality -r 1 --warmup 0");
   ASSERT_EQ(small.exitCode, 0) << small.out;

@@ -9,7 +9,8 @@
 
 namespace mfr {
 
-// Bytes this process can still touch without swapping: Linux's MemAvailable (/proc/meminfo), and
+// Bytes this process can still touch without swapping: Linux's MemAvailable (/proc/meminfo), at
+// most what a container's cgroup memory limit leaves, and
 // where the environment sets MFR_MEMORY_LIMIT_MIB, at most that limit less this process's resident
 // memory. nullopt where neither is known (no /proc): nothing is refused then.
 std::optional<std::uint64_t> availableHostMemory();

@@ -103,6 +103,7 @@ void KPeeling::capture(const FrameContext& ctx) {
   const std::uint64_t reach = static_cast<std::uint64_t>(k_) * maxIterations_;
   if (maxCount_ > reach) {
     std::vector<std::uint32_t> counts(static_cast<std::size_t>(width_) * height_);
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);  // the count pass wrote it with image atomics
     glGetTextureImage(counts_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, static_cast<GLsizei>(4 * counts.size()),
                       counts.data());
     stats_.overflowPixels = static_cast<std::uint64_t>(

@@ -447,11 +447,11 @@ FlipResult flip(const ImageRGBA8& reference, const ImageRGBA8& test, double pixe
   if (!(pixelsPerDegree > 0.0) || !std::isfinite(pixelsPerDegree)) {
     throw Error("flip", "pixels per degree must be positive and finite, got " + std::to_string(pixelsPerDegree));
   }
-  // Float planes at the peak, in the colour pass: each image's three YCxCz planes and four planes
-  // filtered along x, and the pass's output.
+  // Float planes at the peak, in the colour pass: the error map, each image's three YCxCz planes
+  // and four planes filtered along x, and the pass's output.
   requireHostMemory(
       "flip", "FLIP of " + std::to_string(reference.width) + "x" + std::to_string(reference.height) + " pixels",
-      static_cast<std::uint64_t>(reference.width) * static_cast<std::uint64_t>(reference.height) * 15 * sizeof(float));
+      static_cast<std::uint64_t>(reference.width) * static_cast<std::uint64_t>(reference.height) * 16 * sizeof(float));
   FlipResult result;
   result.errorMap = ImageF(reference.width, reference.height, 1);
   if (reference.empty()) return result;

@@ -716,8 +716,9 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     }
     // Every 64 MiB of rows, ask whether the lists cast so far could still be copied into one
     // array at the end (below); if not, stop now rather than after casting the rest.
+    out.shrink_to_fit();  // growth left up to twice the row's fragments allocated
     constexpr std::size_t kCheckEvery = std::size_t{64} << 20;
-    const std::size_t rowBytes = out.capacity() * sizeof(Fragment);
+    const std::size_t rowBytes = out.size() * sizeof(Fragment);
     const std::size_t cast = castBytes.fetch_add(rowBytes) + rowBytes;
     if (uncheckedBytes.fetch_add(rowBytes) + rowBytes >= kCheckEvery) {
       uncheckedBytes = 0;

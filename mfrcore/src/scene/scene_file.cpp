@@ -479,10 +479,10 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
   }
   const Reader r(name);
   r.object(doc, "top level", {"name", "background", "sample", "objects", "volumes", "views", "csg", "clip", "section"});
-  Scene scene;
+  // The sample first, so that the file's own name and background replace the sample's.
+  Scene scene = r.flag(doc, "sample", "top level", false) ? makeSampleScene() : Scene();
   scene.name = r.string(doc, "name", "top level", std::filesystem::path(name).stem().string());
   if (doc.contains("background")) scene.background = glm::vec3(r.vec3(doc["background"], "background"));
-  if (r.flag(doc, "sample", "top level", false)) scene = makeSampleScene();
   if (doc.contains("clip")) {
     const json& clip = r.object(doc["clip"], "clip", {"min", "max"});
     if (!clip.contains("min") || !clip.contains("max")) r.fail("clip", "expected \"min\" and \"max\" corners");
