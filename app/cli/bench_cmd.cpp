@@ -77,7 +77,9 @@ void addBench(CLI::App& app) {
                     "a CPU method, not a GPU one: bench times the GPU methods (optimal-k "
                     "runs in mfr evaluate and mfr render)");
       if (req.method == "oracle")
-        throw Error("--methods " + spec, "the CPU reference, not a GPU method: bench measures every row against it");
+        throw Error("--method oracle",
+                    "the CPU reference, not a GPU method: it cannot be used here (mfr bench "
+                    "measures every row against it)");  // createMethod's words
       // The whole spec before any work, so that a typo costs no oracle and prints no half table.
       const MethodInfo* info = findMethodInfo(req.method);
       if (!info) {

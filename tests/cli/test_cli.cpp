@@ -342,7 +342,7 @@ TEST_F(Cli, BenchRefusesBadSpecsBeforeAnyWork) {
            {"abuffer-ll,bogus", "mfr: --methods bogus: unknown method (available: abuffer-ll, "},
            {"abuffer-ll,kplus-array:kk=3", "mfr: --param kk: not a parameter of kplus-array"},
            {"abuffer-ll:op=magic", "mfr: --op magic: unknown operation"},
-           {"oracle", "mfr: --methods oracle: the CPU reference, not a GPU method"}}) {
+           {"oracle", "mfr: --method oracle: the CPU reference, not a GPU method"}}) {
     const CliResult r = runCli("bench @sample -s 16x16 -r 1 --methods " + methods);
     EXPECT_EQ(r.exitCode, 1) << methods << ": " << r.out;
     EXPECT_EQ(r.out, r.out.substr(0, r.out.find('\n') + 1)) << "more than one line: " << r.out;
