@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <utility>
 
@@ -90,10 +89,6 @@ std::optional<std::uint64_t> environmentLimit() {
   if (errno != 0 || *end != '\0' || mib == 0 || mib > (UINT64_MAX >> 20)) throw refuse();
   return static_cast<std::uint64_t>(mib) << 20;
 }
-
-}  // namespace
-
-namespace {
 
 struct Available {
   std::optional<std::uint64_t> bytes;
