@@ -269,6 +269,25 @@ std::vector<std::uint32_t> toGlRows(const std::vector<std::uint32_t>& image, int
   return gl;
 }
 
+// Renders `req` once to set the method up, then again keeping its per-pixel maps: the method and
+// that frame's n(p) and m(p) (GL rows). method is null when it is not a variable k-buffer.
+struct CountsAndRuns {
+  VariableKBuffer* method = nullptr;
+  std::vector<std::uint32_t> n, m;
+};
+CountsAndRuns countsAndRuns(GpuRenderer& gpu, const Camera& camera, const RenderRequest& req) {
+  gpu.render(camera, req);
+  CountsAndRuns out;
+  out.method = dynamic_cast<VariableKBuffer*>(gpu.method());
+  if (out.method == nullptr) return out;
+  out.method->setKeepImportance(true);
+  gpu.render(camera, req);
+  out.n = out.method->lastCounts();
+  out.m = out.method->lastTailRuns();
+  out.method->setKeepImportance(false);
+  return out;
+}
+
 // With tail_runs, the GPU finds the oracle's final runs m(p), and a budget of Σ max(1, n − m)
 // slots gives every pixel k = max(1, n − m) and the exact image; the bound max(1, n − 1) alone
 // leaves that budget short of exact.
@@ -280,14 +299,8 @@ TEST_P(VariableK, TailRunsMakeOneColourTailsFree) {
   GpuRenderer gpu;
   gpu.setScene(scene);
   const VariableKLayout layout = variableKLayout(pixels(), memberFixed(GetParam()));
-  RenderRequest probe = budgetRequest(GetParam(), layout.bytes(pixels()));
-  gpu.render(camera, probe);
-  auto* method = dynamic_cast<VariableKBuffer*>(gpu.method());
+  const auto [method, n, m] = countsAndRuns(gpu, camera, budgetRequest(GetParam(), layout.bytes(pixels())));
   ASSERT_NE(method, nullptr);
-  method->setKeepImportance(true);
-  gpu.render(camera, probe);
-  const std::vector<std::uint32_t> n = method->lastCounts(), m = method->lastTailRuns();
-  method->setKeepImportance(false);
   ASSERT_EQ(m.size(), n.size());
   // m(p) on the GPU = the oracle's, wherever the two see the same list length.
   const std::vector<std::uint32_t> oracleN = toGlRows(oracle.counts(), kW, kH);
@@ -377,14 +390,9 @@ TEST(VariableKRealParts, TailRunsMatchTheOracle) {
   const FragmentLists oracle = castFragments(scene, camera, kW, kH);
   GpuRenderer gpu;
   gpu.setScene(scene);
-  RenderRequest req = budgetRequest("vkb", variableKLayout(pixels(), 0).bytes(pixels()));
-  gpu.render(camera, req);
-  auto* method = dynamic_cast<VariableKBuffer*>(gpu.method());
+  const auto [method, n, m] =
+      countsAndRuns(gpu, camera, budgetRequest("vkb", variableKLayout(pixels(), 0).bytes(pixels())));
   ASSERT_NE(method, nullptr);
-  method->setKeepImportance(true);
-  gpu.render(camera, req);
-  const std::vector<std::uint32_t> n = method->lastCounts(), m = method->lastTailRuns();
-  method->setKeepImportance(false);
   ASSERT_EQ(m.size(), n.size());
   const std::vector<std::uint32_t> oracleN = toGlRows(oracle.counts(), kW, kH);
   const std::vector<std::uint32_t> oracleM = toGlRows(tailRunLengths(oracle), kW, kH);
