@@ -2,12 +2,18 @@
 // reported by file and line, injected defines, pass timers.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdlib>
+#include <fstream>
+#include <string_view>
+
+#include <unistd.h>
 #include <filesystem>
 #include <iostream>
 
 #include "gl_fixture.hpp"
 #include "mfr/error.hpp"
+#include "mfr/gl/objects.hpp"
 #include "mfr/gl/program.hpp"
 #include "mfr/gl/timer.hpp"
 #include "test_files.hpp"
@@ -114,6 +120,44 @@ TEST(GlInfrastructure, PassTimerReportsEveryPassInOrder) {
     EXPECT_EQ(passes[1].first, "b");
     for (const auto& [name, ms] : passes) EXPECT_TRUE(ms >= 0.0 && ms < 10000.0) << name << " " << ms;
   }
+}
+
+// llvmpipe's buffers and textures are main memory, checked against what is available before each
+// allocation (gl/objects.cpp). The checks add up because llvmpipe zero-fills storage when it is
+// created: the first allocation is resident before the second asks, so two that each fit but not
+// together are refused at the second, and memory given back counts again.
+TEST(GlInfrastructure, SoftwareStorageCountsTogetherAgainstTheMemoryLimit) {
+  context();
+  const std::string_view renderer(reinterpret_cast<const char*>(glGetString(GL_RENDERER)));
+  if (renderer.find("llvmpipe") == std::string_view::npos)
+    GTEST_SKIP() << "a hardware driver reports GL_OUT_OF_MEMORY itself: " << renderer;
+  std::uint64_t size = 0, residentPages = 0;
+  std::ifstream("/proc/self/statm") >> size >> residentPages;
+  ASSERT_GT(residentPages, 0u);
+  constexpr std::uint64_t kMiB = std::uint64_t{1} << 20;
+  const std::uint64_t residentMiB = residentPages * static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE)) / kMiB;
+  ::setenv("MFR_MEMORY_LIMIT_MIB", std::to_string(residentMiB + 400).c_str(), 1);
+  struct Unset {
+    ~Unset() { ::unsetenv("MFR_MEMORY_LIMIT_MIB"); }
+  } unset;
+  const auto refusal = [](auto allocate) {
+    try {
+      allocate();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("(allocated)");
+  };
+  {
+    gl::Buffer first = gl::createBuffer(256 * kMiB);  // 400 MiB left: fits
+    const std::string second = refusal([&] { gl::createBuffer(256 * kMiB); });
+    EXPECT_NE(second.find("would take 256 MiB more memory; only "), std::string::npos) << second;
+    // A texture of the same size (8192² texels of 4 bytes) is refused the same way.
+    const std::string texture = refusal([&] { gl::createTexture2D(GL_R32UI, 8192, 8192); });
+    EXPECT_NE(texture.find("would take 256 MiB more memory; only "), std::string::npos) << texture;
+  }
+  glFinish();  // the first buffer is deleted: its memory counts as available again
+  EXPECT_EQ(refusal([&] { gl::Buffer again = gl::createBuffer(256 * kMiB); }), "(allocated)");
 }
 
 }  // namespace

@@ -13,6 +13,9 @@ namespace {
 // A software rasteriser keeps "GPU" storage in this process's memory, where Linux overcommits: an
 // allocation past the machine's memory succeeds and the process is killed when it is touched. A
 // hardware driver reports GL_OUT_OF_MEMORY itself (checkErrors turns it into an mfr::Error).
+// Each allocation is checked on its own; the checks add up because llvmpipe zero-fills storage as
+// it creates it (measured: RSS grows by the size at glNamedBufferStorage), so earlier buffers are
+// already resident and counted (test: GlInfrastructure.SoftwareStorageCountsTogether…).
 bool storageInHostMemory() {
   const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   if (renderer == nullptr) return false;
