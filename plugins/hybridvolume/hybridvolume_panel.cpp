@@ -710,7 +710,7 @@ void HybridVolumePanel::showInfo() {
                .arg(s.z, 0, 'g', 4);
   if (const QStringList fields = context_.volumeFields(); !fields.isEmpty())
     lines << tr("field %1 (of %2)").arg(context_.volumeField(), fields.join(QStringLiteral(", ")));
-  lines << tr("values %1 … %2").arg(r.x, 0, 'g', 5).arg(r.y, 0, 'g', 5);
+  lines << tr("values %1 … %2").arg(r.x, 0, 'g', 6).arg(r.y, 0, 'g', 6);  // as the isosurface hint shows them
   QString step, bytes, sharedBytes;
   for (const auto& [name, value] : context_.stats().notes) {
     if (name == "volume step") step = QString::fromStdString(value);
