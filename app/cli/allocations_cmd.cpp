@@ -51,6 +51,11 @@ void addAllocations(CLI::App& app) {
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->add_option("--json", opt->json, "Write all results as JSON");
   cmd->callback([opt] {
+    std::vector<CommandFile> files;
+    for (const std::string& path : opt->scenes) files.push_back({"scene", path});
+    files.push_back({"--weights", opt->weights});
+    files.push_back({"--json", opt->json, true});
+    checkCommandFiles(files);
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);

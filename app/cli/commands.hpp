@@ -24,6 +24,17 @@ void addEvaluate(CLI::App& app);
 void addAllocations(CLI::App& app);
 void addProbe(CLI::App& app);
 
+// A file a command reads or writes, named by its option (e.g. "--json", "scene", "image A").
+struct CommandFile {
+  std::string option;
+  std::string path;  // empty: not given; "@…": a built-in scene, no file
+  bool output = false;
+};
+// Before any work: each output's folder exists and its name is no folder (checkOutputPath), and no
+// output is the same file as an input or another output (a relative and an absolute name, links
+// and hard links included) — a command never writes over what it reads, nor one file twice.
+// Throws mfr::Error naming the later option of the pair.
+void checkCommandFiles(const std::vector<CommandFile>& files);
 // "WxH" → (w, h); throws mfr::Error naming the option.
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);
 // A list separated by commas (or `separator`), empty items dropped.

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
@@ -8,6 +9,7 @@
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "mfr/io_util.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/contour.hpp"
@@ -15,6 +17,39 @@
 #include "mfr/scene/section.hpp"
 
 namespace mfr::cli {
+
+namespace {
+
+// Whether two names are one file: the same inode where both exist (hard and symbolic links), else
+// the same absolute path with links and "." / ".." resolved as far as the path exists.
+bool sameFile(const std::string& a, const std::string& b) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) {
+    const bool same = fs::equivalent(a, b, ec);
+    if (!ec) return same;
+  }
+  const fs::path pa = fs::weakly_canonical(fs::absolute(a, ec), ec);
+  const fs::path pb = fs::weakly_canonical(fs::absolute(b, ec), ec);
+  return !ec && pa == pb;
+}
+
+}  // namespace
+
+void checkCommandFiles(const std::vector<CommandFile>& files) {
+  for (const CommandFile& f : files)
+    if (f.output && !f.path.empty()) checkOutputPath(f.path);
+  for (std::size_t j = 0; j < files.size(); ++j)
+    for (std::size_t i = 0; i < j; ++i) {
+      const CommandFile &a = files[i], &b = files[j];
+      if (!(a.output || b.output) || a.path.empty() || b.path.empty() || a.path.front() == '@' ||
+          b.path.front() == '@' || !sameFile(a.path, b.path))
+        continue;
+      throw Error(b.option + " " + b.path, "is the same file as " + a.option + " (" + a.path + ")" +
+                                               (a.output && b.output ? ": both would be written to it"
+                                                                     : ": the command would write over what it reads"));
+    }
+}
 
 std::pair<int, int> parseSize(const std::string& option, const std::string& text) {
   int w = 0, h = 0;

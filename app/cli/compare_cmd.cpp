@@ -34,6 +34,11 @@ void addCompare(CLI::App& app) {
     }
     if (!wantRmse && !wantFlip) throw Error("--metric " + opt->metrics, "names no metric (rmse, flip)");
     if (!(opt->ppd > 0) || opt->ppd > 1e4) throw Error("--ppd", "must be in (0, 10000]");
+    // Both outputs checked before the work and before either is written; neither may be an input.
+    checkCommandFiles({{"reference", opt->reference},
+                       {"test", opt->test},
+                       {"--heatmap", opt->heatmap, true},
+                       {"--json", opt->json, true}});
     const ImageRGBA8 ref = readPng(opt->reference);
     const ImageRGBA8 test = readPng(opt->test);
     if (ref.width != test.width || ref.height != test.height)
@@ -55,8 +60,6 @@ void addCompare(CLI::App& app) {
       if (!opt->heatmap.empty()) heat = magma(f.errorMap);
     }
     if (!opt->heatmap.empty() && heat.empty()) heat = heatmap(absoluteDifference(ref, test), 1.0f);
-    if (!opt->heatmap.empty()) checkOutputPath(opt->heatmap);  // both checked before either is written
-    if (!opt->json.empty()) checkOutputPath(opt->json);
     if (!opt->heatmap.empty()) writePng(opt->heatmap, heat);
     if (!opt->json.empty()) writeFileAtomically(opt->json, j.dump(2) + "\n");
   });

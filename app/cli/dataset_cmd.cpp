@@ -75,6 +75,10 @@ void addDataset(CLI::App& app) {
                 "every allocation exact, so their labels teach the network nothing");
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->callback([opt] {
+    std::vector<CommandFile> files;
+    for (const std::string& path : opt->scenes) files.push_back({"scene", path});
+    files.push_back({"-o", opt->output, true});
+    checkCommandFiles(files);
     const std::vector<double> levels = parseBudgetLevels(opt->budgets);
     const std::vector<std::string> views = splitList(opt->views);
     std::vector<std::pair<int, int>> sizes;

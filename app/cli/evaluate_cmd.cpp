@@ -131,6 +131,11 @@ void addEvaluate(CLI::App& app) {
   cmd->add_flag("--k-by-depth", opt->kByDepth,
                 "Also print (and write to the JSON) each method's mean k per depth-complexity class n(p)");
   cmd->callback([opt] {
+    std::vector<CommandFile> files;
+    for (const std::string& path : opt->scenes) files.push_back({"scene", path});
+    files.push_back({"--weights", opt->weights});
+    files.push_back({"--json", opt->json, true});
+    checkCommandFiles(files);
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);

@@ -101,6 +101,7 @@ void addInfo(CLI::App& app) {
                       "and its cross-section area)");
   cmd->add_option("--json", opt->json, "Also write the information as JSON");
   cmd->callback([opt] {
+    checkCommandFiles({{"scene", opt->scene}, {"--json", opt->json, true}});
     if (opt->methods) {
       const nlohmann::ordered_json methods = methodsJson();
       printMethods(methods);

@@ -76,13 +76,9 @@ void addRender(CLI::App& app) {
       ->check(finiteRange(0.0, 1.0));
   cmd->callback([opt, thicknessGiven, stepOption] {
     const auto [w, h] = parseSize("--size", opt->size);
-    // Both outputs checked before the work, so that a bad second path leaves no first file behind.
-    checkOutputPath(opt->output);
-    if (!opt->stats.empty()) checkOutputPath(opt->stats);
-    // One file cannot be both: the JSON would replace the image just written.
-    if (!opt->stats.empty() &&
-        std::filesystem::weakly_canonical(opt->stats) == std::filesystem::weakly_canonical(opt->output))
-      throw Error("--stats " + opt->stats, "is the output image's file too (-o)");
+    // Both outputs checked before the work, so that a bad second path leaves no first file behind;
+    // neither may be the scene, nor both one file (the JSON would replace the image just written).
+    checkCommandFiles({{"scene", opt->scene}, {"-o", opt->output, true}, {"--stats", opt->stats, true}});
     RenderRequest req;
     req.method = opt->method;
     req.operation = opt->op;

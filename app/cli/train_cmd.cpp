@@ -47,6 +47,10 @@ void addTrain(CLI::App& app) {
                   "none, or fragments: rows drawn with probability proportional to n(p), losses weighted by n(p)")
       ->capture_default_str();
   cmd->callback([opt] {
+    std::vector<CommandFile> files;
+    for (const std::string& path : opt->datasets) files.push_back({"dataset", path});
+    files.push_back({"-o", opt->output, true});
+    checkCommandFiles(files);
     DkbDataset all;
     std::string meta = "[";
     for (const std::string& path : opt->datasets) {

@@ -3,12 +3,16 @@
 #include <png.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 #include "mfr/io_util.hpp"
 
 namespace mfr {
@@ -63,6 +67,22 @@ static bool decodePng(const std::string* bytes, ImageRGBA8* image, std::vector<p
   png_read_info(png, info);
   const png_uint_32 w = png_get_image_width(png, info), h = png_get_image_height(png, info);
   if (w == 0 || h == 0 || w > 65536 || h > 65536) png_error(png, "unsupported image size");
+  // The header alone decides the allocation, so a corrupt one of a few bytes could ask for 16 GiB
+  // and the decoder would fill it before finding the data short. Deflate shrinks at most about
+  // 1032 : 1, so the filtered rows cannot be more than that many times the file.
+  const double rowBytes =
+      1.0 + std::ceil(static_cast<double>(w) * png_get_channels(png, info) * png_get_bit_depth(png, info) / 8.0);
+  char reason[160];
+  if (rowBytes * h > 1100.0 * static_cast<double>(bytes->size())) {
+    std::snprintf(reason, sizeof reason, "its header's %ux%u pixels cannot fit in its %zu bytes", w, h, bytes->size());
+    png_error(png, reason);
+  }
+  const std::uint64_t rgba = std::uint64_t{w} * h * 4;
+  if (const std::optional<std::uint64_t> available = availableHostMemory(); available && rgba > *available) {
+    std::snprintf(reason, sizeof reason, "%ux%u pixels would take %s; only %s is available", w, h,
+                  formatMemory(rgba).c_str(), formatMemory(*available).c_str());
+    png_error(png, reason);
+  }
   // Normalise every colour type to 8-bit RGBA.
   png_set_expand(png);
   png_set_strip_16(png);

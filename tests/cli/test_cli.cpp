@@ -18,6 +18,7 @@
 
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/image.hpp"
+#include "mfr/io_util.hpp"
 #include "test_files.hpp"
 
 namespace fs = std::filesystem;
@@ -211,6 +212,51 @@ TEST_F(Cli, GpuMethodsRefuseWhatTheOracleRefuses) {
       SCOPED_TRACE(file.filename().string() + " " + method);
       expectCleanFailure("render " + file.string() + " --size 16x16 -m " + method, reason);
     }
+}
+
+// No command writes over a file it reads or writes one file twice: relative and absolute names,
+// "./" and links included (found by a bug hunt: `compare a.png b.png --json b.png` replaced b.png,
+// `train d.bin -o d.bin` the dataset, `render s.mfrscene -o s.mfrscene` the scene). The inputs
+// are left as they were and no output is written.
+TEST_F(Cli, NoCommandWritesOverItsInputsOrOneFileTwice) {
+  const fs::path png = dir() / "a.png";
+  ASSERT_EQ(runCli("render @sample -s 24x16 -o " + png.string()).exitCode, 0);
+  fs::copy_file(png, dir() / "b.png");
+  const fs::path scene = write("s.mfrscene", R"({"objects": [{"primitive": {"type": "box"}}]})");
+  const fs::path data = dir() / "d.bin";
+  ASSERT_EQ(runCli("dataset @sample --views front -s 24x16 --budgets 1,all -o " + data.string()).exitCode, 0);
+  fs::create_symlink("a.png", dir() / "link.png");
+  fs::create_hard_link(dir() / "b.png", dir() / "hard.png");
+  const std::map<std::string, std::string> before{{"a.png", mfr::readFile(png)},
+                                                  {"b.png", mfr::readFile(dir() / "b.png")},
+                                                  {"s.mfrscene", mfr::readFile(scene)},
+                                                  {"d.bin", mfr::readFile(data)}};
+  const std::string cd = "cd " + dir().string() + " && " + MFR_CLI + " ";
+  for (const auto& [command, mention] : std::vector<std::pair<std::string, std::string>>{
+           {"compare a.png b.png --json b.png", "--json b.png: is the same file as test (b.png)"},
+           {"compare a.png b.png --heatmap ./a.png", "--heatmap ./a.png: is the same file as reference (a.png)"},
+           {"compare a.png b.png --heatmap " + png.string(), "is the same file as reference (a.png)"},
+           {"compare a.png b.png --json link.png", "--json link.png: is the same file as reference"},
+           {"compare a.png b.png --heatmap hard.png", "--heatmap hard.png: is the same file as test"},
+           {"compare a.png b.png --json out.x --heatmap out.x", "is the same file as --heatmap (out.x): both would"},
+           {"render s.mfrscene -s 24x16 -o s.mfrscene", "-o s.mfrscene: is the same file as scene"},
+           {"render @sample -s 24x16 -o q.png --stats ./q.png", "--stats ./q.png: is the same file as -o (q.png)"},
+           {"info s.mfrscene --no-histogram --json ./s.mfrscene", "is the same file as scene (s.mfrscene)"},
+           {"probe s.mfrscene -s 24x16 --pixel 12,8 --json s.mfrscene", "is the same file as scene"},
+           {"bench s.mfrscene -s 16x16 -m abuffer-ll --json s.mfrscene", "is the same file as scene"},
+           {"train d.bin --epochs 1 -o d.bin", "-o d.bin: is the same file as dataset (d.bin)"},
+           {"dataset s.mfrscene --views front -s 24x16 --budgets 1 -o s.mfrscene", "is the same file as scene"},
+           {"evaluate s.mfrscene -s 24x16 --budgets k1 -m fkb --json s.mfrscene", "is the same file as scene"},
+           {"allocations s.mfrscene -s 24x16 --budgets k1 --json s.mfrscene", "is the same file as scene"}}) {
+    const CliResult r = mfr::test::runCommand(cd + command);
+    EXPECT_EQ(r.exitCode, 1) << command << ": " << r.out;
+    EXPECT_NE(r.out.find(mention), std::string::npos) << command << ": " << r.out;
+  }
+  for (const auto& [name, bytes] : before) EXPECT_EQ(mfr::readFile(dir() / name), bytes) << name << " was changed";
+  EXPECT_FALSE(fs::exists(dir() / "out.x"));
+  EXPECT_FALSE(fs::exists(dir() / "q.png"));
+  // A file named twice only as an input is fine.
+  EXPECT_EQ(mfr::test::runCommand(cd + "compare a.png ./a.png --metric rmse").exitCode, 0);
 }
 
 TEST_F(Cli, MissingOutputFolder) {
@@ -652,7 +698,7 @@ TEST_F(Cli, NothingToDrawAndOtherLateRefusals) {
   const fs::path same = dir() / "same.png";
   const CliResult r = runCli("render @sample -s 32x32 -o " + same.string() + " --stats " + same.string());
   EXPECT_EQ(r.exitCode, 1) << r.out;
-  EXPECT_NE(r.out.find("is the output image's file too"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("is the same file as -o"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(same));
   const CliResult info = runCli("info @sample --view orbit:inf:0");
   EXPECT_EQ(info.exitCode, 1) << info.out;

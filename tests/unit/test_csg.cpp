@@ -450,6 +450,21 @@ TEST_F(CsgSceneFileOnDisk, LoadSceneNamesTheFile) {
     objects += std::string(i ? "," : "") + R"({"name": "b)" + std::to_string(i) + R"(", "primitive": {"type": "box"}})";
     names += std::string(i ? "," : "") + "\"b" + std::to_string(i) + "\"";
   }
+  // Nesting deeper than any program of 64 words can hold is refused while parsing: 100,000 levels
+  // crashed the parser's recursion (found by a bug hunt); 32 levels still reach the word limit.
+  const auto nested = [](int levels) {
+    std::string open, close;
+    for (int i = 0; i < levels; ++i) {
+      open += R"({"union": [)";
+      close += R"(, "ball"]})";
+    }
+    return open + "\"block\"" + close;
+  };
+  const auto deep = write("deep.mfrscene", csgFile(nested(100000)));
+  std::string deepError = errorOf([&] { loadScene(deep); });
+  EXPECT_EQ(deepError, deep.string() + ": csg: nested more than 32 levels deep (a CSG program holds at most 64 words)");
+  deepError = errorOf([&] { loadScene(write("deep32.mfrscene", csgFile(nested(32)))); });
+  EXPECT_NE(deepError.find("CSG tree needs 65 program words (at most 64)"), std::string::npos) << deepError;
   const auto many = write("many.mfrscene", R"({"objects": [)" + objects + R"(], "csg": {"union": [)" + names + "]}}");
   const auto open = write("open.mfrscene", csgFile(R"({"union": ["sheet", "block"]})"));
   for (const auto& [path, reason] : {std::pair{many, std::string("CSG tree has 33 distinct objects (at most 32)")},

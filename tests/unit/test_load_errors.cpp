@@ -19,7 +19,10 @@
 #include <string>
 #include <vector>
 
+#include <zlib.h>
+
 #include "mfr/error.hpp"
+#include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
 #include "test_files.hpp"
 
@@ -301,6 +304,71 @@ TEST_F(LoadModel, GarbageOff) {
                   "OFF face 0 declares 2000000000 corners but only 17 bytes follow");
   expectLoadError(write("badface.off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 9\n"),
                   "malformed or truncated OFF");
+  // A negative corner count: CGAL's std::length_error ("vector::_M_default_append") came through.
+  expectLoadError(write("negative.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n"),
+                  "OFF face 0 declares a negative corner count (-3)");
+  const auto be32 = [](std::int64_t v) {
+    std::string b(4, '\0');
+    for (int i = 0; i < 4; ++i) b[static_cast<std::size_t>(i)] = static_cast<char>((v >> (8 * (3 - i))) & 0xff);
+    return b;
+  };
+  std::string binary = "OFF BINARY\n" + be32(3) + be32(1) + be32(0);
+  for (const float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) binary += be32(std::bit_cast<std::int32_t>(f));
+  binary += be32(-3) + be32(0) + be32(1) + be32(2) + be32(0);
+  expectLoadError(write("negative-binary.off", binary), "malformed or truncated OFF");
+}
+
+// A PNG's header alone sizes the decoded image: 69 bytes claiming 60000² pixels took 14 GB and
+// 70 s before "not enough image data" (found by a bug hunt). Deflate shrinks at most ~1032 : 1, so a
+// header whose rows cannot fit in the file is refused before any allocation; the most compressible
+// real image (all zero, level 9, 1028 : 1) still reads.
+TEST_F(LoadModel, PngHeaderLargerThanItsDataIsRefusedAtOnce) {
+  const auto chunk = [](const std::string& type, const std::string& data) {
+    const auto be32 = [](std::uint32_t v) {
+      return std::string{static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8),
+                         static_cast<char>(v)};
+    };
+    const std::string body = type + data;
+    return be32(static_cast<std::uint32_t>(data.size())) + body +
+           be32(static_cast<std::uint32_t>(
+               crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size()))));
+  };
+  const auto png = [&](std::uint32_t w, std::uint32_t h, const std::string& raw) {
+    std::string ihdr{static_cast<char>(w >> 24),
+                     static_cast<char>(w >> 16),
+                     static_cast<char>(w >> 8),
+                     static_cast<char>(w),
+                     static_cast<char>(h >> 24),
+                     static_cast<char>(h >> 16),
+                     static_cast<char>(h >> 8),
+                     static_cast<char>(h),
+                     8,
+                     6,
+                     0,
+                     0,
+                     0};
+    std::string packed(compressBound(static_cast<uLong>(raw.size())), '\0');
+    uLongf size = packed.size();
+    EXPECT_EQ(compress2(reinterpret_cast<Bytef*>(packed.data()), &size, reinterpret_cast<const Bytef*>(raw.data()),
+                        static_cast<uLong>(raw.size()), 9),
+              Z_OK);
+    packed.resize(size);
+    return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", ihdr) + chunk("IDAT", packed) + chunk("IEND", "");
+  };
+  const fs::path huge = write("huge.png", png(60000, 60000, std::string(100, '\0')));
+  std::string what;
+  try {
+    (void)mfr::readPng(huge);
+  } catch (const mfr::Error& e) {
+    what = e.what();
+  }
+  EXPECT_EQ(what, huge.string() + ": corrupt PNG (its header's 60000x60000 pixels cannot fit in its " +
+                      std::to_string(fs::file_size(huge)) + " bytes)");
+  const std::uint32_t side = 2048;
+  const fs::path zeros = write("zeros.png", png(side, side, std::string(std::size_t{side} * (1 + side * 4), '\0')));
+  const mfr::ImageRGBA8 image = mfr::readPng(zeros);
+  EXPECT_EQ(image.width, static_cast<int>(side));
+  EXPECT_EQ(image.height, static_cast<int>(side));
 }
 
 TEST_F(LoadModel, GarbageVtp) {

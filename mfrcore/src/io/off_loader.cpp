@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <iterator>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include <CGAL/IO/OFF.h>
@@ -56,6 +57,9 @@ void checkAsciiFaceSizes(std::string_view bytes, std::size_t pos, std::uint64_t 
     if (first.empty()) continue;  // blank or a comment
     if (records++ < vertices) continue;
     std::uint64_t corners = 0;
+    if (first.front() == '-')
+      throw Error(name, "OFF face " + std::to_string(records - vertices - 1) + " declares a negative corner count (" +
+                            std::string(first) + ")");
     if (!toCount(first, corners)) return;  // CGAL says what is wrong
     if (corners > (bytes.size() - start) / 2)
       throw Error(name, "OFF face " + std::to_string(records - vertices - 1) + " declares " + std::to_string(corners) +
@@ -113,9 +117,14 @@ PolygonSoup parseOff(std::string_view bytes, const std::string& name) {
   std::vector<std::vector<std::size_t>> polygons;
   std::vector<CGAL::IO::Color> colors;
   std::istringstream in{std::string(bytes), std::ios::in | std::ios::binary};
-  const bool ok = CGAL::IO::read_OFF(
-      in, points, polygons,
-      CGAL::parameters::vertex_color_output_iterator(std::back_inserter(colors)).verbose(false));
+  bool ok = false;
+  try {
+    ok = CGAL::IO::read_OFF(in, points, polygons,
+                            CGAL::parameters::vertex_color_output_iterator(std::back_inserter(colors)).verbose(false));
+  } catch (const std::length_error&) {
+    // A binary face's corner count read as a negative 32-bit number sizes a vector past max_size().
+    ok = false;
+  }
   if (!ok || points.size() != vertexCount || polygons.size() != faceCount)
     throw Error(name, "malformed or truncated OFF data (header declares " + std::to_string(vertexCount) +
                           " vertices and " + std::to_string(faceCount) + " faces)");

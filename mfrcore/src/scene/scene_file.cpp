@@ -8,6 +8,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
+#include "common/bindings.h"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
@@ -389,8 +390,14 @@ ContourRequest parseContours(const Reader& r, const json& j, const std::string& 
   return request;
 }
 
-// A CSG node: an object's name, or {"union" | "intersection" | "difference": [≥ 2 nodes]}.
-CsgNode parseCsgNode(const Reader& r, const json& j, const std::string& where, const Scene& scene) {
+// A CSG node: an object's name, or {"union" | "intersection" | "difference": [≥ 2 nodes]}. A tree
+// nested d levels deep has at least d + 1 leaves, so 2d + 1 program words: deeper than the program
+// holds is refused here, before a recursion as deep as the file (a crash at 100,000 levels).
+CsgNode parseCsgNode(const Reader& r, const json& j, const std::string& where, const Scene& scene,
+                     std::size_t depth = 0) {
+  if (depth > MFR_CSG_MAX_PROGRAM / 2)
+    r.fail("csg", "nested more than " + std::to_string(MFR_CSG_MAX_PROGRAM / 2) +
+                      " levels deep (a CSG program holds at most " + std::to_string(MFR_CSG_MAX_PROGRAM) + " words)");
   CsgNode node;
   if (j.is_string()) {
     const std::string name = j.get<std::string>();
@@ -420,7 +427,8 @@ CsgNode parseCsgNode(const Reader& r, const json& j, const std::string& where, c
   if (!operands.is_array() || operands.size() < 2)
     r.fail(where + "." + key, "expected an array of at least 2 operands");
   for (std::size_t i = 0; i < operands.size(); ++i)
-    node.children.push_back(parseCsgNode(r, operands[i], where + "." + key + "[" + std::to_string(i) + "]", scene));
+    node.children.push_back(
+        parseCsgNode(r, operands[i], where + "." + key + "[" + std::to_string(i) + "]", scene, depth + 1));
   return node;
 }
 
