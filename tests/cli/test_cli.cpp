@@ -11,6 +11,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -764,6 +765,20 @@ TEST_F(Cli, BudgetCommandsBadInput) {
   expectCleanFailure("dataset @sample --views nowhere", "view 'nowhere'");
   const fs::path badWeights = write("w.json", R"({"format":"mfr-dkb-weights","version":1})");
   expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + badWeights.string(), "w.json");
+  // JSON errors other than syntax (a number past double's range, a key of the wrong type) were
+  // "internal error" with exit 3 and no file named.
+  std::string shipped = mfr::readFile(MFR_TEST_DATA_DIR "/../../resources/dkb/weights.json");
+  for (const auto& [from, to, mention] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"\"version\": 1", "\"version\": \"one\"", "type must be number"},
+           {"\"input_mean\": [", "\"input_mean\": [1e999, ", "number overflow"}}) {
+    std::string text = shipped;
+    ASSERT_NE(text.find(from), std::string::npos) << from;
+    text.replace(text.find(from), from.size(), to);
+    const fs::path file = write("w2.json", text);
+    expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + file.string(),
+                       "w2.json: not a valid weights file ([json.exception.");
+    expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + file.string(), mention);
+  }
   expectCleanFailure("render @sample -s 16x16 -m vkb -p budget_mib=0", "--param budget_mib=0");
   expectCleanFailure("render @sample -s 16x16 -m fkb -p budget_mib=0.001", "--param budget_mib=0.001");
   expectCleanFailure("render @sample -s 16x16 -m optimal-k --op oit", "--op oit");

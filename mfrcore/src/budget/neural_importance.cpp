@@ -141,13 +141,25 @@ std::vector<std::uint32_t> NeuralImportanceModel::packedWords() const {
   return words;
 }
 
+namespace {
+NeuralImportanceModel parseWeightsJson(const std::string& text, const std::string& source);
+}  // namespace
+
 NeuralImportanceModel parseNeuralImportance(const std::string& text, const std::string& source) {
-  nlohmann::json j;
+  // A number past double's range ("1e999") or a key of the wrong type is nlohmann's out_of_range
+  // or type_error, not parse_error: every JSON error names the file (was "internal error").
   try {
-    j = nlohmann::json::parse(text);
+    return parseWeightsJson(text, source);
   } catch (const nlohmann::json::parse_error& e) {
     throw Error(source, std::string("not valid JSON (") + e.what() + ")");
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(source, std::string("not a valid weights file (") + e.what() + ")");
   }
+}
+
+namespace {
+NeuralImportanceModel parseWeightsJson(const std::string& text, const std::string& source) {
+  const nlohmann::json j = nlohmann::json::parse(text);
   if (!j.is_object() || j.value("format", "") != "mfr-dkb-weights")
     throw Error(source, "not an mfr dkb weights file (\"format\": \"mfr-dkb-weights\" missing)");
   if (j.value("version", 0) != 1) throw Error(source, "unsupported weights file version (expected 1)");
@@ -188,6 +200,7 @@ NeuralImportanceModel parseNeuralImportance(const std::string& text, const std::
   m.trainingJson = j.contains("training") ? j["training"].dump() : "{}";
   return m;
 }
+}  // namespace
 
 std::string neuralImportanceJson(const NeuralImportanceModel& m) {
   if (m.weights.size() != MFR_MLP_FLOATS) throw Error("dkb weights", "model has the wrong number of weights");
