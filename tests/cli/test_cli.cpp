@@ -203,12 +203,24 @@ TEST_F(Cli, GpuMethodsRefuseWhatTheOracleRefuses) {
       "transform": {"matrix": [0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0]}}]})");
   const fs::path huge =
       write("huge.mfrscene", R"({"objects": [{"name": "s", "primitive": {"type": "sphere", "radius": 1e300}}]})");
+  const fs::path plane = write("plane.mfrscene", R"({"objects": [{"primitive": {"type": "plane", "width": 1e300}}]})");
+  const fs::path box = write("box.mfrscene", R"({"objects": [{"primitive": {"type": "box", "size": [1, 1e39, 1]}}]})");
+  const fs::path tube =
+      write("tube.mfrscene", R"({"objects": [{"primitive": {"type": "tube", "path": [[0, 0, 0], [1e300, 0, 0]]}}]})");
   for (const auto& [file, reason] :
        std::vector<std::pair<fs::path, std::string>>{{degenerate, "nothing to render (no visible triangles)"},
                                                      // Refused where it is written (the loader, since
                                                      // this round), for every method alike.
                                                      {zero, "objects[0].transform.matrix: singular"},
-                                                     {huge, "s: non-finite vertex coordinate"}})
+                                                     // Sizes past 1e15 are refused by the file's
+                                                     // reader too ("s: non-finite vertex coordinate"
+                                                     // before, and info measured NaN).
+                                                     {huge, "objects[0].primitive.radius: must be at most 1e15"},
+                                                     {plane, "objects[0].primitive.width: must be at most 1e15"},
+                                                     {box, "objects[0].primitive.size: must be at most 1e15"},
+                                                     {tube,
+                                                      "objects[0].primitive.path[1]: coordinates must be "
+                                                      "within ±1e15"}})
     for (const char* method : {"oracle", "abuffer-ll", "kplus-array"}) {
       SCOPED_TRACE(file.filename().string() + " " + method);
       expectCleanFailure("render " + file.string() + " --size 16x16 -m " + method, reason);

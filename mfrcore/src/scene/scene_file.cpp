@@ -149,6 +149,14 @@ glm::dmat4 parseTransform(const Reader& r, const json& t, const std::string& whe
 
 Mesh parsePrimitive(const Reader& r, const json& p, const std::string& where) {
   r.object(p, where);
+  // Sizes within ±1e15, as transforms' entries: past float's range the mesh is inf and NaN (a
+  // plane of width 1e300 measured "closed" with area NaN).
+  constexpr double kLargest = 1e15;
+  const auto size = [&](const char* key, double fallback) {
+    const double v = r.positive(p, key, where, fallback);
+    if (v > kLargest) r.fail(where + "." + key, "must be at most 1e15");
+    return v;
+  };
   const std::string type = r.string(p, "type", where, "");
   if (type == "sphere") r.object(p, where, {"type", "radius", "slices", "stacks"});
   if (type == "box") r.object(p, where, {"type", "size"});
@@ -158,37 +166,40 @@ Mesh parsePrimitive(const Reader& r, const json& p, const std::string& where) {
   if (type == "tube") r.object(p, where, {"type", "path", "radius", "sides"});
   if (type == "hairball") r.object(p, where, {"type", "radius", "tube_radius", "count", "seed", "segments", "sides"});
   if (type == "sphere")
-    return makeSphere(r.positive(p, "radius", where, 1.0), r.integer(p, "slices", where, 48, 3, 4096),
+    return makeSphere(size("radius", 1.0), r.integer(p, "slices", where, 48, 3, 4096),
                       r.integer(p, "stacks", where, 24, 2, 4096));
   if (type == "box") {
-    const glm::dvec3 size = p.contains("size") ? r.vec3(p["size"], where + ".size") : glm::dvec3(1.0);
-    if (size.x <= 0 || size.y <= 0 || size.z <= 0) r.fail(where + ".size", "must be > 0");
-    return makeBox(size);
+    const glm::dvec3 box = p.contains("size") ? r.vec3(p["size"], where + ".size") : glm::dvec3(1.0);
+    if (box.x <= 0 || box.y <= 0 || box.z <= 0) r.fail(where + ".size", "must be > 0");
+    if (std::max({box.x, box.y, box.z}) > kLargest) r.fail(where + ".size", "must be at most 1e15");
+    return makeBox(box);
   }
   if (type == "cylinder")
-    return makeCylinder(r.positive(p, "radius", where, 0.5), r.positive(p, "height", where, 1.0),
-                        r.integer(p, "slices", where, 48, 3, 4096));
+    return makeCylinder(size("radius", 0.5), size("height", 1.0), r.integer(p, "slices", where, 48, 3, 4096));
   if (type == "torus") {
-    const double major = r.positive(p, "major_radius", where, 1.0);
-    const double minor = r.positive(p, "minor_radius", where, 0.25);
+    const double major = size("major_radius", 1.0);
+    const double minor = size("minor_radius", 0.25);
     if (minor >= major) r.fail(where + ".minor_radius", "must be smaller than major_radius");
     return makeTorus(major, minor, r.integer(p, "major_segments", where, 64, 3, 4096),
                      r.integer(p, "minor_segments", where, 24, 3, 4096));
   }
-  if (type == "plane") return makePlane(r.positive(p, "width", where, 1.0), r.positive(p, "height", where, 1.0));
+  if (type == "plane") return makePlane(size("width", 1.0), size("height", 1.0));
   if (type == "tube") {
     if (!p.contains("path") || !p["path"].is_array() || p["path"].size() < 2)
       r.fail(where + ".path", "expected an array of at least 2 points");
     std::vector<glm::dvec3> path;
     for (std::size_t i = 0; i < p["path"].size(); ++i)
       path.push_back(r.vec3(p["path"][i], where + ".path[" + std::to_string(i) + "]"));
+    for (std::size_t i = 0; i < path.size(); ++i)
+      if (std::max({std::abs(path[i].x), std::abs(path[i].y), std::abs(path[i].z)}) > kLargest)
+        r.fail(where + ".path[" + std::to_string(i) + "]", "coordinates must be within ±1e15");
     for (std::size_t i = 1; i < path.size(); ++i)
       if (path[i] == path[i - 1]) r.fail(where + ".path[" + std::to_string(i) + "]", "repeats the previous point");
-    return makeTube(path, r.positive(p, "radius", where, 0.05), r.integer(p, "sides", where, 12, 3, 1024));
+    return makeTube(path, size("radius", 0.05), r.integer(p, "sides", where, 12, 3, 1024));
   }
   if (type == "hairball") {
-    const double radius = r.positive(p, "radius", where, 1.0);
-    const double tube = r.positive(p, "tube_radius", where, 0.02);
+    const double radius = size("radius", 1.0);
+    const double tube = size("tube_radius", 0.02);
     if (tube >= radius) r.fail(where + ".tube_radius", "must be smaller than radius");
     return makeHairball(r.integer(p, "count", where, 20, 1, 10000), radius, tube,
                         static_cast<std::uint32_t>(r.integer(p, "seed", where, 1, 0, 1 << 30)),
