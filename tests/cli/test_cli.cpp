@@ -272,6 +272,21 @@ TEST_F(Cli, NoCommandWritesOverItsInputsOrOneFileTwice) {
   EXPECT_EQ(mfr::test::runCommand(cd + "compare a.png ./a.png --metric rmse").exitCode, 0);
 }
 
+// An object's file that cannot be read is named with the scene file and the key, as a volume's is
+// (it named only the model, and an empty name printed "mfr: : no such file").
+TEST_F(Cli, SceneFileModelErrorsNameTheSceneAndTheKey) {
+  fs::create_directories(dir() / "sub");
+  const fs::path empty = write("empty.mfrscene", R"({"objects": [{"name": "b", "file": ""}]})");
+  const fs::path missing = write("sub/missing.mfrscene", R"({"objects": [{"name": "b", "file": "nope.stl"}]})");
+  const fs::path nested = write("nested.mfrscene", R"({"objects": [{"name": "b", "file": "empty.mfrscene"}]})");
+  expectCleanFailure("render " + empty.string() + " -s 16x16",
+                     "empty.mfrscene: objects[0].file: expected the name of a model file");
+  expectCleanFailure("render " + missing.string() + " -s 16x16",
+                     "missing.mfrscene: objects[0].file: " + (dir() / "sub" / "nope.stl").string() + ": no such file");
+  expectCleanFailure("render " + nested.string() + " -s 16x16",
+                     "nested.mfrscene: objects[0].file: a scene file cannot include another scene (.mfrscene)");
+}
+
 TEST_F(Cli, MissingOutputFolder) {
   const CliResult r = runCli("render @sample --size 16x16 -o " + (dir() / "no" / "such" / "dir.png").string());
   EXPECT_EQ(r.exitCode, 1) << r.out;

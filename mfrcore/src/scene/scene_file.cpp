@@ -2,6 +2,7 @@
 #include "mfr/scene/scene_file.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <initializer_list>
 
@@ -577,7 +578,9 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
         colorBy.push_back({&o, where, scene.objects.size(), scene.objects.size() + 1, objName});
         scene.objects.push_back(std::move(obj));
       } else {
-        const std::filesystem::path file = baseDir / r.string(o, "file", where, "");
+        const std::string fileName = r.string(o, "file", where, "");
+        if (fileName.empty()) r.fail(where + ".file", "expected the name of a model file");
+        const std::filesystem::path file = baseDir / fileName;
         LoadOptions options;
         if (o.contains("molecule")) {
           const std::string style = r.string(o, "molecule", where, "");
@@ -590,7 +593,19 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
             r.fail(where + ".molecule", "only a molecule file (.pdb .ent .cif .mmcif) has representations");
         }
         options.notes = &scene.notes;
-        std::vector<Object> parts = loadModel(file, options, objectProgress);  // its errors name the model file
+        std::vector<Object> parts;
+        try {
+          parts = loadModel(file, options, objectProgress);
+        } catch (const LoadCancelled&) {
+          throw;
+        } catch (const Error& e) {
+          // Its errors name the model file; this names the scene file and the key as well.
+          std::string ext = file.extension().string();
+          std::transform(ext.begin(), ext.end(), ext.begin(),
+                         [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+          if (ext == ".mfrscene") r.fail(where + ".file", "a scene file cannot include another scene (.mfrscene)");
+          r.fail(where + ".file", e.what());
+        }
         colorBy.push_back(
             {&o, where, scene.objects.size(), scene.objects.size() + parts.size(), file.filename().string()});
         for (Object& part : parts) {
