@@ -287,6 +287,17 @@ TEST_F(Cli, SceneFileModelErrorsNameTheSceneAndTheKey) {
                      "nested.mfrscene: objects[0].file: a scene file cannot include another scene (.mfrscene)");
 }
 
+// @quads' fields are whole: sscanf took "@quads:4x" as 4 and wrapped a seed of -1 or 20 digits.
+TEST_F(Cli, QuadsSceneNameIsReadWhole) {
+  for (const char* name : {"@quads:4x", "@quads:4:1:-1", "@quads:4:0.5:12345678901234567890",
+                           "@quads:", "@quads:4::", "@quads:4:0.5x", "@quads:4:0.5:7:1"})
+    expectCleanFailure(std::string("render ") + name + " -s 16x16",
+                       std::string(name) + ": expected @quads:N[:density[:seed]]");
+  expectCleanFailure("render @quads:0 -s 16x16", "@quads: layer count must be in [1, 4096]");
+  const fs::path png = dir() / "q.png";
+  EXPECT_EQ(runCli("render @quads:4:0.5:7 -s 16x16 -o " + png.string()).exitCode, 0);
+}
+
 TEST_F(Cli, MissingOutputFolder) {
   const CliResult r = runCli("render @sample --size 16x16 -o " + (dir() / "no" / "such" / "dir.png").string());
   EXPECT_EQ(r.exitCode, 1) << r.out;

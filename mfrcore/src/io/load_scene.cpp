@@ -1,5 +1,11 @@
 #include <algorithm>
-#include <cstdio>
+#include <charconv>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <vector>
 
 #include "invesalius_loader.hpp"
 #include "mfr/error.hpp"
@@ -47,12 +53,31 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
   if (text == "@volume") return makeVolumeSampleScene();
   if (text.rfind("@quads:", 0) == 0) {
     // @quads:N[:density[:seed]]
+    // Each field whole: "@quads:4x", a negative or 20-digit seed (wrapped by %u) are refused.
+    std::vector<std::string_view> fields;
+    for (std::string_view rest = std::string_view(text).substr(7);;) {
+      const std::size_t colon = rest.find(':');
+      fields.push_back(rest.substr(0, colon));
+      if (colon == std::string_view::npos) break;
+      rest.remove_prefix(colon + 1);
+    }
+    const auto bad = [&] { return Error(text, "expected @quads:N[:density[:seed]] (N and seed whole numbers)"); };
+    const auto whole = [&](std::string_view field, auto& value) {
+      const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
+      if (field.empty() || ec != std::errc() || end != field.data() + field.size()) throw bad();
+    };
+    if (fields.size() > 3) throw bad();
     int layers = 0;
     double density = 1.0;
-    unsigned seed = 1;
-    char extra = 0;
-    const int got = std::sscanf(text.c_str(), "@quads:%d:%lf:%u%c", &layers, &density, &seed, &extra);
-    if (got < 1 || got > 3) throw Error(text, "expected @quads:N[:density[:seed]]");
+    std::uint32_t seed = 1;
+    whole(fields[0], layers);
+    if (fields.size() > 1) {
+      const std::string field(fields[1]);
+      char* end = nullptr;
+      density = field.empty() ? 0.0 : std::strtod(field.c_str(), &end);
+      if (field.empty() || end != field.c_str() + field.size()) throw bad();
+    }
+    if (fields.size() > 2) whole(fields[2], seed);
     return makeQuadsScene(layers, density, seed);
   }
   if (!text.empty() && text[0] == '@')
