@@ -334,6 +334,11 @@ std::optional<ContourLegend> ContourOptions::apply(Scene& scene, double sceneOpa
                             (names.empty() ? std::string(" (it has none)") : " (volumes: " + names + ")"));
     }
     request.volume = static_cast<std::size_t>(it - scene.volumes.begin());
+    const auto named =
+        std::count_if(scene.volumes.begin(), scene.volumes.end(), [&](const Volume& v) { return v.name == name; });
+    if (named > 1)
+      throw Error(what, std::to_string(named) + " volumes of scene '" + scene.name + "' are named '" + name +
+                            "': name them apart in the scene file");
   } else if (scene.volumes.size() > 1) {
     throw Error(what, "scene '" + scene.name + "' has " + std::to_string(scene.volumes.size()) +
                           " volumes: say which, as VOLUME=V1,V2,… (e.g. '" + scene.volumes[0].name + "=…')");

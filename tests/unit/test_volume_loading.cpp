@@ -914,6 +914,9 @@ TEST_F(SceneVolumes, ErrorsNameTheJsonPath) {
   expectError(R"({"volumes": [{"file": "cube.vti", "field": ""}]})", "volumes[0].field",
               "expected the name of an array or grid of the file");
   expectError(R"({"volumes": [{"file": "cube.vti", "field": 2}]})", "volumes[0].field", "expected a string");
+  // Names find volumes (--contour NAME=…, "@NAME" fields): a second one alike meant the first.
+  expectError(R"({"volumes": [{"file": "cube.vti", "name": "a"}, {"file": "cube.vti", "name": "a"}]})",
+              "volumes[1].name", "'a' is volumes[0]'s name too (names must be unique)");
   expectError(
       R"({"volumes": [{"file": "cube.vti"}, {"file": "cube.vti", "name": "2"}, {"file": "cube.vti", "name": "3"},
                                {"file": "cube.vti", "name": "4"}, {"file": "cube.vti", "name": "5"}]})",

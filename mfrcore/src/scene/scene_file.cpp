@@ -631,6 +631,13 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
         r.fail(where + ".visible", std::to_string(Scene::kMaxVisibleVolumes) +
                                        " volumes are visible already: at most that many can be drawn at once "
                                        "(set \"visible\": false)");
+      // A name given is how --contour NAME=… and a part's "@NAME" field find the volume: two alike
+      // would silently mean the first.
+      if (volumes[i].is_object() && volumes[i].contains("name"))
+        for (std::size_t k = firstVolume; k < scene.volumes.size(); ++k)
+          if (scene.volumes[k].name == volume.name)
+            r.fail(where + ".name", "'" + volume.name + "' is volumes[" + std::to_string(k - firstVolume) +
+                                        "]'s name too (names must be unique)");
       scene.volumes.push_back(std::move(volume));
     }
     // Isosurfaces once every volume is there (a part's "@NAME" fields name them all).
