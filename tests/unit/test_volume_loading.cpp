@@ -420,6 +420,17 @@ TEST_F(VolumeLoading, NrrdSpaceDirectionsOrientTheGrid) {
                           "space directions: (1,0) (0,1,0) (0,0,1)\nencoding: raw\n\n" +
                               nrrdRaw()),
                     "must be vectors (x,y,z) or none");
+  // Two vectors for three axes, and an origin cut short, were read without a word (VTK's defaults).
+  expectVolumeError(write("two.nrrd",
+                          "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3 2\n"
+                          "space directions: (1,0,0) (0,1,0)\nencoding: raw\n\n" +
+                              nrrdRaw()),
+                    "NRRD 'space directions' has 2 entries for dimension 3");
+  expectVolumeError(write("origin.nrrd",
+                          "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3 2\n"
+                          "space origin: (0,0\nencoding: raw\n\n" +
+                              nrrdRaw()),
+                    "NRRD 'space origin' must be one vector (x,y,z) (got '(0,0')");
 }
 
 TEST_F(VolumeLoading, DefaultTransferIsGrayscaleOverTheDataRange) {

@@ -415,13 +415,29 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
       sizes = true;
     } else if (field == "space directions") {
       const std::vector<std::optional<glm::dvec3>> vectors = nrrdDirections(line.substr(colon + 2), name);
-      // Three spatial axes (a 4D file's "none" axis holds components: VTK's business).
+      // One entry per axis, three of them spatial (a 4D file's "none" axis holds components: VTK's
+      // business); VTK took two vectors for three axes without a word.
+      if (dimension >= 1 && static_cast<long>(vectors.size()) != dimension)
+        throw Error(name, "NRRD 'space directions' has " + std::to_string(vectors.size()) + " entries for dimension " +
+                              std::to_string(dimension));
+      if (std::count_if(vectors.begin(), vectors.end(), [](const auto& v) { return v.has_value(); }) != 3)
+        throw Error(name, "NRRD 'space directions' must give 3 spatial axes (vectors; 'none' for others)");
       if (vectors.size() == 3 && vectors[0] && vectors[1] && vectors[2]) {
         const glm::dmat3 m(*vectors[0], *vectors[1], *vectors[2]);
         if (!(std::abs(glm::determinant(m)) > 0.0))
           throw Error(name, "NRRD 'space directions' are not independent (the grid would be flat)");
         orientation.directions = std::array<glm::dvec3, 3>{*vectors[0], *vectors[1], *vectors[2]};
       }
+    } else if (field == "space origin") {
+      // VTK read "(0,0" as the origin without a word.
+      std::vector<std::optional<glm::dvec3>> origin;
+      try {
+        origin = nrrdDirections(line.substr(colon + 2), name);
+      } catch (const Error&) {
+        origin.clear();
+      }
+      if (origin.size() != 1 || !origin[0])
+        throw Error(name, "NRRD 'space origin' must be one vector (x,y,z) (got '" + line.substr(colon + 2) + "')");
     } else if (field == "encoding") {
       const std::string encoding = tokens.empty() ? std::string() : lower(tokens[0]);
       if (encoding == "ascii" || encoding == "txt" || encoding == "text")
