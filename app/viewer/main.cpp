@@ -7,6 +7,7 @@
 #include <clocale>
 
 #include <QApplication>
+#include <QCoreApplication>
 #include <QCommandLineParser>
 #include <QElapsedTimer>
 #include <QJsonDocument>
@@ -18,6 +19,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <map>
 #include <optional>
@@ -65,7 +67,7 @@ QSize parseSize(const QString& option, const QString& text) {
   return size;
 }
 
-CommandLine parseCommandLine(const QApplication& app) {
+CommandLine parseCommandLine(const QCoreApplication& app) {
   QCommandLineParser parser;
   parser.setApplicationDescription(QStringLiteral("Multifragment rendering viewer"));
   parser.addHelpOption();
@@ -228,9 +230,40 @@ CommandLine parseCommandLine(const QApplication& app) {
   return cl;
 }
 
+// --help and --version need no display: answered by a QCoreApplication, which opens none.
+bool onlyHelpOrVersion(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    for (const char* option : {"-h", "--help", "-?", "--help-all", "-v", "--version"})
+      if (std::strcmp(argv[i], option) == 0) return true;
+  return false;
+}
+
+// Qt's xcb platform aborts with a paragraph (and exit 134) when there is no X server to connect
+// to; the usual case, no display at all, is said in one line instead.
+void refuseMissingDisplay(int argc, char** argv) {
+  const QByteArray platform = qgetenv("QT_QPA_PLATFORM");
+  for (int i = 1; i < argc; ++i)
+    if (std::strcmp(argv[i], "-platform") == 0) return;  // the user chose one: Qt checks it
+  if (!platform.isEmpty() && !platform.startsWith("xcb")) return;
+  if (!qEnvironmentVariableIsEmpty("DISPLAY") ||
+      (platform.isEmpty() && !qEnvironmentVariableIsEmpty("WAYLAND_DISPLAY")))
+    return;
+  fail(QStringLiteral("no display: DISPLAY is not set (mfrview needs X11 or Wayland with OpenGL, or xvfb-run; "
+                      "mfr render needs none)"),
+       1);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (onlyHelpOrVersion(argc, argv)) {
+    QCoreApplication core(argc, argv);
+    QCoreApplication::setApplicationName(QStringLiteral("mfrview"));
+    QCoreApplication::setApplicationVersion(QStringLiteral(MFR_VERSION));
+    (void)parseCommandLine(core);  // prints the help or the version and exits
+    return 0;
+  }
+  refuseMissingDisplay(argc, argv);
   // Every GL context mfrview creates is 4.5 core, like mfrcore's headless one.
   QSurfaceFormat format;
   format.setVersion(4, 5);

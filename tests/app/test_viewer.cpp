@@ -641,6 +641,33 @@ class ViewerTest : public QObject {
   // Under a comma-decimal locale (de_DE), QApplication's setlocale made mfrcore's std::stod read
   // "0.9" as 0: mboit's overestimation=0.9 bias=0.3 drew the image of 0 and 0 (RMSE 0.054 from
   // mfr render's). The locale is built with localedef into a temporary folder (LOCPATH).
+  // Without a display, --version and --help answer (Qt's xcb platform aborted them, exit 134) and
+  // anything else is refused in one line instead of Qt's paragraph and an abort.
+  void viewerWithoutADisplay() {
+    const auto run = [](const QStringList& args, QString* out) {
+      QProcess viewer;
+      QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+      env.remove(QStringLiteral("DISPLAY"));
+      env.remove(QStringLiteral("WAYLAND_DISPLAY"));
+      env.remove(QStringLiteral("QT_QPA_PLATFORM"));
+      viewer.setProcessEnvironment(env);
+      viewer.setProcessChannelMode(QProcess::MergedChannels);
+      viewer.start(MFRVIEW, args);
+      if (!viewer.waitForFinished(kTimeoutMs)) return -1;
+      *out = QString::fromUtf8(viewer.readAll());
+      return viewer.exitStatus() == QProcess::NormalExit ? viewer.exitCode() : -2;
+    };
+    QString out;
+    QCOMPARE(run({QStringLiteral("--version")}, &out), 0);
+    QVERIFY2(out.startsWith(QStringLiteral("mfrview ")), qPrintable(out));
+    QCOMPARE(run({QStringLiteral("--help")}, &out), 0);
+    QVERIFY2(out.contains(QStringLiteral("--screenshot")), qPrintable(out));
+    QCOMPARE(run({QStringLiteral("@sample")}, &out), 1);
+    const QStringList lines = out.split(QLatin1Char('\n'), Qt::SkipEmptyParts);
+    QVERIFY2(lines.size() == 1 && lines[0].startsWith(QStringLiteral("mfrview: no display: DISPLAY is not set")),
+             qPrintable(out));
+  }
+
   void viewerReadsNumbersInAnyLocale() {
     QTemporaryDir dir;
     QString out;
