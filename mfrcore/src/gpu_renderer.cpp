@@ -13,6 +13,7 @@
 #include "methods/kbuffer_common.hpp"
 #include "methods/method_util.hpp"
 #include "reference/pixel_region.hpp"
+#include "number_text.hpp"
 
 namespace mfr {
 
@@ -239,9 +240,9 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
     stats.notes.emplace_back("csg buffer (bytes)", std::to_string(csgBytes));
   }
   if (!fieldColorsNote_.empty()) stats.notes.emplace_back("field colours", fieldColorsNote_);
-  if (operation_ == "zthickness") stats.notes.emplace_back("z-thickness", std::to_string(thickness_));
+  if (operation_ == "zthickness") stats.notes.emplace_back("z-thickness", numberText(thickness_));
   if (operation_ == "volume") {
-    stats.notes.emplace_back("volume step", std::to_string(volumeStep_));
+    stats.notes.emplace_back("volume step", numberText(volumeStep_));
     std::size_t bytes = 0, shared = 0;
     for (const auto& v : volumes_) {
       bytes += v->bytes;

@@ -19,6 +19,7 @@
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/hybrid.hpp"
 #include "mfr/reference/oracle.hpp"
+#include "number_text.hpp"
 
 namespace mfr {
 
@@ -44,8 +45,7 @@ double zThicknessDefault(const Bounds& sceneBounds) {
 
 double zThicknessOf(const RenderRequest& request, const Bounds& sceneBounds) {
   if (!std::isfinite(request.thickness) || request.thickness < 0.0)
-    throw Error("--thickness",
-                "must be a positive length in scene units (got " + std::to_string(request.thickness) + ")");
+    throw Error("--thickness", "must be a positive length in scene units (got " + numberText(request.thickness) + ")");
   if (request.thickness > 0.0) return request.thickness;
   const double d = zThicknessDefault(sceneBounds);
   return d > 0.0 ? d : 0.01;  // a flat or point-like scene still gets a usable slab
@@ -103,7 +103,7 @@ std::vector<Volume> volumesAsRequested(const RenderRequest& request, const Scene
 
 double volumeStepOf(const RenderRequest& request, std::span<const Volume> volumes) {
   if (!std::isfinite(request.volumeStep) || request.volumeStep < 0.0)
-    throw Error("--step", "must be a positive length in scene units (got " + std::to_string(request.volumeStep) + ")");
+    throw Error("--step", "must be a positive length in scene units (got " + numberText(request.volumeStep) + ")");
   if (request.volumeStep > 0.0) return request.volumeStep;
   double step = std::numeric_limits<double>::infinity();
   for (const Volume& v : volumes) step = std::min(step, v.defaultStep());
@@ -263,7 +263,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     if (drawn.empty()) throw Error("--op volume", "scene '" + scene.name + "' has no visible volume");
     const double step = volumeStepOf(request, drawn);
     out.image = compositeVolume(lists, camera, drawn, step, scene.background, scene.clipBox, scene.section);
-    out.stats.notes.emplace_back("volume step", std::to_string(step));
+    out.stats.notes.emplace_back("volume step", numberText(step));
     out.stats.notes.emplace_back("volumes", std::to_string(drawn.size()));
     out.stats.notes.emplace_back("volume shading", volumeShadingNote(drawn));
     if (const std::string fields = volumeFieldsNote(drawn); !fields.empty())
@@ -271,7 +271,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
   } else if (operation == "zthickness") {
     const double thickness = zThicknessOf(request, scene.bounds());
     out.image = compositeZThickness(lists, camera, thickness, scene.background);
-    out.stats.notes.emplace_back("z-thickness", std::to_string(thickness));
+    out.stats.notes.emplace_back("z-thickness", numberText(thickness));
   } else if (operation == "csg") {
     if (scene.clipBox) throw Error("--op csg", kCsgClipRefusal);
     if (scene.csg.empty())

@@ -282,6 +282,18 @@ struct ProgressRecorder {
 };
 
 // Runs a program; returns its exit code (output kept for failure messages).
+// A stats note's number, read back exactly (notes are the shortest text of the double); NaN when
+// the note is missing or not a number, which compares unequal to anything.
+double numberOf(const std::string& note) {
+  try {
+    std::size_t used = 0;
+    const double v = std::stod(note, &used);
+    return used == note.size() ? v : std::nan("");
+  } catch (const std::exception&) {
+    return std::nan("");
+  }
+}
+
 int runProgram(const QString& program, const QStringList& args, QString* output) {
   QProcess p;
   p.setProcessChannelMode(QProcess::MergedChannels);
@@ -849,13 +861,13 @@ class ViewerTest : public QObject {
         if (name == "z-thickness") return value;
       return {};
     };
-    QCOMPARE(note(), std::to_string(0.05));
+    QCOMPARE(numberOf(note()), 0.05);
     // The default (thickness 0) is 1 % of the diagonal, as the renderers make it.
     const mfr::Bounds b = m.scene().bounds();
     QVERIFY(std::abs(m.zThicknessDefault() - 0.01 * glm::length(b.max - b.min)) < 1e-12);
     m.setZThickness(0.0);
     settle(m);
-    QCOMPARE(note(), std::to_string(m.zThicknessDefault()));
+    QCOMPARE(numberOf(note()), m.zThicknessDefault());
     QVERIFY(thickness->specialValueText().contains("default"));
     m.setZThickness(0.05);
 
@@ -953,7 +965,7 @@ class ViewerTest : public QObject {
     settle(m);
     QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
     QCOMPARE(QString::fromStdString(m.stats().operation), QStringLiteral("zthickness"));
-    QCOMPARE(note(), std::to_string(m.zThicknessDefault()));
+    QCOMPARE(numberOf(note()), m.zThicknessDefault());
     QCOMPARE(units->value(), std::round(m.zThicknessDefault() * 1e6) / 1e6);  // shown at the default
     const mfr::ImageRGBA8 thin = w->view().renderImage(m.renderSize());
     blend->setChecked(false);
@@ -975,7 +987,7 @@ class ViewerTest : public QObject {
     QVERIFY(std::abs(m.zThickness() - 0.1 * diagonal) < 1e-9 * diagonal);
     QCOMPARE(m.renderRequest(QSize(8, 8)).thickness, m.zThickness());
     settle(m);
-    QCOMPARE(note(), std::to_string(m.zThickness()));
+    QCOMPARE(numberOf(note()), m.zThickness());
     const mfr::ImageRGBA8 thick = w->view().renderImage(m.renderSize());
     qInfo("thickness 1 %% vs 10 %% of the diagonal: RMSE %.5f", mfr::rmse(thin, thick));
     QVERIFY(mfr::rmse(thin, thick) > 0.002);
@@ -987,7 +999,7 @@ class ViewerTest : public QObject {
         static_cast<int>(std::lround(std::log(0.04 / diagonal * 100.0 / 0.05) / std::log(200.0) * 1000.0));
     QCOMPARE(slider->value(), expected);
     settle(m);
-    QCOMPARE(note(), std::to_string(0.04));
+    QCOMPARE(numberOf(note()), 0.04);
     w->findChild<QPushButton*>("ghostThicknessDefault")->click();
     QCOMPARE(m.zThickness(), 0.0);
     m.setZThickness(0.04);
@@ -1155,14 +1167,14 @@ class ViewerTest : public QObject {
     QCOMPARE(m.renderRequest(QSize(8, 8)).volumeStep, 0.02);
     settle(m);
     QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
-    QCOMPARE(note("volume step"), std::to_string(0.02));
+    QCOMPARE(numberOf(note("volume step")), 0.02);
     QVERIFY(std::stoull(note("volume (bytes)")) >= 96ull * 96 * 96 * 4);
     // The default (step 0) is the volume's defaultStep(), as the renderers make it.
     QCOMPARE(m.volumeStepDefault(), m.scene().visibleVolumes().at(0).defaultStep());
     w->findChild<QPushButton*>("volumeStepDefault")->click();
     QCOMPARE(m.volumeStep(), 0.0);
     settle(m);
-    QCOMPARE(note("volume step"), std::to_string(m.volumeStepDefault()));
+    QCOMPARE(numberOf(note("volume step")), m.volumeStepDefault());
     QVERIFY(step->specialValueText().contains("default"));
     // Another operation hides the row.
     m.setOperation("oit");
@@ -1483,7 +1495,7 @@ class ViewerTest : public QObject {
     step->setValue(0.03);
     QCOMPARE(m.volumeStep(), 0.03);
     settle(m);
-    QCOMPARE(note("volume step"), std::to_string(0.03));
+    QCOMPARE(numberOf(note("volume step")), 0.03);
     QVERIFY2(info->text().contains("0.03"), qPrintable(info->text()));
     stepSlider->setValue(stepSlider->maximum());
     QVERIFY(std::abs(m.volumeStep() - 10.0 * m.volumeStepDefault()) < 1e-12);

@@ -54,7 +54,7 @@ TEST_F(CliZThickness, BenchMeasuresRowsAgainstTheOraclesZThickness) {
   ASSERT_EQ(j["results"].size(), 3u);
   EXPECT_EQ(j["results"][1]["method"], "abuffer-ll:op=zthickness:thickness=0.2");
   EXPECT_LT(j["results"][1]["rmse"].get<double>(), 0.01);  // against "over" it would be far larger
-  EXPECT_EQ(j["results"][1]["notes"]["z-thickness"], "0.200000");
+  EXPECT_EQ(j["results"][1]["notes"]["z-thickness"], "0.2");
   // A method whose own operation is zthickness ("auto") is measured against that image too.
   EXPECT_LT(j["results"][2]["rmse"].get<double>(), 0.005);
 }

@@ -13,6 +13,7 @@
 #include "common/bindings.h"
 #include "mfr/error.hpp"
 #include "mfr/scene/section.hpp"
+#include "number_text.hpp"
 
 namespace mfr {
 
@@ -165,7 +166,7 @@ ImageRGBA8 compositeOver(const FragmentLists& lists, const glm::vec3& background
 ImageRGBA8 compositeZThickness(const FragmentLists& lists, const Camera& camera, double thickness,
                                const glm::vec3& background) {
   if (!std::isfinite(thickness) || thickness <= 0.0)
-    throw Error("--thickness", "must be a positive length in scene units (got " + std::to_string(thickness) + ")");
+    throw Error("--thickness", "must be a positive length in scene units (got " + numberText(thickness) + ")");
   const glm::vec4 toEye(camera.depthToEye());
   ImageRGBA8 image(lists.width, lists.height);
   for (int y = 0; y < lists.height; ++y)
@@ -424,7 +425,7 @@ ImageRGBA8 compositeVolume(const FragmentLists& lists, const Camera& camera, std
                            const std::optional<SectionPlane>& section) {
   for (const Volume& volume : volumes) volume.validate();
   if (!std::isfinite(step) || step < 0.0)
-    throw Error("--step", "must be a positive length in scene units (got " + std::to_string(step) + ")");
+    throw Error("--step", "must be a positive length in scene units (got " + numberText(step) + ")");
   const VolumeRaySetup setup = volumeRaySetup(volumes, camera, lists.width, lists.height, step, clip, section);
   ImageRGBA8 image(lists.width, lists.height);
   for (int y = 0; y < lists.height; ++y)
