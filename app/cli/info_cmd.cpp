@@ -126,6 +126,10 @@ void addInfo(CLI::App& app) {
     applySectionOption(scene, opt->section, &section);
     const bool sectioned = !section.outcomes.empty();
     const auto outcome = [&](std::size_t i) { return sectioned ? section.outcomes[i] : SectionOutcome::kKept; };
+    // The oracle's pass before anything is printed too: a scene it refuses (only degenerate
+    // triangles: "nothing to render") is one line, not a report and then an error.
+    std::optional<FragmentLists> lists;
+    if (histogramView) lists = castFragments(scene, *histogramView, w, h);
     std::vector<SurfaceMeasures> measures;
     for (const Object& o : scene.objects) measures.push_back(measureSurface(*o.mesh, o.transform));
     nlohmann::ordered_json j;
@@ -307,13 +311,15 @@ void addInfo(CLI::App& app) {
       }
     }
     j["volumes"] = volumes;
-    if (!opt->noHistogram) {
-      const FragmentLists lists = castFragments(scene, *histogramView, w, h);
-      const std::vector<std::uint64_t> hist = depthComplexityHistogram(lists);
-      j["depth_complexity"] = {{"size", opt->size}, {"view", opt->view}, {"max", lists.maxCount()},
-                               {"fragments", lists.fragments.size()}, {"histogram", hist}};
-      std::cout << "depth complexity (" << opt->size << ", view " << opt->view << "): max " << lists.maxCount()
-                << ", " << lists.fragments.size() << " fragments\n";
+    if (lists) {
+      const std::vector<std::uint64_t> hist = depthComplexityHistogram(*lists);
+      j["depth_complexity"] = {{"size", opt->size},
+                               {"view", opt->view},
+                               {"max", lists->maxCount()},
+                               {"fragments", lists->fragments.size()},
+                               {"histogram", hist}};
+      std::cout << "depth complexity (" << opt->size << ", view " << opt->view << "): max " << lists->maxCount() << ", "
+                << lists->fragments.size() << " fragments\n";
       for (std::size_t n = 0; n < hist.size(); ++n)
         if (hist[n] > 0) std::cout << "  n=" << n << ": " << hist[n] << " pixels\n";
     }

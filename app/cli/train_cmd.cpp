@@ -59,6 +59,12 @@ void addTrain(CLI::App& app) {
       meta += (meta.size() > 1 ? "," : "") + (d.metadata.empty() ? std::string("{}") : d.metadata);
     }
     all.metadata = meta + "]";
+    if (all.size() < 2) {
+      std::string names;
+      for (const std::string& path : opt->datasets) names += (names.empty() ? "" : ", ") + path;
+      throw Error(names, (opt->datasets.size() == 1 ? "holds " : "hold ") + std::to_string(all.size()) +
+                             (all.size() == 1 ? " row" : " rows") + "; training needs at least 2");
+    }
     NeuralTrainingOptions training = opt->training;
     training.progress = [](std::size_t epoch, double train, double valid) {
       std::cout << "epoch " << std::setw(4) << epoch << "  train MSE " << std::scientific << std::setprecision(4)

@@ -65,7 +65,15 @@ TEST_F(Cli, JsonSyntaxError) {
 TEST_F(Cli, SceneFileFlagsAndHugeNumbersNameTheFileAndKey) {
   const std::string sphere = R"({"primitive": {"type": "sphere"})";
   for (const auto& [json, mention] : std::vector<std::pair<std::string, std::string>>{
-           {R"({"sample": "yes"})", "top level.sample: expected true or false"},
+           {R"({"sample": "yes"})", "sample: expected true or false"},  // not "top level.sample"
+           // Views the renderers refused at the first frame without naming the file or the view.
+           {R"({"objects": [)" + sphere + R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "up": [0, 0, 0]}]})",
+            "views[0].up: must not be zero"},
+           {R"({"objects": [)" + sphere + R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "up": [0, 1e308, 1e308]}]})",
+            "views[0].up: too long to normalise"},
+           {R"({"objects": [)" + sphere +
+                R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "near": 1e-30, "far": 1e30}]})",
+            "views[0]: its projection is singular"},
            {R"({"objects": [)" + sphere + R"(, "visible": 1}]})", "objects[0].visible: expected true or false"},
            {R"({"objects": [)" + sphere +
                 R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "target": [0, 0, 0], "fit": null}]})",
@@ -493,6 +501,15 @@ TEST_F(Cli, InfoMeasuresEachPartsSurface) {
   const CliResult c = runCli("info @volume --no-histogram --contour 0.5");
   ASSERT_EQ(c.exitCode, 0) << c.out;
   EXPECT_NE(c.out.find("part 3: field = 0.5"), std::string::npos) << c.out;
+  // Only degenerate triangles: one line before any report (it printed the report, then failed),
+  // and without the histogram no "closed, volume 0".
+  const fs::path point = write("point.obj", "v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n");
+  const CliResult refused = runCli("info " + point.string());
+  EXPECT_EQ(refused.exitCode, 1) << refused.out;
+  EXPECT_EQ(refused.out, "mfr: scene 'point.obj': nothing to render (no visible triangles)\n");
+  const CliResult measured = runCli("info " + point.string() + " --no-histogram");
+  EXPECT_EQ(measured.exitCode, 0) << measured.out;
+  EXPECT_NE(measured.out.find("area 0: no surface (every triangle is degenerate)"), std::string::npos) << measured.out;
 }
 
 // With a section (--section, or the scene file's own) parts are measured as cut: a capped solid is
@@ -799,6 +816,10 @@ TEST_F(Cli, BudgetCommandsBadInput) {
   const fs::path junk = write("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");
   expectCleanFailure("train " + junk.string(), "junk.bin");
   expectCleanFailure("train " + (dir() / "missing.bin").string(), "missing.bin");
+  // One row: the file is named (it was "mfr: mfr train: the dataset has fewer than 2 rows").
+  const fs::path one = dir() / "one.bin";
+  ASSERT_EQ(runCli("dataset @sample --views front -s 1x1 --budgets all --sample 1 -o " + one.string()).exitCode, 0);
+  expectCleanFailure("train " + one.string(), one.string() + ": holds 1 row; training needs at least 2");
   expectCleanFailure("dataset @sample --budgets 0.5", "--budgets 0.5");
   expectCleanFailure("dataset @sample --views nowhere", "view 'nowhere'");
   const fs::path badWeights = write("w.json", R"({"format":"mfr-dkb-weights","version":1})");

@@ -210,7 +210,9 @@ TEST_F(OpenVdbFiles, BadFilesAreOneLineErrors) {
   for (std::size_t cut = 8; cut < bytes.size(); cut += std::max<std::size_t>(1, bytes.size() / 30)) {
     SCOPED_TRACE(cut);
     const fs::path p = write("cut" + std::to_string(cut) + ".vdb", bytes.substr(0, cut));
-    expectError(p, p.string());
+    // Said as what it is: OpenVDB reads garbage sizes past the end, which were "out of memory"
+    // (at 93 MB used) or "no float, double or vector grid", differently from run to run.
+    expectError(p, p.string() + ": corrupt or truncated OpenVDB file (");
   }
 }
 

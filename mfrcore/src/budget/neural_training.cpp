@@ -69,10 +69,10 @@ double meanSquaredError(DkbNet& net, const std::vector<Sample>& x, const std::ve
 }  // namespace
 
 NeuralTrainingResult trainNeuralImportance(const DkbDataset& dataset, const NeuralTrainingOptions& options) {
-  if (dataset.size() < 2) throw Error("mfr train", "the dataset has fewer than 2 rows");
+  if (dataset.size() < 2) throw Error("train", "the dataset has fewer than 2 rows");
   if (options.target != "k_over_n" && options.target != "k_over_budget")
     throw Error("--target " + options.target, "expected k_over_n or k_over_budget");
-  if (options.batchSize == 0 || options.epochs == 0) throw Error("mfr train", "epochs and batch size must be positive");
+  if (options.batchSize == 0 || options.epochs == 0) throw Error("train", "epochs and batch size must be positive");
   if (options.weighting != "none" && options.weighting != "fragments")
     throw Error("--weighting " + options.weighting, "expected none or fragments");
   const bool weighted = options.weighting == "fragments";

@@ -2,8 +2,10 @@
 
 #include <array>
 #include <cstdint>
+#include <exception>
 #include <fstream>
 #include <mutex>
+#include <new>
 
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
@@ -65,9 +67,22 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
   std::call_once(initialized, [] { openvdb::initialize(); });
   checkMagic(path, name);
 
+  // OpenVDB does not check its reads: a truncated file hands it garbage sizes, which ended as
+  // "out of memory" (at 93 MB used) or another reason each run. What it throws is said as what it
+  // most likely is.
+  const auto corrupt = [&](const std::string& what) {
+    return Error(name, "corrupt or truncated OpenVDB file (" + what + ")");
+  };
   openvdb::io::File file(path.string());
-  file.open(false);  // no delayed loading: the file is read now, not when voxels are touched
-  const openvdb::GridPtrVecPtr headers = file.readAllGridMetadata();
+  openvdb::GridPtrVecPtr headers;
+  try {
+    file.open(false);  // no delayed loading: the file is read now, not when voxels are touched
+    headers = file.readAllGridMetadata();
+  } catch (const std::bad_alloc&) {
+    throw corrupt("a size read from it is absurd");
+  } catch (const std::exception& e) {
+    throw corrupt(e.what());
+  }
   // The grid read: the one named `field`; else "density" if the file has that scalar grid, else its
   // first scalar grid, else the magnitude of its first vector grid.
   std::string chosen, list;
@@ -92,11 +107,17 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
   if (!field.empty() && chosen.empty())
     throw FieldNotFound(
         name, "no grid '" + field + "' (" + (list.empty() ? std::string("the file has none") : "grids: " + list) + ")");
-  if (rank == 0)
-    throw Error(name, "no float, double or vector grid in the file" +
-                          (list.empty() ? std::string() : " (it has " + list + ")"));
+  if (headers->empty()) throw corrupt("it lists no grid");
+  if (rank == 0) throw Error(name, "no float, double or vector grid in the file (it has " + list + ")");
   progress.step(0.1);
-  const openvdb::GridBase::Ptr base = file.readGrid(chosen);
+  openvdb::GridBase::Ptr base;
+  try {
+    base = file.readGrid(chosen);
+  } catch (const std::bad_alloc&) {
+    throw corrupt("a size read from it is absurd");
+  } catch (const std::exception& e) {
+    throw corrupt(e.what());
+  }
   file.close();
   progress.step(0.5);
 

@@ -124,7 +124,9 @@ SurfaceMeasures measureSurface(const Mesh& mesh, const glm::dmat4& transform) {
 std::string describeSurface(const SurfaceMeasures& m) {
   std::ostringstream text;  // default stream formatting: six significant digits
   text << "area " << m.area;
-  if (m.closed()) {
+  if (!(m.area > 0.0)) {
+    text << ": no surface (every triangle is degenerate)";  // "closed, volume 0" said nothing true
+  } else if (m.closed()) {
     text << ", closed, volume " << m.volume << (m.volume < 0.0 ? " (inside out)" : "");
   } else {
     text << ", not closed (" << m.boundaryEdges << " boundary edges";

@@ -7,6 +7,7 @@
 #include <initializer_list>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
 
 #include "common/bindings.h"
@@ -29,7 +30,9 @@ class Reader {
   explicit Reader(std::string file) : file_(std::move(file)) {}
 
   [[noreturn]] void fail(const std::string& where, const std::string& reason) const {
-    throw Error(file_, where + ": " + reason);
+    // A top-level key is named alone ("name: …", not "top level.name: …").
+    const std::string at = where.rfind("top level.", 0) == 0 ? where.substr(10) : where;
+    throw Error(file_, at + ": " + reason);
   }
   // An error whose message already says where in the file ("volumes[0].contours: …").
   [[noreturn]] void fail(const Error& e) const { throw Error(file_, e.what()); }
@@ -270,7 +273,10 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
   if (v.contains("target")) c.target = r.vec3(v["target"], where + ".target");
   if (v.contains("up")) c.up = r.vec3(v["up"], where + ".up");
   if (glm::length(c.eye - c.target) == 0.0) r.fail(where, "eye and target coincide");
-  if (glm::length(glm::cross(c.forward(), glm::normalize(c.up))) < 1e-9) r.fail(where + ".up", "parallel to the view direction");
+  if (!(glm::length(c.up) > 0.0)) r.fail(where + ".up", "must not be zero");
+  if (!std::isfinite(glm::length(c.up))) r.fail(where + ".up", "too long to normalise (under 1e150)");
+  if (!(glm::length(glm::cross(c.forward(), glm::normalize(c.up))) >= 1e-9))
+    r.fail(where + ".up", "parallel to the view direction");
   const std::string proj = r.string(v, "projection", where, "perspective");
   if (proj == "orthographic") c.projection = Projection::Orthographic;
   else if (proj != "perspective") r.fail(where + ".projection", "must be 'perspective' or 'orthographic'");
@@ -285,6 +291,12 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
     c.farPlane = r.positive(v, "far", where, c.farPlane);
     if (c.farPlane <= c.nearPlane) r.fail(where + ".far", "must be greater than near");
   }
+  // What the renderers would refuse at the first frame ("camera: projection is singular", naming
+  // neither the file nor the view), said here: near 1e-30 with far 1e30, say.
+  const glm::dmat4 inverse = glm::inverse(c.projectionMatrix(1.0) * c.viewMatrix());
+  const double* m = glm::value_ptr(inverse);
+  if (!std::all_of(m, m + 16, [](double x) { return std::isfinite(x); }))
+    r.fail(where, "its projection is singular (near and far planes too far apart, or too large a scene)");
   return c;
 }
 
@@ -520,6 +532,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     plane.point = r.vec3(section["point"], "section.point");
     plane.normal = r.vec3(section["normal"], "section.normal");
     if (!(glm::length(plane.normal) > 0.0)) r.fail("section.normal", "must not be zero");
+    if (!std::isfinite(glm::length(plane.normal))) r.fail("section.normal", "too long to normalise (under 1e150)");
     if (section.contains("caps")) {
       if (!section["caps"].is_boolean()) r.fail("section.caps", "expected true or false");
       plane.caps = section["caps"].get<bool>();
