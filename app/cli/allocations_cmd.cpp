@@ -52,9 +52,9 @@ void addAllocations(CLI::App& app) {
   cmd->add_option("--json", opt->json, "Write all results as JSON");
   cmd->callback([opt] {
     std::vector<CommandFile> files;
-    for (const std::string& path : opt->scenes) files.push_back({"scene", path});
+    for (const std::string& path : opt->scenes) files.push_back({"scene", path, CommandFile::Role::kScene});
     files.push_back({"--weights", opt->weights});
-    files.push_back({"--json", opt->json, true});
+    files.push_back({"--json", opt->json, CommandFile::Role::kOutput});
     checkCommandFiles(files);
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);

@@ -66,7 +66,8 @@ void addBench(CLI::App& app) {
                 "(for methods whose buffers do not fit the GPU together); default: round-robin");
   cmd->add_option("--json", opt->json, "Write all results as JSON");
   cmd->callback([opt] {
-    checkCommandFiles({{"scene", opt->scene}, {"--json", opt->json, true}});
+    checkCommandFiles(
+        {{"scene", opt->scene, CommandFile::Role::kScene}, {"--json", opt->json, CommandFile::Role::kOutput}});
     const auto [w, h] = parseSize("--size", opt->size);
     std::vector<RenderRequest> requests;
     for (const std::string& spec : splitList(opt->methods)) {

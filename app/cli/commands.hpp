@@ -26,14 +26,20 @@ void addProbe(CLI::App& app);
 
 // A file a command reads or writes, named by its option (e.g. "--json", "scene", "image A").
 struct CommandFile {
+  enum class Role {
+    kInput,           // a file read
+    kScene,           // a file read, or a built-in scene ("@sample"): no file
+    kOutput,          // written when given (empty: not given)
+    kRequiredOutput,  // written; empty is an error
+  };
   std::string option;
-  std::string path;  // empty: not given; "@…": a built-in scene, no file
-  bool output = false;
+  std::string path;
+  Role role = Role::kInput;
 };
-// Before any work: each output's folder exists and its name is no folder (checkOutputPath), and no
-// output is the same file as an input or another output (a relative and an absolute name, links
-// and hard links included) — a command never writes over what it reads, nor one file twice.
-// Throws mfr::Error naming the later option of the pair.
+// Before any work: each output's folder exists and its name is no folder (checkOutputPath), a
+// required output is not empty, and no output is the same file as an input or another output (a
+// relative and an absolute name, links and hard links included) — a command never writes over a
+// file named on its command line, nor one file twice. Throws mfr::Error naming the later option.
 void checkCommandFiles(const std::vector<CommandFile>& files);
 // "WxH" → (w, h); throws mfr::Error naming the option.
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);

@@ -37,17 +37,23 @@ bool sameFile(const std::string& a, const std::string& b) {
 }  // namespace
 
 void checkCommandFiles(const std::vector<CommandFile>& files) {
-  for (const CommandFile& f : files)
-    if (f.output && !f.path.empty()) checkOutputPath(f.path);
+  using Role = CommandFile::Role;
+  const auto output = [](const CommandFile& f) { return f.role == Role::kOutput || f.role == Role::kRequiredOutput; };
+  for (const CommandFile& f : files) {
+    if (f.role == Role::kRequiredOutput && f.path.empty()) throw Error(f.option, "empty file name");
+    if (output(f) && !f.path.empty()) checkOutputPath(f.path);
+  }
+  const auto file = [](const CommandFile& f) {
+    return !f.path.empty() && !(f.role == Role::kScene && f.path.front() == '@');  // a built-in scene
+  };
   for (std::size_t j = 0; j < files.size(); ++j)
     for (std::size_t i = 0; i < j; ++i) {
       const CommandFile &a = files[i], &b = files[j];
-      if (!(a.output || b.output) || a.path.empty() || b.path.empty() || a.path.front() == '@' ||
-          b.path.front() == '@' || !sameFile(a.path, b.path))
-        continue;
-      throw Error(b.option + " " + b.path, "is the same file as " + a.option + " (" + a.path + ")" +
-                                               (a.output && b.output ? ": both would be written to it"
-                                                                     : ": the command would write over what it reads"));
+      if (!(output(a) || output(b)) || !file(a) || !file(b) || !sameFile(a.path, b.path)) continue;
+      throw Error(b.option + " " + b.path,
+                  "is the same file as " + a.option + " (" + a.path + ")" +
+                      (output(a) && output(b) ? ": both would be written to it"
+                                              : ": the command would write over what it reads"));
     }
 }
 

@@ -37,8 +37,8 @@ void addCompare(CLI::App& app) {
     // Both outputs checked before the work and before either is written; neither may be an input.
     checkCommandFiles({{"reference", opt->reference},
                        {"test", opt->test},
-                       {"--heatmap", opt->heatmap, true},
-                       {"--json", opt->json, true}});
+                       {"--heatmap", opt->heatmap, CommandFile::Role::kOutput},
+                       {"--json", opt->json, CommandFile::Role::kOutput}});
     const ImageRGBA8 ref = readPng(opt->reference);
     const ImageRGBA8 test = readPng(opt->test);
     if (ref.width != test.width || ref.height != test.height)

@@ -76,8 +76,8 @@ void addDataset(CLI::App& app) {
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->callback([opt] {
     std::vector<CommandFile> files;
-    for (const std::string& path : opt->scenes) files.push_back({"scene", path});
-    files.push_back({"-o", opt->output, true});
+    for (const std::string& path : opt->scenes) files.push_back({"scene", path, CommandFile::Role::kScene});
+    files.push_back({"-o", opt->output, CommandFile::Role::kRequiredOutput});
     checkCommandFiles(files);
     const std::vector<double> levels = parseBudgetLevels(opt->budgets);
     const std::vector<std::string> views = splitList(opt->views);

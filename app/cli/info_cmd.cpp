@@ -101,7 +101,8 @@ void addInfo(CLI::App& app) {
                       "and its cross-section area)");
   cmd->add_option("--json", opt->json, "Also write the information as JSON");
   cmd->callback([opt] {
-    checkCommandFiles({{"scene", opt->scene}, {"--json", opt->json, true}});
+    checkCommandFiles(
+        {{"scene", opt->scene, CommandFile::Role::kScene}, {"--json", opt->json, CommandFile::Role::kOutput}});
     if (opt->methods) {
       const nlohmann::ordered_json methods = methodsJson();
       printMethods(methods);

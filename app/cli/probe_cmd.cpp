@@ -85,7 +85,8 @@ void addProbe(CLI::App& app) {
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->callback([opt, thicknessGiven] {
-    checkCommandFiles({{"scene", opt->scene}, {"--json", opt->json, true}});
+    checkCommandFiles(
+        {{"scene", opt->scene, CommandFile::Role::kScene}, {"--json", opt->json, CommandFile::Role::kOutput}});
     const auto [w, h] = parseSize("--size", opt->size);
     validateImageSize("--size", w, h);
     const auto [x, y] = parsePixel(opt->pixel);

@@ -78,7 +78,13 @@ void addRender(CLI::App& app) {
     const auto [w, h] = parseSize("--size", opt->size);
     // Both outputs checked before the work, so that a bad second path leaves no first file behind;
     // neither may be the scene, nor both one file (the JSON would replace the image just written).
-    checkCommandFiles({{"scene", opt->scene}, {"-o", opt->output, true}, {"--stats", opt->stats, true}});
+    // A dkb weights file given as a parameter is read too.
+    std::vector<CommandFile> files{{"scene", opt->scene, CommandFile::Role::kScene}};
+    for (const std::string& p : opt->params)
+      if (p.rfind("weights=", 0) == 0) files.push_back({"-p", p.substr(8)});
+    files.push_back({"-o", opt->output, CommandFile::Role::kRequiredOutput});
+    files.push_back({"--stats", opt->stats, CommandFile::Role::kOutput});
+    checkCommandFiles(files);
     RenderRequest req;
     req.method = opt->method;
     req.operation = opt->op;

@@ -49,7 +49,7 @@ void addTrain(CLI::App& app) {
   cmd->callback([opt] {
     std::vector<CommandFile> files;
     for (const std::string& path : opt->datasets) files.push_back({"dataset", path});
-    files.push_back({"-o", opt->output, true});
+    files.push_back({"-o", opt->output, CommandFile::Role::kRequiredOutput});
     checkCommandFiles(files);
     DkbDataset all;
     std::string meta = "[";

@@ -231,7 +231,7 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
 }
 
 // --help and --version need no display: answered by a QCoreApplication, which opens none.
-bool onlyHelpOrVersion(int argc, char** argv) {
+bool mentionsHelpOrVersion(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     for (const char* option : {"-h", "--help", "-?", "--help-all", "-v", "--version"})
       if (std::strcmp(argv[i], option) == 0) return true;
@@ -242,8 +242,8 @@ bool onlyHelpOrVersion(int argc, char** argv) {
 // to; the usual case, no display at all, is said in one line instead.
 void refuseMissingDisplay(int argc, char** argv) {
   const QByteArray platform = qgetenv("QT_QPA_PLATFORM");
-  for (int i = 1; i < argc; ++i)
-    if (std::strcmp(argv[i], "-platform") == 0) return;  // the user chose one: Qt checks it
+  for (int i = 1; i < argc; ++i)  // the user chose one (Qt takes -platform and --platform): Qt checks it
+    if (std::strcmp(argv[i], "-platform") == 0 || std::strcmp(argv[i], "--platform") == 0) return;
   if (!platform.isEmpty() && !platform.startsWith("xcb")) return;
   if (!qEnvironmentVariableIsEmpty("DISPLAY") ||
       (platform.isEmpty() && !qEnvironmentVariableIsEmpty("WAYLAND_DISPLAY")))
@@ -256,12 +256,13 @@ void refuseMissingDisplay(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (onlyHelpOrVersion(argc, argv)) {
+  if (mentionsHelpOrVersion(argc, argv)) {
     QCoreApplication core(argc, argv);
     QCoreApplication::setApplicationName(QStringLiteral("mfrview"));
     QCoreApplication::setApplicationVersion(QStringLiteral(MFR_VERSION));
-    (void)parseCommandLine(core);  // prints the help or the version and exits
-    return 0;
+    // Prints the help or the version and exits; returns only where "-v" was another option's
+    // value (--field -v), and the viewer starts as usual.
+    (void)parseCommandLine(core);
   }
   refuseMissingDisplay(argc, argv);
   // Every GL context mfrview creates is 4.5 core, like mfrcore's headless one.

@@ -51,6 +51,9 @@ void flushNothing(png_structp) {}
 // Decodes with libpng into *image (rows points into its pixels); only trivially destructible
 // locals live across setjmp. Returns false with state->message set on failure.
 static bool decodePng(const std::string* bytes, ImageRGBA8* image, std::vector<png_bytep>* rows, PngErrorState* state) {
+  // Before libpng's structs exist: it may throw (a malformed MFR_MEMORY_LIMIT_MIB), and nothing
+  // that throws may run between their creation and their destruction.
+  const std::optional<std::uint64_t> available = availableHostMemory();
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, state, pngError, pngWarning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
@@ -78,7 +81,7 @@ static bool decodePng(const std::string* bytes, ImageRGBA8* image, std::vector<p
     png_error(png, reason);
   }
   const std::uint64_t rgba = std::uint64_t{w} * h * 4;
-  if (const std::optional<std::uint64_t> available = availableHostMemory(); available && rgba > *available) {
+  if (available && rgba > *available) {
     std::snprintf(reason, sizeof reason, "%ux%u pixels would take %s; only %s is available", w, h,
                   formatMemory(rgba).c_str(), formatMemory(*available).c_str());
     png_error(png, reason);

@@ -30,6 +30,8 @@
 #include <QtTest>
 
 #include <algorithm>
+#include <charconv>
+#include <system_error>
 #include <cmath>
 #include <functional>
 #include <cstdlib>
@@ -281,19 +283,16 @@ struct ProgressRecorder {
   [[nodiscard]] bool monotonic() const { return std::is_sorted(fractions.begin(), fractions.end()); }
 };
 
-// Runs a program; returns its exit code (output kept for failure messages).
-// A stats note's number, read back exactly (notes are the shortest text of the double); NaN when
-// the note is missing or not a number, which compares unequal to anything.
+// A stats note's number, read back exactly (notes are the shortest text of the double, written by
+// std::to_chars; from_chars reads it whatever the locale); NaN when the note is missing or not a
+// number, which compares unequal to anything.
 double numberOf(const std::string& note) {
-  try {
-    std::size_t used = 0;
-    const double v = std::stod(note, &used);
-    return used == note.size() ? v : std::nan("");
-  } catch (const std::exception&) {
-    return std::nan("");
-  }
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(note.data(), note.data() + note.size(), v);
+  return ec == std::errc() && end == note.data() + note.size() && !note.empty() ? v : std::nan("");
 }
 
+// Runs a program; returns its exit code (output kept for failure messages).
 int runProgram(const QString& program, const QStringList& args, QString* output) {
   QProcess p;
   p.setProcessChannelMode(QProcess::MergedChannels);
@@ -650,9 +649,6 @@ class ViewerTest : public QObject {
     }
   }
 
-  // Under a comma-decimal locale (de_DE), QApplication's setlocale made mfrcore's std::stod read
-  // "0.9" as 0: mboit's overestimation=0.9 bias=0.3 drew the image of 0 and 0 (RMSE 0.054 from
-  // mfr render's). The locale is built with localedef into a temporary folder (LOCPATH).
   // Without a display, --version and --help answer (Qt's xcb platform aborted them, exit 134) and
   // anything else is refused in one line instead of Qt's paragraph and an abort.
   void viewerWithoutADisplay() {
@@ -680,6 +676,9 @@ class ViewerTest : public QObject {
              qPrintable(out));
   }
 
+  // Under a comma-decimal locale (de_DE), QApplication's setlocale made mfrcore's std::stod read
+  // "0.9" as 0: mboit's overestimation=0.9 bias=0.3 drew the image of 0 and 0 (RMSE 0.054 from
+  // mfr render's). The locale is built with localedef into a temporary folder (LOCPATH).
   void viewerReadsNumbersInAnyLocale() {
     QTemporaryDir dir;
     QString out;

@@ -243,6 +243,8 @@ TEST_F(Cli, NoCommandWritesOverItsInputsOrOneFileTwice) {
   const fs::path png = dir() / "a.png";
   ASSERT_EQ(runCli("render @sample -s 24x16 -o " + png.string()).exitCode, 0);
   fs::copy_file(png, dir() / "b.png");
+  fs::copy_file(png, dir() / "@r.png");
+  fs::copy_file(MFR_TEST_DATA_DIR "/../../resources/dkb/weights.json", dir() / "w.json");
   const fs::path scene = write("s.mfrscene", R"({"objects": [{"primitive": {"type": "box"}}]})");
   const fs::path data = dir() / "d.bin";
   ASSERT_EQ(runCli("dataset @sample --views front -s 24x16 --budgets 1,all -o " + data.string()).exitCode, 0);
@@ -251,7 +253,9 @@ TEST_F(Cli, NoCommandWritesOverItsInputsOrOneFileTwice) {
   const std::map<std::string, std::string> before{{"a.png", mfr::readFile(png)},
                                                   {"b.png", mfr::readFile(dir() / "b.png")},
                                                   {"s.mfrscene", mfr::readFile(scene)},
-                                                  {"d.bin", mfr::readFile(data)}};
+                                                  {"d.bin", mfr::readFile(data)},
+                                                  {"@r.png", mfr::readFile(dir() / "@r.png")},
+                                                  {"w.json", mfr::readFile(dir() / "w.json")}};
   const std::string cd = "cd " + dir().string() + " && " + MFR_CLI + " ";
   for (const auto& [command, mention] : std::vector<std::pair<std::string, std::string>>{
            {"compare a.png b.png --json b.png", "--json b.png: is the same file as test (b.png)"},
@@ -260,6 +264,10 @@ TEST_F(Cli, NoCommandWritesOverItsInputsOrOneFileTwice) {
            {"compare a.png b.png --json link.png", "--json link.png: is the same file as reference"},
            {"compare a.png b.png --heatmap hard.png", "--heatmap hard.png: is the same file as test"},
            {"compare a.png b.png --json out.x --heatmap out.x", "is the same file as --heatmap (out.x): both would"},
+           // Only a scene can be a built-in: a file whose name starts with '@' is a file.
+           {"compare @r.png b.png --heatmap @r.png", "--heatmap @r.png: is the same file as reference (@r.png)"},
+           {"render @sample -s 24x16 -o @q.png --stats @q.png", "--stats @q.png: is the same file as -o (@q.png)"},
+           {"render @sample -s 24x16 -m dkb -p weights=w.json -o w.json", "-o w.json: is the same file as -p"},
            {"render s.mfrscene -s 24x16 -o s.mfrscene", "-o s.mfrscene: is the same file as scene"},
            {"render @sample -s 24x16 -o q.png --stats ./q.png", "--stats ./q.png: is the same file as -o (q.png)"},
            {"info s.mfrscene --no-histogram --json ./s.mfrscene", "is the same file as scene (s.mfrscene)"},
@@ -276,6 +284,13 @@ TEST_F(Cli, NoCommandWritesOverItsInputsOrOneFileTwice) {
   for (const auto& [name, bytes] : before) EXPECT_EQ(mfr::readFile(dir() / name), bytes) << name << " was changed";
   EXPECT_FALSE(fs::exists(dir() / "out.x"));
   EXPECT_FALSE(fs::exists(dir() / "q.png"));
+  EXPECT_FALSE(fs::exists(dir() / "@q.png"));
+  // An empty output is refused before the work (dataset printed its table first).
+  for (const std::string command : {"render @sample -s 24x16 -o ''", "dataset @sample --views front -s 24x16 -o ''"}) {
+    const CliResult r = mfr::test::runCommand(cd + command);
+    EXPECT_EQ(r.exitCode, 1) << command << ": " << r.out;
+    EXPECT_EQ(r.out, "mfr: -o: empty file name\n") << command;
+  }
   // A file named twice only as an input is fine.
   EXPECT_EQ(mfr::test::runCommand(cd + "compare a.png ./a.png --metric rmse").exitCode, 0);
 }

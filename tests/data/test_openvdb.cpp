@@ -212,7 +212,16 @@ TEST_F(OpenVdbFiles, BadFilesAreOneLineErrors) {
     const fs::path p = write("cut" + std::to_string(cut) + ".vdb", bytes.substr(0, cut));
     // Said as what it is: OpenVDB reads garbage sizes past the end, which were "out of memory"
     // (at 93 MB used) or "no float, double or vector grid", differently from run to run.
-    expectError(p, p.string() + ": corrupt or truncated OpenVDB file (");
+    expectError(p, p.string() + ": ");
+    std::string what;
+    try {
+      (void)loadVolume(p);
+    } catch (const Error& e) {
+      what = e.what();
+    }
+    EXPECT_TRUE(what.find(": corrupt or truncated OpenVDB file (") != std::string::npos ||
+                what.find(": the file has no grids (or is truncated)") != std::string::npos)
+        << what;
   }
 }
 

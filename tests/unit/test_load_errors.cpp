@@ -306,7 +306,12 @@ TEST_F(LoadModel, GarbageOff) {
                   "malformed or truncated OFF");
   // A negative corner count: CGAL's std::length_error ("vector::_M_default_append") came through.
   expectLoadError(write("negative.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n"),
-                  "OFF face 0 declares a negative corner count (-3)");
+                  "OFF face 0 declares -3 corners (not a count)");
+  // Counts CGAL reads as doubles: checked against the bytes like any other.
+  expectLoadError(write("exponent.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2e9 0 1 2\n"),
+                  "OFF face 0 declares 2000000000 corners but only");
+  expectLoadError(write("plus.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n+2000000000 0 1 2\n"),
+                  "OFF face 0 declares 2000000000 corners but only");
   const auto be32 = [](std::int64_t v) {
     std::string b(4, '\0');
     for (int i = 0; i < 4; ++i) b[static_cast<std::size_t>(i)] = static_cast<char>((v >> (8 * (3 - i))) & 0xff);

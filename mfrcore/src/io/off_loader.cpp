@@ -2,10 +2,12 @@
 
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <iterator>
 #include <sstream>
 #include <stdexcept>
+#include <system_error>
 #include <vector>
 
 #include <CGAL/IO/OFF.h>
@@ -57,10 +59,17 @@ void checkAsciiFaceSizes(std::string_view bytes, std::size_t pos, std::uint64_t 
     if (first.empty()) continue;  // blank or a comment
     if (records++ < vertices) continue;
     std::uint64_t corners = 0;
-    if (first.front() == '-')
-      throw Error(name, "OFF face " + std::to_string(records - vertices - 1) + " declares a negative corner count (" +
-                            std::string(first) + ")");
-    if (!toCount(first, corners)) return;  // CGAL says what is wrong
+    if (!toCount(first, corners)) {
+      // CGAL reads the count as a double: "2e9" or "+2000000000" sized a polygon as well.
+      double asRead = 0.0;
+      const char* begin = first.data() + (first.front() == '+' ? 1 : 0);
+      const auto [end, ec] = std::from_chars(begin, first.data() + first.size(), asRead);
+      if (ec != std::errc() || end != first.data() + first.size()) return;  // not a number: CGAL says what is wrong
+      if (!(asRead >= 0.0) || asRead != std::floor(asRead))
+        throw Error(name, "OFF face " + std::to_string(records - vertices - 1) + " declares " + std::string(first) +
+                              " corners (not a count)");
+      corners = asRead < 1e19 ? static_cast<std::uint64_t>(asRead) : ~std::uint64_t{0};
+    }
     if (corners > (bytes.size() - start) / 2)
       throw Error(name, "OFF face " + std::to_string(records - vertices - 1) + " declares " + std::to_string(corners) +
                             " corners but only " + std::to_string(bytes.size() - start) +

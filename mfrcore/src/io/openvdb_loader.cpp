@@ -107,7 +107,8 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
   if (!field.empty() && chosen.empty())
     throw FieldNotFound(
         name, "no grid '" + field + "' (" + (list.empty() ? std::string("the file has none") : "grids: " + list) + ")");
-  if (headers->empty()) throw corrupt("it lists no grid");
+  // A valid file may hold no grid; a file cut after its header reads the same way.
+  if (headers->empty()) throw Error(name, "the file has no grids (or is truncated)");
   if (rank == 0) throw Error(name, "no float, double or vector grid in the file (it has " + list + ")");
   progress.step(0.1);
   openvdb::GridBase::Ptr base;
