@@ -142,22 +142,6 @@ std::vector<std::uint32_t> NeuralImportanceModel::packedWords() const {
 }
 
 namespace {
-NeuralImportanceModel parseWeightsJson(const std::string& text, const std::string& source);
-}  // namespace
-
-NeuralImportanceModel parseNeuralImportance(const std::string& text, const std::string& source) {
-  // A number past double's range ("1e999") or a key of the wrong type is nlohmann's out_of_range
-  // or type_error, not parse_error: every JSON error names the file (was "internal error").
-  try {
-    return parseWeightsJson(text, source);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw Error(source, std::string("not valid JSON (") + e.what() + ")");
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(source, std::string("not a valid weights file (") + e.what() + ")");
-  }
-}
-
-namespace {
 NeuralImportanceModel parseWeightsJson(const std::string& text, const std::string& source) {
   const nlohmann::json j = nlohmann::json::parse(text);
   if (!j.is_object() || j.value("format", "") != "mfr-dkb-weights")
@@ -201,6 +185,18 @@ NeuralImportanceModel parseWeightsJson(const std::string& text, const std::strin
   return m;
 }
 }  // namespace
+
+NeuralImportanceModel parseNeuralImportance(const std::string& text, const std::string& source) {
+  // A number past double's range ("1e999") or a key of the wrong type is nlohmann's out_of_range
+  // or type_error, not parse_error: every JSON error names the file (was "internal error").
+  try {
+    return parseWeightsJson(text, source);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw Error(source, std::string("not valid JSON (") + e.what() + ")");
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(source, std::string("not a valid weights file (") + e.what() + ")");
+  }
+}
 
 std::string neuralImportanceJson(const NeuralImportanceModel& m) {
   if (m.weights.size() != MFR_MLP_FLOATS) throw Error("dkb weights", "model has the wrong number of weights");

@@ -70,19 +70,20 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
   // OpenVDB does not check its reads: a truncated file hands it garbage sizes, which ended as
   // "out of memory" (at 93 MB used) or another reason each run. What it throws is said as what it
   // most likely is.
-  const auto corrupt = [&](const std::string& what) {
-    return Error(name, "corrupt or truncated OpenVDB file (" + what + ")");
+  const auto reading = [&](auto read) {
+    try {
+      return read();
+    } catch (const std::bad_alloc&) {
+      throw Error(name, "corrupt or truncated OpenVDB file (a size read from it is absurd)");
+    } catch (const std::exception& e) {
+      throw Error(name, std::string("corrupt or truncated OpenVDB file (") + e.what() + ")");
+    }
   };
   openvdb::io::File file(path.string());
-  openvdb::GridPtrVecPtr headers;
-  try {
+  const openvdb::GridPtrVecPtr headers = reading([&] {
     file.open(false);  // no delayed loading: the file is read now, not when voxels are touched
-    headers = file.readAllGridMetadata();
-  } catch (const std::bad_alloc&) {
-    throw corrupt("a size read from it is absurd");
-  } catch (const std::exception& e) {
-    throw corrupt(e.what());
-  }
+    return file.readAllGridMetadata();
+  });
   // The grid read: the one named `field`; else "density" if the file has that scalar grid, else its
   // first scalar grid, else the magnitude of its first vector grid.
   std::string chosen, list;
@@ -111,14 +112,7 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
   if (headers->empty()) throw Error(name, "the file has no grids (or is truncated)");
   if (rank == 0) throw Error(name, "no float, double or vector grid in the file (it has " + list + ")");
   progress.step(0.1);
-  openvdb::GridBase::Ptr base;
-  try {
-    base = file.readGrid(chosen);
-  } catch (const std::bad_alloc&) {
-    throw corrupt("a size read from it is absurd");
-  } catch (const std::exception& e) {
-    throw corrupt(e.what());
-  }
+  const openvdb::GridBase::Ptr base = reading([&] { return file.readGrid(chosen); });
   file.close();
   progress.step(0.5);
 

@@ -399,9 +399,9 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
     std::vector<std::string> tokens;
     for (std::string t; value >> t;) tokens.push_back(t);
     if (field == "dimension") {
+      // The array's; "space" and "space dimension" are the space's (a 4D vector file has
+      // "dimension: 4" and "space: LPS").
       dimension = tokens.empty() ? 0 : std::atol(tokens[0].c_str());
-    } else if (field == "space dimension" || field == "space") {
-      // The space's dimension, not the array's: a 4D vector file has "dimension: 4" and "space: LPS".
     } else if (field == "sizes") {
       if (dimension < 1 || dimension > 16) throw Error(name, "NRRD 'sizes' without a valid 'dimension' before it");
       if (static_cast<long>(tokens.size()) != dimension)
