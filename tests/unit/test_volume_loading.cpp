@@ -359,8 +359,7 @@ TEST_F(VolumeLoading, MetaImageWithSeparateRawFile) {
   expectVec(v.spacing, {0.5, 0.25, 4.0});
 }
 
-// NRRD does not tell vector components from axes: VTK takes a first axis of 9 or fewer samples
-// for components, so these grids are 10 wide.
+// A 10x3x2 grid (the narrow case, which vtkNrrdReader alone misread, is NrrdNarrowFirstAxisIsAnAxis).
 std::string nrrdRaw() {
   std::string raw;
   for (int k = 0; k < 2; ++k)
@@ -431,6 +430,91 @@ TEST_F(VolumeLoading, NrrdSpaceDirectionsOrientTheGrid) {
                           "space origin: (0,0\nencoding: raw\n\n" +
                               nrrdRaw()),
                     "NRRD 'space origin' must be one vector (x,y,z) (got '(0,0')");
+}
+
+// A grid 9 or fewer samples wide is a grid: vtkNrrdReader alone took its first axis for vector
+// components ("sizes: 4 3 2" came out as a 4-component 3x2x1 image, refused as flat). Raw, gzip,
+// detached, with spacings or with space directions, and with "kinds" saying so.
+TEST_F(VolumeLoading, NrrdNarrowFirstAxisIsAnAxis) {
+  for (const int width : {2, 4, 9}) {
+    std::string raw;
+    for (int k = 0; k < 2; ++k)
+      for (int j = 0; j < 3; ++j)
+        for (int i = 0; i < width; ++i) raw += bytesOf(field(i, j, k), false);
+    const std::string sizes = "sizes: " + std::to_string(width) + " 3 2\n";
+    const std::string header =
+        "NRRD0004\ntype: float\ndimension: 3\n" + sizes + "spacings: 0.5 1 1.5\nendian: little\n";
+    const std::string tag = std::to_string(width);
+    const mfr::Volume attached = mfr::loadVolume(write("narrow" + tag + ".nrrd", header + "encoding: raw\n\n" + raw));
+    expectField(attached, {width, 3, 2});
+    expectVec(attached.spacing, {0.5, 1.0, 1.5});
+    write("narrow" + tag + ".raw", raw);
+    expectField(
+        mfr::loadVolume(write("narrow" + tag + ".nhdr", header + "encoding: raw\ndata file: narrow" + tag + ".raw\n")),
+        {width, 3, 2});
+    std::ifstream in(writeGz("narrow" + tag + ".gz", raw), std::ios::binary);
+    const std::string gz{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    expectField(mfr::loadVolume(write("narrow" + tag + "z.nrrd", header + "encoding: gzip\n\n" + gz)), {width, 3, 2});
+    const mfr::Volume kinds = mfr::loadVolume(
+        write("kinds" + tag + ".nrrd", "NRRD0004\ntype: float\ndimension: 3\n" + sizes +
+                                           "kinds: domain domain domain\nendian: little\nencoding: raw\n\n" + raw));
+    expectField(kinds, {width, 3, 2});
+    expectVec(kinds.spacing, {1.0, 1.0, 1.0});
+    // Oriented: the first axis steps by its own vector (VTK read "( 0, 2, 0 )" with spaces as
+    // spacing 0, another reason it took the axis for components).
+    const mfr::Volume oriented = mfr::loadVolume(
+        write("oriented" + tag + ".nrrd", "NRRD0004\ntype: float\ndimension: 3\n" + sizes +
+                                              "space directions: ( 0, 2, 0 ) (-3,0,0.5) (0,0.25,1)\n"
+                                              "space origin: (10,-20,30)\nendian: little\nencoding: raw\n\n" +
+                                              raw));
+    expectField(oriented, {width, 3, 2});
+    const glm::dvec3 want = glm::dvec3(10.0, -20.0, 30.0) + double(width - 1) * glm::dvec3(0.0, 2.0, 0.0) +
+                            2.0 * glm::dvec3(-3.0, 0.0, 0.5) + glm::dvec3(0.0, 0.25, 1.0);
+    const glm::dvec3 got(oriented.gridToWorld() * glm::dvec4(double(width - 1), 2.0, 1.0, 1.0));
+    EXPECT_LT(glm::length(got - want), 1e-9) << width;
+  }
+  // Told it is not an axis, the first axis still holds components: a 3x3 RGB image is not a volume.
+  expectVolumeError(write("rgb.nrrd",
+                          "NRRD0004\ntype: float\ndimension: 3\nsizes: 3 10 3\n"
+                          "kinds: RGB-color domain domain\nendian: little\nencoding: raw\n\n" +
+                              std::string(3 * 10 * 3 * 4, '\0')),
+                    "at least 2 points per axis");
+}
+
+// A 4-axis NRRD holds vector components on its first axis ("kinds: vector domain domain
+// domain", "space directions: none (…) (…) (…)"): the volume is the first component, and the
+// three spatial axes keep their directions. Components anywhere else are refused, not misread.
+TEST_F(VolumeLoading, NrrdVectorComponentsOnTheFirstAxis) {
+  std::string raw;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 10; ++i) {
+        raw += bytesOf(field(i, j, k), false);
+        raw += bytesOf(2.0f * field(i, j, k), false);
+      }
+  const std::string head = "NRRD0004\ntype: float\ndimension: 4\nsizes: 2 10 3 2\nendian: little\nencoding: raw\n";
+  const fs::path p = write("vector.nrrd", head +
+                                              "kinds: vector domain domain domain\nspace: right-anterior-superior\n"
+                                              "space directions: none (0,2,0) (-3,0,0.5) (0,0.25,1)\n"
+                                              "space origin: (10,-20,30)\n\n" +
+                                              raw);
+  const mfr::Volume first = mfr::loadVolume(p);  // NRRD's one field: the first component
+  expectField(first, {10, 3, 2});
+  const glm::dvec3 want = glm::dvec3(10.0, -20.0, 30.0) + 9.0 * glm::dvec3(0.0, 2.0, 0.0) +
+                          2.0 * glm::dvec3(-3.0, 0.0, 0.5) + glm::dvec3(0.0, 0.25, 1.0);
+  const glm::dvec3 got(first.gridToWorld() * glm::dvec4(9.0, 2.0, 1.0, 1.0));
+  EXPECT_LT(glm::length(got - want), 1e-9);
+  expectVolumeError(write("last.nrrd", head + "kinds: domain domain domain vector\n\n" + raw),
+                    "NRRD of 4 axes whose vector components are not on the first axis (kinds: domain domain domain "
+                    "vector; space directions: not given): not supported");
+  // VTK read a fifth axis's first three as the grid and dropped the rest.
+  expectVolumeError(write("five.nrrd",
+                          "NRRD0004\ntype: float\ndimension: 5\nsizes: 2 10 3 2 2\nendian: little\n"
+                          "encoding: raw\n\n" +
+                              raw + raw),
+                    "NRRD of 5 axes: a volume has 3 spatial axes and at most one of components");
+  expectVolumeError(write("lastnone.nrrd", head + "space directions: (1,0,0) (0,1,0) (0,0,1) none\n\n" + raw),
+                    "vector components are not on the first axis");
 }
 
 TEST_F(VolumeLoading, DefaultTransferIsGrayscaleOverTheDataRange) {

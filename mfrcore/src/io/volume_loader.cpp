@@ -44,6 +44,7 @@
 #include <vtkMetaImageReader.h>
 #include <vtkNew.h>
 #include <vtkNrrdReader.h>
+#include <vtkObjectFactory.h>
 #include <vtkPointData.h>
 #include <vtkSmartPointer.h>
 #include <vtkStreamingDemandDrivenPipeline.h>
@@ -159,7 +160,54 @@ const char* formatLabel(VolumeFormat format) {
   return "volume";
 }
 
-vtkSmartPointer<vtkAlgorithm> makeReader(VolumeFormat format, const std::string& file) {
+// What the NRRD header says that vtkNrrdReader (VTK 9.1) does not read: see checkNrrdHeader.
+struct NrrdOrientation {
+  std::optional<std::array<glm::dvec3, 3>> directions;  // of the three spatial axes, in order
+  std::vector<long> spatialSizes;                       // the three spatial axes' sizes
+  // Set for a 3D grid whose first axis vtkNrrdReader would take for vector components: each
+  // axis's spacing as vtkNrrdReader would have read it.
+  std::optional<std::array<double, 3>> keepFirstAxis;
+};
+
+// NRRD does not mark which axis holds a vector's components except in "kinds", which
+// vtkNrrdReader ignores: it guesses components from a first axis of 9 or fewer samples (or a
+// first spacing of 0), so an ordinary 8×8×8 scalar grid came out as an 8-component 2D image and
+// was refused. This reader reads the header as vtkNrrdReader does and, where checkNrrdHeader found
+// that the first axis is spatial, puts it back as the grid's first axis.
+class NrrdReader : public vtkNrrdReader {
+ public:
+  static NrrdReader* New();
+  vtkTypeMacro(NrrdReader, vtkNrrdReader) void keepFirstAxis(const std::vector<long>& sizes,
+                                                             const std::array<double, 3>& spacing) {
+    sizes_ = sizes;
+    spacing_ = spacing;
+  }
+
+ protected:
+  NrrdReader() = default;
+  ~NrrdReader() override = default;
+  int ReadHeader(vtkCharArray* headerBuffer) override {
+    if (vtkNrrdReader::ReadHeader(headerBuffer) == 0) return 0;
+    if (sizes_.size() == 3 && NumberOfScalarComponents != 1) {
+      NumberOfScalarComponents = 1;
+      FileDimensionality = 3;
+      for (int a = 0; a < 3; ++a) {
+        DataExtent[2 * a] = 0;
+        DataExtent[2 * a + 1] = static_cast<int>(sizes_[static_cast<std::size_t>(a)] - 1);
+        DataSpacing[a] = spacing_[static_cast<std::size_t>(a)];
+      }
+    }
+    return 1;
+  }
+
+ private:
+  std::vector<long> sizes_;
+  std::array<double, 3> spacing_{1.0, 1.0, 1.0};
+};
+vtkStandardNewMacro(NrrdReader)
+
+    vtkSmartPointer<vtkAlgorithm> makeReader(VolumeFormat format, const std::string& file,
+                                             const NrrdOrientation& nrrd) {
   switch (format) {
     case VolumeFormat::Vti: {
       auto r = vtkSmartPointer<vtkXMLImageDataReader>::New();
@@ -178,8 +226,9 @@ vtkSmartPointer<vtkAlgorithm> makeReader(VolumeFormat format, const std::string&
       return r;
     }
     case VolumeFormat::Nrrd: {
-      auto r = vtkSmartPointer<vtkNrrdReader>::New();
+      auto r = vtkSmartPointer<NrrdReader>::New();
       r->SetFileName(file.c_str());
+      if (nrrd.keepFirstAxis) r->keepFirstAxis(nrrd.spatialSizes, *nrrd.keepFirstAxis);
       return r;
     }
     case VolumeFormat::Inrimage:
@@ -241,10 +290,7 @@ class CerrCapture {
 // It also returns the orientation, which vtkNrrdReader (VTK 9.1) reads only in part: of "space
 // directions" it keeps each vector's length as the spacing and drops its direction. Axis a of the
 // grid steps by directions[a] in the file's space from "space origin" (the NRRD format's definition).
-struct NrrdOrientation {
-  std::optional<std::array<glm::dvec3, 3>> directions;  // three spatial axes, none "none"
-  std::vector<long> sizes;
-};
+// And it says where vtkNrrdReader's guess at the component axis is wrong (NrrdReader, above).
 
 // The value of "space directions": one entry per axis, "(x,y,z)" (spaces allowed inside) or
 // "none" (a non-spatial axis, nothing here). Throws mfr::Error(name, …) for anything else.
@@ -388,7 +434,10 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
   std::string line;
   std::getline(lines, line);  // the magic
   long dimension = 0;
-  bool sizes = false;
+  std::vector<long> sizes;
+  std::vector<double> spacings;
+  std::vector<std::string> kinds;
+  std::vector<std::optional<glm::dvec3>> directions;
   while (std::getline(lines, line)) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) break;
@@ -407,27 +456,32 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
       if (static_cast<long>(tokens.size()) != dimension)
         throw Error(name, "NRRD 'sizes' has " + std::to_string(tokens.size()) + " values for dimension " +
                               std::to_string(dimension));
+      sizes.clear();
       for (const std::string& t : tokens) {
         if (t.find_first_not_of("0123456789") != std::string::npos || std::atol(t.c_str()) < 1)
           throw Error(name, "NRRD 'sizes' must be positive integers (got '" + t + "')");
-        orientation.sizes.push_back(std::atol(t.c_str()));
+        sizes.push_back(std::atol(t.c_str()));
       }
-      sizes = true;
+    } else if (field == "spacings") {
+      spacings.clear();
+      for (const std::string& t : tokens) spacings.push_back(std::atof(t.c_str()));  // as VTK reads them
+    } else if (field == "kinds") {
+      kinds = tokens;
     } else if (field == "space directions") {
-      const std::vector<std::optional<glm::dvec3>> vectors = nrrdDirections(line.substr(colon + 2), name);
-      // One entry per axis, three of them spatial (a 4D file's "none" axis holds components: VTK's
-      // business); VTK took two vectors for three axes without a word.
-      if (dimension >= 1 && static_cast<long>(vectors.size()) != dimension)
-        throw Error(name, "NRRD 'space directions' has " + std::to_string(vectors.size()) + " entries for dimension " +
-                              std::to_string(dimension));
-      if (std::count_if(vectors.begin(), vectors.end(), [](const auto& v) { return v.has_value(); }) != 3)
+      directions = nrrdDirections(line.substr(colon + 2), name);
+      // One entry per axis, three of them spatial; VTK took two vectors for three axes without a word.
+      if (dimension >= 1 && static_cast<long>(directions.size()) != dimension)
+        throw Error(name, "NRRD 'space directions' has " + std::to_string(directions.size()) +
+                              " entries for dimension " + std::to_string(dimension));
+      if (std::count_if(directions.begin(), directions.end(), [](const auto& v) { return v.has_value(); }) != 3)
         throw Error(name, "NRRD 'space directions' must give 3 spatial axes (vectors; 'none' for others)");
-      if (vectors.size() == 3 && vectors[0] && vectors[1] && vectors[2]) {
-        const glm::dmat3 m(*vectors[0], *vectors[1], *vectors[2]);
-        if (!(std::abs(glm::determinant(m)) > 0.0))
-          throw Error(name, "NRRD 'space directions' are not independent (the grid would be flat)");
-        orientation.directions = std::array<glm::dvec3, 3>{*vectors[0], *vectors[1], *vectors[2]};
-      }
+      std::vector<glm::dvec3> spatial;
+      for (const auto& v : directions)
+        if (v) spatial.push_back(*v);
+      if (!(std::abs(glm::determinant(glm::dmat3(spatial[0], spatial[1], spatial[2]))) > 0.0))
+        throw Error(name, "NRRD 'space directions' are not independent (the grid would be flat)");
+      spacings.clear();  // VTK's spacings are the vectors' lengths
+      for (const auto& v : directions) spacings.push_back(v ? glm::length(*v) : 0.0);
     } else if (field == "space origin") {
       // VTK read "(0,0" as the origin without a word.
       std::vector<std::optional<glm::dvec3>> origin;
@@ -448,7 +502,48 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
         throw Error(name, "NRRD data split into several files is not supported");
     }
   }
-  if (!sizes) throw Error(name, "NRRD header has no 'sizes'");
+  if (sizes.empty()) throw Error(name, "NRRD header has no 'sizes'");
+
+  // Which axes are spatial. NRRD's "kinds" says it ("domain", "space" and "time" are axes of the
+  // grid; "vector", "RGB-color", "3-vector", "list", … hold components; "???" and "none" say
+  // nothing); so does a "none" in "space directions". vtkNrrdReader reads a 4D file's first axis
+  // as components, and a 3D file's first axis too when it has 9 or fewer samples or spacing 0.
+  const auto spatialKind = [&](std::size_t axis) -> std::optional<bool> {
+    if (axis >= kinds.size()) return std::nullopt;
+    const std::string k = lower(kinds[axis]);
+    if (k == "???" || k == "none") return std::nullopt;
+    return k == "domain" || k == "space" || k == "time";
+  };
+  const auto spatialAxis = [&](std::size_t axis) -> std::optional<bool> {
+    if (axis < directions.size()) return directions[axis].has_value();
+    return spatialKind(axis);
+  };
+  if (sizes.size() > 4)
+    throw Error(name, "NRRD of " + std::to_string(sizes.size()) +
+                          " axes: a volume has 3 spatial axes and at most one of components");
+  if (sizes.size() == 4) {
+    const bool componentsFirst =
+        spatialAxis(0) != true && spatialAxis(1) != false && spatialAxis(2) != false && spatialAxis(3) != false;
+    if (!componentsFirst) {
+      std::string given;
+      for (const std::string& k : kinds) given += (given.empty() ? "" : " ") + k;
+      throw Error(name, "NRRD of 4 axes whose vector components are not on the first axis (kinds: " +
+                            (given.empty() ? "not given" : given) + "; space directions: " +
+                            (directions.empty() ? "not given" : "'none' elsewhere") + "): not supported");
+    }
+    orientation.spatialSizes.assign(sizes.begin() + 1, sizes.end());
+    if (directions.size() == 4)
+      orientation.directions = std::array<glm::dvec3, 3>{*directions[1], *directions[2], *directions[3]};
+  } else if (sizes.size() == 3 && spatialKind(0) != false) {
+    orientation.spatialSizes = sizes;
+    if (directions.size() == 3)
+      orientation.directions = std::array<glm::dvec3, 3>{*directions[0], *directions[1], *directions[2]};
+    if (sizes[0] <= 9 || (!spacings.empty() && spacings[0] == 0.0)) {
+      std::array<double, 3> spacing{1.0, 1.0, 1.0};
+      for (std::size_t a = 0; a < 3 && a < spacings.size(); ++a) spacing[a] = spacings[a];
+      orientation.keepFirstAxis = spacing;
+    }
+  }
   return orientation;
 }
 
@@ -668,7 +763,7 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   std::optional<CerrCapture> metaIo;
   if (format == VolumeFormat::MetaImage) metaIo.emplace();
   const std::string file = path.string();
-  vtkSmartPointer<vtkAlgorithm> reader = makeReader(format, file);
+  vtkSmartPointer<vtkAlgorithm> reader = makeReader(format, file, nrrd);
   if (!reader) throw Error(name, "internal error: no VTK reader for " + label);
   ProgressRelay relay{&progress};
   vtkNew<vtkCallbackCommand> onProgress;
@@ -776,11 +871,10 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   start[1] = extent[2];
   start[2] = extent[4];
   // NRRD: the directions VTK dropped (it may also misread their lengths: "( -3, 0, 0.5 )" with
-  // spaces gives a spacing of 0). Only when VTK read the grid as the header's three axes (it takes a
-  // first axis of 9 or fewer samples for vector components, and then they do not apply).
-  const bool nrrdOriented = nrrd.directions && nrrd.sizes.size() == 3 && nrrd.sizes[0] == gridDims.x &&
-                            nrrd.sizes[1] == gridDims.y && nrrd.sizes[2] == gridDims.z && extent[0] == 0 &&
-                            extent[2] == 0 && extent[4] == 0;
+  // spaces gives a spacing of 0). Only when the grid is the header's three spatial axes.
+  const bool nrrdOriented = nrrd.directions && nrrd.spatialSizes.size() == 3 && nrrd.spatialSizes[0] == gridDims.x &&
+                            nrrd.spatialSizes[1] == gridDims.y && nrrd.spatialSizes[2] == gridDims.z &&
+                            extent[0] == 0 && extent[2] == 0 && extent[4] == 0;
   if (nrrdOriented)
     for (int a = 0; a < 3; ++a) s[a] = glm::length((*nrrd.directions)[static_cast<std::size_t>(a)]);
   glm::dvec3 spacing, first;
