@@ -319,8 +319,48 @@ TEST_F(LoadModel, GarbageOff) {
   };
   std::string binary = "OFF BINARY\n" + be32(3) + be32(1) + be32(0);
   for (const float f : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) binary += be32(std::bit_cast<std::int32_t>(f));
+  const std::string vertices = binary;
   binary += be32(-3) + be32(0) + be32(1) + be32(2) + be32(0);
-  expectLoadError(write("negative-binary.off", binary), "malformed or truncated OFF");
+  expectLoadError(write("negative-binary.off", binary), "an OFF face declares -3 corners (not a count)");
+  // A binary face's count of 2³¹ − 1 corners: CGAL sized the face from it (16 GB and 70 s for this
+  // 79-byte file); each corner takes 4 bytes, so the count is refused at once.
+  expectLoadError(write("corners-binary.off", vertices + be32(0x7fffffff) + be32(0) + be32(1) + be32(2) + be32(0)),
+                  "an OFF face declares 2147483647 corners, more than the file's 79 bytes hold");
+}
+
+// Binary OFF (Geomview's format, and what CGAL's own writer writes): each face is its corner
+// count, the corners, then a colour — a count of 0–4 and that many floats. CGAL 5.5's reader does
+// not read the colour and took its count for the next face's: two triangles loaded as one, without
+// an error. The faces without a colour (CGAL's reader's own layout) still load.
+TEST_F(LoadModel, BinaryOffFacesWithTheirColours) {
+  const auto be32 = [](std::int64_t v) {
+    std::string b(4, '\0');
+    for (int i = 0; i < 4; ++i) b[static_cast<std::size_t>(i)] = static_cast<char>((v >> (8 * (3 - i))) & 0xff);
+    return b;
+  };
+  const auto floats = [&](std::initializer_list<float> values) {
+    std::string b;
+    for (const float f : values) b += be32(std::bit_cast<std::int32_t>(f));
+    return b;
+  };
+  const std::string head = "OFF BINARY\n" + be32(4) + be32(3) + be32(0) +
+                           floats({0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f, 1.f, 1.f, 0.f});
+  const std::string quad = be32(4) + be32(0) + be32(1) + be32(3) + be32(2);
+  const std::string first = be32(3) + be32(0) + be32(1) + be32(3), second = be32(3) + be32(0) + be32(3) + be32(2);
+  const auto triangles = [&](const std::string& file, const std::string& body) {
+    const auto objects = mfr::loadModel(write(file, head + body));
+    std::size_t n = 0;
+    for (const auto& o : objects) n += o.mesh->triangleCount();
+    return n;
+  };
+  // A quad and two triangles, with no colour, an RGB and an RGBA colour: 4 triangles.
+  EXPECT_EQ(triangles("geomview.off", quad + be32(0) + first + be32(3) + floats({1.f, 0.f, 0.f}) + second + be32(4) +
+                                          floats({0.f, 0.f, 1.f, 0.5f})),
+            4u);
+  EXPECT_EQ(triangles("cgal.off", quad + first + second), 4u);
+  // A colour count past 4 is neither layout: CGAL reads it as the next face (as before), and the
+  // indices that follow do not fit.
+  expectLoadError(write("colours.off", head + quad + be32(9) + first + second), "malformed or truncated OFF");
 }
 
 // A PNG's header alone sizes the decoded image: 69 bytes claiming 60000² pixels took 14 GB and

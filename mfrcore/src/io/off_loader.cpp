@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <iterator>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
@@ -77,9 +78,38 @@ void checkAsciiFaceSizes(std::string_view bytes, std::size_t pos, std::uint64_t 
   }
 }
 
+// A face's corner indices. CGAL sizes each face from the count it reads, before it reads the
+// indices. A binary file's counts are not checked above (its records' length depends on the
+// header's flags): a 60-byte file whose face declared 2³¹ − 1 corners took 16 GB and 70 s before
+// CGAL's error. This container refuses a count that the file's bytes cannot hold.
+struct TooManyCorners {
+  std::size_t count;
+};
+class FaceCorners : public std::vector<std::size_t> {
+ public:
+  explicit FaceCorners(std::size_t limit = 0) : limit_(limit) {}
+  void resize(std::size_t n) {
+    if (n > limit_) throw TooManyCorners{n};
+    std::vector<std::size_t>::resize(n);
+  }
+
+ private:
+  std::size_t limit_;
+};
+class Faces : public std::vector<FaceCorners> {
+ public:
+  explicit Faces(std::size_t cornerLimit) : cornerLimit_(cornerLimit) {}
+  void resize(std::size_t n) { std::vector<FaceCorners>::resize(n, FaceCorners(cornerLimit_)); }
+
+ private:
+  std::size_t cornerLimit_;
+};
+
 // CGAL sizes its arrays straight from the header counts, so absurd counts (a corrupt or
 // truncated file) are rejected here against the bytes actually present.
-void checkHeader(std::string_view bytes, const std::string& name, std::uint64_t& vertices, std::uint64_t& faces) {
+// Returns where a binary file's vertex data starts (after its three counts), 0 for ASCII.
+std::size_t checkHeader(std::string_view bytes, const std::string& name, std::uint64_t& vertices,
+                        std::uint64_t& faces) {
   std::size_t pos = 0;
   const std::string_view keyword = nextToken(bytes, pos);
   if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF")
@@ -114,25 +144,67 @@ void checkHeader(std::string_view bytes, const std::string& name, std::uint64_t&
     throw Error(name, "OFF header declares " + std::to_string(vertices) + " vertices and " + std::to_string(faces) +
                           " faces but the file has only " + std::to_string(bytes.size()) + " bytes (truncated file?)");
   if (faces == 0) throw Error(name, "no triangles (the OFF file has no faces)");
+  return binary ? pos : 0;
+}
+
+std::uint32_t bigEndian32(std::string_view bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  for (std::size_t k = 0; k < 4; ++k) v = v << 8 | static_cast<unsigned char>(bytes[at + k]);
+  return v;
+}
+
+// A binary OFF face is its corner count, the corners, then a colour: a count of 0–4 and that many
+// floats (Geomview's OFF format; CGAL's own writer writes the count too). CGAL 5.5's read_OFF does
+// not read the colour, so the count was taken for the next face's: a file of two triangles came
+// out as one and an empty face, without an error. For a plain "OFF BINARY" file (vertices of three
+// floats) laid out so, this returns the file with each face's colour taken out, for CGAL to read;
+// for any other layout (CGAL's own dialect without the colour, prefixed keywords, corruption),
+// nothing, and CGAL reads the file as it is.
+std::optional<std::string> withoutFaceColours(std::string_view bytes, std::size_t data, std::uint64_t vertices,
+                                              std::uint64_t faces) {
+  std::size_t pos = data + vertices * 12;
+  std::string out(bytes.substr(0, pos));
+  for (std::uint64_t f = 0; f < faces; ++f) {
+    if (bytes.size() - pos < 4) return std::nullopt;
+    const std::uint32_t corners = bigEndian32(bytes, pos);
+    const std::size_t words = (bytes.size() - pos - 4) / 4;  // for the corners and the colour count
+    if (words < 1 || corners > words - 1) return std::nullopt;
+    const std::size_t colourAt = pos + 4 + std::size_t{corners} * 4;
+    const std::uint32_t colours = bigEndian32(bytes, colourAt);
+    if (colours > 4 || bytes.size() - colourAt - 4 < std::size_t{colours} * 4) return std::nullopt;
+    out.append(bytes.substr(pos, colourAt - pos));
+    pos = colourAt + 4 + std::size_t{colours} * 4;
+  }
+  if (bytes.substr(pos).find_first_not_of(" \t\r\n") != std::string_view::npos) return std::nullopt;
+  return out;
 }
 
 }  // namespace
 
 PolygonSoup parseOff(std::string_view bytes, const std::string& name) {
   std::uint64_t vertexCount = 0, faceCount = 0;
-  checkHeader(bytes, name, vertexCount, faceCount);
+  const std::size_t binaryData = checkHeader(bytes, name, vertexCount, faceCount);
+  std::optional<std::string> stripped;
+  std::size_t probe = 0;
+  if (binaryData > 0 && nextToken(bytes, probe) == "OFF")
+    stripped = withoutFaceColours(bytes, binaryData, vertexCount, faceCount);
 
   std::vector<Kernel::Point_3> points;
-  std::vector<std::vector<std::size_t>> polygons;
+  // Each corner takes at least 2 bytes ("0 "), in a binary file 4.
+  Faces polygons(bytes.size() / 2);
   std::vector<CGAL::IO::Color> colors;
-  std::istringstream in{std::string(bytes), std::ios::in | std::ios::binary};
+  std::istringstream in{stripped ? *stripped : std::string(bytes), std::ios::in | std::ios::binary};
   bool ok = false;
   try {
     ok = CGAL::IO::read_OFF(in, points, polygons,
                             CGAL::parameters::vertex_color_output_iterator(std::back_inserter(colors)).verbose(false));
-  } catch (const std::length_error&) {
-    // A binary face's corner count read as a negative 32-bit number sizes a vector past max_size().
-    ok = false;
+  } catch (const TooManyCorners& e) {
+    // CGAL widens a binary count as a signed 32-bit number: -3 arrives as 2⁶⁴ − 3.
+    const auto count = static_cast<std::int64_t>(e.count);
+    throw Error(name, "an OFF face declares " + std::to_string(count) + " corners" +
+                          (count < 0 ? " (not a count)"
+                                     : ", more than the file's " + std::to_string(bytes.size()) + " bytes hold") +
+                          " (corrupt file?)");
   }
   if (!ok || points.size() != vertexCount || polygons.size() != faceCount)
     throw Error(name, "malformed or truncated OFF data (header declares " + std::to_string(vertexCount) +
