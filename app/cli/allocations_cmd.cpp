@@ -60,7 +60,7 @@ void addAllocations(CLI::App& app) {
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
     const NeuralImportanceModel model = loadNeuralImportance(opt->weights).quantised();  // as on the GPU
-    const std::vector<std::string> views = splitList(opt->views);
+    const std::vector<std::string> views = splitList(opt->views, "--views");
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     // Every allocation gets dkb's slots (its layout also holds the weights), so all compete at one F.
     const VariableKLayout layout = variableKLayout(pixels, NeuralImportanceModel::packedBytes());

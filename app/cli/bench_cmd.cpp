@@ -70,7 +70,8 @@ void addBench(CLI::App& app) {
         {{"scene", opt->scene, CommandFile::Role::kScene}, {"--json", opt->json, CommandFile::Role::kOutput}});
     const auto [w, h] = parseSize("--size", opt->size);
     std::vector<RenderRequest> requests;
-    for (const std::string& spec : splitList(opt->methods)) {
+    const std::vector<std::string> specs = splitList(opt->methods, "--methods");
+    for (const std::string& spec : specs) {
       requests.push_back(parseMethodSpec(spec, w, h));
       // The oracle's refusal comes from the registry; optimal-k, a CPU method too, would be refused
       // there as an unknown method.
@@ -99,6 +100,9 @@ void addBench(CLI::App& app) {
     const Camera camera = scene.view(opt->view);  // fit frames the whole scene, cut or not
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
+    for (std::size_t i = 0; i < requests.size(); ++i)
+      if (scene.volumes.empty() && (requests[i].volumeStep > 0.0 || requests[i].volumeShading))
+        throw Error("--methods " + specs[i], "step and shade are the volume's; scene '" + scene.name + "' has none");
 
     ImageRGBA8 reference;
     ImageRGBA8 csgReference;  // the oracle's CSG image, for rows with op=csg

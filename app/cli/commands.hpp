@@ -44,7 +44,8 @@ void checkCommandFiles(const std::vector<CommandFile>& files);
 // "WxH" → (w, h); throws mfr::Error naming the option.
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);
 // A list separated by commas (or `separator`), empty items dropped.
-std::vector<std::string> splitList(const std::string& text, char separator = ',');
+// The items of a list option; an empty item (a doubled or stray separator) is refused, naming the option.
+std::vector<std::string> splitList(const std::string& text, const std::string& option, char separator = ',');
 // --field and --molecule: what to read of a file that holds several things.
 struct ReadOptions {
   std::string field;                    // --field: the array or grid of a volume file

@@ -4,6 +4,7 @@
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <set>
 
 #include "commands.hpp"
 #include "mfr/budget/memory_model.hpp"
@@ -67,8 +68,12 @@ std::pair<int, int> parseSize(const std::string& option, const std::string& text
   return {w, h};
 }
 
-std::vector<std::string> splitList(const std::string& text, char separator) {
-  return mfr::text::splitList(text, separator);
+std::vector<std::string> splitList(const std::string& text, const std::string& option, char separator) {
+  std::vector<std::string> items = mfr::text::splitList(text, separator);
+  if (std::find(items.begin(), items.end(), std::string()) != items.end())
+    throw Error(option + " " + text,
+                std::string("an empty item ('") + separator + separator + "', or '" + separator + "' at an end)");
+  return items;
 }
 
 void ReadOptions::add(CLI::App* cmd) {
@@ -129,17 +134,20 @@ RenderRequest parseMethodSpec(const std::string& spec, int w, int h) {
   r.width = w;
   r.height = h;
   r.operation = "auto";  // the method's own: hybrid for the budget methods (op=… overrides)
-  std::istringstream in(spec);
-  std::string part;
   bool first = true;
-  while (std::getline(in, part, ':')) {
+  std::set<std::string> keys;
+  for (const std::string& part : mfr::text::splitList(spec, ':')) {
     if (first) {
+      if (part.empty()) throw Error("--methods " + spec, "expected name:key=value:… (no method name)");
       r.method = part;
       first = false;
       continue;
     }
     const auto eq = part.find('=');
     if (eq == std::string::npos || eq == 0) throw Error("--methods " + spec, "expected name:key=value:…");
+    // "step=1:step=2" meant one of them; the last silently won.
+    if (!keys.insert(part.substr(0, eq)).second)
+      throw Error("--methods " + spec, "'" + part.substr(0, eq) + "' is given twice");
     if (part.substr(0, eq) == "op") {
       r.operation = part.substr(eq + 1);
       continue;
@@ -212,7 +220,7 @@ BudgetSpec parseBudgetSpec(const std::string& item, std::uint64_t pixels) {
 
 std::vector<BudgetSpec> parseBudgetSpecs(const std::string& text, std::uint64_t pixels) {
   std::vector<BudgetSpec> budgets;
-  for (const std::string& b : splitList(text)) budgets.push_back(parseBudgetSpec(b, pixels));
+  for (const std::string& b : splitList(text, "--budgets")) budgets.push_back(parseBudgetSpec(b, pixels));
   if (budgets.empty()) throw Error("--budgets", "no budget given");
   return budgets;
 }
@@ -290,7 +298,7 @@ void ColorByOptions::apply(Scene& scene) const {
   }
   std::optional<glm::dvec2> values;
   if (!range.empty()) {
-    const std::vector<std::string> items = splitList(range);
+    const std::vector<std::string> items = splitList(range, "--color-range");
     std::optional<double> low, high;
     if (items.size() == 2) {
       low = parseNumber(items[0]);

@@ -23,7 +23,7 @@ namespace {
 // "1.5" → 1.5 slots per non-empty pixel; "all" → every fragment (encoded as −1).
 std::vector<double> parseBudgetLevels(const std::string& text) {
   std::vector<double> out;
-  for (const std::string& item : splitList(text)) {
+  for (const std::string& item : splitList(text, "--budgets")) {
     if (item == "all") {
       out.push_back(-1.0);
       continue;
@@ -80,7 +80,7 @@ void addDataset(CLI::App& app) {
     files.push_back({"-o", opt->output, CommandFile::Role::kRequiredOutput});
     checkCommandFiles(files);
     const std::vector<double> levels = parseBudgetLevels(opt->budgets);
-    const std::vector<std::string> views = splitList(opt->views);
+    const std::vector<std::string> views = splitList(opt->views, "--views");
     std::vector<std::pair<int, int>> sizes;
     for (const std::string& s : opt->sizes) sizes.push_back(parseSize("--size", s));
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);

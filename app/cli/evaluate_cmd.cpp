@@ -139,7 +139,7 @@ void addEvaluate(CLI::App& app) {
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
-    const std::vector<std::string> methods = splitList(opt->methods);
+    const std::vector<std::string> methods = splitList(opt->methods, "--methods");
     if (methods.empty()) throw Error("--methods", "names no method");
     std::map<std::string, RenderRequest> specs;  // each method spec's request, without size and budget
     std::size_t methodWidth = 11;
@@ -167,7 +167,7 @@ void addEvaluate(CLI::App& app) {
       specs[m] = spec;
       methodWidth = std::max(methodWidth, m.size() + 2);
     }
-    const std::vector<std::string> views = splitList(opt->views);
+    const std::vector<std::string> views = splitList(opt->views, "--views");
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     GpuRenderer& gpu = headlessRenderer();
     const gl::ContextInfo info = gl::queryContextInfo();

@@ -108,6 +108,8 @@ void addRender(CLI::App& app) {
     const Camera camera = scene.view(opt->view);
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
+    if (stepOption->count() > 0 && scene.volumes.empty())
+      throw Error("--step", "scene '" + scene.name + "' has no volume");
     if (opt->shade) {
       if (scene.volumes.empty()) throw Error("--shade", "scene '" + scene.name + "' has no volume");
       req.volumeShading = true;

@@ -450,7 +450,17 @@ TEST_F(Cli, BenchRefusesBadSpecsBeforeAnyWork) {
            {"abuffer-ll,bogus", "mfr: --methods bogus: unknown method (available: abuffer-ll, "},
            {"abuffer-ll,kplus-array:kk=3", "mfr: --param kk: not a parameter of kplus-array"},
            {"abuffer-ll:op=magic", "mfr: --op magic: unknown operation"},
-           {"oracle", "mfr: --method oracle: the CPU reference, not a GPU method"}}) {
+           {"oracle", "mfr: --method oracle: the CPU reference, not a GPU method"},
+           // Read past before: an empty item, a key given twice (the last won), a volume's step
+           // and shade on a scene without one, a spec without a name.
+           {"abuffer-ll,,kplus-array", "mfr: --methods abuffer-ll,,kplus-array: an empty item"},
+           {"abuffer-ll,", "mfr: --methods abuffer-ll,: an empty item"},
+           {"abuffer-ll:step=1:step=2", "mfr: --methods abuffer-ll:step=1:step=2: 'step' is given twice"},
+           {"kplus-array:k=2:k=8", "'k' is given twice"},
+           {"abuffer-ll:", "mfr: --methods abuffer-ll:: expected name:key=value"},
+           {":op=oit", "(no method name)"},
+           {"abuffer-ll:shade=1", "step and shade are the volume's; scene 'sample' has none"},
+           {"abuffer-ll:step=0.1", "step and shade are the volume's; scene 'sample' has none"}}) {
     const CliResult r = runCli("bench @sample -s 16x16 -r 1 --methods " + methods);
     EXPECT_EQ(r.exitCode, 1) << methods << ": " << r.out;
     EXPECT_EQ(r.out, r.out.substr(0, r.out.find('\n') + 1)) << "more than one line: " << r.out;
@@ -836,6 +846,17 @@ TEST_F(Cli, BudgetCommandsBadInput) {
   ASSERT_EQ(runCli("dataset @sample --views front -s 1x1 --budgets all --sample 1 -o " + one.string()).exitCode, 0);
   expectCleanFailure("train " + one.string(), one.string() + ": holds 1 row; training needs at least 2");
   expectCleanFailure("dataset @sample --budgets 0.5", "--budgets 0.5");
+  // An empty item in a list option was skipped.
+  expectCleanFailure("dataset @sample --budgets 1,,all", "--budgets 1,,all: an empty item");
+  for (const auto& [args, mention] : std::vector<std::pair<std::string, std::string>>{
+           {"evaluate @sample --budgets k1,", "--budgets k1,: an empty item"},
+           {"evaluate @sample --budgets k1 --views front,,iso", "--views front,,iso: an empty item"},
+           {"evaluate @sample --budgets k1 -m fkb,,vkb", "--methods fkb,,vkb: an empty item"},
+           {"allocations @sample --budgets k1 --views ,front", "--views ,front: an empty item"}}) {
+    const CliResult r = runCli(args);
+    EXPECT_EQ(r.exitCode, 1) << args << ": " << r.out;
+    EXPECT_EQ(r.out, "mfr: " + mention + " (',,', or ',' at an end)\n") << args;
+  }
   expectCleanFailure("dataset @sample --views nowhere", "view 'nowhere'");
   const fs::path badWeights = write("w.json", R"({"format":"mfr-dkb-weights","version":1})");
   expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + badWeights.string(), "w.json");

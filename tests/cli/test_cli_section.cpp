@@ -125,6 +125,10 @@ TEST_F(CliSection, BadPlanesAreRefused) {
   expectCleanFailure("render @sample --size 16x16 --section x=nan", "expected AXIS=VALUE");
   expectCleanFailure("render @sample --size 16x16 --section 0,0,0,0,0,0", "the normal must not be zero");
   expectCleanFailure("render @sample --size 16x16 --section x=0:caps", "the suffixes are :nocaps and :slice");
+  // A stray ':' was read past.
+  expectCleanFailure("render @sample --size 16x16 --section x=0:", "(nothing after ':')");
+  expectCleanFailure("render @sample --size 16x16 --section x=0:nocaps:", "the suffixes are :nocaps and :slice");
+  expectCleanFailure("render @sample --size 16x16 --section 0,0,0,,1,0,0", "expected AXIS=VALUE or six numbers");
   expectCleanFailure("render @sample --size 16x16 --section x=0:slice",
                      "--section x=0:slice: slice: scene 'sample' has no volume");
   expectCleanFailure("render @sample --size 16x16 --section x=100", "section plane: cuts away every visible surface");

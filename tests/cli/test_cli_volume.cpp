@@ -98,6 +98,7 @@ TEST_F(CliVolume, BadInputIsOneLine) {
   expectCleanFailure("render @sample --op volume", "no visible volume");
   expectCleanFailure("render @sample --op volume --method abuffer-ll", "no visible volume");
   expectCleanFailure("render @sample --shade", "--shade");
+  expectCleanFailure("render @sample --step 0.1", "--step: scene 'sample' has no volume");  // was ignored
   const fs::path json = dir() / "b.json";
   const CliResult bench = runCli("bench @volume -m abuffer-ll:step=-3 --json " + json.string());
   EXPECT_NE(bench.exitCode, 0);

@@ -11,13 +11,14 @@
 
 namespace mfr::text {
 
-// The non-empty items of `text` between separators.
+// The items of `text` between separators, empty ones included ("a,,b" has three, "a," two), so
+// that a parser can refuse a doubled or stray separator instead of reading past it; "" has none.
 inline std::vector<std::string> splitList(const std::string& text, char separator = ',') {
   std::vector<std::string> out;
   std::string item;
   std::istringstream in(text);
-  while (std::getline(in, item, separator))
-    if (!item.empty()) out.push_back(item);
+  while (std::getline(in, item, separator)) out.push_back(item);
+  if (!text.empty() && text.back() == separator) out.emplace_back();
   return out;
 }
 

@@ -815,7 +815,9 @@ SectionPlane parseSectionPlane(const std::string& textIn, const std::string& wha
   std::string plane = textIn;
   SectionPlane section;
   if (const std::size_t colon = textIn.find(':'); colon != std::string::npos) {
-    for (const std::string& suffix : text::splitList(textIn.substr(colon + 1), ':')) {
+    const std::string suffixes = textIn.substr(colon + 1);
+    if (suffixes.empty()) throw Error(what, "the suffixes are :nocaps and :slice (nothing after ':')");
+    for (const std::string& suffix : text::splitList(suffixes, ':')) {
       if (suffix == "nocaps")
         section.caps = false;
       else if (suffix == "slice")
