@@ -14,6 +14,7 @@
 #include "methods/method_util.hpp"
 #include "reference/pixel_region.hpp"
 #include "number_text.hpp"
+#include "volume_step_note.hpp"
 
 namespace mfr {
 
@@ -243,6 +244,8 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   if (operation_ == "zthickness") stats.notes.emplace_back("z-thickness", numberText(thickness_));
   if (operation_ == "volume") {
     stats.notes.emplace_back("volume step", numberText(volumeStep_));
+    if (const auto longer = volumeLongRayStepNote(drawnVolumes_, volumeStep_))
+      stats.notes.emplace_back("volume step, long rays", *longer);
     std::size_t bytes = 0, shared = 0;
     for (const auto& v : volumes_) {
       bytes += v->bytes;

@@ -20,6 +20,8 @@
 #include "mfr/reference/hybrid.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "number_text.hpp"
+#include "volume_step_note.hpp"
+#include "common/bindings.h"
 
 namespace mfr {
 
@@ -61,6 +63,20 @@ std::string volumeShadingNote(std::span<const Volume> volumes) {
   std::size_t on = 0;
   for (const Volume& v : volumes) on += v.shading ? 1 : 0;
   return on == 0 ? "off" : on == volumes.size() ? "on" : std::to_string(on) + " of " + std::to_string(volumes.size());
+}
+
+std::optional<std::string> volumeLongRayStepNote(std::span<const Volume> volumes, double step) {
+  if (volumes.empty()) return std::nullopt;
+  Bounds all = volumes.front().bounds();
+  for (const Volume& v : volumes) {
+    const Bounds b = v.bounds();
+    all.min = glm::min(all.min, b.min);
+    all.max = glm::max(all.max, b.max);
+  }
+  const double longest = glm::length(glm::dvec3(all.max - all.min)) / MFR_VOLUME_MAX_STEPS;
+  if (!(longest > step)) return std::nullopt;
+  return "up to " + numberText(longest) + " (a ray longer than " + std::to_string(MFR_VOLUME_MAX_STEPS) +
+         " steps takes its length / " + std::to_string(MFR_VOLUME_MAX_STEPS) + ")";
 }
 
 std::string volumeFieldsNote(std::span<const Volume> volumes) {
@@ -264,6 +280,8 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
     const double step = volumeStepOf(request, drawn);
     out.image = compositeVolume(lists, camera, drawn, step, scene.background, scene.clipBox, scene.section);
     out.stats.notes.emplace_back("volume step", numberText(step));
+    if (const auto longer = volumeLongRayStepNote(drawn, step))
+      out.stats.notes.emplace_back("volume step, long rays", *longer);
     out.stats.notes.emplace_back("volumes", std::to_string(drawn.size()));
     out.stats.notes.emplace_back("volume shading", volumeShadingNote(drawn));
     if (const std::string fields = volumeFieldsNote(drawn); !fields.empty())

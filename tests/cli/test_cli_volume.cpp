@@ -43,6 +43,29 @@ TEST_F(CliVolume, OracleAndGpuAgreeAndTheStepMatters) {
   EXPECT_EQ(j["notes"]["volume (bytes)"], std::to_string(96 * 96 * 96 * 4 + 256 * 16));
 }
 
+// A ray marches at most 4096 steps: with a step so fine that the longest ray through the volume
+// (@volume: [-1, 1]³, diagonal 2√3) would need more, the stats say how long its step gets; the
+// "volume step" note alone stated the step asked for. At the default step no ray is that long.
+TEST_F(CliVolume, StatsSayWhenLongRaysTakeALongerStep) {
+  const fs::path stats = dir() / "stats.json", out = dir() / "out.png";
+  const auto notes = [&](const std::string& args) {
+    const CliResult r =
+        runCli("render @volume --view iso --size 24x20 " + args + " -o " + out.string() + " --stats " + stats.string());
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    std::ifstream in(stats);
+    return nlohmann::json::parse(in)["notes"];
+  };
+  for (const std::string method : {"oracle", "abuffer-sbuffer"}) {
+    const nlohmann::json fine = notes("-m " + method + " --step 0.0001");
+    EXPECT_EQ(fine["volume step"], "1e-04") << method;
+    const std::string longRays = fine.value("volume step, long rays", "");
+    ASSERT_EQ(longRays.rfind("up to ", 0), 0u) << method << ": " << fine.dump();
+    EXPECT_NEAR(std::stod(longRays.substr(6)), 2.0 * std::sqrt(3.0) / 4096.0, 1e-12) << longRays;
+    EXPECT_NE(longRays.find("a ray longer than 4096 steps takes its length / 4096"), std::string::npos);
+    EXPECT_FALSE(notes("-m " + method).contains("volume step, long rays")) << method;
+  }
+}
+
 TEST_F(CliVolume, ShadeTurnsOnGradientShading) {
   const std::string common = "render @volume --view iso --size 96x80";
   const fs::path plain = dir() / "plain.png", oracle = dir() / "oracle.png", gpu = dir() / "gpu.png",
