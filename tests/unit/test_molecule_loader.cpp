@@ -423,6 +423,23 @@ TEST_F(MoleculeLoader, IonsAndMercuryWithoutElementColumns) {
   EXPECT_EQ(elementOf[0], 19) << "POT with the serial *****";
 }
 
+// AMBER's ions, from LEaP's older libraries (IP = Na⁺, IM = Cl⁻) and its "Na+"-style names, where
+// the file gives no element: read as unknown (X) or as a wrong element from the name's first letters.
+TEST_F(MoleculeLoader, AmberIonsWithoutElementColumns) {
+  std::string s;
+  int serial = 1;
+  const std::array<std::pair<const char*, int>, 7> ions = {
+      {{"IP", 11}, {"IM", 17}, {"Na+", 11}, {"Cl-", 17}, {"K+", 19}, {"Li+", 3}, {"Cs+", 55}}};
+  for (std::size_t i = 0; i < ions.size(); ++i) {
+    const std::string name = ions[i].first;
+    s += atomRecord("ATOM", serial++, (name + std::string(4 - name.size(), ' ')).c_str(), ' ', ions[i].first, 'A',
+                    static_cast<int>(i) + 1, 5.0 * static_cast<double>(i), 0.0, 0.0, "");
+  }
+  const mfr::MoleculeStructure m = mfr::readMoleculeStructure(write("amber-ions.pdb", s + "END\n"));
+  ASSERT_EQ(m.atoms.size(), ions.size());
+  for (std::size_t i = 0; i < ions.size(); ++i) EXPECT_EQ(m.atoms[i].atomicNumber, ions[i].second) << ions[i].first;
+}
+
 // An mmCIF file without _entity: gemmi guesses from the subchains (a one-residue ALA subchain a
 // ligand, two SOL residues a polymer); the residues are sorted by kind and bonds instead.
 TEST_F(MoleculeLoader, MmcifWithoutEntitiesIsSortedByKind) {

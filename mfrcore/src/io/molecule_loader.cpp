@@ -519,14 +519,15 @@ void fixChainElements(gemmi::Residue& residue, const std::unordered_set<int>& un
   }
 }
 
-// The element of an ion by its residue name in CHARMM's force field (SOD, POT, CLA, …), where the
-// file does not give it (`unstated`: names from column 13 or 14): gemmi reads the atom names (also
-// SOD, POT) as no element and polonium, or from column 14 as S and P.
-void fixCharmmIon(gemmi::Residue& residue, const std::unordered_set<int>& unstated) {
+// The element of an ion by its residue name in CHARMM's force field (SOD, POT, CLA, …) or AMBER's
+// older LEaP libraries (IP = Na⁺, IM = Cl⁻), where the file does not give it (`unstated`: names from
+// column 13 or 14): gemmi reads the atom names (also SOD, POT, IP, IM) as no element and polonium,
+// or from column 14 as S and P.
+void fixForceFieldIon(gemmi::Residue& residue, const std::unordered_set<int>& unstated) {
   struct Ion {
     std::string_view residue, atom, element;
   };
-  static const std::array<Ion, 11> kIons = {{{"SOD", "SOD", "Na"},
+  static const std::array<Ion, 13> kIons = {{{"SOD", "SOD", "Na"},
                                              {"POT", "POT", "K"},
                                              {"CLA", "CLA", "Cl"},
                                              {"CAL", "CAL", "Ca"},
@@ -536,7 +537,9 @@ void fixCharmmIon(gemmi::Residue& residue, const std::unordered_set<int>& unstat
                                              {"BAR", "BAR", "Ba"},
                                              {"ZN2", "ZN", "Zn"},
                                              {"CD2", "CD", "Cd"},
-                                             {"MG", "MG", "Mg"}}};
+                                             {"MG", "MG", "Mg"},
+                                             {"IP", "IP", "Na"},
+                                             {"IM", "IM", "Cl"}}};
   for (const Ion& ion : kIons) {
     if (residue.name != ion.residue) continue;
     // Each of its atoms named as the ion (several where a program numbered the ions as one residue).
@@ -630,7 +633,7 @@ Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const s
           if (residue.entity_type != gemmi::EntityType::NonPolymer || isChainResidue(residue))
             fixChainElements(residue, unstated.fromColumn13);
           else
-            fixCharmmIon(residue, unstated.anyColumn);
+            fixForceFieldIon(residue, unstated.anyColumn);
         }
     }
   }
