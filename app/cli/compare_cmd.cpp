@@ -27,7 +27,7 @@ void addCompare(CLI::App& app) {
   cmd->add_option("--json", opt->json, "Write the metrics as JSON");
   cmd->callback([opt] {
     bool wantRmse = false, wantFlip = false;
-    for (const std::string& m : splitList(opt->metrics, "--metrics")) {
+    for (const std::string& m : splitList(opt->metrics, "--metric")) {
       if (m == "rmse") wantRmse = true;
       else if (m == "flip") wantFlip = true;
       else throw Error("--metric " + m, "unknown metric (rmse, flip)");
