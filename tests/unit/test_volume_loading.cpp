@@ -359,6 +359,31 @@ TEST_F(VolumeLoading, MetaImageWithSeparateRawFile) {
   expectVec(v.spacing, {0.5, 0.25, 4.0});
 }
 
+// A MetaImage of 3 channels (ElementNumberOfChannels): each channel and the length can be chosen
+// as "components:N" / "components:magnitude"; the first one was read without a word before.
+TEST_F(VolumeLoading, MetaImageChannelsAreComponents) {
+  std::string raw;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i)
+        for (const float scale : {1.0f, -1.0f, 3.0f}) raw += bytesOf(scale * field(i, j, k), false);
+  const fs::path p = write("rgb.mha",
+                           "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_FLOAT\n"
+                           "ElementNumberOfChannels = 3\nBinaryData = True\nBinaryDataByteOrderMSB = "
+                           "False\nElementDataFile = LOCAL\n" +
+                               raw);
+  const mfr::Volume first = mfr::loadVolume(p);
+  expectField(first, {4, 3, 2});
+  EXPECT_EQ(first.fields,
+            (std::vector<std::string>{"components", "components:1", "components:2", "components:magnitude"}));
+  const mfr::Volume third = mfr::loadVolume(p, mfr::LoadOptions{"components:2"});
+  EXPECT_EQ(third.field, "components:2");
+  EXPECT_EQ(third.grid->values[3 + 4 * 2 + 12], 3.0f * field(3, 2, 1));
+  const mfr::Volume length = mfr::loadVolume(p, mfr::LoadOptions{"components:magnitude"});
+  EXPECT_FLOAT_EQ(length.grid->values[3 + 4 * 2 + 12], std::sqrt(11.0f) * std::abs(field(3, 2, 1)));
+  EXPECT_THROW((void)mfr::loadVolume(p, mfr::LoadOptions{"components:3"}), mfr::FieldNotFound);
+}
+
 // A 10x3x2 grid (the narrow case, which vtkNrrdReader alone misread, is NrrdNarrowFirstAxisIsAnAxis).
 std::string nrrdRaw() {
   std::string raw;
@@ -482,8 +507,8 @@ TEST_F(VolumeLoading, NrrdNarrowFirstAxisIsAnAxis) {
 }
 
 // A 4-axis NRRD holds vector components on its first axis ("kinds: vector domain domain
-// domain", "space directions: none (…) (…) (…)"): the volume is the first component, and the
-// three spatial axes keep their directions. Components anywhere else are refused, not misread.
+// domain", "space directions: none (…) (…) (…)"): each component, and the vector's length, can
+// be chosen, and the three spatial axes keep their directions. Components anywhere else are refused, not misread.
 TEST_F(VolumeLoading, NrrdVectorComponentsOnTheFirstAxis) {
   std::string raw;
   for (int k = 0; k < 2; ++k)
@@ -498,8 +523,23 @@ TEST_F(VolumeLoading, NrrdVectorComponentsOnTheFirstAxis) {
                                               "space directions: none (0,2,0) (-3,0,0.5) (0,0.25,1)\n"
                                               "space origin: (10,-20,30)\n\n" +
                                               raw);
-  const mfr::Volume first = mfr::loadVolume(p);  // NRRD's one field: the first component
+  // NRRD names no arrays: the components are "components" (the first), "components:1" and the
+  // length, "components:magnitude". Before, the first component was read without a word and no
+  // other could be chosen.
+  const mfr::Volume first = mfr::loadVolume(p);
   expectField(first, {10, 3, 2});
+  EXPECT_EQ(first.field, "components");
+  EXPECT_EQ(first.fields, (std::vector<std::string>{"components", "components:1", "components:magnitude"}));
+  const mfr::Volume second = mfr::loadVolume(p, mfr::LoadOptions{"components:1"});
+  ASSERT_EQ(second.grid->dims, glm::ivec3(10, 3, 2));
+  EXPECT_EQ(second.grid->values[9 + 10 * 2 + 30], 2.0f * field(9, 2, 1));
+  const mfr::Volume length = mfr::loadVolume(p, mfr::LoadOptions{"components:magnitude"});
+  EXPECT_FLOAT_EQ(length.grid->values[9 + 10 * 2 + 30], std::sqrt(5.0f) * std::abs(field(9, 2, 1)));
+  EXPECT_THROW((void)mfr::loadVolume(p, mfr::LoadOptions{"components:2"}), mfr::FieldNotFound);
+  // A one-component NRRD still has nothing to choose.
+  EXPECT_THROW((void)mfr::loadVolume(write("one.nrrd", std::string(kNrrdHeader) + "encoding: raw\n\n" + nrrdRaw()),
+                                     mfr::LoadOptions{"components"}),
+               mfr::FieldNotFound);
   const glm::dvec3 want = glm::dvec3(10.0, -20.0, 30.0) + 9.0 * glm::dvec3(0.0, 2.0, 0.0) +
                           2.0 * glm::dvec3(-3.0, 0.0, 0.5) + glm::dvec3(0.0, 0.25, 1.0);
   const glm::dvec3 got(first.gridToWorld() * glm::dvec4(9.0, 2.0, 1.0, 1.0));

@@ -140,6 +140,14 @@ bool hasNamedFields(VolumeFormat format) {
   return format == VolumeFormat::Vti || format == VolumeFormat::LegacyVtk || format == VolumeFormat::OpenVdb;
 }
 
+// MetaImage and NRRD name no arrays, but a sample may have several components (a vector, a
+// colour): that one array is then called this, so that a component or the magnitude can be chosen
+// ("components:1", "components:magnitude") as a .vti array's can.
+constexpr const char* kComponentsField = "components";
+bool hasComponentFields(VolumeFormat format) {
+  return format == VolumeFormat::MetaImage || format == VolumeFormat::Nrrd;
+}
+
 const char* formatLabel(VolumeFormat format) {
   switch (format) {
     case VolumeFormat::Vti:
@@ -817,6 +825,17 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   const std::array<std::int64_t, 3> got{dims[0], dims[1], dims[2]};
   if (got != declared)
     fail("cannot read " + label + " (read " + dimsText(got) + " points of the " + dimsText(declared) + " declared)");
+  bool namedFields = hasNamedFields(format);
+  if (hasComponentFields(format)) {
+    vtkDataArray* const scalars = image->GetPointData() != nullptr ? image->GetPointData()->GetScalars() : nullptr;
+    if (scalars != nullptr && scalars->GetNumberOfComponents() > 1) {
+      scalars->SetName(kComponentsField);
+      namedFields = true;
+    } else if (!field.empty()) {
+      throw FieldNotFound(name, label + " files have one unnamed field (this one has one component); field '" + field +
+                                    "' cannot be chosen");
+    }
+  }
   const SampleArray sample = sampleArray(image, name, field);
   vtkDataArray* const array = sample.array;
   const bool cells = sample.cells;
@@ -889,7 +908,7 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   }
   Volume volume;
   volume.grid = std::move(grid);
-  if (hasNamedFields(format)) {  // MetaImage and NRRD arrays are named by VTK's readers, not the file
+  if (namedFields) {  // not MetaImage's and NRRD's one component: VTK's readers name it, not the file
     volume.field = !field.empty() ? field : array->GetName() != nullptr ? array->GetName() : "";
     volume.fields = fieldNames(image);
   }
@@ -1056,7 +1075,7 @@ Volume loadVolume(const std::filesystem::path& path, const LoadOptions& options,
       if (dataset != "STRUCTURED_POINTS")
         throw Error(name, "legacy VTK DATASET " + dataset + " is not a volume (expected STRUCTURED_POINTS)");
     }
-    if (!options.field.empty() && !io::hasNamedFields(*format))
+    if (!options.field.empty() && !io::hasNamedFields(*format) && !io::hasComponentFields(*format))
       throw FieldNotFound(name, std::string(io::formatLabel(*format)) + " files have one unnamed field; field '" +
                                     options.field + "' cannot be chosen");
     Volume volume;
