@@ -1,9 +1,13 @@
 #include "assimp_loader.hpp"
 
 #include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <csignal>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +21,13 @@
 #include <string_view>
 #include <utility>
 
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <assimp/Importer.hpp>
 #include <assimp/ProgressHandler.hpp>
 #include <assimp/config.h>
@@ -25,6 +36,7 @@
 #include <assimp/scene.h>
 
 #include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 #include "vtk_loader.hpp"
 
 namespace mfr::io {
@@ -227,38 +239,172 @@ void checkGltfJsonDepth(const std::filesystem::path& path, const std::string* co
   }
 }
 
+// assimp 5.2 crashes (SIGSEGV; an uncaught DeadlyImportError, abort), hangs, or allocates without
+// end on some truncated or corrupt files — a bug hunt's cases: COB, X, MDL, ASE, 3MF and LWO
+// crashed mfr, SMD, OpenGEX and Q3S hung, DAE and LWS grew past 3 GB. None of that can be caught
+// in this process, so every file is first imported in a child process, under a memory limit (what
+// this process may still take) and a time limit, and only a file the child read is imported here.
+// A failure the child reports (assimp's own error) is thrown as it is. Costs one more import.
+// The time limit: 120 s, or MFR_IMPORT_TIMEOUT_S (whole seconds, 1 … 86400).
+int importSeconds(const std::string& name) {
+  const char* text = std::getenv("MFR_IMPORT_TIMEOUT_S");
+  if (text == nullptr || *text == '\0') return 120;
+  char* end = nullptr;
+  errno = 0;
+  const long seconds = std::strtol(text, &end, 10);
+  if (errno != 0 || *end != '\0' || seconds < 1 || seconds > 86400)
+    throw Error(name, std::string("MFR_IMPORT_TIMEOUT_S=") + text + ": expected whole seconds, 1 to 86400");
+  return static_cast<int>(seconds);
+}
+
+// The error for assimp's refusal `reason`.
+Error importError(const std::string& reason, const std::string& extension, const std::string& name) {
+  // What SortByPType says when it removed every mesh because all were points or lines.
+  if (reason.find("No meshes remaining") != std::string::npos)
+    return Error(name, "no triangles (only points or lines)");
+  return Error(name, "cannot read " + (extension.empty() ? std::string("file") : extension.substr(1)) +
+                         (reason.empty() ? std::string() : ": " + reason));
+}
+
+// One importer, set up as both imports use it.
+const aiScene* importScene(Assimp::Importer& importer, const std::filesystem::path& path, const std::string* contents,
+                           const std::string& extension) {
+  // Points and lines are no surfaces; skeleton dummies are no geometry.
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
+  // No PreTransformVertices: node transforms become Object::transform so instanced meshes are shared.
+  const unsigned flags =
+      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType | aiProcess_ValidateDataStructure;
+  if (contents != nullptr) {
+    const std::string hint = extension.empty() ? std::string() : extension.substr(1);
+    return importer.ReadFileFromMemory(contents->data(), contents->size(), flags, hint.c_str());
+  }
+  return importer.ReadFile(path.string(), flags);
+}
+
+// Imports the file in a child process; throws mfr::Error(name, …) when the child crashes, runs out
+// of time or memory, or assimp refuses the file, LoadCancelled when the load is cancelled meanwhile.
+void importInChild(const std::filesystem::path& path, const std::string* contents, const std::string& extension,
+                   const std::string& name, const LoadProgress& progress) {
+  const int seconds = importSeconds(name);
+  int fds[2];
+  if (pipe(fds) != 0) return;  // no child: the import below runs unguarded, as it always did
+  std::uint64_t limit = 0;
+  const std::optional<std::uint64_t> available = availableHostMemory();
+  if (available) {
+    long pages = 0;
+    std::ifstream statm("/proc/self/statm");
+    statm >> pages;  // the address space already mapped (libraries, buffers) counts against RLIMIT_AS
+    limit = *available + static_cast<std::uint64_t>(std::max(pages, 0L)) * static_cast<std::uint64_t>(getpagesize());
+  }
+  const pid_t child = fork();
+  if (child < 0) {
+    close(fds[0]);
+    close(fds[1]);
+    return;
+  }
+  if (child == 0) {
+    close(fds[0]);
+    const int null = open("/dev/null", O_WRONLY);
+    if (null >= 0) {  // assimp's and the C++ runtime's last words ("terminate called …")
+      dup2(null, 1);
+      dup2(null, 2);
+    }
+    const rlimit noCore{0, 0};
+    setrlimit(RLIMIT_CORE, &noCore);
+    if (limit > 0) {
+      const rlimit memory{limit, limit};
+      setrlimit(RLIMIT_AS, &memory);
+    }
+    std::string report;
+    try {
+      Assimp::Importer importer;
+      report = importScene(importer, path, contents, extension) != nullptr
+                   ? "ok"
+                   : "error " + std::string(importer.GetErrorString());
+    } catch (const std::bad_alloc&) {
+      report = "memory";
+    } catch (...) {
+      report = "exception";
+    }
+    const char* at = report.data();
+    for (std::size_t left = report.size(); left > 0;) {
+      const ssize_t n = write(fds[1], at, left);
+      if (n <= 0) break;
+      at += n;
+      left -= static_cast<std::size_t>(n);
+    }
+    _exit(0);
+  }
+  close(fds[1]);
+  std::string report;
+  bool timedOut = false, cancelled = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
+  for (;;) {
+    pollfd p{fds[0], POLLIN, 0};
+    const int ready = poll(&p, 1, 100);
+    if (ready > 0) {
+      char buffer[4096];
+      const ssize_t n = read(fds[0], buffer, sizeof buffer);
+      if (n > 0) {
+        report.append(buffer, static_cast<std::size_t>(n));
+        continue;
+      }
+      if (n == 0) break;  // the child closed its end: it is done (or dead)
+    }
+    if (ready < 0 && errno != EINTR) break;
+    if (!progress.tryStep(0.0)) {
+      cancelled = true;
+      break;
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      timedOut = true;
+      break;
+    }
+  }
+  close(fds[0]);
+  if (timedOut || cancelled) kill(child, SIGKILL);
+  int status = 0;
+  while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  const std::string format = extension.empty() ? std::string("file") : extension.substr(1);
+  if (cancelled) throw LoadCancelled();
+  if (timedOut)
+    throw Error(name, "cannot read " + format + ": the importer (assimp) did not finish in " + std::to_string(seconds) +
+                          " s (corrupt or truncated file?)");
+  if (report == "memory" || (WIFSIGNALED(status) && limit > 0 && report.empty() && WTERMSIG(status) == SIGKILL))
+    throw Error(name, "cannot read " + format + ": the importer (assimp) ran out of memory (" +
+                          formatMemory(available.value_or(0)) + " available; corrupt or truncated file?)");
+  if (WIFSIGNALED(status))
+    throw Error(name, "cannot read " + format + ": the importer (assimp) crashed (" +
+                          std::string(strsignal(WTERMSIG(status))) + "; corrupt or truncated file?)");
+  if (report == "exception")
+    throw Error(name, "cannot read " + format + ": the importer (assimp) failed (corrupt or truncated file?)");
+  // assimp's own refusal, not imported again (its "std::bad_alloc": the memory limit was reached).
+  if (report.rfind("error ", 0) == 0) {
+    const std::string reason = report.substr(6);
+    if (reason.find("bad_alloc") != std::string::npos)
+      throw Error(name, "cannot read " + format + ": the importer (assimp) ran out of memory (" +
+                            formatMemory(available.value_or(0)) + " available; corrupt or truncated file?)");
+    throw importError(reason, extension, name);
+  }
+}
+
 }  // namespace
 
 std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std::string* contents,
                                    const std::string& extension, const std::string& name,
                                    const LoadProgress& progress) {
   checkGltfJsonDepth(path, contents, extension, name);
+  importInChild(path, contents, extension, name, progress);
   Assimp::Importer importer;
   // The importer owns (and deletes) its progress handler; the import takes the first 80 %.
   auto* importProgress = new ImportProgress(progress.part(0.0, 0.8));
   importer.SetProgressHandler(importProgress);
-  // Points and lines are no surfaces; skeleton dummies are no geometry.
-  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-  importer.SetPropertyBool(AI_CONFIG_IMPORT_NO_SKELETON_MESHES, true);
-  // No PreTransformVertices: node transforms become Object::transform so instanced meshes are shared.
-  const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
-                         aiProcess_ValidateDataStructure;
-  const aiScene* scene = nullptr;
   const MutedStandardStreams muted;
-  if (contents != nullptr) {
-    const std::string hint = extension.empty() ? std::string() : extension.substr(1);
-    scene = importer.ReadFileFromMemory(contents->data(), contents->size(), flags, hint.c_str());
-  } else {
-    scene = importer.ReadFile(path.string(), flags);
-  }
+  const aiScene* scene = importScene(importer, path, contents, extension);
   if (importProgress->cancelled()) throw LoadCancelled();
-  if (scene == nullptr) {
-    std::string reason = importer.GetErrorString();
-    // What SortByPType says when it removed every mesh because all were points or lines.
-    if (reason.find("No meshes remaining") != std::string::npos) throw Error(name, "no triangles (only points or lines)");
-    throw Error(name, "cannot read " + (extension.empty() ? std::string("file") : extension.substr(1)) +
-                          (reason.empty() ? std::string() : ": " + reason));
-  }
+  if (scene == nullptr) throw importError(importer.GetErrorString(), extension, name);
   if (scene->mRootNode == nullptr || scene->mNumMeshes == 0) throw Error(name, "no triangles (the file has no meshes)");
 
   std::vector<std::shared_ptr<const Mesh>> meshes(scene->mNumMeshes);
