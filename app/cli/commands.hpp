@@ -76,6 +76,17 @@ inline CLI::Validator finiteRange(double low, double high) {
       bounds.str());
 }
 
+// Digits only, for unsigned options: CLI11 reads "-1" into an unsigned as 2^64 - 1.
+inline CLI::Validator wholeNumber() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
+          return "'" + text + "' is not a whole number (0, 1, 2, …)";
+        return {};
+      },
+      "");
+}
+
 // --clip: "xmin,ymin,zmin,xmax,ymax,zmax" (world units) sets scene.clipBox, "none" removes the
 // scene's own; empty text leaves the scene as it is. Throws mfr::Error naming --clip.
 void applyClipOption(Scene& scene, const std::string& text);

@@ -33,7 +33,8 @@ void addCompare(CLI::App& app) {
       else throw Error("--metric " + m, "unknown metric (rmse, flip)");
     }
     if (!wantRmse && !wantFlip) throw Error("--metric " + opt->metrics, "names no metric (rmse, flip)");
-    if (!(opt->ppd > 0) || opt->ppd > 1e4) throw Error("--ppd", "must be in (0, 10000]");
+    // Below 0.01 FLIP's filters are degenerate: at 1e-30 every value came out NaN.
+    if (!(opt->ppd >= 0.01) || opt->ppd > 1e4) throw Error("--ppd", "must be in [0.01, 10000]");
     // Both outputs checked before the work and before either is written; neither may be an input.
     checkCommandFiles({{"reference", opt->reference},
                        {"test", opt->test},

@@ -64,7 +64,9 @@ void addDataset(CLI::App& app) {
                   "mean n(p) more often, in proportion to n(p)")
       ->capture_default_str()
       ->check(CLI::IsMember({"pixels", "deep"}));
-  cmd->add_option("--seed", opt->seed, "Random seed of the pixel sampling")->capture_default_str();
+  cmd->add_option("--seed", opt->seed, "Random seed of the pixel sampling")
+      ->capture_default_str()
+      ->check(wholeNumber());
   cmd->add_option("--labels", opt->labels,
                   "optimal: each pixel's k of optimal-k; class-optimal: optimal-k on the curves averaged over the "
                   "pixels of equal n(p), the best a network that cannot see which lists have cheap tails can do")
@@ -84,6 +86,7 @@ void addDataset(CLI::App& app) {
     std::vector<std::pair<int, int>> sizes;
     for (const std::string& s : opt->sizes) sizes.push_back(parseSize("--size", s));
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
+    if (!(opt->sample > 0.0)) throw Error("--sample", "must be in (0, 1]: 0 writes no rows");
     const DatasetSampling sampling = opt->sampleBy == "deep" ? DatasetSampling::DeepPixels : DatasetSampling::Pixels;
     DkbDataset dataset;
     std::mt19937_64 rng(opt->seed);

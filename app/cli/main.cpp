@@ -24,6 +24,14 @@ int main(int argc, char** argv) {
   mfr::cli::addEvaluate(app);
   mfr::cli::addAllocations(app);
   mfr::cli::addProbe(app);
+  // An empty value ("--stats ''", "--view ''", "--contour ''") is refused: to the commands an empty
+  // string meant "not given", so --stats '' wrote no stats without a word.
+  const CLI::Validator nonEmpty(
+      [](const std::string& value) { return value.empty() ? std::string("an empty value") : std::string(); }, "",
+      "non-empty");
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    for (CLI::Option* option : sub->get_options([](CLI::Option*) { return true; }))
+      if (option->get_type_size() != 0) option->check(nonEmpty);
   // A first word that is no command ("mfr rendr") — CLI11 would only say that a subcommand is
   // required, without naming the word.
   if (argc > 1 && argv[1][0] != '-') {

@@ -42,7 +42,9 @@ void addTrain(CLI::App& app) {
   cmd->add_option("--validation", opt->training.validationFraction, "Fraction of rows held out")
       ->capture_default_str()
       ->check(finiteRange(0.0, 0.9));
-  cmd->add_option("--seed", opt->training.seed, "Random seed (split, batches)")->capture_default_str();
+  cmd->add_option("--seed", opt->training.seed, "Random seed (split, batches)")
+      ->capture_default_str()
+      ->check(wholeNumber());
   cmd->add_option("--weighting", opt->training.weighting,
                   "none, or fragments: rows drawn with probability proportional to n(p), losses weighted by n(p)")
       ->capture_default_str();

@@ -78,7 +78,17 @@ TEST_F(Cli, SceneFileFlagsAndHugeNumbersNameTheFileAndKey) {
            {R"({"objects": [)" + sphere +
                 R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "target": [0, 0, 0], "fit": null}]})",
             "views[0].fit: expected true or false"},
-           {R"({"objects": [)" + sphere + R"(, "opacity": 1e400}]})", "JSON number out of range"}}) {
+           {R"({"objects": [)" + sphere + R"(, "opacity": 1e400}]})", "JSON number out of range"},
+           // Accepted before: a background outside [0,1] was composited as it was; a rotation
+           // without axis or degrees was none.
+           {R"({"background": [-5, 0.5, 0.5], "objects": [)" + sphere + "}]}",
+            "background: components must be in [0,1]"},
+           {R"({"background": [1e308, 0, 0], "objects": [)" + sphere + "}]}",
+            "background: components must be in [0,1]"},
+           {R"({"objects": [)" + sphere + R"(, "transform": {"rotate": {}}}]})",
+            "objects[0].transform.rotate.axis: missing"},
+           {R"({"objects": [)" + sphere + R"(, "transform": {"rotate": {"axis": [0, 1, 0]}}}]})",
+            "objects[0].transform.rotate.degrees: missing"}}) {
     SCOPED_TRACE(json);
     const fs::path p = write("flags.mfrscene", json);
     expectCleanFailure("render " + p.string() + " --size 16x16", "flags.mfrscene: " + mention);
@@ -441,6 +451,34 @@ TEST_F(Cli, BenchRowsAndOrders) {
   EXPECT_EQ(r.exitCode, 1) << r.out;
   EXPECT_NE(r.out.find("magic"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(json));
+}
+
+// An empty value meant "not given" (--stats '' wrote no stats, --view '' the default view, without
+// a word); unsigned options read "-1" as 2^64 - 1; --sample 0 wrote a dataset of no rows; a
+// --ppd of 1e-30 gave FLIP values of NaN. Each is one line now, and nothing is written.
+TEST_F(Cli, EmptyValuesAndOutOfRangeNumbersAreRefused) {
+  const std::string out = (dir() / "out.png").string(), a = (dir() / "a.png").string();
+  ASSERT_EQ(runCli("render @sample -s 16x16 -o " + a).exitCode, 0);
+  for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+           {"render @sample -s 16x16 -o " + out + " --stats ''", "mfr: --stats: an empty value"},
+           {"render @sample -s 16x16 -o " + out + " --view ''", "mfr: --view: an empty value"},
+           {"render @sample -s 16x16 -o " + out + " --contour ''", "mfr: --contour: an empty value"},
+           {"render @sample -s 16x16 -o " + out + " --section ''", "mfr: --section: an empty value"},
+           {"render @sample -s 16x16 -o " + out + " --color-by ''", "mfr: --color-by: an empty value"},
+           {"render '' -s 16x16 -o " + out, "mfr: scene: an empty value"},
+           {"info @sample --field ''", "mfr: --field: an empty value"},
+           {"bench @sample -m abuffer-ll --json ''", "mfr: --json: an empty value"},
+           {"compare " + a + " " + a + " --heatmap ''", "mfr: --heatmap: an empty value"},
+           {"compare " + a + " " + a + " --ppd 1e-30", "mfr: --ppd: must be in [0.01, 10000]"},
+           {"train " + a + " -o " + out + " --seed -1", "mfr: --seed: '-1' is not a whole number"},
+           {"dataset @sample -o " + out + " --seed ''", "mfr: --seed: '' is not a whole number"},
+           {"dataset @sample -o " + out + " --sample 0", "mfr: --sample: must be in (0, 1]: 0 writes no rows"}}) {
+    const CliResult r = runCli(args);
+    EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << args << ": " << r.exitCode << " " << r.out;
+    EXPECT_EQ(r.out.rfind(message, 0), 0u) << args << ": " << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    EXPECT_FALSE(fs::exists(out)) << args;
+  }
 }
 
 // A bad spec anywhere in --methods is one line before any work: it used to come after the

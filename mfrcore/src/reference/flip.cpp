@@ -444,8 +444,9 @@ FlipResult flip(const ImageRGBA8& reference, const ImageRGBA8& test, double pixe
                             std::to_string(reference.height) + ", test " + std::to_string(test.width) + "x" +
                             std::to_string(test.height));
   }
-  if (!(pixelsPerDegree > 0.0) || !std::isfinite(pixelsPerDegree)) {
-    throw Error("flip", "pixels per degree must be positive and finite, got " + std::to_string(pixelsPerDegree));
+  // Below 0.01 the filters are degenerate (at 1e-30 every value came out NaN).
+  if (!(pixelsPerDegree >= 0.01) || !(pixelsPerDegree <= 1e4)) {
+    throw Error("flip", "pixels per degree must be in [0.01, 10000], got " + std::to_string(pixelsPerDegree));
   }
   // Float planes at the peak, in the colour pass: the error map, each image's three YCxCz planes
   // and four planes filtered along x, and the pass's output.

@@ -129,10 +129,13 @@ glm::dmat4 parseTransform(const Reader& r, const json& t, const std::string& whe
     const json& rot = t["rotate"];
     if (rot.is_object()) {
       r.object(rot, where + ".rotate", {"axis", "degrees"});
-      const glm::dvec3 axis = r.vec3(rot.value("axis", json::array({0, 0, 1})), where + ".rotate.axis");
+      // Both: {} was no rotation without a word.
+      for (const char* key : {"axis", "degrees"})
+        if (!rot.contains(key))
+          r.fail(where + ".rotate." + key, "missing (a rotation is {\"axis\": [x, y, z], \"degrees\": d})");
+      const glm::dvec3 axis = r.vec3(rot["axis"], where + ".rotate.axis");
       if (glm::length(axis) == 0.0) r.fail(where + ".rotate.axis", "zero axis");
-      out = glm::rotate(out, glm::radians(r.number(rot.value("degrees", json(0.0)), where + ".rotate.degrees")),
-                        glm::normalize(axis));
+      out = glm::rotate(out, glm::radians(r.number(rot["degrees"], where + ".rotate.degrees")), glm::normalize(axis));
     } else {
       // Euler angles in degrees, applied X, then Y, then Z (world = Rz·Ry·Rx·p).
       const glm::dvec3 e = glm::radians(r.vec3(rot, where + ".rotate"));
@@ -514,7 +517,14 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
   // The sample first, so that the file's own name and background replace the sample's.
   Scene scene = r.flag(doc, "sample", "top level", false) ? makeSampleScene() : Scene();
   scene.name = r.string(doc, "name", "top level", std::filesystem::path(name).stem().string());
-  if (doc.contains("background")) scene.background = glm::vec3(r.vec3(doc["background"], "background"));
+  if (doc.contains("background")) {
+    // In [0,1] like a colour: [-5, 0.5, 0.5] was composited as it is (a red sphere over it came out
+    // (0, 32, 32)).
+    const glm::dvec3 background = r.vec3(doc["background"], "background");
+    for (int i = 0; i < 3; ++i)
+      if (!(background[i] >= 0.0 && background[i] <= 1.0)) r.fail("background", "components must be in [0,1]");
+    scene.background = glm::vec3(background);
+  }
   if (doc.contains("clip")) {
     const json& clip = r.object(doc["clip"], "clip", {"min", "max"});
     if (!clip.contains("min") || !clip.contains("max")) r.fail("clip", "expected \"min\" and \"max\" corners");
