@@ -513,7 +513,14 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     object.mesh->validate(object.name);
     ObjectShading& shading = objects[o];
     shading.mesh = object.mesh.get();
-    shading.normalMatrix = glm::transpose(glm::inverse(glm::dmat3(object.transform)));
+    // Scaled to a largest entry of 1: only its direction matters (normals are normalised), and a
+    // part scaled by 1e12 had normals 1e-12 long, under the cancelled-normal test in shade(), so
+    // the oracle drew it flat where the GPU shaded it.
+    const glm::dmat3 inverseTranspose = glm::transpose(glm::inverse(glm::dmat3(object.transform)));
+    double largest = 0.0;
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r) largest = std::max(largest, std::abs(inverseTranspose[c][r]));
+    shading.normalMatrix = largest > 0.0 && std::isfinite(largest) ? inverseTranspose / largest : inverseTranspose;
     shading.materialColor = object.material.color;
     shading.vertexColors = object.material.vertexColors;
     if (const std::optional<FieldColors>& field = object.material.fieldColors;
