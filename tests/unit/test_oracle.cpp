@@ -358,6 +358,21 @@ TEST(OracleShading, DoesNotDependOnTheScale) {
   }
 }
 
+// The fit view frames a scene whatever its size: a sphere 1e-11 across was framed as if 1e-9
+// (absolute floors on the radius and the far plane) and rendered blank, one of 3e-10 as a speck.
+TEST(CameraFit, FramesTinyScenesAsLargeOnes) {
+  const auto fragments = [](double scale) {
+    Scene scene;
+    scene.name = "scaled";
+    addObject(scene, makeSphere(1.0), glm::scale(glm::dmat4(1.0), glm::dvec3(scale)), {1.0f, 0.0f, 0.0f, 0.5f});
+    return castFragments(scene, scene.fit(frontCamera(Projection::Perspective)), 48, 48).fragments.size();
+  };
+  const std::size_t unit = fragments(1.0);
+  ASSERT_GT(unit, 1000u);
+  for (const double scale : {3e-10, 1e-11, 1e-20, 1e20})
+    EXPECT_NEAR(static_cast<double>(fragments(scale)), static_cast<double>(unit), 0.01 * unit) << "scale " << scale;
+}
+
 TEST(OracleHistogram, HandCountedQuads) {
   // 40×40 px over 4×4 world units; every quad side lies on a pixel boundary (multiples of 0.1) and
   // neither diagonal comes within 0.06 px of a pixel centre, so no pixel is ambiguous.

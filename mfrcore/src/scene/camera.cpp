@@ -37,7 +37,9 @@ Camera Camera::fittedTo(const Bounds& b, double radius) const {
   Camera c = *this;
   if (!b.valid()) return c;
   const glm::dvec3 centre = b.center();
-  const double r = std::max(radius > 0.0 ? radius : b.radius(), 1e-9);
+  // No absolute floor: a scene 1e-11 across was framed as if 1e-9 (a blank image).
+  const double given = radius > 0.0 ? radius : b.radius();
+  const double r = given > 0.0 && std::isfinite(given) ? given : 1.0;
   const glm::dvec3 dir = forward();
   // Distance at which a sphere of radius r fills the vertical field of view, with a small margin.
   const double halfFov = glm::radians(std::clamp(fovyDegrees, 1.0, 170.0)) * 0.5;
@@ -51,11 +53,13 @@ Camera Camera::fittedTo(const Bounds& b, double radius) const {
 
 void Camera::fitDepthRange(const Bounds& b, double radius) {
   if (!b.valid()) return;
-  const double r = std::max(radius > 0.0 ? radius : b.radius(), 1e-9);
+  const double given = radius > 0.0 ? radius : b.radius();
+  const double r = given > 0.0 && std::isfinite(given) ? given : 1.0;
   const double d = glm::dot(b.center() - eye, forward());
   // Near/far enclose the bounding sphere; near stays positive and not absurdly small, so depth
-  // precision stays usable (ratio far/near ≤ 1e4).
-  farPlane = std::max(d + 1.01 * r, 1e-6);
+  // precision stays usable (ratio far/near ≤ 1e4). Far at least the sphere's size beyond the eye
+  // (the eye inside the sphere), with no absolute floor.
+  farPlane = std::max(d + 1.01 * r, 1.01 * r);
   nearPlane = std::max(d - 1.01 * r, farPlane * 1e-4);
 }
 
