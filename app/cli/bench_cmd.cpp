@@ -101,7 +101,7 @@ void addBench(CLI::App& app) {
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
     for (std::size_t i = 0; i < requests.size(); ++i)
-      if (scene.volumes.empty() && (requests[i].volumeStep > 0.0 || requests[i].volumeShading))
+      if (scene.volumes.empty() && (requests[i].volumeStep > 0.0 || requests[i].volumeShading.has_value()))
         throw Error("--methods " + specs[i], "step and shade are the volume's; scene '" + scene.name + "' has none");
 
     ImageRGBA8 reference;

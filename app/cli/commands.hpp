@@ -43,7 +43,6 @@ struct CommandFile {
 void checkCommandFiles(const std::vector<CommandFile>& files);
 // "WxH" → (w, h); throws mfr::Error naming the option.
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);
-// A list separated by commas (or `separator`), empty items dropped.
 // The items of a list option; an empty item (a doubled or stray separator) is refused, naming the option.
 std::vector<std::string> splitList(const std::string& text, const std::string& option, char separator = ',');
 // --field and --molecule: what to read of a file that holds several things.

@@ -85,8 +85,8 @@ void addDataset(CLI::App& app) {
     const std::vector<std::string> views = splitList(opt->views, "--views");
     std::vector<std::pair<int, int>> sizes;
     for (const std::string& s : opt->sizes) sizes.push_back(parseSize("--size", s));
-    const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     if (!(opt->sample > 0.0)) throw Error("--sample", "must be in (0, 1]: 0 writes no rows");
+    const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     const DatasetSampling sampling = opt->sampleBy == "deep" ? DatasetSampling::DeepPixels : DatasetSampling::Pixels;
     DkbDataset dataset;
     std::mt19937_64 rng(opt->seed);

@@ -298,8 +298,8 @@ TEST_F(Cli, NoCommandWritesOverItsInputsOrOneFileTwice) {
   // An empty output is refused before the work (dataset printed its table first).
   for (const std::string command : {"render @sample -s 24x16 -o ''", "dataset @sample --views front -s 24x16 -o ''"}) {
     const CliResult r = mfr::test::runCommand(cd + command);
-    EXPECT_EQ(r.exitCode, 1) << command << ": " << r.out;
-    EXPECT_EQ(r.out, "mfr: -o: empty file name\n") << command;
+    EXPECT_EQ(r.exitCode, 2) << command << ": " << r.out;  // refused while parsing, as any empty value
+    EXPECT_EQ(r.out, "mfr: --output: an empty value (see mfr --help)\n") << command;
   }
   // A file named twice only as an input is fine.
   EXPECT_EQ(mfr::test::runCommand(cd + "compare a.png ./a.png --metric rmse").exitCode, 0);
@@ -498,6 +498,7 @@ TEST_F(Cli, BenchRefusesBadSpecsBeforeAnyWork) {
            {"abuffer-ll:", "mfr: --methods abuffer-ll:: expected name:key=value"},
            {":op=oit", "(no method name)"},
            {"abuffer-ll:shade=1", "step and shade are the volume's; scene 'sample' has none"},
+           {"abuffer-ll:shade=0", "step and shade are the volume's; scene 'sample' has none"},
            {"abuffer-ll:step=0.1", "step and shade are the volume's; scene 'sample' has none"}}) {
     const CliResult r = runCli("bench @sample -s 16x16 -r 1 --methods " + methods);
     EXPECT_EQ(r.exitCode, 1) << methods << ": " << r.out;

@@ -324,6 +324,10 @@ TEST_F(LoadModel, GarbageOff) {
   expectLoadError(write("negative-binary.off", binary), "an OFF face declares -3 corners (not a count)");
   // A binary face's count of 2³¹ − 1 corners: CGAL sized the face from it (16 GB and 70 s for this
   // 79-byte file); each corner takes 4 bytes, so the count is refused at once.
+  // Cut in its vertex data: the size check counted the header's bytes as data, and the face
+  // colour reader then read past the end of the file.
+  expectLoadError(write("cut-binary.off", "OFF BINARY\n" + be32(4) + be32(4) + be32(0) + std::string(41, '\0')),
+                  "OFF header declares 4 vertices and 4 faces but the file has only 64 bytes");
   expectLoadError(write("corners-binary.off", vertices + be32(0x7fffffff) + be32(0) + be32(1) + be32(2) + be32(0)),
                   "an OFF face declares 2147483647 corners, more than the file's 79 bytes hold");
 }

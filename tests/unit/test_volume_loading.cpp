@@ -547,6 +547,28 @@ TEST_F(VolumeLoading, NrrdVectorComponentsOnTheFirstAxis) {
   expectVolumeError(write("last.nrrd", head + "kinds: domain domain domain vector\n\n" + raw),
                     "NRRD of 4 axes whose vector components are not on the first axis (kinds: domain domain domain "
                     "vector; space directions: not given): not supported");
+  // teem's, ITK's and Slicer's field order: "space" before "sizes", after which vtkNrrdReader
+  // read only three sizes (a 2-component 10x3x1 image, refused as flat).
+  const mfr::Volume teem =
+      mfr::loadVolume(write("teem.nrrd",
+                            "NRRD0004\ntype: float\ndimension: 4\nspace: left-posterior-superior\nsizes: 2 10 3 2\n"
+                            "space directions: none (0,2,0) (-3,0,0.5) (0,0.25,1)\nkinds: vector domain domain domain\n"
+                            "endian: little\nencoding: raw\nspace origin: (10,-20,30)\n\n" +
+                                raw));
+  expectField(teem, {10, 3, 2});
+  EXPECT_LT(glm::length(glm::dvec3(teem.gridToWorld() * glm::dvec4(9.0, 2.0, 1.0, 1.0)) - want), 1e-9);
+  // Components on a later axis of three, and sizes no volume has (cut to 32 bits by VTK: 2^32 + 5
+  // read as 5), are refused.
+  expectVolumeError(write("rgblast.nrrd",
+                          "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3 2\n"
+                          "kinds: space space RGB-color\nendian: little\nencoding: raw\n\n" +
+                              nrrdRaw()),
+                    "NRRD of 3 axes whose components are not on the first axis: not supported");
+  expectVolumeError(write("huge.nrrd",
+                          "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3 4294967298\n"
+                          "endian: little\nencoding: raw\n\n" +
+                              nrrdRaw()),
+                    "NRRD 'sizes' value 4294967298 is too large for a volume");
   // VTK read a fifth axis's first three as the grid and dropped the rest.
   expectVolumeError(write("five.nrrd",
                           "NRRD0004\ntype: float\ndimension: 5\nsizes: 2 10 3 2 2\nendian: little\n"

@@ -24,6 +24,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -282,13 +283,47 @@ const aiScene* importScene(Assimp::Importer& importer, const std::filesystem::pa
   return importer.ReadFile(path.string(), flags);
 }
 
+// The pipe's ends and the child, closed and reaped (killed first if still running) on every way
+// out of importInChild.
+class ChildImport {
+ public:
+  ChildImport() = default;
+  ChildImport(const ChildImport&) = delete;
+  ChildImport& operator=(const ChildImport&) = delete;
+  ~ChildImport() {
+    closeRead();
+    closeWrite();
+    if (pid > 0) {
+      kill(pid, SIGKILL);
+      reap();
+    }
+  }
+  void closeRead() {
+    if (fds[0] >= 0) close(fds[0]);
+    fds[0] = -1;
+  }
+  void closeWrite() {
+    if (fds[1] >= 0) close(fds[1]);
+    fds[1] = -1;
+  }
+  // Waits for the child; its status.
+  int reap() {
+    int status = 0;
+    while (pid > 0 && waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    pid = -1;
+    return status;
+  }
+  int fds[2] = {-1, -1};
+  pid_t pid = -1;
+};
+
 // Imports the file in a child process; throws mfr::Error(name, …) when the child crashes, runs out
-// of time or memory, or assimp refuses the file, LoadCancelled when the load is cancelled meanwhile.
+// of time or memory, ends without a result, or assimp refuses the file; LoadCancelled when the
+// load is cancelled meanwhile. Returns when the child read the file (or no child could be made).
 void importInChild(const std::filesystem::path& path, const std::string* contents, const std::string& extension,
                    const std::string& name, const LoadProgress& progress) {
   const int seconds = importSeconds(name);
-  int fds[2];
-  if (pipe(fds) != 0) return;  // no child: the import below runs unguarded, as it always did
   std::uint64_t limit = 0;
   const std::optional<std::uint64_t> available = availableHostMemory();
   if (available) {
@@ -297,19 +332,20 @@ void importInChild(const std::filesystem::path& path, const std::string* content
     statm >> pages;  // the address space already mapped (libraries, buffers) counts against RLIMIT_AS
     limit = *available + static_cast<std::uint64_t>(std::max(pages, 0L)) * static_cast<std::uint64_t>(getpagesize());
   }
-  const pid_t child = fork();
-  if (child < 0) {
-    close(fds[0]);
-    close(fds[1]);
-    return;
-  }
-  if (child == 0) {
-    close(fds[0]);
-    const int null = open("/dev/null", O_WRONLY);
+  ChildImport job;
+  // Close-on-exec: a process another thread starts meanwhile must not hold the write end open.
+  if (pipe2(job.fds, O_CLOEXEC) != 0) return;  // no child: the import below runs unguarded, as it always did
+  job.pid = fork();
+  if (job.pid < 0) return;
+  if (job.pid == 0) {
+    // Only this thread lives on in the child: it imports, writes one report and leaves by _exit.
+    close(job.fds[0]);
+    const int null = open("/dev/null", O_WRONLY | O_CLOEXEC);
     if (null >= 0) {  // assimp's and the C++ runtime's last words ("terminate called …")
       dup2(null, 1);
       dup2(null, 2);
     }
+    prctl(PR_SET_DUMPABLE, 0);  // no core file, no crash report (apport, systemd-coredump)
     const rlimit noCore{0, 0};
     setrlimit(RLIMIT_CORE, &noCore);
     if (limit > 0) {
@@ -329,65 +365,60 @@ void importInChild(const std::filesystem::path& path, const std::string* content
     }
     const char* at = report.data();
     for (std::size_t left = report.size(); left > 0;) {
-      const ssize_t n = write(fds[1], at, left);
+      const ssize_t n = write(job.fds[1], at, left);
       if (n <= 0) break;
       at += n;
       left -= static_cast<std::size_t>(n);
     }
     _exit(0);
   }
-  close(fds[1]);
+  job.closeWrite();
   std::string report;
-  bool timedOut = false, cancelled = false;
+  bool timedOut = false;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
   for (;;) {
-    pollfd p{fds[0], POLLIN, 0};
+    pollfd p{job.fds[0], POLLIN, 0};
     const int ready = poll(&p, 1, 100);
     if (ready > 0) {
       char buffer[4096];
-      const ssize_t n = read(fds[0], buffer, sizeof buffer);
+      const ssize_t n = read(job.fds[0], buffer, sizeof buffer);
       if (n > 0) {
         report.append(buffer, static_cast<std::size_t>(n));
         continue;
       }
-      if (n == 0) break;  // the child closed its end: it is done (or dead)
-    }
-    if (ready < 0 && errno != EINTR) break;
-    if (!progress.tryStep(0.0)) {
-      cancelled = true;
+      if (n == 0 || errno != EINTR) break;  // the child closed its end: it is done (or dead)
+    } else if (ready < 0 && errno != EINTR) {
       break;
+    }
+    if (!progress.tryStep(0.0)) {
+      kill(job.pid, SIGKILL);
+      throw LoadCancelled();  // the guard reaps the child
     }
     if (std::chrono::steady_clock::now() > deadline) {
       timedOut = true;
+      kill(job.pid, SIGKILL);
       break;
     }
   }
-  close(fds[0]);
-  if (timedOut || cancelled) kill(child, SIGKILL);
-  int status = 0;
-  while (waitpid(child, &status, 0) < 0 && errno == EINTR) {
-  }
+  job.closeRead();
+  const int status = job.reap();
   const std::string format = extension.empty() ? std::string("file") : extension.substr(1);
-  if (cancelled) throw LoadCancelled();
+  const std::string memory = formatMemory(available.value_or(0));
   if (timedOut)
     throw Error(name, "cannot read " + format + ": the importer (assimp) did not finish in " + std::to_string(seconds) +
                           " s (corrupt or truncated file?)");
-  if (report == "memory" || (WIFSIGNALED(status) && limit > 0 && report.empty() && WTERMSIG(status) == SIGKILL))
-    throw Error(name, "cannot read " + format + ": the importer (assimp) ran out of memory (" +
-                          formatMemory(available.value_or(0)) + " available; corrupt or truncated file?)");
+  if (report == "memory" || (report.rfind("error ", 0) == 0 && report.find("bad_alloc") != std::string::npos))
+    throw Error(name, "cannot read " + format + ": the importer (assimp) needed more than the " + memory +
+                          " available (a corrupt file, or one too large for this machine)");
   if (WIFSIGNALED(status))
     throw Error(name, "cannot read " + format + ": the importer (assimp) crashed (" +
                           std::string(strsignal(WTERMSIG(status))) + "; corrupt or truncated file?)");
-  if (report == "exception")
-    throw Error(name, "cannot read " + format + ": the importer (assimp) failed (corrupt or truncated file?)");
-  // assimp's own refusal, not imported again (its "std::bad_alloc": the memory limit was reached).
-  if (report.rfind("error ", 0) == 0) {
-    const std::string reason = report.substr(6);
-    if (reason.find("bad_alloc") != std::string::npos)
-      throw Error(name, "cannot read " + format + ": the importer (assimp) ran out of memory (" +
-                            formatMemory(available.value_or(0)) + " available; corrupt or truncated file?)");
-    throw importError(reason, extension, name);
-  }
+  // assimp's own refusal, not imported again.
+  if (report.rfind("error ", 0) == 0) throw importError(report.substr(6), extension, name);
+  if (report != "ok")
+    throw Error(name, "cannot read " + format + ": the importer (assimp) " +
+                          (report == "exception" ? "failed" : "ended without a result") +
+                          " (corrupt or truncated file?)");
 }
 
 }  // namespace

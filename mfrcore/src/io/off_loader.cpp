@@ -140,7 +140,7 @@ std::size_t checkHeader(std::string_view bytes, const std::string& name, std::ui
   faces = counts[1];
   if (!binary) checkAsciiFaceSizes(bytes, pos, vertices, faces, name);
   if (vertices > 0xffffffffull || faces > 0xffffffffull ||
-      vertices * vertexBytes + faces * faceBytes > bytes.size())
+      vertices * vertexBytes + faces * faceBytes > bytes.size() - (binary ? pos : 0))
     throw Error(name, "OFF header declares " + std::to_string(vertices) + " vertices and " + std::to_string(faces) +
                           " faces but the file has only " + std::to_string(bytes.size()) + " bytes (truncated file?)");
   if (faces == 0) throw Error(name, "no triangles (the OFF file has no faces)");
@@ -162,6 +162,7 @@ std::uint32_t bigEndian32(std::string_view bytes, std::size_t at) {
 // nothing, and CGAL reads the file as it is.
 std::optional<std::string> withoutFaceColours(std::string_view bytes, std::size_t data, std::uint64_t vertices,
                                               std::uint64_t faces) {
+  if (data > bytes.size() || vertices > (bytes.size() - data) / 12) return std::nullopt;  // cut in the vertices
   std::size_t pos = data + vertices * 12;
   std::string out(bytes.substr(0, pos));
   for (std::uint64_t f = 0; f < faces; ++f) {

@@ -172,23 +172,30 @@ const char* formatLabel(VolumeFormat format) {
 struct NrrdOrientation {
   std::optional<std::array<glm::dvec3, 3>> directions;  // of the three spatial axes, in order
   std::vector<long> spatialSizes;                       // the three spatial axes' sizes
-  // Set for a 3D grid whose first axis vtkNrrdReader would take for vector components: each
-  // axis's spacing as vtkNrrdReader would have read it.
-  std::optional<std::array<double, 3>> keepFirstAxis;
+  // The grid as the header gives it, for a file of 3 axes (components 1) or of 4 axes with the
+  // components first: what NrrdReader puts in place of vtkNrrdReader's reading.
+  struct Layout {
+    int components = 1;
+    std::array<int, 3> sizes{};
+    std::array<double, 3> spacing{1.0, 1.0, 1.0};  // as vtkNrrdReader reads it (lengths of directions)
+  };
+  std::optional<Layout> layout;
 };
 
-// NRRD does not mark which axis holds a vector's components except in "kinds", which
-// vtkNrrdReader ignores: it guesses components from a first axis of 9 or fewer samples (or a
-// first spacing of 0), so an ordinary 8×8×8 scalar grid came out as an 8-component 2D image and
-// was refused. This reader reads the header as vtkNrrdReader does and, where checkNrrdHeader found
-// that the first axis is spatial, puts it back as the grid's first axis.
+// NRRD marks which axis holds a vector's components only in "kinds", which vtkNrrdReader ignores:
+// it guesses components from a first axis of 9 or fewer samples (or a first spacing of 0), so an
+// ordinary 8×8×8 scalar grid came out as an 8-component 2D image and was refused; and a "space"
+// field before "sizes" (teem's, ITK's and Slicer's order) makes it cut "sizes" to three values,
+// so a 4-axis vector file came out as a flat image. This reader reads the header as vtkNrrdReader
+// does, then sets the components and the grid as checkNrrdHeader read them.
 class NrrdReader : public vtkNrrdReader {
  public:
   static NrrdReader* New();
-  vtkTypeMacro(NrrdReader, vtkNrrdReader) void keepFirstAxis(const std::vector<long>& sizes,
-                                                             const std::array<double, 3>& spacing) {
-    sizes_ = sizes;
-    spacing_ = spacing;
+  // clang-format off
+  vtkTypeMacro(NrrdReader, vtkNrrdReader)
+      // clang-format on
+      void setLayout(const NrrdOrientation::Layout& layout) {
+    layout_ = layout;
   }
 
  protected:
@@ -196,21 +203,20 @@ class NrrdReader : public vtkNrrdReader {
   ~NrrdReader() override = default;
   int ReadHeader(vtkCharArray* headerBuffer) override {
     if (vtkNrrdReader::ReadHeader(headerBuffer) == 0) return 0;
-    if (sizes_.size() == 3 && NumberOfScalarComponents != 1) {
-      NumberOfScalarComponents = 1;
+    if (layout_) {
+      NumberOfScalarComponents = layout_->components;
       FileDimensionality = 3;
-      for (int a = 0; a < 3; ++a) {
+      for (std::size_t a = 0; a < 3; ++a) {
         DataExtent[2 * a] = 0;
-        DataExtent[2 * a + 1] = static_cast<int>(sizes_[static_cast<std::size_t>(a)] - 1);
-        DataSpacing[a] = spacing_[static_cast<std::size_t>(a)];
+        DataExtent[2 * a + 1] = layout_->sizes[a] - 1;
+        DataSpacing[a] = layout_->spacing[a];
       }
     }
     return 1;
   }
 
  private:
-  std::vector<long> sizes_;
-  std::array<double, 3> spacing_{1.0, 1.0, 1.0};
+  std::optional<NrrdOrientation::Layout> layout_;
 };
 vtkStandardNewMacro(NrrdReader)
 
@@ -236,7 +242,7 @@ vtkStandardNewMacro(NrrdReader)
     case VolumeFormat::Nrrd: {
       auto r = vtkSmartPointer<NrrdReader>::New();
       r->SetFileName(file.c_str());
-      if (nrrd.keepFirstAxis) r->keepFirstAxis(nrrd.spatialSizes, *nrrd.keepFirstAxis);
+      if (nrrd.layout) r->setLayout(*nrrd.layout);
       return r;
     }
     case VolumeFormat::Inrimage:
@@ -298,7 +304,7 @@ class CerrCapture {
 // It also returns the orientation, which vtkNrrdReader (VTK 9.1) reads only in part: of "space
 // directions" it keeps each vector's length as the spacing and drops its direction. Axis a of the
 // grid steps by directions[a] in the file's space from "space origin" (the NRRD format's definition).
-// And it says where vtkNrrdReader's guess at the component axis is wrong (NrrdReader, above).
+// And it says which axis holds components and how large the grid is (NrrdReader, above).
 
 // The value of "space directions": one entry per axis, "(x,y,z)" (spaces allowed inside) or
 // "none" (a non-spatial axis, nothing here). Throws mfr::Error(name, …) for anything else.
@@ -529,6 +535,12 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
   if (sizes.size() > 4)
     throw Error(name, "NRRD of " + std::to_string(sizes.size()) +
                           " axes: a volume has 3 spatial axes and at most one of components");
+  // Sizes VTK takes as int; anything near that is no volume (at most 2048 points per axis, 4096
+  // components) and was cut to 32 bits ("4294967301" read as 5).
+  for (const long n : sizes)
+    if (n > 1000000) throw Error(name, "NRRD 'sizes' value " + std::to_string(n) + " is too large for a volume");
+  const auto spacingOf = [&](std::size_t axis) { return axis < spacings.size() ? spacings[axis] : 1.0; };
+  NrrdOrientation::Layout layout;
   if (sizes.size() == 4) {
     const bool componentsFirst =
         spatialAxis(0) != true && spatialAxis(1) != false && spatialAxis(2) != false && spatialAxis(3) != false;
@@ -539,18 +551,30 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
                             (given.empty() ? "not given" : given) + "; space directions: " +
                             (directions.empty() ? "not given" : "'none' elsewhere") + "): not supported");
     }
+    if (sizes[0] > kMaxComponents)
+      throw Error(name, "NRRD vector of " + std::to_string(sizes[0]) + " components (at most " +
+                            std::to_string(kMaxComponents) + ")");
     orientation.spatialSizes.assign(sizes.begin() + 1, sizes.end());
     if (directions.size() == 4)
       orientation.directions = std::array<glm::dvec3, 3>{*directions[1], *directions[2], *directions[3]};
+    layout.components = static_cast<int>(sizes[0]);
+    for (std::size_t a = 0; a < 3; ++a) {
+      layout.sizes[a] = static_cast<int>(sizes[a + 1]);
+      layout.spacing[a] = spacingOf(a + 1);
+    }
+    orientation.layout = layout;
   } else if (sizes.size() == 3 && spatialKind(0) != false) {
+    // Components on a later axis ("kinds: space space RGB-color") would be read as a grid axis.
+    if (spatialKind(1) == false || spatialKind(2) == false)
+      throw Error(name, "NRRD of 3 axes whose components are not on the first axis: not supported");
     orientation.spatialSizes = sizes;
     if (directions.size() == 3)
       orientation.directions = std::array<glm::dvec3, 3>{*directions[0], *directions[1], *directions[2]};
-    if (sizes[0] <= 9 || (!spacings.empty() && spacings[0] == 0.0)) {
-      std::array<double, 3> spacing{1.0, 1.0, 1.0};
-      for (std::size_t a = 0; a < 3 && a < spacings.size(); ++a) spacing[a] = spacings[a];
-      orientation.keepFirstAxis = spacing;
+    for (std::size_t a = 0; a < 3; ++a) {
+      layout.sizes[a] = static_cast<int>(sizes[a]);
+      layout.spacing[a] = spacingOf(a);
     }
+    orientation.layout = layout;
   }
   return orientation;
 }

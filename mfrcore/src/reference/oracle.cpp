@@ -337,10 +337,11 @@ std::uint32_t shade(const WorldTriangle& tri, const ObjectShading& obj, double u
     n = glm::dvec3(0.0);
     for (int k = 0; k < 3; ++k) n += w[k] * glm::dvec3(mesh.normals[tri.vertex[k]]);
   }
-  glm::dvec3 normal = obj.normalMatrix * n;
   // Opposite vertex normals can cancel: fall back to the face normal rather than let normalize()
-  // produce NaN (the GPU's result is undefined there anyway).
-  if (!(glm::dot(normal, normal) > 1e-24))
+  // produce NaN (the GPU's result is undefined there anyway). Tested on the object's own (unit)
+  // normals: after a scale of 1e12 along one axis, a transformed normal may be 1e-12 long.
+  glm::dvec3 normal = obj.normalMatrix * n;
+  if (!(glm::dot(n, n) > 1e-24) || !(glm::dot(normal, normal) > 0.0) || !std::isfinite(glm::dot(normal, normal)))
     normal = glm::cross(tri.p[1] - tri.p[0], tri.p[2] - tri.p[0]);
   glm::vec4 base = obj.materialColor;
   if (obj.colorMap != nullptr) {
@@ -513,14 +514,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     object.mesh->validate(object.name);
     ObjectShading& shading = objects[o];
     shading.mesh = object.mesh.get();
-    // Scaled to a largest entry of 1: only its direction matters (normals are normalised), and a
-    // part scaled by 1e12 had normals 1e-12 long, under the cancelled-normal test in shade(), so
-    // the oracle drew it flat where the GPU shaded it.
-    const glm::dmat3 inverseTranspose = glm::transpose(glm::inverse(glm::dmat3(object.transform)));
-    double largest = 0.0;
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < 3; ++r) largest = std::max(largest, std::abs(inverseTranspose[c][r]));
-    shading.normalMatrix = largest > 0.0 && std::isfinite(largest) ? inverseTranspose / largest : inverseTranspose;
+    shading.normalMatrix = glm::transpose(glm::inverse(glm::dmat3(object.transform)));
     shading.materialColor = object.material.color;
     shading.vertexColors = object.material.vertexColors;
     if (const std::optional<FieldColors>& field = object.material.fieldColors;
