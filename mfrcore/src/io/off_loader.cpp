@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include <CGAL/IO/OFF.h>
@@ -194,7 +195,7 @@ PolygonSoup parseOff(std::string_view bytes, const std::string& name) {
   // Each corner takes at least 2 bytes ("0 "), in a binary file 4.
   Faces polygons(bytes.size() / 2);
   std::vector<CGAL::IO::Color> colors;
-  std::istringstream in{stripped ? *stripped : std::string(bytes), std::ios::in | std::ios::binary};
+  std::istringstream in{stripped ? std::move(*stripped) : std::string(bytes), std::ios::in | std::ios::binary};
   bool ok = false;
   try {
     ok = CGAL::IO::read_OFF(in, points, polygons,

@@ -171,7 +171,6 @@ const char* formatLabel(VolumeFormat format) {
 // What the NRRD header says that vtkNrrdReader (VTK 9.1) does not read: see checkNrrdHeader.
 struct NrrdOrientation {
   std::optional<std::array<glm::dvec3, 3>> directions;  // of the three spatial axes, in order
-  std::vector<long> spatialSizes;                       // the three spatial axes' sizes
   // The grid as the header gives it, for a file of 3 axes (components 1) or of 4 axes with the
   // components first: what NrrdReader puts in place of vtkNrrdReader's reading.
   struct Layout {
@@ -191,12 +190,8 @@ struct NrrdOrientation {
 class NrrdReader : public vtkNrrdReader {
  public:
   static NrrdReader* New();
-  // clang-format off
+  void setLayout(const NrrdOrientation::Layout& layout) { layout_ = layout; }
   vtkTypeMacro(NrrdReader, vtkNrrdReader)
-      // clang-format on
-      void setLayout(const NrrdOrientation::Layout& layout) {
-    layout_ = layout;
-  }
 
  protected:
   NrrdReader() = default;
@@ -220,8 +215,7 @@ class NrrdReader : public vtkNrrdReader {
 };
 vtkStandardNewMacro(NrrdReader)
 
-    vtkSmartPointer<vtkAlgorithm> makeReader(VolumeFormat format, const std::string& file,
-                                             const NrrdOrientation& nrrd) {
+vtkSmartPointer<vtkAlgorithm> makeReader(VolumeFormat format, const std::string& file, const NrrdOrientation& nrrd) {
   switch (format) {
     case VolumeFormat::Vti: {
       auto r = vtkSmartPointer<vtkXMLImageDataReader>::New();
@@ -554,7 +548,6 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
     if (sizes[0] > kMaxComponents)
       throw Error(name, "NRRD vector of " + std::to_string(sizes[0]) + " components (at most " +
                             std::to_string(kMaxComponents) + ")");
-    orientation.spatialSizes.assign(sizes.begin() + 1, sizes.end());
     if (directions.size() == 4)
       orientation.directions = std::array<glm::dvec3, 3>{*directions[1], *directions[2], *directions[3]};
     layout.components = static_cast<int>(sizes[0]);
@@ -567,7 +560,6 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
     // Components on a later axis ("kinds: space space RGB-color") would be read as a grid axis.
     if (spatialKind(1) == false || spatialKind(2) == false)
       throw Error(name, "NRRD of 3 axes whose components are not on the first axis: not supported");
-    orientation.spatialSizes = sizes;
     if (directions.size() == 3)
       orientation.directions = std::array<glm::dvec3, 3>{*directions[0], *directions[1], *directions[2]};
     for (std::size_t a = 0; a < 3; ++a) {
@@ -915,8 +907,8 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   start[2] = extent[4];
   // NRRD: the directions VTK dropped (it may also misread their lengths: "( -3, 0, 0.5 )" with
   // spaces gives a spacing of 0). Only when the grid is the header's three spatial axes.
-  const bool nrrdOriented = nrrd.directions && nrrd.spatialSizes.size() == 3 && nrrd.spatialSizes[0] == gridDims.x &&
-                            nrrd.spatialSizes[1] == gridDims.y && nrrd.spatialSizes[2] == gridDims.z &&
+  const bool nrrdOriented = nrrd.directions && nrrd.layout && nrrd.layout->sizes[0] == gridDims.x &&
+                            nrrd.layout->sizes[1] == gridDims.y && nrrd.layout->sizes[2] == gridDims.z &&
                             extent[0] == 0 && extent[2] == 0 && extent[4] == 0;
   if (nrrdOriented)
     for (int a = 0; a < 3; ++a) s[a] = glm::length((*nrrd.directions)[static_cast<std::size_t>(a)]);
