@@ -130,7 +130,11 @@ void addInfo(CLI::App& app) {
     // The oracle's pass before anything is printed too: a scene it refuses (only degenerate
     // triangles: "nothing to render") is one line, not a report and then an error.
     std::optional<FragmentLists> lists;
-    if (histogramView) lists = castFragments(scene, *histogramView, w, h);
+    if (histogramView) {
+      OracleOptions counting;
+      counting.countsOnly = true;  // the histogram needs n(p) only
+      lists = castFragments(scene, *histogramView, w, h, counting);
+    }
     std::vector<SurfaceMeasures> measures;
     for (const Object& o : scene.objects) measures.push_back(measureSurface(*o.mesh, o.transform));
     nlohmann::ordered_json j;
@@ -317,10 +321,10 @@ void addInfo(CLI::App& app) {
       j["depth_complexity"] = {{"size", opt->size},
                                {"view", opt->view},
                                {"max", lists->maxCount()},
-                               {"fragments", lists->fragments.size()},
+                               {"fragments", lists->offsets.back()},
                                {"histogram", hist}};
       std::cout << "depth complexity (" << opt->size << ", view " << opt->view << "): max " << lists->maxCount() << ", "
-                << lists->fragments.size() << " fragments\n";
+                << lists->offsets.back() << " fragments\n";
       for (std::size_t n = 0; n < hist.size(); ++n)
         if (hist[n] > 0) std::cout << "  n=" << n << ": " << hist[n] << " pixels\n";
     }

@@ -506,6 +506,22 @@ TEST(OracleThreads, ResultDoesNotDependOnThreadCount) {
   }
 }
 
+// `mfr info`'s histogram casts counts only: the same n(p) and flags as the full lists, and no
+// fragment kept (the memory such lists take is what the option saves).
+TEST(OracleCountsOnly, SameCountsAndFlagsWithoutFragments) {
+  const Scene scene = nestedSpheres();
+  const Camera camera = frontCamera(Projection::Perspective);
+  OracleOptions counting;
+  counting.countsOnly = true;
+  const FragmentLists full = castFragments(scene, camera, 50, 37);
+  const FragmentLists counted = castFragments(scene, camera, 50, 37, counting);
+  ASSERT_GT(full.fragments.size(), 1000u);
+  EXPECT_EQ(counted.offsets, full.offsets);
+  EXPECT_EQ(counted.flags, full.flags);
+  EXPECT_TRUE(counted.fragments.empty());
+  EXPECT_EQ(depthComplexityHistogram(counted), depthComplexityHistogram(full));
+}
+
 // The broad phase bins each triangle to the pixels near its window polygon; testing every
 // triangle against every ray must give the same lists, bit for bit, and the same flags. The
 // scenes are the cases a bin could miss: a fan of slivers (each a fraction of a pixel wide),

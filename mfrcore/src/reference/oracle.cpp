@@ -694,7 +694,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
         Fragment frag;
         frag.depth = static_cast<float>(depth);
         frag.depthSlope = static_cast<float>(depthSlope(tri, normal, depth, x + 0.5, wy));
-        frag.color = shade(tri, objects[tri.objectId], u, v, viewDir);
+        if (!options.countsOnly) frag.color = shade(tri, objects[tri.objectId], u, v, viewDir);
         frag.objectId = tri.objectId;
         frag.frontFacing = glm::dot(normal, dir) < 0.0;
         hits.push_back({depth, tri.objectId, index, frag});
@@ -711,7 +711,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
                     kSubpixelStep * (static_cast<double>(hits[i].fragment.depthSlope) +
                                      static_cast<double>(hits[i - 1].fragment.depthSlope)))
           rayFlags[pixel] |= FragmentLists::kDepthTie;
-        out.push_back(hits[i].fragment);
+        if (!options.countsOnly) out.push_back(hits[i].fragment);
       }
       counts[pixel] = static_cast<std::uint32_t>(hits.size());
     }
@@ -742,6 +742,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   }
   if (total > UINT32_MAX) throw Error("oracle", "more than 2^32 fragments in one image");
   lists.offsets[pixelCount] = static_cast<std::uint32_t>(total);
+  if (options.countsOnly) return lists;
   requireHostMemory("oracle", listsOfSize, total * sizeof(Fragment));
   lists.fragments.reserve(total);
   for (std::vector<Fragment>& row : rowFragments) {
