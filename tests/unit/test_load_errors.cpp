@@ -545,6 +545,37 @@ TEST_F(LoadModel, ObjMaterialsBecomeColouredParts) {
   expectBounds(*objects[1].mesh, {0, 0, 0}, {1, 0, 4});
 }
 
+// A missing .mtl, or a material no library defines, loses only colours: the parts load with the
+// default colour, and a note says why (it was silent: a grey model with no word).
+TEST_F(LoadModel, ObjMissingMaterialsAreNoted) {
+  const std::string geometry = "v 0 0 0\nv 1 0 0\nv 1 1 0\n";
+  mfr::LoadOptions options;
+  std::vector<std::string> notes;
+  options.notes = &notes;
+  const auto missing =
+      mfr::loadModel(write("missing.obj", "mtllib gone.mtl\n" + geometry + "usemtl red\nf 1 2 3\n"), options);
+  ASSERT_EQ(missing.size(), 1u);
+  EXPECT_EQ(missing[0].material.color, mfr::Material{}.color);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("missing.obj: material library 'gone.mtl' not found"), std::string::npos) << notes[0];
+
+  notes.clear();
+  write("some.mtl", "newmtl red\nKd 1 0 0\n");
+  const auto partly = mfr::loadModel(
+      write("partly.obj", "mtllib some.mtl\n" + geometry + "usemtl red\nf 1 2 3\nusemtl blue\nf 3 2 1\n"), options);
+  ASSERT_EQ(partly.size(), 2u);
+  EXPECT_EQ(partly[0].material.color, glm::vec4(1, 0, 0, 1));
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("partly.obj: 1 material defined in no material library ('blue')"), std::string::npos)
+      << notes[0];
+
+  notes.clear();
+  mfr::loadModel(write("found.obj", "mtllib some.mtl\n" + geometry + "usemtl red\nf 1 2 3\n"), options);
+  mfr::loadModel(write("plain.obj", geometry + "f 1 2 3\n"), options);
+  mfr::loadModel(write("named.obj", geometry + "usemtl Default\nf 1 2 3\n"), options);  // no library named
+  EXPECT_TRUE(notes.empty()) << notes.front();
+}
+
 TEST_F(LoadModel, ObjNormalsFromTheFileAreKept) {
   const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0.6 0 0.8\nf 1//1 2//1 3//1\n";
   const auto objects = mfr::loadModel(write("normals.obj", obj));

@@ -181,7 +181,7 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
     }
     case Family::Obj: {
       if (!gz) data = readAll(path, name);
-      std::vector<io::ObjPart> parts = io::parseObj(data, path.parent_path(), name);
+      std::vector<io::ObjPart> parts = io::parseObj(data, path.parent_path(), name, options.notes);
       data.clear();
       data.shrink_to_fit();
       std::vector<Object> objects;

@@ -46,12 +46,29 @@ bool parseInt(std::string_view t, std::int64_t& v) {
 }
 
 // Material colours from .mtl files: Kd, and opacity from d (or 1 − Tr).
-std::map<std::string, glm::vec4> readMaterials(const fs::path& file) {
+// Empty `why` when read; else why not (the file is then skipped: only colours are lost).
+std::map<std::string, glm::vec4> readMaterials(const fs::path& file, std::string& why) {
   std::map<std::string, glm::vec4> out;
   std::error_code ec;
+  why.clear();
+  if (!fs::exists(file, ec)) {
+    why = "not found";
+    return out;
+  }
+  if (!fs::is_regular_file(file, ec)) {
+    why = "not a file";
+    return out;
+  }
   const std::uintmax_t size = fs::file_size(file, ec);
-  if (ec || size > kMaxMtlBytes || !fs::is_regular_file(file, ec)) return out;
+  if (ec || size > kMaxMtlBytes) {
+    why = ec ? "unreadable" : "larger than 64 MiB";
+    return out;
+  }
   std::ifstream in(file, std::ios::binary);
+  if (!in) {
+    why = "unreadable";
+    return out;
+  }
   std::string line;
   std::string current;
   while (std::getline(in, line)) {
@@ -90,13 +107,16 @@ struct RawPart {
 
 }  // namespace
 
-std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory, const std::string& name) {
+std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory, const std::string& name,
+                              std::vector<std::string>* notes) {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> vertexColors;
   bool allColored = true;
   std::vector<glm::vec3> normals;
   std::vector<RawPart> parts(1);
   std::map<std::string, std::size_t> partOf{{"", 0}};
+  bool libraryNamed = false;  // no mtllib: material names are only names, and no note is due
+  bool libraryUnread = false;
   std::size_t current = 0;
   std::map<std::string, glm::vec4> materials;
   std::vector<Corner> face;
@@ -171,13 +191,21 @@ std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory,
       }
       current = it->second;
     } else if (w[0] == "mtllib") {
-      for (std::size_t k = 1; k < w.size(); ++k)
-        for (auto& [key, c] : readMaterials(directory / std::string(w[k]))) materials.emplace(key, c);
+      libraryNamed = libraryNamed || w.size() > 1;
+      for (std::size_t k = 1; k < w.size(); ++k) {
+        std::string why;
+        for (auto& [key, c] : readMaterials(directory / std::string(w[k]), why)) materials.emplace(key, c);
+        libraryUnread = libraryUnread || !why.empty();
+        if (!why.empty() && notes != nullptr)
+          notes->push_back(name + ": material library '" + std::string(w[k]) + "' " + why +
+                           " (its materials get the default colour)");
+      }
     }
     // vt, vp, g, o, s, l, p and the free-form statements carry nothing we draw.
   }
 
   std::vector<ObjPart> out;
+  std::vector<std::string> undefined;
   for (RawPart& raw : parts) {
     if (raw.corners.empty()) continue;
     const bool withNormals = std::all_of(raw.corners.begin(), raw.corners.end(), [&](const Corner& c) {
@@ -186,7 +214,10 @@ std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory,
     const bool withColors = allColored && vertexColors.size() == positions.size();
     ObjPart part;
     part.material = raw.material;
-    if (auto m = materials.find(raw.material); m != materials.end()) part.color = m->second;
+    if (auto m = materials.find(raw.material); m != materials.end())
+      part.color = m->second;
+    else if (!raw.material.empty())
+      undefined.push_back(raw.material);
     // Each part gets the vertices it uses; with normals, a vertex is a (position, normal) pair.
     std::unordered_map<std::uint64_t, std::uint32_t> index;
     part.soup.ids.reserve(raw.corners.size());
@@ -202,6 +233,15 @@ std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory,
     }
     part.soup.offsets = std::move(raw.offsets);
     out.push_back(std::move(part));
+  }
+  // One note for the materials the libraries, all read, do not define (when one was not read, its
+  // note above already says why parts are grey).
+  if (!undefined.empty() && libraryNamed && !libraryUnread && notes != nullptr) {
+    std::string list;
+    for (std::size_t i = 0; i < undefined.size() && i < 5; ++i) list += (i > 0 ? ", '" : "'") + undefined[i] + "'";
+    if (undefined.size() > 5) list += " and " + std::to_string(undefined.size() - 5) + " more";
+    notes->push_back(name + ": " + std::to_string(undefined.size()) + " material" + (undefined.size() == 1 ? "" : "s") +
+                     " defined in no material library (" + list + "): the default colour");
   }
   if (out.empty()) {
     if (positions.empty()) throw Error(name, "no triangles (no vertices or faces: is this an OBJ file?)");

@@ -22,8 +22,10 @@ struct ObjPart {
 };
 
 // v (optionally with r g b), vn, f with v, v/vt, v//vn, v/vt/vn and negative indices, usemtl and
-// mtllib (read from `directory`; a missing .mtl only loses colours). Other statements are
-// ignored. Throws mfr::Error(name, "line N: reason").
-std::vector<ObjPart> parseObj(std::string_view bytes, const std::filesystem::path& directory, const std::string& name);
+// mtllib (read from `directory`; a missing .mtl only loses colours, and says so in `notes`, as does
+// a material no library defines). Other statements are ignored. Throws mfr::Error(name, "line N:
+// reason").
+std::vector<ObjPart> parseObj(std::string_view bytes, const std::filesystem::path& directory, const std::string& name,
+                              std::vector<std::string>* notes = nullptr);
 
 }  // namespace mfr::io
