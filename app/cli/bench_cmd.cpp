@@ -66,8 +66,7 @@ void addBench(CLI::App& app) {
                 "(for methods whose buffers do not fit the GPU together); default: round-robin");
   cmd->add_option("--json", opt->json, "Write all results as JSON");
   cmd->callback([opt] {
-    checkCommandFiles(
-        {{"scene", opt->scene, CommandFile::Role::kScene}, {"--json", opt->json, CommandFile::Role::kOutput}});
+    std::vector<CommandFile> files{{"scene", opt->scene, CommandFile::Role::kScene}};
     const auto [w, h] = parseSize("--size", opt->size);
     std::vector<RenderRequest> requests;
     const std::vector<std::string> specs = splitList(opt->methods, "--methods");
@@ -91,8 +90,11 @@ void addBench(CLI::App& app) {
       }
       (void)Params(info->params, req.params, req.method);
       validateOperation(req.operation);
+      addParameterFiles(files, "--methods " + spec, req.method, req.params);  // dkb's weights are read
     }
     if (requests.empty()) throw Error("--methods", "no method given");
+    files.push_back({"--json", opt->json, CommandFile::Role::kOutput});
+    checkCommandFiles(files);
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->read);
     opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <sstream>
+#include <map>
 #include <string>
 
 #include "mfr/io/load.hpp"
@@ -41,6 +42,11 @@ struct CommandFile {
 // relative and an absolute name, links and hard links included) — a command never writes over a
 // file named on its command line, nor one file twice. Throws mfr::Error naming the later option.
 void checkCommandFiles(const std::vector<CommandFile>& files);
+// The files a method's parameters name (its Text parameters: dkb's `weights`), as inputs given by
+// `option`, so that checkCommandFiles refuses an output that would write over one. An unknown
+// method adds nothing (it is refused elsewhere).
+void addParameterFiles(std::vector<CommandFile>& files, const std::string& option, const std::string& method,
+                       const std::map<std::string, std::string>& params);
 // "WxH" → (w, h); throws mfr::Error naming the option.
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);
 // The items of a list option; an empty item (a doubled or stray separator) is refused, naming the option.

@@ -58,6 +58,15 @@ void checkCommandFiles(const std::vector<CommandFile>& files) {
     }
 }
 
+void addParameterFiles(std::vector<CommandFile>& files, const std::string& option, const std::string& method,
+                       const std::map<std::string, std::string>& params) {
+  const MethodInfo* info = findMethodInfo(method);
+  if (info == nullptr) return;
+  for (const ParamSpec& spec : info->params)
+    if (const auto given = params.find(spec.name); spec.type == ParamSpec::Type::Text && given != params.end())
+      files.push_back({option, given->second});
+}
+
 std::pair<int, int> parseSize(const std::string& option, const std::string& text) {
   int w = 0, h = 0;
   char x = 0, extra = 0;

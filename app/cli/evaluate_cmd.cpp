@@ -151,8 +151,12 @@ void addEvaluate(CLI::App& app) {
       // The registry's methods and optimal-k have a description; the oracle (no budget) has none.
       const MethodInfo* methodInfo = findMethodInfo(spec.method);
       if (!methodInfo) throw Error("--methods " + m, "not a method (see mfr info --methods)");
-      if (const auto weights = spec.params.find("weights"); weights != spec.params.end())
+      if (const auto weights = spec.params.find("weights"); weights != spec.params.end()) {
+        std::vector<CommandFile> read{{"--methods " + m, weights->second}};
+        read.push_back({"--json", opt->json, CommandFile::Role::kOutput});
+        checkCommandFiles(read);  // the JSON must not replace the weights it reads
         (void)loadNeuralImportance(weights->second);
+      }
       // The rest of the spec too, before anything renders: a bad parameter or operation is the
       // user's mistake, which every row would only repeat (with exit 0).
       if (std::none_of(methodInfo->params.begin(), methodInfo->params.end(),

@@ -85,8 +85,6 @@ void addProbe(CLI::App& app) {
   cmd->add_option("--section", opt->section, kSectionHelp);
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->callback([opt, thicknessGiven] {
-    checkCommandFiles(
-        {{"scene", opt->scene, CommandFile::Role::kScene}, {"--json", opt->json, CommandFile::Role::kOutput}});
     const auto [w, h] = parseSize("--size", opt->size);
     validateImageSize("--size", w, h);
     const auto [x, y] = parsePixel(opt->pixel);
@@ -108,6 +106,10 @@ void addProbe(CLI::App& app) {
     } else if (!req.params.empty()) {
       throw Error("--param", "needs --method");
     }
+    std::vector<CommandFile> files{{"scene", opt->scene, CommandFile::Role::kScene}};
+    addParameterFiles(files, "-p", req.method, req.params);  // dkb's weights are read
+    files.push_back({"--json", opt->json, CommandFile::Role::kOutput});
+    checkCommandFiles(files);
     validateOperation(opt->op);
     req.operation = opt->op;
     req.thickness = thicknessOption(*thicknessGiven, opt->thickness);

@@ -78,10 +78,12 @@ void addRender(CLI::App& app) {
     const auto [w, h] = parseSize("--size", opt->size);
     // Both outputs checked before the work, so that a bad second path leaves no first file behind;
     // neither may be the scene, nor both one file (the JSON would replace the image just written).
-    // A dkb weights file given as a parameter is read too.
+    // A file a parameter names (dkb's weights) is read too.
     std::vector<CommandFile> files{{"scene", opt->scene, CommandFile::Role::kScene}};
+    std::map<std::string, std::string> named;
     for (const std::string& p : opt->params)
-      if (p.rfind("weights=", 0) == 0) files.push_back({"-p", p.substr(8)});
+      if (const auto eq = p.find('='); eq != std::string::npos) named[p.substr(0, eq)] = p.substr(eq + 1);
+    addParameterFiles(files, "-p", opt->method, named);
     files.push_back({"-o", opt->output, CommandFile::Role::kRequiredOutput});
     files.push_back({"--stats", opt->stats, CommandFile::Role::kOutput});
     checkCommandFiles(files);

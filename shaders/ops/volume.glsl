@@ -54,8 +54,11 @@ struct OpState {
 float volumeSample(int v, vec3 g) { return mfrTrilinear(uVolume[v], uGridDims[v], g); }
 
 // (rgb, σ) of a scalar: volume v's table interpolated linearly (TransferFunction::table).
+// Halved first, exactly (`precise`: not folded back): value − low overflows a float beyond
+// ±1.7e38; NaN (a table of one value) is the first entry.
 vec4 volumeTransfer(int v, float value) {
-  float u = clamp((value - uTfLow[v]) / (uTfHigh[v] - uTfLow[v]), 0.0, 1.0) * float(MFR_VOLUME_TF_SIZE - 1);
+  precise float along = (0.5 * value - 0.5 * uTfLow[v]) / (0.5 * uTfHigh[v] - 0.5 * uTfLow[v]);
+  float u = (along > 0.0 ? min(along, 1.0) : 0.0) * float(MFR_VOLUME_TF_SIZE - 1);
   int i = min(int(u), MFR_VOLUME_TF_SIZE - 2);
   float f = u - float(i);
   return mix(texelFetch(uTransfer[v], i, 0), texelFetch(uTransfer[v], i + 1, 0), f);
@@ -64,17 +67,25 @@ vec4 volumeTransfer(int v, float value) {
 // The emission factor of a shaded volume at grid point g (MFR_VOLUME_AMBIENT in common/bindings.h;
 // Levoy 1988): headlight diffuse on the normalised world gradient, faded out where the gradient
 // is small against the transfer function's range.
+float volumeHalfDifference(int v, vec3 g, vec3 d) {
+  precise float difference = 0.5 * volumeSample(v, g + d) - 0.5 * volumeSample(v, g - d);
+  return difference;
+}
+
+// Central differences halved before subtracting and measured in units of the largest component:
+// no step overflows a float (VolumeMarcher::shade, the same steps).
 float volumeShade(int v, vec3 g, vec3 rayDir) {
-  vec3 gradient =
-      0.5 * vec3(volumeSample(v, g + vec3(1.0, 0.0, 0.0)) - volumeSample(v, g - vec3(1.0, 0.0, 0.0)),
-                 volumeSample(v, g + vec3(0.0, 1.0, 0.0)) - volumeSample(v, g - vec3(0.0, 1.0, 0.0)),
-                 volumeSample(v, g + vec3(0.0, 0.0, 1.0)) - volumeSample(v, g - vec3(0.0, 0.0, 1.0)));
-  float perCell = length(gradient);
-  if (!(perCell > 0.0)) return 1.0;
-  vec3 world = transpose(mat3(uWorldToGrid[v])) * gradient;
+  vec3 gradient = vec3(volumeHalfDifference(v, g, vec3(1.0, 0.0, 0.0)), volumeHalfDifference(v, g, vec3(0.0, 1.0, 0.0)),
+                       volumeHalfDifference(v, g, vec3(0.0, 0.0, 1.0)));
+  float largest = max(max(abs(gradient.x), abs(gradient.y)), abs(gradient.z));
+  if (!(largest > 0.0)) return 1.0;
+  vec3 unit = gradient / largest;
+  float perCell = length(unit);
+  vec3 world = transpose(mat3(uWorldToGrid[v])) * unit;
   float facing = abs(dot(world, rayDir)) / length(world);
   float lit = float(MFR_VOLUME_AMBIENT) + float(MFR_VOLUME_DIFFUSE) * facing;
-  float w = perCell / (perCell + float(MFR_VOLUME_SHADE_EDGE) * (uTfHigh[v] - uTfLow[v]));
+  precise float range = 2.0 * ((0.5 * uTfHigh[v] - 0.5 * uTfLow[v]) / largest);
+  float w = perCell / (perCell + float(MFR_VOLUME_SHADE_EDGE) * range);
   return mix(1.0, lit, w);
 }
 

@@ -278,6 +278,14 @@ TEST_F(Cli, NoCommandWritesOverItsInputsOrOneFileTwice) {
            {"compare @r.png b.png --heatmap @r.png", "--heatmap @r.png: is the same file as reference (@r.png)"},
            {"render @sample -s 24x16 -o @q.png --stats @q.png", "--stats @q.png: is the same file as -o (@q.png)"},
            {"render @sample -s 24x16 -m dkb -p weights=w.json -o w.json", "-o w.json: is the same file as -p"},
+           // A method parameter's file too, in every command that takes one (probe, bench and
+           // evaluate wrote their JSON over the weights).
+           {"probe @sample -s 24x16 --pixel 12,8 -m dkb -p weights=w.json --json ./w.json",
+            "--json ./w.json: is the same file as -p (w.json)"},
+           {"bench @sample -s 16x16 -m dkb:weights=w.json --json w.json",
+            "--json w.json: is the same file as --methods dkb:weights=w.json"},
+           {"evaluate @sample -s 24x16 --budgets k1 -m dkb:weights=w.json --json w.json",
+            "--json w.json: is the same file as --methods dkb:weights=w.json"},
            {"render s.mfrscene -s 24x16 -o s.mfrscene", "-o s.mfrscene: is the same file as scene"},
            {"render @sample -s 24x16 -o q.png --stats ./q.png", "--stats ./q.png: is the same file as -o (q.png)"},
            {"info s.mfrscene --no-histogram --json ./s.mfrscene", "is the same file as scene (s.mfrscene)"},

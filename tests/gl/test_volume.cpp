@@ -114,6 +114,52 @@ TEST(VolumeGpu, ShadedEqualsTheOracle) {
   }
 }
 
+// Values near ±FLT_MAX (a file's "no data" marks, or a field in large units): the transfer
+// function's v − low and the gradient's differences overflow a float if taken as written (the
+// oracle crashed on an infinite table index; the GPU drew no medium). The sample's field and its
+// transfer points, mapped affinely onto [−3e38, 3e38], must give the image of the unmapped ones,
+// shaded and not, on both renderers.
+TEST(VolumeGpu, ValuesNearFloatMaxRenderAsSmallOnes) {
+  context();
+  for (const bool shaded : {false, true}) {
+    SCOPED_TRACE(shaded ? "shaded" : "unshaded");
+    Scene scene = makeVolumeSampleScene();
+    scene.volumes[0].shading = shaded;
+    Scene huge = scene;
+    Volume& volume = huge.volumes[0];
+    const glm::vec2 range = volume.grid->range();
+    const double mid = 0.5 * (static_cast<double>(range.x) + range.y);
+    const double scale = 3e38 / (0.5 * (static_cast<double>(range.y) - range.x));
+    auto grid = std::make_shared<VolumeGrid>(*volume.grid);
+    for (float& v : grid->values) v = static_cast<float>((v - mid) * scale);
+    volume.grid = grid;
+    for (TransferPoint& p : volume.transfer.points) p.value = (p.value - mid) * scale;
+    ASSERT_GT(static_cast<double>(volume.grid->range().y) - volume.grid->range().x, 5e38);
+
+    const int w = 96, h = 80;
+    const Camera camera = scene.view("iso");
+    const FragmentLists oracle = castFragments(scene, camera, w, h);
+    RenderRequest req;
+    req.operation = "volume";
+    req.width = w;
+    req.height = h;
+    req.method = "abuffer-ll";
+    const double step = volumeStepOf(req, scene.visibleVolumes());
+    const ImageRGBA8 expected = compositeVolume(oracle, camera, scene.visibleVolumes(), step, scene.background);
+    const ImageRGBA8 oracleHuge = compositeVolume(oracle, camera, huge.visibleVolumes(), step, huge.background);
+    GpuRenderer gpu;
+    gpu.setScene(huge);
+    const ImageRGBA8 gpuHuge = gpu.render(camera, req).image;
+    for (const ImageRGBA8* image : {&oracleHuge, &gpuHuge}) {
+      const Comparison c = compareOffEdges(oracle, expected, *image, scene.background, 2);
+      EXPECT_GT(c.volumeOnly, 100u);  // measured: 137
+      EXPECT_GE(static_cast<double>(c.within) / c.compared, 0.999)
+          << (image == &gpuHuge ? "gpu: " : "oracle: ") << c.compared - c.within
+          << " pixels off by more than 2/255, max " << c.maxDifference;
+    }
+  }
+}
+
 // The medium changes the image: the same scene with "oit" differs from "volume" wherever the
 // volume is, and a scene of the volume alone (no triangles) renders on both renderers alike.
 TEST(VolumeGpu, VolumeAloneAndAutoOperation) {

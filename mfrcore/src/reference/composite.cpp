@@ -237,8 +237,10 @@ struct VolumeMarcher {
   }
 
   [[nodiscard]] glm::vec4 transfer(const VolumeMedium& m, float v) const {
-    const float u =
-        std::clamp((v - m.tfLow) / (m.tfHigh - m.tfLow), 0.0f, 1.0f) * static_cast<float>(MFR_VOLUME_TF_SIZE - 1);
+    // Halved first, exactly: v − low overflows a float for values beyond ±1.7e38 (a file's
+    // ±FLT_MAX "no data" marks). A NaN position (a table of one value) is the first entry.
+    const float along = (0.5f * v - 0.5f * m.tfLow) / (0.5f * m.tfHigh - 0.5f * m.tfLow);
+    const float u = (along > 0.0f ? std::min(along, 1.0f) : 0.0f) * static_cast<float>(MFR_VOLUME_TF_SIZE - 1);
     const int i = std::min(static_cast<int>(u), MFR_VOLUME_TF_SIZE - 2);
     const float f = u - static_cast<float>(i);
     return glm::mix(m.table[static_cast<std::size_t>(i)], m.table[static_cast<std::size_t>(i) + 1], f);
@@ -247,17 +249,21 @@ struct VolumeMarcher {
   // The emission factor of a shaded volume at grid point g (shaders/ops/volume.glsl volumeShade).
   [[nodiscard]] float shade(const VolumeMedium& m, const glm::vec3& g) const {
     const VolumeGrid& grid = *m.grid;
-    const glm::vec3 gradient =
-        0.5f * glm::vec3(grid.sample(g + glm::vec3(1.0f, 0.0f, 0.0f)) - grid.sample(g - glm::vec3(1.0f, 0.0f, 0.0f)),
-                         grid.sample(g + glm::vec3(0.0f, 1.0f, 0.0f)) - grid.sample(g - glm::vec3(0.0f, 1.0f, 0.0f)),
-                         grid.sample(g + glm::vec3(0.0f, 0.0f, 1.0f)) - grid.sample(g - glm::vec3(0.0f, 0.0f, 1.0f)));
-    const float perCell = glm::length(gradient);
-    if (!(perCell > 0.0f)) return 1.0f;
+    // Central differences, halved before subtracting and measured in units of the largest
+    // component, so that no step overflows a float (values near ±FLT_MAX; transfer above).
+    const auto half = [&](const glm::vec3& d) { return 0.5f * grid.sample(g + d) - 0.5f * grid.sample(g - d); };
+    const glm::vec3 gradient(half({1.0f, 0.0f, 0.0f}), half({0.0f, 1.0f, 0.0f}), half({0.0f, 0.0f, 1.0f}));
+    const float largest = std::max({std::abs(gradient.x), std::abs(gradient.y), std::abs(gradient.z)});
+    if (!(largest > 0.0f)) return 1.0f;
+    const glm::vec3 unit = gradient / largest;
+    const float perCell = glm::length(unit);  // |∇| / largest, in [1, √3]
     // ∇ in world units: the transpose of world → grid's linear part applied to ∇ in grid units.
-    const glm::vec3 world = glm::transpose(glm::mat3(m.worldToGrid)) * gradient;
+    const glm::vec3 world = glm::transpose(glm::mat3(m.worldToGrid)) * unit;
     const float facing = std::abs(glm::dot(world, rayDir)) / glm::length(world);
     const float lit = static_cast<float>(MFR_VOLUME_AMBIENT) + static_cast<float>(MFR_VOLUME_DIFFUSE) * facing;
-    const float w = perCell / (perCell + static_cast<float>(MFR_VOLUME_SHADE_EDGE) * (m.tfHigh - m.tfLow));
+    // |∇| / (|∇| + edge · (high − low)), both terms divided by `largest`.
+    const float range = 2.0f * ((0.5f * m.tfHigh - 0.5f * m.tfLow) / largest);
+    const float w = perCell / (perCell + static_cast<float>(MFR_VOLUME_SHADE_EDGE) * range);
     return glm::mix(1.0f, lit, w);
   }
 

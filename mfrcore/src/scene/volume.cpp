@@ -17,12 +17,13 @@ float VolumeGrid::sample(const glm::vec3& g) const {
   const glm::vec3 c = glm::clamp(g, glm::vec3(0.0f), last);
   const glm::ivec3 i0 = glm::min(glm::ivec3(glm::floor(c)), dims - 2);
   const glm::vec3 f = c - glm::vec3(i0);
-  const auto v = [&](int dx, int dy, int dz) { return at(i0.x + dx, i0.y + dy, i0.z + dz); };
+  // Halved, and the result doubled, exactly, as the shader does (its mix may subtract).
+  const auto v = [&](int dx, int dy, int dz) { return 0.5f * at(i0.x + dx, i0.y + dy, i0.z + dz); };
   const float x00 = glm::mix(v(0, 0, 0), v(1, 0, 0), f.x);
   const float x10 = glm::mix(v(0, 1, 0), v(1, 1, 0), f.x);
   const float x01 = glm::mix(v(0, 0, 1), v(1, 0, 1), f.x);
   const float x11 = glm::mix(v(0, 1, 1), v(1, 1, 1), f.x);
-  return glm::mix(glm::mix(x00, x10, f.y), glm::mix(x01, x11, f.y), f.z);
+  return 2.0f * glm::mix(glm::mix(x00, x10, f.y), glm::mix(x01, x11, f.y), f.z);
 }
 
 glm::vec2 VolumeGrid::range() const {
@@ -70,6 +71,9 @@ void TransferFunction::validate(const std::string& what) const {
     const TransferPoint& p = points[i];
     if (!std::isfinite(p.value))
       throw Error(what, "transfer function point " + std::to_string(i) + " has a non-finite value");
+    // Both renderers take the range as floats: a larger value would be infinite there.
+    if (std::abs(p.value) > std::numeric_limits<float>::max())
+      throw Error(what, "transfer function point " + std::to_string(i) + " lies beyond a float's range (±3.4e38)");
     for (int c = 0; c < 4; ++c)
       if (!(p.color[c] >= 0.0f && p.color[c] <= 1.0f))
         throw Error(what, "transfer function point " + std::to_string(i) + ": colour and opacity must be in [0, 1]");
