@@ -26,39 +26,70 @@ std::string readFile(const std::filesystem::path& path) {
   return ss.str();
 }
 
-void checkOutputPath(const std::filesystem::path& path) {
-  if (path.empty()) throw Error("output", "empty file name");
-  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+namespace {
+
+// Where an output is written: the file a symbolic link names (the link stays a link, as when a
+// program opens it for writing; a rename over the link replaced it with a plain file). Throws for a
+// link that names no file, or a loop.
+std::filesystem::path outputTarget(const std::filesystem::path& path) {
   std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec)) throw Error(path.string(), "folder does not exist");
-  const std::filesystem::file_status status = std::filesystem::status(path, ec);
-  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
-    throw Error(path.string(), std::filesystem::is_directory(status)
-                                   ? "is a folder, not a file"
-                                   : "exists and is not a regular file (a device or pipe): not replaced");
+  if (!std::filesystem::is_symlink(std::filesystem::symlink_status(path, ec))) return path;
+  const std::filesystem::path target = std::filesystem::canonical(path, ec);
+  if (ec) throw Error(path.string(), "a link to a missing file or a loop of links (" + ec.message() + ")");
+  return target;
 }
 
-void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes) {
-  checkOutputPath(path);
+// A file created and removed in `dir`: whether outputs can be written there at all (a folder can
+// exist and refuse files: /proc, a read-only mount, another user's), checked before any work.
+void checkFolderTakesFiles(const std::filesystem::path& dir, const std::filesystem::path& output) {
+  std::filesystem::path probe = dir / (".mfr-write-check-" + std::to_string(::getpid()) + "-" +
+                                       std::to_string(std::random_device{}() & 0xFFFFFF));
+  {
+    std::ofstream out(probe, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(output.string(), std::string("cannot write in its folder (") + std::strerror(errno) + ")");
+  }
+  std::error_code ec;
+  std::filesystem::remove(probe, ec);
+}
+
+}  // namespace
+
+void checkOutputPath(const std::filesystem::path& given) {
+  if (given.empty()) throw Error("output", "empty file name");
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(given, ec);
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw Error(given.string(), std::filesystem::is_directory(status)
+                                    ? "is a folder, not a file"
+                                    : "exists and is not a regular file (a device or pipe): not replaced");
+  const std::filesystem::path path = outputTarget(given);
+  const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+  if (!std::filesystem::is_directory(dir, ec)) throw Error(given.string(), "folder does not exist");
+  checkFolderTakesFiles(dir, given);
+}
+
+void writeFileAtomically(const std::filesystem::path& given, std::string_view bytes) {
+  checkOutputPath(given);
+  const std::filesystem::path path = outputTarget(given);  // a link's file, not the link
   std::error_code ec;
   // Temporary beside the target (same file system), renamed over it only when complete.
   std::filesystem::path tmp = path;
   tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(std::random_device{}() & 0xFFFFFF);
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(path.string(), std::string("cannot write (") + std::strerror(errno) + ")");
+    if (!out) throw Error(given.string(), std::string("cannot write (") + std::strerror(errno) + ")");
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     out.close();
     if (!out) {
       std::filesystem::remove(tmp, ec);
-      throw Error(path.string(), "write failed (disk full?)");
+      throw Error(given.string(), "write failed (disk full?)");
     }
   }
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
     const std::string why = ec.message();  // before remove() reuses ec
     std::filesystem::remove(tmp, ec);
-    throw Error(path.string(), "cannot replace file (" + why + ")");
+    throw Error(given.string(), "cannot replace file (" + why + ")");
   }
 }
 

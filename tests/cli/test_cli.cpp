@@ -374,6 +374,35 @@ TEST_F(Cli, BadOutputsLeaveNothingAndReplaceNoDevice) {
   EXPECT_FALSE(fs::exists(heat));
 }
 
+// An output that is a symbolic link writes the file it names and stays a link (a rename replaced
+// the link with a plain file and left its file as it was); a link to no file is refused. A folder
+// that exists but takes no file (/proc) is refused before any work, so the PNG written before the
+// stats failed is not left behind (found by a bug hunt).
+TEST_F(Cli, OutputLinksAreWrittenThroughAndUnwritableFoldersRefusedFirst) {
+  const fs::path target = write("t.png", "orig");
+  fs::create_symlink("t.png", dir() / "l.png");
+  CliResult r = runCli("render @sample --size 16x16 -o " + (dir() / "l.png").string());
+  EXPECT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_TRUE(fs::is_symlink(dir() / "l.png"));
+  EXPECT_EQ(mfr::readPng(target).width, 16);
+  fs::create_symlink("gone.png", dir() / "dangling.png");
+  r = runCli("render @sample --size 16x16 -o " + (dir() / "dangling.png").string());
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find("dangling.png: a link to a missing file"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir() / "dangling.png")));
+  EXPECT_FALSE(fs::exists(dir() / "gone.png"));
+
+  const fs::path png = dir() / "r.png";
+  r = runCli("render @sample --size 16x16 -o " + png.string() + " --stats /proc/mfr-test-stats.json");
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find("/proc/mfr-test-stats.json: cannot write in its folder"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(png));
+  r = runCli("dataset @sample --views front -s 24x16 --budgets 1 -o /proc/mfr-test.bin");
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_EQ(r.out.rfind("mfr: /proc/mfr-test.bin: cannot write in its folder (", 0), 0u) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;  // one line, no table first
+}
+
 TEST_F(Cli, CompareSizeMismatchAndCorruptPng) {
   mfr::writePng(dir() / "a.png", mfr::ImageRGBA8(4, 4));
   mfr::writePng(dir() / "b.png", mfr::ImageRGBA8(5, 4));

@@ -6,12 +6,13 @@
 
 namespace mfr {
 
-// Writes bytes to path.tmp-XXXX then renames over path. Throws mfr::Error naming path (and first
-// checkOutputPath's refusals).
+// Writes bytes to path.tmp-XXXX then renames over path; a symbolic link's file is written, and the
+// link kept. Throws mfr::Error naming path (and first checkOutputPath's refusals).
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
-// Whether an output could be written there, before anything is: its folder exists, and the path is
-// not something other than a regular file (a folder, a device such as /dev/full, a pipe), which a
-// rename would replace. Commands with several outputs check them all first, so that a bad second
+// Whether an output could be written there, before anything is: its folder exists and takes a new
+// file (one is created and removed), the path is not something other than a regular file (a
+// folder, a device such as /dev/full, a pipe), which a rename would replace, and not a link to no
+// file. Commands with several outputs check them all first, so that a bad second
 // path leaves no first file behind. Throws mfr::Error naming path.
 void checkOutputPath(const std::filesystem::path& path);
 
