@@ -48,7 +48,19 @@ double zThicknessDefault(const Bounds& sceneBounds) {
 double zThicknessOf(const RenderRequest& request, const Bounds& sceneBounds) {
   if (!std::isfinite(request.thickness) || request.thickness < 0.0)
     throw Error("--thickness", "must be a positive length in scene units (got " + numberText(request.thickness) + ")");
-  if (request.thickness > 0.0) return request.thickness;
+  if (request.thickness > 0.0) {
+    // Both renderers take eye depths and the slab σ = −ln(1 − α)/τ as floats: a slab shorter than
+    // a few units of a depth's last place ends where it begins (the image came out blank, and the
+    // oracle agreed), and above 1e30 σ falls towards the denormals (a τ of 3.4e38 was infinite).
+    const double diagonal = sceneBounds.valid() ? glm::length(sceneBounds.max - sceneBounds.min) : 0.0;
+    const double least = 1e-6 * diagonal;
+    if (request.thickness < least)
+      throw Error("--thickness " + numberText(request.thickness),
+                  "below a millionth of the scene's diagonal (" + numberText(least) +
+                      "): the slabs would be shorter than the depth precision");
+    if (request.thickness > 1e30) throw Error("--thickness " + numberText(request.thickness), "above 1e30 scene units");
+    return request.thickness;
+  }
   const double d = zThicknessDefault(sceneBounds);
   return d > 0.0 ? d : 0.01;  // a flat or point-like scene still gets a usable slab
 }

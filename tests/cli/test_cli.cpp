@@ -509,7 +509,13 @@ TEST_F(Cli, EmptyValuesAndOutOfRangeNumbersAreRefused) {
            {"compare " + a + " " + a + " --ppd 1e-30", "mfr: --ppd: must be in [0.01, 10000]"},
            {"train " + a + " -o " + out + " --seed -1", "mfr: --seed: '-1' is not a whole number"},
            {"dataset @sample -o " + out + " --seed ''", "mfr: --seed: '' is not a whole number"},
-           {"dataset @sample -o " + out + " --sample 0", "mfr: --sample: must be in (0, 1]: 0 writes no rows"}}) {
+           {"dataset @sample -o " + out + " --sample 0", "mfr: --sample: must be in (0, 1]: 0 writes no rows"},
+           // A slab below the float depth precision drew nothing (the oracle too), one of 3.4e38
+           // was infinite: found by a bug hunt.
+           {"render @sample -s 16x16 -o " + out + " --op zthickness --thickness 1e-7",
+            "mfr: --thickness 1e-07: below a millionth of the scene's diagonal"},
+           {"render @sample -s 16x16 -o " + out + " -m kbuffer-zmerge --thickness 3.4e38",
+            "mfr: --thickness 3.4e+38: above 1e30 scene units"}}) {
     const CliResult r = runCli(args);
     EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << args << ": " << r.exitCode << " " << r.out;
     EXPECT_EQ(r.out.rfind(message, 0), 0u) << args << ": " << r.out;

@@ -9,6 +9,8 @@
 #include <string>
 #include <utility>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "common/bindings.h"
 #include "gl_fixture.hpp"
 #include "image_compare.hpp"
@@ -102,16 +104,19 @@ TEST(ZThicknessGpu, CoincidentPartsLookTheSameInEitherDrawOrder) {
 }
 
 // kbuffer-zmerge with a slot for every fragment merges nothing: its own resolve of the stored
-// segments must then give the operation's image (the oracle's), coincident faces included.
+// segments must then give the operation's image (the oracle's), coincident faces included. Also
+// with the scene scaled by 1e7, whose default slab (1 % of the diagonal) is longer than a half
+// float holds: the segments kept their lengths in scene units, and the image came out blank.
 TEST(ZThicknessMergeKBuffer, WithRoomForEveryFragmentEqualsTheOracle) {
   context();
-  const Scene scene = makeIntersectingSampleScene();
   const int w = 128, h = 112;
-  GpuRenderer gpu;
-  gpu.setScene(scene);
-  for (const char* view : {"iso", "front"}) {
-    SCOPED_TRACE(view);
-    const Camera camera = scene.view(view);
+  for (const auto& [scale, view] : {std::pair{1.0, "iso"}, std::pair{1.0, "front"}, std::pair{1e7, "iso"}}) {
+    SCOPED_TRACE(std::string(view) + " scale " + std::to_string(scale));
+    Scene scene = makeIntersectingSampleScene();
+    for (Object& o : scene.objects) o.transform = glm::scale(glm::dmat4(1.0), glm::dvec3(scale)) * o.transform;
+    GpuRenderer gpu;
+    gpu.setScene(scene);
+    const Camera camera = scene.fit(scene.view(view));  // the view's direction, framing the scaled scene too
     const FragmentLists oracle = castFragments(scene, camera, w, h);
     ASSERT_LE(oracle.maxCount(), static_cast<std::uint32_t>(MFR_ZMERGE_MAX_K));
     RenderRequest req;

@@ -43,7 +43,8 @@ void validateOperation(const std::string& operation);
 // The default z-thickness: 1 % of the diagonal of the scene's bounds.
 double zThicknessDefault(const Bounds& sceneBounds);
 // The thickness a request asks for (its own, or the default); throws mfr::Error("--thickness", …)
-// for a negative, infinite or NaN value.
+// for a negative, infinite or NaN value, one below a millionth of the scene's diagonal (shorter
+// than the float depth precision) or above 1e30.
 double zThicknessOf(const RenderRequest& request, const Bounds& sceneBounds);
 // The step a request asks for (its own, or the smallest default step of the volumes); throws
 // mfr::Error("--step", …) for a negative, infinite or NaN value.

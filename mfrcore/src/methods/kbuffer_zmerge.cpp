@@ -81,6 +81,7 @@ void KBufferZThicknessMerge::capture(const FrameContext& ctx) {
     store_.set("uZmK", k_);
     store_.set("uSpinLimit", spinLimit_);
     store_.set("uZThickness", ctx.zThickness);
+    store_.set("uZmThickness", ctx.zThickness);
     store_.set("uDepthToEye", ctx.depthToEye);
     ctx.timer.begin("store");
     ctx.scene.draw(store_, ctx.frame);
@@ -112,6 +113,7 @@ void KBufferZThicknessMerge::resolve(const FrameContext& ctx, const Operation& o
   resolve_.set("uZmWidth", width_);
   resolve_.set("uZmPixels", static_cast<unsigned>(static_cast<std::uint64_t>(width_) * height_));
   resolve_.set("uZmK", k_);
+  resolve_.set("uZmThickness", ctx.zThickness);
   runResolvePass(ctx, resolve_, Operation{op.name, op.glslFile, nullptr});
 }
 
