@@ -31,6 +31,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <exception>
 
 #include "camera_navigator.hpp"
@@ -230,7 +231,15 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
     if (!model_->scene().volumes.empty())
       if (auto* volumeDock = findChild<QDockWidget*>(QStringLiteral("plugin-hybridvolume"))) volumeDock->raise();
     if (pendingSession_) {
-      applySession(*pendingSession_, *model_);
+      const QStringList notes = applySession(*pendingSession_, *model_);
+      if (!notes.isEmpty()) {
+        // Also for scripted runs (--screenshot), which have no status bar to read.
+        for (const QString& note : notes)
+          std::cerr << "note: " << QFileInfo(pendingSessionFile_).fileName().toStdString() << ": " << note.toStdString()
+                    << "\n";
+        statusBar()->showMessage(
+            QFileInfo(pendingSessionFile_).fileName() + QStringLiteral(": ") + notes.join(QStringLiteral("; ")), 20000);
+      }
       if (model_->compareEnabled()) compareDock_->show();
       for (const PluginRecord& r : plugins_.records())
         if (r.plugin && pendingSession_->plugins.contains(r.id))

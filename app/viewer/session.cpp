@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "mfr/error.hpp"
+#include "mfr/render.hpp"
 #include "viewer_model.hpp"
 
 namespace {
@@ -87,6 +88,45 @@ class Reader {
     if (!o.value(key).isDouble()) fail(where + "." + key, QStringLiteral("expected a number"));
     return o.value(key).toDouble();
   }
+  // A value in [0, 1] (a colour channel, an opacity).
+  double unit(const QJsonValue& v, const QString& where) const {
+    if (!v.isDouble() || !(v.toDouble() >= 0.0 && v.toDouble() <= 1.0))
+      fail(where, QStringLiteral("expected a number in [0, 1]"));
+    return v.toDouble();
+  }
+  // true or false ("no" was read as true: every non-boolean was).
+  bool boolean(const QJsonObject& o, const QString& key, const QString& where, bool fallback) const {
+    if (!o.contains(key)) return fallback;
+    if (!o.value(key).isBool()) fail(where + "." + key, QStringLiteral("expected true or false"));
+    return o.value(key).toBool();
+  }
+  QString string(const QJsonObject& o, const QString& key, const QString& where) const {
+    if (!o.contains(key) || o.value(key).isNull()) return {};
+    if (!o.value(key).isString()) fail(where.isEmpty() ? key : where + "." + key, QStringLiteral("expected a string"));
+    return o.value(key).toString();
+  }
+  QJsonObject object(const QJsonValue& v, const QString& where) const {
+    if (!v.isObject()) fail(where, QStringLiteral("expected an object"));
+    return v.toObject();
+  }
+  // A method the viewer draws with, or an operation (empty: not given).
+  QString method(const QJsonObject& o, const QString& key, const QString& where) const {
+    const QString name = string(o, key, where);
+    const mfr::MethodInfo* info = name.isEmpty() ? nullptr : mfr::findMethodInfo(name.toStdString());
+    if (!name.isEmpty() && info == nullptr)
+      fail(where.isEmpty() ? key : where + "." + key, QStringLiteral("unknown method '%1'").arg(name));
+    return name;
+  }
+  QString operation(const QJsonObject& o, const QString& key, const QString& where) const {
+    const QString name = string(o, key, where);
+    if (!name.isEmpty()) try {
+        mfr::validateOperation(name.toStdString());
+      } catch (const mfr::Error&) {
+        fail(where.isEmpty() ? key : where + "." + key, QStringLiteral("unknown operation '%1' (available: %2)")
+                                                            .arg(name, QString::fromStdString(mfr::operationNames())));
+      }
+    return name;
+  }
 
  private:
   QString file_;
@@ -131,19 +171,34 @@ Session captureSession(const ViewerModel& model) {
   return s;
 }
 
-void applySession(const Session& session, ViewerModel& model) {
+QStringList applySession(const Session& session, ViewerModel& model) {
+  QStringList notes;
   // The isosurfaces first: their parts are among the session's objects.
   if (session.volumes.size() == model.scene().volumes.size())
     for (std::size_t i = 0; i < session.volumes.size(); ++i)
       model.setIsosurfacesAt(static_cast<int>(i), session.volumes[i].isosurfaces, session.volumes[i].isosurfaceOpacity);
-  if (session.objects.size() == model.scene().objects.size()) {
-    for (std::size_t i = 0; i < session.objects.size(); ++i) {
-      const Session::ObjectState& o = session.objects[i];
-      const int index = static_cast<int>(i);
-      model.setObjectVisible(index, o.visible);
-      model.setObjectMaterial(index, o.color, o.vertexColors);
+  // Objects by name: the n-th entry of a name goes to the scene's n-th part of that name, so a
+  // scene file that gained, lost or reordered parts keeps the overrides of the parts it still has
+  // (by index, a changed count dropped them all, and a renamed part took another's state).
+  const std::vector<mfr::Object>& parts = model.scene().objects;
+  std::map<QString, int> seen;  // entries of each name so far
+  QStringList unmatched;
+  for (const Session::ObjectState& o : session.objects) {
+    int nth = seen[o.name]++;
+    int index = -1;
+    for (std::size_t i = 0; i < parts.size() && index < 0; ++i)
+      if (QString::fromStdString(parts[i].name) == o.name && nth-- == 0) index = static_cast<int>(i);
+    if (index < 0) {
+      unmatched << QStringLiteral("'%1'").arg(o.name);
+      continue;
     }
+    model.setObjectVisible(index, o.visible);
+    model.setObjectMaterial(index, o.color, o.vertexColors);
   }
+  if (!unmatched.isEmpty())
+    notes << (unmatched.size() == 1 ? QStringLiteral("the session's object %1 is no part of the scene: left out")
+                                    : QStringLiteral("the session's objects %1 are no part of the scene: left out"))
+                 .arg(unmatched.join(QStringLiteral(", ")));
   model.setAllParams(session.params);
   model.setZThickness(session.thickness);
   if (session.hasClip) model.setClipBox(session.clip);
@@ -172,6 +227,7 @@ void applySession(const Session& session, ViewerModel& model) {
   model.setCompareEnabled(session.compare.enabled);
   model.setDataView(session.dataView, session.dataOverImage);
   model.setCamera(session.camera);
+  return notes;
 }
 
 QJsonObject sessionToJson(const Session& s) {
@@ -251,8 +307,11 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   const Reader r(file);
   if (json.value("format").toString() != QLatin1String("mfrview-session"))
     r.fail(QStringLiteral("format"), QStringLiteral("not an mfrview session (expected \"format\": \"mfrview-session\")"));
+  // Version 1 is the only one yet; a later one may mean keys that this viewer would misread.
+  if (json.contains("version") && json.value("version") != QJsonValue(1))
+    r.fail(QStringLiteral("version"), QStringLiteral("expected 1 (a session of a newer mfrview, or not a number)"));
   Session s;
-  s.scenePath = json.value("scene").toString();
+  s.scenePath = r.string(json, "scene", {});
   if (s.scenePath.isEmpty()) r.fail(QStringLiteral("scene"), QStringLiteral("missing scene path"));
   if (json.contains("molecule")) {
     if (!json.value("molecule").isString())
@@ -275,8 +334,8 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   s.camera.orthoHeight = r.number(cam, "ortho_height", "camera", s.camera.orthoHeight);
   s.camera.nearPlane = r.number(cam, "near", "camera", s.camera.nearPlane);
   s.camera.farPlane = r.number(cam, "far", "camera", s.camera.farPlane);
-  s.method = json.value("method").toString();
-  s.operation = json.value("operation").toString();
+  s.method = r.method(json, "method", {});
+  s.operation = r.operation(json, "operation", {});
   // Optional (sessions written before the operation zthickness have none: the default).
   if (json.contains("thickness") && !json.value("thickness").isDouble())
     r.fail(QStringLiteral("thickness"), QStringLiteral("expected a number"));
@@ -337,21 +396,22 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   }
   const QJsonArray volumes = json.value("volumes").toArray();
   for (qsizetype i = 0; i < volumes.size(); ++i) {
-    const QJsonObject v = volumes[i].toObject();
-    const QString where = QStringLiteral("volumes[%1].transfer").arg(i);
-    const QJsonObject t = v.value("transfer").toObject();
-    Session::VolumeState state{v.value("name").toString(),
-                               v.value("visible").toBool(true),
+    const QString at = QStringLiteral("volumes[%1]").arg(i);
+    const QJsonObject v = r.object(volumes[i], at);
+    const QString where = at + QStringLiteral(".transfer");
+    const QJsonObject t = r.object(v.value("transfer"), where);
+    Session::VolumeState state{r.string(v, "name", at),
+                               r.boolean(v, "visible", at, true),
                                {},
-                               v.value("shading").toBool(false),
-                               v.value("field").toString(),
+                               r.boolean(v, "shading", at, false),
+                               r.string(v, "field", at),
                                {},
                                0.5};
     state.transfer.unitDistance = r.number(t, "unit_distance", where, 1.0);
     const QJsonArray points = t.value("points").toArray();
     for (qsizetype j = 0; j < points.size(); ++j) {
       const QJsonArray p = points[j].toArray();
-      if (p.size() != 5)
+      if (p.size() != 5 || !std::all_of(p.begin(), p.end(), [](const QJsonValue& x) { return x.isDouble(); }))
         r.fail(where + QStringLiteral(".points[%1]").arg(j), QStringLiteral("expected [value, r, g, b, a]"));
       state.transfer.points.push_back(
           {p[0].toDouble(), glm::vec4(glm::dvec4(p[1].toDouble(), p[2].toDouble(), p[3].toDouble(), p[4].toDouble()))});
@@ -363,41 +423,43 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
     }
     // Optional (sessions written before isosurfaces have none); the viewer checks the values.
     if (v.contains("isosurfaces")) {
-      const QString at = QStringLiteral("volumes[%1].isosurfaces").arg(i);
+      const QString isoAt = at + QStringLiteral(".isosurfaces");
       const QJsonObject iso = v.value("isosurfaces").toObject();
       const QJsonArray values = iso.value("values").toArray();
       for (qsizetype j = 0; j < values.size(); ++j) {
         if (!values[j].isDouble())
-          r.fail(at + QStringLiteral(".values[%1]").arg(j), QStringLiteral("expected a number"));
+          r.fail(isoAt + QStringLiteral(".values[%1]").arg(j), QStringLiteral("expected a number"));
         state.isosurfaces.push_back(values[j].toDouble());
       }
-      state.isosurfaceOpacity = r.number(iso, "opacity", at, 0.5);
+      state.isosurfaceOpacity = r.number(iso, "opacity", isoAt, 0.5);
     }
     s.volumes.push_back(std::move(state));
   }
   s.params = r.params(json.value("params").toObject(), QStringLiteral("params"));
   // Optional (sessions written before compare mode have neither).
   const QJsonObject compare = json.value("compare").toObject();
-  s.compare.enabled = compare.value("enabled").toBool(false);
+  s.compare.enabled = r.boolean(compare, "enabled", QStringLiteral("compare"), false);
   s.compare.layout = r.choice(compare, "layout", "compare", kLayouts, CompareLayout::SideBySide);
   s.compare.split = std::clamp(r.number(compare, "split", "compare", 0.5), 0.0, 1.0);
   s.compare.display = r.choice(compare, "display", "compare", kDisplays, CompareDisplay::Images);
-  s.compare.method = compare.value("method").toString();
-  s.compare.operation = compare.value("operation").toString();
+  s.compare.method = r.method(compare, "method", QStringLiteral("compare"));
+  s.compare.operation = r.operation(compare, "operation", QStringLiteral("compare"));
   s.compare.params = r.params(compare.value("params").toObject(), QStringLiteral("compare.params"));
   const QJsonObject dataView = json.value("data_view").toObject();
   s.dataView = r.choice(dataView, "mode", "data_view", kDataViews, DataView::Image);
-  s.dataOverImage = dataView.value("over_image").toBool(false);
+  s.dataOverImage = r.boolean(dataView, "over_image", QStringLiteral("data_view"), false);
   const QJsonArray objects = json.value("objects").toArray();
   for (qsizetype i = 0; i < objects.size(); ++i) {
-    const QJsonObject o = objects[i].toObject();
+    const QString at = QStringLiteral("objects[%1]").arg(i);
+    const QJsonObject o = r.object(objects[i], at);
     const QJsonArray c = o.value("color").toArray();
-    if (c.size() != 3) r.fail(QStringLiteral("objects[%1].color").arg(i), QStringLiteral("expected [r, g, b]"));
-    const glm::dvec4 rgba(c[0].toDouble(), c[1].toDouble(), c[2].toDouble(),
-                          r.number(o, "opacity", QStringLiteral("objects[%1]").arg(i), 1.0));
+    if (c.size() != 3) r.fail(at + QStringLiteral(".color"), QStringLiteral("expected [r, g, b]"));
+    glm::dvec4 rgba(1.0);
+    for (int k = 0; k < 3; ++k) rgba[k] = r.unit(c[k], at + QStringLiteral(".color[%1]").arg(k));
+    rgba.a = o.contains("opacity") ? r.unit(o.value("opacity"), at + QStringLiteral(".opacity")) : 1.0;
     // vertex_colors: absent in sessions written before it existed, when colours always multiplied.
-    s.objects.push_back({o.value("name").toString(), o.value("visible").toBool(true), glm::vec4(rgba),
-                         o.value("vertex_colors").toBool(true)});
+    s.objects.push_back({r.string(o, "name", at), r.boolean(o, "visible", at, true), glm::vec4(rgba),
+                         r.boolean(o, "vertex_colors", at, true)});
   }
   s.plugins = json.value("plugins").toObject();
   return s;

@@ -6,6 +6,7 @@
 // Doubles are written shortest-round-trip, so a reloaded session renders the same image.
 #include <QJsonObject>
 #include <QString>
+#include <QStringList>
 
 #include <map>
 #include <optional>
@@ -53,7 +54,7 @@ struct Session {
   };
   std::vector<VolumeState> volumes;                                  // by volume index
   std::map<std::string, std::map<std::string, std::string>> params;  // per method
-  std::vector<ObjectState> objects;                                  // by object index
+  std::vector<ObjectState> objects;                                  // matched to parts by name
   struct CompareState {
     bool enabled = false;
     CompareLayout layout = CompareLayout::SideBySide;
@@ -70,8 +71,9 @@ struct Session {
 // The model's current state (plugins filled in by the caller).
 Session captureSession(const ViewerModel& model);
 // Camera, method, parameters and object overrides onto the loaded scene. Objects are matched by
-// index; a session written for a different scene (other object count) keeps the file's objects.
-void applySession(const Session& session, ViewerModel& model);
+// name (the n-th entry of a name to the n-th part of that name); parts the session does not name
+// keep the file's state. Returns notes for the user (the session's objects the scene lacks).
+QStringList applySession(const Session& session, ViewerModel& model);
 
 QJsonObject sessionToJson(const Session& session);
 // Throws mfr::Error("<file>: <json path>", reason) for malformed content.

@@ -590,6 +590,77 @@ class ViewerTest : public QObject {
     QCOMPARE(maxChannelDifference(before, after), 0);
   }
 
+  // A session's values of the wrong type or range are one line naming the file and the key: they
+  // were read as something else without a word ("visible": "no" as visible, a colour of [1, 0, "x"]
+  // as black, opacity 5, "method": 3 as the current method, version 99 as 1; found by a bug hunt).
+  void badSessionValuesAreRefused() {
+    const QJsonObject good{
+        {"format", "mfrview-session"},
+        {"version", 1},
+        {"scene", "@sample"},
+        {"camera",
+         QJsonObject{{"eye", QJsonArray{3, 2, 4}}, {"target", QJsonArray{0, 0, 0}}, {"up", QJsonArray{0, 1, 0}}}},
+        {"method", "abuffer-ll"},
+        {"objects", QJsonArray{QJsonObject{{"name", "tangle"}, {"color", QJsonArray{1, 0, 0}}}}}};
+    (void)sessionFromJson(good, "s.mfrsession");  // throws if the base is bad
+    const auto with = [&](const QString& key, const QJsonValue& value) {
+      QJsonObject json = good;
+      json.insert(key, value);
+      return json;
+    };
+    const auto object = [](const QJsonObject& extra) {
+      QJsonObject o{{"name", "tangle"}, {"color", QJsonArray{1, 0, 0}}};
+      for (auto it = extra.begin(); it != extra.end(); ++it) o.insert(it.key(), it.value());
+      return QJsonArray{o};
+    };
+    const QList<std::pair<QJsonObject, QString>> cases{
+        {with("objects", object({{"visible", "no"}})), "s.mfrsession: objects[0].visible: expected true or false"},
+        {with("objects", object({{"color", QJsonArray{1, 0, "x"}}})),
+         "s.mfrsession: objects[0].color[2]: expected a number in [0, 1]"},
+        {with("objects", object({{"opacity", 5}})), "s.mfrsession: objects[0].opacity: expected a number in [0, 1]"},
+        {with("objects", QJsonArray{7}), "s.mfrsession: objects[0]: expected an object"},
+        {with("method", 3), "s.mfrsession: method: expected a string"},
+        {with("method", "nosuch"), "s.mfrsession: method: unknown method 'nosuch'"},
+        {with("operation", "xyz"), "s.mfrsession: operation: unknown operation 'xyz'"},
+        {with("version", 99), "s.mfrsession: version: expected 1"},
+        {with("compare", QJsonObject{{"enabled", 1}}), "s.mfrsession: compare.enabled: expected true or false"},
+        {with("volumes",
+              QJsonArray{QJsonObject{{"transfer", QJsonObject{{"points", QJsonArray{QJsonArray{0, 0, 0, 0, 0},
+                                                                                    QJsonArray{1, "a", 1, 1, 1}}}}}}}),
+         "s.mfrsession: volumes[0].transfer.points[1]: expected [value, r, g, b, a]"},
+    };
+    for (const auto& [json, message] : cases) {
+      try {
+        (void)sessionFromJson(json, "s.mfrsession");
+        QFAIL(qPrintable("accepted, expected: " + message));
+      } catch (const mfr::Error& e) {
+        QVERIFY2(QString::fromUtf8(e.what()).startsWith(message), e.what());
+      }
+    }
+  }
+
+  // A session's objects go to the parts of the same name, whatever their order and count: by index,
+  // a scene with one part more dropped every override, and a renamed part took another's state.
+  // Names the scene lacks are a note.
+  void sessionObjectsMatchPartsByName() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    const std::vector<mfr::Object>& parts = m.scene().objects;
+    QCOMPARE(parts[5].name, std::string("tangle"));
+    QCOMPARE(parts[1].name, std::string("middle shell"));
+    Session session = captureSession(m);
+    session.objects = {{"tangle", false, glm::vec4(1, 0, 0, 0.5f), false},
+                       {"nosuch", false, glm::vec4(0, 1, 0, 1), false},
+                       {"middle shell", true, glm::vec4(0, 0, 1, 0.25f), false}};
+    const QStringList notes = applySession(session, m);
+    QVERIFY(!parts[5].visible);
+    QCOMPARE(parts[5].material.color, glm::vec4(1, 0, 0, 0.5f));
+    QCOMPARE(parts[1].material.color, glm::vec4(0, 0, 1, 0.25f));
+    QVERIFY(parts[0].visible && parts[2].visible);  // not named: as the file has them
+    QCOMPARE(notes, QStringList{"the session's object 'nosuch' is no part of the scene: left out"});
+  }
+
   // `mfrview --screenshot` and `mfr render` with the same scene, view, size and settings.
   void viewerScreenshotEqualsCli() {
     QTemporaryDir dir;
