@@ -74,8 +74,11 @@ void addTrain(CLI::App& app) {
     };
     const NeuralTrainingResult r = trainNeuralImportance(all, training);
     writeFileAtomically(opt->output, neuralImportanceJson(r.model));
-    std::cout << opt->output << ": best epoch " << r.bestEpoch << ", validation MSE " << r.validationLoss << " ("
-              << r.trainingRows << " training rows, " << r.validationRows << " validation rows)\n";
+    // Too few rows leave none for validation: the best epoch is then chosen on the training rows.
+    std::cout << opt->output << ": best epoch " << r.bestEpoch
+              << (r.validationRows > 0 ? ", validation MSE " : ", training MSE ") << r.validationLoss << " ("
+              << r.trainingRows << " training rows, "
+              << (r.validationRows > 0 ? std::to_string(r.validationRows) : std::string("no")) << " validation rows)\n";
   });
 }
 

@@ -128,6 +128,12 @@ TEST_F(CliVolume, BadInputIsOneLine) {
   EXPECT_EQ(std::count(bench.out.begin(), bench.out.end(), '\n'), 1) << bench.out;
   EXPECT_NE(bench.out.find("step"), std::string::npos) << bench.out;
   EXPECT_FALSE(fs::exists(json));
+  // A file's own origin far beyond what can be drawn (found by a bug hunt: it rendered blank).
+  const fs::path far = write("far.vtk",
+                             "# vtk DataFile Version 3.0\nfar\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 2 2 2\n"
+                             "ORIGIN 1e300 0 0\nSPACING 1 1 1\nPOINT_DATA 8\nSCALARS v float 1\n"
+                             "LOOKUP_TABLE default\n0 1 0 1 0 1 0 1\n");
+  expectCleanFailure("render " + far.string(), "far.vtk: volume 'far.vtk': reaches beyond ±1e15");
 }
 
 // A legacy VTK structured-points file: the box [-1, 1]³ on a 5³ grid, every value 0.5.

@@ -15,6 +15,8 @@
 #include <random>
 #include <span>
 
+#include <nlohmann/json.hpp>
+
 #include "budget/mlp_layout.h"
 
 #include "fragments.hpp"
@@ -195,6 +197,15 @@ TEST(NeuralImportance, WeightsFileRoundTripAndErrors) {
   text.replace(text.find("\"input_std\": ["), 14, "\"input_std\": [-1,");  // a wrong-length, negative std
   EXPECT_THROW(mfr::parseNeuralImportance(text, "bad.json"), mfr::Error);
   EXPECT_THROW(mfr::loadNeuralImportance("/nonexistent/weights.json"), mfr::Error);
+  // A finite double beyond a float (the network runs in floats: 1e39 was infinite there).
+  nlohmann::json huge = nlohmann::json::parse(mfr::neuralImportanceJson(m));
+  huge["input_mean"][0] = 1e39;
+  try {
+    mfr::parseNeuralImportance(huge.dump(), "huge.json");
+    ADD_FAILURE() << "accepted a mean of 1e39";
+  } catch (const mfr::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("beyond a float's range"), std::string::npos) << e.what();
+  }
 }
 
 // dkb's GPU copy: input statistics and biases exact, each weight scale(row)·q with q a signed byte
@@ -282,6 +293,19 @@ TEST(DkbDataset, FramesFileRoundTripAndCorruptFiles) {
   const std::string bytes = mfr::readFile(path);
   mfr::writeFileAtomically(dir / "cut.bin", bytes.substr(0, bytes.size() - 5));
   mfr::writeFileAtomically(dir / "foreign.bin", "PNG\x89 not a dataset at all, really");
+  // A row whose labels mfr dataset cannot have written (k/F of 1e30: training went to NaN).
+  std::uint32_t metaLength = 0;
+  std::memcpy(&metaLength, bytes.data() + 20, 4);
+  std::string absurd = bytes;
+  const float huge = 1e30f;
+  std::memcpy(absurd.data() + 24 + metaLength + 4 * mfr::kDatasetLabel, &huge, 4);
+  mfr::writeFileAtomically(dir / "absurd.bin", absurd);
+  try {
+    mfr::readDataset(dir / "absurd.bin");
+    ADD_FAILURE() << "absurd.bin";
+  } catch (const mfr::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("absurd.bin: row 0: labels out of range"), std::string::npos) << e.what();
+  }
   for (const char* name : {"cut.bin", "foreign.bin", "missing.bin"}) {
     try {
       mfr::readDataset(dir / name);
@@ -395,6 +419,23 @@ TEST(NeuralTraining, ExportedWeightsReproduceDlibsLoss) {
 
 // Rows drawn in proportion to n(p): the network still learns, the reported losses are weighted by
 // n (so they differ from the unweighted ones of the same weights), and a bad option is refused.
+// A run whose loss stops being finite (labels far outside [0, 1], which mfr dataset files can no
+// longer hold) is one error saying so: it ended in "unexpected dlib fc layer size" (a bug hunt).
+TEST(NeuralTraining, ADivergedRunIsAnError) {
+  const mfr::DkbDataset d = syntheticDataset(
+      3, 200, 8.0f, [](int) { return 1.0f; }, [](const float*, float) { return 1e30f; });
+  mfr::NeuralTrainingOptions o;
+  o.epochs = 2;
+  o.batchSize = 32;
+  o.target = "k_over_budget";
+  try {
+    (void)mfr::trainNeuralImportance(d, o);
+    ADD_FAILURE() << "trained on labels of 1e27";
+  } catch (const mfr::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the loss is not finite after epoch 1"), std::string::npos) << e.what();
+  }
+}
+
 TEST(NeuralTraining, FragmentWeighting) {
   const mfr::DkbDataset d = syntheticDataset(
       4, 2000, 30.0f, [](int) { return 1.0f; },

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mfr/error.hpp"
+#include "number_text.hpp"
 #include "mfr/io_util.hpp"
 
 namespace mfr {
@@ -88,6 +89,17 @@ DkbDataset readDataset(const std::filesystem::path& path) {
   std::memcpy(d.rows.data(), bytes.data() + header + metaLength, payload);
   for (float v : d.rows)
     if (!std::isfinite(v)) throw Error(where, "holds a non-finite value");
+  // The labels as mfr dataset writes them: n(p) ≥ 1 and k(p) whole, 1 ≤ k(p) ≤ n(p), k(p)/F in
+  // (0, 1]. A row outside them trained on (a label of 1e30 drove the loss to NaN).
+  for (std::size_t i = 0; i < d.size(); ++i) {
+    const float* row = d.row(i);
+    const float n = row[kDatasetN], k = row[kDatasetK], label = row[kDatasetLabel];
+    if (!(n >= 1.0f && n == std::floor(n) && k >= 1.0f && k <= n && k == std::floor(k) && label > 0.0f &&
+          label <= 1.0f))
+      throw Error(where, "row " + std::to_string(i) + ": labels out of range (n(p) " + numberText(n) + ", k(p) " +
+                             numberText(k) + ", k(p)/F " + numberText(label) +
+                             "; expected whole numbers 1 <= k <= n and 0 < k/F <= 1)");
+  }
   return d;
 }
 

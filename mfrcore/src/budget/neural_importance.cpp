@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstring>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string_view>
 
@@ -81,6 +82,10 @@ std::vector<float> floats(const nlohmann::json& j, std::size_t count, const std:
     if (!v.is_number()) throw Error(source, where + " holds a non-number");
     const double d = v.get<double>();
     if (!std::isfinite(d)) throw Error(source, where + " holds a non-finite number");
+    // Both the CPU and the GPU network compute in floats: 1e39 became infinite, and dkb quietly
+    // fell back to the flat allocation.
+    if (std::abs(d) > std::numeric_limits<float>::max())
+      throw Error(source, where + " holds a number beyond a float's range (±3.4e38)");
     out.push_back(static_cast<float>(d));
   }
   return out;

@@ -151,6 +151,10 @@ NeuralTrainingResult trainNeuralImportance(const DkbDataset& dataset, const Neur
     trainer.get_net(dlib::force_flush_to_disk::no);  // waits for the trainer's thread
     const double trainLoss = meanSquaredError(net, trainX, trainY, trainW);
     const double validLoss = validX.empty() ? trainLoss : meanSquaredError(net, validX, validY, validW);
+    // A diverged run keeps no network worth writing (it ended in a confusing dlib layer error).
+    if (!std::isfinite(trainLoss) || !std::isfinite(validLoss))
+      throw Error("dkb training", "the loss is not finite after epoch " + std::to_string(epoch) +
+                                      " (diverged: try a smaller learning rate)");
     if (options.progress) options.progress(epoch, trainLoss, validLoss);
     if (validLoss < result.validationLoss) {
       result.validationLoss = validLoss;

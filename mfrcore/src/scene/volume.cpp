@@ -163,6 +163,12 @@ void Volume::validate() const {
       throw Error(what, "spacing must be positive and the origin finite");
   const double det = glm::determinant(glm::dmat3(gridToWorld()));
   if (!std::isfinite(det) || std::abs(det) < 1e-300) throw Error(what, "transform is singular or not finite");
+  // Within ±1e15, as a scene file's coordinates and transforms: a file's own origin of 1e300 was
+  // read, and the view's projection degenerated to a blank image.
+  const Bounds b = bounds();
+  for (int a = 0; a < 3; ++a)
+    if (!(std::abs(b.min[a]) <= 1e15 && std::abs(b.max[a]) <= 1e15))
+      throw Error(what, "reaches beyond ±1e15 (origin, spacing or transform): it cannot be drawn");
   transfer.validate(what);
 }
 
