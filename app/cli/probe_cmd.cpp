@@ -2,6 +2,7 @@
 // facing, share of the pixel's colour) and, with --method, which of those fragments the GPU method
 // holds and the colour it draws there.
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -22,14 +23,17 @@ namespace mfr::cli {
 
 namespace {
 
+// Whole numbers in digits ("1e1" was 10; a value past int was undefined behaviour).
 std::pair<int, int> parsePixel(const std::string& text) {
+  const auto whole = [](std::string_view t, int& v) {
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    return ec == std::errc() && end == t.data() + t.size() && !t.empty();
+  };
   const auto comma = text.find(',');
-  if (comma != std::string::npos) {
-    const std::optional<double> x = parseNumber(text.substr(0, comma));
-    const std::optional<double> y = parseNumber(text.substr(comma + 1));
-    if (x && y && *x == static_cast<int>(*x) && *y == static_cast<int>(*y))
-      return {static_cast<int>(*x), static_cast<int>(*y)};
-  }
+  int x = 0, y = 0;
+  if (comma != std::string::npos && whole(std::string_view(text).substr(0, comma), x) &&
+      whole(std::string_view(text).substr(comma + 1), y))
+    return {x, y};
   throw Error("--pixel " + text, "expected X,Y (whole pixels, 0,0 the top-left)");
 }
 

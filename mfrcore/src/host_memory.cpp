@@ -86,7 +86,10 @@ std::optional<std::uint64_t> environmentLimit() {
   errno = 0;
   char* end = nullptr;
   const unsigned long long mib = std::strtoull(text, &end, 10);
-  if (errno != 0 || *end != '\0' || mib == 0 || mib > (UINT64_MAX >> 20)) throw refuse();
+  if (errno != 0 || *end != '\0' || mib == 0) throw refuse();
+  if (mib > (UINT64_MAX >> 20))
+    throw Error("MFR_MEMORY_LIMIT_MIB",
+                "'" + std::string(text) + "' MiB is more bytes than 2^64: at most " + std::to_string(UINT64_MAX >> 20));
   return static_cast<std::uint64_t>(mib) << 20;
 }
 

@@ -916,6 +916,13 @@ TEST_F(Cli, MoreMemoryThanThereIsIsRefused) {
   EXPECT_EQ(bad.exitCode, 1) << bad.out;
   EXPECT_NE(bad.out.find("MFR_MEMORY_LIMIT_MIB: '-5' is not a positive whole number of MiB"), std::string::npos)
       << bad.out;
+  // A whole number too large for bytes: it was called "not a positive whole number".
+  const CliResult huge =
+      mfr::test::runCommand("MFR_MEMORY_LIMIT_MIB=9223372036854775807 " + std::string(MFR_CLI) + " info @sample");
+  EXPECT_EQ(huge.exitCode, 1) << huge.out;
+  EXPECT_NE(huge.out.find("'9223372036854775807' MiB is more bytes than 2^64: at most 17592186044415"),
+            std::string::npos)
+      << huge.out;
 }
 
 TEST_F(Cli, BudgetCommandsBadInput) {

@@ -212,11 +212,18 @@ TEST_F(CliProbe, ZThicknessShowsEachSurfacesShareOfTheBlend) {
 TEST_F(CliProbe, BadInputIsOneLineAndWritesNoJson) {
   const fs::path json = dir() / "probe.json";
   const std::pair<std::string, std::string> cases[] = {
-      {"--pixel 64,0", "outside the 64x48 image"},           {"--pixel 3,-1", "outside the 64x48 image"},
-      {"--pixel 1.5,2", "--pixel 1.5,2: expected X,Y"},      {"--pixel banana", "--pixel banana: expected X,Y"},
-      {"--pixel 3,3 -p k=2", "--param: needs --method"},     {"--pixel 3,3 -m oracle", "not a GPU method"},
-      {"--pixel 3,3 -m nonsense", "not a GPU method"},       {"--pixel 3,3 -m kplus-array -p k=0", "k"},
+      {"--pixel 64,0", "outside the 64x48 image"},
+      {"--pixel 3,-1", "outside the 64x48 image"},
+      {"--pixel 1.5,2", "--pixel 1.5,2: expected X,Y"},
+      {"--pixel banana", "--pixel banana: expected X,Y"},
+      {"--pixel 3,3 -p k=2", "--param: needs --method"},
+      {"--pixel 3,3 -m oracle", "not a GPU method"},
+      {"--pixel 3,3 -m nonsense", "not a GPU method"},
+      {"--pixel 3,3 -m kplus-array -p k=0", "k"},
       {"--pixel 3,3 -m dkb --op nonsense", "--op nonsense"},
+      // Digits only: "1e1" was read as 10, and 1e300 was cast to int (undefined behaviour).
+      {"--pixel 1e1,2", "--pixel 1e1,2: expected X,Y"},
+      {"--pixel 1e300,2", "--pixel 1e300,2: expected X,Y"},
   };
   for (const auto& [args, mention] : cases) {
     SCOPED_TRACE(args);

@@ -132,6 +132,10 @@ TEST_F(CliSection, BadPlanesAreRefused) {
   expectCleanFailure("render @sample --size 16x16 --section x=0:slice",
                      "--section x=0:slice: slice: scene 'sample' has no volume");
   expectCleanFailure("render @sample --size 16x16 --section x=100", "section plane: cuts away every visible surface");
+  // CSG on solids a section without caps cut open: the message said only "object 'a': not a
+  // closed surface", as if the file were at fault (a bug hunt).
+  expectCleanFailure("render @csg --size 16x16 --section x=0:nocaps --op csg",
+                     "the section without caps cut it open: CSG needs the caps");
 }
 
 }  // namespace

@@ -145,6 +145,20 @@ TEST(FieldColoring, FieldsByNameComponentAndMagnitude) {
   EXPECT_TRUE(fieldValues(*m, "tri", "square").cellData);
   EXPECT_EQ(fieldRange(fieldValues(*m, "x", "square").values), glm::dvec2(-10.0, 10.0));
   EXPECT_EQ(fieldRange({4.0f, 4.0f}), glm::dvec2(3.0, 5.0));
+  // A large constant: ±1 would be the same float (1e8 ± 1), and the renderers refused the range.
+  for (const float big : {1e8f, -3e20f, std::numeric_limits<float>::max()}) {
+    const glm::dvec2 r = fieldRange({big, big});
+    EXPECT_LT(static_cast<float>(r.x), static_cast<float>(r.y)) << big;
+    EXPECT_TRUE(std::isfinite(static_cast<float>(r.y) - static_cast<float>(r.x))) << big;
+    EXPECT_LE(r.x, big);
+    EXPECT_GE(r.y, big);
+    // A constant volume's default transfer function likewise (1e8 … 1e8 as floats was empty).
+    VolumeGrid constant;
+    constant.dims = {2, 2, 2};
+    constant.values.assign(8, big);
+    const TransferFunction tf = defaultTransfer(constant, Bounds{});
+    EXPECT_LT(static_cast<float>(tf.low()), static_cast<float>(tf.high())) << big;
+  }
   EXPECT_EQ(fieldRange({std::numeric_limits<float>::quiet_NaN(), 2.0f, 7.0f}), glm::dvec2(2.0, 7.0));
   EXPECT_EQ(fieldRange({}), glm::dvec2(0.0, 1.0));
   try {

@@ -182,7 +182,13 @@ std::optional<glm::dvec2> finiteSpan(const std::vector<float>& values) {
 glm::dvec2 fieldRange(const std::vector<float>& values) {
   const std::optional<glm::dvec2> span = finiteSpan(values);
   if (!span) return {0.0, 1.0};
-  if (span->x == span->y) return {span->x - 1.0, span->y + 1.0};
+  // A constant: one step either side that floats tell apart from it (1e8 ± 1 is 1e8 as a float,
+  // and the renderers refused the range the user never gave).
+  if (span->x == span->y) {
+    const double step = std::max(1.0, std::abs(span->x) * 0x1p-20);
+    const double largest = std::numeric_limits<float>::max();
+    return {std::max(span->x - step, -largest), std::min(span->y + step, largest)};
+  }
   return *span;
 }
 

@@ -266,16 +266,20 @@ void validateCsg(const Scene& scene) {
   if (maxDepth > MFR_CSG_MAX_PRIMITIVES)
     throw Error(where, "CSG program needs a stack of " + std::to_string(maxDepth) + " (at most " +
                            std::to_string(MFR_CSG_MAX_PRIMITIVES) + ")");
+  // A section without caps leaves every cut solid open: say so, or the file seems to blame.
+  const std::string cutOpen = scene.sectionCut && scene.section && !scene.section->caps
+                                  ? "; the section without caps cut it open: CSG needs the caps"
+                                  : "";
   for (const std::uint32_t index : primitives) {
     const Object& object = scene.objects[index];
-    const std::string name = "object '" + object.name + "'";
+    const std::string name = (cutOpen.empty() ? "" : where + ": ") + "object '" + object.name + "'";
     if (!object.mesh) throw Error(name, "has no mesh (CSG needs a closed solid)");
     object.mesh->validate(name);
     const long long bad = badEdges(*object.mesh);
-    if (bad < 0) throw Error(name, "not a closed surface: no triangle of non-zero area (CSG needs solids)");
+    if (bad < 0) throw Error(name, "not a closed surface: no triangle of non-zero area (CSG needs solids)" + cutOpen);
     if (bad > 0)
       throw Error(name, "not a closed surface: " + std::to_string(bad) +
-                            " edges on the border or shared by more than two triangles (CSG needs solids)");
+                            " edges on the border or shared by more than two triangles (CSG needs solids)" + cutOpen);
   }
 }
 

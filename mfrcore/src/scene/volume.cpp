@@ -126,7 +126,12 @@ TransferFunction transferPreset(const std::string& name, double low, double high
 TransferFunction defaultTransfer(const VolumeGrid& grid, const Bounds& worldBounds) {
   const glm::vec2 r = grid.range();
   double low = r.x, high = r.y;
-  if (!(high > low)) high = low + 1.0;
+  // A constant volume: a range that floats tell apart (as fieldRange: 1e8 + 1 is 1e8 as a float).
+  if (!(high > low)) {
+    const double step = std::max(1.0, std::abs(low) * 0x1p-20);
+    high = std::min(low + step, static_cast<double>(std::numeric_limits<float>::max()));
+    if (!(high > low)) low -= step;
+  }
   const double diagonal = worldBounds.valid() ? glm::length(worldBounds.max - worldBounds.min) : 0.0;
   return transferPreset("grayscale", low, high, diagonal > 0.0 && std::isfinite(diagonal) ? diagonal / 50.0 : 1.0);
 }
