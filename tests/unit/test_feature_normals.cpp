@@ -69,6 +69,35 @@ TEST(FeatureNormals, CubeIsRewoundOutwardAndSplitAtEveryEdge) {
   }
 }
 
+// One triangle listed first and wound against the other eleven: VTK's rule keeps the seed's winding
+// and turns the cube inside out; the loaders' majority rule keeps the file's (a bug hunt: such an
+// STL measured volume −1 and drew its near faces as back faces).
+TEST(FeatureNormals, MajorityWindingKeepsWhatMostTrianglesSay) {
+  std::vector<glm::dvec3> p;
+  for (int i = 0; i < 8; ++i) p.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  const std::uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                     {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  std::vector<std::uint32_t> idx;
+  for (const auto& q : quads) idx.insert(idx.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+  std::swap(idx[1], idx[2]);  // the first triangle reversed
+  const auto outward = [&](const mfr::FeatureSplit& s) {
+    std::vector<glm::dvec3> positions;
+    for (const std::uint32_t v : s.source) positions.push_back(p[v]);
+    int count = 0;
+    for (std::size_t t = 0; t < 12; ++t) {
+      const glm::dvec3 centre = (positions[s.indices[3 * t]] + positions[s.indices[3 * t + 2]]) * 0.5;
+      count += glm::dot(faceNormal(positions, s.indices, t), centre - glm::dvec3(0.5)) > 0.0;
+    }
+    return count;
+  };
+  const mfr::FeatureSplit majority = mfr::orientAndSplitAtFeatures(p, idx, 30.0, true);
+  EXPECT_EQ(majority.reversed, 1u);
+  EXPECT_EQ(outward(majority), 12);
+  const mfr::FeatureSplit seed = mfr::orientAndSplitAtFeatures(p, idx, 30.0, false);
+  EXPECT_EQ(seed.reversed, 11u);
+  EXPECT_EQ(outward(seed), 0);
+}
+
 TEST(FeatureNormals, FanOfTwoHundredThousandTrianglesStaysOneRegion) {
   std::vector<glm::dvec3> p;
   std::vector<std::uint32_t> idx;

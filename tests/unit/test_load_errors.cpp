@@ -21,6 +21,7 @@
 
 #include <zlib.h>
 
+#include "mfr/scene/measure.hpp"
 #include "mfr/error.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
@@ -574,6 +575,20 @@ TEST_F(LoadModel, ObjMissingMaterialsAreNoted) {
   mfr::loadModel(write("plain.obj", geometry + "f 1 2 3\n"), options);
   mfr::loadModel(write("named.obj", geometry + "usemtl Default\nf 1 2 3\n"), options);  // no library named
   EXPECT_TRUE(notes.empty()) << notes.front();
+}
+
+// A file whose first triangle is wound against the other eleven: the part keeps the winding most
+// of its triangles have (it was turned inside out: volume −1, near faces drawn as back faces).
+TEST_F(LoadModel, OneReversedFirstTriangleDoesNotTurnThePartInsideOut) {
+  const std::string cube =
+      "v 0 0 0\nv 0 0 1\nv 0 1 0\nv 0 1 1\nv 1 0 0\nv 1 0 1\nv 1 1 0\nv 1 1 1\n"
+      "f 1 4 2\nf 1 4 3\nf 5 7 8\nf 5 8 6\nf 1 5 6\nf 1 6 2\nf 3 4 8\nf 3 8 7\nf 1 3 7\nf 1 7 5\n"
+      "f 2 6 8\nf 2 8 4\n";
+  const auto objects = mfr::loadModel(write("flip.obj", cube));
+  ASSERT_EQ(objects.size(), 1u);
+  const mfr::SurfaceMeasures m = mfr::measureSurface(*objects[0].mesh, glm::dmat4(1.0));
+  EXPECT_NEAR(m.volume, 1.0, 1e-9);
+  EXPECT_EQ(m.boundaryEdges + m.orientationFlips, 0u);
 }
 
 TEST_F(LoadModel, ObjNormalsFromTheFileAreKept) {

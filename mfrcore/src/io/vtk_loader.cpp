@@ -392,7 +392,8 @@ Mesh finish(vtkPolyData* input, const std::string& name) {
       mesh.normals[i] = glm::vec3(v[0], v[1], v[2]);
     }
   } else {
-    FeatureSplit split = orientAndSplitAtFeatures(points, std::move(indices), kFeatureAngleDegrees);
+    FeatureSplit split =
+        orientAndSplitAtFeatures(points, std::move(indices), kFeatureAngleDegrees, /*majorityWinding=*/true);
     mesh.indices = std::move(split.indices);
     source = std::move(split.source);
     mesh.normals = std::move(split.normals);

@@ -61,7 +61,7 @@ EdgeMap buildEdgeMap(const std::vector<std::uint32_t>& indices) {
 }  // namespace
 
 FeatureSplit orientAndSplitAtFeatures(const std::vector<glm::dvec3>& positions, std::vector<std::uint32_t> indices,
-                                      double featureAngleDegrees) {
+                                      double featureAngleDegrees, bool majorityWinding) {
   FeatureSplit out;
   // Corner slots, edge groups and vertex ids are 32-bit (as Mesh::indices are).
   if (indices.size() >= std::numeric_limits<std::uint32_t>::max() ||
@@ -82,15 +82,19 @@ FeatureSplit orientAndSplitAtFeatures(const std::vector<glm::dvec3>& positions, 
 
   // Winding: breadth-first waves from each triangle not yet reached. Once one triangle has looked
   // across an edge, every triangle of that edge is reached, so each edge is looked across once:
-  // linear even where thousands of triangles share an edge.
+  // linear even where thousands of triangles share an edge. With majorityWinding each connected
+  // region then keeps the winding most of its triangles have in the file, not its first
+  // triangle's: one reversed triangle first in a file turned the whole part inside out.
   {
     std::vector<char> reached(triangles, 0);
     std::vector<char> crossed(edges.start.size() - 1, 0);
-    std::vector<std::uint32_t> wave, next;
+    std::vector<std::uint32_t> wave, next, region;
     for (std::size_t seed = 0; seed < triangles; ++seed) {
       if (reached[seed] != 0) continue;
       reached[seed] = 1;
       wave.assign(1, static_cast<std::uint32_t>(seed));
+      region.assign(1, static_cast<std::uint32_t>(seed));
+      std::size_t turned = 0;  // of the region's triangles, reversed to match the seed
       while (!wave.empty()) {
         next.clear();
         for (const std::uint32_t c : wave)
@@ -107,14 +111,20 @@ FeatureSplit orientAndSplitAtFeatures(const std::vector<glm::dvec3>& positions, 
               while (l < 2 && indices[3 * t + l] != q) ++l;
               if (indices[3 * t + (l + 1) % 3] != p) {
                 std::swap(indices[3 * t], indices[3 * t + 2]);
-                ++out.reversed;
+                ++turned;
               }
               reached[t] = 1;
               next.push_back(t);
+              region.push_back(t);
             }
           }
         std::swap(wave, next);
       }
+      if (majorityWinding && 2 * turned > region.size()) {  // the seed was in the minority: turn all over
+        for (const std::uint32_t t : region) std::swap(indices[3 * t], indices[3 * t + 2]);
+        turned = region.size() - turned;
+      }
+      out.reversed += turned;
     }
   }
 

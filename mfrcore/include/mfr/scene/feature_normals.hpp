@@ -28,7 +28,10 @@ struct FeatureSplit {
 
 // Winding: from the lowest-numbered triangle not yet reached, a breadth-first wave over shared
 // edges (also non-manifold ones) reverses each newly reached triangle that runs a shared edge in
-// the same direction as the triangle it was reached from; the seed keeps its winding.
+// the same direction as the triangle it was reached from; the seed keeps its winding, as in VTK's
+// filter — or, with `majorityWinding` (the loaders), each connected region keeps the winding most
+// of its triangles have as given (the seed's in a tie), so that one reversed triangle listed first
+// does not turn a whole part inside out.
 // Splitting: around each vertex, triangles joined by a manifold edge (two triangles) whose normals
 // are less than `featureAngleDegrees` apart form one region; each region after the first (in
 // triangle order) gets its own copy of the vertex. Indices must be < positions.size() (the loaders
@@ -36,6 +39,7 @@ struct FeatureSplit {
 // between the repeated corners (where VTK's filter does odd things). Throws std::length_error past
 // 2^32 − 1 corners or vertices.
 [[nodiscard]] FeatureSplit orientAndSplitAtFeatures(const std::vector<glm::dvec3>& positions,
-                                                    std::vector<std::uint32_t> indices, double featureAngleDegrees);
+                                                    std::vector<std::uint32_t> indices, double featureAngleDegrees,
+                                                    bool majorityWinding = false);
 
 }  // namespace mfr
