@@ -141,6 +141,10 @@ void addEvaluate(CLI::App& app) {
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
     const std::vector<std::string> methods = splitList(opt->methods, "--methods");
     if (methods.empty()) throw Error("--methods", "names no method");
+    for (std::size_t i = 0; i < methods.size(); ++i)  // "vkb,vkb" printed a row twice and "tie vkb=vkb"
+      if (std::find(methods.begin(), methods.begin() + static_cast<std::ptrdiff_t>(i), methods[i]) !=
+          methods.begin() + static_cast<std::ptrdiff_t>(i))
+        throw Error("--methods " + opt->methods, "'" + methods[i] + "' is given twice");
     std::map<std::string, RenderRequest> specs;  // each method spec's request, without size and budget
     std::size_t methodWidth = 11;
     // A weights file that cannot be read is the user's mistake, not one row's failure: refused

@@ -947,6 +947,12 @@ TEST_F(Cli, BudgetCommandsBadInput) {
     EXPECT_EQ(r.out, "mfr: " + mention + " (',,', or ',' at an end)\n") << args;
   }
   expectCleanFailure("dataset @sample --views nowhere", "view 'nowhere'");
+  {
+    // A method named twice printed its row twice and "tie vkb=vkb" (a bug hunt).
+    const CliResult r = runCli("evaluate @sample --budgets k1 -m vkb,fkb,vkb");
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    EXPECT_EQ(r.out, "mfr: --methods vkb,fkb,vkb: 'vkb' is given twice\n");
+  }
   const fs::path badWeights = write("w.json", R"({"format":"mfr-dkb-weights","version":1})");
   expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + badWeights.string(), "w.json");
   // JSON errors other than syntax (a number past double's range, a key of the wrong type) were

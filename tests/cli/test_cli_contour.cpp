@@ -137,6 +137,9 @@ TEST_F(CliContour, LegendShowsTheIsosurfacesMapInTheCorner) {
 TEST_F(CliContour, BadInputIsOneLine) {
   expectCleanFailure("render @volume --contour abc", "--contour abc: 'abc' is not a number");
   expectCleanFailure("render @volume --contour 0.3,", "--contour 0.3,");
+  // Coincident isosurfaces of one name (a bug hunt: two parts, fighting in depth).
+  expectCleanFailure("render @volume --contour 0.3,0.3", "0.3 is given twice");
+  expectCleanFailure("render @volume --contour 0.3,0.30000001", "values 0.3 and 0.30000001 are one isosurface");
   expectCleanFailure("render @volume --contour 5", "5 lies outside the open range");
   expectCleanFailure("render @volume --contour nan", "--contour nan");
   expectCleanFailure("render @volume --contour 1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1,1", "at most 16");

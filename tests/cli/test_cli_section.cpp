@@ -128,6 +128,8 @@ TEST_F(CliSection, BadPlanesAreRefused) {
   // A stray ':' was read past.
   expectCleanFailure("render @sample --size 16x16 --section x=0:", "(nothing after ':')");
   expectCleanFailure("render @sample --size 16x16 --section x=0:nocaps:", "the suffixes are :nocaps and :slice");
+  expectCleanFailure("render @volume --size 16x16 --section x=0:slice:slice",
+                     "--section x=0:slice:slice: :slice is given twice");
   expectCleanFailure("render @sample --size 16x16 --section 0,0,0,,1,0,0", "expected AXIS=VALUE or six numbers");
   expectCleanFailure("render @sample --size 16x16 --section x=0:slice",
                      "--section x=0:slice: slice: scene 'sample' has no volume");

@@ -23,6 +23,7 @@
 #include <map>
 #include <numbers>
 #include <regex>
+#include <tuple>
 #include <set>
 #include <string>
 #include <utility>
@@ -531,6 +532,20 @@ TEST(StepBadInput, OneLineErrorsNamingTheFile) {
     expectLoadError(dir.write("bigid.step", std::regex_replace(screw, point, "#2147483648")),
                     "entity id #2147483648 out of range");
     EXPECT_NO_THROW((void)mfr::loadModel(dir.write("maxid.step", std::regex_replace(screw, point, "#2147483647"))));
+  }
+  // Geometry the transfer cannot take (a bug hunt): a vertex at a point of 2 coordinates crashed
+  // it (signal 11), one of none too (read as 2); a zero direction lost faces without a word.
+  for (const auto& [from, to, mention] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"#20 = CARTESIAN_POINT('',(-27.8196811084,0.423702927757,5.43633));", "#20 = CARTESIAN_POINT('',(1.,2.));",
+            "entity #19: a vertex at a point of 2 coordinates (expected 3)"},
+           {"#20 = CARTESIAN_POINT('',(-27.8196811084,0.423702927757,5.43633));", "#20 = CARTESIAN_POINT('',());",
+            "entity #19: a vertex at a point of"},
+           {"#52 = DIRECTION('',(0.E+000,1.,0.E+000));", "#52 = DIRECTION('',(0.,0.,0.));",
+            "entity #52: a direction of zero length"}}) {
+    std::string text = screw;
+    ASSERT_NE(text.find(from), std::string::npos) << from;
+    text.replace(text.find(from), from.size(), to);
+    expectLoadError(dir.write("geometry.step", text), "not a readable STEP file (" + mention);
   }
   // A product whose shape is one edge: nothing to draw.
   const fs::path wire = dir.path() / "wire.step";

@@ -665,6 +665,34 @@ TEST_F(LoadModel, OffWithPolygonsCommentsAndColors) {
   expectUsableNormals(mesh);
 }
 
+// Colours spelled as floats are floats, as Geomview's format defines them, also when their values
+// are whole: CGAL went by the value, and white "1.0 1.0 1.0" was read as 1/255 (a bug hunt). Digits
+// only are 0–255; CNOFF's normals come before the colour, STCOFF's texture coordinates after it.
+TEST_F(LoadModel, OffColoursSpelledAsFloatsAreFloats) {
+  const auto colourAt = [](const mfr::Mesh& mesh, const glm::vec3& where) {
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+      if (mesh.positions[i] == where) return glm::vec3(mesh.colors[i]);
+    ADD_FAILURE() << "no vertex at " << where.x << " " << where.y << " " << where.z;
+    return glm::vec3(-1.0f);
+  };
+  for (const auto& [name, text] : std::vector<std::pair<std::string, std::string>>{
+           {"float.off", "COFF\n3 1 0\n0 0 0 1.0 1.0 1.0 1.0\n1 0 0 0.0 0.0 1.0 1\n0 1 0 255 0 0 255\n3 0 1 2\n"},
+           {"normals.off",
+            "CNOFF\n3 1 0\n0 0 0 0 0 1 1.0 1.0 1.0\n1 0 0 0 0 1 0. 0. 1e0\n0 1 0 0 0 1 255 0 0\n3 0 1 2\n"},
+           {"texture.off",
+            "STCOFF\n3 1 0\n0 0 0 1.0 1.0 1.0 1.0 0 0\n1 0 0 0.0 0.0 1.0 1.0 1 0\n0 1 0 255 0 0 255 0 1\n"
+            "3 0 1 2\n"}}) {
+    SCOPED_TRACE(name);
+    const auto objects = mfr::loadModel(write(name, text));
+    ASSERT_EQ(objects.size(), 1u);
+    const mfr::Mesh& mesh = *objects[0].mesh;
+    ASSERT_EQ(mesh.colors.size(), mesh.positions.size());
+    EXPECT_EQ(colourAt(mesh, {0, 0, 0}), glm::vec3(1, 1, 1));
+    EXPECT_EQ(colourAt(mesh, {1, 0, 0}), glm::vec3(0, 0, 1));
+    EXPECT_EQ(colourAt(mesh, {0, 1, 0}), glm::vec3(1, 0, 0));
+  }
+}
+
 TEST_F(LoadModel, GzippedOff) {
   const auto objects = mfr::loadModel(writeGz("tri.off.gz", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"));
   EXPECT_EQ(triangles(objects), 1u);

@@ -1,5 +1,6 @@
 #include "off_loader.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -181,6 +182,61 @@ std::optional<std::string> withoutFaceColours(std::string_view bytes, std::size_
   return out;
 }
 
+// Vertex colours as Geomview's OFF format spells them: a component written with a decimal point or
+// an exponent is a float in [0, 1], one of digits only an integer in [0, 255]. CGAL's reader goes by
+// the value, so "1.0 1.0 1.0" (white) was read as 1/255 (nearly black). Nullopt where the vertex
+// lines are not one per line as x y z [normal] r g b [a] [s t]: CGAL's reading then stands.
+std::optional<std::vector<glm::vec4>> asciiVertexColours(std::string_view bytes, std::uint64_t vertexCount) {
+  std::size_t pos = 0;
+  std::string_view keyword = nextToken(bytes, pos);
+  const bool texture = keyword.starts_with("ST");
+  if (texture) keyword.remove_prefix(2);
+  if (keyword.starts_with("C")) keyword.remove_prefix(1);
+  const bool normals = keyword.starts_with("N");
+  if (normals) keyword.remove_prefix(1);
+  if (keyword != "OFF") return std::nullopt;  // 4OFF, nOFF: other layouts
+  for (int i = 0; i < 3; ++i)
+    if (nextToken(bytes, pos).empty()) return std::nullopt;
+  pos = bytes.find('\n', pos);
+  std::vector<glm::vec4> out;
+  std::vector<std::string_view> tokens;
+  while (pos != std::string_view::npos && out.size() < vertexCount) {
+    const std::size_t begin = pos + 1;
+    pos = bytes.find('\n', begin);
+    std::string_view line = bytes.substr(begin, pos == std::string_view::npos ? std::string_view::npos : pos - begin);
+    line = line.substr(0, line.find('#'));
+    tokens.clear();
+    for (std::size_t at = 0;;) {
+      const std::string_view t = nextToken(line, at);
+      if (t.empty()) break;
+      tokens.push_back(t);
+    }
+    if (tokens.empty()) continue;
+    const std::size_t first = normals ? 6 : 3;
+    std::size_t last = tokens.size();
+    if (texture) {
+      if (last < first + 2) return std::nullopt;
+      last -= 2;
+    }
+    if (last != first + 3 && last != first + 4) return std::nullopt;
+    bool spelledAsFloat = false;
+    for (std::size_t k = first; k < last; ++k)
+      spelledAsFloat = spelledAsFloat || tokens[k].find_first_of(".eE") != std::string_view::npos;
+    glm::vec4 colour(1.0f);
+    for (std::size_t k = first; k < first + 3; ++k) {
+      double v = 0.0;
+      std::string_view t = tokens[k];
+      if (t.starts_with('+')) t.remove_prefix(1);
+      const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+      if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v)) return std::nullopt;
+      colour[static_cast<int>(k - first)] = static_cast<float>(std::clamp(spelledAsFloat ? v : v / 255.0, 0.0, 1.0));
+    }
+    out.push_back(colour);
+  }
+  if (out.size() != vertexCount) return std::nullopt;
+  return out;
+}
+
 }  // namespace
 
 PolygonSoup parseOff(std::string_view bytes, const std::string& name) {
@@ -217,9 +273,14 @@ PolygonSoup parseOff(std::string_view bytes, const std::string& name) {
   for (const Kernel::Point_3& p : points)
     soup.points.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
   if (colors.size() == points.size()) {
-    soup.colors.reserve(colors.size());
-    for (const CGAL::IO::Color& c : colors)
-      soup.colors.emplace_back(c.red() / 255.0f, c.green() / 255.0f, c.blue() / 255.0f, 1.0f);
+    if (std::optional<std::vector<glm::vec4>> spelled =
+            binaryData == 0 ? asciiVertexColours(bytes, vertexCount) : std::nullopt) {
+      soup.colors = std::move(*spelled);
+    } else {
+      soup.colors.reserve(colors.size());
+      for (const CGAL::IO::Color& c : colors)
+        soup.colors.emplace_back(c.red() / 255.0f, c.green() / 255.0f, c.blue() / 255.0f, 1.0f);
+    }
   }
   std::vector<std::uint32_t> polygon;
   soup.offsets.reserve(polygons.size() + 1);

@@ -48,9 +48,12 @@
 #include <StepData_Protocol.hxx>
 #include <StepData_StepModel.hxx>
 #include <StepFile_Read.hxx>
+#include <StepGeom_CartesianPoint.hxx>
+#include <StepGeom_Direction.hxx>
 #include <StepGeom_GeomRepContextAndGlobUnitAssCtxAndGlobUncertaintyAssCtx.hxx>
 #include <StepGeom_GeometricRepresentationContextAndGlobalUnitAssignedContext.hxx>
 #include <StepRepr_GlobalUnitAssignedContext.hxx>
+#include <StepShape_VertexPoint.hxx>
 #include <TCollection_AsciiString.hxx>
 #include <TDF_Label.hxx>
 #include <TDF_LabelSequence.hxx>
@@ -546,6 +549,40 @@ std::string firstParseFailure(const Handle(StepData_StepModel) & model) {
   return {};
 }
 
+// Geometry the transfer cannot survive or silently drops, found by a bug hunt: a vertex's
+// CARTESIAN_POINT of fewer than 3 coordinates (a segmentation fault in the transfer), a point of
+// none or more than 3, a DIRECTION of none, more than 3 or all-zero ratios (the faces on a zero
+// one were dropped without a word). 2D points and directions are valid (parameter-space curves).
+// (A point written with 4 coordinates is read as its first 3 by Open CASCADE: not caught here.)
+std::string firstGeometryFault(const Handle(StepData_StepModel) & model) {
+  const auto at = [&](const Handle(Standard_Transient) & entity) {
+    const Standard_Integer id = model->IdentLabel(entity);
+    return id > 0 ? "entity #" + std::to_string(id) + ": " : std::string();
+  };
+  for (Standard_Integer i = 1; i <= model->NbEntities(); ++i) {
+    const Handle(Standard_Transient)& entity = model->Value(i);
+    if (const Handle(StepGeom_CartesianPoint) point = Handle(StepGeom_CartesianPoint)::DownCast(entity);
+        !point.IsNull()) {
+      const Standard_Integer n = point->NbCoordinates();
+      if (n < 1 || n > 3) return at(entity) + "a point of " + std::to_string(n) + " coordinates";
+    } else if (const Handle(StepGeom_Direction) direction = Handle(StepGeom_Direction)::DownCast(entity);
+               !direction.IsNull()) {
+      const Standard_Integer n = direction->NbDirectionRatios();
+      if (n < 1 || n > 3) return at(entity) + "a direction of " + std::to_string(n) + " ratios";
+      bool zero = true;
+      for (Standard_Integer k = 1; k <= n; ++k) zero = zero && direction->DirectionRatiosValue(k) == 0.0;
+      if (zero) return at(entity) + "a direction of zero length";
+    } else if (const Handle(StepShape_VertexPoint) vertex = Handle(StepShape_VertexPoint)::DownCast(entity);
+               !vertex.IsNull()) {
+      const Handle(StepGeom_CartesianPoint) at3 = Handle(StepGeom_CartesianPoint)::DownCast(vertex->VertexGeometry());
+      if (!at3.IsNull() && at3->NbCoordinates() != 3)
+        return at(entity) + "a vertex at a point of " + std::to_string(at3->NbCoordinates()) +
+               " coordinates (expected 3)";
+    }
+  }
+  return {};
+}
+
 // A read-only stream over bytes already in memory (std::istringstream would copy them).
 class MemoryBuffer final : public std::streambuf {
  public:
@@ -661,6 +698,7 @@ void parse(STEPCAFControl_Reader& reader, const std::filesystem::path& path, con
   bytes.shrink_to_fit();
   std::string why = status != 0 ? messages.failure() : std::string();
   if (why.empty()) why = firstParseFailure(model);
+  if (why.empty() && status == 0) why = firstGeometryFault(model);
   if (status != 0 || !why.empty())
     throw Error(name, "not a readable STEP file" + (why.empty() ? std::string() : " (" + why + ")"));
   session->SetModel(model);

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "mfr/error.hpp"
+#include "number_text.hpp"
 #include "mfr/scene/color_map.hpp"
 
 namespace mfr {
@@ -160,6 +161,15 @@ std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request
       throw Error(what, valueText(value) + " lies outside the open range " + rangeText + " of volume '" + volume.name +
                             "': no surface");
   }
+  // Two values of one name (the same value twice, or closer than the name's 6 digits) would be
+  // coincident surfaces, fighting in depth, that no one can tell apart by their names.
+  for (std::size_t i = 0; i < request.values.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (valueText(request.values[i]) == valueText(request.values[j]))
+        throw Error(what, request.values[i] == request.values[j]
+                              ? valueText(request.values[i]) + " is given twice"
+                              : "values " + numberText(request.values[j]) + " and " + numberText(request.values[i]) +
+                                    " are one isosurface to 6 digits: give values that differ there");
   const glm::vec2 colourRange(contourColorRange(request.values, glm::dvec2(range)));
   // Every surface is made before the scene is touched, so that a failure leaves it as it was.
   std::vector<Object> parts;

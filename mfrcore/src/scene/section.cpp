@@ -818,6 +818,8 @@ SectionPlane parseSectionPlane(const std::string& textIn, const std::string& wha
     const std::string suffixes = textIn.substr(colon + 1);
     if (suffixes.empty()) throw Error(what, "the suffixes are :nocaps and :slice (nothing after ':')");
     for (const std::string& suffix : text::splitList(suffixes, ':')) {
+      if ((suffix == "nocaps" && !section.caps) || (suffix == "slice" && section.slice))
+        throw Error(what, ":" + suffix + " is given twice");
       if (suffix == "nocaps")
         section.caps = false;
       else if (suffix == "slice")
