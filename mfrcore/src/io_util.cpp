@@ -1,5 +1,6 @@
 #include "mfr/io_util.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -44,12 +45,11 @@ std::filesystem::path outputTarget(const std::filesystem::path& path) {
 void checkFolderTakesFiles(const std::filesystem::path& dir, const std::filesystem::path& output) {
   std::filesystem::path probe = dir / (".mfr-write-check-" + std::to_string(::getpid()) + "-" +
                                        std::to_string(std::random_device{}() & 0xFFFFFF));
-  {
-    std::ofstream out(probe, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(output.string(), std::string("cannot write in its folder (") + std::strerror(errno) + ")");
-  }
-  std::error_code ec;
-  std::filesystem::remove(probe, ec);
+  // O_EXCL: a name someone placed there (a link) is never followed or truncated.
+  const int fd = ::open(probe.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0600);
+  if (fd < 0) throw Error(output.string(), std::string("cannot write in its folder (") + std::strerror(errno) + ")");
+  ::close(fd);
+  ::unlink(probe.c_str());
 }
 
 }  // namespace

@@ -54,10 +54,18 @@ struct OpState {
 float volumeSample(int v, vec3 g) { return mfrTrilinear(uVolume[v], uGridDims[v], g); }
 
 // (rgb, σ) of a scalar: volume v's table interpolated linearly (TransferFunction::table).
+// a / b with both scaled by 2^-32 (exactly) where |b| > 2^100: GLSL's division is accurate only for
+// divisors up to 2^126, and a reciprocal of a larger one may flush to 0 (VolumeMarcher::divide).
+float volumeDivide(float a, float b) {
+  precise float s = abs(b) > 1.2676506002282294e30 ? 2.3283064365386963e-10 : 1.0;
+  precise float q = (a * s) / (b * s);
+  return q;
+}
+
 // Halved first, exactly (`precise`: not folded back): value − low overflows a float beyond
 // ±1.7e38; NaN (a table of one value) is the first entry.
 vec4 volumeTransfer(int v, float value) {
-  precise float along = (0.5 * value - 0.5 * uTfLow[v]) / (0.5 * uTfHigh[v] - 0.5 * uTfLow[v]);
+  precise float along = volumeDivide(0.5 * value - 0.5 * uTfLow[v], 0.5 * uTfHigh[v] - 0.5 * uTfLow[v]);
   float u = (along > 0.0 ? min(along, 1.0) : 0.0) * float(MFR_VOLUME_TF_SIZE - 1);
   int i = min(int(u), MFR_VOLUME_TF_SIZE - 2);
   float f = u - float(i);
@@ -79,12 +87,13 @@ float volumeShade(int v, vec3 g, vec3 rayDir) {
                        volumeHalfDifference(v, g, vec3(0.0, 0.0, 1.0)));
   float largest = max(max(abs(gradient.x), abs(gradient.y)), abs(gradient.z));
   if (!(largest > 0.0)) return 1.0;
-  vec3 unit = gradient / largest;
+  vec3 unit = vec3(volumeDivide(gradient.x, largest), volumeDivide(gradient.y, largest),
+                   volumeDivide(gradient.z, largest));
   float perCell = length(unit);
   vec3 world = transpose(mat3(uWorldToGrid[v])) * unit;
   float facing = abs(dot(world, rayDir)) / length(world);
   float lit = float(MFR_VOLUME_AMBIENT) + float(MFR_VOLUME_DIFFUSE) * facing;
-  precise float range = 2.0 * ((0.5 * uTfHigh[v] - 0.5 * uTfLow[v]) / largest);
+  precise float range = 2.0 * volumeDivide(0.5 * uTfHigh[v] - 0.5 * uTfLow[v], largest);
   float w = perCell / (perCell + float(MFR_VOLUME_SHADE_EDGE) * range);
   return mix(1.0, lit, w);
 }

@@ -603,6 +603,13 @@ class ViewerTest : public QObject {
         {"method", "abuffer-ll"},
         {"objects", QJsonArray{QJsonObject{{"name", "tangle"}, {"color", QJsonArray{1, 0, 0}}}}}};
     (void)sessionFromJson(good, "s.mfrsession");  // throws if the base is bad
+    // The viewer's CPU methods are methods of sessions too (the first strict reader refused them).
+    for (const char* cpu : {"oracle", "optimal-k"}) {
+      QJsonObject json = good;
+      json.insert("method", cpu);
+      json.insert("compare", QJsonObject{{"method", cpu}});
+      QCOMPARE(sessionFromJson(json, "s.mfrsession").method, QString(cpu));
+    }
     const auto with = [&](const QString& key, const QJsonValue& value) {
       QJsonObject json = good;
       json.insert(key, value);

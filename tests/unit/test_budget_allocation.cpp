@@ -417,8 +417,6 @@ TEST(NeuralTraining, ExportedWeightsReproduceDlibsLoss) {
   EXPECT_EQ(mfr::predictNeuralImportance(back, x), mfr::predictNeuralImportance(r.model, x));
 }
 
-// Rows drawn in proportion to n(p): the network still learns, the reported losses are weighted by
-// n (so they differ from the unweighted ones of the same weights), and a bad option is refused.
 // A run whose loss stops being finite (labels far outside [0, 1], which mfr dataset files can no
 // longer hold) is one error saying so: it ended in "unexpected dlib fc layer size" (a bug hunt).
 TEST(NeuralTraining, ADivergedRunIsAnError) {
@@ -436,6 +434,8 @@ TEST(NeuralTraining, ADivergedRunIsAnError) {
   }
 }
 
+// Rows drawn in proportion to n(p): the network still learns, the reported losses are weighted by
+// n (so they differ from the unweighted ones of the same weights), and a bad option is refused.
 TEST(NeuralTraining, FragmentWeighting) {
   const mfr::DkbDataset d = syntheticDataset(
       4, 2000, 30.0f, [](int) { return 1.0f; },

@@ -553,7 +553,7 @@ std::string firstParseFailure(const Handle(StepData_StepModel) & model) {
 // CARTESIAN_POINT of fewer than 3 coordinates (a segmentation fault in the transfer), a point of
 // none or more than 3, a DIRECTION of none, more than 3 or all-zero ratios (the faces on a zero
 // one were dropped without a word). 2D points and directions are valid (parameter-space curves).
-// (A point written with 4 coordinates is read as its first 3 by Open CASCADE: not caught here.)
+// (Open CASCADE's parser keeps the first 3 of a point written with 4, so n > 3 does not see it.)
 std::string firstGeometryFault(const Handle(StepData_StepModel) & model) {
   const auto at = [&](const Handle(Standard_Transient) & entity) {
     const Standard_Integer id = model->IdentLabel(entity);

@@ -236,10 +236,17 @@ struct VolumeMarcher {
     return glm::vec3(p) / p.w;
   }
 
+  // a / b with both scaled by 2^-32 (exactly) where |b| > 2^100, as the shader does (volumeDivide:
+  // GPU division is accurate only for divisors up to 2^126).
+  [[nodiscard]] static float divide(float a, float b) {
+    const float s = std::abs(b) > 0x1p100f ? 0x1p-32f : 1.0f;
+    return (a * s) / (b * s);
+  }
+
   [[nodiscard]] glm::vec4 transfer(const VolumeMedium& m, float v) const {
     // Halved first, exactly: v − low overflows a float for values beyond ±1.7e38 (a file's
     // ±FLT_MAX "no data" marks). A NaN position (a table of one value) is the first entry.
-    const float along = (0.5f * v - 0.5f * m.tfLow) / (0.5f * m.tfHigh - 0.5f * m.tfLow);
+    const float along = divide(0.5f * v - 0.5f * m.tfLow, 0.5f * m.tfHigh - 0.5f * m.tfLow);
     const float u = (along > 0.0f ? std::min(along, 1.0f) : 0.0f) * static_cast<float>(MFR_VOLUME_TF_SIZE - 1);
     const int i = std::min(static_cast<int>(u), MFR_VOLUME_TF_SIZE - 2);
     const float f = u - static_cast<float>(i);
@@ -255,14 +262,14 @@ struct VolumeMarcher {
     const glm::vec3 gradient(half({1.0f, 0.0f, 0.0f}), half({0.0f, 1.0f, 0.0f}), half({0.0f, 0.0f, 1.0f}));
     const float largest = std::max({std::abs(gradient.x), std::abs(gradient.y), std::abs(gradient.z)});
     if (!(largest > 0.0f)) return 1.0f;
-    const glm::vec3 unit = gradient / largest;
+    const glm::vec3 unit(divide(gradient.x, largest), divide(gradient.y, largest), divide(gradient.z, largest));
     const float perCell = glm::length(unit);  // |∇| / largest, in [1, √3]
     // ∇ in world units: the transpose of world → grid's linear part applied to ∇ in grid units.
     const glm::vec3 world = glm::transpose(glm::mat3(m.worldToGrid)) * unit;
     const float facing = std::abs(glm::dot(world, rayDir)) / glm::length(world);
     const float lit = static_cast<float>(MFR_VOLUME_AMBIENT) + static_cast<float>(MFR_VOLUME_DIFFUSE) * facing;
     // |∇| / (|∇| + edge · (high − low)), both terms divided by `largest`.
-    const float range = 2.0f * ((0.5f * m.tfHigh - 0.5f * m.tfLow) / largest);
+    const float range = 2.0f * divide(0.5f * m.tfHigh - 0.5f * m.tfLow, largest);
     const float w = perCell / (perCell + static_cast<float>(MFR_VOLUME_SHADE_EDGE) * range);
     return glm::mix(1.0f, lit, w);
   }
