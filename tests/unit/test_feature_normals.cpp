@@ -37,18 +37,25 @@ void fan(std::size_t n, std::vector<glm::dvec3>& points, std::vector<std::uint32
   }
 }
 
+// The unit cube's corners (corner i at (i & 1, i >> 1 & 1, i >> 2 & 1)) and its faces as quads wound
+// counter-clockwise seen from outside.
+std::vector<glm::dvec3> unitCubeCorners() {
+  std::vector<glm::dvec3> p;
+  for (int i = 0; i < 8; ++i) p.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
+  return p;
+}
+constexpr std::uint32_t kCubeQuads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                                            {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+
 }  // namespace
 
 TEST(FeatureNormals, CubeIsRewoundOutwardAndSplitAtEveryEdge) {
-  std::vector<glm::dvec3> p;
-  for (int i = 0; i < 8; ++i) p.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
-  // Outward-wound quads (corners counter-clockwise seen from outside); the first triangle of each
-  // is kept, the second reversed for odd faces, so the rewinding must fix three faces' halves.
-  const std::uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                     {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  const std::vector<glm::dvec3> p = unitCubeCorners();
+  // The first triangle of each quad is kept, the second reversed for odd faces, so the rewinding
+  // must fix three faces' halves.
   std::vector<std::uint32_t> idx;
   for (int f = 0; f < 6; ++f) {
-    const auto& q = quads[f];
+    const auto& q = kCubeQuads[f];
     idx.insert(idx.end(), {q[0], q[1], q[2]});
     if (f % 2 == 1)
       idx.insert(idx.end(), {q[3], q[2], q[0]});
@@ -73,12 +80,9 @@ TEST(FeatureNormals, CubeIsRewoundOutwardAndSplitAtEveryEdge) {
 // and turns the cube inside out; the loaders' majority rule keeps the file's (a bug hunt: such an
 // STL measured volume −1 and drew its near faces as back faces).
 TEST(FeatureNormals, MajorityWindingKeepsWhatMostTrianglesSay) {
-  std::vector<glm::dvec3> p;
-  for (int i = 0; i < 8; ++i) p.emplace_back(i & 1, (i >> 1) & 1, (i >> 2) & 1);
-  const std::uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                                     {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  const std::vector<glm::dvec3> p = unitCubeCorners();
   std::vector<std::uint32_t> idx;
-  for (const auto& q : quads) idx.insert(idx.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+  for (const auto& q : kCubeQuads) idx.insert(idx.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
   std::swap(idx[1], idx[2]);  // the first triangle reversed
   const auto outward = [&](const mfr::FeatureSplit& s) {
     std::vector<glm::dvec3> positions;
