@@ -11,12 +11,15 @@
 // cancellation.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <zlib.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -551,6 +554,62 @@ TEST(StepBadInput, OneLineErrorsNamingTheFile) {
   const fs::path wire = dir.path() / "wire.step";
   ASSERT_TRUE(writeDemo(wire, /*edgeOnly=*/true));
   expectLoadError(wire, "no surfaces");
+}
+
+// Faces Open CASCADE drops without failing the read (a cone of negative radius: the transfer
+// leaves the face out; a B-spline edge whose first knot is repeated 40 times: the face is not
+// meshed) are a note each, and the rest of the part is drawn; the file as it is gives none.
+TEST(StepBadInput, DroppedFacesAreNoted) {
+  TempDir dir;
+  const std::string screw = readText(requireFile(kScrew));
+  const auto load = [](const fs::path& path, std::vector<std::string>& notes) {
+    mfr::LoadOptions options;
+    options.notes = &notes;
+    const std::vector<mfr::Object> objects = mfr::loadModel(path, options);
+    std::size_t triangles = 0;
+    for (const mfr::Object& o : objects) triangles += o.mesh->triangleCount();
+    return triangles;
+  };
+  std::vector<std::string> notes;
+  const std::size_t whole = load(kScrew, notes);
+  EXPECT_TRUE(notes.empty()) << notes.front();
+  for (const auto& [from, to, note] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"#153 = CONICAL_SURFACE('',#154,7.5,0.785398163397);",
+            "#153 = CONICAL_SURFACE('',#154,-7.5,0.785398163397);",
+            "1 of the file's 10 faces could not be read (damaged geometry; not drawn)"},
+           {"(4,2,2,2,2,3,2,2,2,2,4),(-9.753048731913", "(40,2,2,2,2,3,2,2,2,2,4),(-9.753048731913",
+            "1 of 10 faces could not be meshed (not drawn)"}}) {
+    std::string text = screw;
+    ASSERT_NE(text.find(from), std::string::npos) << from;
+    text.replace(text.find(from), from.size(), to);
+    const fs::path damaged = dir.write("damaged.step", text);
+    notes.clear();
+    const std::size_t triangles = load(damaged, notes);
+    EXPECT_GT(triangles, 0u);
+    ASSERT_EQ(notes.size(), 1u) << to;
+    EXPECT_EQ(notes[0], damaged.string() + ": " + note);
+  }
+  EXPECT_GT(whole, 0u);
+}
+
+// Open CASCADE runs in a child process: what it cannot do within the memory limit is one line
+// naming the file (its own Standard_OutOfMemory is the limit's message too), and this process
+// goes on to read the file when the limit allows.
+TEST(StepBadInput, TheMemoryLimitIsOneLine) {
+  std::uint64_t size = 0, residentPages = 0;
+  std::ifstream("/proc/self/statm") >> size >> residentPages;
+  const std::uint64_t residentMiB = residentPages * static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE)) >> 20;
+  const fs::path linkrods = requireFile(kLinkrods);
+  ASSERT_EQ(setenv("MFR_MEMORY_LIMIT_MIB", std::to_string(residentMiB + 5).c_str(), 1), 0);
+  std::string error;
+  try {
+    (void)mfr::loadModel(linkrods);
+  } catch (const mfr::Error& e) {
+    error = e.what();
+  }
+  ASSERT_EQ(unsetenv("MFR_MEMORY_LIMIT_MIB"), 0);
+  EXPECT_EQ(error.rfind(linkrods.string() + ": cannot read step: Open CASCADE needed more than the ", 0), 0u) << error;
+  EXPECT_EQ(mfr::loadModel(linkrods).size(), 1u);
 }
 
 // Truncations anywhere and damaged bytes: an error or a model, never a crash, hang or foreign

@@ -1,9 +1,6 @@
 #include "assimp_loader.hpp"
 
 #include <algorithm>
-#include <cerrno>
-#include <chrono>
-#include <csignal>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -13,6 +10,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <new>
 #include <mutex>
 #include <system_error>
 #include <iterator>
@@ -21,14 +19,6 @@
 #include <string_view>
 #include <utility>
 
-#include <fcntl.h>
-#include <poll.h>
-#include <signal.h>
-#include <sys/prctl.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <assimp/Importer.hpp>
 #include <assimp/ProgressHandler.hpp>
 #include <assimp/config.h>
@@ -36,8 +26,8 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include "child_process.hpp"
 #include "mfr/error.hpp"
-#include "mfr/host_memory.hpp"
 #include "vtk_loader.hpp"
 
 namespace mfr::io {
@@ -243,20 +233,9 @@ void checkGltfJsonDepth(const std::filesystem::path& path, const std::string* co
 // assimp 5.2 crashes (SIGSEGV; an uncaught DeadlyImportError, abort), hangs, or allocates without
 // end on some truncated or corrupt files — a bug hunt's cases: COB, X, MDL, ASE, 3MF and LWO
 // crashed mfr, SMD, OpenGEX and Q3S hung, DAE and LWS grew past 3 GB. None of that can be caught
-// in this process, so every file is first imported in a child process, under a memory limit (what
-// this process may still take) and a time limit, and only a file the child read is imported here.
-// A failure the child reports (assimp's own error) is thrown as it is. Costs one more import.
-// The time limit: 120 s, or MFR_IMPORT_TIMEOUT_S (whole seconds, 1 … 86400).
-int importSeconds(const std::string& name) {
-  const char* text = std::getenv("MFR_IMPORT_TIMEOUT_S");
-  if (text == nullptr || *text == '\0') return 120;
-  char* end = nullptr;
-  errno = 0;
-  const long seconds = std::strtol(text, &end, 10);
-  if (errno != 0 || *end != '\0' || seconds < 1 || seconds > 86400)
-    throw Error(name, std::string("MFR_IMPORT_TIMEOUT_S=") + text + ": expected whole seconds, 1 to 86400");
-  return static_cast<int>(seconds);
-}
+// in this process, so every file is first imported in a child process (child_process.hpp), and
+// only a file the child read is imported here. A failure the child reports (assimp's own error)
+// is thrown as it is. Costs one more import.
 
 // The error for assimp's refusal `reason`.
 Error importError(const std::string& reason, const std::string& extension, const std::string& name) {
@@ -283,142 +262,21 @@ const aiScene* importScene(Assimp::Importer& importer, const std::filesystem::pa
   return importer.ReadFile(path.string(), flags);
 }
 
-// The pipe's ends and the child, closed and reaped (killed first if still running) on every way
-// out of importInChild.
-class ChildImport {
- public:
-  ChildImport() = default;
-  ChildImport(const ChildImport&) = delete;
-  ChildImport& operator=(const ChildImport&) = delete;
-  ~ChildImport() {
-    closeRead();
-    closeWrite();
-    if (pid > 0) {
-      kill(pid, SIGKILL);
-      reap();
-    }
-  }
-  void closeRead() {
-    if (fds[0] >= 0) close(fds[0]);
-    fds[0] = -1;
-  }
-  void closeWrite() {
-    if (fds[1] >= 0) close(fds[1]);
-    fds[1] = -1;
-  }
-  // Waits for the child; its status.
-  int reap() {
-    int status = 0;
-    while (pid > 0 && waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
-    pid = -1;
-    return status;
-  }
-  int fds[2] = {-1, -1};
-  pid_t pid = -1;
-};
-
 // Imports the file in a child process; throws mfr::Error(name, …) when the child crashes, runs out
 // of time or memory, ends without a result, or assimp refuses the file; LoadCancelled when the
 // load is cancelled meanwhile. Returns when the child read the file (or no child could be made).
 void importInChild(const std::filesystem::path& path, const std::string* contents, const std::string& extension,
                    const std::string& name, const LoadProgress& progress) {
-  const int seconds = importSeconds(name);
-  std::uint64_t limit = 0;
-  const std::optional<std::uint64_t> available = availableHostMemory();
-  if (available) {
-    long pages = 0;
-    std::ifstream statm("/proc/self/statm");
-    statm >> pages;  // the address space already mapped (libraries, buffers) counts against RLIMIT_AS
-    limit = *available + static_cast<std::uint64_t>(std::max(pages, 0L)) * static_cast<std::uint64_t>(getpagesize());
-  }
-  ChildImport job;
-  // Close-on-exec: a process another thread starts meanwhile must not hold the write end open.
-  if (pipe2(job.fds, O_CLOEXEC) != 0) return;  // no child: the import below runs unguarded, as it always did
-  job.pid = fork();
-  if (job.pid < 0) return;
-  if (job.pid == 0) {
-    // Only this thread lives on in the child: it imports, writes one report and leaves by _exit.
-    close(job.fds[0]);
-    const int null = open("/dev/null", O_WRONLY | O_CLOEXEC);
-    if (null >= 0) {  // assimp's and the C++ runtime's last words ("terminate called …")
-      dup2(null, 1);
-      dup2(null, 2);
+  const ChildLibrary assimp{extension.empty() ? std::string("file") : extension.substr(1), "the importer (assimp)"};
+  runInChild(name, assimp, progress, [&](const LoadProgress&) {
+    Assimp::Importer importer;
+    if (importScene(importer, path, contents, extension) == nullptr) {
+      const std::string reason = importer.GetErrorString();
+      if (reason.find("bad_alloc") != std::string::npos) throw std::bad_alloc();
+      throw importError(reason, extension, name);
     }
-    prctl(PR_SET_DUMPABLE, 0);  // no core file, no crash report (apport, systemd-coredump)
-    const rlimit noCore{0, 0};
-    setrlimit(RLIMIT_CORE, &noCore);
-    if (limit > 0) {
-      const rlimit memory{limit, limit};
-      setrlimit(RLIMIT_AS, &memory);
-    }
-    std::string report;
-    try {
-      Assimp::Importer importer;
-      report = importScene(importer, path, contents, extension) != nullptr
-                   ? "ok"
-                   : "error " + std::string(importer.GetErrorString());
-    } catch (const std::bad_alloc&) {
-      report = "memory";
-    } catch (...) {
-      report = "exception";
-    }
-    const char* at = report.data();
-    for (std::size_t left = report.size(); left > 0;) {
-      const ssize_t n = write(job.fds[1], at, left);
-      if (n <= 0) break;
-      at += n;
-      left -= static_cast<std::size_t>(n);
-    }
-    _exit(0);
-  }
-  job.closeWrite();
-  std::string report;
-  bool timedOut = false;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
-  for (;;) {
-    pollfd p{job.fds[0], POLLIN, 0};
-    const int ready = poll(&p, 1, 100);
-    if (ready > 0) {
-      char buffer[4096];
-      const ssize_t n = read(job.fds[0], buffer, sizeof buffer);
-      if (n > 0) {
-        report.append(buffer, static_cast<std::size_t>(n));
-        continue;
-      }
-      if (n == 0 || errno != EINTR) break;  // the child closed its end: it is done (or dead)
-    } else if (ready < 0 && errno != EINTR) {
-      break;
-    }
-    if (!progress.tryStep(0.0)) {
-      kill(job.pid, SIGKILL);
-      throw LoadCancelled();  // the guard reaps the child
-    }
-    if (std::chrono::steady_clock::now() > deadline) {
-      timedOut = true;
-      kill(job.pid, SIGKILL);
-      break;
-    }
-  }
-  job.closeRead();
-  const int status = job.reap();
-  const std::string format = extension.empty() ? std::string("file") : extension.substr(1);
-  const std::string memory = formatMemory(available.value_or(0));
-  if (timedOut)
-    throw Error(name, "cannot read " + format + ": the importer (assimp) did not finish in " + std::to_string(seconds) +
-                          " s (corrupt or truncated file?)");
-  if (report == "memory" || (report.rfind("error ", 0) == 0 && report.find("bad_alloc") != std::string::npos))
-    throw Error(name, "cannot read " + format + ": the importer (assimp) needed more than the " + memory +
-                          " available (a corrupt file, or one too large for this machine)");
-  if (WIFSIGNALED(status))
-    throw Error(name, "cannot read " + format + ": the importer (assimp) crashed (" +
-                          std::string(strsignal(WTERMSIG(status))) + "; corrupt or truncated file?)");
-  // assimp's own refusal, not imported again.
-  if (report.rfind("error ", 0) == 0) throw importError(report.substr(6), extension, name);
-  if (report != "ok")
-    throw Error(name, "cannot read " + format + ": the importer (assimp) " +
-                          (report == "exception" ? "failed" : "ended without a result") +
-                          " (corrupt or truncated file?)");
+    return std::string();
+  });
 }
 
 }  // namespace

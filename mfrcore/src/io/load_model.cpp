@@ -198,7 +198,8 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
       return objects;
     }
     case Family::Assimp: return io::readWithAssimp(path, contents, ext, name, progress.part(gz ? 0.3 : 0.0, 0.95));
-    case Family::Step: return io::readStep(path, contents, stem, name, progress.part(gz ? 0.3 : 0.0, 0.95));
+    case Family::Step:
+      return io::readStep(path, contents, stem, name, progress.part(gz ? 0.3 : 0.0, 0.95), options.notes);
     case Family::Molecule: {
       if (!gz) data = readAll(path, name);
       const auto molecule = ext == ".pdb" || ext == ".ent" ? io::MoleculeFormat::Pdb : io::MoleculeFormat::Mmcif;

@@ -18,6 +18,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <set>
 #include <streambuf>
@@ -44,6 +45,7 @@
 #include <STEPConstruct_UnitContext.hxx>
 #include <STEPControl_Reader.hxx>
 #include <Standard_Failure.hxx>
+#include <Standard_OutOfMemory.hxx>
 #include <StepData_GlobalFactors.hxx>
 #include <StepData_Protocol.hxx>
 #include <StepData_StepModel.hxx>
@@ -53,6 +55,10 @@
 #include <StepGeom_GeomRepContextAndGlobUnitAssCtxAndGlobUncertaintyAssCtx.hxx>
 #include <StepGeom_GeometricRepresentationContextAndGlobalUnitAssignedContext.hxx>
 #include <StepRepr_GlobalUnitAssignedContext.hxx>
+#include <StepShape_ConnectedFaceSet.hxx>
+#include <StepShape_Face.hxx>
+#include <StepShape_FaceSurface.hxx>
+#include <StepShape_OrientedFace.hxx>
 #include <StepShape_VertexPoint.hxx>
 #include <TCollection_AsciiString.hxx>
 #include <TDF_Label.hxx>
@@ -77,6 +83,7 @@
 #include <gp_Pnt.hxx>
 #include <gp_Trsf.hxx>
 
+#include "child_process.hpp"
 #include "mfr/error.hpp"
 
 namespace mfr::io {
@@ -391,7 +398,8 @@ struct PartMesh {
   Mesh mesh;                     // positions, normals, indices; no colours
   std::vector<int> vertexStyle;  // index into styles, −1: none; empty when no face has a style
   std::vector<glm::vec4> styles;
-  std::size_t faces = 0;
+  std::size_t faces = 0;                                               // of the shape
+  std::size_t unmeshed = 0;                                            // of those, faces BRepMesh gave no triangles
   std::map<std::array<float, 4>, std::shared_ptr<const Mesh>> shared;  // by the colour baked in
   std::shared_ptr<const Mesh> plain;
 };
@@ -434,7 +442,10 @@ PartMesh collectTriangles(const TopoDS_Shape& shape, const TopTools_DataMapOfSha
     ++part.faces;
     TopLoc_Location location;
     const Handle(Poly_Triangulation)& triangulation = BRep_Tool::Triangulation(face, location);
-    if (triangulation.IsNull() || triangulation->NbTriangles() == 0 || triangulation->NbNodes() < 3) continue;
+    if (triangulation.IsNull() || triangulation->NbTriangles() == 0 || triangulation->NbNodes() < 3) {
+      ++part.unmeshed;
+      continue;
+    }
     const gp_Trsf trsf = (toPart * location).Transformation();
     const bool reversed = face.Orientation() == TopAbs_REVERSED;
     // A mirroring location turns the winding too.
@@ -583,6 +594,24 @@ std::string firstGeometryFault(const Handle(StepData_StepModel) & model) {
   return {};
 }
 
+// The faces of the file's shells (ADVANCED_FACE, FACE_SURFACE; an ORIENTED_FACE's face once):
+// what the transfer should make.
+std::size_t shellFaces(const Handle(Interface_InterfaceModel) & model) {
+  std::set<const Standard_Transient*> faces;
+  for (Standard_Integer i = 1; !model.IsNull() && i <= model->NbEntities(); ++i) {
+    const Handle(StepShape_ConnectedFaceSet) shell = Handle(StepShape_ConnectedFaceSet)::DownCast(model->Value(i));
+    if (shell.IsNull() || shell->CfsFaces().IsNull()) continue;
+    for (Standard_Integer k = 1; k <= shell->NbCfsFaces(); ++k) {
+      Handle(StepShape_Face) face = shell->CfsFacesValue(k);
+      if (const Handle(StepShape_OrientedFace) oriented = Handle(StepShape_OrientedFace)::DownCast(face);
+          !oriented.IsNull())
+        face = oriented->FaceElement();
+      if (!Handle(StepShape_FaceSurface)::DownCast(face).IsNull()) faces.insert(face.get());
+    }
+  }
+  return faces.size();
+}
+
 // A read-only stream over bytes already in memory (std::istringstream would copy them).
 class MemoryBuffer final : public std::streambuf {
  public:
@@ -699,6 +728,8 @@ void parse(STEPCAFControl_Reader& reader, const std::filesystem::path& path, con
   std::string why = status != 0 ? messages.failure() : std::string();
   if (why.empty()) why = firstParseFailure(model);
   if (why.empty() && status == 0) why = firstGeometryFault(model);
+  // The parser catches its own Standard_OutOfMemory and reports it as a failure of the file.
+  if (why.find("Standard_OutOfMemory") != std::string::npos) throw std::bad_alloc();
   if (status != 0 || !why.empty())
     throw Error(name, "not a readable STEP file" + (why.empty() ? std::string() : " (" + why + ")"));
   session->SetModel(model);
@@ -706,7 +737,8 @@ void parse(STEPCAFControl_Reader& reader, const std::filesystem::path& path, con
 }
 
 std::vector<Object> read(const std::filesystem::path& path, const std::string* contents, const std::string& stem,
-                         const std::string& name, const LoadProgress& progress, const QuietMessenger& messages) {
+                         const std::string& name, const LoadProgress& progress, const QuietMessenger& messages,
+                         std::vector<std::string>* notes) {
   progress.step(0.0);
   STEPCAFControl_Reader reader;
   reader.SetColorMode(Standard_True);
@@ -719,6 +751,7 @@ std::vector<Object> read(const std::filesystem::path& path, const std::string* c
   parse(reader, path, contents, name, messages);
   progress.step(0.3);
   if (reader.NbRootsForTransfer() <= 0) throw Error(name, "no shapes (the file has no product with a shape)");
+  const std::size_t defined = shellFaces(reader.ChangeReader().Model());
 
   Handle(TDocStd_Document) doc = new TDocStd_Document("MDTV-XCAF");
   // Keep the file's length unit: Open CASCADE would convert to millimetres.
@@ -763,7 +796,7 @@ std::vector<Object> read(const std::filesystem::path& path, const std::string* c
     if (partIndex.emplace(entry(instance.part), partLabels.size()).second) partLabels.push_back(instance.part);
   std::vector<PartMesh> parts;
   parts.reserve(partLabels.size());
-  std::size_t faces = 0;
+  std::size_t faces = 0, unmeshed = 0;
   for (std::size_t i = 0; i < partLabels.size(); ++i) {
     const double from = 0.55 + 0.45 * static_cast<double>(i) / static_cast<double>(partLabels.size());
     const double to = 0.55 + 0.45 * static_cast<double>(i + 1) / static_cast<double>(partLabels.size());
@@ -778,9 +811,19 @@ std::vector<Object> read(const std::filesystem::path& path, const std::string* c
     const TopTools_DataMapOfShapeInteger styleOfFace = faceStyles(walker, partLabels[i], styles);
     parts.push_back(shape.IsNull() ? PartMesh{} : collectTriangles(shape, styleOfFace, std::move(styles), name));
     faces += parts.back().faces;
+    unmeshed += parts.back().unmeshed;
     progress.step(to);
   }
   if (faces == 0) throw Error(name, "no surfaces (the file's shapes have no faces)");
+  // Open CASCADE drops a face whose geometry it cannot use (a bad B-spline, parallel axes, a
+  // degenerate edge) without failing the transfer; shape healing may also split a face in two, so
+  // this sees a loss only where it is larger than the splits.
+  if (notes != nullptr && faces < defined)
+    notes->push_back(name + ": " + std::to_string(defined - faces) + " of the file's " + std::to_string(defined) +
+                     " faces could not be read (damaged geometry; not drawn)");
+  if (notes != nullptr && unmeshed > 0)
+    notes->push_back(name + ": " + std::to_string(unmeshed) + " of " + std::to_string(faces) +
+                     " faces could not be meshed (not drawn)");
 
   const bool palette = !walker.fileHasColors();
   std::vector<Object> objects;
@@ -815,19 +858,41 @@ std::vector<Object> read(const std::filesystem::path& path, const std::string* c
   return objects;
 }
 
-}  // namespace
-
-std::vector<Object> readStep(const std::filesystem::path& path, const std::string* contents, const std::string& stem,
-                             const std::string& name, const LoadProgress& progress) {
+// The whole read in this process, one at a time.
+std::vector<Object> readHere(const std::filesystem::path& path, const std::string* contents, const std::string& stem,
+                             const std::string& name, const LoadProgress& progress, std::vector<std::string>* notes) {
   const std::lock_guard<std::mutex> lock(occtMutex());
   const QuietMessenger messages;
   const SessionLengthUnit millimetres;
   try {
-    return read(path, contents, stem, name, progress, messages);
+    return read(path, contents, stem, name, progress, messages, notes);
+  } catch (const Standard_OutOfMemory&) {
+    throw std::bad_alloc();  // the memory limit's message (child_process.hpp)
   } catch (const Standard_Failure& failure) {
     const char* what = failure.GetMessageString();
     throw Error(name, std::string("Open CASCADE failed (") + failure.DynamicType()->Name() +
                           (what != nullptr && *what != '\0' ? std::string(": ") + what : std::string()) + ")");
+  }
+}
+
+}  // namespace
+
+// Open CASCADE 7.6 crashes on some damaged files that no check above foresees (each check there
+// was a crash or a hang found by a bug hunt or fuzzing): the read runs in a child process
+// (child_process.hpp), whose parts come back as bytes — read once, not twice.
+std::vector<Object> readStep(const std::filesystem::path& path, const std::string* contents, const std::string& stem,
+                             const std::string& name, const LoadProgress& progress, std::vector<std::string>* notes) {
+  const ChildLibrary occt{"step", "Open CASCADE"};
+  if (const std::optional<std::string> bytes = runInChild(name, occt, progress, [&](const LoadProgress& childProgress) {
+        std::vector<std::string> childNotes;
+        std::vector<Object> objects = readHere(path, contents, stem, name, childProgress, &childNotes);
+        return packObjects(objects, childNotes);
+      }))
+    return unpackObjects(*bytes, notes);
+  try {
+    return readHere(path, contents, stem, name, progress, notes);
+  } catch (const std::bad_alloc&) {
+    throw Error(name, "cannot read step: Open CASCADE ran out of memory");
   }
 }
 

@@ -12,10 +12,12 @@
 namespace mfr::io {
 
 // Reads `path`, or `contents` (decompressed bytes) when not null. `stem` names a part that the
-// file leaves unnamed. Reports reading, transfer and each part meshed. Throws mfr::Error(name,
-// reason), or LoadCancelled.
+// file leaves unnamed. Reports reading, transfer and each part meshed. Faces the file defines but
+// Open CASCADE could not read or mesh are a line in `notes` (when not null). Runs Open CASCADE in a
+// child process (child_process.hpp). Throws mfr::Error(name, reason), or LoadCancelled.
 std::vector<Object> readStep(const std::filesystem::path& path, const std::string* contents, const std::string& stem,
-                             const std::string& name, const LoadProgress& progress = {});
+                             const std::string& name, const LoadProgress& progress = {},
+                             std::vector<std::string>* notes = nullptr);
 
 // The linear meshing tolerance as a share of the model's bounding-box diagonal, and the angular
 // one in radians (documented in docs/architecture.md, Loaders).

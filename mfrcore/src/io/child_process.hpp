@@ -1,0 +1,43 @@
+#pragma once
+// Loaders whose library can crash, hang or allocate without end on a damaged file (assimp, Open
+// CASCADE) run it in a child process (private to mfrcore/io): a crash, a hang or a runaway is then
+// one error naming the file, and the process that asked (mfr, or mfrview loading a scene) lives on.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mfr/io/load.hpp"
+#include "mfr/scene/scene.hpp"
+
+namespace mfr::io {
+
+// Who does the work, for messages: "cannot read <format>: <library> crashed (…)".
+struct ChildLibrary {
+  std::string format;   // "step", "obj", … ("file" when the name has no extension)
+  std::string library;  // "the importer (assimp)", "Open CASCADE"
+};
+
+// The time limit: 120 s, or MFR_IMPORT_TIMEOUT_S (whole seconds, 1 … 86400). Throws
+// mfr::Error(name, …) for any other value.
+int importSeconds(const std::string& name);
+
+// Runs `work` in a forked child process, under a memory limit (what this process may still take,
+// host_memory.hpp) and a time limit (importSeconds) counted from the child's last progress report,
+// and returns the bytes it returned. `work` gets a LoadProgress whose reports reach `progress`
+// here; cancelling `progress` kills the child and throws LoadCancelled. An mfr::Error that `work`
+// throws is thrown here with its message; a crash, the time limit, the memory limit or a child
+// that ends without a result is an mfr::Error(name, "cannot read <format>: <library> …").
+// std::nullopt when no child could be made (the caller then does the work itself, unguarded).
+std::optional<std::string> runInChild(const std::string& name, const ChildLibrary& library,
+                                      const LoadProgress& progress,
+                                      const std::function<std::string(const LoadProgress&)>& work);
+
+// Objects and a loader's notes as bytes and back, to pass a loader's result out of its child:
+// names, meshes (shared meshes stay shared), fields, transforms, materials, visibility. Only for
+// bytes packObjects wrote in a process of the same build (std::logic_error for others); the notes
+// are appended to `notes` when it is not null.
+std::string packObjects(const std::vector<Object>& objects, const std::vector<std::string>& notes = {});
+std::vector<Object> unpackObjects(const std::string& bytes, std::vector<std::string>* notes = nullptr);
+
+}  // namespace mfr::io
