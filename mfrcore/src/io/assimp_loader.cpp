@@ -12,6 +12,7 @@
 #include <memory>
 #include <new>
 #include <mutex>
+#include <optional>
 #include <system_error>
 #include <iterator>
 #include <streambuf>
@@ -230,13 +231,6 @@ void checkGltfJsonDepth(const std::filesystem::path& path, const std::string* co
   }
 }
 
-// assimp 5.2 crashes (SIGSEGV; an uncaught DeadlyImportError, abort), hangs, or allocates without
-// end on some truncated or corrupt files — a bug hunt's cases: COB, X, MDL, ASE, 3MF and LWO
-// crashed mfr, SMD, OpenGEX and Q3S hung, DAE and LWS grew past 3 GB. None of that can be caught
-// in this process, so every file is first imported in a child process (child_process.hpp), and
-// only a file the child read is imported here. A failure the child reports (assimp's own error)
-// is thrown as it is. Costs one more import.
-
 // The error for assimp's refusal `reason`.
 Error importError(const std::string& reason, const std::string& extension, const std::string& name) {
   // What SortByPType says when it removed every mesh because all were points or lines.
@@ -262,30 +256,9 @@ const aiScene* importScene(Assimp::Importer& importer, const std::filesystem::pa
   return importer.ReadFile(path.string(), flags);
 }
 
-// Imports the file in a child process; throws mfr::Error(name, …) when the child crashes, runs out
-// of time or memory, ends without a result, or assimp refuses the file; LoadCancelled when the
-// load is cancelled meanwhile. Returns when the child read the file (or no child could be made).
-void importInChild(const std::filesystem::path& path, const std::string* contents, const std::string& extension,
-                   const std::string& name, const LoadProgress& progress) {
-  const ChildLibrary assimp{extension.empty() ? std::string("file") : extension.substr(1), "the importer (assimp)"};
-  runInChild(name, assimp, progress, [&](const LoadProgress&) {
-    Assimp::Importer importer;
-    if (importScene(importer, path, contents, extension) == nullptr) {
-      const std::string reason = importer.GetErrorString();
-      if (reason.find("bad_alloc") != std::string::npos) throw std::bad_alloc();
-      throw importError(reason, extension, name);
-    }
-    return std::string();
-  });
-}
-
-}  // namespace
-
-std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std::string* contents,
-                                   const std::string& extension, const std::string& name,
-                                   const LoadProgress& progress) {
-  checkGltfJsonDepth(path, contents, extension, name);
-  importInChild(path, contents, extension, name, progress);
+// The import and the conversion into objects, in this process.
+std::vector<Object> readHere(const std::filesystem::path& path, const std::string* contents,
+                             const std::string& extension, const std::string& name, const LoadProgress& progress) {
   Assimp::Importer importer;
   // The importer owns (and deletes) its progress handler; the import takes the first 80 %.
   auto* importProgress = new ImportProgress(progress.part(0.0, 0.8));
@@ -293,7 +266,11 @@ std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std:
   const MutedStandardStreams muted;
   const aiScene* scene = importScene(importer, path, contents, extension);
   if (importProgress->cancelled()) throw LoadCancelled();
-  if (scene == nullptr) throw importError(importer.GetErrorString(), extension, name);
+  if (scene == nullptr) {
+    const std::string reason = importer.GetErrorString();
+    if (reason.find("bad_alloc") != std::string::npos) throw std::bad_alloc();  // the memory limit's message
+    throw importError(reason, extension, name);
+  }
   if (scene->mRootNode == nullptr || scene->mNumMeshes == 0) throw Error(name, "no triangles (the file has no meshes)");
 
   std::vector<std::shared_ptr<const Mesh>> meshes(scene->mNumMeshes);
@@ -350,6 +327,30 @@ std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std:
   }
   if (objects.empty()) throw Error(name, "no triangles");
   return objects;
+}
+
+}  // namespace
+
+// assimp 5.2 crashes (SIGSEGV; an uncaught DeadlyImportError, abort), hangs, or allocates without
+// end on some truncated or corrupt files — a bug hunt's cases: COB, X, MDL, ASE, 3MF and LWO
+// crashed mfr, SMD, OpenGEX and Q3S hung, DAE and LWS grew past 3 GB. None of that can be caught
+// in this process, so the import and the conversion run in a child process (child_process.hpp),
+// whose objects come back as bytes; a failure the child reports (assimp's own error) is thrown as
+// it is.
+std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std::string* contents,
+                                   const std::string& extension, const std::string& name,
+                                   const LoadProgress& progress) {
+  checkGltfJsonDepth(path, contents, extension, name);
+  const ChildLibrary assimp{extension.empty() ? std::string("file") : extension.substr(1), "the importer (assimp)"};
+  if (const std::optional<std::string> bytes = runInChild(name, assimp, progress, [&](const LoadProgress& child) {
+        return packObjects(readHere(path, contents, extension, name, child));
+      }))
+    return unpackObjects(*bytes);
+  try {
+    return readHere(path, contents, extension, name, progress);
+  } catch (const std::bad_alloc&) {
+    throw Error(name, "cannot read " + assimp.format + ": the importer (assimp) ran out of memory");
+  }
 }
 
 std::vector<std::string> assimpExtensions() {
