@@ -172,6 +172,12 @@ void addEvaluate(CLI::App& app) {
       values["budget_mib"] = "1";
       (void)Params(methodInfo->params, values, spec.method);
       if (spec.operation != "auto") validateOperation(spec.operation);
+      // Every row is measured against the exact "over" image: an operation that draws another
+      // image (a volume, a CSG result, merged z-thickness slabs) would only be a row of errors
+      // or of meaningless numbers for every scene, view and budget.
+      if (spec.operation != "auto" && spec.operation != "hybrid" && spec.operation != "oit")
+        throw Error("--methods " + m, "evaluate measures against the exact 'over' image; operation " + spec.operation +
+                                          " draws another image (use hybrid, the default, or oit)");
       specs[m] = spec;
       methodWidth = std::max(methodWidth, m.size() + 2);
     }

@@ -953,6 +953,16 @@ TEST_F(Cli, BudgetCommandsBadInput) {
     EXPECT_EQ(r.exitCode, 1) << r.out;
     EXPECT_EQ(r.out, "mfr: --methods vkb,fkb,vkb: 'vkb' is given twice\n");
   }
+  // An operation that draws another image than the exact "over" every row is measured against
+  // was a row of errors per scene, view and budget with exit 0 (op=volume on a scene without a
+  // volume), or numbers against the wrong image.
+  for (const std::string op : {"volume", "csg", "zthickness"}) {
+    const CliResult r = runCli("evaluate @sample --budgets k1 -s 32x24 -m vkb,fkb:op=" + op);
+    EXPECT_EQ(r.exitCode, 1) << op << ": " << r.out;
+    EXPECT_EQ(r.out, "mfr: --methods fkb:op=" + op + ": evaluate measures against the exact 'over' image; operation " +
+                         op + " draws another image (use hybrid, the default, or oit)\n");
+  }
+  EXPECT_EQ(runCli("evaluate @sample --budgets k1 -s 32x24 -m vkb,fkb:op=oit,fkb:op=hybrid").exitCode, 0);
   const fs::path badWeights = write("w.json", R"({"format":"mfr-dkb-weights","version":1})");
   expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + badWeights.string(), "w.json");
   // JSON errors other than syntax (a number past double's range, a key of the wrong type) were
