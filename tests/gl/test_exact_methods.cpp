@@ -3,7 +3,13 @@
 // their own files (test_<method>.cpp) with INSTANTIATE_TEST_SUITE_P(…, ExactMethod, …).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <filesystem>
+#include <map>
+#include <string>
+#include <tuple>
+#include <vector>
 
 #include "exact_method.hpp"
 #include "gl_fixture.hpp"
@@ -58,4 +64,74 @@ TEST_P(ExactMethod, RealModelsMatchOracle) {
 }
 
 }  // namespace
+}  // namespace mfr::test
+
+namespace mfr::test {
+
+// The exact A-buffers size their storage from the frame (a count pass), or take a fixed pool. A
+// frame whose fragments do not fit in the largest shader storage block was drawn without the
+// rest (exit 0, a band of the image missing, a bug hunt's 1800x1800 @sample); it is refused in
+// one line, and so is a fixed pool larger than the block (it was cut to fit without a word). The
+// layer counts are made from this context's limit, so the frame is just too deep on any GPU.
+TEST(ExactMethodStorage, FramesBeyondTheLargestStorageBlockAreRefused) {
+  context();
+  GLint64 blockBytes = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &blockBytes);
+  ASSERT_GT(blockBytes, 0);
+  const auto block = static_cast<std::uint64_t>(blockBytes);
+  constexpr int kSide = 1024;
+  constexpr std::uint64_t kPixels = std::uint64_t{kSide} * kSide;
+  for (const auto& [method, params, fragmentBytes] :
+       std::vector<std::tuple<std::string, std::map<std::string, std::string>, std::uint64_t>>{
+           {"abuffer-ll", {}, 12}, {"abuffer-sbuffer", {}, 8}, {"abuffer-array", {{"slots", "0"}}, 8}}) {
+    SCOPED_TRACE(method);
+    // Every covered pixel of @quads:N's front view holds exactly N fragments.
+    const std::uint64_t layers = std::min<std::uint64_t>(block / fragmentBytes, 0xFFFFFFFFull) / kPixels + 1;
+    ASSERT_LE(layers, 4096u);
+    const Scene scene = makeQuadsScene(static_cast<int>(layers));
+    GpuRenderer gpu;
+    gpu.setScene(scene);
+    RenderRequest req;
+    req.method = method;
+    req.width = kSide;
+    req.height = kSide;
+    req.params = params;
+    try {
+      (void)gpu.render(scene.view("front"), req);
+      ADD_FAILURE() << layers << " fragments per pixel were drawn";
+    } catch (const Error& e) {
+      const std::string need =
+          method == "abuffer-array"
+              ? "1024x1024 pixels x " + std::to_string(layers) + " slots (the deepest pixel's fragments)"
+              : "1024x1024: the frame's " + std::to_string(layers * kPixels) + " fragments";
+      EXPECT_EQ(std::string(e.what()).rfind(
+                    "--method " + method + ": " + need + " x " + std::to_string(fragmentBytes) + " bytes = ", 0),
+                0u)
+          << e.what();
+      EXPECT_NE(std::string(e.what()).find(", more than the largest shader storage block of this GL context holds"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  for (const std::string method : {"abuffer-ll", "abuffer-sbuffer"}) {
+    const Scene scene = makeSampleScene();
+    GpuRenderer gpu;
+    gpu.setScene(scene);
+    RenderRequest req;
+    req.method = method;
+    req.width = 16;
+    req.height = 16;
+    const std::string mib = std::to_string(block / (1024 * 1024) + 1);
+    req.params = {{"pool", "fixed"}, {"pool_mib", mib}};
+    try {
+      (void)gpu.render(scene.view("front"), req);
+      ADD_FAILURE() << method << " took a pool of " << mib << " MiB";
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("--param pool_mib=" + mib + ": a ", 0), 0u) << e.what();
+    }
+    req.params = {{"pool", "fixed"}, {"pool_mib", std::to_string(block / (1024 * 1024))}};  // exactly the block fits
+    EXPECT_NO_THROW((void)gpu.render(scene.view("front"), req)) << method;
+  }
+}
+
 }  // namespace mfr::test

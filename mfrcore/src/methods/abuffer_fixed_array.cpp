@@ -1,10 +1,10 @@
 #include "abuffer_fixed_array.hpp"
 
 #include <algorithm>
-#include <sstream>
 
 #include "common/bindings.h"
 #include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 #include "method_util.hpp"
 
 namespace mfr {
@@ -14,12 +14,6 @@ constexpr std::uint32_t kMaxSlots = 1024;
 // Fragments one array may hold: the largest storage block, and 32-bit slot addresses.
 std::uint64_t maxFragments() { return std::min<std::uint64_t>(maxStorageElements(8), 0xFFFFFFFFull); }
 
-std::string mib(std::uint64_t bytes) {
-  std::ostringstream s;
-  s.precision(4);
-  s << static_cast<double>(bytes) / (1024.0 * 1024.0) << " MiB";
-  return s.str();
-}
 }  // namespace
 
 const MethodInfo& ABufferFixedArray::info() const {
@@ -56,12 +50,12 @@ void ABufferFixedArray::configure(int width, int height, const Params& params) {
     const std::uint64_t pixels = static_cast<std::uint64_t>(width_) * height_;
     const std::uint64_t limit = maxFragments();
     if (pixels * requestedSlots_ > limit) {
-      throw Error("--param slots=" + std::to_string(requestedSlots_),
-                  std::to_string(width_) + "x" + std::to_string(height_) + " pixels x " +
-                      std::to_string(requestedSlots_) + " slots x 8 bytes = " +
-                      mib(pixels * requestedSlots_ * kFragmentBytes) +
-                      " exceeds the largest shader storage block of this GL context (" + mib(limit * kFragmentBytes) +
-                      "); at most " + std::to_string(limit / pixels) + " slots fit");
+      throw Error(
+          "--param slots=" + std::to_string(requestedSlots_),
+          std::to_string(width_) + "x" + std::to_string(height_) + " pixels x " + std::to_string(requestedSlots_) +
+              " slots x 8 bytes = " + formatMemory(pixels * requestedSlots_ * kFragmentBytes) +
+              " exceeds the largest shader storage block of this GL context (" + formatMemory(limit * kFragmentBytes) +
+              "); at most " + std::to_string(limit / pixels) + " slots fit");
     }
     ensureSlots(requestedSlots_);
   }
@@ -104,7 +98,7 @@ void ABufferFixedArray::capture(const FrameContext& ctx) {
 
   if (requestedSlots_ == 0) {
     // Automatic sizing: count pass, reduce to the largest per-pixel count (one 16-byte read-back),
-    // allocate that many slots (clamped to 1..1024 and to the largest storage block).
+    // allocate that many slots (clamped to 1..1024; refused beyond the largest storage block).
     glClearTexImage(counts_.id(), 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     {
@@ -116,9 +110,14 @@ void ABufferFixedArray::capture(const FrameContext& ctx) {
     }
     stats_.passes += 1;
     const Reduced counted = reduceCounts(ctx, "count max");  // slots_ is stale here: only maxCount is used
-    const std::uint64_t fit = std::max<std::uint64_t>(maxFragments() / pixels, 1);
-    const auto want = static_cast<std::uint32_t>(
-        std::min<std::uint64_t>({std::max<std::uint32_t>(counted.maxCount, 1), kMaxSlots, fit}));
+    const auto want =
+        static_cast<std::uint32_t>(std::min<std::uint64_t>(std::max<std::uint32_t>(counted.maxCount, 1), kMaxSlots));
+    // The deepest pixel's slots for every pixel, or a refusal: cutting them to what fits dropped
+    // fragments of an "exact" method without a word.
+    requireStorageFits("--method abuffer-array",
+                       std::to_string(width_) + "x" + std::to_string(height_) + " pixels x " + std::to_string(want) +
+                           " slots (the deepest pixel's fragments) x 8 bytes",
+                       pixels * want, maxFragments(), kFragmentBytes, "; a smaller --size needs less");
     ensureSlots(want);
   }
 

@@ -28,6 +28,10 @@ const MethodInfo& ABufferLinkedList::info() const {
 void ABufferLinkedList::configure(int width, int height, const Params& params) {
   sizing_ = params.text("pool");
   fixedPoolNodes_ = static_cast<std::uint64_t>(params.real("pool_mib") * 1024.0 * 1024.0) / kNodeBytes;
+  if (sizing_ == "fixed")  // it was cut to what fits without a word
+    requireStorageFits("--param pool_mib=" + params.text("pool_mib"),
+                       "a pool of " + std::to_string(fixedPoolNodes_) + " nodes x 12 bytes", fixedPoolNodes_,
+                       maxStorageElements(kNodeBytes), kNodeBytes, "");
   if (width != width_ || height != height_) {
     width_ = width;
     height_ = height;
@@ -41,6 +45,7 @@ void ABufferLinkedList::configure(int width, int height, const Params& params) {
 }
 
 void ABufferLinkedList::ensurePool(std::uint64_t nodes) {
+  // Only pool=previous's guess is ever cut here (its overflow is counted, as documented).
   nodes = std::clamp<std::uint64_t>(nodes, 1, maxStorageElements(kNodeBytes));
   if (nodes != poolNodes_) {
     pool_ = gl::createBuffer(nodes * kNodeBytes);
@@ -64,6 +69,11 @@ void ABufferLinkedList::capture(const FrameContext& ctx) {
     std::uint32_t counts[2] = {0, 0};
     glGetNamedBufferSubData(counter_.id(), 0, sizeof counts, counts);
     want = counts[0];
+    // The exact pool: a frame whose fragments do not fit is refused, not drawn without some.
+    requireStorageFits("--method abuffer-ll",
+                       std::to_string(width_) + "x" + std::to_string(height_) + ": the frame's " +
+                           std::to_string(want) + " fragments x 12 bytes",
+                       want, maxStorageElements(kNodeBytes), kNodeBytes, "; a smaller --size needs less");
     glNamedBufferSubData(counter_.id(), 0, sizeof zero, zero);
     stats_.passes += 1;
   } else if (sizing_ == "previous") {

@@ -33,6 +33,10 @@ const MethodInfo& ABufferSBuffer::info() const {
 void ABufferSBuffer::configure(int width, int height, const Params& params) {
   sizing_ = params.text("pool");
   fixedCapacity_ = static_cast<std::uint64_t>(params.real("pool_mib") * 1024.0 * 1024.0) / kFragmentBytes;
+  if (sizing_ == "fixed")  // it was cut to what fits without a word
+    requireStorageFits("--param pool_mib=" + params.text("pool_mib"),
+                       "a buffer of " + std::to_string(fixedCapacity_) + " fragments x 8 bytes", fixedCapacity_,
+                       maxFragments(), kFragmentBytes, "");
   if (width != width_ || height != height_) {
     width_ = width;
     height_ = height;
@@ -80,8 +84,14 @@ void ABufferSBuffer::capture(const FrameContext& ctx) {
   ctx.timer.end();
 
   if (sizing_ == "count") {
-    // The one CPU round trip: the total sizes the fragment buffer exactly.
-    ensureCapacity(scan_.readTotal());
+    // The one CPU round trip: the total sizes the fragment buffer exactly; a frame whose fragments
+    // do not fit is refused, not drawn without some.
+    const std::uint64_t total = scan_.readTotal();
+    requireStorageFits("--method abuffer-sbuffer",
+                       std::to_string(width_) + "x" + std::to_string(height_) + ": the frame's " +
+                           std::to_string(total) + " fragments x 8 bytes",
+                       total, maxFragments(), kFragmentBytes, "; a smaller --size needs less");
+    ensureCapacity(total);
   } else if (sizing_ == "previous") {
     // First frame: a guess of 8 fragments per pixel; afterwards last frame's total + 10 %.
     ensureCapacity(previousTotal_ > 0 ? previousTotal_ + previousTotal_ / 10 + 1024 : pixels * 8);

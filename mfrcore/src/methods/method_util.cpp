@@ -1,5 +1,8 @@
 #include "method_util.hpp"
 
+#include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
+
 namespace mfr {
 
 GeometryPassState::GeometryPassState(bool colorWrites, bool depthTest) {
@@ -60,6 +63,14 @@ std::uint64_t maxStorageElements(std::uint64_t elementBytes) {
   GLint64 maxBytes = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBytes);
   return static_cast<std::uint64_t>(maxBytes) / elementBytes;
+}
+
+void requireStorageFits(const std::string& what, const std::string& need, std::uint64_t count, std::uint64_t limit,
+                        std::uint64_t elementBytes, const std::string& advice) {
+  if (count <= limit) return;
+  throw Error(what, need + " = " + formatMemory(count * elementBytes) +
+                        ", more than the largest shader storage block of this GL context holds (" +
+                        formatMemory(limit * elementBytes) + ")" + advice);
 }
 
 }  // namespace mfr

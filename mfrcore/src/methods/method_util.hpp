@@ -2,6 +2,7 @@
 // Small pieces every method's C++ side uses: GL state for geometry passes, the resolve pass
 // draw, storage limits.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "mfr/gl/objects.hpp"
@@ -36,5 +37,12 @@ std::vector<std::uint32_t> readCapacities(const gl::Buffer& offsets, std::uint64
 
 // Largest element count of the given size one shader storage buffer may hold on this context.
 std::uint64_t maxStorageElements(std::uint64_t elementBytes);
+
+// An exact method's buffer of `count` elements of `elementBytes` where at most `limit` fit (the
+// largest storage block, or 32-bit addresses): throws mfr::Error(what, need + " = <bytes>, more
+// than the largest shader storage block of this GL context holds (<limit bytes>)" + advice) when
+// it does not fit. Exact methods refuse rather than drop fragments without a word.
+void requireStorageFits(const std::string& what, const std::string& need, std::uint64_t count, std::uint64_t limit,
+                        std::uint64_t elementBytes, const std::string& advice);
 
 }  // namespace mfr
