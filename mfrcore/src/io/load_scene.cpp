@@ -100,13 +100,7 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
         scene.objects = loadModel(path, model, progress);
       }
     }
-    Camera front;
-    front.eye = {0.0, 0.0, 1.0};
-    front.target = {0.0, 0.0, 0.0};
-    scene.views.push_back({"front", scene.fit(front)});
-    Camera iso = front;
-    iso.eye = {1.0, 0.8, 1.0};
-    scene.views.push_back({"iso", scene.fit(iso)});
+    for (const char* standard : {"front", "iso"}) scene.views.push_back({standard, *scene.standardView(standard)});
   }
   scene.validate();
   return scene;

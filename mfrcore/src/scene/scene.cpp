@@ -114,12 +114,24 @@ bool insideClipBox(const std::optional<Bounds>& box, const glm::dvec3& p) {
 std::vector<std::string> Scene::viewNames() const {
   std::vector<std::string> names{"fit"};
   for (const NamedView& v : views) names.push_back(v.name);
+  for (const char* standard : {"front", "iso"})
+    if (std::find(names.begin(), names.end(), standard) == names.end()) names.emplace_back(standard);
   return names;
+}
+
+std::optional<Camera> Scene::standardView(const std::string& viewName) const {
+  if (viewName != "front" && viewName != "iso") return std::nullopt;
+  Camera base;
+  base.eye = viewName == "front" ? glm::dvec3(0.0, 0.0, 1.0) : glm::dvec3(1.0, 0.8, 1.0);
+  base.target = glm::dvec3(0.0);
+  return fit(base);
 }
 
 Camera Scene::view(const std::string& viewName) const {
   for (const NamedView& v : views)
     if (v.name == viewName) return v.camera;
+  // Commands whose default view is "iso" (evaluate, dataset, allocations) work on every scene.
+  if (const std::optional<Camera> standard = standardView(viewName)) return *standard;
   if (viewName.rfind("orbit:", 0) == 0) {
     // orbit:AZIMUTH:ELEVATION (degrees): a fit-all view from that direction, +Y up; azimuth 0
     // looks from +Z, 90 from +X.

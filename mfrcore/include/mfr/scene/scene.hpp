@@ -108,10 +108,14 @@ struct Scene {
   // Throws mfr::Error when there is nothing visible to draw (no triangles, no volume), when more
   // than kMaxVisibleVolumes volumes are visible, or for an invalid volume.
   void validate() const;
-  // The named view, or the fit-all view for "fit" / empty name. Throws mfr::Error listing the
-  // available names for an unknown one.
+  // The named view, or the fit-all view for "fit" / empty name. Every scene has "front" (from +Z)
+  // and "iso" (from (1, 0.8, 1)), fit-all, unless it has views of those names of its own (a scene
+  // file's "views", @quads's orthographic front). Throws mfr::Error listing the available names for
+  // an unknown one.
   [[nodiscard]] Camera view(const std::string& name) const;
   [[nodiscard]] std::vector<std::string> viewNames() const;
+  // The fit-all "front" or "iso" view; nullopt for any other name.
+  [[nodiscard]] std::optional<Camera> standardView(const std::string& name) const;
 };
 
 // A clip box as `mfr render --clip` and `mfrview --clip` take it: six numbers
