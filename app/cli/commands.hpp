@@ -154,6 +154,9 @@ std::optional<double> parseNumber(const std::string& text);
 // "name" or "name:key=value:key=value" → request of w×h (a method run with several settings);
 // op=… sets the operation (default "auto"). Throws mfr::Error naming --methods.
 RenderRequest parseMethodSpec(const std::string& spec, int w, int h);
+// The -p name=value options as a map. Throws mfr::Error("--param …") for one without a name or
+// '=', and for a name given twice (the last silently won).
+std::map<std::string, std::string> parseParamOptions(const std::vector<std::string>& params);
 // A memory budget of mfr evaluate / mfr allocations: "3.5" MiB; "kN" the bytes of a uniform-k
 // k+-buffer with the tail (fkb's layout) at k = N; "fN" the bytes with which the variable-k layout
 // holds N % of the frame's fragments; "eN" N % of Σ max(1, n − 1), the slots after which hybrid

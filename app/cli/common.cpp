@@ -138,6 +138,17 @@ double median(std::vector<double> values) {
 }
 
 // "name" or "name:key=value:key=value" → request (a method may be benchmarked with several settings).
+std::map<std::string, std::string> parseParamOptions(const std::vector<std::string>& params) {
+  std::map<std::string, std::string> out;
+  for (const std::string& p : params) {
+    const auto eq = p.find('=');
+    if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");
+    if (!out.emplace(p.substr(0, eq), p.substr(eq + 1)).second)
+      throw Error("--param " + p, "'" + p.substr(0, eq) + "' is given twice");
+  }
+  return out;
+}
+
 RenderRequest parseMethodSpec(const std::string& spec, int w, int h) {
   RenderRequest r;
   r.width = w;

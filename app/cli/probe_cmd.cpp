@@ -96,11 +96,7 @@ void addProbe(CLI::App& app) {
     RenderRequest req;
     req.width = w;
     req.height = h;
-    for (const std::string& p : opt->params) {
-      const auto eq = p.find('=');
-      if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");
-      req.params[p.substr(0, eq)] = p.substr(eq + 1);
-    }
+    req.params = parseParamOptions(opt->params);
     const MethodInfo* info = nullptr;
     if (!opt->method.empty()) {
       info = findMethodInfo(opt->method);

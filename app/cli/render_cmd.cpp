@@ -80,9 +80,7 @@ void addRender(CLI::App& app) {
     // neither may be the scene, nor both one file (the JSON would replace the image just written).
     // A file a parameter names (dkb's weights) is read too.
     std::vector<CommandFile> files{{"scene", opt->scene, CommandFile::Role::kScene}};
-    std::map<std::string, std::string> named;
-    for (const std::string& p : opt->params)
-      if (const auto eq = p.find('='); eq != std::string::npos) named[p.substr(0, eq)] = p.substr(eq + 1);
+    const std::map<std::string, std::string> named = parseParamOptions(opt->params);
     addParameterFiles(files, "-p", opt->method, named);
     files.push_back({"-o", opt->output, CommandFile::Role::kRequiredOutput});
     files.push_back({"--stats", opt->stats, CommandFile::Role::kOutput});
@@ -96,11 +94,7 @@ void addRender(CLI::App& app) {
     if (stepOption->count() > 0 && !(opt->step > 0.0 && std::isfinite(opt->step)))
       throw Error("--step", "must be a positive length in scene units");
     req.volumeStep = opt->step;
-    for (const std::string& p : opt->params) {
-      const auto eq = p.find('=');
-      if (eq == std::string::npos || eq == 0) throw Error("--param " + p, "expected name=value");
-      req.params[p.substr(0, eq)] = p.substr(eq + 1);
-    }
+    req.params = named;
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->read);
     const std::optional<ContourLegend> contourLegend = opt->contours.apply(scene, opt->opacity);
     opt->colorBy.apply(scene);

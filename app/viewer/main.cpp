@@ -139,6 +139,13 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
                      colorRange, contour, legend,    param,         view,  size,     screenshot, windowScreenshot,
                      windowSize, clip,    section,   pluginSettings});
   parser.process(app);
+  // An empty value is refused, as mfr refuses it: read as "not given", --screenshot '' opened the
+  // interactive window and never quit.
+  for (const QCommandLineOption& option :
+       {method, op, thickness, step, field, molecule, colorBy, colorMap, colorRange, contour, param, view, size,
+        screenshot, windowScreenshot, windowSize, clip, section, pluginSettings})
+    for (const QString& value : parser.values(option))
+      if (value.isEmpty()) fail(QStringLiteral("--%1: an empty value").arg(option.names().constLast()), 2);
 
   CommandLine cl;
   if (parser.positionalArguments().size() > 1) fail(QStringLiteral("expected one scene, got %1").arg(parser.positionalArguments().size()), 2);
@@ -219,7 +226,9 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
   for (const QString& p : parser.values(param)) {
     const qsizetype eq = p.indexOf(QLatin1Char('='));
     if (eq <= 0) fail(QStringLiteral("--param %1: expected name=value").arg(p), 2);
-    cl.params[p.left(eq).toStdString()] = p.mid(eq + 1).toStdString();
+    // -p k=4 -p k=2 meant one of them; the last silently won.
+    if (!cl.params.emplace(p.left(eq).toStdString(), p.mid(eq + 1).toStdString()).second)
+      fail(QStringLiteral("--param %1: '%2' is given twice").arg(p, p.left(eq)), 2);
   }
   for (const QString& p : parser.values(pluginSettings)) {
     const qsizetype eq = p.indexOf(QLatin1Char('='));

@@ -593,6 +593,34 @@ class ViewerTest : public QObject {
   // A session's values of the wrong type or range are one line naming the file and the key: they
   // were read as something else without a word ("visible": "no" as visible, a colour of [1, 0, "x"]
   // as black, opacity 5, "method": 3 as the current method, version 99 as 1; found by a bug hunt).
+  // An empty value was "not given": --screenshot '' opened the interactive window and never quit
+  // (a bug hunt), -m '' drew the default method. A -p name given twice kept the last without a
+  // word. Each is one line and exit 2, as mfr refuses them.
+  void emptyAndRepeatedOptionsAreRefused() {
+    QTemporaryDir dir;
+    const QString png = dir.filePath(QStringLiteral("empty.png"));
+    for (const QString& option :
+         {QStringLiteral("--screenshot"), QStringLiteral("--window-screenshot"), QStringLiteral("-m"),
+          QStringLiteral("--op"), QStringLiteral("--view"), QStringLiteral("--color-by"), QStringLiteral("--size")}) {
+      QStringList args{QStringLiteral("@sample"), option, QString()};
+      if (!option.endsWith(QStringLiteral("screenshot"))) args << QStringLiteral("--screenshot") << png;
+      QString out;
+      QCOMPARE(runProgram(MFRVIEW, args, &out), 2);
+      const QString name = option == QStringLiteral("-m") ? QStringLiteral("method") : option.mid(2);
+      QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(),
+               QStringLiteral("mfrview: --%1: an empty value").arg(name));
+    }
+    QString out;
+    QCOMPARE(
+        runProgram(MFRVIEW,
+                   {"@sample", "-m", "kplus-array", "-p", "k=4", "-p", "k=2", "--size", "32x32", "--screenshot", png},
+                   &out),
+        2);
+    QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(),
+             QStringLiteral("mfrview: --param k=2: 'k' is given twice"));
+    QVERIFY(!QFile::exists(png));
+  }
+
   void badSessionValuesAreRefused() {
     const QJsonObject good{
         {"format", "mfrview-session"},

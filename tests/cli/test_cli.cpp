@@ -515,7 +515,12 @@ TEST_F(Cli, EmptyValuesAndOutOfRangeNumbersAreRefused) {
            {"render @sample -s 16x16 -o " + out + " --op zthickness --thickness 1e-7",
             "mfr: --thickness 1e-07: below a millionth of the scene's diagonal"},
            {"render @sample -s 16x16 -o " + out + " -m kbuffer-zmerge --thickness 3.4e38",
-            "mfr: --thickness 3.4e+38: above 1e30 scene units"}}) {
+            "mfr: --thickness 3.4e+38: above 1e30 scene units"},
+           // A -p name given twice kept the last without a word (a bug hunt); bench's specs refuse it.
+           {"render @sample -s 16x16 -o " + out + " -m kplus-array -p k=4 -p k=2",
+            "mfr: --param k=2: 'k' is given twice"},
+           {"probe @sample -s 16x16 --pixel 8,8 -m kplus-array -p k=4 -p k=4",
+            "mfr: --param k=4: 'k' is given twice"}}) {
     const CliResult r = runCli(args);
     EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << args << ": " << r.exitCode << " " << r.out;
     EXPECT_EQ(r.out.rfind(message, 0), 0u) << args << ": " << r.out;
