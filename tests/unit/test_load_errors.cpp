@@ -801,3 +801,43 @@ TEST(SupportedModelExtensions, ListsEveryFamilyInLowerCase) {
 }
 
 }  // namespace
+
+namespace {
+
+// A scene file's primitive whose counts are each in range but together ask for more vertices than
+// memory holds (a bug hunt: a hairball at its largest counts grew past 2 GB and was killed, or
+// ended in "internal error: std::bad_alloc") is one line naming the file and the primitive, before
+// any vertex is made.
+TEST_F(LoadModel, PrimitivesBeyondMemoryAreRefusedFirst) {
+  const auto errorOf = [&](const std::string& name, const std::string& json) {
+    try {
+      (void)mfr::loadScene(write(name, json));
+    } catch (const mfr::Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("loaded");
+  };
+  const std::string hairball =
+      errorOf("hair.mfrscene",
+              R"({"objects": [{"primitive": {"type": "hairball", "count": 10000, "segments": 4096, "sides": 256}}]})");
+  // 10,000 tubes × (4,097 × 257 + 2 × 257) vertices.
+  EXPECT_EQ(hairball.rfind(
+                (dir() / "hair.mfrscene").string() + ": objects[0].primitive: its 10534430000 vertices would take ", 0),
+            0u)
+      << hairball;
+  EXPECT_NE(hairball.find(" more memory; only "), std::string::npos) << hairball;
+  // Under a memory limit, a sphere of 4,097 × 4,097 vertices (about 1 GiB) too; the default one
+  // loads.
+  std::uint64_t size = 0, residentPages = 0;
+  std::ifstream("/proc/self/statm") >> size >> residentPages;
+  const std::uint64_t residentMiB = residentPages * static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE)) >> 20;
+  ASSERT_EQ(setenv("MFR_MEMORY_LIMIT_MIB", std::to_string(residentMiB + 200).c_str(), 1), 0);
+  const std::string sphere =
+      errorOf("sphere.mfrscene", R"({"objects": [{"primitive": {"type": "sphere", "slices": 4096, "stacks": 4096}}]})");
+  const std::string plain = errorOf("plain.mfrscene", R"({"objects": [{"primitive": {"type": "sphere"}}]})");
+  ASSERT_EQ(unsetenv("MFR_MEMORY_LIMIT_MIB"), 0);
+  EXPECT_NE(sphere.find("objects[0].primitive: its 16785409 vertices would take "), std::string::npos) << sphere;
+  EXPECT_EQ(plain, "loaded");
+}
+
+}  // namespace

@@ -4,7 +4,10 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <initializer_list>
+#include <optional>
+#include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -12,6 +15,7 @@
 
 #include "common/bindings.h"
 #include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
 #include "mfr/scene/color_map.hpp"
@@ -164,6 +168,18 @@ Mesh parsePrimitive(const Reader& r, const json& p, const std::string& where) {
     if (v > kLargest) r.fail(where + "." + key, "must be at most 1e15");
     return v;
   };
+  // Each count is bounded, but together they can ask for 10^10 vertices (a hairball of 10,000
+  // tubes of 4,096 segments, 256 sides): refused in one line before any is made, as the oracle's
+  // and the GPU's allocations are (host_memory.hpp). About 64 bytes per vertex: its position and
+  // normal, two triangles' indices, and the growth of the vectors that hold them.
+  const auto requireVertices = [&](double vertices) {
+    constexpr double kBytesPerVertex = 64.0;
+    const std::optional<std::uint64_t> available = availableHostMemory();
+    if (available && vertices * kBytesPerVertex > static_cast<double>(*available))
+      r.fail(where, "its " + std::to_string(static_cast<std::uint64_t>(vertices)) + " vertices would take " +
+                        formatMemory(static_cast<std::uint64_t>(std::min(vertices * kBytesPerVertex, 1.8e19))) +
+                        " more memory; only " + formatMemory(*available) + " is available");
+  };
   const std::string type = r.string(p, "type", where, "");
   if (type == "sphere") r.object(p, where, {"type", "radius", "slices", "stacks"});
   if (type == "box") r.object(p, where, {"type", "size"});
@@ -172,9 +188,12 @@ Mesh parsePrimitive(const Reader& r, const json& p, const std::string& where) {
   if (type == "plane") r.object(p, where, {"type", "width", "height"});
   if (type == "tube") r.object(p, where, {"type", "path", "radius", "sides"});
   if (type == "hairball") r.object(p, where, {"type", "radius", "tube_radius", "count", "seed", "segments", "sides"});
-  if (type == "sphere")
-    return makeSphere(size("radius", 1.0), r.integer(p, "slices", where, 48, 3, 4096),
-                      r.integer(p, "stacks", where, 24, 2, 4096));
+  if (type == "sphere") {
+    const double radius = size("radius", 1.0);
+    const int slices = r.integer(p, "slices", where, 48, 3, 4096), stacks = r.integer(p, "stacks", where, 24, 2, 4096);
+    requireVertices((slices + 1.0) * (stacks + 1.0));
+    return makeSphere(radius, slices, stacks);
+  }
   if (type == "box") {
     const glm::dvec3 box = p.contains("size") ? r.vec3(p["size"], where + ".size") : glm::dvec3(1.0);
     if (box.x <= 0 || box.y <= 0 || box.z <= 0) r.fail(where + ".size", "must be > 0");
@@ -187,8 +206,10 @@ Mesh parsePrimitive(const Reader& r, const json& p, const std::string& where) {
     const double major = size("major_radius", 1.0);
     const double minor = size("minor_radius", 0.25);
     if (minor >= major) r.fail(where + ".minor_radius", "must be smaller than major_radius");
-    return makeTorus(major, minor, r.integer(p, "major_segments", where, 64, 3, 4096),
-                     r.integer(p, "minor_segments", where, 24, 3, 4096));
+    const int majorSegments = r.integer(p, "major_segments", where, 64, 3, 4096);
+    const int minorSegments = r.integer(p, "minor_segments", where, 24, 3, 4096);
+    requireVertices((majorSegments + 1.0) * (minorSegments + 1.0));
+    return makeTorus(major, minor, majorSegments, minorSegments);
   }
   if (type == "plane") return makePlane(size("width", 1.0), size("height", 1.0));
   if (type == "tube") {
@@ -202,15 +223,20 @@ Mesh parsePrimitive(const Reader& r, const json& p, const std::string& where) {
         r.fail(where + ".path[" + std::to_string(i) + "]", "coordinates must be within ±1e15");
     for (std::size_t i = 1; i < path.size(); ++i)
       if (path[i] == path[i - 1]) r.fail(where + ".path[" + std::to_string(i) + "]", "repeats the previous point");
-    return makeTube(path, size("radius", 0.05), r.integer(p, "sides", where, 12, 3, 1024));
+    const double radius = size("radius", 0.05);
+    const int sides = r.integer(p, "sides", where, 12, 3, 1024);
+    requireVertices(static_cast<double>(path.size()) * (sides + 1.0) + 2.0 * (sides + 1.0));
+    return makeTube(path, radius, sides);
   }
   if (type == "hairball") {
     const double radius = size("radius", 1.0);
     const double tube = size("tube_radius", 0.02);
     if (tube >= radius) r.fail(where + ".tube_radius", "must be smaller than radius");
-    return makeHairball(r.integer(p, "count", where, 20, 1, 10000), radius, tube,
-                        static_cast<std::uint32_t>(r.integer(p, "seed", where, 1, 0, 1 << 30)),
-                        r.integer(p, "segments", where, 64, 2, 4096), r.integer(p, "sides", where, 10, 3, 256));
+    const int count = r.integer(p, "count", where, 20, 1, 10000);
+    const auto seed = static_cast<std::uint32_t>(r.integer(p, "seed", where, 1, 0, 1 << 30));
+    const int segments = r.integer(p, "segments", where, 64, 2, 4096), sides = r.integer(p, "sides", where, 10, 3, 256);
+    requireVertices(count * ((segments + 1.0) * (sides + 1.0) + 2.0 * (sides + 1.0)));
+    return makeHairball(count, radius, tube, seed, segments, sides);
   }
   r.fail(where + ".type", "unknown primitive '" + type + "' (sphere, box, cylinder, torus, plane, tube, hairball)");
 }
