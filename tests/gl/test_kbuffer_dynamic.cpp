@@ -115,5 +115,36 @@ TEST(KPlusDynamic, BudgetBelowOneSlotIsRefused) {
   }
 }
 
+// A k it chose whose slots do not fit in one storage block is refused naming the method and that
+// k: the message named "--param k=36", a parameter kplus-dynamic does not have (a bug hunt). The
+// layers of @quads:N make every covered pixel N deep, so with robustness 1 and room in the budget
+// the method picks k = N; N is made from this context's limit.
+TEST(KPlusDynamic, AChosenKBeyondTheStorageBlockNamesTheMethod) {
+  context();
+  GLint64 blockBytes = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &blockBytes);
+  constexpr int kSide = 2048;
+  constexpr std::uint64_t kSidePixels = std::uint64_t{kSide} * kSide;
+  const std::uint64_t layers =
+      std::min<std::uint64_t>(static_cast<std::uint64_t>(blockBytes) / 8, 0xFFFFFFFFull) / kSidePixels + 1;
+  ASSERT_LE(layers, 256u) << "beyond the k kplus-dynamic may choose";
+  const std::uint64_t budgetMiB = (2 * layers * 8 * kSidePixels >> 20) + 64;
+  ASSERT_LE(budgetMiB, 65536u);
+  const Scene scene = makeQuadsScene(static_cast<int>(layers));
+  GpuRenderer gpu;
+  gpu.setScene(scene);
+  RenderRequest req = request({{"budget_mib", std::to_string(budgetMiB)}, {"robustness", "1"}});
+  req.width = kSide;
+  req.height = kSide;
+  try {
+    (void)gpu.render(scene.view("front"), req);
+    ADD_FAILURE() << layers << " slots per pixel were allocated";
+  } catch (const Error& e) {
+    EXPECT_EQ(
+        std::string(e.what()).rfind("--method kplus-dynamic (its chosen k = " + std::to_string(layers) + "): ", 0), 0u)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace mfr::test

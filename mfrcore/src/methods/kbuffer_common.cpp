@@ -98,7 +98,14 @@ void KBufferFamily::allocateSlots(std::uint64_t slots, std::uint64_t auxBytes) {
     std::ostringstream why;
     why << width_ << "x" << height_ << " pixels need " << slots << " slots x 8 bytes, more than the largest shader "
         << "storage block of this GL context holds (" << limit << " slots)";
-    throw Error("--param k=" + std::to_string(k_), why.str());
+    // kplus-dynamic has no k of its own: it names the k it chose (a bug hunt's message named
+    // "--param k=36", a parameter the method does not have).
+    const MethodInfo& method = info();
+    const bool userK =
+        std::any_of(method.params.begin(), method.params.end(), [](const ParamSpec& p) { return p.name == "k"; });
+    throw Error(userK ? "--param k=" + std::to_string(k_)
+                      : "--method " + method.name + " (its chosen k = " + std::to_string(k_) + ")",
+                why.str());
   }
   if (slots != slots_ || !entries_) {
     entries_ = gl::createBuffer(slots * kEntryBytes);
