@@ -12,6 +12,7 @@
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
 #include "mfr/render.hpp"
+#include "mfr/scene/clip_box.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/contour.hpp"
 #include "mfr/list_text.hpp"
@@ -279,17 +280,7 @@ void applyClipOption(Scene& scene, const std::string& text) {
   const Bounds box = parseClipBox(text, "--clip " + text);
   // A box that holds nothing of the scene draws an empty image, as a section plane that cuts away
   // everything would: both are refused (found by fuzzing).
-  const Bounds b = scene.bounds();
-  bool holds = b.valid();
-  for (int a = 0; a < 3; ++a)
-    holds = holds && box.max[a] > box.min[a] && box.min[a] < b.max[a] && box.max[a] > b.min[a];
-  if (!holds) {
-    std::ostringstream bounds;
-    bounds << "[" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – [" << b.max.x << ", " << b.max.y << ", "
-           << b.max.z << "]";
-    throw Error("--clip " + text, "holds nothing of scene '" + scene.name +
-                                      "' (a flat box, or one outside its bounds " + bounds.str() + ")");
-  }
+  requireClipBoxHoldsScene(scene, box, "--clip " + text);
   scene.clipBox = box;
 }
 

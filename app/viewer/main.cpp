@@ -27,6 +27,7 @@
 #include "main_window.hpp"
 #include "mfr/error.hpp"
 #include "mfr/host_memory.hpp"
+#include "mfr/scene/clip_box.hpp"
 #include "mfr/scene/scene.hpp"
 #include "mfr/scene/section.hpp"
 #include "render_view.hpp"
@@ -51,6 +52,7 @@ struct CommandLine {
   // --clip, --section: as mfr render's; "none" removes the scene's own.
   std::optional<std::optional<mfr::Bounds>> clip;
   std::optional<std::optional<mfr::SectionPlane>> section;
+  QString clipText, sectionText;  // as given, for messages
 };
 
 [[noreturn]] void fail(const QString& message, int code) {
@@ -208,10 +210,12 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
   try {
     if (parser.isSet(clip)) {
       const std::string text = parser.value(clip).toStdString();
+      cl.clipText = parser.value(clip);
       cl.clip = text == "none" ? std::optional<mfr::Bounds>() : mfr::parseClipBox(text, "--clip " + text);
     }
     if (parser.isSet(section)) {
       const std::string text = parser.value(section).toStdString();
+      cl.sectionText = parser.value(section);
       cl.section =
           text == "none" ? std::optional<mfr::SectionPlane>() : mfr::parseSectionPlane(text, "--section " + text);
     }
@@ -336,8 +340,28 @@ int main(int argc, char** argv) {
     // A new scene starts at the default thickness (scene units): --thickness applies to this one.
     if (cl.thickness > 0.0) model.setZThickness(cl.thickness);
     if (cl.step > 0.0) model.setVolumeStep(cl.step);  // likewise the volume step
-    if (cl.clip) model.setClipBox(*cl.clip);
-    if (cl.section) model.setSection(*cl.section);
+    // What mfr render refuses for this scene, refused here too (a box that holds nothing drew an
+    // empty image with exit 0; ':slice' without a volume was dropped).
+    const auto refuse = [&](const QString& message) {
+      if (scripted) fail(message, 1);
+      window.statusBar()->showMessage(message);
+    };
+    bool clipOk = true, sectionOk = true;
+    if (cl.clip && *cl.clip) {
+      try {
+        mfr::requireClipBoxHoldsScene(model.scene(), **cl.clip, "--clip " + cl.clipText.toStdString());
+      } catch (const mfr::Error& e) {
+        clipOk = false;
+        refuse(QString::fromUtf8(e.what()));
+      }
+    }
+    if (cl.section && *cl.section && (*cl.section)->slice && model.scene().volumes.empty()) {
+      sectionOk = false;
+      refuse(QStringLiteral("--section %1: slice: scene '%2' has no volume")
+                 .arg(cl.sectionText, QString::fromStdString(model.scene().name)));
+    }
+    if (cl.clip && clipOk) model.setClipBox(*cl.clip);
+    if (cl.section && sectionOk) model.setSection(*cl.section);
     if (!cl.contour.empty()) {
       // Before --color-by, which then colours them too.
       QStringList texts;

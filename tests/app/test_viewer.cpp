@@ -621,6 +621,32 @@ class ViewerTest : public QObject {
     QVERIFY(!QFile::exists(png));
   }
 
+  // mfrview took a --clip box that holds nothing of the scene (an empty image, exit 0) and
+  // dropped ':slice' on a scene without a volume, both of which mfr render refuses (a bug hunt).
+  // The same line now, from both programs.
+  void clipAndSliceRefusedAsByMfr() {
+    QTemporaryDir dir;
+    const QString png = dir.filePath(QStringLiteral("refused.png"));
+    for (const QStringList& options : {QStringList{"--clip", "5,5,5,6,6,6"}, QStringList{"--section", "z=0:slice"}}) {
+      QString viewer, cli;
+      QCOMPARE(runProgram(MFRVIEW, QStringList{"@sample", "--size", "32x32", "--screenshot", png} + options, &viewer),
+               1);
+      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@sample", "-s", "32x32", "-o", png} + options, &cli), 1);
+      const QString viewerLine = viewer.trimmed().split(QLatin1Char('\n')).constLast();
+      const QString cliLine = cli.trimmed().split(QLatin1Char('\n')).constLast();
+      QVERIFY2(viewerLine.startsWith(QStringLiteral("mfrview: ")) && cliLine.startsWith(QStringLiteral("mfr: ")),
+               qPrintable(viewerLine + " | " + cliLine));
+      QCOMPARE(viewerLine.mid(9), cliLine.mid(5));
+      QVERIFY(!QFile::exists(png));
+    }
+    // A box that holds part of the scene, and a slice of a volume, are drawn.
+    QString out;
+    QCOMPARE(runProgram(MFRVIEW, {"@sample", "--size", "32x32", "--screenshot", png, "--clip", "0,0,0,6,6,6"}, &out),
+             0);
+    QCOMPARE(runProgram(MFRVIEW, {"@volume", "--size", "32x32", "--screenshot", png, "--section", "z=0:slice"}, &out),
+             0);
+  }
+
   void badSessionValuesAreRefused() {
     const QJsonObject good{
         {"format", "mfrview-session"},

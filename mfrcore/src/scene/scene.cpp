@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include <glm/trigonometric.hpp>
 
 #include "mfr/error.hpp"
 #include "mfr/list_text.hpp"
+#include "mfr/scene/clip_box.hpp"
 
 namespace mfr {
 
@@ -156,6 +158,19 @@ Camera Scene::view(const std::string& viewName) const {
   for (const std::string& n : viewNames()) list += (list.empty() ? "" : ", ") + n;
   throw Error("view '" + viewName + "'",
               "not in scene '" + name + "' (available: " + list + ", or orbit:AZIMUTH:ELEVATION)");
+}
+
+void requireClipBoxHoldsScene(const Scene& scene, const Bounds& box, const std::string& what) {
+  const Bounds b = scene.bounds();
+  bool holds = b.valid();
+  for (int a = 0; a < 3; ++a)
+    holds = holds && box.max[a] > box.min[a] && box.min[a] < b.max[a] && box.max[a] > b.min[a];
+  if (holds) return;
+  std::ostringstream bounds;
+  bounds << "[" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – [" << b.max.x << ", " << b.max.y << ", "
+         << b.max.z << "]";
+  throw Error(
+      what, "holds nothing of scene '" + scene.name + "' (a flat box, or one outside its bounds " + bounds.str() + ")");
 }
 
 Bounds parseClipBox(const std::string& text, const std::string& what) {

@@ -1,0 +1,14 @@
+#pragma once
+// The check both programs make of a clip box given on their command line (mfr render --clip,
+// mfrview --clip), so that they refuse the same boxes in the same words.
+#include <string>
+
+#include "mfr/scene/scene.hpp"
+
+namespace mfr {
+
+// Throws mfr::Error(what, "holds nothing of scene …") for a clip box that is flat or lies outside
+// the scene's bounds: it would draw an empty image.
+void requireClipBoxHoldsScene(const Scene& scene, const Bounds& box, const std::string& what);
+
+}  // namespace mfr
