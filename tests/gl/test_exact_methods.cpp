@@ -87,7 +87,9 @@ TEST(ExactMethodStorage, FramesBeyondTheLargestStorageBlockAreRefused) {
     SCOPED_TRACE(method);
     // Every covered pixel of @quads:N's front view holds exactly N fragments.
     const std::uint64_t layers = std::min<std::uint64_t>(block / fragmentBytes, 0xFFFFFFFFull) / kPixels + 1;
-    ASSERT_LE(layers, 4096u);
+    // A block this large holds what @quads (4096 layers at most) or abuffer-array (1024 slots) can
+    // ask for at this size: nothing to refuse.
+    if (layers > (method == "abuffer-array" ? 1024u : 4096u)) continue;
     const Scene scene = makeQuadsScene(static_cast<int>(layers));
     GpuRenderer gpu;
     gpu.setScene(scene);
@@ -121,6 +123,7 @@ TEST(ExactMethodStorage, FramesBeyondTheLargestStorageBlockAreRefused) {
     req.method = method;
     req.width = 16;
     req.height = 16;
+    if (block / (1024 * 1024) + 1 > 65536) continue;  // beyond pool_mib's own range
     const std::string mib = std::to_string(block / (1024 * 1024) + 1);
     req.params = {{"pool", "fixed"}, {"pool_mib", mib}};
     try {

@@ -86,14 +86,25 @@ bool writeRecord(int fd, char tag, const std::string& bytes) {
 
 constexpr std::size_t kRecordHeader = 1 + sizeof(std::uint64_t);
 
-// The child's side: runs `work`, writes its records and never returns.
-[[noreturn]] void childMain(int fd, std::uint64_t memoryLimit,
-                            const std::function<std::string(const LoadProgress&)>& work) {
+// The child's side: runs `work`, writes its records and never returns. noexcept: an exception
+// that escaped would unwind the parent's copied stack in the child; it aborts instead (a crash).
+[[noreturn]] void childMain(int fd, pid_t parent, std::uint64_t memoryLimit,
+                            const std::function<std::string(const LoadProgress&)>& work) noexcept {
+  // Dies with the parent: a hung child outlived a killed mfr or mfrview.
+  prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (getppid() != parent) _exit(1);
   const int null = open("/dev/null", O_WRONLY | O_CLOEXEC);
   if (null >= 0) {  // the library's and the C++ runtime's last words ("terminate called …")
     dup2(null, 1);
     dup2(null, 2);
   }
+  // Only the pipe's write end (as fd 3) and 0–2 stay open: another thread's child must not hold
+  // this pipe (its end of file would wait for that child), nor this child the parent's sockets.
+  if (fd != 3) {
+    dup2(fd, 3);
+    fd = 3;
+  }
+  close_range(4, ~0U, 0);
   prctl(PR_SET_DUMPABLE, 0);  // no core file, no crash report (apport, systemd-coredump)
   const rlimit noCore{0, 0};
   setrlimit(RLIMIT_CORE, &noCore);
@@ -149,7 +160,7 @@ int importSeconds(const std::string& name) {
 std::optional<std::string> runInChild(const std::string& name, const ChildLibrary& library,
                                       const LoadProgress& progress,
                                       const std::function<std::string(const LoadProgress&)>& work) {
-  const int seconds = importSeconds(name);
+  const int seconds = importSeconds(name) + std::max(library.graceSeconds, 0);
   std::uint64_t limit = 0;
   const std::optional<std::uint64_t> available = availableHostMemory();
   if (available) {
@@ -159,14 +170,16 @@ std::optional<std::string> runInChild(const std::string& name, const ChildLibrar
     limit = *available + static_cast<std::uint64_t>(std::max(pages, 0L)) * static_cast<std::uint64_t>(getpagesize());
   }
   ChildGuard job;
-  // Close-on-exec: a process another thread starts meanwhile must not hold the write end open.
+  // Close-on-exec: a program another thread starts meanwhile must not hold the write end open
+  // (a child another thread forks closes it first thing, in childMain).
   if (pipe2(job.fds, O_CLOEXEC) != 0) return std::nullopt;
+  const pid_t parent = getpid();
   job.pid = fork();
   if (job.pid < 0) return std::nullopt;
   if (job.pid == 0) {
     // Only this thread lives on in the child: it works, reports and leaves by _exit.
     close(job.fds[0]);
-    childMain(job.fds[1], limit, work);
+    childMain(job.fds[1], parent, limit, work);
   }
   job.closeWrite();
 
@@ -185,6 +198,8 @@ std::optional<std::string> runInChild(const std::string& name, const ChildLibrar
       const ssize_t n = read(job.fds[0], chunk, sizeof chunk);
       if (n > 0) {
         buffer.append(chunk, static_cast<std::size_t>(n));
+        // Bytes arriving are progress too (a large result takes a while through the pipe).
+        deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
       } else if (n == 0 || errno != EINTR) {
         open = false;  // the child closed its end: it is done (or dead)
       }

@@ -16,6 +16,9 @@ namespace mfr::io {
 struct ChildLibrary {
   std::string format;   // "step", "obj", … ("file" when the name has no extension)
   std::string library;  // "the importer (assimp)", "Open CASCADE"
+  // Seconds added to the time limit, for work that reports no progress for a time that grows with
+  // the file (Open CASCADE's parse).
+  int graceSeconds = 0;
 };
 
 // The time limit: 120 s, or MFR_IMPORT_TIMEOUT_S (whole seconds, 1 … 86400). Throws

@@ -22,6 +22,7 @@
 #include <optional>
 #include <set>
 #include <streambuf>
+#include <system_error>
 #include <thread>
 #include <tuple>
 #include <utility>
@@ -882,7 +883,11 @@ std::vector<Object> readHere(const std::filesystem::path& path, const std::strin
 // (child_process.hpp), whose parts come back as bytes — read once, not twice.
 std::vector<Object> readStep(const std::filesystem::path& path, const std::string* contents, const std::string& stem,
                              const std::string& name, const LoadProgress& progress, std::vector<std::string>* notes) {
-  const ChildLibrary occt{"step", "Open CASCADE"};
+  // The parse reports nothing until it is done: one more second of the time limit per MiB.
+  std::error_code error;
+  const std::uintmax_t fileBytes = contents != nullptr ? contents->size() : std::filesystem::file_size(path, error);
+  const ChildLibrary occt{"step", "Open CASCADE",
+                          error ? 0 : static_cast<int>(std::min<std::uintmax_t>(fileBytes >> 20, 86400))};
   if (const std::optional<std::string> bytes = runInChild(name, occt, progress, [&](const LoadProgress& childProgress) {
         std::vector<std::string> childNotes;
         std::vector<Object> objects = readHere(path, contents, stem, name, childProgress, &childNotes);

@@ -98,14 +98,12 @@ void KBufferFamily::allocateSlots(std::uint64_t slots, std::uint64_t auxBytes) {
     std::ostringstream why;
     why << width_ << "x" << height_ << " pixels need " << slots << " slots x 8 bytes, more than the largest shader "
         << "storage block of this GL context holds (" << limit << " slots)";
-    // kplus-dynamic has no k of its own: it names the k it chose (a bug hunt's message named
-    // "--param k=36", a parameter the method does not have).
+    // A method that chooses its k (kplus-dynamic, the budget methods) is named instead of a
+    // "--param k=36" the user never gave (a bug hunt); the slots say how many it asked for.
     const MethodInfo& method = info();
     const bool userK =
         std::any_of(method.params.begin(), method.params.end(), [](const ParamSpec& p) { return p.name == "k"; });
-    throw Error(userK ? "--param k=" + std::to_string(k_)
-                      : "--method " + method.name + " (its chosen k = " + std::to_string(k_) + ")",
-                why.str());
+    throw Error(userK ? "--param k=" + std::to_string(k_) : "--method " + method.name, why.str());
   }
   if (slots != slots_ || !entries_) {
     entries_ = gl::createBuffer(slots * kEntryBytes);
