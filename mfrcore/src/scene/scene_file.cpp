@@ -174,11 +174,12 @@ Mesh parsePrimitive(const Reader& r, const json& p, const std::string& where) {
   // normal, two triangles' indices, and the growth of the vectors that hold them.
   const auto requireVertices = [&](double vertices) {
     constexpr double kBytesPerVertex = 64.0;
-    const std::optional<std::uint64_t> available = availableHostMemory();
-    if (available && vertices * kBytesPerVertex > static_cast<double>(*available))
-      r.fail(where, "its " + std::to_string(static_cast<std::uint64_t>(vertices)) + " vertices would take " +
-                        formatMemory(static_cast<std::uint64_t>(std::min(vertices * kBytesPerVertex, 1.8e19))) +
-                        " more memory; only " + formatMemory(*available) + " is available");
+    try {
+      requireHostMemory(where, "its " + std::to_string(static_cast<std::uint64_t>(vertices)) + " vertices",
+                        static_cast<std::uint64_t>(std::min(vertices * kBytesPerVertex, 1.8e19)));
+    } catch (const Error& e) {
+      r.fail(e);  // "file: objects[i].primitive: its N vertices would take …"
+    }
   };
   const std::string type = r.string(p, "type", where, "");
   if (type == "sphere") r.object(p, where, {"type", "radius", "slices", "stacks"});
