@@ -9,6 +9,7 @@
 
 #include "commands.hpp"
 #include "mfr/error.hpp"
+#include "mfr/operation_settings.hpp"
 #include "mfr/gl/context.hpp"
 #include "mfr/gpu_renderer.hpp"
 #include "mfr/io/load.hpp"
@@ -102,9 +103,12 @@ void addBench(CLI::App& app) {
     const Camera camera = scene.view(opt->view);  // fit frames the whole scene, cut or not
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
-    for (std::size_t i = 0; i < requests.size(); ++i)
+    for (std::size_t i = 0; i < requests.size(); ++i) {
       if (scene.volumes.empty() && (requests[i].volumeStep > 0.0 || requests[i].volumeShading.has_value()))
         throw Error("--methods " + specs[i], "step and shade are the volume's; scene '" + scene.name + "' has none");
+      if (const auto unused = unusedOperationSetting(requests[i], scene.hasVisibleVolume()))
+        throw Error("--methods " + specs[i], unused->name + ": " + unused->reason);
+    }
 
     ImageRGBA8 reference;
     ImageRGBA8 csgReference;  // the oracle's CSG image, for rows with op=csg

@@ -18,6 +18,7 @@
 #include "mfr/budget/neural_importance.hpp"
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/error.hpp"
+#include "mfr/operation_settings.hpp"
 #include "mfr/gl/context.hpp"
 #include "mfr/gpu_renderer.hpp"
 #include "mfr/io/load.hpp"
@@ -178,6 +179,9 @@ void addEvaluate(CLI::App& app) {
       if (spec.operation != "auto" && spec.operation != "hybrid" && spec.operation != "oit")
         throw Error("--methods " + m, "evaluate measures against the exact 'over' image; operation " + spec.operation +
                                           " draws another image (use hybrid, the default, or oit)");
+      // Nor do hybrid and oit use a thickness, a step or shading, which would change nothing.
+      if (const auto unused = unusedOperationSetting(spec, false))
+        throw Error("--methods " + m, unused->name + ": " + unused->reason);
       specs[m] = spec;
       methodWidth = std::max(methodWidth, m.size() + 2);
     }
@@ -226,7 +230,17 @@ void addEvaluate(CLI::App& app) {
         exactRequest.method = "abuffer-ll";
         exactRequest.width = w;
         exactRequest.height = h;
-        const ImageRGBA8 gpuExact = gpu.render(camera, exactRequest).image;
+        ImageRGBA8 gpuExact;
+        try {
+          gpuExact = gpu.render(camera, exactRequest).image;
+        } catch (const Error& e) {
+          // Its refusal (a frame beyond the storage block) named "--method abuffer-ll", which the
+          // user never gave: it is evaluate's own reference.
+          std::string reason = e.what();
+          if (const std::string given = "--method abuffer-ll: "; reason.starts_with(given))
+            reason.erase(0, given.size());
+          throw Error("scene '" + scenes[s].name + "', view " + v + ": the exact reference (abuffer-ll)", reason);
+        }
         const std::uint64_t total = lists.fragments.size();
         const std::uint64_t exactSlots = exactHybridSlots(lists), exactSlotsRuns = exactHybridSlots(lists, tailRunLengths(lists));
         // --k-by-depth: n(p) of each method's own lists (the GPU's rasterisation, the oracle's rays).

@@ -13,6 +13,7 @@
 
 #include "commands.hpp"
 #include "mfr/error.hpp"
+#include "mfr/operation_settings.hpp"
 #include "mfr/gpu_renderer.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io_util.hpp"
@@ -120,6 +121,8 @@ void addProbe(CLI::App& app) {
     const Camera camera = scene.view(opt->view);  // fit frames the whole scene, cut or not
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
+    if (const auto unused = unusedOperationSetting(req, scene.hasVisibleVolume()))
+      throw Error("--" + unused->name, unused->reason);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);
     // What the method (or, without one, the oracle) does with the lists: hybrid and volume are taken apart.
     const std::string operation = effectiveOperation(req.operation, info, scene.hasVisibleVolume());

@@ -7,6 +7,7 @@
 
 #include "commands.hpp"
 #include "mfr/error.hpp"
+#include "mfr/operation_settings.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
@@ -110,6 +111,8 @@ void addRender(CLI::App& app) {
       if (scene.volumes.empty()) throw Error("--shade", "scene '" + scene.name + "' has no volume");
       req.volumeShading = true;
     }
+    if (const auto unused = unusedOperationSetting(req, scene.hasVisibleVolume()))
+      throw Error("--" + unused->name, unused->reason);
     if (opt->blend && opt->dataView.empty()) throw Error("--blend", "needs --data-view");
     if (opt->dataView == "capacity" && opt->method == "oracle")
       throw Error("--data-view capacity", "the oracle keeps every fragment: it has no k(p) (use a method that does)");

@@ -27,6 +27,8 @@
 #include "main_window.hpp"
 #include "mfr/error.hpp"
 #include "mfr/host_memory.hpp"
+#include "mfr/operation_settings.hpp"
+#include "mfr/render.hpp"
 #include "mfr/scene/clip_box.hpp"
 #include "mfr/scene/scene.hpp"
 #include "mfr/scene/section.hpp"
@@ -61,11 +63,16 @@ struct CommandLine {
 }
 
 QSize parseSize(const QString& option, const QString& text) {
-  const QStringList parts = text.split(QLatin1Char('x'));
+  const QStringList parts = text.toLower().split(QLatin1Char('x'));
   bool okW = false, okH = false;
   const QSize size = parts.size() == 2 ? QSize(parts[0].toInt(&okW), parts[1].toInt(&okH)) : QSize();
-  if (!okW || !okH || size.width() <= 0 || size.height() <= 0 || size.width() > 16384 || size.height() > 16384)
-    fail(QStringLiteral("%1 %2: expected WIDTHxHEIGHT, e.g. 800x600").arg(option, text), 2);
+  if (!okW || !okH) fail(QStringLiteral("%1 %2: expected WIDTHxHEIGHT, e.g. 800x600").arg(option, text), 2);
+  try {
+    // The reason in mfr's words (0x0 said "expected WIDTHxHEIGHT", as if the form were wrong).
+    mfr::validateImageSize((option + QLatin1Char(' ') + text).toStdString(), size.width(), size.height());
+  } catch (const mfr::Error& e) {
+    fail(QString::fromUtf8(e.what()), 2);
+  }
   return size;
 }
 
@@ -322,6 +329,10 @@ int main(int argc, char** argv) {
       fail(QStringLiteral("--plugin-settings %1: no plugin of that id is loaded (loaded: %2)")
                .arg(id, loaded.isEmpty() ? QStringLiteral("none") : loaded.join(QStringLiteral(", "))),
            2);
+    for (const PluginRecord& r : window.plugins().records())
+      if (r.plugin && r.id == id)
+        if (const QString problem = pluginSettingsProblem(*r.plugin, settings); !problem.isEmpty())
+          fail(QStringLiteral("--plugin-settings %1: %2").arg(id, problem), 2);
   }
   if (!cl.windowSize.isEmpty()) window.resize(cl.windowSize);
   if (!cl.method.isEmpty()) {
@@ -346,22 +357,6 @@ int main(int argc, char** argv) {
       if (scripted) fail(message, 1);
       window.statusBar()->showMessage(message);
     };
-    bool clipOk = true, sectionOk = true;
-    if (cl.clip && *cl.clip) {
-      try {
-        mfr::requireClipBoxHoldsScene(model.scene(), **cl.clip, "--clip " + cl.clipText.toStdString());
-      } catch (const mfr::Error& e) {
-        clipOk = false;
-        refuse(QString::fromUtf8(e.what()));
-      }
-    }
-    if (cl.section && *cl.section && (*cl.section)->slice && model.scene().volumes.empty()) {
-      sectionOk = false;
-      refuse(QStringLiteral("--section %1: slice: scene '%2' has no volume")
-                 .arg(cl.sectionText, QString::fromStdString(model.scene().name)));
-    }
-    if (cl.clip && clipOk) model.setClipBox(*cl.clip);
-    if (cl.section && sectionOk) model.setSection(*cl.section);
     if (!cl.contour.empty()) {
       // Before --color-by, which then colours them too.
       QStringList texts;
@@ -380,6 +375,36 @@ int main(int argc, char** argv) {
       if (scripted) fail(message, 1);
       window.statusBar()->showMessage(message);
     }
+    // --thickness and --step for an operation that does not use them, refused as by mfr render
+    // (they were kept for later and drew the same image, with no word that they did nothing).
+    if (cl.step > 0.0 && model.scene().volumes.empty())
+      refuse(QStringLiteral("--step: scene '%1' has no volume").arg(QString::fromStdString(model.scene().name)));
+    else {
+      mfr::RenderRequest given;
+      given.method = model.method().toStdString();
+      given.operation = model.operation().toStdString();
+      given.thickness = cl.thickness;
+      given.volumeStep = cl.step;
+      if (const auto unused = mfr::unusedOperationSetting(given, model.scene().hasVisibleVolume()))
+        refuse(QString::fromStdString("--" + unused->name + ": " + unused->reason));
+    }
+    // After the isosurfaces, as mfr render checks: they hide the volume and widen the bounds.
+    bool clipOk = true, sectionOk = true;
+    if (cl.clip && *cl.clip) {
+      try {
+        mfr::requireClipBoxHoldsScene(model.scene(), **cl.clip, "--clip " + cl.clipText.toStdString());
+      } catch (const mfr::Error& e) {
+        clipOk = false;
+        refuse(QString::fromUtf8(e.what()));
+      }
+    }
+    if (cl.section && *cl.section && (*cl.section)->slice && model.scene().volumes.empty()) {
+      sectionOk = false;
+      refuse(QStringLiteral("--section %1: slice: scene '%2' has no volume")
+                 .arg(cl.sectionText, QString::fromStdString(model.scene().name)));
+    }
+    if (cl.clip && clipOk) model.setClipBox(*cl.clip);
+    if (cl.section && sectionOk) model.setSection(*cl.section);
     if (!cl.view.isEmpty()) {
       try {
         model.setCamera(model.scene().view(cl.view.toStdString()));

@@ -11,6 +11,7 @@
 #include <QFileInfo>
 #include <QHeaderView>
 #include <QInputDialog>
+#include <QJsonValue>
 #include <QLabel>
 #include <QMenuBar>
 #include <QMessageBox>
@@ -556,6 +557,16 @@ void MainWindow::openScene(const QString& path, const QString& field,
 void MainWindow::openSession(const QString& path) {
   try {
     Session session = readSessionFile(path);
+    // The plugins' settings as the rest of the session: a wrong type or an unknown key is one
+    // line naming the file and key, before anything loads (they were read as defaults).
+    for (const PluginRecord& r : plugins_.records())
+      if (r.plugin && session.plugins.contains(r.id)) {
+        const QJsonValue settings = session.plugins.value(r.id);
+        const QString problem = settings.isObject() ? pluginSettingsProblem(*r.plugin, settings.toObject())
+                                                    : QStringLiteral("expected an object");
+        if (!problem.isEmpty())
+          throw mfr::Error(path.toStdString(), QStringLiteral("plugins.%1: %2").arg(r.id, problem).toStdString());
+      }
     const QString scene = session.scenePath;
     model_->loadSceneAsync(scene, {}, session.molecule);
     pendingSession_ = std::move(session);  // after loadSceneAsync, which cannot finish before we return

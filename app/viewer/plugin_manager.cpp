@@ -2,10 +2,59 @@
 
 #include <QCoreApplication>
 #include <QDir>
+#include <QJsonArray>
+#include <QJsonObject>
+#include <QJsonValue>
 #include <QLibrary>
 #include <QPluginLoader>
 
 #include "viewer_plugin.hpp"
+
+namespace {
+
+QString jsonTypeName(const QJsonValue& value) {
+  switch (value.type()) {
+    case QJsonValue::Null:
+      return QStringLiteral("null");
+    case QJsonValue::Bool:
+      return QStringLiteral("a boolean");
+    case QJsonValue::Double:
+      return QStringLiteral("a number");
+    case QJsonValue::String:
+      return QStringLiteral("a string");
+    case QJsonValue::Array:
+      return QStringLiteral("an array");
+    case QJsonValue::Object:
+      return QStringLiteral("an object");
+    case QJsonValue::Undefined:
+      break;
+  }
+  return QStringLiteral("nothing");
+}
+
+}  // namespace
+
+QString pluginSettingsProblem(const MfrViewerPlugin& plugin, const QJsonObject& given) {
+  const QJsonObject own = plugin.saveSettings();
+  for (auto it = given.begin(); it != given.end(); ++it) {
+    if (!own.contains(it.key()))
+      return QStringLiteral("unknown key '%1' (known: %2)").arg(it.key(), own.keys().join(QStringLiteral(", ")));
+    const QJsonValue expected = own.value(it.key());
+    if (it.value().type() != expected.type())
+      return QStringLiteral("'%1': %2, expected %3").arg(it.key(), jsonTypeName(it.value()), jsonTypeName(expected));
+    if (expected.isArray() && !expected.toArray().isEmpty()) {
+      const QJsonArray values = it.value().toArray();
+      const QJsonValue element = expected.toArray().first();
+      for (qsizetype i = 0; i < values.size(); ++i)
+        if (values[i].type() != element.type())
+          return QStringLiteral("'%1'[%2]: %3, expected %4")
+              .arg(it.key())
+              .arg(i)
+              .arg(jsonTypeName(values[i]), jsonTypeName(element));
+    }
+  }
+  return {};
+}
 
 QStringList PluginManager::searchPaths() {
   QStringList paths;

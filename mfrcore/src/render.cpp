@@ -231,6 +231,8 @@ RenderOutput renderOptimalK(const Scene& scene, const Camera& camera, const Rend
   s.notes.emplace_back("solver", solver);
   s.notes.emplace_back("error", std::to_string(best.error));
   s.notes.emplace_back("device", "CPU ray casting (double precision)");
+  // As the oracle and the GPU methods say it: hybrid composites the surfaces only.
+  if (scene.hasVisibleVolume()) s.notes.emplace_back("volume", "not drawn (operation hybrid)");
   out.kMap = best.k;
   return out;
 }

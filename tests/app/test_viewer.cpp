@@ -627,7 +627,11 @@ class ViewerTest : public QObject {
   void clipAndSliceRefusedAsByMfr() {
     QTemporaryDir dir;
     const QString png = dir.filePath(QStringLiteral("refused.png"));
-    for (const QStringList& options : {QStringList{"--clip", "5,5,5,6,6,6"}, QStringList{"--section", "z=0:slice"}}) {
+    // Also a thickness or step the render's operation does not use (they were kept and did nothing).
+    for (const QStringList& options :
+         {QStringList{"--clip", "5,5,5,6,6,6"}, QStringList{"--section", "z=0:slice"},
+          QStringList{"-m", "abuffer-ll", "--op", "oit", "--thickness", "0.1"},
+          QStringList{"-m", "kplus-array", "--thickness", "0.1"}, QStringList{"-m", "abuffer-ll", "--step", "0.1"}}) {
       QString viewer, cli;
       QCOMPARE(runProgram(MFRVIEW, QStringList{"@sample", "--size", "32x32", "--screenshot", png} + options, &viewer),
                1);
@@ -645,6 +649,71 @@ class ViewerTest : public QObject {
              0);
     QCOMPARE(runProgram(MFRVIEW, {"@volume", "--size", "32x32", "--screenshot", png, "--section", "z=0:slice"}, &out),
              0);
+    // On a scene with a volume a step is the volume's; under --op oit it is refused as by mfr.
+    QString viewer, cli;
+    const QStringList oitStep{"-m", "abuffer-ll", "--op", "oit", "--step", "0.1"};
+    QCOMPARE(runProgram(MFRVIEW, QStringList{"@volume", "--size", "32x32", "--screenshot", png} + oitStep, &viewer), 1);
+    QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@volume", "-s", "32x32", "-o", png} + oitStep, &cli), 1);
+    QCOMPARE(viewer.trimmed().split(QLatin1Char('\n')).constLast(),
+             QStringLiteral("mfrview: --step: only operation volume uses it; this render's operation is oit"));
+    QCOMPARE(cli.trimmed().split(QLatin1Char('\n')).constLast(),
+             QStringLiteral("mfr: --step: only operation volume uses it; this render's operation is oit"));
+    // A size of 0x0 is refused for its reason, in mfr's words (mfrview said "expected WIDTHxHEIGHT").
+    QCOMPARE(runProgram(MFRVIEW, {"@sample", "--size", "0x0", "--screenshot", png}, &viewer), 2);
+    QCOMPARE(runProgram(MFR_CLI, {"render", "@sample", "-s", "0x0", "-o", png}, &cli), 1);
+    QCOMPARE(viewer.trimmed().split(QLatin1Char('\n')).constLast(),
+             QStringLiteral("mfrview: --size 0x0: image size must be positive (got 0x0)"));
+    QCOMPARE(cli.trimmed().split(QLatin1Char('\n')).constLast(),
+             QStringLiteral("mfr: --size 0x0: image size must be positive (got 0x0)"));
+  }
+
+  // Plugin settings were read as defaults when of a wrong type ("budget_mib": "2" rendered at
+  // 16 MiB) and a misspelt key was ignored, from --plugin-settings and from sessions alike (a bug
+  // hunt). Both are one line now, naming the plugin and the key; settings of the right types load.
+  void pluginSettingsAreCheckedAsTheRest() {
+    QTemporaryDir dir;
+    const QString png = dir.filePath(QStringLiteral("p.png"));
+    const QList<std::pair<QString, QString>> cases{
+        {R"(budget={"budget_mib":"2"})", "--plugin-settings budget: 'budget_mib': a string, expected a number"},
+        {R"(budget={"budget_mb":2})", "--plugin-settings budget: unknown key 'budget_mb' (known: budget_mib, driving)"},
+        {R"(hybridvolume={"window":[0,"x"]})",
+         "--plugin-settings hybridvolume: 'window'[1]: a string, expected a number"},
+        {R"(ghosting={"ghost":1})", "--plugin-settings ghosting: 'ghost': a number, expected a boolean"},
+    };
+    for (const auto& [setting, message] : cases) {
+      QString out;
+      QCOMPARE(
+          runProgram(MFRVIEW, {"@volume", "--size", "32x32", "--screenshot", png, "--plugin-settings", setting}, &out),
+          2);
+      QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(), QStringLiteral("mfrview: ") + message);
+      QVERIFY(!QFile::exists(png));
+    }
+    // A session's plugin settings: the same check, naming the file.
+    const auto session = [&](const QJsonObject& budget) {
+      const QString path = dir.filePath(QStringLiteral("s.mfrsession"));
+      QFile f(path);
+      if (!f.open(QIODevice::WriteOnly)) return QString();
+      f.write(QJsonDocument(QJsonObject{{"format", "mfrview-session"},
+                                        {"version", 1},
+                                        {"scene", "@sample"},
+                                        {"camera", QJsonObject{{"eye", QJsonArray{3, 2, 4}},
+                                                               {"target", QJsonArray{0, 0, 0}},
+                                                               {"up", QJsonArray{0, 1, 0}}}},
+                                        {"method", "fkb"},
+                                        {"plugins", QJsonObject{{"budget", budget}}}})
+                  .toJson());
+      return path;
+    };
+    QString out;
+    const QString bad = session(QJsonObject{{"budget_mib", "2"}});
+    QCOMPARE(runProgram(MFRVIEW, {bad, "--size", "32x32", "--screenshot", png}, &out), 1);
+    QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(),
+             QStringLiteral("mfrview: %1: plugins.budget: 'budget_mib': a string, expected a number").arg(bad));
+    QVERIFY(!QFile::exists(png));
+    // Settings of the right types are not refused.
+    const QString good = session(QJsonObject{{"budget_mib", 2}, {"driving", true}});
+    QCOMPARE(runProgram(MFRVIEW, {good, "--size", "32x32", "--screenshot", png}, &out), 0);
+    QVERIFY(QFile::exists(png));
   }
 
   void badSessionValuesAreRefused() {
@@ -958,6 +1027,7 @@ class ViewerTest : public QObject {
       QVERIFY2(diff >= 0 && diff <= 1, qPrintable(c.join(' ') + ": " + QString::number(diff)));
       QStringList oit = common;
       oit[oit.indexOf("zthickness")] = "oit";
+      if (const qsizetype t = oit.indexOf("--thickness"); t >= 0) oit.remove(t, 2);  // oit takes none
       QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@intersect", "-o", png("oit.png")} + oit, &out), 0);
       const double fromOit = mfr::rmse(viewer, mfr::readPng(png("oit.png").toStdString()));
       qInfo("  RMSE against --op oit: %.5f", fromOit);
@@ -1248,6 +1318,7 @@ class ViewerTest : public QObject {
       QVERIFY2(diff == 0, qPrintable(c.join(' ') + ": " + QString::number(diff)));
       QStringList oit = common;
       oit[oit.indexOf("--op") + 1] = "oit";
+      if (const qsizetype t = oit.indexOf("--step"); t >= 0) oit.remove(t, 2);  // oit takes none
       QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@volume", "-o", png("oit.png")} + oit, &out), 0);
       const double fromOit = mfr::rmse(viewer, mfr::readPng(png("oit.png").toStdString()));
       qInfo("  RMSE against --op oit: %.5f", fromOit);

@@ -20,6 +20,7 @@
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io_util.hpp"
+#include "mfr/reference/metrics.hpp"
 #include "test_files.hpp"
 
 namespace fs = std::filesystem;
@@ -74,6 +75,13 @@ TEST_F(Cli, SceneFileFlagsAndHugeNumbersNameTheFileAndKey) {
            {R"({"objects": [)" + sphere +
                 R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "near": 1e-30, "far": 1e30}]})",
             "views[0]: its projection is singular"},
+           // An eye beyond ~1e154 read as "up: parallel to the view direction" (a bug hunt).
+           {R"({"objects": [)" + sphere + R"(}], "views": [{"name": "a", "eye": [0, 0, 1e200]}]})",
+            "views[0]: eye and target too far apart to give a view direction (under 1e150)"},
+           // The second of two views of one name could never be shown (--view finds the first).
+           {R"({"objects": [)" + sphere +
+                R"(}], "views": [{"name": "a", "eye": [0, 0, 5]}, {"name": "a", "eye": [0, 5, 0]}]})",
+            "views[1].name: 'a' is the name of views[0] too"},
            {R"({"objects": [)" + sphere + R"(, "visible": 1}]})", "objects[0].visible: expected true or false"},
            {R"({"objects": [)" + sphere +
                 R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "target": [0, 0, 0], "fit": null}]})",
@@ -527,6 +535,59 @@ TEST_F(Cli, EmptyValuesAndOutOfRangeNumbersAreRefused) {
     EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
     EXPECT_FALSE(fs::exists(out)) << args;
   }
+}
+
+// A thickness, step or shading for a render whose operation ("auto" resolved) does not use it
+// was accepted and ignored: the image was byte for byte the one without it (a bug hunt). Each
+// program that takes them refuses them in one line, before any output.
+TEST_F(Cli, SettingsOfAnotherOperationAreRefused) {
+  const std::string out = (dir() / "out.png").string(), json = (dir() / "out.json").string();
+  for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+           {"render @sample -s 16x16 -o " + out + " --thickness 0.1",
+            "mfr: --thickness: only operation zthickness uses it; this render's operation is oit (auto, for oracle)"},
+           {"render @intersect -s 16x16 -o " + out + " -m abuffer-ll --op oit --thickness 0.1",
+            "mfr: --thickness: only operation zthickness uses it; this render's operation is oit\n"},
+           {"render @volume -s 16x16 -o " + out + " -m abuffer-ll --op oit --step 0.1",
+            "mfr: --step: only operation volume uses it; this render's operation is oit\n"},
+           {"render @volume -s 16x16 -o " + out + " --op zthickness --shade",
+            "mfr: --shade: only operation volume uses it; this render's operation is zthickness\n"},
+           // auto for a method whose own operation is not the volume's
+           {"render @volume -s 16x16 -o " + out + " -m kbuffer-zmerge --step 0.1",
+            "mfr: --step: only operation volume uses it; this render's operation is zthickness (auto, for "
+            "kbuffer-zmerge)"},
+           {"render @volume -s 16x16 -o " + out + " -m optimal-k --shade",
+            "mfr: --shade: only operation volume uses it; this render's operation is hybrid (auto, for optimal-k)"},
+           {"probe @sample -s 16x16 --pixel 8,8 --json " + json + " --thickness 0.1",
+            "mfr: --thickness: only operation zthickness uses it; this render's operation is oit (auto, for oracle)"},
+           {"probe @intersect -s 16x16 --pixel 8,8 -m kplus-array --json " + json + " --thickness 0.1",
+            "mfr: --thickness: only operation zthickness uses it; this render's operation is oit (auto, for "
+            "kplus-array)"},
+           {"bench @intersect -s 16x16 -r 1 -m abuffer-ll,abuffer-ll:thickness=0.2 --json " + json,
+            "mfr: --methods abuffer-ll:thickness=0.2: thickness: only operation zthickness uses it; this render's "
+            "operation is oit (auto, for abuffer-ll)"},
+           {"bench @volume -s 16x16 -r 1 -m abuffer-ll:op=oit:step=0.1 --json " + json,
+            "mfr: --methods abuffer-ll:op=oit:step=0.1: step: only operation volume uses it; this render's "
+            "operation is oit\n"},
+           {"evaluate @sample -s 24x16 --budgets k1 -m fkb:thickness=0.1 --json " + json,
+            "mfr: --methods fkb:thickness=0.1: thickness: only operation zthickness uses it; this render's "
+            "operation is hybrid (auto, for fkb)"}}) {
+    const CliResult r = runCli(args);
+    EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << args << ": " << r.exitCode << " " << r.out;
+    // "\n" in a row: the message ends there (no "(auto, …)" for an operation given by name).
+    if (message.ends_with('\n'))
+      EXPECT_EQ(r.out, message) << args;
+    else
+      EXPECT_EQ(r.out.rfind(message, 0), 0u) << args << ": " << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    EXPECT_FALSE(fs::exists(out)) << args;
+    EXPECT_FALSE(fs::exists(json)) << args;
+  }
+  // Where the operation uses them, they are taken (and change the image).
+  const std::string a = (dir() / "a.png").string(), b = (dir() / "b.png").string();
+  ASSERT_EQ(runCli("render @intersect -s 32x32 -m abuffer-ll --op zthickness --thickness 0.3 -o " + a).exitCode, 0);
+  ASSERT_EQ(runCli("render @intersect -s 32x32 -m abuffer-ll --op zthickness -o " + b).exitCode, 0);
+  EXPECT_GT(mfr::rmse(mfr::readPng(a), mfr::readPng(b)), 0.001);
+  ASSERT_EQ(runCli("render @volume -s 32x32 -m kplus-array --step 0.2 -o " + a).exitCode, 0);
 }
 
 // A bad spec anywhere in --methods is one line before any work: it used to come after the

@@ -99,6 +99,20 @@ TEST_F(CliVolume, BenchMeasuresRowsAgainstTheOraclesVolumeImage) {
   EXPECT_LT(j["results"][2]["rmse"].get<double>(), 0.01);
 }
 
+// Every renderer that leaves a scene's volume out says so; optimal-k (hybrid, surfaces only) did not.
+TEST_F(CliVolume, ARenderWithoutTheVolumeSaysSo) {
+  for (const std::string method : {"oracle --op oit", "abuffer-ll --op oit", "optimal-k"}) {
+    SCOPED_TRACE(method);
+    const fs::path png = dir() / "out.png", stats = dir() / "stats.json";
+    const CliResult r =
+        runCli("render @volume -s 24x24 -m " + method + " -o " + png.string() + " --stats " + stats.string());
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    std::ifstream in(stats);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["notes"]["volume"], "not drawn (operation " + j["operation"].get<std::string>() + ")") << j.dump();
+  }
+}
+
 TEST_F(CliVolume, InfoDescribesTheVolume) {
   const fs::path json = dir() / "info.json";
   const CliResult r = runCli("info @volume --no-histogram --json " + json.string());

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <map>
@@ -134,6 +135,31 @@ TEST(ExactMethodStorage, FramesBeyondTheLargestStorageBlockAreRefused) {
     }
     req.params = {{"pool", "fixed"}, {"pool_mib", std::to_string(block / (1024 * 1024))}};  // exactly the block fits
     EXPECT_NO_THROW((void)gpu.render(scene.view("front"), req)) << method;
+  }
+  // abuffer-array's slots=0 capped at 1,024 slots: the refusal says so (it called the 1,024 "the
+  // deepest pixel's fragments" when that pixel had more). The smallest square frame whose 1,024
+  // slots per pixel exceed the block; a GPU block too large for a quick frame holds it anyway.
+  const auto side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(block / 8 / 1024 + 1))));
+  if (side <= 512) {
+    const Scene quads = makeQuadsScene(1100);
+    GpuRenderer gpu;
+    gpu.setScene(quads);
+    RenderRequest req;
+    req.method = "abuffer-array";
+    req.width = req.height = side;
+    req.params = {{"slots", "0"}};
+    try {
+      (void)gpu.render(quads.view("front"), req);
+      ADD_FAILURE() << "1,024 slots per pixel were drawn at " << side << "x" << side;
+    } catch (const Error& e) {
+      const std::string size = std::to_string(side) + "x" + std::to_string(side);
+      EXPECT_EQ(std::string(e.what()).rfind("--method abuffer-array: " + size +
+                                                " pixels x 1024 slots (the most there "
+                                                "are; the deepest pixel has 1100 fragments) x 8 bytes = ",
+                                            0),
+                0u)
+          << e.what();
+    }
   }
 }
 

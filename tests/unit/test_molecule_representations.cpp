@@ -387,6 +387,10 @@ TEST(MoleculeStyleNames, ParseAndText) {
   EXPECT_EQ(reason("ribbon"),
             "--molecule ribbon: unknown representation 'ribbon': expected spheres, sticks, ball-and-stick, "
             "cartoon or surface, joined by ',' (cartoon,sticks@ligands: '@' limits one to polymer, ligands or water)");
+  // A trailing blank is kept in the quote: 'sticks' read as the valid name (a bug hunt).
+  EXPECT_EQ(reason("sticks "),
+            "--molecule sticks : unknown representation 'sticks ': expected spheres, sticks, ball-and-stick, "
+            "cartoon or surface, joined by ',' (cartoon,sticks@ligands: '@' limits one to polymer, ligands or water)");
   EXPECT_EQ(reason(""),
             "--molecule: expected spheres, sticks, ball-and-stick, cartoon or surface, joined by ',' "
             "(cartoon,sticks@ligands: '@' limits one to polymer, ligands or water)");

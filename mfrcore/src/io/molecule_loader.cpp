@@ -1195,6 +1195,9 @@ MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& w
   const auto quoted = [](const std::string& s) {
     std::string line = io::oneLine(s);
     if (line.size() > 48) line = line.substr(0, 45) + "...";
+    // oneLine drops trailing blanks, and 'sticks ' then read as the valid name it is not.
+    else if (!s.empty() && (s.back() == ' ' || s.back() == '\t'))
+      line += ' ';
     return line;
   };
   constexpr const char* kExpected =

@@ -114,10 +114,13 @@ void ABufferFixedArray::capture(const FrameContext& ctx) {
         static_cast<std::uint32_t>(std::min<std::uint64_t>(std::max<std::uint32_t>(counted.maxCount, 1), kMaxSlots));
     // The deepest pixel's slots for every pixel, or a refusal: cutting them to what fits dropped
     // fragments of an "exact" method without a word.
-    requireStorageFits("--method abuffer-array",
-                       std::to_string(width_) + "x" + std::to_string(height_) + " pixels x " + std::to_string(want) +
-                           " slots (the deepest pixel's fragments) x 8 bytes",
-                       pixels * want, maxFragments(), kFragmentBytes, "; a smaller --size needs less");
+    requireStorageFits(
+        "--method abuffer-array",
+        std::to_string(width_) + "x" + std::to_string(height_) + " pixels x " + std::to_string(want) +
+            (counted.maxCount > kMaxSlots ? " slots (the most there are; the deepest pixel has " +
+                                                std::to_string(counted.maxCount) + " fragments) x 8 bytes"
+                                          : " slots (the deepest pixel's fragments) x 8 bytes"),
+        pixels * want, maxFragments(), kFragmentBytes, "; a smaller --size needs less");
     ensureSlots(want);
   }
 

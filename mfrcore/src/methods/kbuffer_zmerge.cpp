@@ -23,7 +23,8 @@ const MethodInfo& KBufferZThicknessMerge::info() const {
         1,
         MFR_ZMERGE_MAX_K,
         {},
-        "capacity per pixel; beyond it the two nearest segments are merged (nothing is dropped)"},
+        "capacity per pixel; beyond it two segments are merged, the pair that overlaps most or, when none do, the "
+        "two farthest (nothing is dropped)"},
        {"spin_limit",
         "Spin-lock attempts",
         ParamSpec::Type::Int,

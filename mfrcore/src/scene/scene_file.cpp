@@ -303,6 +303,9 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
   if (v.contains("target")) c.target = r.vec3(v["target"], where + ".target");
   if (v.contains("up")) c.up = r.vec3(v["up"], where + ".up");
   if (glm::length(c.eye - c.target) == 0.0) r.fail(where, "eye and target coincide");
+  // Beyond ~1e154 apart the view direction cannot be normalised (it read as "up: parallel").
+  if (!std::isfinite(glm::length(c.eye - c.target)))
+    r.fail(where, "eye and target too far apart to give a view direction (under 1e150)");
   if (!(glm::length(c.up) > 0.0)) r.fail(where + ".up", "must not be zero");
   if (!std::isfinite(glm::length(c.up))) r.fail(where + ".up", "too long to normalise (under 1e150)");
   if (!(glm::length(glm::cross(c.forward(), glm::normalize(c.up))) >= 1e-9))
@@ -726,6 +729,10 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
       const std::string where = "views[" + std::to_string(i) + "]";
       const std::string viewName = r.string(views[i], "name", where, "view " + std::to_string(i));
       if (viewName == "fit") r.fail(where + ".name", "'fit' is reserved for the fit-all view");
+      // --view finds the first of a name: a second view of it could never be shown.
+      for (std::size_t j = 0; j < scene.views.size(); ++j)
+        if (scene.views[j].name == viewName)
+          r.fail(where + ".name", "'" + viewName + "' is the name of views[" + std::to_string(j) + "] too");
       scene.views.push_back({viewName, parseView(r, views[i], where, bounds, radius)});
     }
   }

@@ -1,0 +1,24 @@
+#pragma once
+// The settings of one operation (zthickness's thickness, volume's step and shading) that a
+// command line gives for a render whose operation does not use them. mfr render, probe, bench,
+// evaluate and mfrview refuse them in the same words: an ignored option gave the same image as
+// without it, with no hint that it was not applied.
+#include <optional>
+#include <string>
+
+#include "mfr/render.hpp"
+
+namespace mfr {
+
+struct UnusedOperationSetting {
+  std::string name;    // the option's word: "thickness", "step" or "shade"
+  std::string reason;  // e.g. "only operation zthickness uses it; this render's operation is oit"
+};
+
+// The first of the request's thickness (> 0), volumeStep (> 0) and volumeShading (set) that its
+// operation, "auto" resolved for its method on a scene with or without a visible volume, does not
+// use; nullopt when each is used or unset, and for a method render() does not know (render()
+// names that).
+std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, bool sceneHasVolume);
+
+}  // namespace mfr

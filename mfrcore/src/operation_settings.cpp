@@ -1,0 +1,23 @@
+#include "mfr/operation_settings.hpp"
+
+#include <algorithm>
+#include <vector>
+
+namespace mfr {
+
+std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, bool sceneHasVolume) {
+  const std::vector<std::string> methods = availableMethods();
+  if (std::find(methods.begin(), methods.end(), request.method) == methods.end()) return std::nullopt;
+  const std::string operation = effectiveOperation(request.operation, findMethodInfo(request.method), sceneHasVolume);
+  const auto unused = [&](const char* name, const char* user) -> std::optional<UnusedOperationSetting> {
+    std::string reason = std::string("only operation ") + user + " uses it; this render's operation is " + operation;
+    if (request.operation == "auto") reason += " (auto, for " + request.method + ")";
+    return UnusedOperationSetting{name, reason};
+  };
+  if (request.thickness > 0.0 && operation != "zthickness") return unused("thickness", "zthickness");
+  if (request.volumeStep > 0.0 && operation != "volume") return unused("step", "volume");
+  if (request.volumeShading.has_value() && operation != "volume") return unused("shade", "volume");
+  return std::nullopt;
+}
+
+}  // namespace mfr
