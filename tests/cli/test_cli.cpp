@@ -991,6 +991,22 @@ TEST_F(Cli, MoreMemoryThanThereIsIsRefused) {
       << huge.out;
 }
 
+// evaluate's exact reference (the linked-list A-buffer) refuses a frame beyond the storage
+// block; the refusal named "--method abuffer-ll", an option the user never gave.
+TEST_F(Cli, EvaluatesExactReferenceRefusalNamesTheReference) {
+  const std::string png = (dir() / "q.png").string();
+  // @quads:1100 at 104x104: 11.9M fragments, 136 MiB of linked-list nodes.
+  if (runCli("render @quads:1100 -s 104x104 -m abuffer-ll --view front -o " + png).exitCode == 0)
+    GTEST_SKIP() << "this GL context's largest storage block holds the frame: nothing to refuse";
+  const CliResult r = runCli("evaluate @quads:1100 -s 104x104 --budgets k1 -m fkb --views front");
+  EXPECT_EQ(r.exitCode, 1) << r.out;
+  EXPECT_NE(r.out.find("mfr: scene 'quads-1100', view front: the exact reference (abuffer-ll): 104x104: the frame's "
+                       "11897600 fragments x 12 bytes = "),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("--method"), std::string::npos) << r.out;
+}
+
 TEST_F(Cli, BudgetCommandsBadInput) {
   // A corrupt dataset, a missing dataset, bad budgets, a bad weights file.
   const fs::path junk = write("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");
