@@ -236,6 +236,17 @@ TEST_F(CliColorBy, BadFieldsMapsAndRangesAreOneLine) {
   const fs::path badMap =
       write("map.mfrscene", R"({"objects": [{"file": "sheet.vtp", "color_by": {"field": "zone", "map": "jet"}}]})");
   expectCleanFailure("render " + badMap.string() + " --size 16x16", "objects[0].color_by.map: unknown colour map");
+  // "@NAME" names a volume, and a volume alone has no surface: both were blamed on an array.
+  expectCleanFailure("render @volume --size 16x16 --color-by @x",
+                     "--color-by @x: volume: no volume 'x' to sample (volumes: @field)");
+  expectCleanFailure("render @sample --size 16x16 --color-by @x",
+                     "--color-by @x: sample: no volume 'x' to sample (the scene has none)");
+  const fs::path grid = write("grid.vtk",
+                              "# vtk DataFile Version 3.0\ngrid\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 2 2 2\n"
+                              "ORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 8\nSCALARS v float 1\n"
+                              "LOOKUP_TABLE default\n0 1 0 1 0 1 0 1\n");
+  expectCleanFailure("render " + grid.string() + " --size 16x16 --color-by @v",
+                     "--color-by @v: grid.vtk: no surfaces to colour (--contour adds isosurfaces of a volume)");
 }
 
 }  // namespace

@@ -339,10 +339,23 @@ std::size_t colorObjectsByField(const std::vector<Object*>& objects, const std::
     having.push_back(o);
     meshes.push_back(o->mesh.get());
   }
-  if (having.empty())
+  if (having.empty()) {
+    // Blamed on the array, these were puzzling: a volume alone has no surface to colour, and
+    // "@NAME" names a volume, not an array.
+    if (std::none_of(objects.begin(), objects.end(), [](const Object* o) { return o != nullptr && o->mesh; }))
+      throw FieldNotFound(what, "no surfaces to colour (--contour adds isosurfaces of a volume)");
+    if (field.starts_with('@')) {
+      std::vector<std::string> volumes;
+      for (const std::string& n : available)
+        if (n.starts_with('@')) volumes.push_back(n);
+      throw FieldNotFound(
+          what, "no volume '" + field.substr(1) + "' to sample (" +
+                    (volumes.empty() ? std::string("the scene has none") : "volumes: " + list(volumes)) + ")");
+    }
     throw FieldNotFound(what, "no point-data or cell-data array '" + field + "' (" +
                                   (available.empty() ? std::string("it has none") : "fields: " + list(available)) +
                                   ")");
+  }
   const glm::dvec2 shared = range ? *range : sharedFieldRange(meshes, field);
   for (Object* o : having) colorByField(*o, field, map, shared);
   return having.size();
