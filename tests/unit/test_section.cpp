@@ -723,6 +723,18 @@ TEST(Section, AVolumeSliceIsThePlanesCrossSectionOfItsBox) {
 
   EXPECT_TRUE(volumeSlicePolygon(cube, glm::dvec4(0.0, 0.0, 1.0, -2.0)).empty());               // beside it
   EXPECT_TRUE(volumeSlicePolygon(cube, glm::dvec4(n, -3.0 / std::sqrt(3.0) + 1e-15)).empty());  // a corner
+  // A plane on a face gives that face from either side (one side called it a miss: a hunt).
+  for (int axis = 0; axis < 3; ++axis)
+    for (const double at : {0.0, 1.0})
+      for (const double sign : {1.0, -1.0}) {
+        glm::dvec4 plane(0.0);
+        plane[axis] = sign;
+        plane.w = -sign * at;
+        const std::vector<glm::dvec3> onFace = volumeSlicePolygon(cube, plane);
+        ASSERT_EQ(onFace.size(), 4u) << axis << " " << at << " " << sign;
+        EXPECT_NEAR(std::abs(polygonArea(onFace)[axis]), 1.0, 1e-12);
+        for (const glm::dvec3& p : onFace) EXPECT_NEAR(p[axis], at, 1e-12);
+      }
 }
 
 // Two volumes whose boxes overlap: their slices are not coplanar (they would z-fight) but one step

@@ -1,6 +1,7 @@
 #include "mfr/scene/section.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -666,22 +667,31 @@ std::vector<glm::dvec3> volumeSlicePolygon(const Volume& volume, const glm::dvec
     return glm::dvec3((i & 1) ? last.x : 0.0, (i & 2) ? last.y : 0.0, (i & 4) ? last.z : 0.0);
   };
   const double scale = glm::length(glm::dvec3(gridPlane)) * glm::length(last);
+  // Each corner's side of the plane, corners on it (to rounding) on neither: a plane through a
+  // face of the box then gives that face on both of its sides (one side had dropped it as a miss).
+  const double onPlane = 1e-12 * scale;
+  std::array<double, 8> distance{};
+  std::array<int, 8> side{};
+  for (int i = 0; i < 8; ++i) {
+    distance[i] = glm::dot(glm::dvec3(gridPlane), corner(i)) + gridPlane.w;
+    side[i] = distance[i] > onPlane ? 1 : distance[i] < -onPlane ? -1 : 0;
+  }
   std::vector<glm::dvec3> points;
-  for (int i = 0; i < 8; ++i)
+  const auto add = [&](const glm::dvec3& g) {
+    const glm::dvec3 w(toWorld * glm::dvec4(g, 1.0));
+    // A plane through a corner meets three edges there: one point.
+    if (std::none_of(points.begin(), points.end(),
+                     [&](const glm::dvec3& o) { return glm::length(o - w) <= 1e-9 * (1.0 + scale); }))
+      points.push_back(w);
+  };
+  for (int i = 0; i < 8; ++i) {
+    if (side[i] == 0) add(corner(i));
     for (int axis = 0; axis < 3; ++axis) {
       const int j = i | (1 << axis);
-      if (j == i) continue;
-      const glm::dvec3 p = corner(i), q = corner(j);
-      const double dp = glm::dot(glm::dvec3(gridPlane), p) + gridPlane.w;
-      const double dq = glm::dot(glm::dvec3(gridPlane), q) + gridPlane.w;
-      if ((dp < 0.0) == (dq < 0.0) || dp == dq) continue;
-      const glm::dvec3 g = p + (q - p) * (dp / (dp - dq));
-      const glm::dvec3 w(toWorld * glm::dvec4(g, 1.0));
-      // A plane through a corner crosses three edges there: one point.
-      if (std::none_of(points.begin(), points.end(),
-                       [&](const glm::dvec3& o) { return glm::length(o - w) <= 1e-9 * (1.0 + scale); }))
-        points.push_back(w);
+      if (j == i || side[i] * side[j] >= 0) continue;  // no edge crossed strictly between its ends
+      add(corner(i) + (corner(j) - corner(i)) * (distance[i] / (distance[i] - distance[j])));
     }
+  }
   if (points.size() < 3) return {};
   // Counter-clockwise about −n: sorted by angle in a basis (u, v) of the plane with u × v = −n.
   glm::dvec3 centre(0.0);
