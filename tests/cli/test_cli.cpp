@@ -233,20 +233,20 @@ TEST_F(Cli, GpuMethodsRefuseWhatTheOracleRefuses) {
   const fs::path box = write("box.mfrscene", R"({"objects": [{"primitive": {"type": "box", "size": [1, 1e39, 1]}}]})");
   const fs::path tube =
       write("tube.mfrscene", R"({"objects": [{"primitive": {"type": "tube", "path": [[0, 0, 0], [1e300, 0, 0]]}}]})");
-  for (const auto& [file, reason] :
-       std::vector<std::pair<fs::path, std::string>>{{degenerate, "nothing to render (no visible triangles)"},
-                                                     // Refused where it is written (the loader, since
-                                                     // this round), for every method alike.
-                                                     {zero, "objects[0].transform.matrix: singular"},
-                                                     // Sizes past 1e15 are refused by the file's
-                                                     // reader too ("s: non-finite vertex coordinate"
-                                                     // before, and info measured NaN).
-                                                     {huge, "objects[0].primitive.radius: must be at most 1e15"},
-                                                     {plane, "objects[0].primitive.width: must be at most 1e15"},
-                                                     {box, "objects[0].primitive.size: must be at most 1e15"},
-                                                     {tube,
-                                                      "objects[0].primitive.path[1]: coordinates must be "
-                                                      "within ±1e15"}})
+  for (const auto& [file, reason] : std::vector<std::pair<fs::path, std::string>>{
+           {degenerate, "nothing to render (its one visible triangle is degenerate: no area)"},
+           // Refused where it is written (the loader, since
+           // this round), for every method alike.
+           {zero, "objects[0].transform.matrix: singular"},
+           // Sizes past 1e15 are refused by the file's
+           // reader too ("s: non-finite vertex coordinate"
+           // before, and info measured NaN).
+           {huge, "objects[0].primitive.radius: must be at most 1e15"},
+           {plane, "objects[0].primitive.width: must be at most 1e15"},
+           {box, "objects[0].primitive.size: must be at most 1e15"},
+           {tube,
+            "objects[0].primitive.path[1]: coordinates must be "
+            "within ±1e15"}})
     for (const char* method : {"oracle", "abuffer-ll", "kplus-array"}) {
       SCOPED_TRACE(file.filename().string() + " " + method);
       expectCleanFailure("render " + file.string() + " --size 16x16 -m " + method, reason);
@@ -679,7 +679,8 @@ TEST_F(Cli, InfoMeasuresEachPartsSurface) {
   const fs::path point = write("point.obj", "v 0 0 0\nv 0 0 0\nv 0 0 0\nf 1 2 3\n");
   const CliResult refused = runCli("info " + point.string());
   EXPECT_EQ(refused.exitCode, 1) << refused.out;
-  EXPECT_EQ(refused.out, "mfr: scene 'point.obj': nothing to render (no visible triangles)\n");
+  EXPECT_EQ(refused.out,
+            "mfr: scene 'point.obj': nothing to render (its one visible triangle is degenerate: no area)\n");
   const CliResult measured = runCli("info " + point.string() + " --no-histogram");
   EXPECT_EQ(measured.exitCode, 0) << measured.out;
   EXPECT_NE(measured.out.find("area 0: no surface (every triangle is degenerate)"), std::string::npos) << measured.out;

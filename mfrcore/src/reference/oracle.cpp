@@ -480,6 +480,7 @@ void checkDrawable(const Scene& scene, const Camera& camera, int width, int heig
   glm::dmat4 viewProj(1.0);
   (void)invertibleViewProjection(camera, width, height, viewProj);
   bool drawable = scene.hasVisibleVolume();
+  std::size_t flat = 0;  // visible triangles without area, for the message
   for (const Object& object : scene.objects) {
     if (!object.visible || !object.mesh || object.mesh->triangleCount() == 0) continue;
     object.mesh->validate(object.name);
@@ -489,9 +490,16 @@ void checkDrawable(const Scene& scene, const Camera& camera, int width, int heig
       for (int k = 0; k < 3; ++k)
         p[k] = transformPoint(object.transform, glm::dvec3(mesh.positions[mesh.indices[3 * t + k]]));
       drawable = hasArea(p);
+      if (!drawable) ++flat;
     }
   }
-  if (!drawable) throw Error("scene '" + scene.name + "'", "nothing to render (no visible triangles)");
+  // "No visible triangles" was wrong for a file whose triangles are all degenerate (collinear).
+  if (!drawable)
+    throw Error("scene '" + scene.name + "'",
+                flat == 0   ? std::string("nothing to render (no visible triangles)")
+                : flat == 1 ? std::string("nothing to render (its one visible triangle is degenerate: no area)")
+                            : "nothing to render (its " + std::to_string(flat) +
+                                  " visible triangles are all degenerate: no area)");
 }
 
 FragmentLists castFragments(const Scene& scene, const Camera& camera, int width, int height,
@@ -537,8 +545,10 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
   lists.flags.assign(pixelCount, 0);
   if (triangles.empty()) {
     // A scene of volumes only: every list is empty.
-    if (!scene.hasVisibleVolume())
+    if (!scene.hasVisibleVolume()) {
+      checkDrawable(scene, camera, width, height);  // says why: degenerate triangles, or none
       throw Error("scene '" + scene.name + "'", "nothing to render (no visible triangles)");
+    }
     lists.offsets.assign(pixelCount + 1, 0);
     return lists;
   }
