@@ -210,8 +210,19 @@ std::optional<std::string> runInChild(const std::string& name, const ChildLibrar
     while (finalTag == '\0' && buffer.size() - used >= kRecordHeader) {
       std::uint64_t size = 0;
       std::memcpy(&size, buffer.data() + used + 1, sizeof size);
-      if (buffer.size() - used - kRecordHeader < size) break;
       const char tag = buffer[used];
+      if (buffer.size() - used - kRecordHeader < size) {
+        // A result arriving: room for all of it at once, not the doublings of append (the parent
+        // held a large model up to three times while receiving it).
+        if (tag != 'P' && buffer.capacity() < used + kRecordHeader + size) {
+          try {
+            buffer.reserve(used + kRecordHeader + static_cast<std::size_t>(size));
+          } catch (const std::exception&) {
+            // append says so if it really does not fit
+          }
+        }
+        break;
+      }
       const char* payload = buffer.data() + used + kRecordHeader;
       if (tag == 'P' && size == sizeof(double)) {
         double fraction = 0.0;
@@ -224,8 +235,14 @@ std::optional<std::string> runInChild(const std::string& name, const ChildLibrar
           throw LoadCancelled();  // the guard reaps the child
         }
       } else {
+        // The last record: its bytes moved out of the buffer, not copied.
         finalTag = tag;
-        finalBytes.assign(payload, static_cast<std::size_t>(size));
+        buffer.erase(0, used + kRecordHeader);
+        buffer.resize(static_cast<std::size_t>(size));
+        finalBytes = std::move(buffer);
+        buffer = std::string();
+        used = 0;
+        break;
       }
       used += kRecordHeader + static_cast<std::size_t>(size);
     }
