@@ -19,6 +19,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <cstring>
 #include <exception>
 #include <map>
@@ -343,6 +344,12 @@ int main(int argc, char** argv) {
   if (!cl.op.isEmpty()) model.setOperation(cl.op);
   if (!cl.params.empty()) model.setParams(cl.params);
 
+  // Plugins' notes on stderr as the session's own (scripted runs have no status bar), except
+  // those that end a scripted run as a refusal of --plugin-settings.
+  bool quietNotes = false;
+  QObject::connect(&model, &ViewerContext::noted, &window, [&quietNotes](const QString& text) {
+    if (!quietNotes) std::cerr << "note: " << text.toStdString() << "\n";
+  });
   // Applied once the scene has loaded: the view and, for scripted runs, the pictures.
   bool applied = false;
   QObject::connect(&model, &ViewerModel::sceneLoaded, &window, [&] {
@@ -414,7 +421,21 @@ int main(int argc, char** argv) {
       }
     }
     for (const PluginRecord& r : window.plugins().records())
-      if (r.plugin && cl.pluginSettings.contains(r.id)) r.plugin->loadSettings(cl.pluginSettings.at(r.id));
+      if (r.plugin && cl.pluginSettings.contains(r.id)) {
+        // A value the plugin takes other than as given (out of range, a part or preset the scene
+        // lacks) is its note; given on a scripted command line it is a refusal, as mfr's options.
+        QString first;
+        const QMetaObject::Connection noted =
+            QObject::connect(&model, &ViewerContext::noted, &window, [&first](const QString& text) {
+              if (first.isEmpty()) first = text;
+            });
+        quietNotes = scripted;
+        r.plugin->loadSettings(cl.pluginSettings.at(r.id));
+        quietNotes = false;
+        QObject::disconnect(noted);
+        if (first.startsWith(r.id + QStringLiteral(": "))) first = first.mid(r.id.size() + 2);
+        if (scripted && !first.isEmpty()) fail(QStringLiteral("--plugin-settings %1: %2").arg(r.id, first), 2);
+      }
   });
   if (scripted) {
     QObject::connect(&model, &ViewerModel::loadFailed, &app, [](const QString&, const QString& message) { fail(message, 1); });

@@ -260,6 +260,11 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
     statusBar()->showMessage(tr("Loading cancelled; the current scene stays."), 5000);
   });
   connect(model_, &ViewerModel::frameRendered, this, &MainWindow::updateFrameInfo);
+  // Plugins' notes (ViewerContext::note) in the status bar; main() also writes them to stderr.
+  connect(model_, &ViewerContext::noted, this, [this](const QString& text) {
+    const QString shown = statusBar()->currentMessage();
+    statusBar()->showMessage(shown.isEmpty() ? text : shown + QStringLiteral("; ") + text, 20000);
+  });
   connect(model_, &ViewerModel::renderErrorChanged, this, [this](const QString& message) {
     if (!message.isEmpty()) statusBar()->showMessage(tr("Cannot render: %1").arg(message));
   });

@@ -205,6 +205,11 @@ class ViewerContext : public QObject {
   [[nodiscard]] virtual double isosurfaceOpacity() const = 0;  // of the current set; 0.5 without one
   virtual QString setIsosurfaces(const std::vector<double>& values, double opacity) = 0;
 
+  // 1.10: a one-line note for the user about something taken but not as given (a session's focus
+  // part the scene lacks, a value clamped to its range): the status bar shows it, and stderr
+  // gets it (also for scripted runs, which have no status bar), as the session's own notes.
+  void note(const QString& text) { emit noted(text); }
+
  signals:
   void sceneChanged();  // a new scene, or an object edited
   void viewChanged();   // camera or image size
@@ -219,6 +224,7 @@ class ViewerContext : public QObject {
   void zThicknessChanged(double thickness);  // zThickness(), 0 = the default
   void volumeChanged();  // 1.4: a new scene, or a volume's visibility, transfer function or step; 1.6: the current
                          // volume; 1.7: a field read started or ended
+  void noted(const QString& text);  // 1.10: note()
 };
 
 class MfrViewerPlugin {
@@ -247,5 +253,6 @@ class MfrViewerPlugin {
 // 1.8: isosurfaces of a volume: isosurfaceValues, isosurfaceOpacity, setIsosurfaces.
 // 1.9: imageSize (the image stats() describes) instead of renderSize (the whole view's, which
 //      side by side is two images).
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.9"
+// 1.10: note (and the signal noted): notes of a plugin for the status bar and stderr.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.10"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -398,7 +398,15 @@ void BudgetPanel::showFrame() {
 QJsonObject BudgetPanel::saveSettings() const { return {{"budget_mib", budgetMiB()}, {"driving", driving_}}; }
 
 void BudgetPanel::loadSettings(const QJsonObject& settings) {
-  const int mib = settings.value("budget_mib").toInt(kDefaultBudgetMiB);
+  // A number that is not a whole MiB in the spin box's range was the default, or clamped, silently.
+  const double given = settings.value("budget_mib").toDouble(kDefaultBudgetMiB);
+  const int mib = static_cast<int>(std::lround(std::clamp(given, double(spin_->minimum()), double(spin_->maximum()))));
+  if (given != mib)
+    ctx_.note(tr("budget: budget_mib %1 is not a whole number of MiB in %2 … %3: %4 is used")
+                  .arg(given)
+                  .arg(spin_->minimum())
+                  .arg(spin_->maximum())
+                  .arg(mib));
   const QSignalBlocker a(slider_), b(spin_);
   slider_->setValue(mib);
   spin_->setValue(mib);

@@ -146,6 +146,8 @@ QJsonObject CsgPanel::saveSettings() const {
 void CsgPanel::loadSettings(const QJsonObject& settings) {
   const QString tree = settings.value(QStringLiteral("tree")).toString();
   if (!context_.hasScene() || tree == context_.csgTree()) return;
-  showError(context_.setCsgTree(tree));
+  const QString error = context_.setCsgTree(tree);
+  showError(error);
+  if (!error.isEmpty()) context_.note(tr("csg: tree: %1 (the scene's tree is kept)").arg(error));
   sceneChanged();
 }

@@ -308,6 +308,10 @@ void GhostingPanel::loadSettings(const QJsonObject& settings) {
   {
     const QSignalBlocker blockList(parts_), blockGhost(ghost_), blockSlider(ghostSlider_);
     const double opacity = settings.value(QStringLiteral("ghost_opacity")).toDouble(kDefaultGhostOpacity);
+    if (!(opacity >= 0.02 && opacity <= 1.0))
+      context_.note(tr("ghosting: ghost_opacity %1 is outside 0.02 … 1: %2 is used")
+                        .arg(opacity)
+                        .arg(std::clamp(opacity, 0.02, 1.0)));
     ghostSlider_->setValue(static_cast<int>(std::lround(std::clamp(opacity, 0.02, 1.0) * 100.0)));
     ghostValue_->setText(QString::number(ghostOpacity(), 'f', 2));
     saved_.clear();
@@ -318,6 +322,12 @@ void GhostingPanel::loadSettings(const QJsonObject& settings) {
       if (ghosted.contains(item->text())) saved_.insert(id, ghosted.value(item->text()).toDouble());
     }
     ghost_->setChecked(settings.value(QStringLiteral("ghost")).toBool(false));
+    // A focus part the scene lacks was dropped without a word (the rest was ghosted around nothing).
+    QStringList missing;
+    for (const QString& name : focus)
+      if (parts_->findItems(name, Qt::MatchExactly).isEmpty()) missing << QStringLiteral("'%1'").arg(name);
+    if (!missing.isEmpty())
+      context_.note(tr("ghosting: no part %1 in this scene to focus on").arg(missing.join(QStringLiteral(", "))));
   }
   applyGhosting();
   showBlendState();

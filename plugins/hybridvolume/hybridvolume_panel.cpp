@@ -748,32 +748,61 @@ QJsonObject HybridVolumePanel::saveSettings() const {
 void HybridVolumePanel::loadSettings(const QJsonObject& settings) {
   if (!context_.hasScene() || !context_.hasVolume()) return;
   // The volume the panel showed (absent in sessions of one volume): its controls get the settings.
-  context_.setCurrentVolume(settings.value(QStringLiteral("volume")).toInt(context_.currentVolume()));
+  // Values taken other than as given are notes (they were defaults or clamps without a word).
+  const auto note = [&](const QString& text) { context_.note(QStringLiteral("hybridvolume: ") + text); };
+  const int volume = settings.value(QStringLiteral("volume")).toInt(context_.currentVolume());
+  if (volume < 0 || volume >= context_.volumeCount())
+    note(tr("volume %1: the scene has %2 (volume %3 is shown)")
+             .arg(volume)
+             .arg(context_.volumeCount())
+             .arg(context_.currentVolume()));
+  else
+    context_.setCurrentVolume(volume);
   volumeChanged();  // this scene's volume (sessions load settings after their own state)
   previousOperation_ = settings.value(QStringLiteral("previous_operation")).toString();
   previousMethod_ = settings.value(QStringLiteral("previous_method")).toString();
   const mfr::TransferFunction base = transferFromJson(settings.value(QStringLiteral("base")).toObject());
-  if (!context_.transferTable(base).empty()) base_ = base;
+  if (!context_.transferTable(base).empty())
+    base_ = base;
+  else if (settings.contains(QStringLiteral("base")))
+    note(tr("base: not a transfer function the volume can use (the volume's own is kept)"));
   {
     const QSignalBlocker blockPreset(preset_), blockMin(windowMin_), blockMax(windowMax_), blockOpacity(opacity_);
-    const int preset = preset_->findData(settings.value(QStringLiteral("preset")).toString(kCustom));
+    const QString presetName = settings.value(QStringLiteral("preset")).toString(kCustom);
+    const int preset = preset_->findData(presetName);
+    if (preset < 0) note(tr("preset '%1': no such preset (custom is used)").arg(presetName));
     preset_->setCurrentIndex(preset >= 0 ? preset : preset_->findData(kCustom));
     const QJsonArray window = settings.value(QStringLiteral("window")).toArray();
-    if (window.size() == 2) {
+    if (settings.contains(QStringLiteral("window")) && window.size() != 2)
+      note(tr("window: expected [low, high] (the window is kept)"));
+    if (window.size() == 2 && !(window[0].toDouble() < window[1].toDouble()))
+      note(tr("window [%1, %2]: low must be below high (the window is kept)")
+               .arg(window[0].toDouble())
+               .arg(window[1].toDouble()));
+    else if (window.size() == 2) {
       windowLow_ = window[0].toDouble();
       windowHigh_ = window[1].toDouble();
       windowMin_->setValue(windowLow_);
       windowMax_->setValue(windowHigh_);
     }
     const double scale = settings.value(QStringLiteral("opacity_scale")).toDouble(1.0);
+    if (!(scale >= kMinScale && scale <= kMaxScale))
+      note(
+          tr("opacity_scale %1 is outside %2 … %3 (the nearest end is used)").arg(scale).arg(kMinScale).arg(kMaxScale));
     opacity_->setValue(logPosition(scale, kMinScale, kMaxScale));
     showScaleValue();
   }
   applyTransfer();  // the session's own function again (no change), or --plugin-settings' one
   if (settings.contains(QStringLiteral("shading")))
     context_.setVolumeShading(settings.value(QStringLiteral("shading")).toBool());
-  if (settings.contains(QStringLiteral("step")))
-    context_.setVolumeStep(settings.value(QStringLiteral("step")).toDouble());
+  if (settings.contains(QStringLiteral("step"))) {
+    // 0 is the default step; a negative one was ignored without a word.
+    const double step = settings.value(QStringLiteral("step")).toDouble();
+    if (step >= 0.0)
+      context_.setVolumeStep(step);
+    else
+      note(tr("step %1: must be a positive length in scene units, or 0 for the default (the step is kept)").arg(step));
+  }
   if (settings.contains(QStringLiteral("show")) &&
       settings.value(QStringLiteral("show")).toBool() != show_->isChecked())
     setShow(settings.value(QStringLiteral("show")).toBool());

@@ -688,6 +688,34 @@ class ViewerTest : public QObject {
       QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(), QStringLiteral("mfrview: ") + message);
       QVERIFY(!QFile::exists(png));
     }
+    // Values of the right type that a plugin cannot take as given: its note, which on a scripted
+    // command line is a refusal (they were defaults or clamps without a word: a bug hunt).
+    const QList<std::tuple<QString, QString, QString>> values{
+        {"@volume", R"(budget={"budget_mib":3.7})",
+         "--plugin-settings budget: budget_mib 3.7 is not a whole number of MiB in 1 … 4096: 4 is used"},
+        {"@volume", R"(hybridvolume={"volume":99})",
+         "--plugin-settings hybridvolume: volume 99: the scene has 1 (volume 0 is shown)"},
+        {"@volume", R"(hybridvolume={"step":-1})",
+         "--plugin-settings hybridvolume: step -1: must be a positive length in scene units, or 0 for the default (the "
+         "step is kept)"},
+        {"@volume", R"(hybridvolume={"preset":"nope"})",
+         "--plugin-settings hybridvolume: preset 'nope': no such preset (custom is used)"},
+        {"@volume", R"(hybridvolume={"window":[5,1]})",
+         "--plugin-settings hybridvolume: window [5, 1]: low must be below high (the window is kept)"},
+        {"@sample", R"(ghosting={"focus":["nope","tangle"]})",
+         "--plugin-settings ghosting: no part 'nope' in this scene to focus on"},
+        {"@csg", QStringLiteral("csg={\"tree\":\"{\\\"union\\\":[\\\"block\\\",\\\"nope\\\"]}\"}"),
+         "--plugin-settings csg: tree: "},
+    };
+    for (const auto& [scene, setting, message] : values) {
+      QString out;
+      QCOMPARE(runProgram(MFRVIEW, {scene, "--size", "32x32", "--screenshot", png, "--plugin-settings", setting}, &out),
+               2);
+      const QStringList lines = out.trimmed().split(QLatin1Char('\n'));
+      QVERIFY2(lines.constLast().startsWith(QStringLiteral("mfrview: ") + message), qPrintable(out));
+      QVERIFY2(!out.contains(QStringLiteral("note: ")), qPrintable(out));  // one line, not a note and a refusal
+      QVERIFY(!QFile::exists(png));
+    }
     // A session's plugin settings: the same check, naming the file.
     const auto session = [&](const QJsonObject& budget) {
       const QString path = dir.filePath(QStringLiteral("s.mfrsession"));
@@ -713,6 +741,13 @@ class ViewerTest : public QObject {
     // Settings of the right types are not refused.
     const QString good = session(QJsonObject{{"budget_mib", 2}, {"driving", true}});
     QCOMPARE(runProgram(MFRVIEW, {good, "--size", "32x32", "--screenshot", png}, &out), 0);
+    QVERIFY(QFile::exists(png));
+    // In a session, a value taken other than as given is a note on stderr, and the run goes on.
+    QFile::remove(png);
+    const QString clamped = session(QJsonObject{{"budget_mib", 5000}});
+    QCOMPARE(runProgram(MFRVIEW, {clamped, "--size", "32x32", "--screenshot", png}, &out), 0);
+    QVERIFY2(out.contains("note: budget: budget_mib 5000 is not a whole number of MiB in 1 … 4096: 4096 is used"),
+             qPrintable(out));
     QVERIFY(QFile::exists(png));
   }
 
