@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "mfr/json_text.hpp"
 #include "mfr/budget/k_allocation.hpp"
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/budget/neural_importance.hpp"
@@ -149,7 +150,8 @@ void addAllocations(CLI::App& app) {
           rows.push_back(row);
         }
       }
-    if (!opt->json.empty()) writeFileAtomically(opt->json, nlohmann::ordered_json{{"results", rows}}.dump(2) + "\n");
+    if (!opt->json.empty())
+      writeFileAtomically(opt->json, jsonText(nlohmann::ordered_json{{"results", rows}}, 2) + "\n");
   });
 }
 

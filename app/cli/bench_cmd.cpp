@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "mfr/json_text.hpp"
 #include "mfr/error.hpp"
 #include "mfr/operation_settings.hpp"
 #include "mfr/gl/context.hpp"
@@ -269,7 +270,7 @@ void addBench(CLI::App& app) {
                 << passText.str() << (last.stats.overflow ? "  OVERFLOW" : "") << "\n";
     }
     out["results"] = rows;
-    if (!opt->json.empty()) writeFileAtomically(opt->json, out.dump(2) + "\n");
+    if (!opt->json.empty()) writeFileAtomically(opt->json, jsonText(out, 2) + "\n");
   });
 }
 

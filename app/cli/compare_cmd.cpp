@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "mfr/json_text.hpp"
 #include "mfr/error.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io_util.hpp"
@@ -62,7 +63,7 @@ void addCompare(CLI::App& app) {
     }
     if (!opt->heatmap.empty() && heat.empty()) heat = heatmap(absoluteDifference(ref, test), 1.0f);
     if (!opt->heatmap.empty()) writePng(opt->heatmap, heat);
-    if (!opt->json.empty()) writeFileAtomically(opt->json, j.dump(2) + "\n");
+    if (!opt->json.empty()) writeFileAtomically(opt->json, jsonText(j, 2) + "\n");
   });
 }
 

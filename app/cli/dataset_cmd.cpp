@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "mfr/json_text.hpp"
 #include "mfr/budget/dataset.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
@@ -142,7 +143,7 @@ void addDataset(CLI::App& app) {
           }
         }
     meta["frames"] = frames;
-    dataset.metadata = meta.dump();
+    dataset.metadata = jsonText(meta);
     writeDataset(opt->output, dataset);
     std::cout << opt->output << ": " << dataset.size() << " rows\n";
   });

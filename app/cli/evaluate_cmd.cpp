@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "mfr/json_text.hpp"
 #include "mfr/budget/neural_importance.hpp"
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/error.hpp"
@@ -344,7 +345,7 @@ void addEvaluate(CLI::App& app) {
     printWins("FLIP", flipWins);
     printWins("RMSE", rmseWins);
     out["results"] = rows;
-    if (!opt->json.empty()) writeFileAtomically(opt->json, out.dump(2) + "\n");
+    if (!opt->json.empty()) writeFileAtomically(opt->json, jsonText(out, 2) + "\n");
   });
 }
 

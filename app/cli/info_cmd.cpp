@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "mfr/json_text.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io/molecule.hpp"
@@ -108,7 +109,7 @@ void addInfo(CLI::App& app) {
       printMethods(methods);
       if (opt->scene.empty()) {
         if (!opt->json.empty())
-          writeFileAtomically(opt->json, nlohmann::ordered_json{{"methods", methods}}.dump(2) + "\n");
+          writeFileAtomically(opt->json, jsonText(nlohmann::ordered_json{{"methods", methods}}, 2) + "\n");
         return;
       }
     }
@@ -328,7 +329,7 @@ void addInfo(CLI::App& app) {
       for (std::size_t n = 0; n < hist.size(); ++n)
         if (hist[n] > 0) std::cout << "  n=" << n << ": " << hist[n] << " pixels\n";
     }
-    if (!opt->json.empty()) writeFileAtomically(opt->json, j.dump(2) + "\n");
+    if (!opt->json.empty()) writeFileAtomically(opt->json, jsonText(j, 2) + "\n");
   });
 }
 

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "mfr/json_text.hpp"
 #include "mfr/error.hpp"
 #include "mfr/operation_settings.hpp"
 #include "mfr/gpu_renderer.hpp"
@@ -342,7 +343,7 @@ void addProbe(CLI::App& app) {
       }
       j["method"] = m;
     }
-    if (!opt->json.empty()) writeFileAtomically(opt->json, j.dump(2) + "\n");
+    if (!opt->json.empty()) writeFileAtomically(opt->json, jsonText(j, 2) + "\n");
     std::cout << text.str();
   });
 }

@@ -590,6 +590,30 @@ TEST_F(Cli, SettingsOfAnotherOperationAreRefused) {
   ASSERT_EQ(runCli("render @volume -s 32x32 -m kplus-array --step 0.2 -o " + a).exitCode, 0);
 }
 
+// A part name in Latin-1 (assimp's regr01.obj has "Terraind\xe6k") ended info --json and
+// probe --json in "internal error" (exit 3) after the work: a bug hunt. Names are read as UTF-8,
+// Latin-1 where they are not, and JSON never fails on a byte.
+TEST_F(Cli, NamesInAnotherEncodingAreWrittenAsUtf8) {
+  // Two materials, two parts: a part is named after its material (one alone after its file).
+  const fs::path obj = write("lat\xe6.obj",
+                             "usemtl Terrain\xe6k\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n"
+                             "usemtl rest\nv 5 5 0\nv 6 5 0\nv 5 6 0\nf 4 5 6\n");
+  const fs::path json = dir() / "info.json", probe = dir() / "probe.json";
+  const CliResult info = runCli("info " + obj.string() + " --no-histogram --json " + json.string());
+  ASSERT_EQ(info.exitCode, 0) << info.out;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["part_list"][0]["name"].get<std::string>(), "Terrain\xc3\xa6k");
+  EXPECT_EQ(j["scene"].get<std::string>(), "lat\xc3\xa6.obj");
+  const CliResult p =
+      runCli("probe " + obj.string() + " -s 64x64 --view front --pixel 16,43 -m abuffer-ll --json " + probe.string());
+  ASSERT_EQ(p.exitCode, 0) << p.out;
+  std::ifstream pin(probe);
+  const nlohmann::json pj = nlohmann::json::parse(pin);
+  ASSERT_FALSE(pj["fragments"].empty()) << pj.dump();
+  EXPECT_EQ(pj["fragments"][0]["part"].get<std::string>(), "Terrain\xc3\xa6k") << pj.dump();
+}
+
 // A bad spec anywhere in --methods is one line before any work: it used to come after the
 // oracle's image and the table's head.
 TEST_F(Cli, BenchRefusesBadSpecsBeforeAnyWork) {

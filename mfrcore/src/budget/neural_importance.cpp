@@ -1,6 +1,7 @@
 // The dkb network's weights, CPU forward pass and features (mfr/budget/neural_importance.hpp).
 // The forward pass and the features are the shaders' own definitions (shaders/budget/mlp.h,
 // features.h) compiled as C++.
+#include "mfr/json_text.hpp"
 #include "mfr/budget/neural_importance.hpp"
 
 #include <algorithm>
@@ -186,7 +187,7 @@ NeuralImportanceModel parseWeightsJson(const std::string& text, const std::strin
         floats(layer.value("bias", nlohmann::json()), static_cast<std::size_t>(outputs), where + ".bias", source);
     std::copy(bias.begin(), bias.end(), m.weights.begin() + kLayerBias[l]);
   }
-  m.trainingJson = j.contains("training") ? j["training"].dump() : "{}";
+  m.trainingJson = j.contains("training") ? jsonText(j["training"]) : "{}";
   return m;
 }
 }  // namespace
@@ -228,7 +229,7 @@ std::string neuralImportanceJson(const NeuralImportanceModel& m) {
   }
   j["layers"] = layers;
   j["training"] = nlohmann::ordered_json::parse(m.trainingJson.empty() ? "{}" : m.trainingJson);
-  return j.dump(1) + "\n";
+  return jsonText(j, 1) + "\n";
 }
 
 NeuralImportanceModel loadNeuralImportance(const std::string& path) {

@@ -1,6 +1,7 @@
 // dkb training with dlib (mfr/budget/neural_training.hpp). The network is dlib's; this file only
 // feeds it rows, runs epochs and copies its layers into the shader layout of
 // shaders/budget/mlp.h.
+#include "mfr/json_text.hpp"
 #include "mfr/budget/neural_training.hpp"
 
 #include <algorithm>
@@ -194,7 +195,7 @@ NeuralTrainingResult trainNeuralImportance(const DkbDataset& dataset, const Neur
   t["validation_mse"] = result.validationLoss;
   t["seed"] = options.seed;
   t["dataset"] = nlohmann::ordered_json::parse(dataset.metadata.empty() ? "{}" : dataset.metadata, nullptr, false);
-  m.trainingJson = t.dump();
+  m.trainingJson = jsonText(t);
   m.source = "trained";
   return result;
 }

@@ -26,6 +26,40 @@ void checkReadable(const fs::path& path, const std::string& name, std::string_vi
   if (fs::file_size(path, ec) == 0 && !ec) throw Error(name, "empty file");
 }
 
+namespace {
+
+// The length of the valid UTF-8 sequence at s[i], or 0.
+std::size_t utf8SequenceAt(const std::string& s, std::size_t i) {
+  const auto lead = static_cast<unsigned char>(s[i]);
+  const std::size_t length = lead < 0x80           ? 1
+                             : (lead >> 5) == 0x6  ? 2
+                             : (lead >> 4) == 0xE  ? 3
+                             : (lead >> 3) == 0x1E ? 4
+                                                   : 0;
+  if (length == 0 || i + length > s.size()) return 0;
+  for (std::size_t k = 1; k < length; ++k)
+    if ((static_cast<unsigned char>(s[i + k]) >> 6) != 0x2) return 0;
+  return length;
+}
+
+}  // namespace
+
+std::string utf8Name(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (std::size_t i = 0; i < s.size();) {
+    if (const std::size_t length = utf8SequenceAt(s, i); length > 0) {
+      out.append(s, i, length);
+      i += length;
+      continue;
+    }
+    const auto byte = static_cast<unsigned char>(s[i++]);  // Latin-1: U+0080 … U+00FF
+    out += static_cast<char>(0xC0 | (byte >> 6));
+    out += static_cast<char>(0x80 | (byte & 0x3F));
+  }
+  return out;
+}
+
 std::string oneLine(std::string s) {
   // Libraries quote bytes of a corrupt file in their messages (VTK: "Unsupported data type: "
   // and four bytes of garbage): control characters and bytes that are not UTF-8 become '?'.

@@ -19,6 +19,10 @@ void checkReadable(const std::filesystem::path& path, const std::string& name, s
 // A library's (possibly multi-line) message as one line: newlines and tabs become spaces, runs of
 // spaces collapse, trailing spaces go.
 std::string oneLine(std::string s);
+// A name read from a file as valid UTF-8: unchanged when it is; else every byte that does not
+// begin a valid UTF-8 sequence is read as Latin-1 (Windows tools write "Terraindæk" so), so that
+// JSON, Qt and messages show the name instead of failing on it.
+std::string utf8Name(const std::string& s);
 
 // Runs load() and turns whatever it throws into one mfr::Error line that starts with the file's
 // name: library messages are folded into one line, bad_alloc and unknown exceptions named;

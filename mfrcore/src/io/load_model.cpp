@@ -248,6 +248,8 @@ std::vector<Object> loadModel(const fs::path& path, const LoadOptions& options, 
     progress.step(0.0);
     std::vector<Object> objects = load(path, name, options, progress);
     if (objects.empty()) throw Error(name, "no triangles");
+    // Part names as UTF-8 (a Latin-1 name in an OBJ ended `--json` in an internal error).
+    for (Object& object : objects) object.name = io::utf8Name(object.name);
     // Every mesh once (assemblies share meshes between parts): the invariants renderers rely on.
     std::set<const Mesh*> checked;
     for (Object& object : objects) {

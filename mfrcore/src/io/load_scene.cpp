@@ -7,6 +7,7 @@
 #include <system_error>
 #include <vector>
 
+#include "file_checks.hpp"
 #include "invesalius_loader.hpp"
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
@@ -91,7 +92,7 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
     if (ext == ".inv3") {  // a volume with its segmented surfaces
       scene = io::loadInvesaliusScene(path, progress);
     } else {
-      scene.name = path.filename().string();
+      scene.name = io::utf8Name(path.filename().string());
       if (isVolumeFile(path))
         scene.volumes.push_back(loadVolume(path, options, progress));
       else {

@@ -1,3 +1,4 @@
+#include "mfr/json_text.hpp"
 #include "mfr/methods/stats.hpp"
 
 #include <nlohmann/json.hpp>
@@ -27,7 +28,7 @@ std::string toJson(const Stats& s, int indent) {
   nlohmann::ordered_json notes = nlohmann::ordered_json::object();
   for (const auto& [k, v] : s.notes) notes[k] = v;
   j["notes"] = notes;
-  return j.dump(indent);
+  return jsonText(j, indent);
 }
 
 }  // namespace mfr

@@ -1,4 +1,5 @@
 // The .mfrscene format: see docs/scene-format.md. Every error names the file and the JSON path.
+#include "mfr/json_text.hpp"
 #include "mfr/scene/scene_file.hpp"
 
 #include <algorithm>
@@ -519,7 +520,7 @@ CsgTree parseCsgText(const std::string& text, const Scene& scene) {
 }
 
 std::string csgText(const CsgTree& tree, const Scene& scene) {
-  return tree.empty() ? std::string() : csgJson(*tree.root, scene).dump();
+  return tree.empty() ? std::string() : jsonText(csgJson(*tree.root, scene));
 }
 
 Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseDir, const std::string& name,
