@@ -725,6 +725,27 @@ TEST_F(VolumeLoading, BadVti) {
   expectVolumeError(
       write("two.vti", vti("0 3 0 2 0 1", "0 0", "1 1 1", dataArray("Float32", "f", asciiValues(4, 3, 2)))),
       "ImageData Origin '0 0' has 2 numbers");
+  // Pieces that leave part of the whole extent out were read as whatever the memory held (two
+  // reads drew different images: a bug hunt); one outside it is refused too.
+  const auto withPieces = [&](const std::vector<std::pair<std::string, int>>& pieces) {
+    std::string text =
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\">\n"
+        "<ImageData WholeExtent=\"0 7 0 7 0 7\" Origin=\"0 0 0\" Spacing=\"1 1 1\">\n";
+    for (const auto& [extent, nx] : pieces)
+      text += "<Piece Extent=\"" + extent + "\"><PointData>" + dataArray("Float32", "f", asciiValues(nx, 8, 8)) +
+              "</PointData><CellData></CellData></Piece>\n";
+    return text + "</ImageData>\n</VTKFile>\n";
+  };
+  expectVolumeError(write("half.vti", withPieces({{"0 3 0 7 0 7", 4}})),
+                    "its pieces cover 147 of the 343 cells of the WholeExtent '0 7 0 7 0 7' (VTK would leave the rest "
+                    "of the grid unset)");
+  expectVolumeError(write("outside.vti", withPieces({{"0 9 0 7 0 7", 10}})),
+                    "Piece Extent '0 9 0 7 0 7' is not inside the WholeExtent '0 7 0 7 0 7'");
+  // Two pieces that tile it are one grid, each sample where its piece puts it.
+  const mfr::Volume tiled = mfr::loadVolume(write("tiled.vti", withPieces({{"0 3 0 7 0 7", 4}, {"3 7 0 7 0 7", 5}})));
+  ASSERT_EQ(tiled.grid->dims, glm::ivec3(8, 8, 8));
+  EXPECT_FLOAT_EQ(tiled.grid->at(2, 5, 6), field(2, 5, 6));
+  EXPECT_FLOAT_EQ(tiled.grid->at(6, 5, 6), field(3, 5, 6));  // the second piece's own x = 3
 }
 
 // VTK 9.1's XML reader crashes on a String array: such arrays are skipped (the numbers beside them

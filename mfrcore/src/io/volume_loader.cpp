@@ -707,6 +707,17 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
   };
   std::vector<std::pair<std::string, bool>> found;
   enum class Section { kNone, kPoints, kCells, kField } section = Section::kNone;
+  // Extents as 6 whole numbers (x0 x1 y0 y1 z0 z1), when they are.
+  using Extent = std::array<long long, 6>;
+  const auto extentOf = [](const std::string& text) -> std::optional<Extent> {
+    std::istringstream numbers(text);
+    Extent e{};
+    for (long long& v : e)
+      if (!(numbers >> v)) return std::nullopt;
+    return e;
+  };
+  std::optional<Extent> whole;
+  std::vector<Extent> pieces;
   for (const std::string& tagText : tags) {
     const std::string_view tag(tagText);
     const auto is = [&](std::string_view element) {
@@ -733,6 +744,9 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
           throw Error(name, std::string("ImageData ") + key + " '" + text.substr(0, 64) + "' has " +
                                 std::to_string(count) + " numbers");
       }
+    if (is("ImageData")) whole = extentOf(attribute(tag, "WholeExtent"));
+    if (is("Piece"))
+      if (const std::optional<Extent> e = extentOf(attribute(tag, "Extent"))) pieces.push_back(*e);
     if (is("PointData")) section = Section::kPoints;
     if (is("CellData")) section = Section::kCells;
     if (is("FieldData")) section = Section::kField;
@@ -757,6 +771,44 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
     if (section == Section::kField)
       throw Error(name, "field data array '" + attribute(tag, "Name") + "' holds text, which VTK's reader cannot skip");
     if (section != Section::kNone) found.emplace_back(attribute(tag, "Name"), section == Section::kCells);
+  }
+  // Pieces that leave part of the WholeExtent out: VTK reads them into a grid of the whole extent
+  // and leaves the rest as it was allocated (two reads of one file drew different images; a bug
+  // hunt). Counted in cells, half-open per axis (a flat axis as one layer), which pieces tile.
+  if (whole && !pieces.empty() && pieces.size() <= 4096) {
+    const auto text = [](const Extent& e) {
+      std::string t;
+      for (const long long v : e) t += (t.empty() ? "" : " ") + std::to_string(v);
+      return t;
+    };
+    const auto cells = [](const Extent& e) {
+      long long n = 1;
+      for (int a = 0; a < 3; ++a) n *= std::max<long long>(1, e[2 * a + 1] - e[2 * a]);
+      return n;
+    };
+    const auto overlap = [](const Extent& p, const Extent& q) {
+      for (int a = 0; a < 3; ++a) {
+        const long long lo = std::max(p[2 * a], q[2 * a]);
+        const long long hi = std::min(std::max(p[2 * a + 1], p[2 * a] + 1), std::max(q[2 * a + 1], q[2 * a] + 1));
+        if (lo >= hi) return false;
+      }
+      return true;
+    };
+    long long covered = 0;
+    bool overlapping = false;
+    for (std::size_t i = 0; i < pieces.size(); ++i) {
+      for (int a = 0; a < 3; ++a)
+        if (pieces[i][2 * a] < (*whole)[2 * a] || pieces[i][2 * a + 1] > (*whole)[2 * a + 1] ||
+            pieces[i][2 * a] > pieces[i][2 * a + 1])
+          throw Error(name,
+                      "Piece Extent '" + text(pieces[i]) + "' is not inside the WholeExtent '" + text(*whole) + "'");
+      covered += cells(pieces[i]);
+      for (std::size_t j = 0; j < i && !overlapping; ++j) overlapping = overlap(pieces[i], pieces[j]);
+    }
+    if (!overlapping && covered < cells(*whole))
+      throw Error(name, "its pieces cover " + std::to_string(covered) + " of the " + std::to_string(cells(*whole)) +
+                            " cells of the WholeExtent '" + text(*whole) +
+                            "' (VTK would leave the rest of the grid unset)");
   }
   return found;
 }
