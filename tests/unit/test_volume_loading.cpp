@@ -772,6 +772,34 @@ TEST_F(VolumeLoading, VtiTextArraysAreSkippedNotRead) {
   EXPECT_EQ(cellText.field, "f");  // the cell data's text skipped, the point data read
 }
 
+// A header that declares far more samples than the file holds, or than memory holds, is refused
+// before VTK allocates the grid: a 400-byte legacy file declaring 10^9 points took 8 GB, and
+// MFR_MEMORY_LIMIT_MIB was not asked (a bug hunt).
+TEST_F(VolumeLoading, DeclaredGridsBeyondTheFileOrMemoryAreRefusedFirst) {
+  const std::string header =
+      "# vtk DataFile Version 3.0\nbig\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 1024 1024 1000\n"
+      "ORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 1048576000\nSCALARS f double 1\nLOOKUP_TABLE default\n";
+  const fs::path tiny = write("tiny.vtk", header + std::string(400, '\0'));
+  expectVolumeError(tiny, "the file's " + std::to_string(fs::file_size(tiny)) +
+                              " bytes cannot hold the 1024x1024x1000 points its DIMENSIONS declare");
+  // As large as it says (sparse: no disk used), 1 GiB of doubles and 0.5 GiB of floats: over a
+  // memory limit, refused by it before anything is read.
+  const std::string header512 =
+      "# vtk DataFile Version 3.0\nbig\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 512 512 512\n"
+      "ORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 134217728\nSCALARS f double 1\nLOOKUP_TABLE default\n";
+  const fs::path large = write("large.vtk", header512);
+  fs::resize_file(large, header512.size() + std::uint64_t{134217728} * 8);
+  ASSERT_EQ(setenv("MFR_MEMORY_LIMIT_MIB", "1024", 1), 0);
+  std::string error = "loaded";
+  try {
+    (void)mfr::loadVolume(large);
+  } catch (const mfr::Error& e) {
+    error = e.what();
+  }
+  ASSERT_EQ(unsetenv("MFR_MEMORY_LIMIT_MIB"), 0);
+  EXPECT_EQ(error.rfind(large.string() + ": its 512x512x512 samples would take 1.50 GiB more memory", 0), 0u) << error;
+}
+
 TEST_F(VolumeLoading, BadLegacyMetaImageAndNrrd) {
   const std::string head =
       "# vtk DataFile Version 3.0\ng\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 4 3 2\n"

@@ -36,6 +36,7 @@
 #include <vtkCommand.h>
 #include <vtkDataArray.h>
 #include <vtkDataArraySelection.h>
+#include <vtkDataObject.h>
 #include <vtkDataSetAttributes.h>
 #include <vtkFieldData.h>
 #include <vtkImageData.h>
@@ -52,6 +53,7 @@
 #include <vtkXMLImageDataReader.h>
 
 #include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "file_checks.hpp"
 #include "invesalius_loader.hpp"
@@ -873,6 +875,30 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
                                              std::int64_t{extent[3]} - extent[2] + 1,
                                              std::int64_t{extent[5]} - extent[4] + 1};
   checkDims(declared, name);
+  const auto points = static_cast<std::uint64_t>(declared[0] * declared[1] * declared[2]);
+  // A legacy file is not compressed: fewer bytes than points cannot hold a sample each, and VTK
+  // allocated the whole grid before it found so (a 400-byte file declaring 10^9 points took 8 GB).
+  if (format == VolumeFormat::LegacyVtk) {
+    std::error_code error;
+    const std::uintmax_t bytes = fs::file_size(path, error);
+    if (!error && bytes < points)
+      throw Error(name, "the file's " + std::to_string(bytes) + " bytes cannot hold the " + dimsText(declared) +
+                            " points its DIMENSIONS declare (at least a byte each: a truncated file?)");
+  }
+  // VTK's array in the file's type and the grid's floats, asked for before either is allocated.
+  {
+    std::uint64_t sampleBytes = 8;  // not declared: the widest scalar
+    if (vtkInformation* scalars = vtkDataObject::GetActiveFieldInformation(
+            info, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
+        scalars != nullptr && scalars->Has(vtkDataObject::FIELD_ARRAY_TYPE())) {
+      const int components = scalars->Has(vtkDataObject::FIELD_NUMBER_OF_COMPONENTS())
+                                 ? std::max(1, scalars->Get(vtkDataObject::FIELD_NUMBER_OF_COMPONENTS()))
+                                 : 1;
+      sampleBytes = static_cast<std::uint64_t>(
+          std::max(1, vtkDataArray::GetDataTypeSize(scalars->Get(vtkDataObject::FIELD_ARRAY_TYPE()))) * components);
+    }
+    requireHostMemory(name, "its " + dimsText(declared) + " samples", points * (sampleBytes + sizeof(float)));
+  }
   if (auto* xml = vtkXMLImageDataReader::SafeDownCast(reader))
     for (const auto& [array, cells] : xmlStringArrays(path, name)) {
       if (!field.empty() && (field == array || field.rfind(array + ":", 0) == 0))
