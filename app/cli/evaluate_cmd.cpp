@@ -258,7 +258,9 @@ void addEvaluate(CLI::App& app) {
             RenderRequest req = specs.at(m);
             if (req.operation == "auto") req.operation = "hybrid";
             req.params["budget_mib"] = b.paramText();
-            if (req.method == "dkb" && !opt->weights.empty()) req.params["weights"] = opt->weights;
+            // --weights for the dkb rows that name none of their own (dkb:weights=FILE wins).
+            if (req.method == "dkb" && !opt->weights.empty() && !req.params.contains("weights"))
+              req.params["weights"] = opt->weights;
             const bool cpu = req.method == "optimal-k";
             nlohmann::ordered_json row;
             row["scene"] = opt->scenes[s];

@@ -1032,6 +1032,28 @@ TEST_F(Cli, EvaluatesExactReferenceRefusalNamesTheReference) {
   EXPECT_EQ(r.out.find("--method"), std::string::npos) << r.out;
 }
 
+// evaluate --weights replaced a spec's own dkb:weights=FILE while the row kept that file's name
+// (a bug hunt): the spec's own weights win; --weights is for the dkb rows without.
+TEST_F(Cli, EvaluatesSpecWeightsWinOverWeights) {
+  const fs::path own = dir() / "w.json", other = dir() / "other.json";
+  fs::copy_file(MFR_TEST_DATA_DIR "/../../resources/dkb/weights.json", own);
+  nlohmann::json shifted = nlohmann::json::parse(mfr::readFile(own));
+  for (auto& mean : shifted["input_mean"]) mean = mean.get<double>() + 3.0;  // other predictions
+  std::ofstream(other) << shifted.dump();
+  const auto rmse = [&](const std::string& args) {
+    const fs::path json = dir() / "e.json";
+    const CliResult r = runCli("evaluate @sample -s 64x48 --budgets e70 " + args + " --json " + json.string());
+    EXPECT_EQ(r.exitCode, 0) << r.out;
+    const nlohmann::json j = nlohmann::json::parse(mfr::readFile(json));
+    return j["results"].at(0).value("rmse", -1.0);
+  };
+  const double withOwn = rmse("-m dkb:weights=" + own.string());
+  EXPECT_GT(withOwn, 0.0);
+  EXPECT_EQ(rmse("-m dkb:weights=" + own.string() + " --weights " + other.string()), withOwn);
+  // The other file does change a row that names none (else this test would show nothing).
+  EXPECT_NE(rmse("-m dkb --weights " + other.string()), withOwn);
+}
+
 TEST_F(Cli, BudgetCommandsBadInput) {
   // A corrupt dataset, a missing dataset, bad budgets, a bad weights file.
   const fs::path junk = write("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");
