@@ -243,7 +243,8 @@ void addEvaluate(CLI::App& app) {
           throw Error("scene '" + scenes[s].name + "', view " + v + ": the exact reference (abuffer-ll)", reason);
         }
         const std::uint64_t total = lists.fragments.size();
-        const std::uint64_t exactSlots = exactHybridSlots(lists), exactSlotsRuns = exactHybridSlots(lists, tailRunLengths(lists));
+        const std::uint64_t exactSlots = exactHybridSlots(lists),
+                            exactSlotsRuns = exactHybridSlots(lists, tailRunLengths(lists));
         // --k-by-depth: n(p) of each method's own lists (the GPU's rasterisation, the oracle's rays).
         std::vector<std::uint32_t> gpuDepth, oracleDepth;
         if (opt->kByDepth) {

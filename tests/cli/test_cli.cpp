@@ -1108,6 +1108,13 @@ TEST_F(Cli, BudgetCommandsBadInput) {
                        "w2.json: not a valid weights file ([json.exception.");
     expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + file.string(), mention);
   }
+  {
+    // A subnormal std was taken, and the CPU and GPU networks then disagreed (a bug hunt).
+    nlohmann::json weights = nlohmann::json::parse(shipped);
+    weights["input_std"][0] = 1e-45;
+    expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + write("w3.json", weights.dump()).string(),
+                       "w3.json: input_std must be at least 1e-6");
+  }
   expectCleanFailure("render @sample -s 16x16 -m vkb -p budget_mib=0", "--param budget_mib=0");
   expectCleanFailure("render @sample -s 16x16 -m fkb -p budget_mib=0.001", "--param budget_mib=0.001");
   expectCleanFailure("render @sample -s 16x16 -m optimal-k --op oit", "--op oit");

@@ -1,7 +1,6 @@
 // The dkb network's weights, CPU forward pass and features (mfr/budget/neural_importance.hpp).
 // The forward pass and the features are the shaders' own definitions (shaders/budget/mlp.h,
 // features.h) compiled as C++.
-#include "mfr/json_text.hpp"
 #include "mfr/budget/neural_importance.hpp"
 
 #include <algorithm>
@@ -18,6 +17,8 @@
 #include "budget/mlp_layout.h"
 #include "mfr/error.hpp"
 #include "mfr/io_util.hpp"
+#include "mfr/json_text.hpp"
+#include "number_text.hpp"
 
 namespace mfr {
 
@@ -165,7 +166,11 @@ NeuralImportanceModel parseWeightsJson(const std::string& text, const std::strin
   const std::vector<float> mean = floats(j.value("input_mean", nlohmann::json()), MFR_MLP_INPUTS, "input_mean", source);
   const std::vector<float> stddev = floats(j.value("input_std", nlohmann::json()), MFR_MLP_INPUTS, "input_std", source);
   for (int i = 0; i < MFR_MLP_INPUTS; ++i) {
-    if (!(stddev[static_cast<std::size_t>(i)] > 0.0f)) throw Error(source, "input_std must be positive");
+    // mfr train's floor: below it a standardised feature overflows the network's floats, and the
+    // CPU and GPU inferences fell back differently (1e-45 was taken; a bug hunt).
+    if (!(stddev[static_cast<std::size_t>(i)] >= 1e-6f))
+      throw Error(source, "input_std must be at least 1e-6 (mfr train's floor; got " +
+                              numberText(stddev[static_cast<std::size_t>(i)]) + ")");
     m.weights[MFR_MLP_MEAN + i] = mean[static_cast<std::size_t>(i)];
     m.weights[MFR_MLP_STD + i] = stddev[static_cast<std::size_t>(i)];
   }

@@ -1,7 +1,6 @@
 // dkb training with dlib (mfr/budget/neural_training.hpp). The network is dlib's; this file only
 // feeds it rows, runs epochs and copies its layers into the shader layout of
 // shaders/budget/mlp.h.
-#include "mfr/json_text.hpp"
 #include "mfr/budget/neural_training.hpp"
 
 #include <algorithm>
@@ -21,6 +20,7 @@
 
 #include "budget/mlp_layout.h"
 #include "mfr/error.hpp"
+#include "mfr/json_text.hpp"
 
 namespace mfr {
 

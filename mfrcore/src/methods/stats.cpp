@@ -1,7 +1,8 @@
-#include "mfr/json_text.hpp"
 #include "mfr/methods/stats.hpp"
 
 #include <nlohmann/json.hpp>
+
+#include "mfr/json_text.hpp"
 
 namespace mfr {
 

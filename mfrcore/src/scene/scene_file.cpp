@@ -1,5 +1,4 @@
 // The .mfrscene format: see docs/scene-format.md. Every error names the file and the JSON path.
-#include "mfr/json_text.hpp"
 #include "mfr/scene/scene_file.hpp"
 
 #include <algorithm>
@@ -19,6 +18,7 @@
 #include "mfr/host_memory.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
+#include "mfr/json_text.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/contour.hpp"
 #include "mfr/scene/csg.hpp"
@@ -61,7 +61,8 @@ class Reader {
     const json& j = obj[key];
     if (!j.is_number_integer()) fail(where + "." + key, "expected an integer");
     const long long v = j.get<long long>();
-    if (v < lo || v > hi) fail(where + "." + key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    if (v < lo || v > hi)
+      fail(where + "." + key, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     return static_cast<int>(v);
   }
   bool flag(const json& obj, const char* key, const std::string& where, bool fallback) const {
@@ -312,14 +313,17 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
   if (!(glm::length(glm::cross(c.forward(), glm::normalize(c.up))) >= 1e-9))
     r.fail(where + ".up", "parallel to the view direction");
   const std::string proj = r.string(v, "projection", where, "perspective");
-  if (proj == "orthographic") c.projection = Projection::Orthographic;
-  else if (proj != "perspective") r.fail(where + ".projection", "must be 'perspective' or 'orthographic'");
+  if (proj == "orthographic")
+    c.projection = Projection::Orthographic;
+  else if (proj != "perspective")
+    r.fail(where + ".projection", "must be 'perspective' or 'orthographic'");
   c.fovyDegrees = r.number(v, "fovy", where, c.fovyDegrees);
   if (c.fovyDegrees <= 0 || c.fovyDegrees >= 180) r.fail(where + ".fovy", "must be in (0, 180) degrees");
   c.orthoHeight = r.positive(v, "height", where, c.orthoHeight);
   if (r.flag(v, "fit", where, false))
     c = c.fittedTo(bounds, radius);
-  else c.fitDepthRange(bounds, radius);
+  else
+    c.fitDepthRange(bounds, radius);
   if (v.contains("near") || v.contains("far")) {
     c.nearPlane = r.positive(v, "near", where, c.nearPlane);
     c.farPlane = r.positive(v, "far", where, c.farPlane);
@@ -612,7 +616,8 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
           r.object(objects[i], where,
                    {"name", "file", "primitive", "transform", "color", "opacity", "visible", "molecule", "color_by"});
       const std::string objName = r.string(o, "name", where, "object " + std::to_string(i));
-      const glm::dmat4 xf = o.contains("transform") ? parseTransform(r, o["transform"], where + ".transform") : glm::dmat4(1.0);
+      const glm::dmat4 xf =
+          o.contains("transform") ? parseTransform(r, o["transform"], where + ".transform") : glm::dmat4(1.0);
       const bool visible = r.flag(o, "visible", where, true);
       if (o.contains("file") == o.contains("primitive")) r.fail(where, "needs exactly one of 'file' or 'primitive'");
       if (o.contains("primitive")) {
