@@ -12,6 +12,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/render.hpp"
+#include "mfr/scene/color_map.hpp"
 #include "viewer_model.hpp"
 
 namespace {
@@ -203,10 +204,14 @@ QStringList applySession(const Session& session, ViewerModel& model) {
   model.setZThickness(session.thickness);
   if (session.hasClip) model.setClipBox(session.clip);
   if (session.hasSection) model.setSection(session.section);
-  if (session.hasColorBy)
-    model.setFieldColoring(session.colorBy ? QString::fromStdString(session.colorBy->field) : QString(),
-                           session.colorBy ? QString::fromStdString(session.colorBy->map) : QString(),
-                           session.colorBy ? std::optional<glm::dvec2>(session.colorBy->range) : std::nullopt);
+  // A field this scene lacks is a note, as parts it lacks (it was dropped without a word).
+  if (session.hasColorBy &&
+      !model.setFieldColoring(session.colorBy ? QString::fromStdString(session.colorBy->field) : QString(),
+                              session.colorBy ? QString::fromStdString(session.colorBy->map) : QString(),
+                              session.colorBy ? std::optional<glm::dvec2>(session.colorBy->range) : std::nullopt))
+    notes << QStringLiteral("color_by %1: %2 (not applied)")
+                 .arg(session.colorBy ? QString::fromStdString(session.colorBy->field) : QString(),
+                      model.fieldColoringError());
   if (session.volumes.size() == model.scene().volumes.size())
     for (std::size_t i = 0; i < session.volumes.size(); ++i) {
       const Session::VolumeState& v = session.volumes[i];
@@ -334,6 +339,15 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   s.camera.orthoHeight = r.number(cam, "ortho_height", "camera", s.camera.orthoHeight);
   s.camera.nearPlane = r.number(cam, "near", "camera", s.camera.nearPlane);
   s.camera.farPlane = r.number(cam, "far", "camera", s.camera.farPlane);
+  // As a scene file's views are checked (a fovy of -40 drew the view upside down; 0 was "projection
+  // is singular" naming neither the file nor the key).
+  if (!(s.camera.fovyDegrees > 0.0 && s.camera.fovyDegrees < 180.0))
+    r.fail(QStringLiteral("camera.fovy_degrees"), QStringLiteral("must be in (0, 180) degrees"));
+  if (!(s.camera.orthoHeight > 0.0))
+    r.fail(QStringLiteral("camera.ortho_height"), QStringLiteral("must be a positive height in scene units"));
+  if (!(s.camera.nearPlane > 0.0)) r.fail(QStringLiteral("camera.near"), QStringLiteral("must be positive"));
+  if (!(s.camera.farPlane > s.camera.nearPlane))
+    r.fail(QStringLiteral("camera.far"), QStringLiteral("must be greater than near"));
   s.method = r.method(json, "method", {});
   s.operation = r.operation(json, "operation", {});
   // Optional (sessions written before the operation zthickness have none: the default).
@@ -371,6 +385,9 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
       plane.normal = r.vec3(section, "normal", "section");
       if (!(glm::length(plane.normal) > 0.0))
         r.fail(QStringLiteral("section"), QStringLiteral("the normal must not be zero"));
+      // mfr refuses it; the viewer drew the scene uncut.
+      if (!std::isfinite(glm::length(plane.normal)))
+        r.fail(QStringLiteral("section"), QStringLiteral("the normal is too long to normalise (under 1e150)"));
       if (section.contains("caps") && !section.value("caps").isBool())
         r.fail(QStringLiteral("section"), QStringLiteral("caps: expected true or false"));
       plane.caps = section.value("caps").toBool(true);
@@ -389,6 +406,10 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
           !c.value("map").isString() || range.size() != 2 || !range[0].isDouble() || !range[1].isDouble() ||
           !(range[1].toDouble() > range[0].toDouble()))
         r.fail(QStringLiteral("color_by"), QStringLiteral("expected null or {field, map, range: [low, high]}"));
+      const std::vector<std::string>& maps = mfr::colorMapNames();
+      if (std::find(maps.begin(), maps.end(), c.value("map").toString().toStdString()) == maps.end())
+        r.fail(QStringLiteral("color_by.map"),
+               QStringLiteral("unknown colour map '%1'").arg(c.value("map").toString()));
       s.colorBy = mfr::FieldColors{c.value("field").toString().toStdString(),
                                    c.value("map").toString().toStdString(),
                                    {range[0].toDouble(), range[1].toDouble()}};

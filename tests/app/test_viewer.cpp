@@ -773,6 +773,11 @@ class ViewerTest : public QObject {
       json.insert(key, value);
       return json;
     };
+    const auto camera = [&](const QJsonObject& extra) {
+      QJsonObject c = good.value("camera").toObject();
+      for (auto it = extra.begin(); it != extra.end(); ++it) c.insert(it.key(), it.value());
+      return c;
+    };
     const auto object = [](const QJsonObject& extra) {
       QJsonObject o{{"name", "tangle"}, {"color", QJsonArray{1, 0, 0}}};
       for (auto it = extra.begin(); it != extra.end(); ++it) o.insert(it.key(), it.value());
@@ -789,6 +794,17 @@ class ViewerTest : public QObject {
         {with("operation", "xyz"), "s.mfrsession: operation: unknown operation 'xyz'"},
         {with("version", 99), "s.mfrsession: version: expected 1"},
         {with("compare", QJsonObject{{"enabled", 1}}), "s.mfrsession: compare.enabled: expected true or false"},
+        // Taken before (a bug hunt): a negative fovy drew the view upside down, a negative height
+        // and an overflowing section normal drew it uncut, an unknown map was dropped.
+        {with("camera", camera({{"fovy_degrees", -40}})),
+         "s.mfrsession: camera.fovy_degrees: must be in (0, 180) degrees"},
+        {with("camera", camera({{"projection", "orthographic"}, {"ortho_height", -3}})),
+         "s.mfrsession: camera.ortho_height: must be a positive height in scene units"},
+        {with("camera", camera({{"near", 2}, {"far", 1}})), "s.mfrsession: camera.far: must be greater than near"},
+        {with("section", QJsonObject{{"point", QJsonArray{0, 0, 0}}, {"normal", QJsonArray{1e200, 1e200, 0}}}),
+         "s.mfrsession: section: the normal is too long to normalise (under 1e150)"},
+        {with("color_by", QJsonObject{{"field", "b"}, {"map", "badmap"}, {"range", QJsonArray{0, 1}}}),
+         "s.mfrsession: color_by.map: unknown colour map 'badmap'"},
         {with("volumes",
               QJsonArray{QJsonObject{{"transfer", QJsonObject{{"points", QJsonArray{QJsonArray{0, 0, 0, 0, 0},
                                                                                     QJsonArray{1, "a", 1, 1, 1}}}}}}}),
@@ -824,6 +840,15 @@ class ViewerTest : public QObject {
     QCOMPARE(parts[1].material.color, glm::vec4(0, 0, 1, 0.25f));
     QVERIFY(parts[0].visible && parts[2].visible);  // not named: as the file has them
     QCOMPARE(notes, QStringList{"the session's object 'nosuch' is no part of the scene: left out"});
+    // A field the scene lacks is a note too (it was dropped without a word: a bug hunt).
+    Session coloured = captureSession(m);
+    coloured.hasColorBy = true;
+    coloured.colorBy = mfr::FieldColors{"nope", "viridis", glm::dvec2(0.0, 1.0)};
+    const QStringList colourNotes = applySession(coloured, m);
+    QCOMPARE(colourNotes.size(), 1);
+    QVERIFY2(colourNotes[0].startsWith(QStringLiteral("color_by nope: ")) &&
+                 colourNotes[0].endsWith(QStringLiteral(" (not applied)")),
+             qPrintable(colourNotes.join('|')));
   }
 
   // `mfrview --screenshot` and `mfr render` with the same scene, view, size and settings.
