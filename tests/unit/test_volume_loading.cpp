@@ -725,6 +725,10 @@ TEST_F(VolumeLoading, BadVti) {
   expectVolumeError(
       write("two.vti", vti("0 3 0 2 0 1", "0 0", "1 1 1", dataArray("Float32", "f", asciiValues(4, 3, 2)))),
       "ImageData Origin '0 0' has 2 numbers");
+  // A spacing too fine for the renderers' floats drew nothing, with exit 0 (a bug hunt).
+  expectVolumeError(write("fine.vti", vti("0 3 0 2 0 1", "0 0 0", "1e-24 1e-24 1e-24",
+                                          dataArray("Float32", "f", asciiValues(4, 3, 2)))),
+                    "a grid spacing of 1e-24 scene units (with its transform) is below 1e-15: too fine to be drawn");
   // Pieces that leave part of the whole extent out were read as whatever the memory held (two
   // reads drew different images: a bug hunt); one outside it is refused too.
   const auto withPieces = [&](const std::vector<std::pair<std::string, int>>& pieces) {
