@@ -1,11 +1,13 @@
 // mfr dataset: training data for dkb — per scene × view × budget, the oracle's exact lists, the
 // optimal k(p) under the budget and the 12 features of a random sample of the non-empty pixels
 // (format: mfr/budget/dataset.hpp, docs/methods.md).
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <iostream>
 #include <memory>
 #include <random>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -31,6 +33,9 @@ std::vector<double> parseBudgetLevels(const std::string& text) {
     }
     const std::optional<double> v = parseNumber(item);
     if (!v || *v < 1.0) throw Error("--budgets " + item, "expected slots per non-empty pixel (a number >= 1) or 'all'");
+    // "1,1" wrote each frame twice (a repeated 'all' was written once).
+    if (std::find(out.begin(), out.end(), *v) != out.end())
+      throw Error("--budgets " + text, "'" + item + "' is given twice");
     out.push_back(*v);
   }
   if (out.empty()) throw Error("--budgets", "no budget given");
@@ -142,6 +147,14 @@ void addDataset(CLI::App& app) {
                               {"solver", f.solver}});
           }
         }
+    // An empty file was written with exit 0 (train then refused it): say why instead.
+    if (dataset.size() == 0)
+      throw Error(
+          "-o " + opt->output,
+          std::string("no rows to write: ") +
+              (opt->skipExact && frames.empty()
+                   ? "--skip-exact-budgets left out every frame's budget (each holds the exact tails)"
+                   : "the sample drew no pixel (--sample " + (std::ostringstream() << opt->sample).str() + ")"));
     meta["frames"] = frames;
     dataset.metadata = jsonText(meta);
     writeDataset(opt->output, dataset);

@@ -1054,6 +1054,25 @@ TEST_F(Cli, EvaluatesSpecWeightsWinOverWeights) {
   EXPECT_NE(rmse("-m dkb --weights " + other.string()), withOwn);
 }
 
+// dataset wrote a file of no rows with exit 0 (train refused it later), and "--budgets 1,1" each
+// frame twice (a bug hunt).
+TEST_F(Cli, DatasetWritesNoEmptyFileAndNoFrameTwice) {
+  const std::string out = (dir() / "d.bin").string();
+  for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+           {"--budgets all --skip-exact-budgets",
+            "mfr: -o " + out +
+                ": no rows to write: --skip-exact-budgets left out every frame's budget (each holds the exact tails)"},
+           {"--sample 1e-300", "mfr: -o " + out + ": no rows to write: the sample drew no pixel (--sample 1e-300)"},
+           {"--budgets 1,2,1", "mfr: --budgets 1,2,1: '1' is given twice"}}) {
+    const CliResult r = runCli("dataset @sample -s 16x16 -o " + out + " " + args);
+    EXPECT_EQ(r.exitCode, 1) << args << ": " << r.out;
+    EXPECT_NE(r.out.find(message + "\n"), std::string::npos) << args << ": " << r.out;
+    EXPECT_FALSE(fs::exists(out)) << args;
+  }
+  EXPECT_EQ(runCli("dataset @sample -s 16x16 --budgets 1,2 -o " + out).exitCode, 0);
+  EXPECT_TRUE(fs::exists(out));
+}
+
 TEST_F(Cli, BudgetCommandsBadInput) {
   // A corrupt dataset, a missing dataset, bad budgets, a bad weights file.
   const fs::path junk = write("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");
