@@ -294,9 +294,14 @@ void addInfo(CLI::App& app) {
       const glm::ivec3 d = v.grid->dims;
       const glm::vec2 range = v.grid->range();
       const Bounds vb = v.bounds();
+      // The grid's steps in scene units, its transform included: a .vdb keeps its voxel size in
+      // the transform, and "spacing 1 1 1" beside a default step of 0.3 contradicted itself.
+      const glm::dmat4 toWorld = v.gridToWorld();
+      const glm::dvec3 spacing(glm::length(glm::dvec3(toWorld[0])), glm::length(glm::dvec3(toWorld[1])),
+                               glm::length(glm::dvec3(toWorld[2])));
       volumes.push_back({{"name", v.name},
                          {"dims", {d.x, d.y, d.z}},
-                         {"spacing", {v.spacing.x, v.spacing.y, v.spacing.z}},
+                         {"spacing", {spacing.x, spacing.y, spacing.z}},
                          {"range", {range.x, range.y}},
                          {"bounds", {{"min", {vb.min.x, vb.min.y, vb.min.z}}, {"max", {vb.max.x, vb.max.y, vb.max.z}}}},
                          {"transfer_range", {v.transfer.low(), v.transfer.high()}},
@@ -306,9 +311,9 @@ void addInfo(CLI::App& app) {
                          {"field", v.field},
                          {"fields", v.fields}});
       std::cout << "  volume: " << v.name << (v.field.empty() ? "" : " [" + v.field + "]") << " (" << d.x << "x" << d.y
-                << "x" << d.z << " points, spacing " << v.spacing.x << " " << v.spacing.y << " " << v.spacing.z
-                << ", values " << range.x << " … " << range.y << ", transfer " << v.transfer.low() << " … "
-                << v.transfer.high() << " per " << v.transfer.unitDistance << ", default step " << v.defaultStep()
+                << "x" << d.z << " points, spacing " << spacing.x << " " << spacing.y << " " << spacing.z << ", values "
+                << range.x << " … " << range.y << ", transfer " << v.transfer.low() << " … " << v.transfer.high()
+                << " per " << v.transfer.unitDistance << ", default step " << v.defaultStep()
                 << (v.visible ? "" : ", hidden") << ")\n";
       if (v.fields.size() > 1) {
         std::cout << "    fields:";

@@ -9,10 +9,13 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <regex>
 #include <string>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
@@ -105,6 +108,14 @@ TEST_F(OpenVdbFiles, SceneOfAVdbFile) {
   EXPECT_EQ(scene.volumes[0].name, "ball.vdb");
   EXPECT_NEAR(scene.volumes[0].transfer.high(), 1.0, 1e-6);  // grayscale over the density's range
   EXPECT_NEAR(scene.volumes[0].defaultStep(), 0.025, 1e-6);
+  // mfr info gives the grid's spacing in scene units (a .vdb keeps its voxel size in its transform:
+  // it said "spacing 1 1 1" beside a default step of 0.025; a bug hunt).
+  const fs::path json = fog.parent_path() / "info.json";
+  const CliResult r = runCli("info " + fog.string() + " --no-histogram --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("points, spacing 0.05 0.05 0.05,"), std::string::npos) << r.out;
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(json));
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(j["volumes"][0]["spacing"][a].get<double>(), 0.05, 1e-6);
 }
 
 // A vector grid (the gradient of a fog sphere, made by vdb_tool -grad) is read as its magnitude:
