@@ -232,7 +232,12 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
     if (!model_->scene().volumes.empty())
       if (auto* volumeDock = findChild<QDockWidget*>(QStringLiteral("plugin-hybridvolume"))) volumeDock->raise();
     if (pendingSession_) {
-      const QStringList notes = applySession(*pendingSession_, *model_);
+      QStringList notes = applySession(*pendingSession_, *model_);
+      // Settings of a plugin that is not loaded (not installed here) were dropped without a word.
+      for (const QString& id : pendingSession_->plugins.keys())
+        if (std::none_of(plugins_.records().begin(), plugins_.records().end(),
+                         [&](const PluginRecord& r) { return r.plugin && r.id == id; }))
+          notes << QStringLiteral("plugins.%1: no plugin of that id is loaded (its settings are left out)").arg(id);
       if (!notes.isEmpty()) {
         // Also for scripted runs (--screenshot), which have no status bar to read.
         for (const QString& note : notes)

@@ -73,7 +73,12 @@ class Reader {
   }
   ParamsByMethod params(const QJsonObject& json, const QString& where) const {
     ParamsByMethod out;
+    const std::vector<std::string> known = mfr::availableMethods();
     for (auto m = json.begin(); m != json.end(); ++m) {
+      // Parameters of a method mfrview does not have, or not an object of them, were taken and never used.
+      if (std::find(known.begin(), known.end(), m.key().toStdString()) == known.end())
+        fail(where + "." + m.key(), QStringLiteral("unknown method '%1'").arg(m.key()));
+      if (!m.value().isObject()) fail(where + "." + m.key(), QStringLiteral("expected an object of name: value"));
       auto& values = out[m.key().toStdString()];
       const QJsonObject p = m.value().toObject();
       for (auto v = p.begin(); v != p.end(); ++v) {

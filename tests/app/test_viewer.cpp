@@ -742,6 +742,21 @@ class ViewerTest : public QObject {
     const QString good = session(QJsonObject{{"budget_mib", 2}, {"driving", true}});
     QCOMPARE(runProgram(MFRVIEW, {good, "--size", "32x32", "--screenshot", png}, &out), 0);
     QVERIFY(QFile::exists(png));
+    // Settings of a plugin that is not loaded are a note (they were dropped without a word).
+    {
+      QFile f(dir.filePath(QStringLiteral("s.mfrsession")));
+      QVERIFY(f.open(QIODevice::ReadWrite));
+      QJsonObject json = QJsonDocument::fromJson(f.readAll()).object();
+      QJsonObject plugins = json.value("plugins").toObject();
+      plugins.insert("nope", QJsonObject{{"x", 1}});
+      json.insert("plugins", plugins);
+      f.resize(0);
+      f.write(QJsonDocument(json).toJson());
+    }
+    QCOMPARE(runProgram(MFRVIEW, {good, "--size", "32x32", "--screenshot", png}, &out), 0);
+    QVERIFY2(
+        out.contains("note: s.mfrsession: plugins.nope: no plugin of that id is loaded (its settings are left out)"),
+        qPrintable(out));
     // In a session, a value taken other than as given is a note on stderr, and the run goes on.
     QFile::remove(png);
     const QString clamped = session(QJsonObject{{"budget_mib", 5000}});
@@ -805,6 +820,10 @@ class ViewerTest : public QObject {
          "s.mfrsession: section: the normal is too long to normalise (under 1e150)"},
         {with("color_by", QJsonObject{{"field", "b"}, {"map", "badmap"}, {"range", QJsonArray{0, 1}}}),
          "s.mfrsession: color_by.map: unknown colour map 'badmap'"},
+        {with("params", QJsonObject{{"nosuch", QJsonObject{{"k", "4"}}}}),
+         "s.mfrsession: params.nosuch: unknown method 'nosuch'"},
+        {with("params", QJsonObject{{"kbuffer", 3}}),
+         "s.mfrsession: params.kbuffer: expected an object of name: value"},
         {with("volumes",
               QJsonArray{QJsonObject{{"transfer", QJsonObject{{"points", QJsonArray{QJsonArray{0, 0, 0, 0, 0},
                                                                                     QJsonArray{1, "a", 1, 1, 1}}}}}}}),
