@@ -306,6 +306,22 @@ TEST(DkbDataset, FramesFileRoundTripAndCorruptFiles) {
   } catch (const mfr::Error& e) {
     EXPECT_NE(std::string(e.what()).find("absurd.bin: row 0: labels out of range"), std::string::npos) << e.what();
   }
+  // A NaN is named by its row and column, as docs/methods.md says (it was "holds a non-finite value").
+  if (d.size() > 1) {
+    std::string nan = bytes;
+    const float notANumber = std::numeric_limits<float>::quiet_NaN();
+    std::memcpy(nan.data() + 24 + metaLength + 4 * (mfr::kDatasetColumns + 3), &notANumber, 4);
+    mfr::writeFileAtomically(dir / "nan.bin", nan);
+    try {
+      mfr::readDataset(dir / "nan.bin");
+      ADD_FAILURE() << "nan.bin";
+    } catch (const mfr::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("nan.bin: row 1, column 3: a non-finite value"), std::string::npos)
+          << e.what();
+    }
+  } else {
+    ADD_FAILURE() << "the dataset has one row: no second row to corrupt";
+  }
   for (const char* name : {"cut.bin", "foreign.bin", "missing.bin"}) {
     try {
       mfr::readDataset(dir / name);

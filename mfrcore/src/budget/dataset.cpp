@@ -87,8 +87,10 @@ DkbDataset readDataset(const std::filesystem::path& path) {
     throw Error(where, "corrupt (its metadata is not JSON)");
   d.rows.resize(rows * kDatasetColumns);
   std::memcpy(d.rows.data(), bytes.data() + header + metaLength, payload);
-  for (float v : d.rows)
-    if (!std::isfinite(v)) throw Error(where, "holds a non-finite value");
+  for (std::size_t i = 0; i < d.rows.size(); ++i)
+    if (!std::isfinite(d.rows[i]))  // with its row and column, as docs/methods.md says
+      throw Error(where, "row " + std::to_string(i / kDatasetColumns) + ", column " +
+                             std::to_string(i % kDatasetColumns) + ": a non-finite value");
   // The labels as mfr dataset writes them: n(p) ≥ 1 and k(p) whole, 1 ≤ k(p) ≤ n(p), k(p)/F in
   // (0, 1]. A row outside them trained on (a label of 1e30 drove the loss to NaN).
   for (std::size_t i = 0; i < d.size(); ++i) {
