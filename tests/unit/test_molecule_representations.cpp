@@ -388,8 +388,9 @@ TEST(MoleculeStyleNames, ParseAndText) {
             "--molecule ribbon: unknown representation 'ribbon': expected spheres, sticks, ball-and-stick, "
             "cartoon or surface, joined by ',' (cartoon,sticks@ligands: '@' limits one to polymer, ligands or water)");
   // A trailing blank is kept in the quote: 'sticks' read as the valid name (a bug hunt).
+  EXPECT_NE(reason("sticks\n").find("unknown representation 'sticks ': "), std::string::npos) << reason("sticks\n");
   EXPECT_EQ(reason("sticks "),
-            "--molecule sticks : unknown representation 'sticks ': expected spheres, sticks, ball-and-stick, "
+            "--molecule sticks: unknown representation 'sticks ': expected spheres, sticks, ball-and-stick, "
             "cartoon or surface, joined by ',' (cartoon,sticks@ligands: '@' limits one to polymer, ligands or water)");
   EXPECT_EQ(reason(""),
             "--molecule: expected spheres, sticks, ball-and-stick, cartoon or surface, joined by ',' "

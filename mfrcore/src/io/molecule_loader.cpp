@@ -1195,9 +1195,13 @@ MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& w
   const auto quoted = [](const std::string& s) {
     std::string line = io::oneLine(s);
     if (line.size() > 48) line = line.substr(0, 45) + "...";
-    // oneLine drops trailing blanks, and 'sticks ' then read as the valid name it is not.
-    else if (!s.empty() && (s.back() == ' ' || s.back() == '\t'))
-      line += ' ';
+    return line;
+  };
+  // A name in quotes keeps a trailing blank, which oneLine drops: 'sticks ' read as the valid name
+  // it is not.
+  const auto quotedName = [&](const std::string& s) {
+    std::string line = quoted(s);
+    if (line.size() <= 48 && !s.empty() && std::isspace(static_cast<unsigned char>(s.back())) != 0) line += ' ';
     return line;
   };
   constexpr const char* kExpected =
@@ -1217,9 +1221,9 @@ MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& w
     const auto representation =
         std::find_if(kRepresentations.begin(), kRepresentations.end(), [&](const auto& r) { return name == r.second; });
     if (representation == kRepresentations.end())
-      throw Error(quoted(what),
-                  (item.empty() ? std::string("expected") : "unknown representation '" + quoted(name) + "': expected") +
-                      kExpected);
+      throw Error(quoted(what), (item.empty() ? std::string("expected")
+                                              : "unknown representation '" + quotedName(name) + "': expected") +
+                                    kExpected);
     MoleculeParts& parts = style.*(representation->first);
     if (at == std::string::npos) {
       parts = MoleculeParts::all();
@@ -1228,7 +1232,7 @@ MoleculeStyle MoleculeStyle::parse(const std::string& text, const std::string& w
       const auto k =
           std::find_if(kPartKinds.begin(), kPartKinds.end(), [&](const auto& p) { return kind == p.second; });
       if (k == kPartKinds.end())
-        throw Error(quoted(what), "unknown part '" + quoted(kind) + "' after '" + quoted(name) +
+        throw Error(quoted(what), "unknown part '" + quotedName(kind) + "' after '" + quoted(name) +
                                       "@': expected polymer, ligands or water");
       parts.*(k->first) = true;
     }
