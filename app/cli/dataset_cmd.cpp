@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 #include <random>
+#include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -120,6 +121,7 @@ void addDataset(CLI::App& app) {
           const std::uint64_t nonEmpty = minimumSlots(errors);
           if (nonEmpty == 0) throw Error(opt->scenes[s] + " view " + v, "nothing visible");
           bool allDone = false;  // levels at or above Σn all mean "every fragment": one frame of those
+          std::set<std::uint64_t> written;  // budgets in slots: 1 and 1.0001 can round to one F
           const std::uint64_t exactSlots = exactHybridSlots(lists);
           for (double level : levels) {
             const std::uint64_t F =
@@ -128,6 +130,7 @@ void addDataset(CLI::App& app) {
                                 lists.fragments.size(),
                                 static_cast<std::uint64_t>(std::llround(level * static_cast<double>(nonEmpty))));
             if (opt->skipExact && F >= exactSlots) continue;
+            if (!written.insert(F).second) continue;
             if (F >= lists.fragments.size()) {
               if (allDone) continue;
               allDone = true;

@@ -181,7 +181,9 @@ void addEvaluate(CLI::App& app) {
         throw Error("--methods " + m, "evaluate measures against the exact 'over' image; operation " + spec.operation +
                                           " draws another image (use hybrid, the default, or oit)");
       // Nor do hybrid and oit use a thickness, a step or shading, which would change nothing.
-      if (const auto unused = unusedOperationSetting(spec, false))
+      RenderRequest asRun = spec;  // auto is hybrid here, whatever the method's own (see below)
+      if (asRun.operation == "auto") asRun.operation = "hybrid";
+      if (const auto unused = unusedOperationSetting(asRun, false))
         throw Error("--methods " + m, unused->name + ": " + unused->reason);
       specs[m] = spec;
       methodWidth = std::max(methodWidth, m.size() + 2);

@@ -382,19 +382,6 @@ int main(int argc, char** argv) {
       if (scripted) fail(message, 1);
       window.statusBar()->showMessage(message);
     }
-    // --thickness and --step for an operation that does not use them, refused as by mfr render
-    // (they were kept for later and drew the same image, with no word that they did nothing).
-    if (cl.step > 0.0 && model.scene().volumes.empty())
-      refuse(QStringLiteral("--step: scene '%1' has no volume").arg(QString::fromStdString(model.scene().name)));
-    else {
-      mfr::RenderRequest given;
-      given.method = model.method().toStdString();
-      given.operation = model.operation().toStdString();
-      given.thickness = cl.thickness;
-      given.volumeStep = cl.step;
-      if (const auto unused = mfr::unusedOperationSetting(given, model.scene().hasVisibleVolume()))
-        refuse(QString::fromStdString("--" + unused->name + ": " + unused->reason));
-    }
     // After the isosurfaces, as mfr render checks: they hide the volume and widen the bounds.
     bool clipOk = true, sectionOk = true;
     if (cl.clip && *cl.clip) {
@@ -436,6 +423,24 @@ int main(int argc, char** argv) {
         if (first.startsWith(r.id + QStringLiteral(": "))) first = first.mid(r.id.size() + 2);
         if (scripted && !first.isEmpty()) fail(QStringLiteral("--plugin-settings %1: %2").arg(r.id, first), 2);
       }
+    // --thickness and --step for an operation that does not use them, refused as by mfr render
+    // (they were kept for later and drew the same image, with no word that they did nothing).
+    // After the plugins' settings, which may show the volume; either side of compare mode may use them.
+    if (cl.step > 0.0 && model.scene().volumes.empty()) {
+      refuse(QStringLiteral("--step: scene '%1' has no volume").arg(QString::fromStdString(model.scene().name)));
+    } else {
+      const auto unusedOn = [&](int side) {
+        mfr::RenderRequest given;
+        given.method = model.methodOf(side).toStdString();
+        given.operation = model.operationOf(side).toStdString();
+        given.thickness = cl.thickness;
+        given.volumeStep = cl.step;
+        return mfr::unusedOperationSetting(given, model.scene().hasVisibleVolume());
+      };
+      std::optional<mfr::UnusedOperationSetting> unused = unusedOn(0);
+      if (unused && model.compareEnabled() && !unusedOn(1)) unused.reset();
+      if (unused) refuse(QString::fromStdString("--" + unused->name + ": " + unused->reason));
+    }
   });
   if (scripted) {
     QObject::connect(&model, &ViewerModel::loadFailed, &app, [](const QString&, const QString& message) { fail(message, 1); });

@@ -36,10 +36,12 @@ QString jsonTypeName(const QJsonValue& value) {
 
 QString pluginSettingsProblem(const MfrViewerPlugin& plugin, const QJsonObject& given) {
   const QJsonObject own = plugin.saveSettings();
+  if (own.isEmpty()) return {};  // a plugin without a panel (or settings) says nothing to check by
   for (auto it = given.begin(); it != given.end(); ++it) {
     if (!own.contains(it.key()))
       return QStringLiteral("unknown key '%1' (known: %2)").arg(it.key(), own.keys().join(QStringLiteral(", ")));
     const QJsonValue expected = own.value(it.key());
+    if (expected.isNull()) continue;  // a value saved as null (Qt's NaN) tells no type
     if (it.value().type() != expected.type())
       return QStringLiteral("'%1': %2, expected %3").arg(it.key(), jsonTypeName(it.value()), jsonTypeName(expected));
     if (expected.isArray() && !expected.toArray().isEmpty()) {

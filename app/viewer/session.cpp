@@ -487,6 +487,8 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
     s.objects.push_back({r.string(o, "name", at), r.boolean(o, "visible", at, true), glm::vec4(rgba),
                          r.boolean(o, "vertex_colors", at, true)});
   }
+  if (json.contains("plugins") && !json.value("plugins").isObject())
+    r.fail(QStringLiteral("plugins"), QStringLiteral("expected an object of plugin id: settings"));
   s.plugins = json.value("plugins").toObject();
   return s;
 }

@@ -235,7 +235,10 @@ class MfrViewerPlugin {
   [[nodiscard]] virtual QString description() const = 0;
   // The plugin's panel; the viewer puts it into a dock widget and owns it.
   virtual QWidget* createPanel(ViewerContext& context, QWidget* parent) = 0;
-  // State stored in session files (under "plugins"/id()).
+  // State stored in session files (under "plugins"/id()). Settings given to loadSettings (a
+  // session's, --plugin-settings') are checked against what saveSettings() writes now: every key it
+  // may take should be written always, with one JSON type whatever the state (keys it does not
+  // write are refused as unknown, values of another type as wrong); a key left out keeps its default.
   [[nodiscard]] virtual QJsonObject saveSettings() const = 0;
   virtual void loadSettings(const QJsonObject& settings) = 0;
 };

@@ -3,11 +3,19 @@
 #include <algorithm>
 #include <vector>
 
+#include "mfr/error.hpp"
+
 namespace mfr {
 
 std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, bool sceneHasVolume) {
   const std::vector<std::string> methods = availableMethods();
   if (std::find(methods.begin(), methods.end(), request.method) == methods.end()) return std::nullopt;
+  // A misspelt --op is render()'s to name (it was blamed on the thickness: "operation is zthicknes").
+  try {
+    validateOperation(request.operation);
+  } catch (const Error&) {
+    return std::nullopt;
+  }
   const std::string operation = effectiveOperation(request.operation, findMethodInfo(request.method), sceneHasVolume);
   const auto unused = [&](const char* name, const char* user) -> std::optional<UnusedOperationSetting> {
     std::string reason = std::string("only operation ") + user + " uses it; this render's operation is " + operation;

@@ -716,6 +716,22 @@ class ViewerTest : public QObject {
       QVERIFY2(!out.contains(QStringLiteral("note: ")), qPrintable(out));  // one line, not a note and a refusal
       QVERIFY(!QFile::exists(png));
     }
+    // --step is checked after the plugins' settings, which may turn the volume on (it was refused
+    // though then used: a review); without them, wboit's "oit" does not use it.
+    {
+      QString out;
+      QCOMPARE(runProgram(MFRVIEW,
+                          {"@volume", "--size", "32x32", "--screenshot", png, "-m", "wboit", "--step", "0.05",
+                           "--plugin-settings", R"(hybridvolume={"show":true})"},
+                          &out),
+               0);
+      QFile::remove(png);
+      QCOMPARE(runProgram(MFRVIEW, {"@volume", "--size", "32x32", "--screenshot", png, "-m", "wboit", "--step", "0.05"},
+                          &out),
+               1);
+      QVERIFY2(out.contains("mfrview: --step: only operation volume uses it"), qPrintable(out));
+      QVERIFY(!QFile::exists(png));
+    }
     // A session's plugin settings: the same check, naming the file.
     const auto session = [&](const QJsonObject& budget) {
       const QString path = dir.filePath(QStringLiteral("s.mfrsession"));
@@ -824,6 +840,7 @@ class ViewerTest : public QObject {
          "s.mfrsession: params.nosuch: unknown method 'nosuch'"},
         {with("params", QJsonObject{{"kbuffer", 3}}),
          "s.mfrsession: params.kbuffer: expected an object of name: value"},
+        {with("plugins", 3), "s.mfrsession: plugins: expected an object of plugin id: settings"},
         {with("volumes",
               QJsonArray{QJsonObject{{"transfer", QJsonObject{{"points", QJsonArray{QJsonArray{0, 0, 0, 0, 0},
                                                                                     QJsonArray{1, "a", 1, 1, 1}}}}}}}),

@@ -570,7 +570,9 @@ TEST_F(Cli, SettingsOfAnotherOperationAreRefused) {
             "operation is oit\n"},
            {"evaluate @sample -s 24x16 --budgets k1 -m fkb:thickness=0.1 --json " + json,
             "mfr: --methods fkb:thickness=0.1: thickness: only operation zthickness uses it; this render's "
-            "operation is hybrid (auto, for fkb)"}}) {
+            "operation is hybrid\n"},
+           // A misspelt --op is named as such (it was blamed on the thickness: a review).
+           {"render @sample -s 16x16 -o " + out + " --op zthicknes --thickness 0.1", "mfr: --op zthicknes: "}}) {
     const CliResult r = runCli(args);
     EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << args << ": " << r.exitCode << " " << r.out;
     // "\n" in a row: the message ends there (no "(auto, …)" for an operation given by name).
@@ -597,13 +599,15 @@ TEST_F(Cli, NamesInAnotherEncodingAreWrittenAsUtf8) {
   // Two materials, two parts: a part is named after its material (one alone after its file).
   const fs::path obj = write("lat\xe6.obj",
                              "usemtl Terrain\xe6k\nv -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n"
-                             "usemtl rest\nv 5 5 0\nv 6 5 0\nv 5 6 0\nf 4 5 6\n");
+                             "usemtl r\xc0\xb0st\nv 5 5 0\nv 6 5 0\nv 5 6 0\nf 4 5 6\n");
   const fs::path json = dir() / "info.json", probe = dir() / "probe.json";
   const CliResult info = runCli("info " + obj.string() + " --no-histogram --json " + json.string());
   ASSERT_EQ(info.exitCode, 0) << info.out;
   std::ifstream in(json);
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j["part_list"][0]["name"].get<std::string>(), "Terrain\xc3\xa6k");
+  // An overlong form (C0 B0) is not UTF-8 either: read as Latin-1 too, not replaced.
+  EXPECT_EQ(j["part_list"][1]["name"].get<std::string>(), "r\xc3\x80\xc2\xb0st");
   EXPECT_EQ(j["scene"].get<std::string>(), "lat\xc3\xa6.obj");
   const CliResult p =
       runCli("probe " + obj.string() + " -s 64x64 --view front --pixel 16,43 -m abuffer-ll --json " + probe.string());
@@ -612,6 +616,14 @@ TEST_F(Cli, NamesInAnotherEncodingAreWrittenAsUtf8) {
   const nlohmann::json pj = nlohmann::json::parse(pin);
   ASSERT_FALSE(pj["fragments"].empty()) << pj.dump();
   EXPECT_EQ(pj["fragments"][0]["part"].get<std::string>(), "Terrain\xc3\xa6k") << pj.dump();
+  // A volume's name (its file's) too.
+  const fs::path grid = write("vol\xe6.vtk",
+                              "# vtk DataFile Version 3.0\ngrid\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 2 2 2\n"
+                              "ORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 8\nSCALARS v float 1\n"
+                              "LOOKUP_TABLE default\n0 1 0 1 0 1 0 1\n");
+  ASSERT_EQ(runCli("info " + grid.string() + " --no-histogram --json " + json.string()).exitCode, 0);
+  const nlohmann::json v = nlohmann::json::parse(mfr::readFile(json));
+  EXPECT_EQ(v["volumes"][0]["name"].get<std::string>(), "vol\xc3\xa6.vtk") << v.dump();
 }
 
 // A bad spec anywhere in --methods is one line before any work: it used to come after the
@@ -1071,6 +1083,10 @@ TEST_F(Cli, DatasetWritesNoEmptyFileAndNoFrameTwice) {
   }
   EXPECT_EQ(runCli("dataset @sample -s 16x16 --budgets 1,2 -o " + out).exitCode, 0);
   EXPECT_TRUE(fs::exists(out));
+  // Two budgets of one slot count are one frame (1.0001 slots per pixel rounds to 1's F here).
+  const CliResult near = runCli("dataset @sample -s 16x16 --budgets 1,1.0001 -o " + out);
+  ASSERT_EQ(near.exitCode, 0) << near.out;
+  EXPECT_EQ(std::count(near.out.begin(), near.out.end(), '\n'), 3) << near.out;  // head, one frame, the file
 }
 
 TEST_F(Cli, BudgetCommandsBadInput) {

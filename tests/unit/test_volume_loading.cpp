@@ -741,15 +741,19 @@ TEST_F(VolumeLoading, BadVti) {
     return text + "</ImageData>\n</VTKFile>\n";
   };
   expectVolumeError(write("half.vti", withPieces({{"0 3 0 7 0 7", 4}})),
-                    "its pieces cover 147 of the 343 cells of the WholeExtent '0 7 0 7 0 7' (VTK would leave the rest "
-                    "of the grid unset)");
+                    "its pieces leave out 256 of the 512 points of the WholeExtent '0 7 0 7 0 7' (VTK would leave "
+                    "them unset)");
   expectVolumeError(write("outside.vti", withPieces({{"0 9 0 7 0 7", 10}})),
                     "Piece Extent '0 9 0 7 0 7' is not inside the WholeExtent '0 7 0 7 0 7'");
-  // Two pieces that tile it are one grid, each sample where its piece puts it.
+  // Two pieces that tile it are one grid, each sample where its piece puts it: sharing their
+  // boundary points (VTK's writers) or not, and beside an empty piece (more pieces than cells).
   const mfr::Volume tiled = mfr::loadVolume(write("tiled.vti", withPieces({{"0 3 0 7 0 7", 4}, {"3 7 0 7 0 7", 5}})));
   ASSERT_EQ(tiled.grid->dims, glm::ivec3(8, 8, 8));
   EXPECT_FLOAT_EQ(tiled.grid->at(2, 5, 6), field(2, 5, 6));
   EXPECT_FLOAT_EQ(tiled.grid->at(6, 5, 6), field(3, 5, 6));  // the second piece's own x = 3
+  const mfr::Volume apart =
+      mfr::loadVolume(write("apart.vti", withPieces({{"0 3 0 7 0 7", 4}, {"4 7 0 7 0 7", 4}, {"0 -1 0 -1 0 -1", 0}})));
+  EXPECT_FLOAT_EQ(apart.grid->at(5, 5, 6), field(1, 5, 6));
 }
 
 // VTK 9.1's XML reader crashes on a String array: such arrays are skipped (the numbers beside them
@@ -785,7 +789,15 @@ TEST_F(VolumeLoading, DeclaredGridsBeyondTheFileOrMemoryAreRefusedFirst) {
       "ORIGIN 0 0 0\nSPACING 1 1 1\nPOINT_DATA 1048576000\nSCALARS f double 1\nLOOKUP_TABLE default\n";
   const fs::path tiny = write("tiny.vtk", header + std::string(400, '\0'));
   expectVolumeError(tiny, "the file's " + std::to_string(fs::file_size(tiny)) +
-                              " bytes cannot hold the 1024x1024x1000 points its DIMENSIONS declare");
+                              " bytes cannot hold the samples of the 1024x1024x1000 points its DIMENSIONS declare");
+  // Fewer bytes than points is fine for cell data of one byte (a label volume): it loads.
+  const fs::path labels =
+      write("labels.vtk",
+            "# vtk DataFile Version 3.0\nlabels\nBINARY\nDATASET STRUCTURED_POINTS\nDIMENSIONS 10 10 10\n"
+            "ORIGIN 0 0 0\nSPACING 1 1 1\nCELL_DATA 729\nSCALARS c unsigned_char 1\nLOOKUP_TABLE default\n" +
+                std::string(729, '\x07') + "\n");
+  ASSERT_LT(fs::file_size(labels), 1000u);
+  EXPECT_EQ(mfr::loadVolume(labels).grid->dims, glm::ivec3(9, 9, 9));
   // As large as it says (sparse: no disk used), 1 GiB of doubles and 0.5 GiB of floats: over a
   // memory limit, refused by it before anything is read.
   const std::string header512 =

@@ -17,8 +17,8 @@ struct UnusedOperationSetting {
 
 // The first of the request's thickness (> 0), volumeStep (> 0) and volumeShading (set) that its
 // operation, "auto" resolved for its method on a scene with or without a visible volume, does not
-// use; nullopt when each is used or unset, and for a method render() does not know (render()
-// names that).
+// use; nullopt when each is used or unset, and for a method or operation render() does not know
+// (render() names those).
 std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, bool sceneHasVolume);
 
 }  // namespace mfr

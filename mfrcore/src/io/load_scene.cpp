@@ -92,7 +92,7 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
     if (ext == ".inv3") {  // a volume with its segmented surfaces
       scene = io::loadInvesaliusScene(path, progress);
     } else {
-      scene.name = io::utf8Name(path.filename().string());
+      scene.name = path.filename().string();
       if (isVolumeFile(path))
         scene.volumes.push_back(loadVolume(path, options, progress));
       else {
@@ -116,6 +116,11 @@ Scene loadScene(const std::filesystem::path& path, const LoadProgress& progress)
 Scene loadScene(const std::filesystem::path& path, const LoadOptions& options, const LoadProgress& progress) {
   progress.step(0.0);
   Scene scene = loadSceneWithoutEndReport(path, options, progress);
+  // Names as UTF-8, whatever the file's encoding (JSON, Qt and messages need it; Latin-1 otherwise).
+  scene.name = io::utf8Name(scene.name);
+  for (Object& object : scene.objects) object.name = io::utf8Name(object.name);
+  // Not the fields: their names are the file's, to read them again by (JSON replaces what is not UTF-8).
+  for (Volume& volume : scene.volumes) volume.name = io::utf8Name(volume.name);
   addVolumeFields(scene);  // a .mfrscene has them already (its color_by may use them)
   progress.step(1.0);
   return scene;

@@ -774,43 +774,51 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
       throw Error(name, "field data array '" + attribute(tag, "Name") + "' holds text, which VTK's reader cannot skip");
     if (section != Section::kNone) found.emplace_back(attribute(tag, "Name"), section == Section::kCells);
   }
-  // Pieces that leave part of the WholeExtent out: VTK reads them into a grid of the whole extent
-  // and leaves the rest as it was allocated (two reads of one file drew different images; a bug
-  // hunt). Counted in cells, half-open per axis (a flat axis as one layer), which pieces tile.
-  if (whole && !pieces.empty() && pieces.size() <= 4096) {
+  // Pieces that leave points of the WholeExtent out: VTK reads them into a grid of the whole
+  // extent and leaves the rest as it was allocated (two reads of one file drew different images; a
+  // bug hunt). Points, not cells (pieces need not share their boundary points), by the pieces'
+  // own boundaries on each axis: every box between them must lie in some piece. Empty pieces
+  // (x1 < x0: more pieces than cells) hold nothing.
+  std::erase_if(pieces, [](const Extent& e) { return e[1] < e[0] || e[3] < e[2] || e[5] < e[4]; });
+  if (whole && !pieces.empty() && pieces.size() <= 32) {
     const auto text = [](const Extent& e) {
       std::string t;
       for (const long long v : e) t += (t.empty() ? "" : " ") + std::to_string(v);
       return t;
     };
-    const auto cells = [](const Extent& e) {
-      long long n = 1;
-      for (int a = 0; a < 3; ++a) n *= std::max<long long>(1, e[2 * a + 1] - e[2 * a]);
-      return n;
-    };
-    const auto overlap = [](const Extent& p, const Extent& q) {
-      for (int a = 0; a < 3; ++a) {
-        const long long lo = std::max(p[2 * a], q[2 * a]);
-        const long long hi = std::min(std::max(p[2 * a + 1], p[2 * a] + 1), std::max(q[2 * a + 1], q[2 * a] + 1));
-        if (lo >= hi) return false;
-      }
-      return true;
-    };
-    long long covered = 0;
-    bool overlapping = false;
-    for (std::size_t i = 0; i < pieces.size(); ++i) {
+    for (const Extent& piece : pieces)
       for (int a = 0; a < 3; ++a)
-        if (pieces[i][2 * a] < (*whole)[2 * a] || pieces[i][2 * a + 1] > (*whole)[2 * a + 1] ||
-            pieces[i][2 * a] > pieces[i][2 * a + 1])
-          throw Error(name,
-                      "Piece Extent '" + text(pieces[i]) + "' is not inside the WholeExtent '" + text(*whole) + "'");
-      covered += cells(pieces[i]);
-      for (std::size_t j = 0; j < i && !overlapping; ++j) overlapping = overlap(pieces[i], pieces[j]);
+        if (piece[2 * a] < (*whole)[2 * a] || piece[2 * a + 1] > (*whole)[2 * a + 1])
+          throw Error(name, "Piece Extent '" + text(piece) + "' is not inside the WholeExtent '" + text(*whole) + "'");
+    std::array<std::vector<long long>, 3> cuts;  // half-open point ranges [lo, hi + 1) per axis
+    for (int a = 0; a < 3; ++a) {
+      cuts[a] = {(*whole)[2 * a], (*whole)[2 * a + 1] + 1};
+      for (const Extent& piece : pieces) {
+        cuts[a].push_back(piece[2 * a]);
+        cuts[a].push_back(piece[2 * a + 1] + 1);
+      }
+      std::sort(cuts[a].begin(), cuts[a].end());
+      cuts[a].erase(std::unique(cuts[a].begin(), cuts[a].end()), cuts[a].end());
     }
-    if (!overlapping && covered < cells(*whole))
-      throw Error(name, "its pieces cover " + std::to_string(covered) + " of the " + std::to_string(cells(*whole)) +
-                            " cells of the WholeExtent '" + text(*whole) +
-                            "' (VTK would leave the rest of the grid unset)");
+    long long missing = 0;
+    for (std::size_t i = 0; i + 1 < cuts[0].size(); ++i)
+      for (std::size_t j = 0; j + 1 < cuts[1].size(); ++j)
+        for (std::size_t k = 0; k + 1 < cuts[2].size(); ++k) {
+          const std::array<long long, 3> at{cuts[0][i], cuts[1][j], cuts[2][k]};
+          const bool covered = std::any_of(pieces.begin(), pieces.end(), [&](const Extent& e) {
+            for (int a = 0; a < 3; ++a)
+              if (at[a] < e[2 * a] || at[a] > e[2 * a + 1]) return false;
+            return true;
+          });
+          if (!covered)
+            missing += (cuts[0][i + 1] - cuts[0][i]) * (cuts[1][j + 1] - cuts[1][j]) * (cuts[2][k + 1] - cuts[2][k]);
+        }
+    if (missing > 0) {
+      long long total = 1;
+      for (int a = 0; a < 3; ++a) total *= (*whole)[2 * a + 1] - (*whole)[2 * a] + 1;
+      throw Error(name, "its pieces leave out " + std::to_string(missing) + " of the " + std::to_string(total) +
+                            " points of the WholeExtent '" + text(*whole) + "' (VTK would leave them unset)");
+    }
   }
   return found;
 }
@@ -876,18 +884,20 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
                                              std::int64_t{extent[5]} - extent[4] + 1};
   checkDims(declared, name);
   const auto points = static_cast<std::uint64_t>(declared[0] * declared[1] * declared[2]);
-  // A legacy file is not compressed: fewer bytes than points cannot hold a sample each, and VTK
-  // allocated the whole grid before it found so (a 400-byte file declaring 10^9 points took 8 GB).
+  // A legacy file is not compressed: its samples take at least a bit per cell (cell data of
+  // bit scalars, the least there can be), and VTK allocated the whole grid before it found a file
+  // far too short (a 400-byte file declaring 10^9 points took 8 GB).
   if (format == VolumeFormat::LegacyVtk) {
     std::error_code error;
     const std::uintmax_t bytes = fs::file_size(path, error);
-    if (!error && bytes < points)
-      throw Error(name, "the file's " + std::to_string(bytes) + " bytes cannot hold the " + dimsText(declared) +
-                            " points its DIMENSIONS declare (at least a byte each: a truncated file?)");
+    const std::uint64_t cells = static_cast<std::uint64_t>((declared[0] - 1) * (declared[1] - 1) * (declared[2] - 1));
+    if (!error && bytes < cells / 8)
+      throw Error(name, "the file's " + std::to_string(bytes) + " bytes cannot hold the samples of the " +
+                            dimsText(declared) + " points its DIMENSIONS declare (a truncated file?)");
   }
   // VTK's array in the file's type and the grid's floats, asked for before either is allocated.
   {
-    std::uint64_t sampleBytes = 8;  // not declared: the widest scalar
+    std::uint64_t sampleBytes = 4;  // not declared: a float, the usual (a guard, not an exact count)
     if (vtkInformation* scalars = vtkDataObject::GetActiveFieldInformation(
             info, vtkDataObject::FIELD_ASSOCIATION_POINTS, vtkDataSetAttributes::SCALARS);
         scalars != nullptr && scalars->Has(vtkDataObject::FIELD_ARRAY_TYPE())) {
