@@ -812,6 +812,9 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
     for (std::size_t v = 0; v < scene.volumes.size(); ++v)
       if (std::optional<Object> slice = volumeSlice(scene, v, world, step * static_cast<double>(v + 1))) {
         out.objects.push_back(std::move(*slice));
+        // An entry per part of the result: mfr info read past the end for a slice (a crash).
+        local.outcomes.push_back(SectionOutcome::kKept);
+        local.capAreas.push_back(0.0);
         ++local.slices;
       }
   }

@@ -64,9 +64,10 @@ struct SectionReport {
   std::size_t removed = 0;
   std::vector<std::string> open;  // names of objects cut without a cap though caps were asked for
   std::size_t slices = 0;         // volume slices added (SectionPlane::slice)
-  // Per object of the scene: what the plane did to it (kKept for hidden or empty ones too), and the
-  // world area of its cap — the part's cross-section, FreeCAD's section area —, 0 without one. A
-  // solid split over parts and capped jointly has the whole cap on the part that holds it.
+  // Per object of the sectioned scene, the slices added last included (kKept, no cap): what the
+  // plane did to it (kKept for hidden or empty ones too), and the world area of its cap — the part's cross-section,
+  // FreeCAD's section area —, 0 without one. A solid split over parts and capped jointly has the whole cap on the part
+  // that holds it.
   std::vector<SectionOutcome> outcomes;
   std::vector<double> capAreas;
   [[nodiscard]] double totalCapArea() const;
