@@ -109,6 +109,17 @@ TEST(VolumeTransfer, TableHoldsColourAndExtinctionOfTheControlPoints) {
   EXPECT_THROW(tf.validate("tf"), Error);  // not ascending
   tf.points = {{1.0, glm::vec4(0.5f)}, {1.0, glm::vec4(0.5f)}};
   EXPECT_THROW(tf.validate("tf"), Error);  // empty range
+  // A step at the first value: below it (entry 0, where values below the range clamp) the first
+  // point, above it the second (entry 0 took the second: the range below was drawn clear; a bug
+  // hunt). A step at the last value: the last point at the top.
+  tf.points = {{0.1, {1.0f, 0.0f, 0.0f, 1.0f}}, {0.1, {0.0f, 1.0f, 0.0f, 0.0f}}, {0.9, {0.0f, 1.0f, 0.0f, 0.0f}}};
+  const std::vector<glm::vec4> stepped = tf.table();
+  EXPECT_EQ(stepped[0].r, 1.0f);
+  EXPECT_GT(stepped[0].a, 1.0f);  // opaque
+  EXPECT_EQ(stepped[1].g, 1.0f);
+  EXPECT_EQ(stepped[1].a, 0.0f);
+  tf.points = {{0.1, {0.0f, 1.0f, 0.0f, 0.0f}}, {0.9, {0.0f, 1.0f, 0.0f, 0.0f}}, {0.9, {0.0f, 0.0f, 1.0f, 1.0f}}};
+  EXPECT_EQ(tf.table().back().b, 1.0f);
 }
 
 TEST(VolumeComposite, HomogeneousMediumIsBeerLambert) {

@@ -59,7 +59,11 @@ std::vector<glm::vec4> TransferFunction::table() const {
     const TransferPoint& a = points[seg];
     const TransferPoint& b = points[seg + 1];
     const double t = b.value > a.value ? std::clamp((v - a.value) / (b.value - a.value), 0.0, 1.0) : 1.0;
-    const glm::dvec4 c = glm::mix(glm::dvec4(a.color), glm::dvec4(b.color), t);
+    // Entry 0 is also every value below the range (clamped there): the first point's colour, even
+    // where a step at the first value gives the second point's just above (it took the step's
+    // second colour for the whole range below: a bug hunt).
+    const glm::dvec4 c =
+        e == 0 ? glm::dvec4(points.front().color) : glm::mix(glm::dvec4(a.color), glm::dvec4(b.color), t);
     const double alpha = std::min(c.a, static_cast<double>(MFR_VOLUME_MAX_ALPHA));
     out[static_cast<std::size_t>(e)] = glm::vec4(glm::vec3(c), static_cast<float>(-std::log1p(-alpha) / unitDistance));
   }
