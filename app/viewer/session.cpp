@@ -12,6 +12,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/render.hpp"
+#include "mfr/scene/clip_box.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "viewer_model.hpp"
 
@@ -376,6 +377,11 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
       box.min = r.vec3(clip, "min", "clip");
       box.max = r.vec3(clip, "max", "clip");
       if (!box.valid()) r.fail(QStringLiteral("clip"), QStringLiteral("min must not exceed max on any axis"));
+      try {
+        mfr::requireClipBoxInFloatRange(box, "clip");
+      } catch (const mfr::Error& e) {
+        r.fail(QStringLiteral("clip"), QString::fromUtf8(e.what()).mid(QStringLiteral("clip: ").size()));
+      }
       s.clip = box;
     }
   }

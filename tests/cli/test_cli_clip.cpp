@@ -63,6 +63,9 @@ TEST_F(CliClip, BadBoxesAndCsgAreRefused) {
   // nothing is refused too.
   expectCleanFailure("render @sample --size 16x16 --clip 100,100,100,101,101,101", "holds nothing of scene 'sample'");
   expectCleanFailure("render @sample --size 16x16 -m abuffer-ll --clip 0,0,0,0,0,0", "holds nothing of scene 'sample'");
+  // Beyond a float's range the GPU's box held nothing and the oracle's everything (a bug hunt).
+  expectCleanFailure("render @sample --size 16x16 -m abuffer-ll --clip=-1e39,-1,-1,1,1,1",
+                     "--clip -1e39,-1,-1,1,1,1: a corner lies beyond a float's range (±3.4e38)");
   expectCleanFailure("render @csg --size 16x16 --op csg -m abuffer-ll --clip -1,-1,-1,1,1,1", "clip box");
   expectCleanFailure("render @csg --size 16x16 --op csg --clip -1,-1,-1,1,1,1", "clip box");
 }

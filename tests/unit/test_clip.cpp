@@ -140,6 +140,10 @@ TEST_F(SceneFileClip, ClipKeyAndItsErrors) {
       {R"("clip": {"min": [0, 0], "max": [1, 1, 1]})", "clip.min: expected an array of 3 numbers"},
       {R"("clip": {"min": [0, 0, 0], "max": [1, "a", 1]})", "clip.max[1]"},
       {R"("clip": {"min": [0, 2, 0], "max": [1, 1, 1]})", "clip: min must not exceed max"},
+      // A flat box drew an empty image; one beyond a float's range drew nothing on the GPU and
+      // everything in the oracle (a bug hunt).
+      {R"("clip": {"min": [0, -1, -1], "max": [0, 1, 1]})", "clip: holds nothing of scene 'bad' (a flat box"},
+      {R"("clip": {"min": [-1e39, 0, 0], "max": [1, 1, 1]})", "clip: a corner lies beyond a float's range (±3.4e38)"},
   };
   for (const auto& [json, mention] : bad) {
     SCOPED_TRACE(json);

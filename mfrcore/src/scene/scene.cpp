@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include <glm/trigonometric.hpp>
@@ -173,6 +174,13 @@ void requireClipBoxHoldsScene(const Scene& scene, const Bounds& box, const std::
       what, "holds nothing of scene '" + scene.name + "' (a flat box, or one outside its bounds " + bounds.str() + ")");
 }
 
+void requireClipBoxInFloatRange(const Bounds& box, const std::string& what) {
+  for (int a = 0; a < 3; ++a)
+    for (const double v : {box.min[a], box.max[a]})
+      if (!(std::abs(v) <= static_cast<double>(std::numeric_limits<float>::max())))
+        throw Error(what, "a corner lies beyond a float's range (±3.4e38)");
+}
+
 Bounds parseClipBox(const std::string& text, const std::string& what) {
   const auto corners = text::parseTwoVectors<glm::dvec3>(text);
   if (!corners) throw Error(what, "expected six numbers xmin,ymin,zmin,xmax,ymax,zmax (or none)");
@@ -180,6 +188,7 @@ Bounds parseClipBox(const std::string& text, const std::string& what) {
   box.min = corners->first;
   box.max = corners->second;
   if (!box.valid()) throw Error(what, "min must not exceed max on any axis");
+  requireClipBoxInFloatRange(box, what);
   return box;
 }
 

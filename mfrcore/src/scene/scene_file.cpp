@@ -19,6 +19,7 @@
 #include "mfr/io/load.hpp"
 #include "mfr/io_util.hpp"
 #include "mfr/json_text.hpp"
+#include "mfr/scene/clip_box.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/contour.hpp"
 #include "mfr/scene/csg.hpp"
@@ -567,6 +568,11 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     box.min = r.vec3(clip["min"], "clip.min");
     box.max = r.vec3(clip["max"], "clip.max");
     if (!box.valid()) r.fail("clip", "min must not exceed max on any axis");
+    try {
+      requireClipBoxInFloatRange(box, "clip");
+    } catch (const Error& e) {
+      r.fail("clip", std::string(e.what()).substr(std::string("clip: ").size()));
+    }
     scene.clipBox = box;
   }
   if (doc.contains("section")) {
@@ -723,6 +729,14 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
       validateCsg(scene);  // closed meshes, limits
     } catch (const Error& e) {
       r.fail("csg", e.what());
+    }
+  }
+  // A box that holds nothing drew an empty image with exit 0, where --clip refuses it (a bug hunt).
+  if (scene.clipBox) {
+    try {
+      requireClipBoxHoldsScene(scene, *scene.clipBox, "clip");
+    } catch (const Error& e) {
+      r.fail("clip", std::string(e.what()).substr(std::string("clip: ").size()));
     }
   }
   const Bounds bounds = scene.bounds();

@@ -11,4 +11,8 @@ namespace mfr {
 // the scene's bounds: it would draw an empty image.
 void requireClipBoxHoldsScene(const Scene& scene, const Bounds& box, const std::string& what);
 
+// Throws mfr::Error(what, …) for a corner beyond a float's range (±3.4e38): the GPU renderers take
+// the box as floats, where it was infinite and held nothing, while the oracle drew everything.
+void requireClipBoxInFloatRange(const Bounds& box, const std::string& what);
+
 }  // namespace mfr
