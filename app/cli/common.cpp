@@ -341,6 +341,11 @@ std::optional<ContourLegend> ContourOptions::apply(Scene& scene, double sceneOpa
   if (values.empty()) {
     if (opacity >= 0.0) throw Error("--contour-opacity", "needs --contour");
     if (keepVolume) throw Error("--keep-volume", "needs --contour");
+    // A volume alone has no surface for --opacity: it was taken and changed nothing (a bug hunt).
+    if (sceneOpacity >= 0.0 && scene.objects.empty())
+      throw Error("--opacity", "scene '" + scene.name +
+                                   "' has no surfaces (a volume's opacity is its transfer function's; --contour "
+                                   "adds isosurfaces)");
     return std::nullopt;
   }
   const std::string what = "--contour " + values;

@@ -394,8 +394,8 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
       mfr::SectionPlane plane;
       plane.point = r.vec3(section, "point", "section");
       plane.normal = r.vec3(section, "normal", "section");
-      if (!(glm::length(plane.normal) > 0.0))
-        r.fail(QStringLiteral("section"), QStringLiteral("the normal must not be zero"));
+      if (!(glm::length(plane.normal) > 1e-12))
+        r.fail(QStringLiteral("section"), QStringLiteral("the normal must not be zero (a length above 1e-12)"));
       // mfr refuses it; the viewer drew the scene uncut.
       if (!std::isfinite(glm::length(plane.normal)))
         r.fail(QStringLiteral("section"), QStringLiteral("the normal is too long to normalise (under 1e150)"));

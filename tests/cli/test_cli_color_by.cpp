@@ -247,6 +247,14 @@ TEST_F(CliColorBy, BadFieldsMapsAndRangesAreOneLine) {
                               "LOOKUP_TABLE default\n0 1 0 1 0 1 0 1\n");
   expectCleanFailure("render " + grid.string() + " --size 16x16 --color-by @v",
                      "--color-by @v: grid.vtk: no surfaces to colour (--contour adds isosurfaces of a volume)");
+  // Nor any for --opacity, which was taken and changed nothing (a bug hunt); with --contour it has.
+  expectCleanFailure("render " + grid.string() + " --size 16x16 --opacity 0.5",
+                     "--opacity: scene 'grid.vtk' has no surfaces (a volume's opacity is its transfer function's; "
+                     "--contour adds isosurfaces)");
+  EXPECT_EQ(
+      runCli("render " + grid.string() + " --size 16x16 --opacity 0.5 --contour 0.5 -o " + (dir() / "c.png").string())
+          .exitCode,
+      0);
 }
 
 }  // namespace

@@ -810,6 +810,9 @@ TEST_F(SceneFileSection, SectionKeyAndItsErrors) {
       {R"("section": {"point": [0, 0, 0]})", "section: expected \"point\" and \"normal\""},
       {R"("section": {"point": [0, 0], "normal": [1, 0, 0]})", "section.point: expected an array of 3 numbers"},
       {R"("section": {"point": [0, 0, 0], "normal": [0, 0, 0]})", "section.normal: must not be zero"},
+      // Below Scene::validate's bound: the message named neither the file nor the key (a bug hunt).
+      {R"("section": {"point": [0, 0, 0], "normal": [0, 0, 1e-30]})",
+       "section.normal: must not be zero (a length above 1e-12)"},
       // Its length overflows: normalised it was NaN, refused later as "section plane: …" without the file.
       {R"("section": {"point": [0, 0, 0], "normal": [0, 0, 1e308]})", "section.normal: too long to normalise"},
       {R"("section": {"point": [0, 0, 0], "normal": [0, 0, 1], "caps": 1})", "section.caps: expected true or false"},

@@ -582,7 +582,8 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     SectionPlane plane;
     plane.point = r.vec3(section["point"], "section.point");
     plane.normal = r.vec3(section["normal"], "section.normal");
-    if (!(glm::length(plane.normal) > 0.0)) r.fail("section.normal", "must not be zero");
+    // Scene::validate's bound, said here with the file and key (it named neither: a bug hunt).
+    if (!(glm::length(plane.normal) > 1e-12)) r.fail("section.normal", "must not be zero (a length above 1e-12)");
     if (!std::isfinite(glm::length(plane.normal))) r.fail("section.normal", "too long to normalise (under 1e150)");
     if (section.contains("caps")) {
       if (!section["caps"].is_boolean()) r.fail("section.caps", "expected true or false");
