@@ -157,9 +157,13 @@ void addRender(CLI::App& app) {
       const std::string name = depth ? "n(p)" : "k(p)";
       out.stats.notes.emplace_back("data view", name + " " + std::to_string(*lo) + " … " + std::to_string(*hi));
       out.image = countHeatmap(counts, w, h, opt->blend ? &out.image : nullptr);
-      if (opt->legend)
-        drawColorLegend(out.image, FieldColors{name, "magma", glm::dvec2(0.0, std::max<std::uint32_t>(1, *hi))},
-                        scene.background);
+      if (opt->legend) {
+        // Its text stands out from what lies under it: the map's dark end on empty pixels, not the
+        // scene's background (black on black on a white scene; a bug hunt). The corner it sits in.
+        const std::uint8_t* corner = out.image.at(w - 1, h - 1);
+        const glm::vec3 under(corner[0] / 255.0f, corner[1] / 255.0f, corner[2] / 255.0f);
+        drawColorLegend(out.image, FieldColors{name, "magma", glm::dvec2(0.0, std::max<std::uint32_t>(1, *hi))}, under);
+      }
       std::cout << (depth ? "depth complexity " : "capacity ") << name << ": " << *lo << " … " << *hi << "\n";
     } else if (legend) {
       drawColorLegend(out.image, legend->colors, scene.background, legend->ticks);

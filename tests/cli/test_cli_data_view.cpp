@@ -99,6 +99,24 @@ TEST_F(CliDataView, DepthComplexityAndCapacityAreTheOraclesCounts) {
   EXPECT_GT(checked, static_cast<std::size_t>(kWidth * kHeight / 2));
 }
 
+// The legend's text took its colour from the scene's white background: black on the map's black
+// empty pixels, unreadable (a bug hunt). Over the data view it is white; the map never is (magma's
+// brightest blue channel is about 0.75), so near-white pixels are the text's.
+TEST_F(CliDataView, TheLegendStandsOutFromTheMap) {
+  const fs::path png = dir() / "legend.png";
+  const CliResult r =
+      runCli("render @sample -s 160x160 --legend --data-view depth-complexity -m abuffer-ll -o " + png.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  const mfr::ImageRGBA8 image = mfr::readPng(png);
+  int white = 0;
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = image.at(x, y);
+      if (std::min({p[0], p[1], p[2]}) > 230) ++white;
+    }
+  EXPECT_GT(white, 30);  // the title n(p) and three tick labels
+}
+
 TEST_F(CliDataView, MethodsWithoutACapacityAndBadOptionsAreRefused) {
   const fs::path png = dir() / "x.png";
   const std::string common = "render @sample -s 32x32 ";
