@@ -373,6 +373,10 @@ int main(int argc, char** argv) {
         const QString message = QStringLiteral("--contour %1: %2").arg(texts.join(QLatin1Char(',')), reason);
         if (scripted) fail(message, 1);
         window.statusBar()->showMessage(message);
+      } else if (cl.view.isEmpty()) {
+        // The fit view of what is drawn now, as mfr render frames it (the view framed the hidden
+        // volume's box: the two programs' images differed; a bug hunt).
+        model.setCamera(model.scene().view("fit"));
       }
     }
     if (!cl.colorBy.isEmpty() &&

@@ -3408,6 +3408,23 @@ class ViewerTest : public QObject {
     QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@volume", "--contour", "0.45", "-o", cliPng} + common, &out),
              0);
     QCOMPARE(maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString())), 0);
+    // Without --view both frame what is drawn, the isosurface (mfrview framed the hidden volume's
+    // box: a bug hunt).
+    {
+      // A volume alone, a peak at its centre: the isosurface is far smaller than the box.
+      const QString peak = dir.filePath("peak.vtk");
+      QFile file(peak);
+      QVERIFY(file.open(QIODevice::WriteOnly));
+      file.write(
+          "# vtk DataFile Version 3.0\npeak\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 3 3 3\n"
+          "ORIGIN -1 -1 -1\nSPACING 1 1 1\nPOINT_DATA 27\nSCALARS v float 1\nLOOKUP_TABLE default\n"
+          "0 0 0 0 0 0 0 0 0  0 0 0 0 1 0 0 0 0  0 0 0 0 0 0 0 0 0\n");
+      file.close();
+      const QStringList fit{"--size", "96x72", "-m", "abuffer-ll", "--contour", "0.5"};
+      QCOMPARE(runProgram(MFRVIEW, QStringList{peak, "--screenshot", viewerPng} + fit, &out), 0);
+      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", peak, "-o", cliPng} + fit, &out), 0);
+      QCOMPARE(maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString())), 0);
+    }
     // --legend: the isosurfaces' map, as mfr render --legend draws it.
     QStringList larger = common;
     larger[1] = QStringLiteral("200x150");
