@@ -81,7 +81,9 @@ void addBench(CLI::App& app) {
         throw Error("--methods " + spec,
                     "a CPU method, not a GPU one: bench times the GPU methods (optimal-k "
                     "runs in mfr evaluate and mfr render)");
-      if (req.method == "oracle") (void)createMethod(req.method);  // refuses it: the CPU reference
+      // Named by the option given (the registry's refusal named --method).
+      if (req.method == "oracle")
+        throw Error("--methods " + spec, "the CPU reference, not a GPU method: bench measures every row against it");
       // The whole spec before any work, so that a typo costs no oracle and prints no half table.
       const MethodInfo* info = findMethodInfo(req.method);
       if (!info) {
@@ -139,8 +141,9 @@ void addBench(CLI::App& app) {
     out["gl_version"] = info.version;
     out["timing"] =
         GpuRenderer::defaultFinishTiming() ? "glFinish + CPU clock per pass (llvmpipe)" : "GPU timestamp queries";
-    out["oracle_fragments"] = totalFragments;
-    out["oracle_ms"] = oracleMs;
+    // Not measured under --no-quality: null, not 0 (which read as a measurement).
+    out["oracle_fragments"] = opt->noQuality ? nlohmann::ordered_json() : nlohmann::ordered_json(totalFragments);
+    out["oracle_ms"] = opt->noQuality ? nlohmann::ordered_json() : nlohmann::ordered_json(oracleMs);
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
 
     // One renderer per method (sharing the scene), frames interleaved round-robin: a slow spell

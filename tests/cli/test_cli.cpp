@@ -490,7 +490,8 @@ TEST_F(Cli, BenchRowsAndOrders) {
       EXPECT_EQ(runs["round-robin"]["results"][i][key], runs["sequential"]["results"][i][key]) << key;
   const CliResult oracle = runCli("bench @sample --size 16x16 -m oracle");
   EXPECT_EQ(oracle.exitCode, 1) << oracle.out;
-  EXPECT_NE(oracle.out.find("--method oracle: the CPU reference, not a GPU method"), std::string::npos) << oracle.out;
+  // Named by the option given (it said --method; a bug hunt).
+  EXPECT_NE(oracle.out.find("--methods oracle: the CPU reference, not a GPU method"), std::string::npos) << oracle.out;
   const fs::path json = dir() / "bad.json";
   const CliResult r = runCli("bench @sample -m abuffer-ll,magic --size 16x16 --json " + json.string());
   EXPECT_EQ(r.exitCode, 1) << r.out;
@@ -633,7 +634,7 @@ TEST_F(Cli, BenchRefusesBadSpecsBeforeAnyWork) {
            {"abuffer-ll,bogus", "mfr: --methods bogus: unknown method (available: abuffer-ll, "},
            {"abuffer-ll,kplus-array:kk=3", "mfr: --param kk: not a parameter of kplus-array"},
            {"abuffer-ll:op=magic", "mfr: --op magic: unknown operation"},
-           {"oracle", "mfr: --method oracle: the CPU reference, not a GPU method"},
+           {"oracle", "mfr: --methods oracle: the CPU reference, not a GPU method"},
            // Read past before: an empty item, a key given twice (the last won), a volume's step
            // and shade on a scene without one, a spec without a name.
            {"abuffer-ll,,kplus-array", "mfr: --methods abuffer-ll,,kplus-array: an empty item"},
@@ -1004,8 +1005,16 @@ TEST_F(Cli, MoreMemoryThanThereIsIsRefused) {
   refused("compare " + blankA.string() + " " + blankB.string() + " --metric flip",
           "flip: FLIP of 4096x2048 pixels would take 512 MiB more memory");
   // llvmpipe's buffers are main memory; a hardware driver answers GL_OUT_OF_MEMORY itself.
-  const CliResult small = runCli("bench @sample -m abuffer-ll -s 8x8 --no-quality -r 1 --warmup 0");
+  const fs::path smallJson = dir() / "small.json";
+  const CliResult small =
+      runCli("bench @sample -m abuffer-ll -s 8x8 --no-quality -r 1 --warmup 0 --json " + smallJson.string());
   ASSERT_EQ(small.exitCode, 0) << small.out;
+  {
+    // Without the oracle its numbers are null, not a measured-looking 0 (a bug hunt).
+    const nlohmann::json j = nlohmann::json::parse(mfr::readFile(smallJson));
+    EXPECT_TRUE(j["oracle_ms"].is_null()) << j.dump();
+    EXPECT_TRUE(j["oracle_fragments"].is_null()) << j.dump();
+  }
   const CliResult bench =
       mfr::test::runCommand(limit + MFR_CLI + " bench @sample -m abuffer-ll -s 4096x4096 --no-quality -r 1 --warmup 0");
   if (small.out.find("renderer: llvmpipe") != std::string::npos) {
