@@ -109,7 +109,7 @@ void addBench(CLI::App& app) {
     for (std::size_t i = 0; i < requests.size(); ++i) {
       if (scene.volumes.empty() && (requests[i].volumeStep > 0.0 || requests[i].volumeShading.has_value()))
         throw Error("--methods " + specs[i], "step and shade are the volume's; scene '" + scene.name + "' has none");
-      if (const auto unused = unusedOperationSetting(requests[i], scene.hasVisibleVolume()))
+      if (const auto unused = unusedOperationSetting(requests[i], scene))
         throw Error("--methods " + specs[i], unused->name + ": " + unused->reason);
     }
 

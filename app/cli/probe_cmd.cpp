@@ -122,8 +122,7 @@ void addProbe(CLI::App& app) {
     const Camera camera = scene.view(opt->view);  // fit frames the whole scene, cut or not
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
-    if (const auto unused = unusedOperationSetting(req, scene.hasVisibleVolume()))
-      throw Error("--" + unused->name, unused->reason);
+    if (const auto unused = unusedOperationSetting(req, scene)) throw Error("--" + unused->name, unused->reason);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);
     // What the method (or, without one, the oracle) does with the lists: hybrid and volume are taken apart.
     const std::string operation = effectiveOperation(req.operation, info, scene.hasVisibleVolume());

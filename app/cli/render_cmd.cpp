@@ -111,8 +111,7 @@ void addRender(CLI::App& app) {
       if (scene.volumes.empty()) throw Error("--shade", "scene '" + scene.name + "' has no volume");
       req.volumeShading = true;
     }
-    if (const auto unused = unusedOperationSetting(req, scene.hasVisibleVolume()))
-      throw Error("--" + unused->name, unused->reason);
+    if (const auto unused = unusedOperationSetting(req, scene)) throw Error("--" + unused->name, unused->reason);
     if (opt->blend && opt->dataView.empty()) throw Error("--blend", "needs --data-view");
     if (opt->dataView == "capacity" && opt->method == "oracle")
       throw Error("--data-view capacity", "the oracle keeps every fragment: it has no k(p) (use a method that does)");

@@ -439,7 +439,7 @@ int main(int argc, char** argv) {
         given.operation = model.operationOf(side).toStdString();
         given.thickness = cl.thickness;
         given.volumeStep = cl.step;
-        return mfr::unusedOperationSetting(given, model.scene().hasVisibleVolume());
+        return mfr::unusedOperationSetting(given, model.scene());
       };
       std::optional<mfr::UnusedOperationSetting> unused = unusedOn(0);
       if (unused && model.compareEnabled() && !unusedOn(1)) unused.reset();

@@ -28,4 +28,11 @@ std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest
   return std::nullopt;
 }
 
+std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, const Scene& scene) {
+  std::optional<UnusedOperationSetting> unused = unusedOperationSetting(request, scene.hasVisibleVolume());
+  if (unused && unused->name != "thickness" && !scene.volumes.empty() && !scene.hasVisibleVolume())
+    unused->reason += "; the scene's volume is hidden";
+  return unused;
+}
+
 }  // namespace mfr

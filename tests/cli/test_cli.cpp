@@ -556,6 +556,10 @@ TEST_F(Cli, SettingsOfAnotherOperationAreRefused) {
            {"render @volume -s 16x16 -o " + out + " -m kbuffer-zmerge --step 0.1",
             "mfr: --step: only operation volume uses it; this render's operation is zthickness (auto, for "
             "kbuffer-zmerge)"},
+           // A volume hidden by --contour: said so (a review).
+           {"render @volume -s 16x16 -o " + out + " --contour 0.5 --step 0.1",
+            "mfr: --step: only operation volume uses it; this render's operation is oit (auto, for oracle); the "
+            "scene's volume is hidden\n"},
            {"render @volume -s 16x16 -o " + out + " -m optimal-k --shade",
             "mfr: --shade: only operation volume uses it; this render's operation is hybrid (auto, for optimal-k)"},
            {"probe @sample -s 16x16 --pixel 8,8 --json " + json + " --thickness 0.1",

@@ -20,5 +20,8 @@ struct UnusedOperationSetting {
 // use; nullopt when each is used or unset, and for a method or operation render() does not know
 // (render() names those).
 std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, bool sceneHasVolume);
+// The same for a scene: its visible volume decides "auto", and a reason about the volume's step
+// or shading says when the scene's volume is there but hidden (--contour hides it).
+std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, const Scene& scene);
 
 }  // namespace mfr
