@@ -117,8 +117,8 @@ Scene loadScene(const std::filesystem::path& path, const LoadOptions& options, c
   progress.step(0.0);
   Scene scene = loadSceneWithoutEndReport(path, options, progress);
   // Names as UTF-8, whatever the file's encoding (JSON, Qt and messages need it; Latin-1 otherwise).
+  // Parts' names are loadModel's to convert (every model file's parts come through it).
   scene.name = io::utf8Name(scene.name);
-  for (Object& object : scene.objects) object.name = io::utf8Name(object.name);
   // Not the fields: their names are the file's, to read them again by (JSON replaces what is not UTF-8).
   for (Volume& volume : scene.volumes) volume.name = io::utf8Name(volume.name);
   addVolumeFields(scene);  // a .mfrscene has them already (its color_by may use them)

@@ -561,6 +561,14 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
       if (!(background[i] >= 0.0 && background[i] <= 1.0)) r.fail("background", "components must be in [0,1]");
     scene.background = glm::vec3(background);
   }
+  // The checks --clip shares (scene/clip_box.hpp), their "clip: …" as the file's key.
+  const auto clipCheck = [&](const auto& check) {
+    try {
+      check();
+    } catch (const Error& e) {
+      r.fail("clip", std::string(e.what()).substr(std::string("clip: ").size()));
+    }
+  };
   if (doc.contains("clip")) {
     const json& clip = r.object(doc["clip"], "clip", {"min", "max"});
     if (!clip.contains("min") || !clip.contains("max")) r.fail("clip", "expected \"min\" and \"max\" corners");
@@ -568,11 +576,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     box.min = r.vec3(clip["min"], "clip.min");
     box.max = r.vec3(clip["max"], "clip.max");
     if (!box.valid()) r.fail("clip", "min must not exceed max on any axis");
-    try {
-      requireClipBoxInFloatRange(box, "clip");
-    } catch (const Error& e) {
-      r.fail("clip", std::string(e.what()).substr(std::string("clip: ").size()));
-    }
+    clipCheck([&] { requireClipBoxInFloatRange(box, "clip"); });
     scene.clipBox = box;
   }
   if (doc.contains("section")) {
@@ -733,13 +737,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     }
   }
   // A box that holds nothing drew an empty image with exit 0, where --clip refuses it (a bug hunt).
-  if (scene.clipBox) {
-    try {
-      requireClipBoxHoldsScene(scene, *scene.clipBox, "clip");
-    } catch (const Error& e) {
-      r.fail("clip", std::string(e.what()).substr(std::string("clip: ").size()));
-    }
-  }
+  if (scene.clipBox) clipCheck([&] { requireClipBoxHoldsScene(scene, *scene.clipBox, "clip"); });
   const Bounds bounds = scene.bounds();
   const double radius = scene.boundingRadius();
   if (doc.contains("views")) {
