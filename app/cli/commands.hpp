@@ -144,6 +144,9 @@ struct ContourOptions {
   bool keepVolume = false;
   void add(CLI::App* cmd);
   std::optional<ContourLegend> apply(Scene& scene, double sceneOpacity) const;
+  // After apply: throws mfr::Error naming --keep-volume (and `spec`, a bench row, when given) when
+  // the request's operation does not draw the volume it keeps.
+  void requireKeptVolumeDrawn(const RenderRequest& request, const Scene& scene, const std::string& spec = {}) const;
 };
 
 // --thickness (operation zthickness) as given: 0 when absent (the scene's default); throws

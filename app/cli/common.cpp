@@ -16,6 +16,7 @@
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/contour.hpp"
 #include "mfr/list_text.hpp"
+#include "mfr/operation_settings.hpp"
 #include "mfr/scene/section.hpp"
 
 namespace mfr::cli {
@@ -390,6 +391,13 @@ std::optional<ContourLegend> ContourOptions::apply(Scene& scene, double sceneOpa
   if (!keepVolume) volume.visible = false;
   const glm::dvec2 range = contourColorRange(request.values, glm::dvec2(volume.grid->range()));
   return ContourLegend{{volume.name, "cool-warm", range}, request.values};
+}
+
+void ContourOptions::requireKeptVolumeDrawn(const RenderRequest& request, const Scene& scene,
+                                            const std::string& spec) const {
+  if (!keepVolume) return;
+  if (const std::optional<std::string> reason = volumeNotDrawnReason(request, scene))
+    throw Error(spec.empty() ? std::string("--keep-volume") : spec, (spec.empty() ? "" : "--keep-volume: ") + *reason);
 }
 
 namespace {

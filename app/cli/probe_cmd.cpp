@@ -123,6 +123,7 @@ void addProbe(CLI::App& app) {
     applySectionOption(scene, opt->section);
     refuseEmptyView(scene);
     if (const auto unused = unusedOperationSetting(req, scene)) throw Error("--" + unused->name, unused->reason);
+    opt->contours.requireKeptVolumeDrawn(req, scene);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);
     // What the method (or, without one, the oracle) does with the lists: hybrid and volume are taken apart.
     const std::string operation = effectiveOperation(req.operation, info, scene.hasVisibleVolume());

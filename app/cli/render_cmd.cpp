@@ -112,6 +112,7 @@ void addRender(CLI::App& app) {
       req.volumeShading = true;
     }
     if (const auto unused = unusedOperationSetting(req, scene)) throw Error("--" + unused->name, unused->reason);
+    opt->contours.requireKeptVolumeDrawn(req, scene);
     if (opt->blend && opt->dataView.empty()) throw Error("--blend", "needs --data-view");
     if (opt->dataView == "capacity" && opt->method == "oracle")
       throw Error("--data-view capacity", "the oracle keeps every fragment: it has no k(p) (use a method that does)");

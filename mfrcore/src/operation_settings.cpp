@@ -7,24 +7,40 @@
 
 namespace mfr {
 
-std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, bool sceneHasVolume) {
+namespace {
+
+// The operation the request runs, "auto" resolved, or nullopt for a method or operation render()
+// does not know (render() names those; a misspelt --op was blamed on the thickness:
+// "operation is zthicknes").
+std::optional<std::string> knownOperation(const RenderRequest& request, bool sceneHasVolume) {
   const std::vector<std::string> methods = availableMethods();
   if (std::find(methods.begin(), methods.end(), request.method) == methods.end()) return std::nullopt;
-  // A misspelt --op is render()'s to name (it was blamed on the thickness: "operation is zthicknes").
   try {
     validateOperation(request.operation);
   } catch (const Error&) {
     return std::nullopt;
   }
-  const std::string operation = effectiveOperation(request.operation, findMethodInfo(request.method), sceneHasVolume);
+  return effectiveOperation(request.operation, findMethodInfo(request.method), sceneHasVolume);
+}
+
+std::string thisRendersOperation(const RenderRequest& request, const std::string& operation) {
+  std::string text = "this render's operation is " + operation;
+  if (request.operation == "auto") text += " (auto, for " + request.method + ")";
+  return text;
+}
+
+}  // namespace
+
+std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, bool sceneHasVolume) {
+  const std::optional<std::string> operation = knownOperation(request, sceneHasVolume);
+  if (!operation) return std::nullopt;
   const auto unused = [&](const char* name, const char* user) -> std::optional<UnusedOperationSetting> {
-    std::string reason = std::string("only operation ") + user + " uses it; this render's operation is " + operation;
-    if (request.operation == "auto") reason += " (auto, for " + request.method + ")";
-    return UnusedOperationSetting{name, reason};
+    return UnusedOperationSetting{
+        name, std::string("only operation ") + user + " uses it; " + thisRendersOperation(request, *operation)};
   };
-  if (request.thickness > 0.0 && operation != "zthickness") return unused("thickness", "zthickness");
-  if (request.volumeStep > 0.0 && operation != "volume") return unused("step", "volume");
-  if (request.volumeShading.has_value() && operation != "volume") return unused("shade", "volume");
+  if (request.thickness > 0.0 && *operation != "zthickness") return unused("thickness", "zthickness");
+  if (request.volumeStep > 0.0 && *operation != "volume") return unused("step", "volume");
+  if (request.volumeShading.has_value() && *operation != "volume") return unused("shade", "volume");
   return std::nullopt;
 }
 
@@ -33,6 +49,13 @@ std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest
   if (unused && unused->name != "thickness" && !scene.volumes.empty() && !scene.hasVisibleVolume())
     unused->reason += "; the scene's volume is hidden";
   return unused;
+}
+
+std::optional<std::string> volumeNotDrawnReason(const RenderRequest& request, const Scene& scene) {
+  if (!scene.hasVisibleVolume()) return std::nullopt;
+  const std::optional<std::string> operation = knownOperation(request, true);
+  if (!operation || *operation == "volume") return std::nullopt;
+  return thisRendersOperation(request, *operation) + "; only operation volume draws the volume";
 }
 
 }  // namespace mfr

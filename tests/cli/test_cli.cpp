@@ -577,7 +577,19 @@ TEST_F(Cli, SettingsOfAnotherOperationAreRefused) {
             "mfr: --methods fkb:thickness=0.1: thickness: only operation zthickness uses it; this render's "
             "operation is hybrid\n"},
            // A misspelt --op is named as such (it was blamed on the thickness: a review).
-           {"render @sample -s 16x16 -o " + out + " --op zthicknes --thickness 0.1", "mfr: --op zthicknes: "}}) {
+           {"render @sample -s 16x16 -o " + out + " --op zthicknes --thickness 0.1", "mfr: --op zthicknes: "},
+           // --keep-volume keeps the volume beside its isosurfaces: an operation that does not draw
+           // it took the option and changed nothing (a bug hunt).
+           {"render @volume -s 16x16 -o " + out + " --contour 0.5 --keep-volume --op oit",
+            "mfr: --keep-volume: this render's operation is oit; only operation volume draws the volume\n"},
+           {"render @volume -s 16x16 -o " + out + " --contour 0.5 --keep-volume -m fkb",
+            "mfr: --keep-volume: this render's operation is hybrid (auto, for fkb); only operation volume draws "
+            "the volume\n"},
+           {"probe @volume -s 16x16 --pixel 8,8 --json " + json + " --contour 0.5 --keep-volume --op hybrid",
+            "mfr: --keep-volume: this render's operation is hybrid; only operation volume draws the volume\n"},
+           {"bench @volume -s 16x16 -r 1 -m abuffer-ll,kbuffer:op=oit --contour 0.5 --keep-volume --json " + json,
+            "mfr: --methods kbuffer:op=oit: --keep-volume: this render's operation is oit; only operation volume "
+            "draws the volume\n"}}) {
     const CliResult r = runCli(args);
     EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << args << ": " << r.exitCode << " " << r.out;
     // "\n" in a row: the message ends there (no "(auto, …)" for an operation given by name).
@@ -595,6 +607,10 @@ TEST_F(Cli, SettingsOfAnotherOperationAreRefused) {
   ASSERT_EQ(runCli("render @intersect -s 32x32 -m abuffer-ll --op zthickness -o " + b).exitCode, 0);
   EXPECT_GT(mfr::rmse(mfr::readPng(a), mfr::readPng(b)), 0.001);
   ASSERT_EQ(runCli("render @volume -s 32x32 -m kplus-array --step 0.2 -o " + a).exitCode, 0);
+  // --keep-volume where the volume is drawn: taken, and the kept volume is in the image.
+  ASSERT_EQ(runCli("render @volume -s 32x32 -m abuffer-ll --contour 0.5 --keep-volume -o " + a).exitCode, 0);
+  ASSERT_EQ(runCli("render @volume -s 32x32 -m abuffer-ll --contour 0.5 -o " + b).exitCode, 0);
+  EXPECT_GT(mfr::rmse(mfr::readPng(a), mfr::readPng(b)), 0.001);
 }
 
 // A part name in Latin-1 (assimp's regr01.obj has "Terraind\xe6k") ended info --json and

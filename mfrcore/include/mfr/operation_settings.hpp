@@ -24,4 +24,10 @@ std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest
 // or shading says when the scene's volume is there but hidden (--contour hides it).
 std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, const Scene& scene);
 
+// Why the request's operation leaves the scene's visible volume undrawn (e.g. "this render's
+// operation is oit; only operation volume draws the volume"), or nullopt when it draws it, when
+// the scene shows no volume, and for a method or operation render() does not know. For
+// --keep-volume, which asks for the volume beside its isosurfaces: it was taken and changed nothing.
+std::optional<std::string> volumeNotDrawnReason(const RenderRequest& request, const Scene& scene);
+
 }  // namespace mfr
