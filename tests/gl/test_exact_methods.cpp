@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <iostream>
 #include <map>
 #include <string>
 #include <tuple>
@@ -82,6 +83,10 @@ TEST(ExactMethodStorage, FramesBeyondTheLargestStorageBlockAreRefused) {
   const auto block = static_cast<std::uint64_t>(blockBytes);
   constexpr int kSide = 1024;
   constexpr std::uint64_t kPixels = std::uint64_t{kSide} * kSide;
+  // A GPU's block can hold every frame a case can make: such a case is left out, and said so (it
+  // was left out without a word); when all are, the test is a skip, not a pass.
+  std::vector<std::string> leftOut;
+  int checked = 0;
   for (const auto& [method, params, fragmentBytes] :
        std::vector<std::tuple<std::string, std::map<std::string, std::string>, std::uint64_t>>{
            {"abuffer-ll", {}, 12}, {"abuffer-sbuffer", {}, 8}, {"abuffer-array", {{"slots", "0"}}, 8}}) {
@@ -90,7 +95,11 @@ TEST(ExactMethodStorage, FramesBeyondTheLargestStorageBlockAreRefused) {
     const std::uint64_t layers = std::min<std::uint64_t>(block / fragmentBytes, 0xFFFFFFFFull) / kPixels + 1;
     // A block this large holds what @quads (4096 layers at most) or abuffer-array (1024 slots) can
     // ask for at this size: nothing to refuse.
-    if (layers > (method == "abuffer-array" ? 1024u : 4096u)) continue;
+    if (layers > (method == "abuffer-array" ? 1024u : 4096u)) {
+      leftOut.push_back(method + " at " + std::to_string(layers) + " layers");
+      continue;
+    }
+    ++checked;
     const Scene scene = makeQuadsScene(static_cast<int>(layers));
     GpuRenderer gpu;
     gpu.setScene(scene);
@@ -124,7 +133,11 @@ TEST(ExactMethodStorage, FramesBeyondTheLargestStorageBlockAreRefused) {
     req.method = method;
     req.width = 16;
     req.height = 16;
-    if (block / (1024 * 1024) + 1 > 65536) continue;  // beyond pool_mib's own range
+    if (block / (1024 * 1024) + 1 > 65536) {  // beyond pool_mib's own range
+      leftOut.push_back(method + " pool_mib");
+      continue;
+    }
+    ++checked;
     const std::string mib = std::to_string(block / (1024 * 1024) + 1);
     req.params = {{"pool", "fixed"}, {"pool_mib", mib}};
     try {
@@ -140,7 +153,9 @@ TEST(ExactMethodStorage, FramesBeyondTheLargestStorageBlockAreRefused) {
   // deepest pixel's fragments" when that pixel had more). The smallest square frame whose 1,024
   // slots per pixel exceed the block; a GPU block too large for a quick frame holds it anyway.
   const auto side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(block / 8 / 1024 + 1))));
+  if (side > 512) leftOut.push_back("abuffer-array's capped slots at " + std::to_string(side) + " pixels a side");
   if (side <= 512) {
+    ++checked;
     const Scene quads = makeQuadsScene(1100);
     GpuRenderer gpu;
     gpu.setScene(quads);
@@ -161,6 +176,13 @@ TEST(ExactMethodStorage, FramesBeyondTheLargestStorageBlockAreRefused) {
           << e.what();
     }
   }
+  std::string cases;
+  for (const std::string& c : leftOut) cases += (cases.empty() ? "" : "; ") + c;
+  if (checked == 0)
+    GTEST_SKIP() << "this context's largest storage block (" << block / (1024 * 1024)
+                 << " MiB) holds every frame the test makes: " << cases;
+  if (!leftOut.empty())
+    std::cout << "[   NOTE   ] left out, the block (" << block / (1024 * 1024) << " MiB) holds them: " << cases << "\n";
 }
 
 }  // namespace mfr::test
