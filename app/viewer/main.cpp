@@ -347,8 +347,8 @@ int main(int argc, char** argv) {
   // Plugins' notes on stderr as the session's own (scripted runs have no status bar), except
   // those that end a scripted run as a refusal of --plugin-settings.
   bool quietNotes = false;
-  QObject::connect(&model, &ViewerContext::noted, &window, [&quietNotes](const QString& text) {
-    if (!quietNotes) std::cerr << "note: " << text.toStdString() << "\n";
+  QObject::connect(&model, &ViewerContext::noted, &window, [&quietNotes, &window](const QString& text) {
+    if (!quietNotes) std::cerr << "note: " << (window.notePrefix() + text).toStdString() << "\n";
   });
   // Applied once the scene has loaded: the view and, for scripted runs, the pictures.
   bool applied = false;

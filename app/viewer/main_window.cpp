@@ -247,9 +247,11 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
             QFileInfo(pendingSessionFile_).fileName() + QStringLiteral(": ") + notes.join(QStringLiteral("; ")), 20000);
       }
       if (model_->compareEnabled()) compareDock_->show();
+      notePrefix_ = QFileInfo(pendingSessionFile_).fileName() + QStringLiteral(": plugins.");
       for (const PluginRecord& r : plugins_.records())
         if (r.plugin && pendingSession_->plugins.contains(r.id))
           r.plugin->loadSettings(pendingSession_->plugins.value(r.id).toObject());
+      notePrefix_.clear();
       addRecentFile(pendingSessionFile_);
       pendingSession_.reset();
     }
@@ -266,7 +268,8 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
   });
   connect(model_, &ViewerModel::frameRendered, this, &MainWindow::updateFrameInfo);
   // Plugins' notes (ViewerContext::note) in the status bar; main() also writes them to stderr.
-  connect(model_, &ViewerContext::noted, this, [this](const QString& text) {
+  connect(model_, &ViewerContext::noted, this, [this](const QString& note) {
+    const QString text = notePrefix_ + note;
     const QString shown = statusBar()->currentMessage();
     statusBar()->showMessage(shown.isEmpty() ? text : shown + QStringLiteral("; ") + text, 20000);
   });

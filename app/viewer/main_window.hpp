@@ -49,6 +49,9 @@ class MainWindow final : public QMainWindow {
   [[nodiscard]] const PluginManager& plugins() const { return plugins_; }
   // The last load error shown to the user (empty when the last load succeeded).
   [[nodiscard]] const QString& lastError() const { return lastError_; }
+  // While a session's plugin settings are applied, "FILE: plugins.": their notes (which begin with
+  // the plugin's id) are prefixed with it, as the session's own notes name the file and key.
+  [[nodiscard]] const QString& notePrefix() const { return notePrefix_; }
 
  protected:
   void closeEvent(QCloseEvent* event) override;
@@ -88,4 +91,5 @@ class MainWindow final : public QMainWindow {
   bool restoredLayout_ = false;
   std::optional<Session> pendingSession_;  // applied once its scene has loaded
   QString pendingSessionFile_;
+  QString notePrefix_;
 };
