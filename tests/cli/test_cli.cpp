@@ -343,6 +343,11 @@ TEST_F(Cli, QuadsSceneNameIsReadWhole) {
     expectCleanFailure(std::string("render ") + name + " -s 16x16",
                        std::string(name) + ": expected @quads:N[:density[:seed]]");
   expectCleanFailure("render @quads:0 -s 16x16", "@quads: layer count must be in [1, 4096]");
+  // Whole but too large: its range, not "not whole" (a bug hunt).
+  expectCleanFailure("render @quads:4:0.5:4294967296 -s 16x16",
+                     "@quads:4:0.5:4294967296: expected @quads:N[:density[:seed]]: the seed 4294967296 is beyond "
+                     "4294967295 (32 bits)");
+  expectCleanFailure("render @quads:99999999999 -s 16x16", "@quads: layer count must be in [1, 4096]");
   const fs::path png = dir() / "q.png";
   EXPECT_EQ(runCli("render @quads:4:0.5:7 -s 16x16 -o " + png.string()).exitCode, 0);
 }

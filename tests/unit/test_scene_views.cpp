@@ -58,4 +58,20 @@ TEST_F(SceneViews, AScenesOwnViewsComeFirst) {
   expectFitFrom(model, model.view("front"), {0.0, 0.0, 1.0});
 }
 
+// orbit:AZIMUTH:ELEVATION is read whole: sscanf's %lf skipped blanks, so "orbit: 5:0" was
+// taken (a bug hunt) where no other view name is trimmed.
+TEST_F(SceneViews, OrbitViewsAreReadWhole) {
+  const mfr::Scene sample = mfr::loadScene("@sample");
+  expectFitFrom(sample, sample.view("orbit:90:0"), {1.0, 0.0, 0.0});
+  for (const std::string name : {"orbit: 5:0", "orbit:5: 0", "orbit:5:0 ", "orbit:5:0x", "orbit:5:90", "orbit:5"}) {
+    try {
+      (void)sample.view(name);
+      ADD_FAILURE() << "'" << name << "' was taken";
+    } catch (const mfr::Error& e) {
+      EXPECT_EQ(std::string(e.what()),
+                "view '" + name + "': expected orbit:AZIMUTH:ELEVATION in degrees, |elevation| <= 89");
+    }
+  }
+}
+
 }  // namespace

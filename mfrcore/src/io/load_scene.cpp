@@ -5,6 +5,7 @@
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <type_traits>
 #include <vector>
 
 #include "file_checks.hpp"
@@ -65,7 +66,15 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
     const auto bad = [&] { return Error(text, "expected @quads:N[:density[:seed]] (N and seed whole numbers)"); };
     const auto whole = [&](std::string_view field, auto& value) {
       const auto [end, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
-      if (field.empty() || ec != std::errc() || end != field.data() + field.size()) throw bad();
+      if (field.empty() || end != field.data() + field.size()) throw bad();
+      // A whole number too large for its field was called "not whole" (a bug hunt): say its range.
+      if (ec == std::errc::result_out_of_range) {
+        const bool isSeed = std::is_unsigned_v<std::remove_reference_t<decltype(value)>>;
+        if (!isSeed) throw Error("@quads", "layer count must be in [1, 4096]");
+        throw Error(text, "expected @quads:N[:density[:seed]]: the seed " + std::string(field) +
+                              " is beyond 4294967295 (32 bits)");
+      }
+      if (ec != std::errc()) throw bad();
     };
     if (fields.size() > 3) throw bad();
     int layers = 0;

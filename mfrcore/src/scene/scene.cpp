@@ -1,6 +1,7 @@
 #include "mfr/scene/scene.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -140,7 +141,9 @@ Camera Scene::view(const std::string& viewName) const {
     // looks from +Z, 90 from +X.
     double azimuth = 0, elevation = 0;
     char extra = 0;
-    if (std::sscanf(viewName.c_str(), "orbit:%lf:%lf%c", &azimuth, &elevation, &extra) != 2 ||
+    // sscanf's %lf skips blanks: "orbit: 5:0" was taken (a bug hunt), as other views' names are not.
+    const bool blank = std::any_of(viewName.begin(), viewName.end(), [](unsigned char c) { return std::isspace(c); });
+    if (blank || std::sscanf(viewName.c_str(), "orbit:%lf:%lf%c", &azimuth, &elevation, &extra) != 2 ||
         !std::isfinite(azimuth) || !std::isfinite(elevation) || std::abs(elevation) > 89.0)
       throw Error("view '" + viewName + "'", "expected orbit:AZIMUTH:ELEVATION in degrees, |elevation| <= 89");
     const double az = glm::radians(azimuth), el = glm::radians(elevation);
