@@ -841,3 +841,27 @@ TEST_F(LoadModel, PrimitivesBeyondMemoryAreRefusedFirst) {
 }
 
 }  // namespace
+
+namespace {
+
+// A tube whose path turns straight back has no direction at the turn: makeTube said "repeated path
+// point" and named none (a bug hunt). The scene file names the point; a sharp turn that is not
+// straight back still makes a tube.
+TEST_F(LoadModel, ATubeTurningStraightBackNamesThePoint) {
+  const fs::path back = write("back.mfrscene", R"({"objects": [{"primitive": {"type": "tube",
+      "path": [[0, 0, 0], [1, 0, 0], [2, 0, 0], [1, 0, 0]], "radius": 0.1}}]})");
+  try {
+    (void)mfr::loadScene(back);
+    ADD_FAILURE() << "a tube turning straight back was made";
+  } catch (const mfr::Error& e) {
+    EXPECT_EQ(std::string(e.what()), back.string() +
+                                         ": objects[0].primitive.path[3]: returns to path[1]: the tube has no "
+                                         "direction at path[2], where it turns straight back");
+  }
+  const mfr::Scene sharp = mfr::loadScene(write("sharp.mfrscene", R"({"objects": [{"primitive": {"type": "tube",
+      "path": [[0, 0, 0], [1, 0, 0], [0, 0.1, 0]], "radius": 0.1}}]})"));
+  ASSERT_EQ(sharp.objects.size(), 1u);
+  EXPECT_GT(sharp.objects[0].mesh->triangleCount(), 0u);
+}
+
+}  // namespace

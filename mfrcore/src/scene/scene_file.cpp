@@ -227,6 +227,13 @@ Mesh parsePrimitive(const Reader& r, const json& p, const std::string& where) {
         r.fail(where + ".path[" + std::to_string(i) + "]", "coordinates must be within ±1e15");
     for (std::size_t i = 1; i < path.size(); ++i)
       if (path[i] == path[i - 1]) r.fail(where + ".path[" + std::to_string(i) + "]", "repeats the previous point");
+    // A path that turns straight back has no direction at the turn (makeTube's "repeated path
+    // point" named no point: a bug hunt).
+    for (std::size_t i = 2; i < path.size(); ++i)
+      if (path[i] == path[i - 2])
+        r.fail(where + ".path[" + std::to_string(i) + "]",
+               "returns to path[" + std::to_string(i - 2) + "]: the tube has no direction at path[" +
+                   std::to_string(i - 1) + "], where it turns straight back");
     const double radius = size("radius", 0.05);
     const int sides = r.integer(p, "sides", where, 12, 3, 1024);
     requireVertices(static_cast<double>(path.size()) * (sides + 1.0) + 2.0 * (sides + 1.0));
