@@ -4,6 +4,8 @@
 // coloured by a volume field, and bad input fails with one line and no output.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -76,6 +78,45 @@ TEST_F(CliContour, ColouredByAVolumeFieldTheyShowTheirValue) {
   const std::string line = r.out.substr(at, r.out.find('\n', at) - at);
   EXPECT_NE(line.find("@field 0.600"), std::string::npos) << line;
   EXPECT_NE(line.find("148 148 148"), std::string::npos) << line;  // grayscale at 0.6 (ColorMaps.* check the map)
+}
+
+// An isosurface coloured by its own volume is one value, up to float rounding (0.7 ± 6e-8 here):
+// that rounding was spread over the whole map, in speckles the oracle and the GPU drew apart
+// (RMSE 0.01–0.035, a bug hunt). It is now a constant, drawn in the map's middle colour.
+TEST_F(CliContour, ColouredByTheirOwnVolumeTheyAreOneColour) {
+  {
+    std::ofstream grid(dir() / "ball.vtk");  // distance from the centre, 24³ points over [-1, 1]³
+    grid << "# vtk DataFile Version 3.0\nball\nASCII\nDATASET STRUCTURED_POINTS\nDIMENSIONS 24 24 24\n"
+            "ORIGIN -1 -1 -1\nSPACING "
+         << 2.0 / 23 << " " << 2.0 / 23 << " " << 2.0 / 23
+         << "\nPOINT_DATA 13824\nSCALARS d float 1\nLOOKUP_TABLE default\n";
+    for (int k = 0; k < 24; ++k)
+      for (int j = 0; j < 24; ++j)
+        for (int i = 0; i < 24; ++i) {
+          const double x = -1 + 2.0 * i / 23, y = -1 + 2.0 * j / 23, z = -1 + 2.0 * k / 23;
+          grid << std::sqrt(x * x + y * y + z * z) << "\n";
+        }
+  }
+  const std::string ball = (dir() / "ball.vtk").string();
+  const CliResult r = runCli("probe " + ball +
+                             " --size 64x64 --pixel 32,32 --contour 0.7 --color-by @ball.vtk "
+                             "--color-map grayscale -m abuffer-ll");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '@'), 2) << r.out;  // both fragments of the sphere
+  std::size_t grays = 0;
+  for (std::size_t at = r.out.find("127 127 127 128"); at != std::string::npos;
+       at = r.out.find("127 127 127 128", at + 1))
+    ++grays;
+  EXPECT_EQ(grays, 2u) << r.out;  // grayscale's middle, at opacity 0.5
+  // The GPU agrees with the oracle as it does uncoloured (edge pixels only).
+  const fs::path oracle = dir() / "o.png", gpu = dir() / "g.png", plainOracle = dir() / "po.png",
+                 plainGpu = dir() / "pg.png";
+  const std::string common = "render " + ball + " --size 96x96 --contour 0.7 ";
+  ASSERT_EQ(runCli(common + "--color-by @ball.vtk -o " + oracle.string()).exitCode, 0);
+  ASSERT_EQ(runCli(common + "--color-by @ball.vtk -m abuffer-ll -o " + gpu.string()).exitCode, 0);
+  ASSERT_EQ(runCli(common + "-o " + plainOracle.string()).exitCode, 0);
+  ASSERT_EQ(runCli(common + "-m abuffer-ll -o " + plainGpu.string()).exitCode, 0);
+  EXPECT_LT(rmseOf(oracle, gpu), rmseOf(plainOracle, plainGpu) + 0.002);
 }
 
 TEST_F(CliContour, BenchAcceptsIsosurfaces) {

@@ -145,6 +145,16 @@ TEST(FieldColoring, FieldsByNameComponentAndMagnitude) {
   EXPECT_TRUE(fieldValues(*m, "tri", "square").cellData);
   EXPECT_EQ(fieldRange(fieldValues(*m, "x", "square").values), glm::dvec2(-10.0, 10.0));
   EXPECT_EQ(fieldRange({4.0f, 4.0f}), glm::dvec2(3.0, 5.0));
+  // Within float rounding of a constant (an isosurface coloured by its own volume: 0.5 ± a few
+  // steps) is a constant: its middle ± 1, not its rounding noise over the whole map.
+  {
+    const glm::dvec2 r = fieldRange({std::nextafter(0.5f, 0.0f), 0.5f, std::nextafter(0.5f, 1.0f)});
+    EXPECT_NEAR(r.x, -0.5, 1e-6);
+    EXPECT_NEAR(r.y, 1.5, 1e-6);
+  }
+  // A small span that is not rounding is kept, however small its values.
+  EXPECT_EQ(fieldRange({0.0f, 1e-30f}), glm::dvec2(0.0, double(1e-30f)));
+  EXPECT_EQ(fieldRange({1000.0f, 1000.1f}), glm::dvec2(1000.0, double(1000.1f)));
   // A large constant: ±1 would be the same float (1e8 ± 1), and the renderers refused the range.
   for (const float big : {1e8f, -3e20f, std::numeric_limits<float>::max()}) {
     const glm::dvec2 r = fieldRange({big, big});

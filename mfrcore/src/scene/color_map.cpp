@@ -184,10 +184,15 @@ glm::dvec2 fieldRange(const std::vector<float>& values) {
   if (!span) return {0.0, 1.0};
   // A constant: one step either side that floats tell apart from it (1e8 ± 1 is 1e8 as a float,
   // and the renderers refused the range the user never gave).
-  if (span->x == span->y) {
-    const double step = std::max(1.0, std::abs(span->x) * 0x1p-20);
+  // A span of a few float steps is a constant too: an isosurface coloured by its own volume
+  // (0.5 ± 6e-8 from rounding) spread that noise over the whole map, in speckles that the oracle
+  // and the GPU drew apart (RMSE 0.01–0.035, a bug hunt).
+  const double magnitude = std::max(std::abs(span->x), std::abs(span->y));
+  if (span->y - span->x <= magnitude * 0x1p-20) {
+    const double centre = span->x + 0.5 * (span->y - span->x);
+    const double step = std::max(1.0, std::abs(centre) * 0x1p-20);
     const double largest = std::numeric_limits<float>::max();
-    return {std::max(span->x - step, -largest), std::min(span->y + step, largest)};
+    return {std::max(centre - step, -largest), std::min(centre + step, largest)};
   }
   return *span;
 }

@@ -57,7 +57,8 @@ FieldValues fieldValues(const Mesh& mesh, const std::string& field, const std::s
 
 // The smallest and largest finite value, if there is one (what mfr info reports).
 std::optional<glm::dvec2> finiteSpan(const std::vector<float>& values);
-// The same as a colour map's range: an empty span widened to value ± 1; [0, 1] without any.
+// The same as a colour map's range: an empty span — or one within float rounding of a constant,
+// at most 2^-20 of its magnitude — widened to its middle ± 1; [0, 1] without any.
 glm::dvec2 fieldRange(const std::vector<float>& values);
 
 // Colours `object` by `field` of its mesh with `map` over `range` (default: fieldRange of the
