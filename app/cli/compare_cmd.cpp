@@ -62,8 +62,10 @@ void addCompare(CLI::App& app) {
       if (!opt->heatmap.empty()) heat = magma(f.errorMap);
     }
     if (!opt->heatmap.empty() && heat.empty()) heat = heatmap(absoluteDifference(ref, test), 1.0f);
-    if (!opt->heatmap.empty()) writePng(opt->heatmap, heat);
-    if (!opt->json.empty()) writeFileAtomically(opt->json, jsonText(j, 2) + "\n");
+    std::vector<std::pair<std::filesystem::path, std::string>> outputs;
+    if (!opt->heatmap.empty()) outputs.emplace_back(opt->heatmap, encodePng(opt->heatmap, heat));
+    if (!opt->json.empty()) outputs.emplace_back(opt->json, jsonText(j, 2) + "\n");
+    writeFilesAtomically(outputs);
   });
 }
 

@@ -169,8 +169,10 @@ void addRender(CLI::App& app) {
       drawColorLegend(out.image, legend->colors, scene.background, legend->ticks);
     }
     // Both outputs are produced before either is written, and each is written atomically.
-    writePng(opt->output, out.image);
-    if (!opt->stats.empty()) writeFileAtomically(opt->stats, toJson(out.stats) + "\n");
+    std::vector<std::pair<std::filesystem::path, std::string>> outputs{
+        {opt->output, encodePng(opt->output, out.image)}};
+    if (!opt->stats.empty()) outputs.emplace_back(opt->stats, toJson(out.stats) + "\n");
+    writeFilesAtomically(outputs);
     std::cout << opt->output << "\n";
   });
 }

@@ -139,14 +139,18 @@ static bool encodePng(const ImageRGBA8& image, const png_const_bytep* rows, std:
   return true;
 }
 
-void writePng(const std::filesystem::path& path, const ImageRGBA8& image) {
+std::string encodePng(const std::filesystem::path& path, const ImageRGBA8& image) {
   if (image.empty()) throw Error(path.string(), "cannot write an empty image");
   std::vector<png_const_bytep> rows(static_cast<std::size_t>(image.height));
   for (int y = 0; y < image.height; ++y) rows[static_cast<std::size_t>(y)] = image.at(0, y);
   std::string encoded;
   PngErrorState state;
   if (!encodePng(image, rows.data(), &encoded, &state)) throw Error(path.string(), "PNG encoding failed (" + state.message + ")");
-  writeFileAtomically(path, encoded);
+  return encoded;
+}
+
+void writePng(const std::filesystem::path& path, const ImageRGBA8& image) {
+  writeFileAtomically(path, encodePng(path, image));
 }
 
 void flipVertically(ImageRGBA8& image) {

@@ -9,6 +9,8 @@
 #include <random>
 #include <sstream>
 #include <system_error>
+#include <utility>
+#include <vector>
 
 #include "mfr/error.hpp"
 
@@ -68,28 +70,64 @@ void checkOutputPath(const std::filesystem::path& given) {
   checkFolderTakesFiles(dir, given);
 }
 
-void writeFileAtomically(const std::filesystem::path& given, std::string_view bytes) {
+namespace {
+
+// A finished temporary beside its output, renamed over it by commit().
+struct Temporary {
+  std::filesystem::path given, target, tmp;
+};
+
+Temporary writeTemporary(const std::filesystem::path& given, std::string_view bytes) {
   checkOutputPath(given);
-  const std::filesystem::path path = outputTarget(given);  // a link's file, not the link
-  std::error_code ec;
+  Temporary t{given, outputTarget(given), {}};  // a link's file, not the link
   // Temporary beside the target (same file system), renamed over it only when complete.
-  std::filesystem::path tmp = path;
-  tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(std::random_device{}() & 0xFFFFFF);
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(given.string(), std::string("cannot write (") + std::strerror(errno) + ")");
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) {
-      std::filesystem::remove(tmp, ec);
-      throw Error(given.string(), "write failed (disk full?)");
-    }
+  t.tmp = t.target;
+  t.tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(std::random_device{}() & 0xFFFFFF);
+  std::ofstream out(t.tmp, std::ios::binary | std::ios::trunc);
+  if (!out) throw Error(given.string(), std::string("cannot write (") + std::strerror(errno) + ")");
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  out.close();
+  if (!out) {
+    std::error_code ec;
+    std::filesystem::remove(t.tmp, ec);
+    throw Error(given.string(), "write failed (disk full?)");
   }
-  std::filesystem::rename(tmp, path, ec);
+  return t;
+}
+
+void commit(const Temporary& t) {
+  std::error_code ec;
+  std::filesystem::rename(t.tmp, t.target, ec);
   if (ec) {
     const std::string why = ec.message();  // before remove() reuses ec
-    std::filesystem::remove(tmp, ec);
-    throw Error(given.string(), "cannot replace file (" + why + ")");
+    std::filesystem::remove(t.tmp, ec);
+    throw Error(t.given.string(), "cannot replace file (" + why + ")");
+  }
+}
+
+}  // namespace
+
+void writeFileAtomically(const std::filesystem::path& given, std::string_view bytes) {
+  commit(writeTemporary(given, bytes));
+}
+
+void writeFilesAtomically(const std::vector<std::pair<std::filesystem::path, std::string>>& files) {
+  std::vector<Temporary> written;
+  try {
+    for (const auto& [path, bytes] : files) written.push_back(writeTemporary(path, bytes));
+  } catch (...) {
+    std::error_code ec;
+    for (const Temporary& t : written) std::filesystem::remove(t.tmp, ec);
+    throw;
+  }
+  for (std::size_t i = 0; i < written.size(); ++i) {
+    try {
+      commit(written[i]);
+    } catch (...) {
+      std::error_code ec;
+      for (std::size_t j = i + 1; j < written.size(); ++j) std::filesystem::remove(written[j].tmp, ec);
+      throw;
+    }
   }
 }
 

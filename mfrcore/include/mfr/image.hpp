@@ -44,6 +44,8 @@ struct ImageF {
 // leaves a half-written output. Both throw mfr::Error naming the file.
 ImageRGBA8 readPng(const std::filesystem::path& path);
 void writePng(const std::filesystem::path& path, const ImageRGBA8& image);
+// The PNG file's bytes, for writeFilesAtomically (errors name `path`).
+std::string encodePng(const std::filesystem::path& path, const ImageRGBA8& image);
 
 // Flip rows in place (GL's bottom-up read-back to our top-down order).
 void flipVertically(ImageRGBA8& image);

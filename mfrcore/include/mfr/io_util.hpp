@@ -2,13 +2,20 @@
 // Small file helpers shared by the CLI and writers: atomic writes so that no failure leaves a
 // half-written output file behind.
 #include <filesystem>
+#include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace mfr {
 
 // Writes bytes to path.tmp-XXXX then renames over path; a symbolic link's file is written, and the
 // link kept. Throws mfr::Error naming path (and first checkOutputPath's refusals).
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
+// Several outputs of one command, all or none: every temporary is written before any is renamed,
+// so a second output that fails (disk full) leaves no first one behind (a bug hunt: mfr render's
+// PNG stayed when its --stats failed). Throws as writeFileAtomically.
+void writeFilesAtomically(const std::vector<std::pair<std::filesystem::path, std::string>>& files);
 // Whether an output could be written there, before anything is: its folder exists and takes a new
 // file (one is created and removed), the path is not something other than a regular file (a
 // folder, a device such as /dev/full, a pipe), which a rename would replace, and not a link to no
