@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <map>
 #include <optional>
+#include <string>
 
 #include "common/bindings.h"
 #include "mfr/error.hpp"
@@ -136,7 +138,19 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
     for (const auto& v : volumes_) drawnVolumes_.push_back(volumeAsRequested(request, v->volume));
     volumeStep_ = volumeStepOf(request, drawnVolumes_);
   }
-  const Params params(method_->info().params, request.params, request.method);
+  std::map<std::string, std::string> given = request.params;
+  // vkb's and dkb's exact tail leaves each pixel's last fragments to the hybrid tail: under another
+  // operation there is none, and their notes said "every pixel exact" over a wrong image (a bug
+  // hunt). There the bound is off by default, and refused when asked for.
+  const auto& specs = method_->info().params;
+  if (operation_ != "hybrid" &&
+      std::any_of(specs.begin(), specs.end(), [](const ParamSpec& p) { return p.name == "exact_tail"; })) {
+    if (const auto it = given.find("exact_tail"); it != given.end() && it->second == "true")
+      throw Error("--param exact_tail=true",
+                  "only operation hybrid composites a tail; this render's operation is " + operation_);
+    given["exact_tail"] = "false";
+  }
+  const Params params(specs, given, request.method);
   method_->configure(request.width, request.height, params);
   if (operation_ == "hybrid") {
     // The tail sums exist only in the k-buffer family's tail hook.

@@ -1082,6 +1082,38 @@ TEST_F(Cli, EvaluatesExactReferenceRefusalNamesTheReference) {
 
 // evaluate --weights replaced a spec's own dkb:weights=FILE while the row kept that file's name
 // (a bug hunt): the spec's own weights win; --weights is for the dkb rows without.
+// vkb's and dkb's exact tail leaves each pixel's last fragments to the hybrid tail. Under --op oit
+// there is none: the bound was kept and the notes said "every pixel exact" over an image up to
+// 40/255 off (a bug hunt). It is off there, asking for it is refused, and at the notes' "exact at"
+// budget the image is the exact one.
+TEST_F(Cli, VariableKBuffersUnderOitKeepNoExactTail) {
+  const std::string png = (dir() / "v.png").string(), json = (dir() / "v.json").string(),
+                    exact = (dir() / "exact.png").string();
+  ASSERT_EQ(runCli("render @sample -s 96x72 --view iso -m abuffer-ll -o " + exact).exitCode, 0);
+  for (const std::string method : {"vkb", "dkb"}) {
+    SCOPED_TRACE(method);
+    const std::string common = "render @sample -s 96x72 --view iso --op oit -m " + method + " -o " + png;
+    ASSERT_EQ(runCli(common + " -p budget_mib=16 --stats " + json).exitCode, 0);
+    const nlohmann::json roomy = nlohmann::json::parse(mfr::readFile(json));
+    EXPECT_EQ(roomy["notes"]["exact tail"], "off (1 <= k <= n)") << roomy.dump();
+    // ">= 0.349 MiB (21350 slots)": every fragment, as no tail draws the last one.
+    const std::string exactAt = roomy["notes"]["exact at"].get<std::string>();
+    const double mib = std::stod(exactAt.substr(3));
+    ASSERT_EQ(runCli(common + " -p budget_mib=" + std::to_string(mib + 0.01) + " --stats " + json).exitCode, 0);
+    const nlohmann::json atExact = nlohmann::json::parse(mfr::readFile(json));
+    EXPECT_EQ(atExact["fragments_stored"], atExact["fragments_generated"]) << atExact.dump();
+    EXPECT_LT(mfr::rmse(mfr::readPng(png), mfr::readPng(exact)), 1e-6);
+    const CliResult asked = runCli(common + " -p exact_tail=true");
+    EXPECT_EQ(asked.exitCode, 1) << asked.out;
+    EXPECT_EQ(asked.out,
+              "mfr: --param exact_tail=true: only operation hybrid composites a tail; this render's operation is "
+              "oit\n");
+  }
+  // Under hybrid (auto) the bound stays the default.
+  ASSERT_EQ(runCli("render @sample -s 96x72 --view iso -m vkb -o " + png + " --stats " + json).exitCode, 0);
+  EXPECT_NE(nlohmann::json::parse(mfr::readFile(json))["notes"]["exact tail"], "off (1 <= k <= n)");
+}
+
 TEST_F(Cli, EvaluatesSpecWeightsWinOverWeights) {
   const fs::path own = dir() / "w.json", other = dir() / "other.json";
   fs::copy_file(MFR_TEST_DATA_DIR "/../../resources/dkb/weights.json", own);
