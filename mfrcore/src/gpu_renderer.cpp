@@ -177,16 +177,10 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
 }
 
 FrameContext GpuRenderer::frameContext(const Camera& camera, int width, int height, gl::PassTimer& timer) const {
-  gl::FrameUniforms frame;
   const double aspect = static_cast<double>(width) / height;
-  frame.viewProj = glm::mat4(camera.projectionMatrix(aspect) * camera.viewMatrix());
+  gl::FrameUniforms frame = scene_->relativeFrame(camera.projectionMatrix(aspect) * camera.viewMatrix(), clipBox_);
   frame.viewDir = glm::vec3(camera.forward());
   frame.payload = operation_ == "csg" ? MFR_PAYLOAD_OBJECT : MFR_PAYLOAD_COLOR;
-  if (clipBox_) {
-    frame.clip = true;
-    frame.clipMin = glm::vec3(clipBox_->min);
-    frame.clipMax = glm::vec3(clipBox_->max);
-  }
   return FrameContext{*scene_,
                       frame,
                       background_,

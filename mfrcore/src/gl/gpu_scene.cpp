@@ -1,6 +1,10 @@
 #include "mfr/gl/gpu_scene.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "common/bindings.h"
 #include "mfr/scene/color_map.hpp"
@@ -38,6 +42,8 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
   if (previous)
     for (const std::shared_ptr<const GpuMesh>& g : previous->meshes_) before.emplace(g->source.get(), g);
   std::map<const Mesh*, std::size_t> uploaded;
+  origin_ = scene.bounds().center();
+  if (!(std::isfinite(origin_.x) && std::isfinite(origin_.y) && std::isfinite(origin_.z))) origin_ = glm::dvec3(0.0);
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
     if (!o.visible || !o.mesh || o.mesh->triangleCount() == 0) continue;
@@ -47,11 +53,19 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
         meshes_.push_back(shared->second);
       } else {
         const Mesh& m = *o.mesh;
+        auto g = std::make_shared<GpuMesh>();
+        // Relative to the mesh's own centre, so that a mesh far from its origin keeps its detail.
+        glm::dvec3 low(std::numeric_limits<double>::infinity()), high(-low);
+        for (const glm::vec3& p : m.positions) {
+          low = glm::min(low, glm::dvec3(p));
+          high = glm::max(high, glm::dvec3(p));
+        }
+        if (low.x <= high.x) g->centre = 0.5 * (low + high);
         std::vector<Vertex> v(m.positions.size());
         for (std::size_t k = 0; k < v.size(); ++k)
-          v[k] = {m.positions[k], m.normals.empty() ? glm::vec3(0, 0, 1) : m.normals[k],
+          v[k] = {glm::vec3(glm::dvec3(m.positions[k]) - g->centre),
+                  m.normals.empty() ? glm::vec3(0, 0, 1) : m.normals[k],
                   m.colors.empty() ? glm::vec4(1.0f) : m.colors[k], m.scalars.empty() ? 0.0f : m.scalars[k]};
-        auto g = std::make_shared<GpuMesh>();
         g->source = o.mesh;
         g->vertices = createBuffer(v.size() * sizeof(Vertex), v.data(), 0);
         g->indices = createBuffer(m.indices.size() * sizeof(std::uint32_t), m.indices.data(), 0);
@@ -75,7 +89,11 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
       }
       bytes_ += meshes_.back()->bytes;
     }
-    const glm::mat4 model(o.transform);
+    // Mesh centre → world → relative to origin_, composed in double: what the GPU computes in
+    // float stays near zero.
+    const glm::dvec3 centre = meshes_[it->second]->centre;
+    const glm::dmat4 toMesh = glm::translate(glm::dmat4(1.0), centre);
+    const glm::mat4 model(glm::translate(glm::dmat4(1.0), -origin_) * o.transform * toMesh);
     // A field colouring needs the field's values on the mesh (colorByField puts them there).
     const std::optional<FieldColors>& field = o.material.fieldColors;
     const bool mapped = field && o.mesh->scalars.size() == o.mesh->positions.size();
@@ -105,7 +123,7 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
         known = fieldGrids_.end() - 1;
       }
       item.fieldGrid = static_cast<int>(known - fieldGrids_.begin());
-      item.fieldToGrid = glm::mat4(sampler->objectToGrid);
+      item.fieldToGrid = glm::mat4(sampler->objectToGrid * toMesh);
     }
     triangles_ += o.mesh->triangleCount();
   }
@@ -115,6 +133,17 @@ std::shared_ptr<Texture> GpuScene::fieldGrid(const VolumeGrid* grid) const {
   for (const FieldGrid& f : fieldGrids_)
     if (f.source.get() == grid) return f.texture;
   return nullptr;
+}
+
+FrameUniforms GpuScene::relativeFrame(const glm::dmat4& viewProj, const std::optional<Bounds>& clipBox) const {
+  FrameUniforms frame;
+  frame.viewProj = glm::mat4(viewProj * glm::translate(glm::dmat4(1.0), origin_));
+  if (clipBox) {
+    frame.clip = true;
+    frame.clipMin = glm::vec3(clipBox->min - origin_);
+    frame.clipMax = glm::vec3(clipBox->max - origin_);
+  }
+  return frame;
 }
 
 void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
