@@ -78,6 +78,17 @@ bool Scene::hasVisibleVolume() const {
   return std::any_of(volumes.begin(), volumes.end(), [](const Volume& v) { return v.visible; });
 }
 
+namespace {
+
+// Six significant digits: a float's coordinates read back as doubles (1e33 is 9.999999944957273e+32).
+std::string shortNumber(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
+}  // namespace
+
 void Scene::validate() const {
   std::size_t visibleVolumes = 0;
   for (const Volume& v : volumes) {
@@ -89,6 +100,21 @@ void Scene::validate() const {
   if (visibleVolumes > kMaxVisibleVolumes)
     throw Error("scene '" + name + "'", std::to_string(visibleVolumes) + " visible volumes: at most " +
                                             std::to_string(kMaxVisibleVolumes) + " can be drawn at once");
+  // Where single precision draws it: within ±1e15, as a scene file's coordinates and volumes, and
+  // not below 1e-30 across. A model file's triangle at 1e31 was drawn as a sliver and at 1e33 not at
+  // all, one at 1e-38 not at all, by the GPU with exit 0, while the oracle drew them (a bug hunt).
+  const Bounds extent = bounds();
+  if (extent.valid()) {
+    for (int a = 0; a < 3; ++a)
+      if (!(std::abs(extent.min[a]) <= 1e15 && std::abs(extent.max[a]) <= 1e15))
+        throw Error("scene '" + name + "'",
+                    "reaches beyond ±1e15 (to " +
+                        shortNumber(std::max(std::abs(extent.min[a]), std::abs(extent.max[a]))) +
+                        "): too far out to be drawn in single precision");
+    if (const double across = glm::length(extent.max - extent.min); across < 1e-30)
+      throw Error("scene '" + name + "'",
+                  "is " + shortNumber(across) + " across, below 1e-30: too small to be drawn in single precision");
+  }
   validateCsg(*this);
   validateClipBox(clipBox, "clip box");
   validateSectionPlane(section, "section plane");
