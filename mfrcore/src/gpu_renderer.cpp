@@ -201,6 +201,10 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   gl::checkErrors(("capture " + request.method).c_str());
   glBindFramebuffer(GL_FRAMEBUFFER, target);
   glViewport(0, 0, request.width, request.height);
+  if (resolveCut_.id() == 0) resolveCut_ = gl::createBuffer(sizeof(std::uint32_t));
+  const std::uint32_t zero = 0;
+  glClearNamedBufferData(resolveCut_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_RESOLVE_CUT, resolveCut_.id());
   if (operation_ == "csg") {
     renderCsg(ctx, method);
   } else if (operation_ == "volume") {
@@ -240,6 +244,17 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   }
   gl::checkErrors(("resolve " + request.method).c_str());
   Stats stats = method.stats();
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  std::uint32_t cut = 0;
+  glGetNamedBufferSubData(resolveCut_.id(), 0, sizeof cut, &cut);
+  if (cut > 0) {
+    stats.overflow = true;
+    stats.overflowPixels += cut;
+    stats.notes.emplace_back("resolve cut", std::to_string(cut) +
+                                                " pixels resolved short: this GL ended their loops early "
+                                                "(llvmpipe: 65,535 loop steps per pixel, which lists of about 700 "
+                                                "fragments reach); their images lack fragments");
+  }
   if (operation_ == "csg") {
     // The operation's own buffer: each pixel's visible (object + 1, depth), 8 bytes.
     const std::uint64_t csgBytes = 8ull * static_cast<std::uint64_t>(request.width) * request.height;

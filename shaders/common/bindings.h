@@ -28,6 +28,7 @@
 #define MFR_SSBO_ARENA 9      // per-pixel arena of the variable-k buffers (features, k(p), …)
 #define MFR_SSBO_BUDGET 10    // per-frame budget state: image sums, allocation search, F(M)
 #define MFR_SSBO_CSG 11       // operation "csg": per-pixel visible surface (object id, depth)
+#define MFR_SSBO_RESOLVE_CUT 12  // the resolve's count of pixels whose list came out short (common/resolve.glsl)
 
 // Image units
 #define MFR_IMAGE_HEADS 0

@@ -17,6 +17,12 @@
 
 uniform uint uMaxListLength;  // bound on any pixel's list walk (pool or array capacity)
 
+// Pixels whose list was not walked or composited whole. llvmpipe (Mesa) ends every loop of a shader
+// invocation once its loops have taken 65,535 steps in all: pixels of ~700 fragments and more came
+// out short, with exit 0 and nothing in the stats (a bug hunt). The renderer reads this count into
+// the stats (overflow_pixels and a note); where it is 0, every list was resolved whole.
+layout(std430, binding = MFR_SSBO_RESOLVE_CUT) buffer ResolveCut { uint mfrResolveCutPixels; };
+
 layout(location = 0) out vec4 outColor;
 
 MfrFragment gLocal[MFR_RESOLVE_LOCAL];
@@ -76,15 +82,22 @@ void main() {
     }
     ++n;
   }
+  // A walk that stopped before the list's end and before its bound was cut short (no loop here: a
+  // loop would not run once the limit is reached).
+  MfrFragment beyond;
+  bool walkCut = n < walk && mfrNext(cursor, beyond);
+  uint emitted = 0u;
   if (n <= uint(MFR_RESOLVE_LOCAL)) {
     sortLocal(n);
-    for (uint i = 0u; i < n; ++i) opFragment(s, gLocal[i], i);
+    for (uint i = 0u; i < n; ++i) {
+      opFragment(s, gLocal[i], i);
+      ++emitted;
+    }
   } else {
     // l+-depth-sorting rounds.
     float lastDepth = -1.0;
     uint lastIndex = 0u;
     bool first = true;
-    uint emitted = 0u;
     uint rounds = (n + uint(MFR_RESOLVE_LOCAL) - 1u) / uint(MFR_RESOLVE_LOCAL);
     for (uint r = 0u; r < rounds; ++r) {
       uint m = 0u;  // gLocal[0..m) sorted ascending, the m nearest after the last key
@@ -114,5 +127,6 @@ void main() {
       first = false;
     }
   }
+  if (walkCut || emitted < n) atomicAdd(mfrResolveCutPixels, 1u);
   outColor = opEnd(s, p, n);
 }

@@ -107,6 +107,7 @@ class GpuRenderer {
   std::vector<Volume> drawnVolumes_;  // of the prepared request (volumesAsRequested: its shading)
   void uploadVolumes(const Scene& scene);
   gl::Buffer csgVisible_;
+  gl::Buffer resolveCut_;  // common/resolve.glsl's count of pixels it could not resolve whole
   std::size_t csgPixels_ = 0;
   gl::Program csgShade_;
   bool finishTiming_ = false;
