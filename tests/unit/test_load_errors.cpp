@@ -865,3 +865,23 @@ TEST_F(LoadModel, ATubeTurningStraightBackNamesThePoint) {
 }
 
 }  // namespace
+
+namespace {
+
+// A file name that is not UTF-8 is named once, as the one-line message shows it: it was named
+// twice, raw and folded ("bad\xff.ply: bad?.ply: PLY header …", a bug hunt).
+TEST_F(LoadModel, ANameThatIsNotUtf8IsNamedOnce) {
+  const fs::path bad = write("bad\xff\xfe.ply", "ply\nformat ascii 1.0\nelement vertex 3\n");
+  try {
+    (void)mfr::loadScene(bad);
+    ADD_FAILURE() << "a PLY without end_header loaded";
+  } catch (const mfr::Error& e) {
+    const std::string shown = (dir() / "bad??.ply").string();
+    const std::string message = e.what();
+    EXPECT_EQ(message.rfind(shown + ": ", 0), 0u) << message;
+    EXPECT_EQ(message.find("bad??.ply", shown.size()), std::string::npos) << message;
+    EXPECT_EQ(message.find('\xff'), std::string::npos) << message;
+  }
+}
+
+}  // namespace

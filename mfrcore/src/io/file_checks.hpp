@@ -35,18 +35,20 @@ auto withFileErrors(const std::string& name, Load&& load) -> decltype(load()) {
     throw;
   } catch (const FieldNotFound& e) {  // kept apart: a scene file reports it at its 'field' key
     std::string message = oneLine(e.what());
-    if (message.rfind(name, 0) != 0) message = name + ": " + message;
+    // The name as the folded message shows it: a name that is not UTF-8 was named twice, raw and
+    // folded ("bad\xff.ply: bad?.ply: …", a bug hunt).
+    if (const std::string shown = oneLine(name); message.rfind(shown, 0) != 0) message = shown + ": " + message;
     throw FieldNotFound(message);
   } catch (const Error& e) {
     std::string message = oneLine(e.what());
-    if (message.rfind(name, 0) != 0) message = name + ": " + message;
+    if (const std::string shown = oneLine(name); message.rfind(shown, 0) != 0) message = shown + ": " + message;
     throw Error(message);
   } catch (const std::bad_alloc&) {
-    throw Error(name, "out of memory while loading");
+    throw Error(oneLine(name), "out of memory while loading");
   } catch (const std::exception& e) {
-    throw Error(name, oneLine(e.what()));
+    throw Error(oneLine(name), oneLine(e.what()));
   } catch (...) {
-    throw Error(name, "unknown error while loading");
+    throw Error(oneLine(name), "unknown error while loading");
   }
 }
 
