@@ -329,6 +329,35 @@ std::vector<Object> readHere(const std::filesystem::path& path, const std::strin
   return objects;
 }
 
+// An IFC file is a STEP physical file (ISO 10303-21): it ends with "END-ISO-10303-21;". assimp's
+// IFC reader takes a file cut off anywhere and builds what came before it — 4 of 294 parts of a
+// house cut at 10 %, with exit 0 and no note (a bug hunt). A file that begins as one and lacks the
+// end is refused.
+void checkStepPhysicalFileEnd(const std::filesystem::path& path, const std::string* contents,
+                              const std::string& extension, const std::string& name) {
+  if (extension != ".ifc") return;
+  constexpr std::size_t kTail = 4096;
+  std::string head, tail;
+  if (contents != nullptr) {
+    head = contents->substr(0, 64);
+    tail = contents->substr(contents->size() - std::min(contents->size(), kTail));
+  } else {
+    std::ifstream in(path, std::ios::binary);
+    head.resize(64);
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in.gcount()));
+    in.clear();
+    in.seekg(0, std::ios::end);
+    const auto size = static_cast<std::size_t>(std::max<std::streamoff>(in.tellg(), 0));
+    in.seekg(static_cast<std::streamoff>(size - std::min(size, kTail)));
+    tail.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const std::size_t start = head.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
+  if (start == std::string::npos || head.compare(start, 12, "ISO-10303-21") != 0) return;  // assimp names it
+  if (tail.find("END-ISO-10303-21") == std::string::npos)
+    throw Error(name, "truncated: the IFC (ISO 10303-21) file does not end with END-ISO-10303-21;");
+}
+
 }  // namespace
 
 // assimp 5.2 crashes (SIGSEGV; an uncaught DeadlyImportError, abort), hangs, or allocates without
@@ -341,6 +370,7 @@ std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std:
                                    const std::string& extension, const std::string& name,
                                    const LoadProgress& progress) {
   checkGltfJsonDepth(path, contents, extension, name);
+  checkStepPhysicalFileEnd(path, contents, extension, name);
   const ChildLibrary assimp{extension.empty() ? std::string("file") : extension.substr(1), "the importer (assimp)"};
   if (const std::optional<std::string> bytes = runInChild(name, assimp, progress, [&](const LoadProgress& child) {
         return packObjects(readHere(path, contents, extension, name, child));

@@ -101,9 +101,9 @@ void Scene::validate() const {
     throw Error("scene '" + name + "'", std::to_string(visibleVolumes) + " visible volumes: at most " +
                                             std::to_string(kMaxVisibleVolumes) + " can be drawn at once");
   // Where single precision draws it: within ±1e15, as a scene file's coordinates and volumes, and
-  // not below 1e-30 across (0 across: every triangle degenerate, which checkDrawable names). A model file's triangle at
-  // 1e31 was drawn as a sliver and at 1e33 not at all, one at 1e-38 not at all, by the GPU with exit 0, while the
-  // oracle drew them (a bug hunt).
+  // not below 1e-30 across (0 across: every triangle degenerate, which checkDrawable names). A
+  // model file's triangle at 1e31 was drawn as a sliver and at 1e33 or 1e-38 not at all by the GPU,
+  // with exit 0, while the oracle drew them (a bug hunt).
   const Bounds extent = bounds();
   if (extent.valid()) {
     for (int a = 0; a < 3; ++a)
