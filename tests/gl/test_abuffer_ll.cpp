@@ -1,5 +1,7 @@
 // abuffer-ll (Yang et al. 2010) against the oracle, with each pool-sizing policy; overflow of a
 // too-small pool is detected and counted, never written out of bounds.
+#include <algorithm>
+
 #include "exact_method.hpp"
 #include "gl_fixture.hpp"
 #include "mfr/scene/sample.hpp"
@@ -26,6 +28,11 @@ TEST(ABufferLinkedList, SmallPoolOverflowIsCountedAndBounded) {
   EXPECT_EQ(out.stats.fragmentsStored, 873u);
   EXPECT_EQ(out.stats.fragmentsGenerated, out.stats.fragmentsStored + out.stats.fragmentsDropped);
   EXPECT_EQ(out.stats.bytesAllocated, 96u * 96u * 4u + 873u * 12u + 8u);
+  // Which pixels lost fragments is not known: said so, not left as "0 pixels" (a bug hunt).
+  const auto note = std::find_if(out.stats.notes.begin(), out.stats.notes.end(),
+                                 [](const auto& n) { return n.first == "overflow pixels"; });
+  ASSERT_NE(note, out.stats.notes.end());
+  EXPECT_EQ(note->second.rfind("not counted", 0), 0u) << note->second;
 }
 
 TEST(ABufferLinkedList, PreviousFrameSizingAdaptsAfterOverflow) {
