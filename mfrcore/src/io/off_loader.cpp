@@ -77,6 +77,16 @@ void checkAsciiFaceSizes(std::string_view bytes, std::size_t pos, std::uint64_t 
       throw Error(name, "OFF face " + std::to_string(records - vertices - 1) + " declares " + std::to_string(corners) +
                             " corners but only " + std::to_string(bytes.size() - start) +
                             " bytes follow (corrupt file?)");
+    // Its corners on its line are whole indices: CGAL read "1.9" as 1 and went on with ".9" as
+    // nothing (a bug hunt). A face laid over several lines is left to CGAL.
+    for (std::uint64_t c = 0; c < corners; ++c) {
+      const std::string_view corner = nextToken(text, at);
+      if (corner.empty()) break;
+      std::uint64_t index = 0;
+      if (!toCount(corner, index))
+        throw Error(name, "OFF face " + std::to_string(records - vertices - 1) + ": corner '" + std::string(corner) +
+                              "' is not a vertex index");
+    }
   }
 }
 
