@@ -426,6 +426,38 @@ TEST_F(DamagedMolecules, TruncatedCorruptAndEmptied) {
   expectLoadError(write("4cup-nan.cif", nan), "not finite");
 }
 
+// Atoms held twice, and atoms of no known element, were drawn without a word, with bonds missing
+// around them; a cartoon was refused over CA atoms of element X ("needs Cα atoms", a bug hunt).
+// Both are notes now, and backbone atoms are taken by their names.
+TEST_F(DamagedMolecules, RepeatedAtomsAndUnknownElementsAreNoted) {
+  const std::string pdb = readTestFile(requireFile(kPymolDemo / "pept.pdb", "Debian package pymol-data"));
+  std::string atoms, unknown;
+  std::istringstream in(pdb);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("ATOM", 0) != 0) continue;
+    atoms += line + "\n";
+    if (line.size() < 78) line.resize(78, ' ');
+    unknown += line.substr(0, 76) + "XX\n";  // the element column
+  }
+  const std::size_t count = static_cast<std::size_t>(std::count(atoms.begin(), atoms.end(), '\n'));
+  ASSERT_GT(count, 50u);
+  const auto notesOf = [&](const std::string& file, const std::string& text, const char* style) {
+    std::vector<std::string> notes;
+    mfr::LoadOptions options({}, mfr::MoleculeStyle::parse(style, "test"));
+    options.notes = &notes;
+    (void)mfr::loadModel(write(file, text), options);
+    return notes;
+  };
+  EXPECT_TRUE(notesOf("pept.pdb", atoms, "sticks").empty());
+  const std::vector<std::string> twice = notesOf("twice.pdb", atoms + atoms, "sticks");
+  ASSERT_EQ(twice.size(), 1u);
+  EXPECT_NE(twice[0].find(std::to_string(count) + " atoms at the position of another atom"), std::string::npos)
+      << twice[0];
+  const std::vector<std::string> x = notesOf("x.pdb", unknown, "cartoon");
+  ASSERT_EQ(x.size(), 1u);
+  EXPECT_NE(x[0].find(std::to_string(count) + " atoms of no known element"), std::string::npos) << x[0];
+}
+
 // ---- rendering: the exact fragment lists of a structure ------------------------------------------
 
 // Space-filling atoms are a deep scene: along a ray through the protein, the front and back of

@@ -13,9 +13,11 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 #include <string_view>
+#include <tuple>
 #include <unordered_set>
 #include <utility>
 
@@ -255,12 +257,16 @@ struct Part {
 // The atoms of the first model sorted into parts: polymer chains by name in order of appearance,
 // then ligands, then water. Of alternative locations, the first one that appears at a residue
 // position (chain, sequence number, insertion code) is kept, and atoms without one.
-std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
+std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name, std::vector<std::string>& notes) {
   std::vector<Part> chains;
   std::map<std::string, std::size_t> chainIndex;
   Part ligands{"ligands", {}, PartKind::Ligands, {}, {}}, water{"water", {}, PartKind::Water, {}, {}};
   std::map<std::pair<std::string, gemmi::SeqId>, char> firstAltloc;
   std::size_t total = 0;
+  // Atoms of no known element, and atoms at another's position (a file holding its atoms twice):
+  // both were drawn without a word, with bonds missing around them (a bug hunt).
+  std::size_t unknownElement = 0, repeated = 0;
+  std::set<std::tuple<double, double, double>> positions;
   for (const gemmi::Chain& chain : model.chains) {
     for (const gemmi::Residue& residue : chain.residues) {
       char& chosen = firstAltloc[{chain.name, residue.seqid}];
@@ -285,6 +291,8 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
         }
         if (++total > kMaxAtoms)
           throw Error(name, "more than " + std::to_string(kMaxAtoms) + " atoms in the first model: too many to draw");
+        unknownElement += atom.element.elem == gemmi::El::X ? 1 : 0;
+        repeated += positions.emplace(p.x, p.y, p.z).second ? 0 : 1;
         Part* part = nullptr;
         if (residue.entity_type == gemmi::EntityType::Polymer) {
           const auto [it, isNew] = chainIndex.try_emplace(chain.name, chains.size());
@@ -300,15 +308,18 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
         part->atoms.push_back({p, atom.element.elem, atom.b_iso, atom.occ, number, atom.serial});
         if (residue.entity_type != gemmi::EntityType::Polymer) continue;
         polymer = part;
-        // The backbone atoms by name: PDB's and mmCIF's (label_atom_id) are the same.
-        const bool carbon = atom.element.elem == gemmi::El::C;
-        if (atom.name == "N" && atom.element.elem == gemmi::El::N && !backbone.n) backbone.n = p;
+        // The backbone atoms by name: PDB's and mmCIF's (label_atom_id) are the same. An atom of no
+        // known element is taken by its name (a cartoon was refused for "no Cα" over CA atoms of
+        // element X).
+        const bool unknown = atom.element.elem == gemmi::El::X;
+        const bool carbon = atom.element.elem == gemmi::El::C || unknown;
+        if (atom.name == "N" && (atom.element.elem == gemmi::El::N || unknown) && !backbone.n) backbone.n = p;
         if (atom.name == "CA" && carbon && !backbone.ca) {
           backbone.ca = p;
           trace = part->atoms.back();
         }
         if (atom.name == "C" && carbon && !backbone.c) backbone.c = p;
-        if (atom.name == "O" && atom.element.elem == gemmi::El::O && !backbone.o) backbone.o = p;
+        if (atom.name == "O" && (atom.element.elem == gemmi::El::O || unknown) && !backbone.o) backbone.o = p;
         // The ladder's end: N1 of a purine (which has N9), N3 of a pyrimidine.
         if (atom.name == "N1" && !n1) n1 = p;
         if (atom.name == "N3" && !n3) n3 = p;
@@ -332,6 +343,13 @@ std::vector<Part> partsOf(const gemmi::Model& model, const std::string& name) {
   }
   if (!ligands.atoms.empty()) chains.push_back(std::move(ligands));
   if (!water.atoms.empty()) chains.push_back(std::move(water));
+  if (unknownElement > 0)
+    notes.push_back(name + ": " + std::to_string(unknownElement) +
+                    " atoms of no known element (drawn as element X; bonds near them may be missing)");
+  if (repeated > 0)
+    notes.push_back(name + ": " + std::to_string(repeated) +
+                    " atoms at the position of another atom (the file holds them twice?); bonds near them may be "
+                    "missing");
   return chains;
 }
 
@@ -348,6 +366,7 @@ struct Parsed {
   std::size_t models = 1;
   std::vector<RecordedRange> recorded;  // the file's HELIX/SHEET (mmCIF struct_conf/sheet_range)
   bool structureFromFile = false;       // assignStructure took the records
+  std::vector<std::string> notes;       // what was read other than a reader would expect
 };
 
 // Each polymer residue's secondary structure: the file's records when it has any that hold a
@@ -637,7 +656,9 @@ Parsed parseMolecule(const std::string& contents, MoleculeFormat format, const s
         }
     }
   }
-  Parsed parsed{partsOf(st.models[0], name), models, {}};
+  std::vector<std::string> notes;
+  std::vector<Part> parts = partsOf(st.models[0], name, notes);
+  Parsed parsed{std::move(parts), models, {}, false, std::move(notes)};
   for (const gemmi::Helix& h : st.helices)
     parsed.recorded.push_back(
         {h.start.chain_name, h.start.res_id.seqid, h.end.res_id.seqid, SecondaryStructure::Helix});
@@ -898,6 +919,7 @@ std::vector<Object> readMolecule(const std::string& contents, MoleculeFormat for
                                  std::vector<std::string>* notes) {
   Parsed parsed = parseMolecule(contents, format, name, progress);
   std::vector<Part>& parts = parsed.parts;
+  if (notes != nullptr) notes->insert(notes->end(), parsed.notes.begin(), parsed.notes.end());
 
   std::size_t atoms = 0;
   for (const Part& part : parts) atoms += part.atoms.size();
