@@ -145,8 +145,9 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
   const auto& specs = method_->info().params;
   if (operation_ != "hybrid" &&
       std::any_of(specs.begin(), specs.end(), [](const ParamSpec& p) { return p.name == "exact_tail"; })) {
-    if (const auto it = given.find("exact_tail"); it != given.end() && it->second == "true")
-      throw Error("--param exact_tail=true",
+    const Params asGiven(specs, given, request.method);  // a value that is no flag is named as such first
+    if (const auto it = given.find("exact_tail"); it != given.end() && asGiven.flag("exact_tail"))
+      throw Error("--param exact_tail=" + it->second,
                   "only operation hybrid composites a tail; this render's operation is " + operation_);
     given["exact_tail"] = "false";
   }
@@ -176,6 +177,20 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
   return *method_;
 }
 
+void GpuRenderer::beginResolveCount() {
+  if (resolveCut_.id() == 0) resolveCut_ = gl::createBuffer(sizeof(std::uint32_t));
+  const std::uint32_t zero = 0;
+  glClearNamedBufferData(resolveCut_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_RESOLVE_CUT, resolveCut_.id());
+}
+
+std::uint32_t GpuRenderer::resolveCount() const {
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  std::uint32_t cut = 0;
+  glGetNamedBufferSubData(resolveCut_.id(), 0, sizeof cut, &cut);
+  return cut;
+}
+
 FrameContext GpuRenderer::frameContext(const Camera& camera, int width, int height, gl::PassTimer& timer) const {
   const double aspect = static_cast<double>(width) / height;
   gl::FrameUniforms frame = scene_->relativeFrame(camera.projectionMatrix(aspect) * camera.viewMatrix(), clipBox_);
@@ -201,10 +216,7 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   gl::checkErrors(("capture " + request.method).c_str());
   glBindFramebuffer(GL_FRAMEBUFFER, target);
   glViewport(0, 0, request.width, request.height);
-  if (resolveCut_.id() == 0) resolveCut_ = gl::createBuffer(sizeof(std::uint32_t));
-  const std::uint32_t zero = 0;
-  glClearNamedBufferData(resolveCut_.id(), GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, MFR_SSBO_RESOLVE_CUT, resolveCut_.id());
+  beginResolveCount();
   if (operation_ == "csg") {
     renderCsg(ctx, method);
   } else if (operation_ == "volume") {
@@ -244,12 +256,10 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   }
   gl::checkErrors(("resolve " + request.method).c_str());
   Stats stats = method.stats();
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-  std::uint32_t cut = 0;
-  glGetNamedBufferSubData(resolveCut_.id(), 0, sizeof cut, &cut);
-  if (cut > 0) {
+  if (const std::uint32_t cut = resolveCount(); cut > 0) {
+    // The same pixels may have lost fragments to a full structure too: at least this many did.
     stats.overflow = true;
-    stats.overflowPixels += cut;
+    stats.overflowPixels = std::max<std::uint64_t>(stats.overflowPixels, cut);
     stats.notes.emplace_back("resolve cut", std::to_string(cut) +
                                                 " pixels resolved short: this GL ended their loops early "
                                                 "(llvmpipe: 65,535 loop steps per pixel, which lists of about 700 "
@@ -431,6 +441,7 @@ CapturedLists GpuRenderer::capture(const Camera& camera, const RenderRequest& re
   method.capture(ctx);
   glBindFramebuffer(GL_FRAMEBUFFER, fbo.id());
   glViewport(0, 0, w, h);
+  beginResolveCount();  // the shared resolve writes it: bound, as for a render
   method.resolve(ctx, dump);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   gl::checkErrors(("capture (dump) " + request.method).c_str());

@@ -17,7 +17,8 @@ uniform vec2 uColorMapRange;  // common/color_map.glsl: the field's values at th
 // A surface coloured by a volume: object → that volume's grid coordinates (common/fragment.glsl
 // samples it per fragment at vFieldGrid; affine, so interpolating it is exact).
 uniform mat4 uFieldToGrid;
-// Scene::clipBox (world space): distances to its six faces, positive inside. GL clips with them
+// Scene::clipBox: distances to its six faces, positive inside. uModel, uViewProj and the box are
+// relative to the scene's centre (gl::GpuScene::origin), so that far scenes keep float precision. GL clips with them
 // only while GpuScene::draw enables GL_CLIP_DISTANCE0…5 (a scene with a clip box).
 uniform vec3 uClipMin;
 uniform vec3 uClipMax;

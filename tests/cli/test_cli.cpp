@@ -1126,11 +1126,18 @@ TEST_F(Cli, VariableKBuffersUnderOitKeepNoExactTail) {
     const nlohmann::json atExact = nlohmann::json::parse(mfr::readFile(json));
     EXPECT_EQ(atExact["fragments_stored"], atExact["fragments_generated"]) << atExact.dump();
     EXPECT_LT(mfr::rmse(mfr::readPng(png), mfr::readPng(exact)), 1e-6);
-    const CliResult asked = runCli(common + " -p exact_tail=true");
-    EXPECT_EQ(asked.exitCode, 1) << asked.out;
-    EXPECT_EQ(asked.out,
-              "mfr: --param exact_tail=true: only operation hybrid composites a tail; this render's operation is "
-              "oit\n");
+    for (const std::string value : {"true", "1", "on"}) {  // every spelling Params reads as true
+      const CliResult asked = runCli(common + " -p exact_tail=" + value);
+      EXPECT_EQ(asked.exitCode, 1) << asked.out;
+      EXPECT_EQ(asked.out, "mfr: --param exact_tail=" + value +
+                               ": only operation hybrid composites a tail; this render's operation is oit\n");
+    }
+    // A value that is no flag is named as under hybrid (it was overwritten and taken: a review).
+    const CliResult bad = runCli(common + " -p exact_tail=maybe");
+    EXPECT_EQ(bad.exitCode, 1) << bad.out;
+    EXPECT_NE(bad.out.find("exact_tail"), std::string::npos) << bad.out;
+    EXPECT_EQ(bad.out.find("only operation hybrid"), std::string::npos) << bad.out;
+    EXPECT_EQ(runCli(common + " -p exact_tail=false").exitCode, 0);
   }
   // Under hybrid (auto) the bound stays the default.
   ASSERT_EQ(runCli("render @sample -s 96x72 --view iso -m vkb -o " + png + " --stats " + json).exitCode, 0);

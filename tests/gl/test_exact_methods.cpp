@@ -69,8 +69,23 @@ TEST(ExactMethodDepth, VeryDeepPixelsAreExactOrCounted) {
   oracle.width = 16;
   oracle.height = 12;
   const ImageRGBA8 expected = render(scene, camera, oracle).image;
+  // The pixels the quads cover: no more can be counted (a probe loop flagged shallow pixels
+  // beside deep ones, 186 of 144: a review).
+  std::size_t covered = 0;
+  for (int y = 0; y < expected.height; ++y)
+    for (int x = 0; x < expected.width; ++x)
+      for (int c = 0; c < 3; ++c)
+        if (std::abs(int(expected.at(x, y)[c]) - int(std::lround(scene.background[c] * 255.0f))) > 2) {
+          ++covered;
+          break;
+        }
+  ASSERT_GT(covered, 0u);
   for (const auto& [method, params] : std::vector<std::pair<std::string, std::map<std::string, std::string>>>{
-           {"abuffer-ll", {}}, {"abuffer-sbuffer", {}}, {"abuffer-array", {{"slots", "1024"}}}}) {
+           {"abuffer-ll", {}},
+           {"abuffer-sbuffer", {}},
+           {"abuffer-array", {{"slots", "1024"}}},
+           // Slots fewer than the fragments, and a resolve cut, on the same pixels: counted once.
+           {"abuffer-array", {{"slots", "800"}}}}) {
     SCOPED_TRACE(method);
     RenderRequest gpu = oracle;
     gpu.method = method;
@@ -80,6 +95,7 @@ TEST(ExactMethodDepth, VeryDeepPixelsAreExactOrCounted) {
     if (wrong > 0) {
       EXPECT_TRUE(out.stats.overflow) << wrong << " pixels wrong";
       EXPECT_GE(out.stats.overflowPixels, wrong);
+      EXPECT_LE(out.stats.overflowPixels, covered) << "more pixels than the quads cover";
       const auto note = std::find_if(out.stats.notes.begin(), out.stats.notes.end(),
                                      [](const auto& n) { return n.first == "resolve cut"; });
       EXPECT_NE(note, out.stats.notes.end()) << wrong << " pixels wrong without a note";

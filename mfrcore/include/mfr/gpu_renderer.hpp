@@ -108,6 +108,10 @@ class GpuRenderer {
   void uploadVolumes(const Scene& scene);
   gl::Buffer csgVisible_;
   gl::Buffer resolveCut_;  // common/resolve.glsl's count of pixels it could not resolve whole
+  // Zeroes and binds resolveCut_ before a resolve (every resolve that includes the shared driver
+  // writes it); resolveCount() reads it after.
+  void beginResolveCount();
+  [[nodiscard]] std::uint32_t resolveCount() const;
   std::size_t csgPixels_ = 0;
   gl::Program csgShade_;
   bool finishTiming_ = false;

@@ -20,6 +20,7 @@
 namespace mfr::gl {
 
 struct FrameUniforms {
+  // Relative to GpuScene::origin(), as are clipMin/clipMax: made by GpuScene::relativeFrame.
   glm::mat4 viewProj{1.0f};
   glm::vec3 viewDir{0.0f, 0.0f, -1.0f};  // headlight direction (camera forward), world space
   int payload = 0;  // what capture passes store in a fragment's colour word: MFR_PAYLOAD_* (bindings.h)
