@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -55,12 +54,7 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
         const Mesh& m = *o.mesh;
         auto g = std::make_shared<GpuMesh>();
         // Relative to the mesh's own centre, so that a mesh far from its origin keeps its detail.
-        glm::dvec3 low(std::numeric_limits<double>::infinity()), high(-low);
-        for (const glm::vec3& p : m.positions) {
-          low = glm::min(low, glm::dvec3(p));
-          high = glm::max(high, glm::dvec3(p));
-        }
-        if (low.x <= high.x) g->centre = 0.5 * (low + high);
+        if (const Bounds b = m.bounds(); b.valid()) g->centre = b.center();
         std::vector<Vertex> v(m.positions.size());
         for (std::size_t k = 0; k < v.size(); ++k)
           v[k] = {glm::vec3(glm::dvec3(m.positions[k]) - g->centre),

@@ -120,16 +120,8 @@ Mesh contourVolume(const Volume& volume, double value) {
   return mesh;
 }
 
-namespace {
-std::string valueText(double value) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
-}  // namespace
-
 std::string contourPartName(const std::string& volumeName, double value) {
-  return volumeName + " = " + valueText(value);
+  return volumeName + " = " + shortNumberText(value);
 }
 
 glm::dvec2 contourColorRange(const std::vector<double>& values, const glm::dvec2& gridRange) {
@@ -154,20 +146,20 @@ std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request
   if (!(request.opacity >= 0.0f && request.opacity <= 1.0f)) throw Error(what, "opacity must lie in [0, 1]");
   const Volume& volume = scene.volumes[request.volume];
   const glm::vec2 range = volume.grid->range();
-  const std::string rangeText = "[" + valueText(range.x) + ", " + valueText(range.y) + "]";
+  const std::string rangeText = "[" + shortNumberText(range.x) + ", " + shortNumberText(range.y) + "]";
   for (const double value : request.values) {
     if (!std::isfinite(value)) throw Error(what, "the value must be a finite number");
     if (!(value > static_cast<double>(range.x) && value < static_cast<double>(range.y)))
-      throw Error(what, valueText(value) + " lies outside the open range " + rangeText + " of volume '" + volume.name +
-                            "': no surface");
+      throw Error(what, shortNumberText(value) + " lies outside the open range " + rangeText + " of volume '" +
+                            volume.name + "': no surface");
   }
   // Two values of one name (the same value twice, or closer than the name's 6 digits) would be
   // coincident surfaces, fighting in depth, that no one can tell apart by their names.
   for (std::size_t i = 0; i < request.values.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
-      if (valueText(request.values[i]) == valueText(request.values[j]))
+      if (shortNumberText(request.values[i]) == shortNumberText(request.values[j]))
         throw Error(what, request.values[i] == request.values[j]
-                              ? valueText(request.values[i]) + " is given twice"
+                              ? shortNumberText(request.values[i]) + " is given twice"
                               : "values " + numberText(request.values[j]) + " and " + numberText(request.values[i]) +
                                     " are one isosurface to 6 digits: give values that differ there");
   const glm::vec2 colourRange(contourColorRange(request.values, glm::dvec2(range)));
@@ -176,7 +168,7 @@ std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request
   for (const double value : request.values) {
     Mesh mesh = contourVolume(volume, value);
     if (mesh.triangleCount() == 0)
-      throw Error(what, "volume '" + volume.name + "' has no surface at " + valueText(value));
+      throw Error(what, "volume '" + volume.name + "' has no surface at " + shortNumberText(value));
     mesh.validate(contourPartName(volume.name, value));
     Object part;
     part.name = contourPartName(volume.name, value);

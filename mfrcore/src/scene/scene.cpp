@@ -12,6 +12,7 @@
 #include "mfr/error.hpp"
 #include "mfr/list_text.hpp"
 #include "mfr/scene/clip_box.hpp"
+#include "number_text.hpp"
 
 namespace mfr {
 
@@ -78,17 +79,6 @@ bool Scene::hasVisibleVolume() const {
   return std::any_of(volumes.begin(), volumes.end(), [](const Volume& v) { return v.visible; });
 }
 
-namespace {
-
-// Six significant digits: a float's coordinates read back as doubles (1e33 is 9.999999944957273e+32).
-std::string shortNumber(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
-
-}  // namespace
-
 void Scene::validate() const {
   std::size_t visibleVolumes = 0;
   for (const Volume& v : volumes) {
@@ -110,11 +100,11 @@ void Scene::validate() const {
       if (!(std::abs(extent.min[a]) <= 1e15 && std::abs(extent.max[a]) <= 1e15))
         throw Error("scene '" + name + "'",
                     "reaches beyond ±1e15 (to " +
-                        shortNumber(std::max(std::abs(extent.min[a]), std::abs(extent.max[a]))) +
+                        shortNumberText(std::max(std::abs(extent.min[a]), std::abs(extent.max[a]))) +
                         "): too far out to be drawn in single precision");
     if (const double across = glm::length(extent.max - extent.min); across > 0.0 && across < 1e-30)
       throw Error("scene '" + name + "'",
-                  "is " + shortNumber(across) + " across, below 1e-30: too small to be drawn in single precision");
+                  "is " + shortNumberText(across) + " across, below 1e-30: too small to be drawn in single precision");
   }
   validateCsg(*this);
   validateClipBox(clipBox, "clip box");
