@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <initializer_list>
+#include <vector>
 
 #include "exact_method.hpp"
 #include "gl_fixture.hpp"
@@ -84,7 +85,7 @@ TEST(DepthPeeling, PassCountFollowsDepthComplexity) {
   EXPECT_LE(layers, oracle.maxCount());
   EXPECT_GT(layers, 20u);
   const Stats sf = gpu.render(camera, f2b).stats;
-  EXPECT_EQ(sf.passes, layers + 1);
+  EXPECT_EQ(sf.passes, layers + 2);  // the count pass, the layers, the pass that finds nothing
   EXPECT_EQ(note(sf, "layers peeled"), std::to_string(layers));
   EXPECT_FALSE(sf.overflow);
 
@@ -122,7 +123,7 @@ TEST(DepthPeeling, FrontToBackPassLimitOverflows) {
   const RenderRequest limited = request("peel-f2b", w, h, {{"max_passes", std::to_string(k)}});
   const RenderOutput out = gpu.render(camera, limited);
   EXPECT_TRUE(out.stats.overflow);
-  EXPECT_EQ(out.stats.passes, k + 1);  // k layers + the counting pass
+  EXPECT_EQ(out.stats.passes, k + 2);  // the count pass, k layers, the overflow check
   EXPECT_EQ(out.stats.fragmentsDropped, dropped);
   EXPECT_EQ(out.stats.overflowPixels, pixels);
   EXPECT_EQ(out.stats.fragmentsGenerated, exact.fragmentsGenerated);
@@ -174,6 +175,78 @@ TEST(DepthPeeling, DualPassLimitOverflows) {
   EXPECT_EQ(lc.colorMismatches, 0u) << lc.firstMismatch;
 }
 
+// Depth ties: @intersect holds one surface twice, so many pixels have two fragments at one depth.
+// Peeling composites one per depth; the stats count every fragment rasterised (as the A-buffer
+// does), the composited ones (the distinct depths of each pixel's list), those beyond the pass
+// limit, and note the rest as depth ties. Expected counts come from the linked-list A-buffer's lists.
+TEST(DepthPeeling, DepthTiesAreCountedNotStored) {
+  context();
+  const Scene scene = makeIntersectingSampleScene();
+  const Camera camera = scene.views.front().camera;
+  const int w = 96, h = 72;
+  GpuRenderer gpu;
+  gpu.setScene(scene);
+  const Stats all = gpu.render(camera, request("abuffer-ll", w, h)).stats;
+  std::uint32_t deepest = 0;
+  for (const std::uint32_t n : gpu.capture(camera, request("abuffer-ll", w, h), 1).counts)
+    deepest = std::max(deepest, n);
+  const CapturedLists lists = gpu.capture(camera, request("abuffer-ll", w, h), static_cast<int>(deepest));
+  // Per pixel: the distinct depths, nearest first, and how many fragments lie at each.
+  std::vector<std::vector<std::uint32_t>> perDepth;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      std::vector<float> depths;
+      for (std::uint32_t i = 0; i < lists.count(x, y); ++i) depths.push_back(lists.pixel(x, y)[i].depth);
+      std::sort(depths.begin(), depths.end());
+      std::vector<std::uint32_t> runs;
+      for (std::size_t i = 0; i < depths.size(); ++i)
+        if (i > 0 && depths[i] == depths[i - 1])
+          ++runs.back();
+        else
+          runs.push_back(1);
+      perDepth.push_back(std::move(runs));
+    }
+  std::uint64_t ties = 0;
+  for (const auto& runs : perDepth)
+    for (const std::uint32_t r : runs) ties += r - 1;
+  ASSERT_GT(ties, 100u);
+
+  // Expected stats when peeling keeps `front` nearest and `back` farthest depths of each pixel.
+  const auto expect = [&](const Stats& s, std::uint32_t front, std::uint32_t back) {
+    std::uint64_t stored = 0, dropped = 0, tied = 0;
+    for (const auto& runs : perDepth)
+      for (std::size_t i = 0; i < runs.size(); ++i)
+        if (i < front || i + back >= runs.size()) {
+          ++stored;
+          tied += runs[i] - 1;
+        } else {
+          dropped += runs[i];
+        }
+    EXPECT_EQ(s.fragmentsGenerated, all.fragmentsGenerated);
+    EXPECT_EQ(s.fragmentsStored, stored);
+    EXPECT_EQ(s.fragmentsDropped, dropped);
+    EXPECT_EQ(s.overflow, dropped > 0);
+    EXPECT_EQ(note(s, "depth ties").substr(0, note(s, "depth ties").find(' ')), std::to_string(tied));
+  };
+  const std::uint32_t unlimited = 1024;
+  {
+    SCOPED_TRACE("peel-f2b");
+    expect(gpu.render(camera, request("peel-f2b", w, h)).stats, unlimited, 0);
+  }
+  {
+    SCOPED_TRACE("peel-dual");
+    expect(gpu.render(camera, request("peel-dual", w, h)).stats, unlimited, 0);
+  }
+  {
+    SCOPED_TRACE("peel-f2b max_passes=2");
+    expect(gpu.render(camera, request("peel-f2b", w, h, {{"max_passes", "2"}})).stats, 2, 0);
+  }
+  {
+    SCOPED_TRACE("peel-dual max_passes=1");
+    expect(gpu.render(camera, request("peel-dual", w, h, {{"max_passes", "1"}})).stats, 1, 1);
+  }
+}
+
 // Memory: fixed bytes per pixel, whatever the depth complexity or the pass limit.
 TEST(DepthPeeling, MemoryIsPerPixelOnly) {
   context();
@@ -206,7 +279,7 @@ TEST(DepthPeeling, SphereNeedsTwoLayers) {
   gpu.setScene(sphere);
   const Camera camera = sphere.view("fit");
   const Stats f2b = gpu.render(camera, request("peel-f2b", 64, 64, {{"max_passes", "2"}})).stats;
-  EXPECT_EQ(f2b.passes, 3u);  // 2 layers + the counting pass at the limit, which finds nothing
+  EXPECT_EQ(f2b.passes, 4u);  // the count pass, 2 layers, the overflow check, which finds nothing
   EXPECT_FALSE(f2b.overflow);
   const Stats dual = gpu.render(camera, request("peel-dual", 64, 64, {{"max_passes", "1"}})).stats;
   EXPECT_EQ(dual.passes, 2u);

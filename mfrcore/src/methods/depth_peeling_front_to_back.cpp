@@ -1,5 +1,6 @@
 #include "depth_peeling_front_to_back.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <string>
 
@@ -8,21 +9,6 @@
 #include "method_util.hpp"
 
 namespace mfr {
-namespace {
-
-// Runs draw() inside a GL_SAMPLES_PASSED query and returns the samples that passed (waits).
-template <class Draw>
-std::uint64_t countSamples(Draw&& draw) {
-  const gl::Query query = gl::createQuery(GL_SAMPLES_PASSED);
-  glBeginQuery(GL_SAMPLES_PASSED, query.id());
-  draw();
-  glEndQuery(GL_SAMPLES_PASSED);
-  GLuint64 samples = 0;
-  glGetQueryObjectui64v(query.id(), GL_QUERY_RESULT, &samples);
-  return samples;
-}
-
-}  // namespace
 
 const MethodInfo& DepthPeelingFrontToBack::info() const {
   static const MethodInfo i{
@@ -108,6 +94,19 @@ void DepthPeelingFrontToBack::resolve(const FrameContext& ctx, const Operation& 
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     dumpProgram->set("uWriteCounts", 0);
   }
+
+  // Count pass: every fragment lies behind the "before first" layer, so with the depth test and
+  // colour writes off the query counts all rasterised fragments. Peeling alone cannot know them:
+  // a fragment at exactly a peeled layer's depth is never peeled (a coplanar tie).
+  glBindFramebuffer(GL_FRAMEBUFFER, peelFbo_[0].id());
+  glBindTextureUnit(MFR_TEX_AUX0, layers_[1].id());
+  {
+    GeometryPassState state(false, false);
+    ctx.timer.begin("count");
+    stats_.fragmentsGenerated = countSamples([&] { ctx.scene.draw(peel_, ctx.frame); });
+    ctx.timer.end();
+  }
+  ++stats_.passes;
 
   int cur = 0;
   bool exhausted = false;
@@ -197,12 +196,15 @@ void DepthPeelingFrontToBack::resolve(const FrameContext& ctx, const Operation& 
   glBindVertexArray(0);
 
   stats_.overflow = stats_.fragmentsDropped > 0;
-  stats_.fragmentsGenerated = stats_.fragmentsStored + stats_.fragmentsDropped;
+  // What is neither peeled nor behind the last layer lay at exactly a peeled layer's depth.
+  const std::uint64_t ties =
+      stats_.fragmentsGenerated - std::min(stats_.fragmentsGenerated, stats_.fragmentsStored + stats_.fragmentsDropped);
   stats_.bytesAllocated = kBytesPerPixel * static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
   stats_.bytesUsed = stats_.bytesAllocated;
   stats_.kMin = stats_.kMax = static_cast<std::uint32_t>(maxPasses_);
   stats_.notes.emplace_back("layers peeled", std::to_string(layersPeeled));
   stats_.notes.emplace_back("max_passes", std::to_string(maxPasses_));
+  if (ties > 0) stats_.notes.emplace_back("depth ties", depthTiesNote(ties));
   stats_.notes.emplace_back("capture/resolve", "all passes run in resolve: peeling composites while it peels");
 }
 

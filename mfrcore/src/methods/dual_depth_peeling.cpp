@@ -1,6 +1,8 @@
 #include "dual_depth_peeling.hpp"
 
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "common/bindings.h"
 #include "mfr/error.hpp"
@@ -8,18 +10,6 @@
 
 namespace mfr {
 namespace {
-
-// Runs draw() inside a GL_SAMPLES_PASSED query and returns the samples that passed (waits).
-template <class Draw>
-std::uint64_t countSamples(Draw&& draw) {
-  const gl::Query query = gl::createQuery(GL_SAMPLES_PASSED);
-  glBeginQuery(GL_SAMPLES_PASSED, query.id());
-  draw();
-  glEndQuery(GL_SAMPLES_PASSED);
-  GLuint64 samples = 0;
-  glGetQueryObjectui64v(query.id(), GL_QUERY_RESULT, &samples);
-  return samples;
-}
 
 constexpr float kEmptyRange[2] = {-2.0f, -2.0f};  // nearest 2 > farthest −2 (layers.glsl)
 constexpr float kNoLayers[4] = {-1.0f, -1.0f, -1.0f, -1.0f};
@@ -150,11 +140,31 @@ void DualDepthPeeling::resolve(const FrameContext& ctx, const Operation& op) {
     glClearTexImage(back_.id(), 0, GL_RGBA, GL_FLOAT, backInit);
   }
 
+  // Layer counts: queries on the counting pass, read once after the last pass so that they add
+  // no wait. The first range's non-empty pixels, and per pass the pixels that peel two layers.
+  std::vector<gl::Query> layerQueries;
+  const auto queueLayerCount = [&](const gl::Texture& range, int twoLayers) {
+    sideEffectsOnly();
+    glBindFramebuffer(GL_FRAMEBUFFER, noAttachFbo_.id());
+    glBindTextureUnit(MFR_TEX_AUX0, range.id());
+    remaining_.set("uTwoLayers", twoLayers);
+    layerQueries.push_back(gl::createQuery(GL_SAMPLES_PASSED));
+    ctx.timer.begin("layer count");
+    glBeginQuery(GL_SAMPLES_PASSED, layerQueries.back().id());
+    fullScreen(remaining_);
+    glEndQuery(GL_SAMPLES_PASSED);
+    ctx.timer.end();
+    remaining_.set("uTwoLayers", 0);
+  };
+
   int cur = 0;
   std::uint64_t remainingPixels = stats_.fragmentsGenerated > 0 ? 1 : 0;
+  std::uint64_t layersComposited = 0;  // one per non-empty range a pass peels, two where its ends differ
   std::uint32_t peelPasses = 0;
+  if (remainingPixels > 0) queueLayerCount(range_[0], 0);
   while (remainingPixels > 0 && peelPasses < static_cast<std::uint32_t>(maxPasses_)) {
     const int next = 1 - cur;
+    queueLayerCount(range_[cur], 1);
     // Peel the front and back layers of range_[cur]; the fragments between form range_[next].
     glClearTexImage(range_[next].id(), 0, GL_RG, GL_FLOAT, kEmptyRange);
     glClearTexImage(layers_.id(), 0, GL_RGBA, GL_FLOAT, kNoLayers);
@@ -203,6 +213,13 @@ void DualDepthPeeling::resolve(const FrameContext& ctx, const Operation& op) {
     remainingPixels = countSamples([&] { fullScreen(remaining_); });
     ctx.timer.end();
     cur = next;
+    // The next pass peels one layer at each of these pixels (its front).
+    if (peelPasses < static_cast<std::uint32_t>(maxPasses_)) layersComposited += remainingPixels;
+  }
+  for (const gl::Query& query : layerQueries) {
+    GLuint64 pixels = 0;
+    glGetQueryObjectui64v(query.id(), GL_QUERY_RESULT, &pixels);
+    layersComposited += pixels;
   }
 
   if (remainingPixels > 0) {
@@ -237,12 +254,15 @@ void DualDepthPeeling::resolve(const FrameContext& ctx, const Operation& op) {
   glBindVertexArray(0);
 
   stats_.overflow = stats_.fragmentsDropped > 0;
-  stats_.fragmentsStored = stats_.fragmentsGenerated - stats_.fragmentsDropped;
+  stats_.fragmentsStored = std::min(layersComposited, stats_.fragmentsGenerated - stats_.fragmentsDropped);
+  // What is neither composited nor left in an unpeeled range lay at a peeled layer's depth.
+  const std::uint64_t ties = stats_.fragmentsGenerated - stats_.fragmentsDropped - stats_.fragmentsStored;
   stats_.bytesAllocated = kBytesPerPixel * static_cast<std::uint64_t>(width_) * static_cast<std::uint64_t>(height_);
   stats_.bytesUsed = stats_.bytesAllocated;
   stats_.kMin = stats_.kMax = static_cast<std::uint32_t>(2 * maxPasses_);
   stats_.notes.emplace_back("peel passes", std::to_string(peelPasses));
   stats_.notes.emplace_back("max_passes", std::to_string(maxPasses_));
+  if (ties > 0) stats_.notes.emplace_back("depth ties", depthTiesNote(ties));
   stats_.notes.emplace_back("capture/resolve", "all passes run in resolve: peeling composites while it peels");
 }
 

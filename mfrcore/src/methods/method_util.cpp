@@ -73,4 +73,9 @@ void requireStorageFits(const std::string& what, const std::string& need, std::u
                         formatMemory(limit * elementBytes) + ")" + advice);
 }
 
+std::string depthTiesNote(std::uint64_t ties) {
+  return std::to_string(ties) + (ties == 1 ? " fragment" : " fragments") +
+         " at exactly the depth of a peeled layer, not composited (peeling keeps one fragment per depth)";
+}
+
 }  // namespace mfr

@@ -45,4 +45,21 @@ std::uint64_t maxStorageElements(std::uint64_t elementBytes);
 void requireStorageFits(const std::string& what, const std::string& need, std::uint64_t count, std::uint64_t limit,
                         std::uint64_t elementBytes, const std::string& advice);
 
+// Runs draw() inside a GL_SAMPLES_PASSED query and returns the samples that passed (waits). The
+// peeling methods count fragments and pixels with it.
+template <class Draw>
+std::uint64_t countSamples(Draw&& draw) {
+  const gl::Query query = gl::createQuery(GL_SAMPLES_PASSED);
+  glBeginQuery(GL_SAMPLES_PASSED, query.id());
+  draw();
+  glEndQuery(GL_SAMPLES_PASSED);
+  GLuint64 samples = 0;
+  glGetQueryObjectui64v(query.id(), GL_QUERY_RESULT, &samples);
+  return samples;
+}
+
+// The note of a peeling method that left `ties` fragments uncomposited at exactly the depth of a
+// layer it peeled (peeling's known limit; methods.md).
+std::string depthTiesNote(std::uint64_t ties);
+
 }  // namespace mfr
