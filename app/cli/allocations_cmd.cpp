@@ -59,9 +59,11 @@ void addAllocations(CLI::App& app) {
     checkCommandFiles(files);
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+    refuseRepeats(opt->scenes, "scenes");
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
     const NeuralImportanceModel model = loadNeuralImportance(opt->weights).quantised();  // as on the GPU
     const std::vector<std::string> views = splitList(opt->views, "--views");
+    refuseRepeats(views, "--views " + opt->views);
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     // Every allocation gets dkb's slots (its layout also holds the weights), so all compete at one F.
     const VariableKLayout layout = variableKLayout(pixels, NeuralImportanceModel::packedBytes());

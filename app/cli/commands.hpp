@@ -2,7 +2,9 @@
 // Subcommands of mfr; each adds itself to the app and runs from its callback.
 #include <CLI/CLI.hpp>
 
+#include <charconv>
 #include <cstdint>
+#include <system_error>
 #include <optional>
 #include <sstream>
 #include <map>
@@ -51,6 +53,10 @@ void addParameterFiles(std::vector<CommandFile>& files, const std::string& optio
 std::pair<int, int> parseSize(const std::string& option, const std::string& text);
 // The items of a list option; an empty item (a doubled or stray separator) is refused, naming the option.
 std::vector<std::string> splitList(const std::string& text, const std::string& option, char separator = ',');
+// Refuses an item named twice ("@sample @sample", --views iso,iso, --budgets f50,f50): the
+// commands that loop over such lists did the work twice and counted it twice. Throws
+// Error(option, "'item' is given twice").
+void refuseRepeats(const std::vector<std::string>& items, const std::string& option);
 // --field and --molecule: what to read of a file that holds several things.
 struct ReadOptions {
   std::string field;                    // --field: the array or grid of a volume file
@@ -87,6 +93,10 @@ inline CLI::Validator wholeNumber() {
       [](std::string& text) -> std::string {
         if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
           return "'" + text + "' is not a whole number (0, 1, 2, …)";
+        // CLI11 clamped 2^64 and beyond to 2^64 − 1, which the dataset's metadata then recorded.
+        std::uint64_t value = 0;
+        if (std::from_chars(text.data(), text.data() + text.size(), value).ec != std::errc())
+          return "'" + text + "' is beyond 18446744073709551615 (64 bits)";
         return {};
       },
       "");
@@ -185,7 +195,8 @@ struct BudgetSpec {
 constexpr double kLargestBudgetMiB = 65536.0;  // the budget methods' largest budget_mib (64 GiB)
 // Throws mfr::Error naming --budgets.
 BudgetSpec parseBudgetSpec(const std::string& item, std::uint64_t pixels);
-// The comma-separated list of --budgets; throws mfr::Error for a bad item or an empty list.
+// The comma-separated list of --budgets; throws mfr::Error for a bad item, an item given twice or
+// an empty list.
 std::vector<BudgetSpec> parseBudgetSpecs(const std::string& text, std::uint64_t pixels);
 // Median of the values (0 for none).
 double median(std::vector<double> values);

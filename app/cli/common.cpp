@@ -87,6 +87,13 @@ std::vector<std::string> splitList(const std::string& text, const std::string& o
   return items;
 }
 
+void refuseRepeats(const std::vector<std::string>& items, const std::string& option) {
+  for (std::size_t i = 0; i < items.size(); ++i)
+    if (std::find(items.begin(), items.begin() + static_cast<std::ptrdiff_t>(i), items[i]) !=
+        items.begin() + static_cast<std::ptrdiff_t>(i))
+      throw Error(option, "'" + items[i] + "' is given twice");
+}
+
 void ReadOptions::add(CLI::App* cmd) {
   cmd->add_option("--field", field,
                   "Volume file: the point-data array (.vti, .vtk) or grid (.vdb) to read instead of the default "
@@ -242,7 +249,9 @@ BudgetSpec parseBudgetSpec(const std::string& item, std::uint64_t pixels) {
 
 std::vector<BudgetSpec> parseBudgetSpecs(const std::string& text, std::uint64_t pixels) {
   std::vector<BudgetSpec> budgets;
-  for (const std::string& b : splitList(text, "--budgets")) budgets.push_back(parseBudgetSpec(b, pixels));
+  const std::vector<std::string> items = splitList(text, "--budgets");
+  refuseRepeats(items, "--budgets " + text);  // f50,f50 measured one case twice and counted it twice
+  for (const std::string& b : items) budgets.push_back(parseBudgetSpec(b, pixels));
   if (budgets.empty()) throw Error("--budgets", "no budget given");
   return budgets;
 }
@@ -259,12 +268,10 @@ void BudgetSpec::resolve(std::uint64_t total, std::uint64_t exactSlots, std::uin
 }
 
 std::string BudgetSpec::paramText() const {
+  // The byte count the methods floor back to: half a byte over it, to 10 decimals of MiB (1e-4
+  // byte). Six decimals of the user's MiB rounded up to 1 byte over the budget (a bug hunt).
   std::ostringstream s;
-  s << std::fixed;
-  if (bytes)
-    s << std::setprecision(10) << (static_cast<double>(bytes) + 0.5) / (1024.0 * 1024.0);
-  else
-    s << std::setprecision(6) << mib;
+  s << std::fixed << std::setprecision(10) << (static_cast<double>(byteCount()) + 0.5) / (1024.0 * 1024.0);
   return s.str();
 }
 

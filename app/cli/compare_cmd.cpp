@@ -41,6 +41,7 @@ void addCompare(CLI::App& app) {
                        {"test", opt->test},
                        {"--heatmap", opt->heatmap, CommandFile::Role::kOutput},
                        {"--json", opt->json, CommandFile::Role::kOutput}});
+    if (!opt->heatmap.empty()) checkPngOutputName("--heatmap", opt->heatmap);
     const ImageRGBA8 ref = readPng(opt->reference);
     const ImageRGBA8 test = readPng(opt->test);
     if (ref.width != test.width || ref.height != test.height)

@@ -89,7 +89,10 @@ void addDataset(CLI::App& app) {
     files.push_back({"-o", opt->output, CommandFile::Role::kRequiredOutput});
     checkCommandFiles(files);
     const std::vector<double> levels = parseBudgetLevels(opt->budgets);
+    refuseRepeats(opt->scenes, "scenes");
     const std::vector<std::string> views = splitList(opt->views, "--views");
+    refuseRepeats(views, "--views " + opt->views);
+    refuseRepeats(opt->sizes, "--size");
     std::vector<std::pair<int, int>> sizes;
     for (const std::string& s : opt->sizes) sizes.push_back(parseSize("--size", s));
     if (!(opt->sample > 0.0)) throw Error("--sample", "must be in (0, 1]: 0 writes no rows");

@@ -140,14 +140,13 @@ void addEvaluate(CLI::App& app) {
     checkCommandFiles(files);
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
+    refuseRepeats(opt->scenes, "scenes");
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
     const std::vector<std::string> methods = splitList(opt->methods, "--methods");
     if (methods.empty()) throw Error("--methods", "names no method");
-    for (std::size_t i = 0; i < methods.size(); ++i)  // "vkb,vkb" printed a row twice and "tie vkb=vkb"
-      if (std::find(methods.begin(), methods.begin() + static_cast<std::ptrdiff_t>(i), methods[i]) !=
-          methods.begin() + static_cast<std::ptrdiff_t>(i))
-        throw Error("--methods " + opt->methods, "'" + methods[i] + "' is given twice");
+    refuseRepeats(methods, "--methods " + opt->methods);  // "vkb,vkb" printed a row twice and "tie vkb=vkb"
     std::map<std::string, RenderRequest> specs;  // each method spec's request, without size and budget
+    std::vector<std::string> interlockRows;      // specs asking for sync=interlock: checked on the context
     std::size_t methodWidth = 11;
     // A weights file that cannot be read is the user's mistake, not one row's failure: refused
     // before anything runs (it was only a row's error, and exit 0).
@@ -172,8 +171,19 @@ void addEvaluate(CLI::App& app) {
         throw Error("--methods " + m, "budget_mib is set by --budgets, not in the method spec");
       std::map<std::string, std::string> values = spec.params;
       values["budget_mib"] = "1";
-      (void)Params(methodInfo->params, values, spec.method);
+      const Params params(methodInfo->params, values, spec.method);
       if (spec.operation != "auto") validateOperation(spec.operation);
+      const auto has = [&](const char* name) {
+        return std::any_of(methodInfo->params.begin(), methodInfo->params.end(),
+                           [&](const ParamSpec& p) { return p.name == name; });
+      };
+      // Hybrid (auto here) composites the k-buffer's tail; without one every row was the renderer's
+      // "--op hybrid: needs --param tail=true", naming options the user never gave (a bug hunt).
+      if ((spec.operation == "auto" || spec.operation == "hybrid") && has("tail") && !params.flag("tail"))
+        throw Error("--methods " + m,
+                    "operation hybrid (evaluate's default) composites the tail this spec turns off "
+                    "(drop tail=false, or add op=oit)");
+      if (has("sync") && params.text("sync") == "interlock") interlockRows.push_back(m);
       // Every row is measured against the exact "over" image: an operation that draws another
       // image (a volume, a CSG result, merged z-thickness slabs) would only be a row of errors
       // or of meaningless numbers for every scene, view and budget.
@@ -189,16 +199,24 @@ void addEvaluate(CLI::App& app) {
       methodWidth = std::max(methodWidth, m.size() + 2);
     }
     const std::vector<std::string> views = splitList(opt->views, "--views");
+    refuseRepeats(views, "--views " + opt->views);
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     GpuRenderer& gpu = headlessRenderer();
     const gl::ContextInfo info = gl::queryContextInfo();
+    for (const std::string& m : interlockRows)  // each row was this error, with exit 0
+      if (!info.fragmentShaderInterlock)
+        throw Error("--methods " + m, "sync=interlock: this OpenGL driver (" + info.renderer +
+                                          ") has no fragment shader interlock (use sync=spinlock, the default)");
+    // The budget column holds "label MiB" (up to 65536.00): a long label ran into the method column.
+    int budgetWidth = 14;
+    for (const BudgetSpec& b : budgets) budgetWidth = std::max(budgetWidth, static_cast<int>(b.label.size()) + 11);
     nlohmann::ordered_json out;
     out["renderer"] = info.renderer;
     out["size"] = opt->size;
     out["repeat"] = opt->repeat;
     nlohmann::ordered_json rows = nlohmann::ordered_json::array();
     std::cout << "renderer: " << info.renderer << ", " << opt->size << ", median of " << opt->repeat << " frames\n";
-    std::cout << std::left << std::setw(22) << "scene" << std::setw(12) << "view" << std::setw(14) << "budget"
+    std::cout << std::left << std::setw(22) << "scene" << std::setw(12) << "view" << std::setw(budgetWidth) << "budget"
               << std::setw(static_cast<int>(methodWidth)) << "method" << std::right << std::setw(9) << "k range"
               << std::setw(10) << "captured" << std::setw(8) << "%" << std::setw(9) << "RMSE" << std::setw(9) << "FLIP"
               << std::setw(10) << "ms\n";
@@ -270,6 +288,7 @@ void addEvaluate(CLI::App& app) {
             row["view"] = v;
             row["budget"] = b.label;
             row["budget_mib"] = b.mib;
+            row["budget_bytes"] = b.byteCount();
             row["exact_slots"] = exactSlots;
             row["exact_slots_tail_runs"] = exactSlotsRuns;
             row["method"] = m;
@@ -290,19 +309,23 @@ void addEvaluate(CLI::App& app) {
               row["error"] = e.what();
               rows.push_back(row);
               std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12)
-                        << v.substr(0, 11) << std::setw(14) << b.label << std::setw(static_cast<int>(methodWidth)) << m
-                        << "  " << e.what() << "\n";
+                        << v.substr(0, 11) << std::setw(budgetWidth) << b.label
+                        << std::setw(static_cast<int>(methodWidth)) << m << "  " << e.what() << "\n";
               continue;
             }
             const ImageRGBA8& reference = cpu ? exact : gpuExact;
             const double e = rmse(reference, r.image);
             const double f = flip(reference, r.image).stats.mean;
+            // A share of the fragments of the method's own rasterisation (a GPU row's count of every
+            // fragment; the oracle's for optimal-k): against the oracle's total a GPU row could
+            // capture 100.1 % (a bug hunt).
+            const std::uint64_t all = cpu ? total : r.stats.fragmentsGenerated;
             const double captured =
-                total ? 100.0 * static_cast<double>(r.stats.fragmentsStored) / static_cast<double>(total) : 0.0;
+                all ? 100.0 * static_cast<double>(r.stats.fragmentsStored) / static_cast<double>(all) : 0.0;
             row["k_min"] = r.stats.kMin;
             row["k_max"] = r.stats.kMax;
             row["fragments_captured"] = r.stats.fragmentsStored;
-            row["fragments_total"] = total;
+            row["fragments_total"] = all;
             row["captured_percent"] = captured;
             row["bytes_allocated"] = r.stats.bytesAllocated;
             row["reference"] = cpu ? "oracle (exact lists, over)" : "abuffer-ll (every rasterised fragment, over)";
@@ -322,8 +345,8 @@ void addEvaluate(CLI::App& app) {
             }
             rows.push_back(row);
             std::cout << std::left << std::setw(22) << scenes[s].name.substr(0, 21) << std::setw(12) << v.substr(0, 11)
-                      << std::setw(14) << (b.label + " " + fixed(b.mib, 2)) << std::setw(static_cast<int>(methodWidth))
-                      << m << std::right << std::setw(9)
+                      << std::setw(budgetWidth) << (b.label + " " + fixed(b.mib, 2))
+                      << std::setw(static_cast<int>(methodWidth)) << m << std::right << std::setw(9)
                       << (std::to_string(r.stats.kMin) + "-" + std::to_string(r.stats.kMax)) << std::setw(10)
                       << r.stats.fragmentsStored << std::setw(8) << fixed(captured, 1) << std::setw(9) << fixed(e, 5)
                       << std::setw(9) << fixed(f, 5) << std::setw(10)

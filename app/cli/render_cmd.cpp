@@ -86,6 +86,7 @@ void addRender(CLI::App& app) {
     files.push_back({"-o", opt->output, CommandFile::Role::kRequiredOutput});
     files.push_back({"--stats", opt->stats, CommandFile::Role::kOutput});
     checkCommandFiles(files);
+    checkPngOutputName("-o", opt->output);
     RenderRequest req;
     req.method = opt->method;
     req.operation = opt->op;

@@ -10,6 +10,7 @@
 #include <QCoreApplication>
 #include <QCommandLineParser>
 #include <QElapsedTimer>
+#include <QImage>
 #include <QJsonDocument>
 #include <QJsonObject>
 #include <QOpenGLContext>
@@ -23,11 +24,14 @@
 #include <cstring>
 #include <exception>
 #include <map>
+#include <utility>
 #include <optional>
 
 #include "main_window.hpp"
 #include "mfr/error.hpp"
 #include "mfr/host_memory.hpp"
+#include "mfr/image.hpp"
+#include "mfr/io_util.hpp"
 #include "mfr/operation_settings.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/clip_box.hpp"
@@ -233,6 +237,17 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
   cl.view = parser.value(view);
   cl.screenshot = parser.value(screenshot);
   cl.windowScreenshot = parser.value(windowScreenshot);
+  // Before any work, as mfr render checks -o: a name that says another format, a missing folder.
+  for (const auto& [option, path] : {std::pair{QStringLiteral("--screenshot"), cl.screenshot},
+                                     std::pair{QStringLiteral("--window-screenshot"), cl.windowScreenshot}}) {
+    if (path.isEmpty()) continue;
+    try {
+      mfr::checkPngOutputName(option.toStdString(), path.toStdString());
+      mfr::checkOutputPath(path.toStdString());
+    } catch (const mfr::Error& e) {
+      fail(QString::fromUtf8(e.what()), 2);
+    }
+  }
   if (parser.isSet(size)) cl.size = parseSize(QStringLiteral("--size"), parser.value(size));
   if (parser.isSet(windowSize)) cl.windowSize = parseSize(QStringLiteral("--window-size"), parser.value(windowSize));
   for (const QString& p : parser.values(param)) {
@@ -472,7 +487,12 @@ int main(int argc, char** argv) {
         if (!cl.windowScreenshot.isEmpty()) {
           // Plugins' panels update from the frame's signals; let them paint first.
           QApplication::processEvents();
-          if (!window.grab().save(cl.windowScreenshot)) fail(QStringLiteral("%1: cannot write").arg(cl.windowScreenshot), 1);
+          // Written as --screenshot is: PNG whatever the name, through a temporary file.
+          const QImage grabbed = window.grab().toImage().convertToFormat(QImage::Format_RGBA8888);
+          mfr::ImageRGBA8 image(grabbed.width(), grabbed.height());
+          for (int y = 0; y < grabbed.height(); ++y)
+            std::memcpy(image.at(0, y), grabbed.constScanLine(y), static_cast<std::size_t>(grabbed.width()) * 4);
+          mfr::writePng(cl.windowScreenshot.toStdString(), image);
         }
       } catch (const std::exception& e) {
         fail(QString::fromUtf8(e.what()), 1);

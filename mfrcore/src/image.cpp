@@ -3,6 +3,8 @@
 #include <png.h>
 
 #include <algorithm>
+#include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -10,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "mfr/error.hpp"
 #include "mfr/host_memory.hpp"
@@ -147,6 +150,34 @@ std::string encodePng(const std::filesystem::path& path, const ImageRGBA8& image
   PngErrorState state;
   if (!encodePng(image, rows.data(), &encoded, &state)) throw Error(path.string(), "PNG encoding failed (" + state.message + ")");
   return encoded;
+}
+
+void checkPngOutputName(const std::string& option, const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  static const std::array<std::pair<const char*, const char*>, 17> kOtherFormats{{{".jpg", "JPEG"},
+                                                                                  {".jpeg", "JPEG"},
+                                                                                  {".jpe", "JPEG"},
+                                                                                  {".jfif", "JPEG"},
+                                                                                  {".bmp", "BMP"},
+                                                                                  {".gif", "GIF"},
+                                                                                  {".tif", "TIFF"},
+                                                                                  {".tiff", "TIFF"},
+                                                                                  {".webp", "WebP"},
+                                                                                  {".ppm", "PPM"},
+                                                                                  {".pgm", "PGM"},
+                                                                                  {".pnm", "PNM"},
+                                                                                  {".exr", "OpenEXR"},
+                                                                                  {".hdr", "Radiance HDR"},
+                                                                                  {".tga", "TGA"},
+                                                                                  {".svg", "SVG"},
+                                                                                  {".pdf", "PDF"}}};
+  for (const auto& [suffix, format] : kOtherFormats)
+    if (ext == suffix)
+      throw Error(option + " " + path.string(), std::string("the name says ") + format +
+                                                    ", but the image is written as PNG, the one format mfr writes: "
+                                                    "name it .png");
 }
 
 void writePng(const std::filesystem::path& path, const ImageRGBA8& image) {

@@ -21,6 +21,9 @@ std::string readFile(const std::filesystem::path& path) {
   const auto status = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(status)) throw Error(path.string(), "no such file");
   if (std::filesystem::is_directory(status)) throw Error(path.string(), "is a directory, not a file");
+  // /dev/zero never ends and a pipe may never be written: read, they grew memory without bound or
+  // waited forever (a bug hunt: -p weights=/dev/zero, mfr train /dev/zero).
+  if (!std::filesystem::is_regular_file(status)) throw Error(path.string(), "not a regular file (a device or pipe)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path.string(), std::string("cannot open (") + std::strerror(errno) + ")");
   std::ostringstream ss;

@@ -1187,6 +1187,71 @@ TEST_F(Cli, DatasetWritesNoEmptyFileAndNoFrameTwice) {
   EXPECT_EQ(std::count(near.out.begin(), near.out.end(), '\n'), 3) << near.out;  // head, one frame, the file
 }
 
+// Found by a bug hunt of the budget commands, each taken before:
+// - a plain MiB budget rounded to 6 decimals up, one byte past the budget;
+// - specs that could not run (hybrid without a tail, interlock on a driver without it): a row of
+//   errors each, exit 0;
+// - scenes, views, budgets, sizes and datasets given twice: the work done and counted twice;
+// - a weights file or dataset that is a device (/dev/zero grew memory without bound);
+// - a seed beyond 64 bits, clamped; an image name that says JPEG over a PNG.
+TEST_F(Cli, BudgetCommandsCheckListsFilesAndBudgetsFirst) {
+  const fs::path json = dir() / "e.json";
+  const CliResult r = runCli(
+      "evaluate @sample -s 40x30 -r 1 -m vkb,dkb,fkb,optimal-k --budgets 0.047908687592,k1 --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  std::ifstream in(json);
+  const nlohmann::json results = nlohmann::json::parse(in).at("results");
+  ASSERT_EQ(results.size(), 8u);
+  for (const nlohmann::json& row : results) {
+    if (row.contains("error")) continue;  // fkb: no k = 1 at 0.048 MiB
+    EXPECT_LE(row.at("bytes_allocated").get<std::uint64_t>(), row.at("budget_bytes").get<std::uint64_t>())
+        << row.dump();
+    EXPECT_LE(row.at("captured_percent").get<double>(), 100.0) << row.dump();
+  }
+  EXPECT_EQ(results[0].at("budget_bytes"), 50235u);  // floor(0.047908687592 · 2^20)
+
+  for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
+           {"evaluate @sample -s 40x30 --budgets k1 -m vkb,fkb:tail=false",
+            "--methods fkb:tail=false: operation hybrid (evaluate's default) composites the tail this spec turns off"},
+           {"evaluate @sample @sample -s 40x30 --budgets k1", "scenes: '@sample' is given twice"},
+           {"evaluate @sample -s 40x30 --budgets f50,k1,f50", "--budgets f50,k1,f50: 'f50' is given twice"},
+           {"evaluate @sample -s 40x30 --budgets k1 --views iso,front,iso",
+            "--views iso,front,iso: 'iso' is given twice"},
+           {"allocations @sample -s 40x30 --budgets e50,e50", "--budgets e50,e50: 'e50' is given twice"},
+           {"dataset @sample -s 40x30 -s 40x30 --budgets 1 -o " + (dir() / "d.bin").string(),
+            "--size: '40x30' is given twice"},
+           {"dataset @sample -s 40x30 --budgets 1 --seed 18446744073709551616 -o " + (dir() / "d.bin").string(),
+            "'18446744073709551616' is beyond 18446744073709551615 (64 bits)"},
+           {"train /dev/zero -o " + (dir() / "w.json").string(), "/dev/zero: not a regular file (a device or pipe)"},
+           {"render @sample -s 16x16 -m dkb -p weights=/dev/zero -o " + (dir() / "x.png").string(),
+            "/dev/zero: not a regular file (a device or pipe)"},
+           {"render @sample -s 16x16 -o " + (dir() / "x.JPG").string(),
+            "x.JPG: the name says JPEG, but the image is written as PNG, the one format mfr writes: name it .png"}}) {
+    const CliResult bad = runCli(args);
+    EXPECT_TRUE(bad.exitCode == 1 || bad.exitCode == 2) << args << ": " << bad.out;
+    EXPECT_EQ(std::count(bad.out.begin(), bad.out.end(), '\n'), 1) << bad.out;
+    EXPECT_NE(bad.out.find(message), std::string::npos) << args << ": " << bad.out;
+  }
+  EXPECT_FALSE(fs::exists(dir() / "d.bin"));
+  EXPECT_FALSE(fs::exists(dir() / "x.JPG"));
+  // The interlock refusal names the driver; a driver with interlock runs the rows instead.
+  const CliResult interlock = runCli("evaluate @sample -s 40x30 -r 1 --budgets k1 -m vkb:sync=interlock");
+  if (interlock.exitCode != 0)
+    EXPECT_NE(interlock.out.find("--methods vkb:sync=interlock: sync=interlock: this OpenGL driver"), std::string::npos)
+        << interlock.out;
+  else
+    EXPECT_EQ(interlock.out.find("error"), std::string::npos) << interlock.out;
+  // compare's heat map is a PNG too; a name without an image suffix is taken.
+  const fs::path a = dir() / "a.png";
+  ASSERT_EQ(runCli("render @sample -s 16x16 -o " + a.string()).exitCode, 0);
+  const CliResult tif = runCli("compare " + a.string() + " " + a.string() + " --heatmap " + (dir() / "h.tif").string());
+  EXPECT_EQ(tif.exitCode, 1) << tif.out;
+  EXPECT_NE(tif.out.find("--heatmap " + (dir() / "h.tif").string() + ": the name says TIFF"), std::string::npos)
+      << tif.out;
+  EXPECT_EQ(runCli("render @sample -s 16x16 -o " + (dir() / "plain").string()).exitCode, 0);
+  EXPECT_NO_THROW((void)mfr::readPng(dir() / "plain"));
+}
+
 TEST_F(Cli, BudgetCommandsBadInput) {
   // A corrupt dataset, a missing dataset, bad budgets, a bad weights file.
   const fs::path junk = write("junk.bin", "MFRDKB1\n\x0f\0\0\0 not really");
@@ -1231,7 +1296,6 @@ TEST_F(Cli, BudgetCommandsBadInput) {
   // "internal error" with exit 3 and no file named.
   std::string shipped = mfr::readFile(MFR_TEST_DATA_DIR "/../../resources/dkb/weights.json");
   for (const auto& [from, to, mention] : std::vector<std::tuple<std::string, std::string, std::string>>{
-           {"\"version\": 1", "\"version\": \"one\"", "type must be number"},
            {"\"input_mean\": [", "\"input_mean\": [1e999, ", "number overflow"}}) {
     std::string text = shipped;
     ASSERT_NE(text.find(from), std::string::npos) << from;
@@ -1247,6 +1311,31 @@ TEST_F(Cli, BudgetCommandsBadInput) {
     weights["input_std"][0] = 1e-45;
     expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + write("w3.json", weights.dump()).string(),
                        "w3.json: input_std must be at least 1e-6");
+  }
+  {
+    // A version of another type, or 1.7, was read as 1 (or as a type error); a mean of 1e38 made
+    // the network's output NaN, and the CPU and GPU fell back differently (a bug hunt).
+    const auto refused = [&](const std::string& key, const nlohmann::json& value, const std::string& mention) {
+      nlohmann::json weights = nlohmann::json::parse(shipped);
+      if (key == "version")
+        weights["version"] = value;
+      else if (key == "input_mean")
+        weights["input_mean"][0] = value;
+      else
+        weights["layers"][1]["weights"][3][5] = value;
+      expectCleanFailure("render @sample -s 16x16 -m dkb -p weights=" + write("w4.json", weights.dump()).string(),
+                         "w4.json: " + mention);
+    };
+    refused("version", "one", "unsupported weights file version \"one\" (expected 1)");
+    refused("version", 1.7, "unsupported weights file version 1.7 (expected 1)");
+    refused("input_mean", 1e38, "input_mean holds 1e+38, beyond ±10000");
+    refused("layers", -2e4, "layers[1].weights[3] holds -20000, beyond ±10000");
+    nlohmann::json weights = nlohmann::json::parse(shipped);
+    weights["layers"][1]["weights"][3][5] = 9999.0;  // large, and inside the bound: taken
+    EXPECT_EQ(runCli("render @sample -s 16x16 -m dkb -p weights=" + write("w5.json", weights.dump()).string() + " -o " +
+                     (dir() / "w5.png").string())
+                  .exitCode,
+              0);
   }
   expectCleanFailure("render @sample -s 16x16 -m vkb -p budget_mib=0", "--param budget_mib=0");
   expectCleanFailure("render @sample -s 16x16 -m fkb -p budget_mib=0.001", "--param budget_mib=0.001");

@@ -708,8 +708,11 @@ TEST_F(VolumeLoading, BadVti) {
   expectVolumeError(write("short.vti", vti("0 3 0 2 0 1", "0 0 0", "1 1 1", dataArray("Float32", "f", "1 2 3"))),
                     "cannot read VTK image data (.vti)");
   const std::string whole = cubeVti();
-  expectVolumeError(write("cut.vti", whole.substr(0, whole.size() / 2)), "cannot read VTK image data (.vti)");
-  expectVolumeError(write("garbage.vti", "<VTKFile type=\"ImageData\"> bogus"), "cannot read VTK image data (.vti)");
+  expectVolumeError(write("cut.vti", whole.substr(0, whole.size() / 2)),
+                    "truncated: a VTK XML file ends with </VTKFile>");
+  expectVolumeError(write("garbage.vti", "<VTKFile type=\"ImageData\"> bogus"), "truncated: a VTK XML file ends with");
+  expectVolumeError(write("binary.vti", std::string("\x89PNG\r\n\x1a\n") + std::string(64, '\x01')),
+                    "cannot read VTK image data (.vti)");
   expectVolumeError(
       write("flat.vti", vti("0 3 0 2 0 0", "0 0 0", "1 1 1", dataArray("Float32", "f", asciiValues(4, 3, 1)))),
       "at least 2 points per axis (the file declares 4x3x1)");
@@ -942,6 +945,65 @@ TEST_F(VolumeLoading, TruncatedAndCorruptedFilesNeverCrash) {
       }
     }
   }
+}
+
+// Found by a bug hunt, each loaded with exit 0 or past the memory limit before:
+// - a .vti cut inside its raw appended data (VTK reads zeros for the missing samples);
+// - a MetaImage of 2^31 − 1 channels (16 GiB allocated for a 130-byte file), or one declaring more
+//   samples than the memory limit allows;
+// - a MetaImage TransformMatrix, which VTK drops: the grid must be rotated, and a singular one refused.
+TEST_F(VolumeLoading, CutRotatedAndOversizedHeadersAreReadAsDeclared) {
+  std::string samples;
+  for (int v = 0; v < 8 * 8 * 8; ++v) samples += bytesOf(1.0f + static_cast<float>(v % 7), false);
+  const std::string head =
+      "<?xml version=\"1.0\"?><VTKFile type=\"ImageData\" version=\"1.0\" byte_order=\"LittleEndian\" "
+      "header_type=\"UInt64\"><ImageData WholeExtent=\"0 7 0 7 0 7\" Origin=\"0 0 0\" Spacing=\"1 1 1\"><Piece "
+      "Extent=\"0 7 0 7 0 7\"><PointData Scalars=\"d\"><DataArray type=\"Float32\" Name=\"d\" format=\"appended\" "
+      "offset=\"0\"/></PointData></Piece></ImageData><AppendedData encoding=\"raw\">_";
+  std::string length(8, '\0');
+  const std::uint64_t bytes = samples.size();
+  std::memcpy(length.data(), &bytes, 8);
+  const std::string whole = head + length + samples + "</AppendedData></VTKFile>\n";
+  const mfr::Volume v = mfr::loadVolume(write("whole.vti", whole));
+  EXPECT_EQ(v.grid->dims, glm::ivec3(8, 8, 8));
+  EXPECT_EQ(*std::min_element(v.grid->values.begin(), v.grid->values.end()), 1.0f);
+  for (const double share : {0.1, 0.5, 0.99})
+    expectVolumeError(
+        write("cut.vti", whole.substr(0, static_cast<std::size_t>(share * static_cast<double>(whole.size())))),
+        "truncated: a VTK XML file ends with </VTKFile>");
+
+  expectVolumeError(write("channels.mha",
+                          "ObjectType = Image\nNDims = 3\nDimSize = 2 2 2\nElementType = MET_UCHAR\n"
+                          "ElementNumberOfChannels = 2147483647\nElementDataFile = LOCAL\n"),
+                    "MetaImage ElementNumberOfChannels = 2147483647: at most 4096 components");
+  const fs::path large = write("large.mha",
+                               "ObjectType = Image\nNDims = 3\nDimSize = 1024 1024 512\nElementType = MET_DOUBLE\n"
+                               "ElementDataFile = LOCAL\n");
+  ASSERT_EQ(setenv("MFR_MEMORY_LIMIT_MIB", "1024", 1), 0);
+  const std::string error = errorOf([&] { (void)mfr::loadVolume(large); });
+  ASSERT_EQ(unsetenv("MFR_MEMORY_LIMIT_MIB"), 0);
+  EXPECT_EQ(error.rfind(large.string() + ": its samples (1 channels) would take 6.00 GiB more memory", 0), 0u) << error;
+
+  std::string raw;
+  for (int k = 0; k < 2; ++k)
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 4; ++i) raw += static_cast<char>(i + 10 * j + 50 * k);
+  const auto metaImage = [&](const std::string& matrix) {
+    return "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_UCHAR\nOffset = 10 20 30\n" + matrix +
+           "ElementDataFile = LOCAL\n" + raw;
+  };
+  // x steps along +y, y along −x: (i, j, k) lies at offset + (−j, i, k).
+  const mfr::Volume rotated =
+      mfr::loadVolume(write("rotated.mha", metaImage("TransformMatrix = 0 1 0 -1 0 0 0 0 1\n")));
+  const mfr::Volume plain = mfr::loadVolume(write("plain.mha", metaImage("")));
+  const auto world = [](const mfr::Volume& vol, glm::dvec3 ijk) {
+    return glm::dvec3(vol.transform * glm::dvec4(vol.origin + vol.spacing * ijk, 1.0));
+  };
+  expectVec(world(plain, {3, 2, 1}), {13.0, 22.0, 31.0});
+  expectVec(world(rotated, {3, 2, 1}), {8.0, 23.0, 31.0});
+  expectVec(world(rotated, {0, 0, 0}), {10.0, 20.0, 30.0});
+  expectVolumeError(write("flat.mha", metaImage("TransformMatrix = 1 0 0 1 0 0 0 0 1\n")),
+                    "MetaImage TransformMatrix = 1 0 0 1 0 0 0 0 1: the axes are not independent");
 }
 
 // ---- loadScene and loadModel on volume files -----------------------------------------------------

@@ -46,6 +46,10 @@ ImageRGBA8 readPng(const std::filesystem::path& path);
 void writePng(const std::filesystem::path& path, const ImageRGBA8& image);
 // The PNG file's bytes, for writeFilesAtomically (errors name `path`).
 std::string encodePng(const std::filesystem::path& path, const ImageRGBA8& image);
+// Refuses an output name whose extension names another image format (x.jpg, x.TIFF, x.exr …):
+// mfr writes PNG only, and a PNG behind a .jpg name misleads every program that trusts the name.
+// Other names (x.png, x, x.out) are taken. Throws mfr::Error naming `option` and the path.
+void checkPngOutputName(const std::string& option, const std::filesystem::path& path);
 
 // Flip rows in place (GL's bottom-up read-back to our top-down order).
 void flipVertically(ImageRGBA8& image);

@@ -23,7 +23,8 @@ void writeFilesAtomically(const std::vector<std::pair<std::filesystem::path, std
 // path leaves no first file behind. Throws mfr::Error naming path.
 void checkOutputPath(const std::filesystem::path& path);
 
-// Reads a whole file. Throws mfr::Error naming path when missing or unreadable.
+// Reads a whole regular file. Throws mfr::Error naming path when missing, not a regular file (a
+// device, a pipe) or unreadable.
 std::string readFile(const std::filesystem::path& path);
 
 }  // namespace mfr

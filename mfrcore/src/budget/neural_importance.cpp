@@ -74,8 +74,15 @@ constexpr int kLayerBias[3] = {MFR_MLP_B1, MFR_MLP_B2, MFR_MLP_B3};
 constexpr int kLayerRows[3] = {0, MFR_MLP_HIDDEN1, MFR_MLP_HIDDEN1 + MFR_MLP_HIDDEN2};  // first row of each layer
 constexpr int kLayerQuant[3] = {MFR_MLP_Q_W1, MFR_MLP_Q_W2, MFR_MLP_Q_W3};
 
+// The largest magnitude of a mean, weight or bias. With features below ~1e10 (F(M)/Σn, the largest)
+// and std at least 1e-6, every layer's sums then stay below ~1e33, inside a float, so the CPU and
+// GPU networks never meet inf or NaN. A mean of 1e38 was taken, the network's output was NaN, and
+// the CPU and GPU fell back to different allocations without a word (a bug hunt). Trained weights
+// stay below 1 (the shipped ones: 0.97).
+constexpr double kLargestParameter = 1e4;
+
 std::vector<float> floats(const nlohmann::json& j, std::size_t count, const std::string& where,
-                          const std::string& source) {
+                          const std::string& source, double limit = kLargestParameter) {
   if (!j.is_array() || j.size() != count)
     throw Error(source, where + " must be an array of " + std::to_string(count) + " numbers");
   std::vector<float> out;
@@ -88,6 +95,9 @@ std::vector<float> floats(const nlohmann::json& j, std::size_t count, const std:
     // fell back to the flat allocation.
     if (std::abs(d) > std::numeric_limits<float>::max())
       throw Error(source, where + " holds a number beyond a float's range (±3.4e38)");
+    if (std::abs(d) > limit)
+      throw Error(source, where + " holds " + numberText(d) + ", beyond ±" + numberText(limit) +
+                              ": no trained network's, and the network's float sums could overflow");
     out.push_back(static_cast<float>(d));
   }
   return out;
@@ -153,7 +163,10 @@ NeuralImportanceModel parseWeightsJson(const std::string& text, const std::strin
   const nlohmann::json j = nlohmann::json::parse(text);
   if (!j.is_object() || j.value("format", "") != "mfr-dkb-weights")
     throw Error(source, "not an mfr dkb weights file (\"format\": \"mfr-dkb-weights\" missing)");
-  if (j.value("version", 0) != 1) throw Error(source, "unsupported weights file version (expected 1)");
+  // An integer 1: j.value("version", 0) read 1.7 as 1.
+  if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<std::int64_t>() != 1)
+    throw Error(source, "unsupported weights file version " +
+                            (j.contains("version") ? jsonText(j["version"]) : std::string("(none)")) + " (expected 1)");
   const nlohmann::json arch = j.value("architecture", nlohmann::json());
   if (arch != nlohmann::json::array({MFR_MLP_INPUTS, MFR_MLP_HIDDEN1, MFR_MLP_HIDDEN2, 1}))
     throw Error(source, "architecture must be [12, 128, 64, 1]");
@@ -164,7 +177,8 @@ NeuralImportanceModel parseWeightsJson(const std::string& text, const std::strin
     throw Error(source, "target must be \"k_over_n\" or \"k_over_budget\"");
   m.weights.assign(MFR_MLP_FLOATS, 0.0f);
   const std::vector<float> mean = floats(j.value("input_mean", nlohmann::json()), MFR_MLP_INPUTS, "input_mean", source);
-  const std::vector<float> stddev = floats(j.value("input_std", nlohmann::json()), MFR_MLP_INPUTS, "input_std", source);
+  const std::vector<float> stddev = floats(j.value("input_std", nlohmann::json()), MFR_MLP_INPUTS, "input_std", source,
+                                           std::numeric_limits<float>::max());
   for (int i = 0; i < MFR_MLP_INPUTS; ++i) {
     // mfr train's floor: below it a standardised feature overflows the network's floats, and the
     // CPU and GPU inferences fell back differently (1e-45 was taken; a bug hunt).

@@ -4,6 +4,8 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <iterator>
+#include <string_view>
 #include <unistd.h>
 
 #include "mfr/error.hpp"
@@ -71,6 +73,29 @@ std::string utf8Name(const std::string& s) {
     out += static_cast<char>(0x80 | (byte & 0x3F));
   }
   return out;
+}
+
+void checkVtkXmlFileEnd(const std::filesystem::path& path, const std::string* contents, const std::string& name) {
+  constexpr std::size_t kTail = 256, kHead = 1024;
+  std::string head, tail;
+  if (contents != nullptr) {
+    head = contents->substr(0, kHead);
+    tail = contents->substr(contents->size() - std::min(contents->size(), kTail));
+  } else {
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    const auto size = static_cast<std::size_t>(std::max<std::streamoff>(in.tellg(), 0));
+    in.seekg(0);
+    head.resize(std::min(size, kHead));
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    in.seekg(static_cast<std::streamoff>(size - std::min(size, kTail)));
+    tail.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  if (head.find("<VTKFile") == std::string::npos) return;  // not VTK XML at all: VTK's reader says so
+  const std::size_t last = tail.find_last_not_of(" \t\r\n");
+  constexpr std::string_view kEnd = "</VTKFile>";
+  if (last == std::string::npos || last + 1 < kEnd.size() ||
+      tail.compare(last + 1 - kEnd.size(), kEnd.size(), kEnd) != 0)
+    throw Error(name, "truncated: a VTK XML file ends with </VTKFile>, and this one does not");
 }
 
 std::string oneLine(std::string s) {

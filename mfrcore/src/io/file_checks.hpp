@@ -16,6 +16,12 @@ namespace mfr::io {
 // what the caller expected ("model", "volume") and appears in the directory message.
 void checkReadable(const std::filesystem::path& path, const std::string& name, std::string_view kind);
 
+// A VTK XML file (.vti, .vtp) ends with </VTKFile>: VTK's XML readers read a file cut inside its
+// raw, base64 or inline data without an error, and the missing samples came out as zeros or
+// garbage with exit 0 (a bug hunt). Reads the end of `contents` when given, else of the file at
+// path. Throws mfr::Error(name, "truncated: …").
+void checkVtkXmlFileEnd(const std::filesystem::path& path, const std::string* contents, const std::string& name);
+
 // A library's (possibly multi-line) message as one line: newlines and tabs become spaces, runs of
 // spaces collapse, trailing spaces go.
 std::string oneLine(std::string s);

@@ -18,6 +18,7 @@
 
 #include "file_checks.hpp"
 #include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 #include "volume_loader.hpp"
 #include "vtk_loader.hpp"
 
@@ -70,20 +71,24 @@ std::map<std::string, std::string> readMembers(const fs::path& path, const std::
     const la_int64_t size = archive_entry_size(entry);
     if (size < 0 || size > kMaxMemberBytes || (endsWith(member, ".plist") && size > kMaxPlistBytes))
       throw Error(name, "project member " + member + " has an implausible size (" + std::to_string(size) + " bytes)");
-    std::string data(static_cast<std::size_t>(size), '\0');
+    // The header's size is only a claim: a 77-byte file claiming 8 GiB was zero-filled to 8 GiB
+    // before the archive ended (a bug hunt). Asked for first, then grown as data arrives.
+    const auto declared = static_cast<std::size_t>(size);
+    requireHostMemory(name, "project member " + member, declared);
+    std::string data;
     std::size_t got = 0;
-    while (got < data.size()) {
-      const la_ssize_t n =
-          archive_read_data(a.get(), data.data() + got, std::min<std::size_t>(data.size() - got, 1 << 20));
+    while (got < declared) {
+      data.resize(std::min(declared, got + (std::size_t{1} << 20)));
+      const la_ssize_t n = archive_read_data(a.get(), data.data() + got, data.size() - got);
       if (n < 0)
         throw Error(name, "corrupt or truncated project archive while reading " + member + ": " +
                               (archive_error_string(a.get()) ? archive_error_string(a.get()) : "read error"));
       if (n == 0) break;
       got += static_cast<std::size_t>(n);
     }
-    if (got != data.size())
+    if (got != declared)
       throw Error(name, "truncated project archive: " + member + " has " + std::to_string(got) + " of " +
-                            std::to_string(data.size()) + " bytes");
+                            std::to_string(declared) + " bytes");
     members[member] = std::move(data);
     progress.step(0.6 * std::min(1.0, static_cast<double>(archive_filter_bytes(a.get(), -1)) / fileSize));
   }

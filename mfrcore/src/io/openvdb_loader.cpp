@@ -1,6 +1,7 @@
 #include "openvdb_loader.hpp"
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <exception>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include <openvdb/openvdb.h>
 
 #include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 #include "volume_loader.hpp"
 
 namespace mfr::io {
@@ -40,9 +42,12 @@ template <typename T>
 float valueOf(const T& v) {
   return static_cast<float>(v);
 }
+// The length in double, as the VTK path's magnitude: in float, x² underflowed for vectors of
+// 1e-25 (a field of zeros) and overflowed for 2e19 ("non-finite"), a bug hunt.
 template <typename T>
 float valueOf(const openvdb::math::Vec3<T>& v) {
-  return static_cast<float>(v.length());
+  const double x = v.x(), y = v.y(), z = v.z();
+  return static_cast<float>(std::sqrt(x * x + y * y + z * z));
 }
 
 template <typename GridT>
@@ -119,8 +124,16 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
   const std::string label = "grid '" + chosen + "'";
   const openvdb::CoordBBox box = base->evalActiveVoxelBoundingBox();
   if (box.empty()) throw Error(name, label + " has no active voxels");
+  // In 64 bits: Coord::dim() is 32-bit, and voxels at ±2^30 gave "-2147483647x4x4".
+  const std::array<std::int64_t, 3> dims{std::int64_t{box.max().x()} - box.min().x() + 1,
+                                         std::int64_t{box.max().y()} - box.min().y() + 1,
+                                         std::int64_t{box.max().z()} - box.min().z() + 1};
+  checkDims(dims, name);
   const openvdb::Coord d = box.dim();
-  checkDims({d.x(), d.y(), d.z()}, name);
+  // The dense copy, asked for before it is made: an 8.9 KB file of one tile over 1024^3 voxels
+  // took 4 GB past MFR_MEMORY_LIMIT_MIB (a bug hunt).
+  requireHostMemory(name, "the dense copy of " + label,
+                    static_cast<std::uint64_t>(dims[0] * dims[1] * dims[2]) * sizeof(float));
   const openvdb::math::Transform& transform = base->transform();
   if (!transform.isLinear()) throw Error(name, label + " has a non-linear (frustum) transform, which is not supported");
 

@@ -391,10 +391,16 @@ void checkLegacyVtkFieldCounts(const fs::path& path, const std::string& name) {
 }
 
 // vtkMetaImageReader loops forever on a negative or huge NDims and reads zeros for 0 channels:
-// the header's keys are checked first (up to ElementDataFile, its last key).
-void checkMetaImageHeader(const fs::path& path, const std::string& name) {
+// the header's keys are checked first (up to ElementDataFile, its last key). Returns the grid's
+// axis directions from TransformMatrix (or its synonyms Rotation, Orientation), which VTK 9.1's
+// reader never sets: a rotated image loaded unrotated without a word (a bug hunt). As ITK reads
+// it, the matrix's consecutive triples are the directions of the x, y and z axes.
+std::optional<glm::dmat3> checkMetaImageHeader(const fs::path& path, const std::string& name) {
+  std::optional<glm::dmat3> direction;
   std::ifstream in(path, std::ios::binary);
   std::string line;
+  std::uint64_t channels = 1, elementBytes = 8;
+  double points = 0;  // DimSize's product (larger grids are refused later, by their dimensions)
   for (int lines = 0; lines < 4096 && std::getline(in, line); ++lines) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const std::size_t eq = line.find('=');
@@ -417,8 +423,52 @@ void checkMetaImageHeader(const fs::path& path, const std::string& name) {
       throw Error(name, "MetaImage NDims = " + value.substr(0, 32) + ": only 3-dimensional images are volumes");
     if (key == "ElementNumberOfChannels" && !(integer().value_or(0) >= 1))
       throw Error(name, "MetaImage ElementNumberOfChannels = " + value.substr(0, 32) + ": needs a positive count");
-    if (key == "ElementDataFile") return;
+    // 2^31 − 1 channels of a 2×2×2 image: VTK allocated 16 GiB before it found 130 bytes of file,
+    // past MFR_MEMORY_LIMIT_MIB (a bug hunt). NRRD and VTI refuse the same bound.
+    if (key == "ElementNumberOfChannels" && integer().value_or(0) > kMaxComponents)
+      throw Error(name, "MetaImage ElementNumberOfChannels = " + value.substr(0, 32) + ": at most " +
+                            std::to_string(kMaxComponents) + " components");
+    if (key == "ElementNumberOfChannels") channels = static_cast<std::uint64_t>(integer().value_or(1));
+    if (key == "ElementType") {
+      elementBytes = value.find("CHAR") != std::string::npos                             ? 1
+                     : value.find("SHORT") != std::string::npos                          ? 2
+                     : value == "MET_INT" || value == "MET_UINT" || value == "MET_FLOAT" ? 4
+                                                                                         : 8;
+    }
+    if (key == "DimSize") {
+      std::istringstream sizes(value);
+      points = 1;
+      for (double d = 0; sizes >> d;) points *= d > 0 ? d : 0;
+    }
+    if (key == "TransformMatrix" || key == "Rotation" || key == "Orientation") {
+      std::istringstream numbers(value);
+      std::vector<double> m;
+      for (std::string word; numbers >> word && m.size() < 10;) {
+        char* end = nullptr;
+        const double v = std::strtod(word.c_str(), &end);
+        if (end == word.c_str() || *end != '\0' || !std::isfinite(v))
+          throw Error(name, "MetaImage " + key + " = " + value.substr(0, 64) + ": expected 9 finite numbers");
+        m.push_back(v);
+      }
+      if (m.size() != 9) throw Error(name, "MetaImage " + key + " = " + value.substr(0, 64) + ": expected 9 numbers");
+      glm::dmat3 d;
+      for (int a = 0; a < 3; ++a) d[a] = glm::dvec3(m[3 * a], m[3 * a + 1], m[3 * a + 2]);
+      // Relative to the axes' lengths: a flat grid has no inside to draw.
+      const double scale = glm::length(d[0]) * glm::length(d[1]) * glm::length(d[2]);
+      if (!(std::abs(glm::determinant(d)) > 1e-9 * scale))
+        throw Error(name, "MetaImage " + key + " = " + value.substr(0, 64) +
+                              ": the axes are not independent (the grid would be flat)");
+      direction = d;
+    }
+    if (key == "ElementDataFile") {
+      // What VTK allocates for the samples, and the grid's floats, asked for before it does.
+      if (points > 0 && points <= static_cast<double>(VolumeGrid::kMaxPoints))
+        requireHostMemory(name, "its samples (" + std::to_string(channels) + " channels)",
+                          static_cast<std::uint64_t>(points) * (channels * elementBytes + sizeof(float)));
+      return direction;
+    }
   }
+  return direction;
 }
 
 NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
@@ -843,8 +893,10 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   const std::string label = formatLabel(format);
   NrrdOrientation nrrd;
   if (format == VolumeFormat::Nrrd) nrrd = checkNrrdHeader(path, name);
-  if (format == VolumeFormat::MetaImage) checkMetaImageHeader(path, name);
+  std::optional<glm::dmat3> metaDirection;  // MetaImage's TransformMatrix, which VTK drops
+  if (format == VolumeFormat::MetaImage) metaDirection = checkMetaImageHeader(path, name);
   if (format == VolumeFormat::LegacyVtk) checkLegacyVtkFieldCounts(path, name);
+  if (format == VolumeFormat::Vti) checkVtkXmlFileEnd(path, nullptr, name);
   VtkMessages messages;  // before the reader: VTK's output window goes quiet
   std::optional<CerrCapture> metaIo;
   if (format == VolumeFormat::MetaImage) metaIo.emplace();
@@ -988,6 +1040,7 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
   if (vtkMatrix3x3* m = image->GetDirectionMatrix(); m != nullptr)
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) direction[c][r] = m->GetElement(r, c);
+  if (metaDirection) direction = *metaDirection;
   int start[3];
   image->GetExtent(extent);
   start[0] = extent[0];
@@ -1053,6 +1106,12 @@ void checkInrimageMagic(const fs::path& path, const std::string& name, bool gz) 
   char head[16] = {};
   const int got = gzread(f, head, static_cast<unsigned>(kMagic.size()));
   if (got < 0) throw Error(name, "corrupt gzip data");
+  // A .gz cut inside its first bytes decompresses to fewer than the magic's: truncated, not
+  // another format (a bug hunt: the first 100 bytes of liver.inr.gz were "not an INRIMAGE file").
+  const bool shortRead = static_cast<std::size_t>(got) < kMagic.size();
+  if (gz && shortRead &&
+      kMagic.substr(0, static_cast<std::size_t>(got)) == std::string_view(head, static_cast<std::size_t>(got)))
+    throw Error(name, "truncated or corrupt gzip data (it ends before the INRIMAGE header)");
   if (std::string_view(head, static_cast<std::size_t>(got)) != kMagic)
     throw Error(name, "not an INRIMAGE file (it does not start with #INRIMAGE-4#{)");
 }
@@ -1104,6 +1163,10 @@ Volume readInrimage(const fs::path& path, const std::string& name, const LoadPro
       throw Error(name, "truncated INRIMAGE file (" + std::to_string(size - static_cast<std::uintmax_t>(headerEnd)) +
                             " of " + std::to_string(bytes) + " bytes of voxel data)");
   }
+  // The samples and the grid's floats, asked for before they are read: a 1 MB .inr.gz of zeros
+  // declaring 1024^3 voxels took 5 GB past MFR_MEMORY_LIMIT_MIB (a bug hunt).
+  requireHostMemory(name, "its " + dimsText(declared) + " samples",
+                    bytes + static_cast<std::uint64_t>(n) * sizeof(float));
   progress.step(0.1);
   if (_readImageData(im.get()) < 0)
     throw Error(name, gz ? "truncated or corrupt INRIMAGE data (gzip stream ends early or is damaged)"

@@ -35,6 +35,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/scene/feature_normals.hpp"
+#include "file_checks.hpp"
 
 namespace mfr::io {
 namespace {
@@ -565,6 +566,7 @@ Mesh readWithVtk(VtkFormat format, const fs::path& path, const std::string* cont
       break;
     }
     case VtkFormat::Vtp: {
+      checkVtkXmlFileEnd(path, contents, name);
       vtkNew<vtkXMLPolyDataReader> reader;
       if (contents != nullptr) {
         reader->ReadFromInputStringOn();

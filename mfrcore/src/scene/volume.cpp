@@ -45,8 +45,10 @@ void VolumeGrid::validate(const std::string& what) const {
   if (n > kMaxPoints) throw Error(what, "volume of more than 2^30 points");
   if (values.size() != n)
     throw Error(what, "volume has " + std::to_string(values.size()) + " values for " + std::to_string(n) + " points");
+  // A double of 1e300 in the file is a float infinity here: say so, not only "non-finite".
   for (const float v : values)
-    if (!std::isfinite(v)) throw Error(what, "volume has a non-finite value");
+    if (!std::isfinite(v))
+      throw Error(what, "volume has a non-finite value (NaN, infinity, or beyond a float's range ±3.4e38)");
 }
 
 std::vector<glm::vec4> TransferFunction::table() const {
