@@ -829,7 +829,10 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
     loadedTransfers_.push_back(v.transfer);
     volumeRanges_.push_back(v.grid ? glm::dvec2(v.grid->range()) : glm::dvec2(0.0));
   }
-  camera_ = scene_.views.empty() ? scene_.view("fit") : scene_.views.front().camera;
+  // The fit-all view, as mfr render's default: the first named view's direction and projection,
+  // framing the whole scene. Its camera as written (a view without "fit": true) drew another
+  // picture than mfr render's on the same scene (a bug hunt).
+  camera_ = scene_.view("fit");
   ++viewRevision_;
   emit sceneLoaded();
   emit sceneChanged();

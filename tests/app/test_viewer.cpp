@@ -921,6 +921,38 @@ class ViewerTest : public QObject {
     }
     qInfo("viewer --screenshot vs mfr render: max channel difference %d over %lld cases", worst,
           static_cast<long long>(cases.size()));
+    {
+      // Without --view both start from the fit-all view, also where the scene's first view is a
+      // camera of its own (the viewer drew that camera as written, mfr render fitted it).
+      const QString scene = dir.filePath("views.mfrscene");
+      QFile file(scene);
+      QVERIFY(file.open(QIODevice::WriteOnly));
+      file.write(R"({"objects": [{"primitive": {"type": "box"}, "opacity": 0.5},
+                                  {"primitive": {"type": "sphere", "radius": 0.4}, "color": [0.9, 0.2, 0.2],
+                                   "transform": {"translate": [1.5, 0, 0]}}],
+                     "views": [{"name": "close", "eye": [0.2, 0.3, 1.2], "target": [0, 0, 0]},
+                               {"name": "side", "eye": [5, 0, 0], "target": [0, 0, 0], "fit": true}]})");
+      file.close();
+      const QString viewerPng = dir.filePath("viewer.png"), cliPng = dir.filePath("cli.png"),
+                    closePng = dir.filePath("close.png");
+      QString out;
+      const QStringList common{"--size", "120x90", "--method", "abuffer-ll"};
+      QCOMPARE(runProgram(MFRVIEW, QStringList{scene, "--screenshot", viewerPng} + common, &out), 0);
+      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", scene, "-o", cliPng} + common, &out), 0);
+      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", scene, "-o", closePng, "--view", "close"} + common, &out), 0);
+      const mfr::ImageRGBA8 viewer = mfr::readPng(viewerPng.toStdString());
+      QVERIFY(maxChannelDifference(viewer, mfr::readPng(cliPng.toStdString())) <= 1);
+      QVERIFY(maxChannelDifference(viewer, mfr::readPng(closePng.toStdString())) >
+              16);  // the camera as written differs
+    }
+    {
+      // A screenshot's name that says another format is refused before any work, as mfr's -o.
+      const QString jpg = dir.filePath("shot.jpg");
+      QString out;
+      QCOMPARE(runProgram(MFRVIEW, {"@sample", "--screenshot", jpg, "--size", "64x48"}, &out), 2);
+      QVERIFY2(out.contains("--screenshot " + jpg + ": the name says JPEG"), qPrintable(out));
+      QVERIFY(!QFile::exists(jpg));
+    }
     // What mfr render refuses, the screenshot refuses too, writing nothing (a scene of degenerate
     // triangles was an empty PNG and exit 0; found by fuzzing).
     const QString flat = dir.filePath("flat.obj"), flatPng = dir.filePath("flat.png");
