@@ -370,6 +370,17 @@ int main(int argc, char** argv) {
   QObject::connect(&model, &ViewerModel::sceneLoaded, &window, [&] {
     if (applied) return;
     applied = true;
+    // A session sets its method, operation and parameters as it loads, after the lines above ran:
+    // the command line's win, as --view and --clip do (they were dropped without a word; a bug hunt).
+    if (!cl.session.isEmpty()) {
+      if (!cl.method.isEmpty()) model.setMethod(cl.method);
+      if (!cl.op.isEmpty()) model.setOperation(cl.op);
+      if (!cl.params.empty()) model.setParams(cl.params);
+    }
+    // What loading could not do as asked (no ligands for sticks@ligands): on stderr as mfr render
+    // prints it, since a scripted run has no status bar to show it in.
+    if (scripted)
+      for (const std::string& note : model.scene().notes) std::cerr << "note: " << note << "\n";
     // A new scene starts at the default thickness (scene units): --thickness applies to this one.
     if (cl.thickness > 0.0) model.setZThickness(cl.thickness);
     if (cl.step > 0.0) model.setVolumeStep(cl.step);  // likewise the volume step

@@ -782,6 +782,23 @@ class ViewerTest : public QObject {
                           "4096: 4096 is used"),
              qPrintable(out));
     QVERIFY(QFile::exists(png));
+    // --method, --op and -p beside a session win over the session's own, as --view does (the
+    // session's fkb was drawn instead, exit 0; a bug hunt).
+    const QString cliPng = dir.filePath("cli.png"), sessionPng = dir.filePath("session.png");
+    QCOMPARE(runProgram(MFRVIEW, {good, "--size", "64x48", "--view", "iso", "--screenshot", sessionPng}, &out), 0);
+    QCOMPARE(runProgram(MFRVIEW,
+                        {good, "--size", "64x48", "--view", "iso", "--screenshot", png, "--method", "kbuffer", "-p",
+                         "k=2", "--op", "oit"},
+                        &out),
+             0);
+    QCOMPARE(runProgram(MFR_CLI,
+                        {"render", "@sample", "-s", "64x48", "--view", "iso", "-o", cliPng, "--method", "kbuffer", "-p",
+                         "k=2", "--op", "oit"},
+                        &out),
+             0);
+    const mfr::ImageRGBA8 overridden = mfr::readPng(png.toStdString());
+    QVERIFY(maxChannelDifference(overridden, mfr::readPng(cliPng.toStdString())) <= 1);
+    QVERIFY(maxChannelDifference(overridden, mfr::readPng(sessionPng.toStdString())) > 8);
   }
 
   void badSessionValuesAreRefused() {
