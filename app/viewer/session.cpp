@@ -180,10 +180,20 @@ Session captureSession(const ViewerModel& model) {
 
 QStringList applySession(const Session& session, ViewerModel& model) {
   QStringList notes;
-  // The isosurfaces first: their parts are among the session's objects.
-  if (session.volumes.size() == model.scene().volumes.size())
+  // The isosurfaces first: their parts are among the session's objects. What the viewer refuses
+  // (a value outside the volume's range, too many) is a note, as for parts the scene lacks: the
+  // whole set vanished without a word (a bug hunt).
+  if (session.volumes.size() == model.scene().volumes.size()) {
     for (std::size_t i = 0; i < session.volumes.size(); ++i)
-      model.setIsosurfacesAt(static_cast<int>(i), session.volumes[i].isosurfaces, session.volumes[i].isosurfaceOpacity);
+      if (const QString reason = model.setIsosurfacesAt(static_cast<int>(i), session.volumes[i].isosurfaces,
+                                                        session.volumes[i].isosurfaceOpacity);
+          !reason.isEmpty())
+        notes << QStringLiteral("volumes[%1].isosurfaces: %2 (left out)").arg(i).arg(reason);
+  } else if (!session.volumes.empty()) {
+    notes << QStringLiteral("the session holds %1 volumes' settings, the scene %2 volumes: left out")
+                 .arg(session.volumes.size())
+                 .arg(model.scene().volumes.size());
+  }
   // Objects by name: the n-th entry of a name goes to the scene's n-th part of that name, so a
   // scene file that gained, lost or reordered parts keeps the overrides of the parts it still has
   // (by index, a changed count dropped them all, and a renamed part took another's state).
@@ -208,7 +218,17 @@ QStringList applySession(const Session& session, ViewerModel& model) {
                  .arg(unmatched.join(QStringLiteral(", ")));
   model.setAllParams(session.params);
   model.setZThickness(session.thickness);
-  if (session.hasClip) model.setClipBox(session.clip);
+  // A box that holds nothing of the scene drew an empty image; mfr render refuses it (a bug hunt).
+  bool clipHolds = true;
+  if (session.hasClip && session.clip) {
+    try {
+      mfr::requireClipBoxHoldsScene(model.scene(), *session.clip, "clip");
+    } catch (const mfr::Error& e) {
+      clipHolds = false;
+      notes << QString::fromUtf8(e.what()) + QStringLiteral(" (not applied)");
+    }
+  }
+  if (session.hasClip && clipHolds) model.setClipBox(session.clip);
   if (session.hasSection) model.setSection(session.section);
   // A field this scene lacks is a note, as parts it lacks (it was dropped without a word).
   if (session.hasColorBy &&

@@ -3491,6 +3491,37 @@ class ViewerTest : public QObject {
     QVERIFY(runProgram(MFRVIEW, QStringList{"@volume", "--contour", "7", "--screenshot", viewerPng} + common, &out) !=
             0);
     QVERIFY2(out.contains(QStringLiteral("--contour 7: isosurfaces: 7 lies outside the open range")), qPrintable(out));
+    // A session's isosurfaces the viewer refuses, and a clip box that holds nothing, are notes
+    // naming the file and key; both were dropped without a word (a bug hunt).
+    QTemporaryDir isoDir;
+    const QString isoSession = isoDir.filePath(QStringLiteral("iso.mfrsession"));
+    {
+      QFile file(isoSession);
+      QVERIFY(file.open(QIODevice::WriteOnly));
+      file.write(QJsonDocument(
+                     QJsonObject{
+                         {"format", "mfrview-session"},
+                         {"version", 1},
+                         {"scene", "@volume"},
+                         {"camera", QJsonObject{{"eye", QJsonArray{3, 2, 4}},
+                                                {"target", QJsonArray{0, 0, 0}},
+                                                {"up", QJsonArray{0, 1, 0}}}},
+                         {"clip", QJsonObject{{"min", QJsonArray{10, 10, 10}}, {"max", QJsonArray{11, 11, 11}}}},
+                         {"volumes", QJsonArray{QJsonObject{
+                                         {"transfer", QJsonObject{{"points", QJsonArray{QJsonArray{0, 0, 0, 0, 0},
+                                                                                        QJsonArray{1, 1, 1, 1, 0.5}}}}},
+                                         {"isosurfaces", QJsonObject{{"values", QJsonArray{7}}}}}}}})
+                     .toJson());
+    }
+    QCOMPARE(runProgram(MFRVIEW, QStringList{isoSession, "--screenshot", viewerPng} + common, &out), 0);
+    const QString name = QStringLiteral("iso.mfrsession");
+    QVERIFY2(out.contains(QStringLiteral("note: %1: volumes[0].isosurfaces: ").arg(name)) &&
+                 out.contains(QStringLiteral("7 lies outside the open range")) &&
+                 out.contains(QStringLiteral("(left out)")),
+             qPrintable(out));
+    QVERIFY2(
+        out.contains(QStringLiteral("note: %1: clip: ").arg(name)) && out.contains(QStringLiteral("(not applied)")),
+        qPrintable(out));
   }
 
   void colorByField() {
