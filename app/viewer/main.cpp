@@ -261,7 +261,9 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
     const qsizetype eq = p.indexOf(QLatin1Char('='));
     const QJsonDocument json = eq > 0 ? QJsonDocument::fromJson(p.mid(eq + 1).toUtf8()) : QJsonDocument();
     if (!json.isObject()) fail(QStringLiteral("--plugin-settings %1: expected id={json object}").arg(p), 2);
-    cl.pluginSettings[p.left(eq)] = json.object();
+    // As -p: two settings of one plugin meant one of them, and the last silently won.
+    if (!cl.pluginSettings.emplace(p.left(eq), json.object()).second)
+      fail(QStringLiteral("--plugin-settings %1: plugin '%2' is given twice").arg(p, p.left(eq)), 2);
   }
   return cl;
 }

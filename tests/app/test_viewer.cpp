@@ -988,6 +988,14 @@ class ViewerTest : public QObject {
     // Settings for a plugin that is not there were dropped without a word.
     QCOMPARE(runProgram(MFRVIEW, {"@sample", "--screenshot", flatPng, "--plugin-settings", "nope={}"}, &out), 2);
     QVERIFY2(out.contains("--plugin-settings nope: no plugin of that id is loaded (loaded: "), qPrintable(out));
+    // Two settings of one plugin: refused as -p refuses a parameter given twice (the last won).
+    QCOMPARE(runProgram(MFRVIEW,
+                        {"@sample", "--screenshot", flatPng, "--plugin-settings", R"(budget={"budget_mib":2})",
+                         "--plugin-settings", R"(budget={"budget_mib":3})"},
+                        &out),
+             2);
+    QVERIFY2(out.contains(R"(--plugin-settings budget={"budget_mib":3}: plugin 'budget' is given twice)"),
+             qPrintable(out));
     QVERIFY(!QFile::exists(flatPng));
     for (const char* method : {"abuffer-ll", "oracle"}) {
       QCOMPARE(runProgram(MFRVIEW, {flat, "--screenshot", flatPng, "--size", "64x64", "--method", method}, &out), 1);
