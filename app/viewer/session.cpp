@@ -87,6 +87,17 @@ class Reader {
           fail(where + "." + m.key() + "." + v.key(), QStringLiteral("expected a string value"));
         values[v.key().toStdString()] = v.value().toString().toStdString();
       }
+      // Checked as a render checks them, but named by the file's key: a bad value was the render's
+      // "--param pool_mib=abc: expected a number", an option never given (a bug hunt).
+      if (const mfr::MethodInfo* info = mfr::findMethodInfo(m.key().toStdString())) {
+        try {
+          (void)mfr::Params(info->params, values, m.key().toStdString());
+        } catch (const mfr::Error& e) {
+          QString why = QString::fromUtf8(e.what());
+          if (why.startsWith(QStringLiteral("--param "))) why = why.mid(8);
+          fail(where + "." + m.key(), why);
+        }
+      }
     }
     return out;
   }

@@ -843,6 +843,11 @@ class ViewerTest : public QObject {
         {with("method", "nosuch"), "s.mfrsession: method: unknown method 'nosuch'"},
         {with("operation", "xyz"), "s.mfrsession: operation: unknown operation 'xyz'"},
         {with("version", 99), "s.mfrsession: version: expected 1"},
+        // A parameter's bad value named --param, an option never given (a bug hunt).
+        {with("params", QJsonObject{{"abuffer-ll", QJsonObject{{"pool_mib", "abc"}}}}),
+         "s.mfrsession: params.abuffer-ll: pool_mib=abc: expected a number"},
+        {with("compare", QJsonObject{{"params", QJsonObject{{"kbuffer", QJsonObject{{"k", "0"}}}}}}),
+         "s.mfrsession: compare.params.kbuffer: k=0: out of range [1, 256]"},
         {with("compare", QJsonObject{{"enabled", 1}}), "s.mfrsession: compare.enabled: expected true or false"},
         // Taken before (a bug hunt): a negative fovy drew the view upside down, a negative height
         // and an overflowing section normal drew it uncut, an unknown map was dropped.
