@@ -793,6 +793,9 @@ void HybridVolumePanel::loadSettings(const QJsonObject& settings) {
     showScaleValue();
   }
   applyTransfer();  // the session's own function again (no change), or --plugin-settings' one
+  // A function the viewer refuses was shown in the panel only: a scripted run drew the old one
+  // with exit 0 (a bug hunt: window [0, 1e308]). A note, as the other settings taken otherwise.
+  if (!error_->text().isEmpty()) note(tr("%1 (the function is kept)").arg(error_->text()));
   if (settings.contains(QStringLiteral("shading")))
     context_.setVolumeShading(settings.value(QStringLiteral("shading")).toBool());
   if (settings.contains(QStringLiteral("step"))) {

@@ -702,6 +702,9 @@ class ViewerTest : public QObject {
          "--plugin-settings hybridvolume: preset 'nope': no such preset (custom is used)"},
         {"@volume", R"(hybridvolume={"window":[5,1]})",
          "--plugin-settings hybridvolume: window [5, 1]: low must be below high (the window is kept)"},
+        // A window the viewer's transfer function refuses was shown in the panel only (a bug hunt).
+        {"@volume", R"(hybridvolume={"window":[0,1e308]})",
+         "--plugin-settings hybridvolume: transfer function: transfer function point 1 lies beyond a float's range"},
         {"@sample", R"(ghosting={"focus":["nope","tangle"]})",
          "--plugin-settings ghosting: no part 'nope' in this scene to focus on"},
         {"@csg", QStringLiteral("csg={\"tree\":\"{\\\"union\\\":[\\\"block\\\",\\\"nope\\\"]}\"}"),
