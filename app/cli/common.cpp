@@ -359,7 +359,8 @@ std::optional<ContourLegend> ContourOptions::apply(Scene& scene, double sceneOpa
   const std::string what = "--contour " + values;
   ContourRequest request;
   std::string list = values;
-  const std::size_t eq = values.find('=');
+  // The last '=': values hold none, a volume's name may ('a=0.3=0.5' was read as volume 'a').
+  const std::size_t eq = values.rfind('=');
   if (eq != std::string::npos) {
     const std::string name = values.substr(0, eq);
     list = values.substr(eq + 1);

@@ -18,6 +18,8 @@
 #include <QSurfaceFormat>
 #include <QTimer>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -26,6 +28,7 @@
 #include <map>
 #include <utility>
 #include <optional>
+#include <thread>
 
 #include "main_window.hpp"
 #include "mfr/error.hpp"
@@ -61,6 +64,9 @@ struct CommandLine {
   std::optional<std::optional<mfr::SectionPlane>> section;
   QString clipText, sectionText;  // as given, for messages
 };
+
+// A scripted run waits at most this long for the scene, the first frame and background work.
+constexpr int kFirstFrameSeconds = 120;
 
 [[noreturn]] void fail(const QString& message, int code) {
   std::fprintf(stderr, "mfrview: %s\n", qPrintable(message));
@@ -482,8 +488,21 @@ int main(int argc, char** argv) {
     auto* clock = new QElapsedTimer;
     clock->start();
     auto* settled = new QElapsedTimer;  // since everything was first drawn and idle
+    // The poll runs on the GUI thread, which a long live frame blocks (a volume at a step of 1e-6:
+    // "timed out" came after 278 s, not 120; a bug hunt). A watchdog thread keeps the promise while
+    // the run waits; it stands down before any picture is written, so it never cuts a file short.
+    static std::atomic<bool> waiting{true};
+    std::thread([] {
+      for (int s = 0; s < kFirstFrameSeconds + 5 && waiting.load(); ++s)
+        std::this_thread::sleep_for(std::chrono::seconds(1));
+      if (waiting.load()) {
+        std::fprintf(stderr, "mfrview: timed out waiting for the first frame (%d s)\n", kFirstFrameSeconds);
+        std::_Exit(1);
+      }
+    }).detach();
     QObject::connect(poll, &QTimer::timeout, &app, [&, poll, clock, settled] {
-      if (clock->elapsed() > 120000) fail(QStringLiteral("timed out waiting for the first frame"), 1);
+      if (clock->elapsed() > 1000 * kFirstFrameSeconds)
+        fail(QStringLiteral("timed out waiting for the first frame (%1 s)").arg(kFirstFrameSeconds), 1);
       // The live view may fail where the screenshot does not (a budget too small for the window's
       // size): a live error ends the wait too, and --screenshot reports its own render's errors.
       const bool drawn = model.framesRendered() > 0 || !model.renderError().isEmpty();
@@ -495,6 +514,7 @@ int main(int argc, char** argv) {
         if (settled->elapsed() < 1500) return;
       }
       poll->stop();
+      waiting.store(false);
       try {
         if (!cl.screenshot.isEmpty()) window.exportImage(cl.screenshot, cl.size, cl.legend);
         if (!cl.windowScreenshot.isEmpty()) {

@@ -123,6 +123,19 @@ class Reader {
     if (!o.value(key).isString()) fail(where.isEmpty() ? key : where + "." + key, QStringLiteral("expected a string"));
     return o.value(key).toString();
   }
+  // An optional object or array at o[key] (`path` names it): absent or null is empty; another JSON
+  // type is refused. They were read as empty: "compare": "yes" or "volumes": {…} dropped their
+  // settings without a word (a bug hunt).
+  QJsonObject objectAt(const QJsonObject& o, const QString& key, const QString& path) const {
+    if (!o.contains(key) || o.value(key).isNull()) return {};
+    if (!o.value(key).isObject()) fail(path, QStringLiteral("expected an object"));
+    return o.value(key).toObject();
+  }
+  QJsonArray arrayAt(const QJsonObject& o, const QString& key, const QString& path) const {
+    if (!o.contains(key) || o.value(key).isNull()) return {};
+    if (!o.value(key).isArray()) fail(path, QStringLiteral("expected an array"));
+    return o.value(key).toArray();
+  }
   QJsonObject object(const QJsonValue& v, const QString& where) const {
     if (!v.isObject()) fail(where, QStringLiteral("expected an object"));
     return v.toObject();
@@ -457,7 +470,7 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
                                    {range[0].toDouble(), range[1].toDouble()}};
     }
   }
-  const QJsonArray volumes = json.value("volumes").toArray();
+  const QJsonArray volumes = r.arrayAt(json, "volumes", QStringLiteral("volumes"));
   for (qsizetype i = 0; i < volumes.size(); ++i) {
     const QString at = QStringLiteral("volumes[%1]").arg(i);
     const QJsonObject v = r.object(volumes[i], at);
@@ -471,7 +484,7 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
                                {},
                                0.5};
     state.transfer.unitDistance = r.number(t, "unit_distance", where, 1.0);
-    const QJsonArray points = t.value("points").toArray();
+    const QJsonArray points = r.arrayAt(t, "points", where + QStringLiteral(".points"));
     for (qsizetype j = 0; j < points.size(); ++j) {
       const QJsonArray p = points[j].toArray();
       if (p.size() != 5 || !std::all_of(p.begin(), p.end(), [](const QJsonValue& x) { return x.isDouble(); }))
@@ -487,8 +500,8 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
     // Optional (sessions written before isosurfaces have none); the viewer checks the values.
     if (v.contains("isosurfaces")) {
       const QString isoAt = at + QStringLiteral(".isosurfaces");
-      const QJsonObject iso = v.value("isosurfaces").toObject();
-      const QJsonArray values = iso.value("values").toArray();
+      const QJsonObject iso = r.objectAt(v, "isosurfaces", isoAt);
+      const QJsonArray values = r.arrayAt(iso, "values", isoAt + QStringLiteral(".values"));
       for (qsizetype j = 0; j < values.size(); ++j) {
         if (!values[j].isDouble())
           r.fail(isoAt + QStringLiteral(".values[%1]").arg(j), QStringLiteral("expected a number"));
@@ -498,20 +511,21 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
     }
     s.volumes.push_back(std::move(state));
   }
-  s.params = r.params(json.value("params").toObject(), QStringLiteral("params"));
+  s.params = r.params(r.objectAt(json, "params", QStringLiteral("params")), QStringLiteral("params"));
   // Optional (sessions written before compare mode have neither).
-  const QJsonObject compare = json.value("compare").toObject();
+  const QJsonObject compare = r.objectAt(json, "compare", QStringLiteral("compare"));
   s.compare.enabled = r.boolean(compare, "enabled", QStringLiteral("compare"), false);
   s.compare.layout = r.choice(compare, "layout", "compare", kLayouts, CompareLayout::SideBySide);
   s.compare.split = std::clamp(r.number(compare, "split", "compare", 0.5), 0.0, 1.0);
   s.compare.display = r.choice(compare, "display", "compare", kDisplays, CompareDisplay::Images);
   s.compare.method = r.method(compare, "method", QStringLiteral("compare"));
   s.compare.operation = r.operation(compare, "operation", QStringLiteral("compare"));
-  s.compare.params = r.params(compare.value("params").toObject(), QStringLiteral("compare.params"));
-  const QJsonObject dataView = json.value("data_view").toObject();
+  s.compare.params =
+      r.params(r.objectAt(compare, "params", QStringLiteral("compare.params")), QStringLiteral("compare.params"));
+  const QJsonObject dataView = r.objectAt(json, "data_view", QStringLiteral("data_view"));
   s.dataView = r.choice(dataView, "mode", "data_view", kDataViews, DataView::Image);
   s.dataOverImage = r.boolean(dataView, "over_image", QStringLiteral("data_view"), false);
-  const QJsonArray objects = json.value("objects").toArray();
+  const QJsonArray objects = r.arrayAt(json, "objects", QStringLiteral("objects"));
   for (qsizetype i = 0; i < objects.size(); ++i) {
     const QString at = QStringLiteral("objects[%1]").arg(i);
     const QJsonObject o = r.object(objects[i], at);

@@ -846,6 +846,11 @@ class ViewerTest : public QObject {
         {with("method", "nosuch"), "s.mfrsession: method: unknown method 'nosuch'"},
         {with("operation", "xyz"), "s.mfrsession: operation: unknown operation 'xyz'"},
         {with("version", 99), "s.mfrsession: version: expected 1"},
+        // Another JSON type where an object or array belongs was read as empty (a bug hunt).
+        {with("compare", "yes"), "s.mfrsession: compare: expected an object"},
+        {with("volumes", QJsonObject{}), "s.mfrsession: volumes: expected an array"},
+        {with("params", QJsonArray{1, 2}), "s.mfrsession: params: expected an object"},
+        {with("data_view", "capacity"), "s.mfrsession: data_view: expected an object"},
         // A parameter's bad value named --param, an option never given (a bug hunt).
         {with("params", QJsonObject{{"abuffer-ll", QJsonObject{{"pool_mib", "abc"}}}}),
          "s.mfrsession: params.abuffer-ll: pool_mib=abc: expected a number"},

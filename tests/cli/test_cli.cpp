@@ -1250,6 +1250,16 @@ TEST_F(Cli, BudgetCommandsCheckListsFilesAndBudgetsFirst) {
       << tif.out;
   EXPECT_EQ(runCli("render @sample -s 16x16 -o " + (dir() / "plain").string()).exitCode, 0);
   EXPECT_NO_THROW((void)mfr::readPng(dir() / "plain"));
+  // A PNG given as weights: the JSON parser's quote of the bytes it read is shown as \xNN, not raw
+  // bytes in the one-line message.
+  const CliResult png =
+      runCli("render @sample -s 16x16 -m dkb -p weights=" + a.string() + " -o " + (dir() / "y.png").string());
+  EXPECT_EQ(png.exitCode, 1) << png.out;
+  EXPECT_NE(png.out.find("a.png: not valid JSON ("), std::string::npos) << png.out;
+  EXPECT_NE(png.out.find("\\x89"), std::string::npos) << png.out;
+  EXPECT_TRUE(std::all_of(png.out.begin(), png.out.end() - 1, [](char c) {
+    return static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f;
+  })) << png.out;
 }
 
 TEST_F(Cli, BudgetCommandsBadInput) {

@@ -153,6 +153,15 @@ TEST_F(CliContour, SeveralVolumesNeedTheVolumesName) {
       runCli("probe " + scene.string() + " --contour b=1.5 --size 64x64 --view orbit:40:20 --pixel 52,32");
   ASSERT_EQ(info.exitCode, 0) << info.out;
   EXPECT_NE(info.out.find("b = 1.5"), std::string::npos) << info.out;
+  // A volume's name may hold '=': the values follow the last one ('a=0.3=1.5' was volume 'a').
+  {
+    std::ofstream named(dir() / "named.mfrscene");
+    named << R"({"volumes": [{"file": "ramp.vtk", "name": "a=0.3"},
+                             {"file": "ramp.vtk", "name": "b", "transform": {"translate": [3, 0, 0]}}]})";
+  }
+  const CliResult eq = runCli("render " + (dir() / "named.mfrscene").string() + " --contour a=0.3=1.5 -s 32x32 -o " +
+                              (dir() / "eq.png").string());
+  EXPECT_EQ(eq.exitCode, 0) << eq.out;
 }
 
 TEST_F(CliContour, LegendShowsTheIsosurfacesMapInTheCorner) {

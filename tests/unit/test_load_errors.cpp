@@ -427,7 +427,19 @@ TEST_F(LoadModel, PngHeaderLargerThanItsDataIsRefusedAtOnce) {
 }
 
 TEST_F(LoadModel, GarbageVtp) {
-  expectLoadError(write("garbage.vtp", "<VTKFile type=\"PolyData\"> bogus"), "cannot read VTP");
+  expectLoadError(write("garbage.vtp", "<VTKFile type=\"PolyData\"> bogus"), "truncated: a VTK XML file ends with");
+  expectLoadError(write("binary.vtp", std::string("\x89PNG\r\n\x1a\n") + std::string(64, '\x01')), "cannot read VTP");
+  // A whole triangle loads; cut inside its data it is refused (VTK read the rest as zeros).
+  const std::string whole =
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      "<PolyData><Piece NumberOfPoints=\"3\" NumberOfPolys=\"1\">\n"
+      "<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 0 1 "
+      "0</DataArray></Points>\n"
+      "<Polys><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1 2</DataArray>\n"
+      "<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">3</DataArray></Polys>\n"
+      "</Piece></PolyData>\n</VTKFile>\n";
+  EXPECT_EQ(mfr::loadModel(write("whole.vtp", whole)).at(0).mesh->triangleCount(), 1u);
+  expectLoadError(write("cut.vtp", whole.substr(0, whole.size() * 3 / 4)), "truncated: a VTK XML file ends with");
 }
 
 TEST_F(LoadModel, GarbageLegacyVtk) {

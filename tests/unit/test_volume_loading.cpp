@@ -690,8 +690,9 @@ TEST_F(VolumeLoading, CorruptInrimageHeaders) {
   expectVolumeError(write("total.inr", withFields("XDIM=2048\nYDIM=2048\nZDIM=512\nTYPE=float\nPIXSIZE=32 bits\n"
                                                   "CPU=pc\n")),
                     "larger than 2^30 points");
+  // ImageIO reads sizes unsigned: -5 was 2^64 − 5, named "9223372036854775807x2x2" (a bug hunt).
   expectVolumeError(write("negative.inr", withFields("XDIM=-5\nYDIM=2\nZDIM=2\nTYPE=float\nPIXSIZE=32 bits\nCPU=pc\n")),
-                    "larger than 2048 points per axis");
+                    "INRIMAGE XDIM is negative (-5): a size must be a positive count");
   expectVolumeError(write("nan.inr", inrHeader("XDIM=2\nYDIM=2\nZDIM=2\nTYPE=float\nPIXSIZE=32 bits\nCPU=pc\n") +
                                          std::string(28, '\0') + bytesOf(std::nanf(""), false)),
                     "non-finite value");

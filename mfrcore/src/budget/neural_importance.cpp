@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <cmath>
 #include <limits>
@@ -211,15 +212,34 @@ NeuralImportanceModel parseWeightsJson(const std::string& text, const std::strin
 }
 }  // namespace
 
+namespace {
+// nlohmann quotes the bytes it last read: a PNG given as weights put a raw 0x89 and control bytes
+// into the one-line message (a bug hunt). Shown as \xNN.
+std::string printable(const std::string& s) {
+  std::string out;
+  for (const char c : s) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u < 0x7f) {
+      out += c;
+    } else {
+      char hex[5];
+      std::snprintf(hex, sizeof hex, "\\x%02X", u);
+      out += hex;
+    }
+  }
+  return out;
+}
+}  // namespace
+
 NeuralImportanceModel parseNeuralImportance(const std::string& text, const std::string& source) {
   // A number past double's range ("1e999") or a key of the wrong type is nlohmann's out_of_range
   // or type_error, not parse_error: every JSON error names the file (was "internal error").
   try {
     return parseWeightsJson(text, source);
   } catch (const nlohmann::json::parse_error& e) {
-    throw Error(source, std::string("not valid JSON (") + e.what() + ")");
+    throw Error(source, "not valid JSON (" + printable(e.what()) + ")");
   } catch (const nlohmann::json::exception& e) {
-    throw Error(source, std::string("not a valid weights file (") + e.what() + ")");
+    throw Error(source, "not a valid weights file (" + printable(e.what()) + ")");
   }
 }
 

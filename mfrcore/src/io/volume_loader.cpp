@@ -1133,7 +1133,13 @@ Volume readInrimage(const fs::path& path, const std::string& name, const LoadPro
   if (im->fd == nullptr || im->openMode == OM_CLOSE) throw Error(name, "cannot open file for reading");
   if (readInrimageHeader(file.c_str(), im.get()) < 0) throw Error(name, "corrupt or unsupported INRIMAGE header");
 
-  // ImageIO's header check passed: positive sizes and voxel sizes, a known word kind.
+  // ImageIO's header check passed: positive sizes and voxel sizes, a known word kind. It reads the
+  // sizes as unsigned: XDIM=-16 came out as 2^64 − 16, named as "9223372036854775807x16x16".
+  for (const auto& [key, size] :
+       {std::pair{"XDIM", im->xdim}, std::pair{"YDIM", im->ydim}, std::pair{"ZDIM", im->zdim}})
+    if (size > static_cast<std::size_t>(INT64_MAX))
+      throw Error(name, std::string("INRIMAGE ") + key + " is negative (" +
+                            std::to_string(static_cast<std::int64_t>(size)) + "): a size must be a positive count");
   const std::array<std::int64_t, 3> declared{static_cast<std::int64_t>(std::min<std::size_t>(im->xdim, INT64_MAX)),
                                              static_cast<std::int64_t>(std::min<std::size_t>(im->ydim, INT64_MAX)),
                                              static_cast<std::int64_t>(std::min<std::size_t>(im->zdim, INT64_MAX))};
