@@ -270,8 +270,13 @@ void BudgetSpec::resolve(std::uint64_t total, std::uint64_t exactSlots, std::uin
 std::string BudgetSpec::paramText() const {
   // The byte count the methods floor back to: half a byte over it, to 10 decimals of MiB (1e-4
   // byte). Six decimals of the user's MiB rounded up to 1 byte over the budget (a bug hunt).
+  // At the methods' largest budget_mib the half byte would cross it (every row refused, a review):
+  // there the exact MiB, which floors to the same bytes.
+  const double bytesNow = static_cast<double>(byteCount());
+  double mibText = (bytesNow + 0.5) / (1024.0 * 1024.0);
+  if (mibText > kLargestBudgetMiB) mibText = bytesNow / (1024.0 * 1024.0);
   std::ostringstream s;
-  s << std::fixed << std::setprecision(10) << (static_cast<double>(byteCount()) + 0.5) / (1024.0 * 1024.0);
+  s << std::fixed << std::setprecision(10) << mibText;
   return s.str();
 }
 

@@ -180,9 +180,11 @@ void addEvaluate(CLI::App& app) {
       // Hybrid (auto here) composites the k-buffer's tail; without one every row was the renderer's
       // "--op hybrid: needs --param tail=true", naming options the user never gave (a bug hunt).
       if ((spec.operation == "auto" || spec.operation == "hybrid") && has("tail") && !params.flag("tail"))
-        throw Error("--methods " + m,
-                    "operation hybrid (evaluate's default) composites the tail this spec turns off "
-                    "(drop tail=false, or add op=oit)");
+        throw Error("--methods " + m, spec.params.contains("tail")
+                                          ? "operation hybrid (evaluate's default) composites the tail this spec turns "
+                                            "off (drop tail=false, or add op=oit)"
+                                          : "operation hybrid (evaluate's default) composites a tail, which " +
+                                                spec.method + " keeps only with tail=true (add it, or op=oit)");
       if (has("sync") && params.text("sync") == "interlock") interlockRows.push_back(m);
       // Every row is measured against the exact "over" image: an operation that draws another
       // image (a volume, a CSG result, merged z-thickness slabs) would only be a row of errors

@@ -269,7 +269,7 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
     if (!json.isObject()) fail(QStringLiteral("--plugin-settings %1: expected id={json object}").arg(p), 2);
     // As -p: two settings of one plugin meant one of them, and the last silently won.
     if (!cl.pluginSettings.emplace(p.left(eq), json.object()).second)
-      fail(QStringLiteral("--plugin-settings %1: plugin '%2' is given twice").arg(p, p.left(eq)), 2);
+      fail(QStringLiteral("--plugin-settings: plugin '%1' is given twice").arg(p.left(eq)), 2);
   }
   return cl;
 }
@@ -490,12 +490,13 @@ int main(int argc, char** argv) {
     auto* settled = new QElapsedTimer;  // since everything was first drawn and idle
     // The poll runs on the GUI thread, which a long live frame blocks (a volume at a step of 1e-6:
     // "timed out" came after 278 s, not 120; a bug hunt). A watchdog thread keeps the promise while
-    // the run waits; it stands down before any picture is written, so it never cuts a file short.
+    // the run waits. Each side claims the run (exchange) before it acts: a picture is written only
+    // once the watchdog has stood down, and the watchdog ends the run only before that.
     static std::atomic<bool> waiting{true};
     std::thread([] {
       for (int s = 0; s < kFirstFrameSeconds + 5 && waiting.load(); ++s)
         std::this_thread::sleep_for(std::chrono::seconds(1));
-      if (waiting.load()) {
+      if (waiting.exchange(false)) {  // claimed: the GUI thread writes nothing now
         std::fprintf(stderr, "mfrview: timed out waiting for the first frame (%d s)\n", kFirstFrameSeconds);
         std::_Exit(1);
       }
@@ -514,7 +515,7 @@ int main(int argc, char** argv) {
         if (settled->elapsed() < 1500) return;
       }
       poll->stop();
-      waiting.store(false);
+      if (!waiting.exchange(false)) return;  // the watchdog claimed the run and is ending it
       try {
         if (!cl.screenshot.isEmpty()) window.exportImage(cl.screenshot, cl.size, cl.legend);
         if (!cl.windowScreenshot.isEmpty()) {

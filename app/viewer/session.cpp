@@ -95,6 +95,7 @@ class Reader {
         } catch (const mfr::Error& e) {
           QString why = QString::fromUtf8(e.what());
           if (why.startsWith(QStringLiteral("--param "))) why = why.mid(8);
+          why.replace(QLatin1Char('\n'), QLatin1Char(' '));  // a value of several lines: one line here
           fail(where + "." + m.key(), why);
         }
       }
@@ -214,9 +215,11 @@ QStringList applySession(const Session& session, ViewerModel& model) {
           !reason.isEmpty())
         notes << QStringLiteral("volumes[%1].isosurfaces: %2 (left out)").arg(i).arg(reason);
   } else if (!session.volumes.empty()) {
-    notes << QStringLiteral("the session holds %1 volumes' settings, the scene %2 volumes: left out")
-                 .arg(session.volumes.size())
-                 .arg(model.scene().volumes.size());
+    const auto volumes = [](std::size_t n) {
+      return n == 1 ? QStringLiteral("1 volume") : QStringLiteral("%1 volumes").arg(n);
+    };
+    notes << QStringLiteral("the session holds the settings of %1, the scene has %2: left out")
+                 .arg(volumes(session.volumes.size()), volumes(model.scene().volumes.size()));
   }
   // Objects by name: the n-th entry of a name goes to the scene's n-th part of that name, so a
   // scene file that gained, lost or reordered parts keeps the overrides of the parts it still has

@@ -1007,8 +1007,7 @@ class ViewerTest : public QObject {
                          "--plugin-settings", R"(budget={"budget_mib":3})"},
                         &out),
              2);
-    QVERIFY2(out.contains(R"(--plugin-settings budget={"budget_mib":3}: plugin 'budget' is given twice)"),
-             qPrintable(out));
+    QVERIFY2(out.contains("--plugin-settings: plugin 'budget' is given twice"), qPrintable(out));
     QVERIFY(!QFile::exists(flatPng));
     for (const char* method : {"abuffer-ll", "oracle"}) {
       QCOMPARE(runProgram(MFRVIEW, {flat, "--screenshot", flatPng, "--size", "64x64", "--method", method}, &out), 1);

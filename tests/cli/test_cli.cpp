@@ -1209,10 +1209,20 @@ TEST_F(Cli, BudgetCommandsCheckListsFilesAndBudgetsFirst) {
     EXPECT_LE(row.at("captured_percent").get<double>(), 100.0) << row.dump();
   }
   EXPECT_EQ(results[0].at("budget_bytes"), 50235u);  // floor(0.047908687592 · 2^20)
+  // The largest budget runs: half a byte over it was past budget_mib's range, every row refused (a review).
+  const CliResult largest = runCli("evaluate @sample -s 16x12 -r 1 -m vkb,dkb --budgets 65536 --json " + json.string());
+  ASSERT_EQ(largest.exitCode, 0) << largest.out;
+  std::ifstream inLargest(json);
+  for (const nlohmann::json& row : nlohmann::json::parse(inLargest).at("results"))
+    EXPECT_FALSE(row.contains("error")) << row.dump();
 
   for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
            {"evaluate @sample -s 40x30 --budgets k1 -m vkb,fkb:tail=false",
             "--methods fkb:tail=false: operation hybrid (evaluate's default) composites the tail this spec turns off"},
+           {"evaluate @sample -s 40x30 --budgets k1 -m kplus-dynamic",
+            "--methods kplus-dynamic: operation hybrid (evaluate's default) composites a tail, which kplus-dynamic "
+            "keeps "
+            "only with tail=true"},
            {"evaluate @sample @sample -s 40x30 --budgets k1", "scenes: '@sample' is given twice"},
            {"evaluate @sample -s 40x30 --budgets f50,k1,f50", "--budgets f50,k1,f50: 'f50' is given twice"},
            {"evaluate @sample -s 40x30 --budgets k1 --views iso,front,iso",
@@ -1342,6 +1352,7 @@ TEST_F(Cli, BudgetCommandsBadInput) {
     refused("layers", -2e4, "layers[1].weights[3] holds -20000, beyond ±10000");
     nlohmann::json weights = nlohmann::json::parse(shipped);
     weights["layers"][1]["weights"][3][5] = 9999.0;  // large, and inside the bound: taken
+    weights["version"] = 1.0;                        // 1.0 is the number 1
     EXPECT_EQ(runCli("render @sample -s 16x16 -m dkb -p weights=" + write("w5.json", weights.dump()).string() + " -o " +
                      (dir() / "w5.png").string())
                   .exitCode,

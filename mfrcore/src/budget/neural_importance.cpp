@@ -164,8 +164,8 @@ NeuralImportanceModel parseWeightsJson(const std::string& text, const std::strin
   const nlohmann::json j = nlohmann::json::parse(text);
   if (!j.is_object() || j.value("format", "") != "mfr-dkb-weights")
     throw Error(source, "not an mfr dkb weights file (\"format\": \"mfr-dkb-weights\" missing)");
-  // An integer 1: j.value("version", 0) read 1.7 as 1.
-  if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<std::int64_t>() != 1)
+  // The number 1 (1.0 too): j.value("version", 0) read 1.7 as 1.
+  if (!j.contains("version") || !j["version"].is_number() || j["version"].get<double>() != 1.0)
     throw Error(source, "unsupported weights file version " +
                             (j.contains("version") ? jsonText(j["version"]) : std::string("(none)")) + " (expected 1)");
   const nlohmann::json arch = j.value("architecture", nlohmann::json());
