@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/packing.hpp>
 
 #include "common/bindings.h"
@@ -182,14 +183,29 @@ VolumeRaySetup volumeRaySetup(std::span<const Volume> volumes, const Camera& cam
     throw Error("operation volume", std::to_string(volumes.size()) + " volumes: at most " +
                                         std::to_string(MFR_MAX_VOLUMES) + " can be drawn at once");
   VolumeRaySetup s;
+  // Every position of the march is relative to the volumes' centre, composed in double: in world
+  // floats a volume 1e6 from the origin lost its detail (RMSE 0.0086 against the same march in
+  // double; 0.32 at 1e8; a bug hunt). Both renderers march with this setup, so they still agree.
+  Bounds all;
+  for (const Volume& volume : volumes) {
+    const Bounds b = volume.bounds();
+    if (b.valid()) {
+      all.extend(b.min);
+      all.extend(b.max);
+    }
+  }
+  s.origin = all.valid() ? all.center() : glm::dvec3(0.0);
+  if (!(std::isfinite(s.origin.x) && std::isfinite(s.origin.y) && std::isfinite(s.origin.z)))
+    s.origin = glm::dvec3(0.0);
+  const glm::dmat4 fromRelative = glm::translate(glm::dmat4(1.0), s.origin);
   const double aspect = static_cast<double>(width) / height;
-  s.invViewProj = glm::mat4(glm::inverse(camera.projectionMatrix(aspect) * camera.viewMatrix()));
+  s.invViewProj = glm::mat4(glm::inverse(camera.projectionMatrix(aspect) * camera.viewMatrix() * fromRelative));
   s.viewport = glm::vec2(static_cast<float>(width), static_cast<float>(height));
   double defaultStep = volumes.front().defaultStep();
   for (const Volume& volume : volumes) {
     VolumeMedium m;
     m.grid = volume.grid;
-    m.worldToGrid = glm::mat4(glm::inverse(volume.gridToWorld()));
+    m.worldToGrid = glm::mat4(glm::inverse(volume.gridToWorld()) * fromRelative);
     m.dims = volume.grid->dims;
     m.tfLow = static_cast<float>(volume.transfer.low());
     m.tfHigh = static_cast<float>(volume.transfer.high());
@@ -201,12 +217,14 @@ VolumeRaySetup volumeRaySetup(std::span<const Volume> volumes, const Camera& cam
   s.step = static_cast<float>(step > 0.0 ? step : defaultStep);
   if (clip) {
     s.clip = true;
-    s.clipMin = glm::vec3(clip->min);
-    s.clipMax = glm::vec3(clip->max);
+    s.clipMin = glm::vec3(clip->min - s.origin);
+    s.clipMax = glm::vec3(clip->max - s.origin);
   }
   if (section) {
     s.section = true;
-    s.sectionPlane = glm::vec4(sectionPlaneEquation(*section));
+    // dot(n, p) + d with p = r + origin: dot(n, r) + (dot(n, origin) + d).
+    const glm::dvec4 plane = sectionPlaneEquation(*section);
+    s.sectionPlane = glm::vec4(glm::dvec4(glm::dvec3(plane), plane.w + glm::dot(glm::dvec3(plane), s.origin)));
   }
   return s;
 }

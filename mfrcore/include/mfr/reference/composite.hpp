@@ -65,8 +65,11 @@ struct VolumeMedium {
   std::vector<glm::vec4> table;  // TransferFunction::table()
   bool shading = false;          // Volume::shading
 };
+// Positions ("world" below) are relative to `origin`, the drawn volumes' centre: NDC, the grids,
+// the clip box and the section plane are all mapped to those coordinates in double, then rounded.
 struct VolumeRaySetup {
-  glm::mat4 invViewProj{1.0f};  // NDC → world (computed in double, rounded to float)
+  glm::dvec3 origin{0.0};       // world position of the march's coordinate origin
+  glm::mat4 invViewProj{1.0f};  // NDC → world − origin (computed in double, rounded to float)
   glm::vec2 viewport{0.0f};
   float step = 0.0f;                // world units
   std::vector<VolumeMedium> media;  // 1 … MFR_MAX_VOLUMES
