@@ -18,6 +18,7 @@
 #include <QSurfaceFormat>
 #include <QTimer>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -53,6 +54,8 @@ struct CommandLine {
   QString colorBy, colorMap;                      // --color-by, --color-map: surfaces coloured by a field
   std::optional<glm::dvec2> colorRange;           // --color-range
   std::vector<double> contour;                    // --contour: isosurfaces of the current volume
+  QString contourVolume;                          // --contour NAME=…: of that volume instead
+  QString contourText;                            // --contour as given, for messages
   bool legend = false;                            // --legend: the scalar bar in the --screenshot
   std::map<QString, QJsonObject> pluginSettings;  // by plugin id
   QSize size{800, 600}, windowSize;
@@ -131,7 +134,8 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
   const QCommandLineOption contour(
       QStringLiteral("contour"),
       QStringLiteral("Isosurfaces of the scene's (current) volume at these values, as parts; the volume is hidden "
-                     "(the Volume panel's Isosurfaces)."),
+                     "(the Volume panel's Isosurfaces). VOLUME=v1,v2,... names the volume of a scene with several "
+                     "(as mfr render)."),
       QStringLiteral("v1,v2,..."));
   const QCommandLineOption legend(
       QStringLiteral("legend"),
@@ -217,7 +221,14 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
   }
   cl.legend = parser.isSet(legend);
   if (parser.isSet(contour)) {
-    for (const QString& item : parser.value(contour).split(QLatin1Char(','))) {
+    // VOLUME=V1,… as mfr render reads it, at the last '=' (a name may hold one, values never do).
+    cl.contourText = parser.value(contour);
+    QString values = cl.contourText;
+    if (const qsizetype eq = values.lastIndexOf(QLatin1Char('=')); eq >= 0) {
+      cl.contourVolume = values.left(eq);
+      values = values.mid(eq + 1);
+    }
+    for (const QString& item : values.split(QLatin1Char(','))) {
       bool ok = false;
       const double v = item.toDouble(&ok);
       if (!ok || !std::isfinite(v))
@@ -400,11 +411,27 @@ int main(int argc, char** argv) {
     };
     if (!cl.contour.empty()) {
       // Before --color-by, which then colours them too.
-      QStringList texts;
-      for (const double v : cl.contour) texts << QString::number(v, 'g', 17);
-      const QString reason = model.setIsosurfaces(cl.contour, 0.5);
+      // The named volume's (as mfr render), else the current one's (the Volume panel's).
+      QString reason;
+      int volume = model.currentVolume();
+      const std::vector<mfr::Volume>& volumes = model.scene().volumes;
+      if (!cl.contourVolume.isEmpty()) {
+        const auto named = std::find_if(volumes.begin(), volumes.end(), [&](const mfr::Volume& v) {
+          return QString::fromStdString(v.name) == cl.contourVolume;
+        });
+        QStringList names;
+        for (const mfr::Volume& v : volumes) names << QString::fromStdString(v.name);
+        if (named == volumes.end())
+          reason = QStringLiteral("no volume '%1' in scene '%2' (%3)")
+                       .arg(cl.contourVolume, QString::fromStdString(model.scene().name),
+                            names.isEmpty() ? QStringLiteral("it has none")
+                                            : QStringLiteral("volumes: ") + names.join(QStringLiteral(", ")));
+        else
+          volume = static_cast<int>(named - volumes.begin());
+      }
+      if (reason.isEmpty()) reason = model.setIsosurfacesAt(volume, cl.contour, 0.5);
       if (!reason.isEmpty()) {
-        const QString message = QStringLiteral("--contour %1: %2").arg(texts.join(QLatin1Char(',')), reason);
+        const QString message = QStringLiteral("--contour %1: %2").arg(cl.contourText, reason);
         if (scripted) fail(message, 1);
         window.statusBar()->showMessage(message);
       } else if (cl.view.isEmpty()) {

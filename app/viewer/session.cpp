@@ -205,6 +205,8 @@ Session captureSession(const ViewerModel& model) {
 
 QStringList applySession(const Session& session, ViewerModel& model) {
   QStringList notes;
+  // A misspelt key ("mehtod") was ignored without a word (a bug hunt).
+  for (const QString& key : session.unknownKeys) notes << QStringLiteral("%1: no such key (left out)").arg(key);
   // The isosurfaces first: their parts are among the session's objects. What the viewer refuses
   // (a value outside the volume's range, too many) is a note, as for parts the scene lacks: the
   // whole set vanished without a word (a bug hunt).
@@ -544,6 +546,11 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   if (json.contains("plugins") && !json.value("plugins").isObject())
     r.fail(QStringLiteral("plugins"), QStringLiteral("expected an object of plugin id: settings"));
   s.plugins = json.value("plugins").toObject();
+  static const QStringList kKeys{"format",    "version",   "scene",       "molecule", "camera",  "method",
+                                 "operation", "thickness", "volume_step", "volumes",  "params",  "objects",
+                                 "compare",   "data_view", "plugins",     "clip",     "section", "color_by"};
+  for (auto it = json.begin(); it != json.end(); ++it)
+    if (!kKeys.contains(it.key())) s.unknownKeys << it.key();
   return s;
 }
 

@@ -66,6 +66,9 @@ struct Session {
   DataView dataView = DataView::Image;
   bool dataOverImage = false;
   QJsonObject plugins;  // by plugin id
+  // Top-level keys no session has (a misspelt "mehtod"): applySession notes them. Not an error:
+  // a later viewer's session may add keys this one can leave out.
+  QStringList unknownKeys;
 };
 
 // The model's current state (plugins filled in by the caller).

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common/bindings.h"
+#include "gl/grid_upload.hpp"
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
 #include "mfr/methods/registry.hpp"
@@ -40,6 +41,7 @@ struct GpuRenderer::GpuVolume {
   gl::Texture transfer;               // RGBA32F, MFR_VOLUME_TF_SIZE: (rgb, σ)
   std::size_t bytes = 0;              // the transfer table's, and the grid's unless an earlier volume holds it
   std::size_t sceneGridBytes = 0;     // the grid's when the scene holds it (surfaces coloured by it: a slice)
+  double valueScale = 1.0;            // gl::gridValueScale: the texture's samples are the grid's times this
 };
 
 GpuRenderer::~GpuRenderer() = default;
@@ -65,12 +67,8 @@ void GpuRenderer::uploadVolumes(const Scene& scene) {
     // A surface coloured by the volume holds its grid already (counted in the scene's bytes).
     const std::shared_ptr<gl::Texture> inScene = scene_->fieldGrid(v.grid.get());
     if (!gpu->grid) gpu->grid = inScene;
-    if (!gpu->grid) {
-      const glm::ivec3 d = v.grid->dims;
-      gpu->grid = std::make_shared<gl::Texture>(gl::createTexture3D(GL_R32F, d.x, d.y, d.z));
-      glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-      glTextureSubImage3D(gpu->grid->id(), 0, 0, 0, 0, d.x, d.y, d.z, GL_RED, GL_FLOAT, v.grid->values.data());
-    }
+    if (!gpu->grid) gpu->grid = gl::uploadGrid(*v.grid);
+    gpu->valueScale = gl::gridValueScale(*v.grid);
     const std::vector<glm::vec4> table = v.transfer.table();
     gpu->transfer = gl::createTexture1D(GL_RGBA32F, MFR_VOLUME_TF_SIZE);
     glTextureSubImage1D(gpu->transfer.id(), 0, 0, MFR_VOLUME_TF_SIZE, GL_RGBA, GL_FLOAT, table.data());
@@ -232,8 +230,13 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
                                       const std::string at = "[" + std::to_string(i) + "]";
                                       p.set(("uWorldToGrid" + at).c_str(), m.worldToGrid);
                                       p.set(("uGridDims" + at).c_str(), m.dims);
-                                      p.set(("uTfLow" + at).c_str(), m.tfLow);
-                                      p.set(("uTfHigh" + at).c_str(), m.tfHigh);
+                                      // Scaled as the texture's samples are (gl::uploadGrid).
+                                      const double scale = volumes_[i]->valueScale;
+                                      const TransferFunction& tf = drawnVolumes_[i].transfer;
+                                      p.set(("uTfLow" + at).c_str(),
+                                            scale == 1.0 ? m.tfLow : static_cast<float>(tf.low() * scale));
+                                      p.set(("uTfHigh" + at).c_str(),
+                                            scale == 1.0 ? m.tfHigh : static_cast<float>(tf.high() * scale));
                                       p.set(("uVolumeShading" + at).c_str(), m.shading ? 1 : 0);
                                       glBindTextureUnit(MFR_TEX_VOLUME + static_cast<GLuint>(i),
                                                         volumes_[i]->grid->id());

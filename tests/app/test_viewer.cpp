@@ -769,6 +769,7 @@ class ViewerTest : public QObject {
       QJsonObject plugins = json.value("plugins").toObject();
       plugins.insert("nope", QJsonObject{{"x", 1}});
       json.insert("plugins", plugins);
+      json.insert("mehtod", "wboit");  // a misspelt key was ignored without a word
       f.resize(0);
       f.write(QJsonDocument(json).toJson());
     }
@@ -776,6 +777,7 @@ class ViewerTest : public QObject {
     QVERIFY2(
         out.contains("note: s.mfrsession: plugins.nope: no plugin of that id is loaded (its settings are left out)"),
         qPrintable(out));
+    QVERIFY2(out.contains("note: s.mfrsession: mehtod: no such key (left out)"), qPrintable(out));
     // In a session, a value taken other than as given is a note on stderr, and the run goes on.
     QFile::remove(png);
     const QString clamped = session(QJsonObject{{"budget_mib", 5000}});
@@ -3511,6 +3513,18 @@ class ViewerTest : public QObject {
     QVERIFY(runProgram(MFRVIEW, QStringList{"@volume", "--contour", "7", "--screenshot", viewerPng} + common, &out) !=
             0);
     QVERIFY2(out.contains(QStringLiteral("--contour 7: isosurfaces: 7 lies outside the open range")), qPrintable(out));
+    // VOLUME=V1,… as mfr render takes it (mfrview said "'field=0.4' is not a number").
+    QCOMPARE(
+        runProgram(MFRVIEW, QStringList{"@volume", "--contour", "field=0.4", "--screenshot", viewerPng} + common, &out),
+        0);
+    QCOMPARE(
+        runProgram(MFR_CLI, QStringList{"render", "@volume", "--contour", "field=0.4", "-o", cliPng} + common, &out),
+        0);
+    QCOMPARE(maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString())), 0);
+    QVERIFY(runProgram(MFRVIEW, QStringList{"@volume", "--contour", "nope=0.4", "--screenshot", viewerPng} + common,
+                       &out) != 0);
+    QVERIFY2(out.contains(QStringLiteral("--contour nope=0.4: no volume 'nope' in scene 'volume' (volumes: field)")),
+             qPrintable(out));
     // A session's isosurfaces the viewer refuses, and a clip box that holds nothing, are notes
     // naming the file and key; both were dropped without a word (a bug hunt).
     QTemporaryDir isoDir;

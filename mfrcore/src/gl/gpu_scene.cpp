@@ -6,6 +6,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "common/bindings.h"
+#include "grid_upload.hpp"
 #include "mfr/scene/color_map.hpp"
 
 namespace mfr::gl {
@@ -106,10 +107,7 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
         std::shared_ptr<Texture> texture = previous ? previous->fieldGrid(grid) : nullptr;
         if (!texture && knownGrid) texture = knownGrid(grid);
         if (!texture) {
-          const glm::ivec3 d = grid->dims;
-          texture = std::make_shared<Texture>(createTexture3D(GL_R32F, d.x, d.y, d.z));
-          glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
-          glTextureSubImage3D(texture->id(), 0, 0, 0, 0, d.x, d.y, d.z, GL_RED, GL_FLOAT, grid->values.data());
+          texture = uploadGrid(*grid);
           uploaded_ += grid->values.size() * sizeof(float);
         }
         fieldGrids_.push_back({sampler->grid, std::move(texture)});
@@ -118,6 +116,9 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
       }
       item.fieldGrid = static_cast<int>(known - fieldGrids_.begin());
       item.fieldToGrid = glm::mat4(sampler->objectToGrid * toMesh);
+      // The samples are uploaded scaled (uploadGrid): so is the range the map compares them with.
+      if (const double scale = gridValueScale(*grid); scale != 1.0)
+        item.colorMapRange = glm::vec2(glm::dvec2(field->range) * scale);
     }
     triangles_ += o.mesh->triangleCount();
   }
