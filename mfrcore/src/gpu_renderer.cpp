@@ -67,8 +67,8 @@ void GpuRenderer::uploadVolumes(const Scene& scene) {
     // A surface coloured by the volume holds its grid already (counted in the scene's bytes).
     const std::shared_ptr<gl::Texture> inScene = scene_->fieldGrid(v.grid.get());
     if (!gpu->grid) gpu->grid = inScene;
-    if (!gpu->grid) gpu->grid = gl::uploadGrid(*v.grid);
-    gpu->valueScale = gl::gridValueScale(*v.grid);
+    if (!gpu->grid) gpu->grid = gl::uploadGrid(v.grid);
+    gpu->valueScale = gl::gridValueScale(v.grid);
     const std::vector<glm::vec4> table = v.transfer.table();
     gpu->transfer = gl::createTexture1D(GL_RGBA32F, MFR_VOLUME_TF_SIZE);
     glTextureSubImage1D(gpu->transfer.id(), 0, 0, MFR_VOLUME_TF_SIZE, GL_RGBA, GL_FLOAT, table.data());

@@ -107,7 +107,7 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
         std::shared_ptr<Texture> texture = previous ? previous->fieldGrid(grid) : nullptr;
         if (!texture && knownGrid) texture = knownGrid(grid);
         if (!texture) {
-          texture = uploadGrid(*grid);
+          texture = uploadGrid(sampler->grid);
           uploaded_ += grid->values.size() * sizeof(float);
         }
         fieldGrids_.push_back({sampler->grid, std::move(texture)});
@@ -117,7 +117,7 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
       item.fieldGrid = static_cast<int>(known - fieldGrids_.begin());
       item.fieldToGrid = glm::mat4(sampler->objectToGrid * toMesh);
       // The samples are uploaded scaled (uploadGrid): so is the range the map compares them with.
-      if (const double scale = gridValueScale(*grid); scale != 1.0)
+      if (const double scale = gridValueScale(sampler->grid); scale != 1.0)
         item.colorMapRange = glm::vec2(glm::dvec2(field->range) * scale);
     }
     triangles_ += o.mesh->triangleCount();

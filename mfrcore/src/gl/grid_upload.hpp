@@ -13,10 +13,12 @@
 namespace mfr::gl {
 
 // 1, or the power of two that brings the grid's largest finite magnitude into [1, 2) when it is
-// below 2^-32 (a double: 2^149 for the smallest subnormal).
-double gridValueScale(const VolumeGrid& grid);
+// below 2^-32 (a double: 2^149 for the smallest subnormal). One pass over the samples the first
+// time a grid is asked for; remembered while the grid lives (every upload of an edited scene asks
+// again, and grids are immutable).
+double gridValueScale(const std::shared_ptr<const VolumeGrid>& grid);
 
 // The grid's samples times gridValueScale(grid), as a 3D R32F texture.
-std::shared_ptr<Texture> uploadGrid(const VolumeGrid& grid);
+std::shared_ptr<Texture> uploadGrid(const std::shared_ptr<const VolumeGrid>& grid);
 
 }  // namespace mfr::gl
