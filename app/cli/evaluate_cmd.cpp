@@ -164,8 +164,11 @@ void addEvaluate(CLI::App& app) {
       }
       // The rest of the spec too, before anything renders: a bad parameter or operation is the
       // user's mistake, which every row would only repeat (with exit 0).
-      if (std::none_of(methodInfo->params.begin(), methodInfo->params.end(),
-                       [](const ParamSpec& p) { return p.name == "budget_mib"; }))
+      const auto has = [&](const char* name) {
+        return std::any_of(methodInfo->params.begin(), methodInfo->params.end(),
+                           [&](const ParamSpec& p) { return p.name == name; });
+      };
+      if (!has("budget_mib"))
         throw Error("--methods " + m, "has no memory budget (budget_mib): evaluate compares methods under --budgets");
       if (spec.params.contains("budget_mib"))
         throw Error("--methods " + m, "budget_mib is set by --budgets, not in the method spec");
@@ -173,10 +176,6 @@ void addEvaluate(CLI::App& app) {
       values["budget_mib"] = "1";
       const Params params(methodInfo->params, values, spec.method);
       if (spec.operation != "auto") validateOperation(spec.operation);
-      const auto has = [&](const char* name) {
-        return std::any_of(methodInfo->params.begin(), methodInfo->params.end(),
-                           [&](const ParamSpec& p) { return p.name == name; });
-      };
       // Hybrid (auto here) composites the k-buffer's tail; without one every row was the renderer's
       // "--op hybrid: needs --param tail=true", naming options the user never gave (a bug hunt).
       if ((spec.operation == "auto" || spec.operation == "hybrid") && has("tail") && !params.flag("tail"))

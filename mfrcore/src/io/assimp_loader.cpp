@@ -28,6 +28,7 @@
 #include <assimp/scene.h>
 
 #include "child_process.hpp"
+#include "file_checks.hpp"
 #include "mfr/error.hpp"
 #include "vtk_loader.hpp"
 
@@ -336,22 +337,7 @@ std::vector<Object> readHere(const std::filesystem::path& path, const std::strin
 void checkStepPhysicalFileEnd(const std::filesystem::path& path, const std::string* contents,
                               const std::string& extension, const std::string& name) {
   if (extension != ".ifc") return;
-  constexpr std::size_t kTail = 4096;
-  std::string head, tail;
-  if (contents != nullptr) {
-    head = contents->substr(0, 64);
-    tail = contents->substr(contents->size() - std::min(contents->size(), kTail));
-  } else {
-    std::ifstream in(path, std::ios::binary);
-    head.resize(64);
-    in.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(in.gcount()));
-    in.clear();
-    in.seekg(0, std::ios::end);
-    const auto size = static_cast<std::size_t>(std::max<std::streamoff>(in.tellg(), 0));
-    in.seekg(static_cast<std::streamoff>(size - std::min(size, kTail)));
-    tail.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
+  const auto [head, tail] = fileEnds(path, contents, 64, 4096);
   const std::size_t start = head.find_first_not_of(" \t\r\n\xEF\xBB\xBF");
   if (start == std::string::npos || head.compare(start, 12, "ISO-10303-21") != 0) return;  // assimp names it
   if (tail.find("END-ISO-10303-21") == std::string::npos)

@@ -75,21 +75,26 @@ std::string utf8Name(const std::string& s) {
   return out;
 }
 
-void checkVtkXmlFileEnd(const std::filesystem::path& path, const std::string* contents, const std::string& name) {
-  constexpr std::size_t kTail = 256, kHead = 1024;
-  std::string head, tail;
+FileEnds fileEnds(const std::filesystem::path& path, const std::string* contents, std::size_t headBytes,
+                  std::size_t tailBytes) {
+  FileEnds ends;
   if (contents != nullptr) {
-    head = contents->substr(0, kHead);
-    tail = contents->substr(contents->size() - std::min(contents->size(), kTail));
-  } else {
-    std::ifstream in(path, std::ios::binary | std::ios::ate);
-    const auto size = static_cast<std::size_t>(std::max<std::streamoff>(in.tellg(), 0));
-    in.seekg(0);
-    head.resize(std::min(size, kHead));
-    in.read(head.data(), static_cast<std::streamsize>(head.size()));
-    in.seekg(static_cast<std::streamoff>(size - std::min(size, kTail)));
-    tail.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    ends.head = contents->substr(0, headBytes);
+    ends.tail = contents->substr(contents->size() - std::min(contents->size(), tailBytes));
+    return ends;
   }
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  const auto size = static_cast<std::size_t>(std::max<std::streamoff>(in.tellg(), 0));
+  in.seekg(0);
+  ends.head.resize(std::min(size, headBytes));
+  in.read(ends.head.data(), static_cast<std::streamsize>(ends.head.size()));
+  in.seekg(static_cast<std::streamoff>(size - std::min(size, tailBytes)));
+  ends.tail.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  return ends;
+}
+
+void checkVtkXmlFileEnd(const std::filesystem::path& path, const std::string* contents, const std::string& name) {
+  const auto [head, tail] = fileEnds(path, contents, 1024, 256);
   if (head.find("<VTKFile") == std::string::npos) return;  // not VTK XML at all: VTK's reader says so
   const std::size_t last = tail.find_last_not_of(" \t\r\n");
   constexpr std::string_view kEnd = "</VTKFile>";

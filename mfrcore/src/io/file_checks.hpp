@@ -1,6 +1,7 @@
 #pragma once
 // Checks shared by the model and volume loaders: a file is looked at before any library reads it,
 // so that missing, unreadable, empty or special files get one line naming them, never a hang.
+#include <cstddef>
 #include <filesystem>
 #include <new>
 #include <stdexcept>
@@ -15,6 +16,14 @@ namespace mfr::io {
 // Throws mfr::Error(name, reason) unless path is a readable, non-empty regular file. `kind` is
 // what the caller expected ("model", "volume") and appears in the directory message.
 void checkReadable(const std::filesystem::path& path, const std::string& name, std::string_view kind);
+
+// The first headBytes and the last tailBytes of `contents` when given (a file decompressed in
+// memory), else of the file at path: what the end checks below and the IFC check look at.
+struct FileEnds {
+  std::string head, tail;
+};
+FileEnds fileEnds(const std::filesystem::path& path, const std::string* contents, std::size_t headBytes,
+                  std::size_t tailBytes);
 
 // A VTK XML file (.vti, .vtp) ends with </VTKFile>: VTK's XML readers read a file cut inside its
 // raw, base64 or inline data without an error, and the missing samples came out as zeros or
