@@ -113,6 +113,14 @@ void addProbe(CLI::App& app) {
     files.push_back({"--json", opt->json, CommandFile::Role::kOutput});
     checkCommandFiles(files);
     validateOperation(opt->op);
+    // What the probe does not take apart was ignored, exit 0, and with a method its colour was
+    // compared with "over" (a bug hunt): csg's classification, and hybrid's split without a method.
+    if (opt->op == "csg")
+      throw Error("--op csg",
+                  "probe lists the fragments, it does not classify them (mfr render --op csg with -m oracle "
+                  "gives the exact image)");
+    if (opt->op == "hybrid" && opt->method.empty())
+      throw Error("--op hybrid", "needs --method (the core and the tail are the method's split)");
     req.operation = opt->op;
     req.thickness = thicknessOption(*thicknessGiven, opt->thickness);
     Scene scene = loadSceneWithOpacity(opt->scene, opt->opacity, opt->read);

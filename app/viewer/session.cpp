@@ -258,7 +258,15 @@ QStringList applySession(const Session& session, ViewerModel& model) {
     }
   }
   if (session.hasClip && clipHolds) model.setClipBox(session.clip);
-  if (session.hasSection) model.setSection(session.section);
+  if (session.hasSection) {
+    std::optional<mfr::SectionPlane> section = session.section;
+    if (section && section->slice && model.scene().volumes.empty()) {
+      notes << QStringLiteral("section.slice: scene '%1' has no volume (the plane cuts, no slice is drawn)")
+                   .arg(QString::fromStdString(model.scene().name));
+      section->slice = false;
+    }
+    model.setSection(section);
+  }
   // A field this scene lacks is a note, as parts it lacks (it was dropped without a word).
   if (session.hasColorBy &&
       !model.setFieldColoring(session.colorBy ? QString::fromStdString(session.colorBy->field) : QString(),
@@ -272,14 +280,49 @@ QStringList applySession(const Session& session, ViewerModel& model) {
       const Session::VolumeState& v = session.volumes[i];
       model.setVolumeStateAt(static_cast<int>(i), v.visible, v.transfer, v.shading);
       // Another field of the file: read in the background; the session's function follows it.
-      if (!v.field.isEmpty() && v.field.toStdString() != model.scene().volumes[i].field)
-        model.setVolumeFieldAt(static_cast<int>(i), v.field, v.transfer);
+      // A field the file lacks, or any other field of a volume made in memory, is a note (it was
+      // left out without a word).
+      const mfr::Volume& volume = model.scene().volumes[i];
+      if (v.field.isEmpty() || v.field.toStdString() == volume.field) continue;
+      if (volume.file.empty() ||
+          std::find(volume.fields.begin(), volume.fields.end(), v.field.toStdString()) == volume.fields.end()) {
+        QStringList fields;
+        for (const std::string& f : volume.fields) fields << QString::fromStdString(f);
+        notes << QStringLiteral("volumes[%1].field: volume '%2' has no field '%3' (%4; left out)")
+                     .arg(i)
+                     .arg(QString::fromStdString(volume.name), v.field,
+                          volume.file.empty() || fields.isEmpty()
+                              ? QStringLiteral("it has one field")
+                              : QStringLiteral("fields: ") + fields.join(QStringLiteral(", ")));
+        continue;
+      }
+      model.setVolumeFieldAt(static_cast<int>(i), v.field, v.transfer);
     }
-  model.setVolumeStep(session.volumeStep);
-  if (!session.operation.isEmpty()) model.setOperation(session.operation);
+  // What only a volume uses, on a scene without one: notes (taken without a word; mfr render
+  // refuses --step and --section …:slice there).
+  if (model.scene().volumes.empty() && session.volumeStep > 0.0)
+    notes << QStringLiteral("volume_step: scene '%1' has no volume (left out)")
+                 .arg(QString::fromStdString(model.scene().name));
+  else
+    model.setVolumeStep(session.volumeStep);
+  // An operation this scene cannot draw is a note, as parts it lacks: the first frame failed with
+  // "--op csg: …", naming an option never given (a bug hunt).
+  const auto drawable = [&](const QString& operation, const QString& key) {
+    const mfr::Scene& scene = model.scene();
+    QString lacks;
+    if (operation == QLatin1String("csg") && scene.csg.empty()) lacks = QStringLiteral("no CSG tree");
+    if (operation == QLatin1String("volume") && scene.volumes.empty()) lacks = QStringLiteral("no volume");
+    if (lacks.isEmpty()) return true;
+    notes << QStringLiteral("%1: %2: scene '%3' has %4 (left out)")
+                 .arg(key, operation, QString::fromStdString(scene.name), lacks);
+    return false;
+  };
+  if (!session.operation.isEmpty() && drawable(session.operation, QStringLiteral("operation")))
+    model.setOperation(session.operation);
   if (!session.method.isEmpty()) model.setMethod(session.method);
   model.setAllParamsOf(1, session.compare.params);
-  if (!session.compare.operation.isEmpty()) model.setOperationOf(1, session.compare.operation);
+  if (!session.compare.operation.isEmpty() && drawable(session.compare.operation, QStringLiteral("compare.operation")))
+    model.setOperationOf(1, session.compare.operation);
   if (!session.compare.method.isEmpty()) model.setMethodOf(1, session.compare.method);
   model.setCompareLayout(session.compare.layout);
   model.setCompareSplit(session.compare.split);
@@ -386,7 +429,10 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   s.camera.eye = r.vec3(cam, "eye", "camera");
   s.camera.target = r.vec3(cam, "target", "camera");
   s.camera.up = r.vec3(cam, "up", "camera");
-  const QString projection = cam.value("projection").toString("perspective");
+  // Another JSON type (a number 3) read as the default, perspective.
+  const QString projection = cam.contains("projection") && !cam.value("projection").isString()
+                                 ? QString()
+                                 : cam.value("projection").toString(QStringLiteral("perspective"));
   if (projection != QLatin1String("perspective") && projection != QLatin1String("orthographic"))
     r.fail(QStringLiteral("camera.projection"), QStringLiteral("expected perspective or orthographic"));
   s.camera.projection = projection == QLatin1String("orthographic") ? mfr::Projection::Orthographic : mfr::Projection::Perspective;
@@ -403,6 +449,15 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   if (!(s.camera.nearPlane > 0.0)) r.fail(QStringLiteral("camera.near"), QStringLiteral("must be positive"));
   if (!(s.camera.farPlane > s.camera.nearPlane))
     r.fail(QStringLiteral("camera.far"), QStringLiteral("must be greater than near"));
+  // As a scene file's views are (it failed the first frame: "camera: projection is singular",
+  // without the file).
+  if (const auto defect = s.camera.frameDefect())
+    r.fail(defect->key.empty() ? QStringLiteral("camera")
+                               : QStringLiteral("camera.") + QString::fromStdString(defect->key),
+           QString::fromStdString(defect->reason));
+  if (s.camera.projectionSingular())
+    r.fail(QStringLiteral("camera"),
+           QStringLiteral("its projection is singular (near and far planes too far apart, or too large a scene)"));
   s.method = r.method(json, "method", {});
   s.operation = r.operation(json, "operation", {});
   // Optional (sessions written before the operation zthickness have none: the default).
@@ -521,7 +576,9 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   const QJsonObject compare = r.objectAt(json, "compare", QStringLiteral("compare"));
   s.compare.enabled = r.boolean(compare, "enabled", QStringLiteral("compare"), false);
   s.compare.layout = r.choice(compare, "layout", "compare", kLayouts, CompareLayout::SideBySide);
-  s.compare.split = std::clamp(r.number(compare, "split", "compare", 0.5), 0.0, 1.0);
+  // The panel's slider holds 0 ... 1; a 7 was clamped to 1 without a word.
+  s.compare.split =
+      r.unit(compare.contains("split") ? compare.value("split") : QJsonValue(0.5), QStringLiteral("compare.split"));
   s.compare.display = r.choice(compare, "display", "compare", kDisplays, CompareDisplay::Images);
   s.compare.method = r.method(compare, "method", QStringLiteral("compare"));
   s.compare.operation = r.operation(compare, "operation", QStringLiteral("compare"));

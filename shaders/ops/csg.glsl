@@ -31,9 +31,11 @@ bool csgInside(uint mask) {
     uint word = uCsgProgram[i];
     uint op = word & 0xFFu;
     if (op == MFR_CSG_PRIMITIVE) {
+      // 32 bits hold a stack 32 deep, what validateCsg allows (a clamp at 31 lost the 32nd
+      // operand of a right-nested tree). Deeper never comes; the guard keeps the shift defined.
       uint bit = (mask >> ((word >> 8u) & 31u)) & 1u;
-      stack = (stack & ~(1u << depth)) | (bit << depth);
-      depth = min(depth + 1u, 31u);
+      if (depth < 32u) stack = (stack & ~(1u << depth)) | (bit << depth);
+      depth = min(depth + 1u, 32u);
     } else {
       depth = max(depth, 2u) - 2u;
       bool a = ((stack >> depth) & 1u) != 0u;

@@ -866,6 +866,17 @@ class ViewerTest : public QObject {
         {with("camera", camera({{"projection", "orthographic"}, {"ortho_height", -3}})),
          "s.mfrsession: camera.ortho_height: must be a positive height in scene units"},
         {with("camera", camera({{"near", 2}, {"far", 1}})), "s.mfrsession: camera.far: must be greater than near"},
+        // A number was read as perspective, and a split of 7 was clamped to 1 without a word.
+        {with("camera", camera({{"projection", 3}})),
+         "s.mfrsession: camera.projection: expected perspective or orthographic"},
+        // A degenerate camera failed the first frame without the file's name (a bug hunt).
+        {with("camera", camera({{"eye", QJsonArray{0, 0, 0}}})), "s.mfrsession: camera: eye and target coincide"},
+        {with("camera", camera({{"up", QJsonArray{3, 2, 4}}})),
+         "s.mfrsession: camera.up: parallel to the view direction"},
+        {with("camera", camera({{"near", 1e-300}, {"far", 1e300}})),
+         "s.mfrsession: camera: its projection is singular"},
+        {with("compare", QJsonObject{{"split", 7}}), "s.mfrsession: compare.split: expected a number in [0, 1]"},
+        {with("compare", QJsonObject{{"split", "0.5"}}), "s.mfrsession: compare.split: expected a number in [0, 1]"},
         {with("section", QJsonObject{{"point", QJsonArray{0, 0, 0}}, {"normal", QJsonArray{1e200, 1e200, 0}}}),
          "s.mfrsession: section: the normal is too long to normalise (under 1e150)"},
         {with("color_by", QJsonObject{{"field", "b"}, {"map", "badmap"}, {"range", QJsonArray{0, 1}}}),
@@ -919,6 +930,39 @@ class ViewerTest : public QObject {
     QVERIFY2(colourNotes[0].startsWith(QStringLiteral("color_by nope: ")) &&
                  colourNotes[0].endsWith(QStringLiteral(" (not applied)")),
              qPrintable(colourNotes.join('|')));
+  }
+
+  // What the session's scene cannot use is a note and left out: an operation it cannot draw (the
+  // first frame failed naming --op, an option never given), the volume step and a slice without a
+  // volume, a volume field the volume lacks (all taken without a word before; a bug hunt).
+  void sessionSettingsTheSceneCannotUseAreNotes() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    Session session = captureSession(m);
+    const QString operation = m.operation();
+    session.operation = QStringLiteral("csg");
+    session.compare.operation = QStringLiteral("volume");
+    session.volumeStep = 0.5;
+    session.hasSection = true;
+    session.section = mfr::SectionPlane{};
+    session.section->normal = {1.0, 0.0, 0.0};
+    session.section->slice = true;
+    const QStringList notes = applySession(session, m);
+    QCOMPARE(notes, (QStringList{"section.slice: scene 'sample' has no volume (the plane cuts, no slice is drawn)",
+                                 "volume_step: scene 'sample' has no volume (left out)",
+                                 "operation: csg: scene 'sample' has no CSG tree (left out)",
+                                 "compare.operation: volume: scene 'sample' has no volume (left out)"}));
+    QCOMPARE(m.operation(), operation);
+    QVERIFY(m.section() && !m.section()->slice);
+    QCOMPARE(m.volumeStep(), 0.0);
+    auto v = openWindow(QStringLiteral("@volume"));
+    QVERIFY(v);
+    Session field = captureSession(v->model());
+    QCOMPARE(field.volumes.size(), std::size_t{1});
+    field.volumes[0].field = QStringLiteral("nope");
+    QCOMPARE(applySession(field, v->model()),
+             QStringList{"volumes[0].field: volume 'field' has no field 'nope' (it has one field; left out)"});
   }
 
   // `mfrview --screenshot` and `mfr render` with the same scene, view, size and settings.

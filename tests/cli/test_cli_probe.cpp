@@ -224,6 +224,10 @@ TEST_F(CliProbe, BadInputIsOneLineAndWritesNoJson) {
       // Digits only: "1e1" was read as 10, and 1e300 was cast to int (undefined behaviour).
       {"--pixel 1e1,2", "--pixel 1e1,2: expected X,Y"},
       {"--pixel 1e300,2", "--pixel 1e300,2: expected X,Y"},
+      // Ignored with exit 0, and with a method compared with "over" (a bug hunt).
+      {"--pixel 3,3 --op csg", "--op csg: probe lists the fragments"},
+      {"--pixel 3,3 -m abuffer-ll --op csg", "--op csg: probe lists the fragments"},
+      {"--pixel 3,3 --op hybrid", "--op hybrid: needs --method"},
   };
   for (const auto& [args, mention] : cases) {
     SCOPED_TRACE(args);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
 
 namespace mfr {
 
@@ -25,6 +26,24 @@ glm::dmat4 Camera::projectionMatrix(double aspect) const {
 glm::dvec4 Camera::depthToEye() const {
   const glm::dmat4 inverse = glm::inverse(projectionMatrix(1.0));
   return {inverse[2][2], inverse[3][2], inverse[2][3], inverse[3][3]};
+}
+
+std::optional<Camera::Defect> Camera::frameDefect() const {
+  if (glm::length(eye - target) == 0.0) return Defect{"", "eye and target coincide"};
+  // Beyond ~1e154 apart the view direction cannot be normalised (it read as "up: parallel").
+  if (!std::isfinite(glm::length(eye - target)))
+    return Defect{"", "eye and target too far apart to give a view direction (under 1e150)"};
+  if (!(glm::length(up) > 0.0)) return Defect{"up", "must not be zero"};
+  if (!std::isfinite(glm::length(up))) return Defect{"up", "too long to normalise (under 1e150)"};
+  if (!(glm::length(glm::cross(forward(), glm::normalize(up))) >= 1e-9))
+    return Defect{"up", "parallel to the view direction"};
+  return std::nullopt;
+}
+
+bool Camera::projectionSingular() const {
+  const glm::dmat4 inverse = glm::inverse(projectionMatrix(1.0) * viewMatrix());
+  const double* m = glm::value_ptr(inverse);
+  return !std::all_of(m, m + 16, [](double x) { return std::isfinite(x); });
 }
 
 glm::dvec3 Camera::forward() const {

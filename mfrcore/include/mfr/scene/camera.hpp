@@ -3,6 +3,8 @@
 // conventions (right-handed eye space looking down -Z, NDC depth in [-1, 1], window depth in
 // [0, 1]). The oracle uses the same matrices, in double precision, to build its rays.
 #include <glm/glm.hpp>
+#include <optional>
+#include <string>
 
 #include "mfr/scene/mesh.hpp"
 
@@ -35,6 +37,17 @@ struct Camera {
   // fills the view, and sets near/far to enclose it.
   // radius > 0 gives a tighter sphere around b's centre than b's half-diagonal (Scene computes
   // it from the vertices).
+  // Why eye, target and up give no view, or nothing: {key ("" or "up"), reason}. Scene files'
+  // views and sessions' cameras are checked with it, so neither reaches a renderer's "projection
+  // is singular" naming neither the file nor the key.
+  struct Defect {
+    std::string key;
+    std::string reason;
+  };
+  [[nodiscard]] std::optional<Defect> frameDefect() const;
+  // The view-projection (aspect 1) has no finite inverse: near 1e-30 with far 1e30, say.
+  [[nodiscard]] bool projectionSingular() const;
+
   [[nodiscard]] Camera fittedTo(const Bounds& b, double radius = 0.0) const;
   // Recomputes only near/far so the sphere lies between them (camera position unchanged).
   void fitDepthRange(const Bounds& b, double radius = 0.0);
