@@ -52,6 +52,8 @@
 namespace {
 
 constexpr int kMaxRecentFiles = 10;
+// Renders of an export at most: a plugin's first guess, then refits from what a render measured.
+constexpr int kMaxExportFits = 4;
 const QString kSessionSuffix = QStringLiteral(".mfrsession");
 
 QString sceneFileFilter() {
@@ -613,7 +615,24 @@ void MainWindow::exportImage(const QString& path, QSize size, bool legend) {
                                        .arg(mfr::kMinLegendImageSize)
                                        .toStdString());
   }
-  mfr::ImageRGBA8 image = view_->renderImage(size);
+  // Plugins' parameters for this size (the budget panel's k or pool, fitted to the view's): a
+  // first guess, then a refit from what that render measured, a few times at most.
+  const auto pluginParams = [&](const std::map<std::string, std::string>* tried, const mfr::Stats* measured) {
+    std::map<std::string, std::string> params;
+    for (const PluginRecord& r : plugins_.records())
+      if (r.plugin)
+        for (const auto& [name, value] : r.plugin->exportParams(size, tried, measured)) params[name] = value;
+    return params;
+  };
+  std::map<std::string, std::string> params = pluginParams(nullptr, nullptr);
+  mfr::RenderOutput out = view_->renderOutput(size, params);
+  for (int tries = 1; tries < kMaxExportFits && !params.empty(); ++tries) {
+    std::map<std::string, std::string> refit = pluginParams(&params, &out.stats);
+    if (refit == params) break;
+    params = std::move(refit);
+    out = view_->renderOutput(size, params);
+  }
+  mfr::ImageRGBA8 image = std::move(out.image);
   if (shown) mfr::drawColorLegend(image, shown->colors, model_->scene().background, shown->ticks);
   mfr::writePng(path.toStdString(), image);
 }

@@ -671,14 +671,19 @@ RenderView::CurrentContext RenderView::currentWithScene(int side) {
 }
 
 mfr::ImageRGBA8 RenderView::renderImage(QSize size) {
+  return renderOutput(size, {}).image;
+}
+
+mfr::RenderOutput RenderView::renderOutput(QSize size, const std::map<std::string, std::string>& params) {
   if (!model_.hasScene()) throw mfr::Error("export", "no scene loaded");
-  const mfr::RenderRequest request = model_.renderRequest(0, size);
-  if (model_.isCpuMethod(model_.method())) return mfr::render(model_.drawnScene(), model_.camera(), request).image;
+  mfr::RenderRequest request = model_.renderRequest(0, size);
+  for (const auto& [name, value] : params) request.params[name] = value;
+  if (model_.isCpuMethod(model_.method())) return mfr::render(model_.drawnScene(), model_.camera(), request);
   // What mfr render refuses (a scene of degenerate triangles, a singular camera) is refused here too.
   mfr::checkDrawable(model_.drawnScene(), model_.camera(), size.width(), size.height());
   const CurrentContext current = currentWithScene(0);
   try {
-    return renderer(0).render(model_.camera(), request).image;
+    return renderer(0).render(model_.camera(), request);
   } catch (...) {
     mfr::gl::discardErrors();
     throw;

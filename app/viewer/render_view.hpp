@@ -61,6 +61,8 @@ class RenderView final : public QOpenGLWidget {
   // offscreen on this view's context exactly as `mfr render` does (GpuRenderer::render, or the
   // oracle on the CPU). Throws mfr::Error (no GL context yet, no scene, bad settings).
   mfr::ImageRGBA8 renderImage(QSize size);
+  // The same with `params` merged over the method's, and the render's stats.
+  mfr::RenderOutput renderOutput(QSize size, const std::map<std::string, std::string>& params);
   [[nodiscard]] bool glReady() const { return renderers_[0] != nullptr; }
   [[nodiscard]] const QString& glInfo() const { return glInfo_; }
   // The image size in device pixels.

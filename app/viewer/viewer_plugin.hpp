@@ -241,6 +241,18 @@ class MfrViewerPlugin {
   // write are refused as unknown, values of another type as wrong); a key left out keeps its default.
   [[nodiscard]] virtual QJsonObject saveSettings() const = 0;
   virtual void loadSettings(const QJsonObject& settings) = 0;
+  // 1.11: parameters of the current method for an image of `size` other than the view's (File →
+  // Export, --screenshot at --size), merged over the view's. A plugin that sets parameters from
+  // the view's image size (the budget panel) keeps its promise at the export's size: an export
+  // at 800x600 drew with the k fitted to the view, 2.6 times the budget (a bug hunt). `tried` and
+  // `measured` are the parameters it gave last and the stats of that render at `size` (null on
+  // the first call); giving the same parameters again ends the tries.
+  [[nodiscard]] virtual std::map<std::string, std::string> exportParams(QSize size,
+                                                                        const std::map<std::string, std::string>* tried,
+                                                                        const mfr::Stats* measured) const {
+    (void)size, (void)tried, (void)measured;
+    return {};
+  }
 };
 
 // 1.1: frame quality and data views in ViewerContext (plugins built for 1.0 are refused).
@@ -257,5 +269,6 @@ class MfrViewerPlugin {
 // 1.9: imageSize (the image stats() describes) instead of renderSize (the whole view's, which
 //      side by side is two images).
 // 1.10: note (and the signal noted): notes of a plugin for the status bar and stderr.
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.10"
+// 1.11: exportParams: a plugin's parameters for an exported image of another size.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.11"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

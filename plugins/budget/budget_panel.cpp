@@ -301,39 +301,77 @@ void BudgetPanel::showQuality() {
   flipLabel_->setText(tr("%1 (max %2)").arg(q.flipMean, 0, 'f', 4).arg(q.flipMax, 0, 'f', 3));
 }
 
-void BudgetPanel::applyBudget() {
-  const Driver d = driverFor(ctx_.method());
+BudgetPanel::Model BudgetPanel::modelAt(double pixels) const {
+  // Measured at the view's size; per-pixel storage scales with the pixels.
+  const double viewPixels = std::max(1.0, static_cast<double>(ctx_.imageSize().width()) * ctx_.imageSize().height());
+  const double scale = pixels / viewPixels;
+  Model m;
+  // Before the first measurement assume 8 bytes per pixel besides the pool (head pointer,
+  // counter); the first frame measures the real overhead.
+  m.poolOverhead = fit_.poolOverhead >= 0 ? fit_.poolOverhead * scale : 8.0 * pixels;
+  m.perSlot = 8.0 * viewPixels;  // RGBA8 + depth per slot until measured
+  if (fit_.bytes.size() >= 2) {
+    const auto lo = fit_.bytes.begin();
+    const auto hi = std::prev(fit_.bytes.end());
+    m.perSlot = static_cast<double>(hi->second - lo->second) / static_cast<double>(hi->first - lo->first);
+    m.fixed = static_cast<double>(lo->second) - m.perSlot * static_cast<double>(lo->first);
+  } else if (fit_.bytes.size() == 1) {
+    m.fixed =
+        static_cast<double>(fit_.bytes.begin()->second) - m.perSlot * static_cast<double>(fit_.bytes.begin()->first);
+  }
+  m.perSlot *= scale;
+  m.fixed *= scale;
+  return m;
+}
+
+std::map<std::string, std::string> BudgetPanel::paramsFor(const Driver& d, const Model& m) const {
   const double budget = budgetMiB() * kMiB;
-  const double pixels = static_cast<double>(ctx_.imageSize().width()) * ctx_.imageSize().height();
   switch (d.knob) {
-    case Knob::None: return;
-    case Knob::Budget: ctx_.setParams({{"budget_mib", std::to_string(budgetMiB())}}); return;
+    case Knob::None:
+      return {};
+    case Knob::Budget:
+      return {{"budget_mib", std::to_string(budgetMiB())}};
     case Knob::Pool: {
-      // Before the first measurement assume 8 bytes per pixel besides the pool (head pointer,
-      // counter); the first frame measures the real overhead.
       // The method rounds the pool to whole nodes, so keep a small margin below the budget, and
       // round the MiB text down, never up.
-      const double overhead = fit_.poolOverhead >= 0 ? fit_.poolOverhead : 8.0 * pixels;
-      const double pool = std::max(budget - overhead - kPoolMarginBytes, kMiB / 64);
+      const double pool = std::max(budget - m.poolOverhead - kPoolMarginBytes, kMiB / 64);
       const double poolMiB = std::floor(pool / kMiB * 1e6) / 1e6;
-      ctx_.setParams({{"pool", "fixed"}, {"pool_mib", QString::number(poolMiB, 'f', 6).toStdString()}});
-      return;
+      return {{"pool", "fixed"}, {"pool_mib", QString::number(poolMiB, 'f', 6).toStdString()}};
     }
     case Knob::Slots: {
-      double perSlot = 8.0 * pixels, fixed = 0.0;  // RGBA8 + depth per slot until measured
-      if (fit_.bytes.size() >= 2) {
-        const auto lo = fit_.bytes.begin();
-        const auto hi = std::prev(fit_.bytes.end());
-        perSlot = static_cast<double>(hi->second - lo->second) / static_cast<double>(hi->first - lo->first);
-        fixed = static_cast<double>(lo->second) - perSlot * static_cast<double>(lo->first);
-      } else if (fit_.bytes.size() == 1) {
-        fixed = static_cast<double>(fit_.bytes.begin()->second) - perSlot * static_cast<double>(fit_.bytes.begin()->first);
-      }
-      const auto k = static_cast<long long>(std::floor((budget - fixed) / std::max(perSlot, 1.0)));
-      ctx_.setParams({{d.param, std::to_string(std::clamp(k, d.minValue, d.maxValue))}});
-      return;
+      const auto k = static_cast<long long>(std::floor((budget - m.fixed) / std::max(m.perSlot, 1.0)));
+      return {{d.param, std::to_string(std::clamp(k, d.minValue, d.maxValue))}};
     }
   }
+  return {};
+}
+
+void BudgetPanel::applyBudget() {
+  const Driver d = driverFor(ctx_.method());
+  if (d.knob == Knob::None) return;
+  ctx_.setParams(paramsFor(d, modelAt(static_cast<double>(ctx_.imageSize().width()) * ctx_.imageSize().height())));
+}
+
+std::map<std::string, std::string> BudgetPanel::exportParams(QSize size,
+                                                             const std::map<std::string, std::string>* tried,
+                                                             const mfr::Stats* measured) const {
+  const Driver d = driverFor(ctx_.method());
+  // The budget's own parameter (budget_mib) holds at any size; at the view's size the view's
+  // fitted parameters hold.
+  if (!driving_ || (d.knob != Knob::Pool && d.knob != Knob::Slots) || (size == ctx_.imageSize() && !tried)) return {};
+  Model m = modelAt(static_cast<double>(size.width()) * size.height());
+  // The last render at this size measured the bytes besides what the parameter buys.
+  if (tried && measured) {
+    const auto given = tried->find(d.knob == Knob::Pool ? std::string("pool_mib") : d.param);
+    if (given != tried->end()) {
+      const double bytes = static_cast<double>(measured->bytesAllocated);
+      if (d.knob == Knob::Pool)
+        m.poolOverhead = bytes - std::stod(given->second) * kMiB;
+      else
+        m.fixed = bytes - m.perSlot * static_cast<double>(std::stoll(given->second));
+    }
+  }
+  return paramsFor(d, m);
 }
 
 void BudgetPanel::frameRendered() {

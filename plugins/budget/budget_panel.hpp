@@ -16,6 +16,7 @@
 // rest, the robustness ratio R_h of methods that have one (kplus-dynamic) and a switch for the
 // k(p) map over the image.
 #include <QJsonObject>
+#include <QSize>
 #include <QWidget>
 
 #include <cstdint>
@@ -34,6 +35,7 @@ class HistogramWidget;
 class ViewerContext;
 namespace mfr {
 struct MethodInfo;
+struct Stats;
 }
 
 class BudgetPanel final : public QWidget {
@@ -44,6 +46,10 @@ class BudgetPanel final : public QWidget {
   [[nodiscard]] QJsonObject saveSettings() const;
   void loadSettings(const QJsonObject& settings);
   [[nodiscard]] int budgetMiB() const;
+  // MfrViewerPlugin::exportParams: the driven parameter fitted to an exported image of `size`.
+  [[nodiscard]] std::map<std::string, std::string> exportParams(QSize size,
+                                                                const std::map<std::string, std::string>* tried,
+                                                                const mfr::Stats* measured) const;
 
  private:
   enum class Knob { None, Budget, Pool, Slots };
@@ -55,6 +61,14 @@ class BudgetPanel final : public QWidget {
   [[nodiscard]] Driver driverFor(const QString& method) const;
   void setBudget(int mib);
   void applyBudget();
+  // The memory model of the current method scaled to an image of `pixels` (bytes per slot and
+  // fixed bytes of the slot methods, bytes besides the pool of the A-buffers), and the parameter
+  // values that fit the budget under it.
+  struct Model {
+    double perSlot = 0.0, fixed = 0.0, poolOverhead = 0.0;
+  };
+  [[nodiscard]] Model modelAt(double pixels) const;
+  [[nodiscard]] std::map<std::string, std::string> paramsFor(const Driver& d, const Model& m) const;
   void frameRendered();
   void showFrame();
   void methodChanged();

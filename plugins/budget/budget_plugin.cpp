@@ -14,6 +14,12 @@ QWidget* BudgetPlugin::createPanel(ViewerContext& context, QWidget* parent) {
 
 QJsonObject BudgetPlugin::saveSettings() const { return panel_ ? panel_->saveSettings() : QJsonObject{}; }
 
+std::map<std::string, std::string> BudgetPlugin::exportParams(QSize size,
+                                                              const std::map<std::string, std::string>* tried,
+                                                              const mfr::Stats* measured) const {
+  return panel_ ? panel_->exportParams(size, tried, measured) : std::map<std::string, std::string>{};
+}
+
 void BudgetPlugin::loadSettings(const QJsonObject& settings) {
   if (panel_) panel_->loadSettings(settings);
 }

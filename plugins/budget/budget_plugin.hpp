@@ -21,6 +21,9 @@ class BudgetPlugin final : public QObject, public MfrViewerPlugin {
   QWidget* createPanel(ViewerContext& context, QWidget* parent) override;
   [[nodiscard]] QJsonObject saveSettings() const override;
   void loadSettings(const QJsonObject& settings) override;
+  [[nodiscard]] std::map<std::string, std::string> exportParams(QSize size,
+                                                                const std::map<std::string, std::string>* tried,
+                                                                const mfr::Stats* measured) const override;
 
  private:
   QPointer<BudgetPanel> panel_;

@@ -965,6 +965,41 @@ class ViewerTest : public QObject {
              QStringList{"volumes[0].field: volume 'field' has no field 'nope' (it has one field; left out)"});
   }
 
+  // A budget in force holds for a picture of another size than the view's: the k fitted to the
+  // view was used for the export, so --screenshot's picture changed with --window-size and took up
+  // to 2.6 times the budget (a bug hunt). The k expected is the largest whose bytes at the
+  // export's size (mfr render --stats) fit the budget.
+  void budgetHoldsAtTheExportSize() {
+    QTemporaryDir dir;
+    QString out;
+    const double budget = 2.0 * 1024 * 1024;
+    int expectedK = 0;
+    for (int k = 1; k <= 6; ++k) {
+      const QString png = dir.filePath(QStringLiteral("k%1.png").arg(k)), stats = dir.filePath("stats.json");
+      QCOMPARE(runProgram(MFR_CLI,
+                          {"render", "@sample", "-m", "kplus-array", "-p", QStringLiteral("k=%1").arg(k), "-s",
+                           "320x240", "-o", png, "--stats", stats},
+                          &out),
+               0);
+      QFile f(stats);
+      QVERIFY(f.open(QIODevice::ReadOnly));
+      if (QJsonDocument::fromJson(f.readAll()).object().value("bytes_allocated").toDouble() <= budget) expectedK = k;
+    }
+    QCOMPARE(expectedK, 2);  // measured: k = 2 takes 1,536,032 bytes, k = 3 2,150,432
+    for (const char* window : {"1100x700", "1500x1000"}) {
+      const QString png = dir.filePath(QStringLiteral("shot-%1.png").arg(window));
+      QCOMPARE(
+          runProgram(MFRVIEW,
+                     {"@sample", "-m", "kplus-array", "--plugin-settings", R"(budget={"budget_mib":2,"driving":true})",
+                      "--window-size", window, "--size", "320x240", "--screenshot", png},
+                     &out),
+          0);
+      QVERIFY2(maxChannelDifference(mfr::readPng(png.toStdString()),
+                                    mfr::readPng(dir.filePath("k2.png").toStdString())) <= 1,
+               window);
+    }
+  }
+
   // `mfrview --screenshot` and `mfr render` with the same scene, view, size and settings.
   void viewerScreenshotEqualsCli() {
     QTemporaryDir dir;
