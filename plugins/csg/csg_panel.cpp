@@ -144,6 +144,8 @@ QJsonObject CsgPanel::saveSettings() const {
 }
 
 void CsgPanel::loadSettings(const QJsonObject& settings) {
+  // A key left out keeps the scene's tree ({} cleared it: a bug hunt); "" clears it, as saved.
+  if (!settings.contains(QStringLiteral("tree"))) return;
   const QString tree = settings.value(QStringLiteral("tree")).toString();
   if (!context_.hasScene() || tree == context_.csgTree()) return;
   const QString error = context_.setCsgTree(tree);

@@ -283,12 +283,25 @@ void GhostingPanel::restoreOpacities() {
 
 // ---- settings -------------------------------------------------------------------------------
 
+// Each part's name in settings: the first part of a name by the name, the n-th (n ≥ 1) as
+// "name#n", so that parts of one name keep their own focus and opacity (by the name alone, the
+// second took the first's: a bug hunt).
+QStringList GhostingPanel::settingNames() const {
+  QStringList names;
+  for (int id = 0; id < parts_->count(); ++id) names << parts_->item(id)->text();
+  QStringList labels = occurrenceKeys(names);
+  for (int id = 0; id < names.size(); ++id)
+    if (labels[id].endsWith(QStringLiteral("#0"))) labels[id] = names[id];
+  return labels;
+}
+
 QJsonObject GhostingPanel::saveSettings() const {
   QJsonArray focus;
   QJsonObject ghosted;
+  const QStringList labels = settingNames();
   for (int id = 0; id < parts_->count(); ++id) {
-    if (isFocus(id)) focus.append(parts_->item(id)->text());
-    if (saved_.contains(id)) ghosted.insert(parts_->item(id)->text(), saved_.value(id));
+    if (isFocus(id)) focus.append(labels[id]);
+    if (saved_.contains(id)) ghosted.insert(labels[id], saved_.value(id));
   }
   return {{QStringLiteral("focus"), focus},
           {QStringLiteral("ghost"), ghost_->isChecked()},
@@ -314,20 +327,38 @@ void GhostingPanel::loadSettings(const QJsonObject& settings) {
                         .arg(std::clamp(opacity, 0.02, 1.0)));
     ghostSlider_->setValue(static_cast<int>(std::lround(std::clamp(opacity, 0.02, 1.0) * 100.0)));
     ghostValue_->setText(QString::number(ghostOpacity(), 'f', 2));
+    // The slider holds hundredths: 0.025 drew as 0.03 without a word (a bug hunt).
+    if (opacity >= 0.02 && opacity <= 1.0 && std::abs(ghostOpacity() - opacity) > 1e-9)
+      context_.note(tr("ghosting: ghost_opacity %1 is not a whole hundredth: %2 is used")
+                        .arg(opacity)
+                        .arg(ghostOpacity(), 0, 'f', 2));
     saved_.clear();
+    const QStringList labels = settingNames();
     for (int id = 0; id < parts_->count(); ++id) {
       QListWidgetItem* item = parts_->item(id);
-      item->setCheckState(focus.contains(item->text()) ? Qt::Checked : Qt::Unchecked);
+      item->setCheckState(focus.contains(labels[id]) ? Qt::Checked : Qt::Unchecked);
       // The opacities the session's ghosted parts had before (the session's objects hold the ghosted ones).
-      if (ghosted.contains(item->text())) saved_.insert(id, ghosted.value(item->text()).toDouble());
+      if (ghosted.contains(labels[id])) {
+        const QJsonValue before = ghosted.value(labels[id]);
+        // Another type (a string, null) read as 0, and 5 was clamped, without a word (a bug hunt).
+        if (!before.isDouble() || !(before.toDouble() >= 0.0 && before.toDouble() <= 1.0))
+          context_.note(tr("ghosting: ghosted '%1': expected an opacity in 0 … 1 (left out)").arg(labels[id]));
+        else
+          saved_.insert(id, before.toDouble());
+      }
     }
     ghost_->setChecked(settings.value(QStringLiteral("ghost")).toBool(false));
     // A focus part the scene lacks was dropped without a word (the rest was ghosted around nothing).
-    QStringList missing;
+    QStringList missing, unknown;
     for (const QString& name : focus)
-      if (parts_->findItems(name, Qt::MatchExactly).isEmpty()) missing << QStringLiteral("'%1'").arg(name);
+      if (!labels.contains(name)) missing << QStringLiteral("'%1'").arg(name);
     if (!missing.isEmpty())
       context_.note(tr("ghosting: no part %1 in this scene to focus on").arg(missing.join(QStringLiteral(", "))));
+    for (auto it = ghosted.begin(); it != ghosted.end(); ++it)
+      if (!labels.contains(it.key())) unknown << QStringLiteral("'%1'").arg(it.key());
+    if (!unknown.isEmpty())
+      context_.note(
+          tr("ghosting: ghosted: no part %1 in this scene (left out)").arg(unknown.join(QStringLiteral(", "))));
   }
   applyGhosting();
   showBlendState();

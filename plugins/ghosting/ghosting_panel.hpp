@@ -49,6 +49,7 @@ class GhostingPanel final : public QWidget {
   [[nodiscard]] double diagonal() const;
   [[nodiscard]] double ghostOpacity() const;
   [[nodiscard]] bool isFocus(int objectId) const;
+  [[nodiscard]] QStringList settingNames() const;  // each part's key in focus and ghosted
   [[nodiscard]] QStringList ownParts(const QStringList& names) const;
 
   ViewerContext& context_;

@@ -1246,6 +1246,12 @@ class ViewerTest : public QObject {
     QCOMPARE(QString::fromStdString(mfr::csgText(m.scene().csg, m.scene())),
              QStringLiteral("{\"difference\":[\"block\",\"drill x\"]}"));
 
+    // Settings without "tree" keep the scene's tree (`--plugin-settings csg={}` cleared it: a bug hunt).
+    for (const PluginRecord& r : w->plugins().records())
+      if (r.id == "csg") r.plugin->loadSettings(QJsonObject{});
+    QCOMPARE(QString::fromStdString(mfr::csgText(m.scene().csg, m.scene())),
+             QStringLiteral("{\"difference\":[\"block\",\"drill x\"]}"));
+
     w->findChild<QPushButton*>("csgClear")->click();
     QVERIFY(m.scene().csg.empty());
     QVERIFY(!show->isChecked());
@@ -1382,6 +1388,56 @@ class ViewerTest : public QObject {
   // The Ghosting plugin on @intersect: the blend switch (picking an A-buffer for a method without
   // sorted lists, and back), the thickness slider and spin box driving the frame's z-thickness,
   // ghosting of the parts not in focus (and their opacities back), and its settings in sessions.
+  // Parts of one name keep their own focus and ghosted opacity through saved settings (by the
+  // name alone the second part took the first's), and ghosted values of another type or range,
+  // names the scene lacks and a ghost opacity between the slider's hundredths are notes (taken
+  // without a word: a string read as 0, 5 clamped, 0.025 drawn as 0.03; a bug hunt).
+  void ghostingKeepsPartsOfOneNameApart() {
+    QTemporaryDir dir;
+    const QString scene = dir.filePath("dup.mfrscene");
+    {
+      QFile f(scene);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(R"({"objects": [
+        {"name": "dup", "primitive": {"type": "sphere", "radius": 0.5}, "opacity": 0.8},
+        {"name": "dup", "primitive": {"type": "box", "size": [1, 1, 1]}, "opacity": 0.7,
+         "transform": {"translate": [1.5, 0, 0]}},
+        {"name": "ball", "primitive": {"type": "sphere", "radius": 0.4}, "opacity": 0.9,
+         "transform": {"translate": [-1.5, 0, 0]}}]})");
+    }
+    auto w = openWindow(scene);
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    MfrViewerPlugin* ghosting = nullptr;
+    for (const PluginRecord& r : w->plugins().records())
+      if (r.id == "ghosting") ghosting = r.plugin;
+    QVERIFY(ghosting);
+    QStringList notes;
+    connect(&m, &ViewerContext::noted, this, [&notes](const QString& text) { notes << text; });
+    ghosting->loadSettings(QJsonObject{{"focus", QJsonArray{"dup#1"}}, {"ghost", true}, {"ghost_opacity", 0.2}});
+    QVERIFY2(notes.isEmpty(), qPrintable(notes.join('|')));
+    QVERIFY(std::abs(m.objectOpacity(0) - 0.2) < 1e-6);  // the first "dup": ghosted
+    QVERIFY(std::abs(m.objectOpacity(1) - 0.7) < 1e-6);  // the second: the focus
+    const QJsonObject saved = ghosting->saveSettings();
+    QCOMPARE(saved.value("focus").toArray(), QJsonArray{"dup#1"});
+    const QJsonObject before = saved.value("ghosted").toObject();
+    QCOMPARE(before.keys(), (QStringList{"ball", "dup"}));  // the focus "dup#1" is not ghosted
+    QVERIFY(std::abs(before.value("dup").toDouble() - 0.8) < 1e-6);
+    // The saved settings give the same state again: ghosting off restores each part's own opacity.
+    ghosting->loadSettings(saved);
+    w->findChild<QCheckBox*>("ghostOthers")->setChecked(false);
+    QVERIFY(std::abs(m.objectOpacity(0) - 0.8) < 1e-6);
+    QVERIFY(std::abs(m.objectOpacity(2) - 0.9) < 1e-6);
+    ghosting->loadSettings(QJsonObject{{"focus", QJsonArray{"ball"}},
+                                       {"ghost", true},
+                                       {"ghost_opacity", 0.025},
+                                       {"ghosted", QJsonObject{{"dup", "x"}, {"dup#1", 5}, {"nosuch", 0.5}}}});
+    QCOMPARE(notes, (QStringList{"ghosting: ghost_opacity 0.025 is not a whole hundredth: 0.03 is used",
+                                 "ghosting: ghosted 'dup': expected an opacity in 0 … 1 (left out)",
+                                 "ghosting: ghosted 'dup#1': expected an opacity in 0 … 1 (left out)",
+                                 "ghosting: ghosted: no part 'nosuch' in this scene (left out)"}));
+  }
+
   void ghostingPanel() {
     auto w = openWindow(QStringLiteral("@intersect"));
     QVERIFY(w);
