@@ -488,6 +488,10 @@ int main(int argc, char** argv) {
         if (first.startsWith(r.id + QStringLiteral(": "))) first = first.mid(r.id.size() + 2);
         if (scripted && !first.isEmpty()) fail(QStringLiteral("--plugin-settings %1: %2").arg(r.id, first), 2);
       }
+    // The command line's thickness and step win over the plugins' settings, as over a session's
+    // (a hybridvolume "step" drew instead of --step; a bug hunt).
+    if (cl.thickness > 0.0) model.setZThickness(cl.thickness);
+    if (cl.step > 0.0) model.setVolumeStep(cl.step);
     // --thickness and --step for an operation that does not use them, refused as by mfr render
     // (they were kept for later and drew the same image, with no word that they did nothing).
     // After the plugins' settings, which may show the volume; either side of compare mode may use them.
@@ -543,6 +547,16 @@ int main(int argc, char** argv) {
       }
       poll->stop();
       if (!waiting.exchange(false)) return;  // the watchdog claimed the run and is ending it
+      // A -p value a plugin replaced (the budget panel drives k and refits it after each frame) is
+      // refused: the picture was not the one asked for, exit 0 (a bug hunt).
+      const std::map<std::string, std::string> inForce = model.params();
+      for (const auto& [name, value] : cl.params)
+        if (const auto it = inForce.find(name); it != inForce.end() && it->second != value)
+          fail(
+              QStringLiteral("-p %1=%2: a plugin's settings set %1=%3 in its place (the budget panel drives it); "
+                             "give one of the two")
+                  .arg(QString::fromStdString(name), QString::fromStdString(value), QString::fromStdString(it->second)),
+              2);
       try {
         if (!cl.screenshot.isEmpty()) window.exportImage(cl.screenshot, cl.size, cl.legend);
         if (!cl.windowScreenshot.isEmpty()) {

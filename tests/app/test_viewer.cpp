@@ -998,6 +998,15 @@ class ViewerTest : public QObject {
                                     mfr::readPng(dir.filePath("k2.png").toStdString())) <= 1,
                window);
     }
+    // -p of the parameter the budget drives was replaced by the budget's k, exit 0 (a bug hunt).
+    const QString png = dir.filePath("conflict.png");
+    QCOMPARE(runProgram(MFRVIEW,
+                        {"@sample", "-m", "kplus-array", "-p", "k=7", "--plugin-settings",
+                         R"(budget={"budget_mib":2,"driving":true})", "--size", "320x240", "--screenshot", png},
+                        &out),
+             2);
+    QVERIFY2(out.contains("mfrview: -p k=7: a plugin's settings set k="), qPrintable(out));
+    QVERIFY(!QFile::exists(png));
   }
 
   // `mfrview --screenshot` and `mfr render` with the same scene, view, size and settings.
