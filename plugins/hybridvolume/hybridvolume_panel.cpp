@@ -52,12 +52,23 @@ QJsonObject transferToJson(const mfr::TransferFunction& t) {
   return {{QStringLiteral("unit_distance"), t.unitDistance}, {QStringLiteral("points"), points}};
 }
 
-mfr::TransferFunction transferFromJson(const QJsonObject& json) {
+// A transfer function from settings; `unitDistance` where the key is left out. What is not one
+// (a point of 3 numbers was dropped, a unit distance "x" read as 1: a bug hunt) is named in `error`.
+mfr::TransferFunction transferFromJson(const QJsonObject& json, double unitDistance, QString& error) {
   mfr::TransferFunction t;
-  t.unitDistance = json.value(QStringLiteral("unit_distance")).toDouble(1.0);
-  for (const QJsonValue& v : json.value(QStringLiteral("points")).toArray()) {
-    const QJsonArray p = v.toArray();
-    if (p.size() != 5) continue;
+  t.unitDistance = unitDistance;
+  if (json.contains(QStringLiteral("unit_distance"))) {
+    if (!json.value(QStringLiteral("unit_distance")).isDouble())
+      error = QStringLiteral("unit_distance: expected a number");
+    t.unitDistance = json.value(QStringLiteral("unit_distance")).toDouble();
+  }
+  const QJsonArray points = json.value(QStringLiteral("points")).toArray();
+  for (qsizetype i = 0; i < points.size(); ++i) {
+    const QJsonArray p = points[i].toArray();
+    if (p.size() != 5 || !std::all_of(p.begin(), p.end(), [](const QJsonValue& x) { return x.isDouble(); })) {
+      if (error.isEmpty()) error = QStringLiteral("points[%1]: expected [value, r, g, b, a]").arg(i);
+      continue;
+    }
     t.points.push_back(
         {p[0].toDouble(), glm::vec4(glm::dvec4(p[1].toDouble(), p[2].toDouble(), p[3].toDouble(), p[4].toDouble()))});
   }
@@ -346,6 +357,8 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
 }
 
 double HybridVolumePanel::opacityScale() const {
+  // A loaded scale holds until the slider moves off its step.
+  if (exactScale_ && logPosition(*exactScale_, kMinScale, kMaxScale) == opacity_->value()) return *exactScale_;
   return logAt(opacity_->value(), kMinScale, kMaxScale);
 }
 
@@ -485,6 +498,7 @@ void HybridVolumePanel::resetToCurrent() {
         break;
       }
   }
+  exactScale_.reset();
   opacity_->setValue(logPosition(1.0, kMinScale, kMaxScale));
   showScaleValue();
   showFunction();
@@ -746,14 +760,23 @@ QJsonObject HybridVolumePanel::saveSettings() const {
 }
 
 void HybridVolumePanel::loadSettings(const QJsonObject& settings) {
-  if (!context_.hasScene() || !context_.hasVolume()) return;
-  // The volume the panel showed (absent in sessions of one volume): its controls get the settings.
   // Values taken other than as given are notes (they were defaults or clamps without a word).
   const auto note = [&](const QString& text) { context_.note(QStringLiteral("hybridvolume: ") + text); };
-  const int volume = settings.value(QStringLiteral("volume")).toInt(context_.currentVolume());
+  if (!context_.hasScene()) return;
+  // Settings for a scene without a volume were dropped without a word (a bug hunt).
+  if (!context_.hasVolume()) {
+    if (!settings.isEmpty()) note(tr("the scene has no volume (the settings are left out)"));
+    return;
+  }
+  // The volume the panel showed (absent in sessions of one volume): its controls get the settings.
+  const QJsonValue given = settings.value(QStringLiteral("volume"));
+  const double asked = given.toDouble(context_.currentVolume());
+  const int volume = given.isUndefined() || (given.isDouble() && asked == std::floor(asked) && std::abs(asked) < 1e9)
+                         ? static_cast<int>(asked)
+                         : -1;  // 1.5 was read as the current volume
   if (volume < 0 || volume >= context_.volumeCount())
     note(tr("volume %1: the scene has %2 (volume %3 is shown)")
-             .arg(volume)
+             .arg(given.isDouble() ? QString::number(asked) : QStringLiteral("?"))
              .arg(context_.volumeCount())
              .arg(context_.currentVolume()));
   else
@@ -761,8 +784,12 @@ void HybridVolumePanel::loadSettings(const QJsonObject& settings) {
   volumeChanged();  // this scene's volume (sessions load settings after their own state)
   previousOperation_ = settings.value(QStringLiteral("previous_operation")).toString();
   previousMethod_ = settings.value(QStringLiteral("previous_method")).toString();
-  const mfr::TransferFunction base = transferFromJson(settings.value(QStringLiteral("base")).toObject());
-  if (!context_.transferTable(base).empty())
+  QString baseError;
+  const mfr::TransferFunction base =
+      transferFromJson(settings.value(QStringLiteral("base")).toObject(), base_.unitDistance, baseError);
+  if (!baseError.isEmpty())
+    note(tr("base.%1 (the volume's own function is kept)").arg(baseError));
+  else if (!context_.transferTable(base).empty())
     base_ = base;
   else if (settings.contains(QStringLiteral("base")))
     note(tr("base: not a transfer function the volume can use (the volume's own is kept)"));
@@ -790,6 +817,8 @@ void HybridVolumePanel::loadSettings(const QJsonObject& settings) {
       note(
           tr("opacity_scale %1 is outside %2 … %3 (the nearest end is used)").arg(scale).arg(kMinScale).arg(kMaxScale));
     opacity_->setValue(logPosition(scale, kMinScale, kMaxScale));
+    // Exactly as given, not the slider's nearest step (2 drew as 2.00373; a bug hunt).
+    exactScale_ = std::clamp(scale, kMinScale, kMaxScale);
     showScaleValue();
   }
   applyTransfer();  // the session's own function again (no change), or --plugin-settings' one

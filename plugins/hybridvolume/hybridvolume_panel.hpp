@@ -28,6 +28,8 @@
 #include <QJsonObject>
 #include <QWidget>
 
+#include <optional>
+
 #include "mfr/scene/volume.hpp"
 
 class QCheckBox;
@@ -93,6 +95,7 @@ class HybridVolumePanel final : public QWidget {
   QDoubleSpinBox* windowMin_ = nullptr;
   QDoubleSpinBox* windowMax_ = nullptr;
   QSlider* opacity_ = nullptr;
+  std::optional<double> exactScale_;  // a loaded opacity_scale, kept exact while the slider is at its step
   QCheckBox* shade_ = nullptr;
   QLabel* opacityValue_ = nullptr;
   QLabel* preview_ = nullptr;

@@ -613,8 +613,9 @@ TEST_F(Cli, SettingsOfAnotherOperationAreRefused) {
            {"render @volume -s 16x16 -o " + out + " --contour 0.5 --keep-volume -m fkb",
             "mfr: --keep-volume: this render's operation is hybrid (auto, for fkb); only operation volume draws "
             "the volume\n"},
-           {"probe @volume -s 16x16 --pixel 8,8 --json " + json + " --contour 0.5 --keep-volume --op hybrid",
-            "mfr: --keep-volume: this render's operation is hybrid; only operation volume draws the volume\n"},
+           // (--op hybrid without a method is refused first by probe: it has no split to show.)
+           {"probe @volume -s 16x16 --pixel 8,8 --json " + json + " --contour 0.5 --keep-volume --op oit",
+            "mfr: --keep-volume: this render's operation is oit; only operation volume draws the volume\n"},
            {"bench @volume -s 16x16 -r 1 -m abuffer-ll,kbuffer:op=oit --contour 0.5 --keep-volume --json " + json,
             "mfr: --methods kbuffer:op=oit: --keep-volume: this render's operation is oit; only operation volume "
             "draws the volume\n"}}) {

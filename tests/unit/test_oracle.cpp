@@ -529,6 +529,57 @@ TEST(OracleCountsOnly, SameCountsAndFlagsWithoutFragments) {
 // quads lying in the near and far planes, edge-on triangles, a random soup with huge triangles,
 // a 170° field of view, an orthographic view, a region of the image, and rays that stray from
 // their pixel centres.
+// A ray exactly through a shared edge or vertex hits one of the triangles there, as GL's
+// rasteriser covers such a sample once: with inclusive bounds it hit them all, so a two-triangle
+// square counted 2 fragments on its diagonal and a fan every sliver at its hub (a bug hunt).
+TEST(Oracle, RaysOnSharedEdgesAndVerticesHitOneTriangle) {
+  // The square fills the orthographic view: its diagonal runs through the pixel centres
+  // (i + 0.5, i + 0.5), and its corners' neighbours along the border.
+  Scene square;
+  square.name = "square";
+  addObject(square, makePlane(2.0, 2.0), glm::dmat4(1.0), {0.8f, 0.2f, 0.2f, 0.5f});
+  const FragmentLists a = castFragments(square, frontCamera(Projection::Orthographic, 2.0), 16, 16);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) EXPECT_EQ(a.count(x, y), 1u) << x << "," << y;
+  // A fan of 12 triangles whose hub is the centre pixel's centre, and a plane of 4 by 4 quads
+  // whose inner vertices are pixel centres, both in perspective and orthographic views.
+  Mesh fan;
+  fan.positions.push_back({0.0f, 0.0f, 0.0f});
+  for (int i = 0; i < 12; ++i) {
+    const double t = 2.0 * 3.14159265358979323846 * i / 12;
+    fan.positions.push_back({static_cast<float>(std::cos(t)), static_cast<float>(std::sin(t)), 0.0f});
+  }
+  for (std::uint32_t i = 0; i < 12; ++i) fan.indices.insert(fan.indices.end(), {0u, 1u + i, 1u + (i + 1) % 12});
+  Scene fans;
+  fans.name = "fan";
+  addObject(fans, fan, glm::dmat4(1.0), {0.2f, 0.2f, 0.8f, 0.5f});
+  for (const Projection projection : {Projection::Perspective, Projection::Orthographic}) {
+    const FragmentLists f = castFragments(fans, frontCamera(projection, 8.0), 15, 15);
+    EXPECT_EQ(f.count(7, 7), 1u);
+    EXPECT_EQ(f.maxCount(), 1u);
+  }
+  Mesh grid;
+  for (int j = 0; j <= 4; ++j)
+    for (int i = 0; i <= 4; ++i) grid.positions.push_back({i * 0.5f - 1.0f, j * 0.5f - 1.0f, 0.0f});
+  for (std::uint32_t j = 0; j < 4; ++j)
+    for (std::uint32_t i = 0; i < 4; ++i) {
+      const std::uint32_t c = j * 5 + i;
+      grid.indices.insert(grid.indices.end(), {c, c + 1, c + 6, c, c + 6, c + 5});
+    }
+  Scene quads;
+  quads.name = "quads";
+  addObject(quads, grid, glm::dmat4(1.0), {0.2f, 0.8f, 0.2f, 0.5f});
+  // 15 pixels over 1.875 units: centres at −0.875 + 0.125·i, so the inner vertices and grid lines
+  // (−0.5, 0, 0.5) lie on the centres of pixels 3, 7 and 11.
+  Camera camera = frontCamera(Projection::Orthographic, 2.0 - 0.125);
+  const FragmentLists g = castFragments(quads, camera, 15, 15);
+  EXPECT_EQ(g.maxCount(), 1u);
+  std::size_t covered = 0;
+  for (int y = 0; y < 15; ++y)
+    for (int x = 0; x < 15; ++x) covered += g.count(x, y);
+  EXPECT_EQ(covered, 15u * 15u);
+}
+
 TEST(OracleBroadPhase, BinsGiveTheListsOfTestingEveryTriangle) {
   const auto expectSameLists = [](const FragmentLists& a, const FragmentLists& b) {
     ASSERT_EQ(a.offsets, b.offsets);
@@ -573,8 +624,9 @@ TEST(OracleBroadPhase, BinsGiveTheListsOfTestingEveryTriangle) {
   addObject(fans, fan, translate(0.4, -0.3, 0.0), {0.8f, 0.2f, 0.2f, 0.5f});
   addObject(fans, fan, glm::rotate(glm::dmat4(1.0), glm::radians(70.0), glm::dvec3(1.0, 0.2, 0.0)),
             {0.2f, 0.2f, 0.8f, 0.5f});
-  EXPECT_GT(check("fans, perspective", fans, frontCamera(Projection::Perspective), 61, 47), 2000u);
-  EXPECT_GT(check("fans, orthographic", fans, frontCamera(Projection::Orthographic), 61, 47), 2000u);
+  // (Over 2,000 before the watertight tie rule: a ray through a hub hit its 3,000 slivers.)
+  EXPECT_GT(check("fans, perspective", fans, frontCamera(Projection::Perspective), 61, 47), 1200u);
+  EXPECT_GT(check("fans, orthographic", fans, frontCamera(Projection::Orthographic), 61, 47), 1200u);
   EXPECT_GT(check("fans, a region", fans, frontCamera(Projection::Perspective), 61, 47, PixelRect{20, 10, 17, 9}),
             100u);
 

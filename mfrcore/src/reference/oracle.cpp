@@ -309,22 +309,48 @@ void runParallel(unsigned threads, std::size_t count, std::size_t chunk, const s
   if (failure) std::rethrow_exception(failure);
 }
 
-// Ray/triangle intersection (Möller–Trumbore) in double: ray parameter t and barycentrics (u, v)
-// of p[1] and p[2]. Rays in the triangle's plane count as misses (GL draws edge-on triangles as
-// nothing).
+// Ray/triangle intersection, watertight (Woop, Benthin, Wald, "Watertight Ray/Triangle
+// Intersection", JCGT 2(1) 2013), in double: barycentrics (u, v) of p[1] and p[2]. The vertices
+// are sheared into the ray's frame and the three edge functions are 2D cross products of the
+// same two vertices for every triangle sharing an edge, so a shared edge's value in one is
+// exactly the negation of its value in the other. A ray exactly on an edge or a vertex belongs to
+// the triangle whose edge there passes a fixed tie rule (a top-left rule, as GL's rasteriser has):
+// with Möller–Trumbore's inclusive bounds such a ray hit every triangle there, so a unit cube's
+// front view counted 4 fragments at its corners and a two-triangle plane 2 on its diagonal (a
+// bug hunt). Rays in the triangle's plane count as misses (GL draws edge-on triangles as nothing).
 bool intersect(const glm::dvec3& origin, const glm::dvec3& dir, const WorldTriangle& tri, double& u, double& v) {
-  const glm::dvec3 e1 = tri.p[1] - tri.p[0];
-  const glm::dvec3 e2 = tri.p[2] - tri.p[0];
-  const glm::dvec3 pv = glm::cross(dir, e2);
-  const double det = glm::dot(e1, pv);
-  if (det == 0.0 || !std::isfinite(det)) return false;
-  const double inv = 1.0 / det;
-  const glm::dvec3 tv = origin - tri.p[0];
-  u = glm::dot(tv, pv) * inv;
-  if (u < 0.0 || u > 1.0) return false;
-  const glm::dvec3 qv = glm::cross(tv, e1);
-  v = glm::dot(dir, qv) * inv;
-  return v >= 0.0 && u + v <= 1.0;
+  const glm::dvec3 a = glm::abs(dir);
+  const int kz = a.x >= a.y ? (a.x >= a.z ? 0 : 2) : (a.y >= a.z ? 1 : 2);
+  int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
+  if (dir[kz] < 0.0) std::swap(kx, ky);  // keeps the winding of the sheared triangle
+  if (dir[kz] == 0.0) return false;
+  const double sx = dir[kx] / dir[kz], sy = dir[ky] / dir[kz];
+  glm::dvec2 q[3];
+  for (int i = 0; i < 3; ++i) {
+    const glm::dvec3 r = tri.p[i] - origin;
+    q[i] = {r[kx] - sx * r[kz], r[ky] - sy * r[kz]};
+  }
+  // e[i]: the edge opposite vertex i, from vertex i+1 to vertex i+2.
+  const double e[3] = {q[2].x * q[1].y - q[2].y * q[1].x, q[0].x * q[2].y - q[0].y * q[2].x,
+                       q[1].x * q[0].y - q[1].y * q[0].x};
+  if (!std::isfinite(e[0]) || !std::isfinite(e[1]) || !std::isfinite(e[2])) return false;
+  const bool anyNegative = e[0] < 0.0 || e[1] < 0.0 || e[2] < 0.0;
+  const bool anyPositive = e[0] > 0.0 || e[1] > 0.0 || e[2] > 0.0;
+  if (anyNegative && anyPositive) return false;
+  const double det = e[0] + e[1] + e[2];
+  if (det == 0.0) return false;
+  // On an edge (a zero edge function): the edge's direction, turned so the triangle lies to its
+  // right, must point up, or left when level. Of two triangles on either side of an edge exactly
+  // one passes; at a vertex exactly one of those around it (a consistent infinitesimal shift).
+  const double sign = det > 0.0 ? 1.0 : -1.0;
+  for (int i = 0; i < 3; ++i) {
+    if (e[i] != 0.0) continue;
+    const glm::dvec2 d = sign * (q[(i + 2) % 3] - q[(i + 1) % 3]);
+    if (!(d.y > 0.0 || (d.y == 0.0 && d.x < 0.0))) return false;
+  }
+  u = e[1] / det;
+  v = e[2] / det;
+  return true;
 }
 
 std::uint32_t shade(const WorldTriangle& tri, const ObjectShading& obj, double u, double v,

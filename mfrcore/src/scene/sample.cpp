@@ -184,8 +184,8 @@ Scene makeQuadsScene(int layers, double density, std::uint32_t seed) {
   };
   const double side = 2.0 * std::sqrt(density);  // the view is 2 × 2 world units
   // Four triangles fanned from an off-centre interior point: the two diagonals of a two-triangle
-  // quad would run exactly through pixel centres of a square image and be double-counted by
-  // the oracle's edge rule.
+  // quad would run exactly through pixel centres of a square image, where the oracle's tie rule
+  // and the rasteriser's may pick different triangles (the same surface, a colour's rounding apart).
   auto quad = std::make_shared<const Mesh>([side] {
     Mesh m;
     const float h = static_cast<float>(side / 2);
