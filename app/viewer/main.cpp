@@ -357,12 +357,16 @@ int main(int argc, char** argv) {
   MainWindow window(MainWindow::Options{.restoreSettings = !scripted, .loadPlugins = true});
   ViewerModel& model = window.model();
   for (const auto& [id, settings] : cl.pluginSettings) {
-    QStringList loaded;
-    for (const PluginRecord& r : window.plugins().records())
+    QStringList loaded, failed;
+    for (const PluginRecord& r : window.plugins().records()) {
       if (r.plugin) loaded << r.id;
+      if (!r.plugin && !r.error.isEmpty()) failed << QStringLiteral("%1: %2").arg(r.file, r.error);
+    }
+    // Files that failed to load are named too: a truncated plugin was not mentioned (a bug hunt).
     if (!loaded.contains(id))
-      fail(QStringLiteral("--plugin-settings %1: no plugin of that id is loaded (loaded: %2)")
-               .arg(id, loaded.isEmpty() ? QStringLiteral("none") : loaded.join(QStringLiteral(", "))),
+      fail(QStringLiteral("--plugin-settings %1: no plugin of that id is loaded (loaded: %2%3)")
+               .arg(id, loaded.isEmpty() ? QStringLiteral("none") : loaded.join(QStringLiteral(", ")),
+                    failed.isEmpty() ? QString() : QStringLiteral("; failed: ") + failed.join(QStringLiteral("; "))),
            2);
     for (const PluginRecord& r : window.plugins().records())
       if (r.plugin && r.id == id)

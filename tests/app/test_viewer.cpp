@@ -729,6 +729,27 @@ class ViewerTest : public QObject {
       QVERIFY2(!out.contains(QStringLiteral("note: ")), qPrintable(out));  // one line, not a note and a refusal
       QVERIFY(!QFile::exists(png));
     }
+    // A plugin file that failed to load is named when settings find no plugin of their id (a
+    // truncated plugin was not mentioned: a bug hunt).
+    {
+      const QString folder = dir.filePath(QStringLiteral("junk"));
+      QVERIFY(QDir().mkpath(folder));
+      QFile junk(folder + QStringLiteral("/mfrview_nosuch.so"));
+      QVERIFY(junk.open(QIODevice::WriteOnly));
+      junk.write("not an ELF object");
+      junk.close();
+      const QByteArray before = qgetenv("MFR_PLUGIN_PATH");
+      qputenv("MFR_PLUGIN_PATH", folder.toUtf8());
+      QString out;
+      const int code = runProgram(
+          MFRVIEW, {"@sample", "--size", "32x32", "--screenshot", png, "--plugin-settings", "nosuch={}"}, &out);
+      qputenv("MFR_PLUGIN_PATH", before);
+      QCOMPARE(code, 2);
+      QVERIFY2(out.contains(QStringLiteral("no plugin of that id is loaded (loaded: ")) &&
+                   out.contains(QStringLiteral("; failed: ") + folder + QStringLiteral("/mfrview_nosuch.so: ")),
+               qPrintable(out));
+      QVERIFY(!QFile::exists(png));
+    }
     // --step is checked after the plugins' settings, which may turn the volume on (it was refused
     // though then used: a review); without them, wboit's "oit" does not use it.
     {
