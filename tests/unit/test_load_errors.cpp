@@ -594,6 +594,31 @@ TEST_F(LoadModel, ObjMissingMaterialsAreNoted) {
   EXPECT_TRUE(notes.empty()) << notes.front();
 }
 
+// Material values taken other than as written, and lines and points (no surface), are notes: they
+// were clamped, replaced or dropped without a word (a bug hunt).
+TEST_F(LoadModel, ObjValuesTakenOtherwiseAreNoted) {
+  write("odd.mtl", "newmtl a\nKd nan 0 0\nd 7\nnewmtl b\nKd 0.5 2 0\n");
+  mfr::LoadOptions options;
+  std::vector<std::string> notes;
+  options.notes = &notes;
+  const auto parts = mfr::loadModel(write("odd.obj",
+                                          "mtllib odd.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n"
+                                          "l 1 2\np 1\nf 1 2\nusemtl b\nf 1 3 2\n"),
+                                    options);
+  ASSERT_EQ(parts.size(), 2u);
+  EXPECT_EQ(parts[0].material.color, glm::vec4(0.8f, 0.8f, 0.8f, 1.0f));  // Kd nan ignored, d 7 clamped
+  EXPECT_EQ(parts[1].material.color, glm::vec4(0.5f, 1.0f, 0.0f, 1.0f));
+  ASSERT_EQ(notes.size(), 4u);
+  EXPECT_NE(notes[0].find("odd.obj: odd.mtl: material 'a': 'Kd nan 0 0': not a number (ignored)"), std::string::npos)
+      << notes[0];
+  EXPECT_NE(notes[1].find("material 'a': 'd 7': outside 0 … 1 (clamped)"), std::string::npos) << notes[1];
+  EXPECT_NE(notes[2].find("material 'b': 'Kd 0.5 2 0': outside 0 … 1 (clamped)"), std::string::npos) << notes[2];
+  EXPECT_NE(notes[3].find("odd.obj: 3 line or point elements (l, p, or faces of fewer than 3 corners) are not a "
+                          "surface: left out"),
+            std::string::npos)
+      << notes[3];
+}
+
 // A file whose first triangle is wound against the other eleven: the part keeps the winding most
 // of its triangles have (it was turned inside out: volume −1, near faces drawn as back faces).
 TEST_F(LoadModel, OneReversedFirstTriangleDoesNotTurnThePartInsideOut) {

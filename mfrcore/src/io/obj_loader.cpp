@@ -46,8 +46,11 @@ bool parseInt(std::string_view t, std::int64_t& v) {
 }
 
 // Material colours from .mtl files: Kd, and opacity from d (or 1 − Tr).
-// Empty `why` when read; else why not (the file is then skipped: only colours are lost).
-std::map<std::string, glm::vec4> readMaterials(const fs::path& file, std::string& why) {
+// Empty `why` when read; else why not (the file is then skipped: only colours are lost). A value
+// taken other than as written (outside 0 … 1: clamped; not finite: the default) is in `taken`
+// (`Kd nan` and `d 7` were taken without a word: a bug hunt).
+std::map<std::string, glm::vec4> readMaterials(const fs::path& file, std::string& why,
+                                               std::vector<std::string>& taken) {
   std::map<std::string, glm::vec4> out;
   std::error_code ec;
   why.clear();
@@ -82,15 +85,23 @@ std::map<std::string, glm::vec4> readMaterials(const fs::path& file, std::string
     if (current.empty()) continue;
     glm::vec4& c = out[current];
     double v[3];
-    if (w[0] == "Kd" && w.size() >= 4 && parseDouble(w[1], v[0]) && parseDouble(w[2], v[1]) && parseDouble(w[3], v[2]))
-      c = glm::vec4(glm::clamp(glm::vec3(v[0], v[1], v[2]), 0.0f, 1.0f), c.a);
-    else if (w[0] == "d" && w.size() >= 2 && parseDouble(w.back(), v[0]))
-      c.a = static_cast<float>(std::clamp(v[0], 0.0, 1.0));
-    else if (w[0] == "Tr" && w.size() >= 2 && parseDouble(w.back(), v[0]))
-      c.a = static_cast<float>(1.0 - std::clamp(v[0], 0.0, 1.0));
+    const auto check = [&](const double* values, int n) {
+      const bool finite = std::all_of(values, values + n, [](double x) { return std::isfinite(x); });
+      const bool inRange = std::all_of(values, values + n, [](double x) { return x >= 0.0 && x <= 1.0; });
+      if (!finite || !inRange)
+        taken.push_back("material '" + current + "': '" + line.substr(0, 64) + "'" +
+                        (finite ? ": outside 0 … 1 (clamped)" : ": not a number (ignored)"));
+      return finite;
+    };
+    if (w[0] == "Kd" && w.size() >= 4 && parseDouble(w[1], v[0]) && parseDouble(w[2], v[1]) &&
+        parseDouble(w[3], v[2])) {
+      if (check(v, 3)) c = glm::vec4(glm::clamp(glm::vec3(v[0], v[1], v[2]), 0.0f, 1.0f), c.a);
+    } else if (w[0] == "d" && w.size() >= 2 && parseDouble(w.back(), v[0])) {
+      if (check(v, 1)) c.a = static_cast<float>(std::clamp(v[0], 0.0, 1.0));
+    } else if (w[0] == "Tr" && w.size() >= 2 && parseDouble(w.back(), v[0])) {
+      if (check(v, 1)) c.a = static_cast<float>(1.0 - std::clamp(v[0], 0.0, 1.0));
+    }
   }
-  for (auto& [key, c] : out)
-    if (!std::isfinite(c.r + c.g + c.b + c.a)) c = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
   return out;
 }
 
@@ -115,6 +126,7 @@ std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory,
   std::vector<glm::vec3> normals;
   std::vector<RawPart> parts(1);
   std::map<std::string, std::size_t> partOf{{"", 0}};
+  std::size_t notSurfaces = 0;  // l and p elements, and faces of fewer than 3 corners
   bool libraryNamed = false;  // no mtllib: material names are only names, and no note is due
   bool libraryUnread = false;
   std::size_t current = 0;
@@ -178,7 +190,10 @@ std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory,
         }
         face.push_back({static_cast<std::uint32_t>(vi), ni});
       }
-      if (face.size() < 3) continue;  // points and edges are no surface
+      if (face.size() < 3) {  // points and edges are no surface
+        ++notSurfaces;
+        continue;
+      }
       RawPart& part = parts[current];
       part.corners.insert(part.corners.end(), face.begin(), face.end());
       part.offsets.push_back(static_cast<std::uint32_t>(part.corners.size()));
@@ -194,15 +209,27 @@ std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory,
       libraryNamed = libraryNamed || w.size() > 1;
       for (std::size_t k = 1; k < w.size(); ++k) {
         std::string why;
-        for (auto& [key, c] : readMaterials(directory / std::string(w[k]), why)) materials.emplace(key, c);
+        std::vector<std::string> taken;
+        for (auto& [key, c] : readMaterials(directory / std::string(w[k]), why, taken)) materials.emplace(key, c);
         libraryUnread = libraryUnread || !why.empty();
         if (!why.empty() && notes != nullptr)
           notes->push_back(name + ": material library '" + std::string(w[k]) + "' " + why +
                            " (its materials get the default colour)");
+        if (notes != nullptr)
+          for (const std::string& t : taken) notes->push_back(name + ": " + std::string(w[k]) + ": " + t);
       }
     }
-    // vt, vp, g, o, s, l, p and the free-form statements carry nothing we draw.
+    // vt, vp, g, o, s and the free-form statements carry nothing we draw; l and p are counted.
+    else if (w[0] == "l" || w[0] == "p") {
+      ++notSurfaces;
+    }
   }
+  // Lines and points were dropped without a word (a bug hunt).
+  if (notSurfaces > 0 && notes != nullptr)
+    notes->push_back(name + ": " + std::to_string(notSurfaces) +
+                     (notSurfaces == 1 ? " line or point element (l, p, or a face of fewer than 3 corners) is"
+                                       : " line or point elements (l, p, or faces of fewer than 3 corners) are") +
+                     " not a surface: left out");
 
   std::vector<ObjPart> out;
   std::vector<std::string> undefined;
