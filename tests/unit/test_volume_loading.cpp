@@ -876,6 +876,11 @@ TEST_F(VolumeLoading, BadLegacyMetaImageAndNrrd) {
                           "ObjectType = Image\nNDims = 3\nDimSize = 5000 5000 5000\nElementType = MET_FLOAT\n"
                           "ElementDataFile = LOCAL\n"),
                     "larger than 2048 points per axis");
+  // A size beyond an int was reported as VTK read it (4294967312 as 2147483648; a bug hunt).
+  expectVolumeError(write("beyond.mha",
+                          "ObjectType = Image\nNDims = 3\nDimSize = 4294967312 2 2\nElementType = MET_UCHAR\n"
+                          "ElementDataFile = LOCAL\nxxxx"),
+                    "MetaImage DimSize = 4294967312 2 2: larger than 2048 points per axis");
 
   const std::string nrrd = std::string(kNrrdHeader) + "encoding: raw\n\n";
   expectVolumeError(write("short.nrrd", nrrd + std::string(200, '\0')), "cannot read NRRD");
@@ -890,6 +895,13 @@ TEST_F(VolumeLoading, BadLegacyMetaImageAndNrrd) {
   expectVolumeError(write("nosizes.nrrd", "NRRD0004\ntype: float\ndimension: 3\nspacings: 0 1 1\n\n"),
                     "NRRD header has no 'sizes'");
   expectVolumeError(write("empty-file.nhdr", std::string(kNrrdHeader) + "data file: \n"), "NRRD 'data file' is empty");
+  // A raw data file shorter than the samples: VTK said "File operation failed: 18446744073709551460"
+  // (a bug hunt); a missing one is named too.
+  write("short.raw", std::string(100, '\0'));
+  expectVolumeError(write("short.nhdr", std::string(kNrrdHeader) + "encoding: raw\ndata file: short.raw\n"),
+                    "NRRD data file 'short.raw' holds 100 bytes; the header's sizes and type need 240");
+  expectVolumeError(write("gone.nhdr", std::string(kNrrdHeader) + "encoding: raw\ndata file: gone.raw\n"),
+                    "NRRD data file 'gone.raw': ");
   expectVolumeError(write("pattern.nhdr", std::string(kNrrdHeader) + "data file: slice%s.raw 1 2 1\n"),
                     "NRRD data split into several files is not supported");
   expectVolumeError(write("sizes.nrrd", "NRRD0004\ntype: float\ndimension: 3\nsizes: 10 3\n\n"),

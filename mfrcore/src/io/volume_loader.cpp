@@ -14,6 +14,7 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -58,6 +59,7 @@
 #include "file_checks.hpp"
 #include "invesalius_loader.hpp"
 #include "openvdb_loader.hpp"
+#include "number_text.hpp"
 #include "vtk_loader.hpp"
 
 namespace mfr::io {
@@ -438,7 +440,13 @@ std::optional<glm::dmat3> checkMetaImageHeader(const fs::path& path, const std::
     if (key == "DimSize") {
       std::istringstream sizes(value);
       points = 1;
-      for (double d = 0; sizes >> d;) points *= d > 0 ? d : 0;
+      for (double d = 0; sizes >> d;) {
+        // VTK reads each size as an int: 4294967312 came out as 2147483648 in the message.
+        if (d > VolumeGrid::kMaxPointsPerAxis)
+          throw Error(name, "MetaImage DimSize = " + value.substr(0, 64) + ": larger than " +
+                                std::to_string(VolumeGrid::kMaxPointsPerAxis) + " points per axis");
+        points *= d > 0 ? d : 0;
+      }
     }
     if (key == "TransformMatrix" || key == "Rotation" || key == "Orientation") {
       std::istringstream numbers(value);
@@ -498,6 +506,8 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
   std::vector<double> spacings;
   std::vector<std::string> kinds;
   std::vector<std::optional<glm::dvec3>> directions;
+  std::string type, encoding = "raw", dataFile;
+  long byteSkip = 0;
   while (std::getline(lines, line)) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) break;
@@ -553,13 +563,18 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
       if (origin.size() != 1 || !origin[0])
         throw Error(name, "NRRD 'space origin' must be one vector (x,y,z) (got '" + line.substr(colon + 2) + "')");
     } else if (field == "encoding") {
-      const std::string encoding = tokens.empty() ? std::string() : lower(tokens[0]);
+      encoding = tokens.empty() ? std::string() : lower(tokens[0]);
       if (encoding == "ascii" || encoding == "txt" || encoding == "text")
         throw Error(name, "NRRD with ASCII encoding is not supported (use raw or gzip)");
     } else if (field == "data file" || field == "datafile") {
       if (tokens.empty()) throw Error(name, "NRRD 'data file' is empty");
       if (tokens.size() > 1 || tokens[0] == "LIST")
         throw Error(name, "NRRD data split into several files is not supported");
+      dataFile = line.substr(colon + 2);
+    } else if (field == "type") {
+      type = lower(line.substr(colon + 2));
+    } else if (field == "byte skip" || field == "byteskip") {
+      byteSkip = tokens.empty() ? 0 : std::atol(tokens[0].c_str());
     }
   }
   if (sizes.empty()) throw Error(name, "NRRD header has no 'sizes'");
@@ -585,6 +600,32 @@ NrrdOrientation checkNrrdHeader(const fs::path& path, const std::string& name) {
   // components) and was cut to 32 bits ("4294967301" read as 5).
   for (const long n : sizes)
     if (n > 1000000) throw Error(name, "NRRD 'sizes' value " + std::to_string(n) + " is too large for a volume");
+  // A raw detached data file shorter than the header's samples: VTK said "File operation failed:
+  // 18446744073709551460" (a bug hunt). Its size is checked here, naming both files.
+  if (!dataFile.empty() && encoding == "raw" && byteSkip >= 0) {
+    static const std::map<std::string, std::uint64_t> kTypeBytes{
+        {"float", 4},          {"double", 8},    {"uchar", 1},   {"unsigned char", 1},
+        {"uint8", 1},          {"uint8_t", 1},   {"char", 1},    {"signed char", 1},
+        {"int8", 1},           {"int8_t", 1},    {"short", 2},   {"ushort", 2},
+        {"unsigned short", 2}, {"int16", 2},     {"uint16", 2},  {"int16_t", 2},
+        {"uint16_t", 2},       {"int", 4},       {"uint", 4},    {"unsigned int", 4},
+        {"int32", 4},          {"uint32", 4},    {"int32_t", 4}, {"uint32_t", 4},
+        {"longlong", 8},       {"ulonglong", 8}, {"int64", 8},   {"uint64", 8},
+        {"int64_t", 8},        {"uint64_t", 8}};
+    const auto bytes = kTypeBytes.find(type);
+    if (bytes != kTypeBytes.end()) {
+      double need = static_cast<double>(bytes->second);  // in double: 4 axes of 10^6 pass a uint64
+      for (const long n : sizes) need *= static_cast<double>(std::max(n, 0L));
+      need += static_cast<double>(byteSkip);
+      const fs::path data = dataFile.front() == '/' ? fs::path(dataFile) : path.parent_path() / dataFile;
+      std::error_code ec;
+      const std::uintmax_t have = fs::file_size(data, ec);
+      if (ec) throw Error(name, "NRRD data file '" + dataFile + "': " + ec.message());
+      if (static_cast<double>(have) < need)
+        throw Error(name, "NRRD data file '" + dataFile + "' holds " + std::to_string(have) +
+                              " bytes; the header's sizes and type need " + numberText(need));
+    }
+  }
   const auto spacingOf = [&](std::size_t axis) { return axis < spacings.size() ? spacings[axis] : 1.0; };
   NrrdOrientation::Layout layout;
   if (sizes.size() == 4) {
