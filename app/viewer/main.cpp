@@ -551,18 +551,21 @@ int main(int argc, char** argv) {
       }
       poll->stop();
       if (!waiting.exchange(false)) return;  // the watchdog claimed the run and is ending it
-      // A -p value a plugin replaced (the budget panel drives k and refits it after each frame) is
-      // refused: the picture was not the one asked for, exit 0 (a bug hunt).
-      const std::map<std::string, std::string> inForce = model.params();
-      for (const auto& [name, value] : cl.params)
-        if (const auto it = inForce.find(name); it != inForce.end() && it->second != value)
-          fail(
-              QStringLiteral("-p %1=%2: a plugin's settings set %1=%3 in its place (the budget panel drives it); "
-                             "give one of the two")
-                  .arg(QString::fromStdString(name), QString::fromStdString(value), QString::fromStdString(it->second)),
-              2);
+      // A -p value a plugin replaced (the budget panel drives k and refits it after each frame, and
+      // for an export at its size) is refused: the picture was not the one asked for, exit 0 (a bug
+      // hunt). Checked on the parameters each picture is drawn with.
+      const auto requireGiven = [&](const std::map<std::string, std::string>& inForce) {
+        for (const auto& [name, value] : cl.params)
+          if (const auto it = inForce.find(name); it != inForce.end() && it->second != value)
+            fail(QStringLiteral("-p %1=%2: a plugin's settings set %1=%3 in its place (the budget panel drives it); "
+                                "give one of the two")
+                     .arg(QString::fromStdString(name), QString::fromStdString(value),
+                          QString::fromStdString(it->second)),
+                 2);
+      };
+      if (!cl.windowScreenshot.isEmpty()) requireGiven(model.params());
       try {
-        if (!cl.screenshot.isEmpty()) window.exportImage(cl.screenshot, cl.size, cl.legend);
+        if (!cl.screenshot.isEmpty()) window.exportImage(cl.screenshot, cl.size, cl.legend, requireGiven);
         if (!cl.windowScreenshot.isEmpty()) {
           // Plugins' panels update from the frame's signals; let them paint first.
           QApplication::processEvents();

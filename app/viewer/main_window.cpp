@@ -53,7 +53,7 @@ namespace {
 
 constexpr int kMaxRecentFiles = 10;
 // Renders of an export at most: a plugin's first guess, then refits from what a render measured.
-constexpr int kMaxExportFits = 4;
+constexpr int kMaxExportFits = 6;
 const QString kSessionSuffix = QStringLiteral(".mfrsession");
 
 QString sceneFileFilter() {
@@ -599,7 +599,36 @@ void MainWindow::saveSession(const QString& path) {
   addRecentFile(QFileInfo(path).absoluteFilePath());
 }
 
-void MainWindow::exportImage(const QString& path, QSize size, bool legend) {
+MainWindow::ExportRender MainWindow::renderForExport(QSize size) {
+  // Plugins' parameters for this size (the budget panel's k or pool, fitted to the view's): a
+  // first guess, then a refit from what that render measured, a few times at most.
+  const auto pluginParams = [&](const std::map<std::string, std::string>* tried, const mfr::Stats* measured) {
+    std::map<std::string, std::string> params;
+    for (const PluginRecord& r : plugins_.records())
+      if (r.plugin)
+        for (const auto& [name, value] : r.plugin->exportParams(size, tried, measured)) params[name] = value;
+    return params;
+  };
+  ExportRender render;
+  render.pluginParams = pluginParams(nullptr, nullptr);
+  render.output = view_->renderOutput(size, render.pluginParams);
+  for (int tries = 1; !render.pluginParams.empty(); ++tries) {
+    std::map<std::string, std::string> refit = pluginParams(&render.pluginParams, &render.output.stats);
+    if (refit == render.pluginParams) break;  // the plugins keep what the last render measured
+    // Never a picture the plugins did not settle on (it could be one over the budget).
+    if (tries == kMaxExportFits)
+      throw mfr::Error("export", QStringLiteral("the plugins' parameters for %1x%2 did not settle in %3 renders")
+                                     .arg(size.width())
+                                     .arg(size.height())
+                                     .arg(kMaxExportFits)
+                                     .toStdString());
+    render.pluginParams = std::move(refit);
+    render.output = view_->renderOutput(size, render.pluginParams);
+  }
+  return render;
+}
+
+void MainWindow::exportImage(const QString& path, QSize size, bool legend, const ExportCheck& check) {
   std::optional<ViewerModel::ColorLegend> shown;
   if (legend) {
     // The field colouring's map, else the current volume's isosurfaces' (as mfr render --legend).
@@ -615,24 +644,13 @@ void MainWindow::exportImage(const QString& path, QSize size, bool legend) {
                                        .arg(mfr::kMinLegendImageSize)
                                        .toStdString());
   }
-  // Plugins' parameters for this size (the budget panel's k or pool, fitted to the view's): a
-  // first guess, then a refit from what that render measured, a few times at most.
-  const auto pluginParams = [&](const std::map<std::string, std::string>* tried, const mfr::Stats* measured) {
-    std::map<std::string, std::string> params;
-    for (const PluginRecord& r : plugins_.records())
-      if (r.plugin)
-        for (const auto& [name, value] : r.plugin->exportParams(size, tried, measured)) params[name] = value;
-    return params;
-  };
-  std::map<std::string, std::string> params = pluginParams(nullptr, nullptr);
-  mfr::RenderOutput out = view_->renderOutput(size, params);
-  for (int tries = 1; tries < kMaxExportFits && !params.empty(); ++tries) {
-    std::map<std::string, std::string> refit = pluginParams(&params, &out.stats);
-    if (refit == params) break;
-    params = std::move(refit);
-    out = view_->renderOutput(size, params);
+  ExportRender render = renderForExport(size);
+  if (check) {
+    std::map<std::string, std::string> params = model_->params();
+    for (const auto& [name, value] : render.pluginParams) params[name] = value;
+    check(params);
   }
-  mfr::ImageRGBA8 image = std::move(out.image);
+  mfr::ImageRGBA8 image = std::move(render.output.image);
   if (shown) mfr::drawColorLegend(image, shown->colors, model_->scene().background, shown->ticks);
   mfr::writePng(path.toStdString(), image);
 }

@@ -3,7 +3,10 @@
 // statistics and each plugin; menus for files, sessions, views and plugins.
 #include <QMainWindow>
 
+#include <functional>
+#include <map>
 #include <optional>
+#include <string>
 
 #include "plugin_manager.hpp"
 #include "session.hpp"
@@ -42,7 +45,17 @@ class MainWindow final : public QMainWindow {
   // `legend`, the field colouring's scalar bar — else the current volume's isosurfaces' — drawn
   // into it as mfr render --legend does (throws mfr::Error when there is neither or the image is too
   // small for one).
-  void exportImage(const QString& path, QSize size, bool legend = false);
+  // `check` (if any) sees the parameters the picture is drawn with before it is written.
+  using ExportCheck = std::function<void(const std::map<std::string, std::string>& params)>;
+  void exportImage(const QString& path, QSize size, bool legend = false, const ExportCheck& check = {});
+  // The render exportImage writes: the view's method at `size`, with the plugins' parameters for
+  // that size (MfrViewerPlugin::exportParams), refitted until they settle; throws mfr::Error when
+  // they do not within a few renders.
+  struct ExportRender {
+    mfr::RenderOutput output;
+    std::map<std::string, std::string> pluginParams;
+  };
+  ExportRender renderForExport(QSize size);
 
   [[nodiscard]] ViewerModel& model() { return *model_; }
   [[nodiscard]] RenderView& view() { return *view_; }

@@ -310,7 +310,11 @@ QStringList applySession(const Session& session, ViewerModel& model) {
   const auto drawable = [&](const QString& operation, const QString& key) {
     const mfr::Scene& scene = model.scene();
     QString lacks;
-    if (operation == QLatin1String("csg") && scene.csg.empty()) lacks = QStringLiteral("no CSG tree");
+    // A tree the CSG panel made is in the plugin's settings, loaded after this (a review).
+    const bool treeInSettings =
+        !session.plugins.value(QStringLiteral("csg")).toObject().value(QStringLiteral("tree")).toString().isEmpty();
+    if (operation == QLatin1String("csg") && scene.csg.empty() && !treeInSettings)
+      lacks = QStringLiteral("no CSG tree");
     if (operation == QLatin1String("volume") && scene.volumes.empty()) lacks = QStringLiteral("no volume");
     if (lacks.isEmpty()) return true;
     notes << QStringLiteral("%1: %2: scene '%3' has %4 (left out)")

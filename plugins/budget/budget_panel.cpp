@@ -360,18 +360,36 @@ std::map<std::string, std::string> BudgetPanel::exportParams(QSize size,
   // fitted parameters hold.
   if (!driving_ || (d.knob != Knob::Pool && d.knob != Knob::Slots) || (size == ctx_.imageSize() && !tried)) return {};
   Model m = modelAt(static_cast<double>(size.width()) * size.height());
-  // The last render at this size measured the bytes besides what the parameter buys.
-  if (tried && measured) {
-    const auto given = tried->find(d.knob == Knob::Pool ? std::string("pool_mib") : d.param);
-    if (given != tried->end()) {
-      const double bytes = static_cast<double>(measured->bytesAllocated);
-      if (d.knob == Knob::Pool)
-        m.poolOverhead = bytes - std::stod(given->second) * kMiB;
-      else
-        m.fixed = bytes - m.perSlot * static_cast<double>(std::stoll(given->second));
-    }
+  if (!tried || !measured) {
+    exportTries_.clear();
+    return paramsFor(d, m);
   }
-  return paramsFor(d, m);
+  const auto given = tried->find(d.knob == Knob::Pool ? std::string("pool_mib") : d.param);
+  if (given == tried->end()) return paramsFor(d, m);
+  // The last render at this size measured the bytes besides what the parameter buys. A render
+  // that fits is kept (the same parameters end the tries) unless a larger value fits too.
+  const double budget = budgetMiB() * kMiB;
+  const double bytes = static_cast<double>(measured->bytesAllocated);
+  if (d.knob == Knob::Pool) {
+    // The method rounds the pool to whole nodes: refitting a pool that fits crept by a node a try.
+    if (bytes <= budget) return *tried;
+    m.poolOverhead = bytes - std::stod(given->second) * kMiB;
+    return paramsFor(d, m);
+  }
+  // Slots: at one size the bytes are linear in the value, so two measured renders give the exact
+  // bytes per slot (the view's model may still be its first guess, 8 bytes per pixel and slot:
+  // kpeel's 16 made the tries swing over and under the budget; a review).
+  const long long value = std::stoll(given->second);
+  exportTries_[value] = measured->bytesAllocated;
+  if (exportTries_.size() >= 2) {
+    const auto lo = exportTries_.begin();
+    const auto hi = std::prev(exportTries_.end());
+    m.perSlot = static_cast<double>(hi->second - lo->second) / static_cast<double>(hi->first - lo->first);
+  }
+  m.fixed = bytes - m.perSlot * static_cast<double>(value);
+  std::map<std::string, std::string> next = paramsFor(d, m);
+  if (bytes <= budget && std::stoll(next[d.param]) <= value) return *tried;
+  return next;
 }
 
 void BudgetPanel::frameRendered() {

@@ -105,4 +105,6 @@ class BudgetPanel final : public QWidget {
     std::map<long long, std::uint64_t> bytes; // parameter value → bytes allocated
     double poolOverhead = -1;                 // bytes besides the pool (A-buffers)
   } fit_;
+  // Bytes measured by the renders of one export, by the driven parameter's value (exportParams).
+  mutable std::map<long long, std::uint64_t> exportTries_;
 };

@@ -746,7 +746,24 @@ void HybridVolumePanel::showInfo() {
 
 // ---- settings -------------------------------------------------------------------------------
 
+// What a scene without a volume saves: the same keys and types, fixed values (the panel's state
+// there is whatever the last volume left), so that such a session's settings are recognised as
+// no news when it is opened again.
+QJsonObject HybridVolumePanel::noVolumeSettings() const {
+  return {{QStringLiteral("volume"), -1},
+          {QStringLiteral("show"), false},
+          {QStringLiteral("preset"), preset_->count() > 0 ? preset_->itemData(0).toString() : QString()},
+          {QStringLiteral("window"), QJsonArray{0.0, 1.0}},
+          {QStringLiteral("opacity_scale"), 1.0},
+          {QStringLiteral("shading"), false},
+          {QStringLiteral("base"), transferToJson(mfr::TransferFunction{})},
+          {QStringLiteral("step"), 0.0},
+          {QStringLiteral("previous_operation"), QString()},
+          {QStringLiteral("previous_method"), QString()}};
+}
+
 QJsonObject HybridVolumePanel::saveSettings() const {
+  if (!context_.hasVolume()) return noVolumeSettings();
   return {{QStringLiteral("volume"), context_.currentVolume()},
           {QStringLiteral("show"), show_->isChecked()},
           {QStringLiteral("preset"), preset_->currentData().toString()},
@@ -763,9 +780,13 @@ void HybridVolumePanel::loadSettings(const QJsonObject& settings) {
   // Values taken other than as given are notes (they were defaults or clamps without a word).
   const auto note = [&](const QString& text) { context_.note(QStringLiteral("hybridvolume: ") + text); };
   if (!context_.hasScene()) return;
-  // Settings for a scene without a volume were dropped without a word (a bug hunt).
+  // Settings for a scene without a volume were dropped without a word (a bug hunt); those the
+  // panel itself saves there (its defaults, in every session of such a scene) are no news.
   if (!context_.hasVolume()) {
-    if (!settings.isEmpty()) note(tr("the scene has no volume (the settings are left out)"));
+    const QJsonObject own = noVolumeSettings();
+    bool same = true;
+    for (auto it = settings.begin(); it != settings.end(); ++it) same = same && own.value(it.key()) == it.value();
+    if (!same) note(tr("the scene has no volume (the settings are left out)"));
     return;
   }
   // The volume the panel showed (absent in sessions of one volume): its controls get the settings.

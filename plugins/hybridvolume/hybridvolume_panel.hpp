@@ -57,6 +57,7 @@ class HybridVolumePanel final : public QWidget {
   static constexpr double kMaxStepFactor = 10.0;
 
   explicit HybridVolumePanel(ViewerContext& context, QWidget* parent = nullptr);
+  [[nodiscard]] QJsonObject noVolumeSettings() const;
   [[nodiscard]] QJsonObject saveSettings() const;
   void loadSettings(const QJsonObject& settings);
 

@@ -522,13 +522,6 @@ TEST(OracleCountsOnly, SameCountsAndFlagsWithoutFragments) {
   EXPECT_EQ(depthComplexityHistogram(counted), depthComplexityHistogram(full));
 }
 
-// The broad phase bins each triangle to the pixels near its window polygon; testing every
-// triangle against every ray must give the same lists, bit for bit, and the same flags. The
-// scenes are the cases a bin could miss: a fan of slivers (each a fraction of a pixel wide),
-// triangles reaching behind the eye and past the far plane, a camera inside nested spheres,
-// quads lying in the near and far planes, edge-on triangles, a random soup with huge triangles,
-// a 170° field of view, an orthographic view, a region of the image, and rays that stray from
-// their pixel centres.
 // A ray exactly through a shared edge or vertex hits one of the triangles there, as GL's
 // rasteriser covers such a sample once: with inclusive bounds it hit them all, so a two-triangle
 // square counted 2 fragments on its diagonal and a fan every sliver at its hub (a bug hunt).
@@ -580,6 +573,13 @@ TEST(Oracle, RaysOnSharedEdgesAndVerticesHitOneTriangle) {
   EXPECT_EQ(covered, 15u * 15u);
 }
 
+// The broad phase bins each triangle to the pixels near its window polygon; testing every
+// triangle against every ray must give the same lists, bit for bit, and the same flags. The
+// scenes are the cases a bin could miss: a fan of slivers (each a fraction of a pixel wide),
+// triangles reaching behind the eye and past the far plane, a camera inside nested spheres,
+// quads lying in the near and far planes, edge-on triangles, a random soup with huge triangles,
+// a 170° field of view, an orthographic view, a region of the image, and rays that stray from
+// their pixel centres.
 TEST(OracleBroadPhase, BinsGiveTheListsOfTestingEveryTriangle) {
   const auto expectSameLists = [](const FragmentLists& a, const FragmentLists& b) {
     ASSERT_EQ(a.offsets, b.offsets);

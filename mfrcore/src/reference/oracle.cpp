@@ -338,7 +338,7 @@ bool intersect(const glm::dvec3& origin, const glm::dvec3& dir, const WorldTrian
   const bool anyPositive = e[0] > 0.0 || e[1] > 0.0 || e[2] > 0.0;
   if (anyNegative && anyPositive) return false;
   const double det = e[0] + e[1] + e[2];
-  if (det == 0.0) return false;
+  if (det == 0.0 || !std::isfinite(det)) return false;  // finite parts can sum past a double (a review)
   // On an edge (a zero edge function): the edge's direction, turned so the triangle lies to its
   // right, must point up, or left when level. Of two triangles on either side of an edge exactly
   // one passes; at a vertex exactly one of those around it (a consistent infinitesimal shift).
