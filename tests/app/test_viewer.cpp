@@ -293,6 +293,13 @@ double numberOf(const std::string& note) {
 }
 
 // Runs a program; returns its exit code (output kept for failure messages).
+// The loaded plugin of that id, or null.
+MfrViewerPlugin* loadedPlugin(const MainWindow& window, const QString& id) {
+  for (const PluginRecord& r : window.plugins().records())
+    if (r.plugin && r.id == id) return r.plugin;
+  return nullptr;
+}
+
 int runProgram(const QString& program, const QStringList& args, QString* output) {
   QProcess p;
   p.setProcessChannelMode(QProcess::MergedChannels);
@@ -1056,9 +1063,7 @@ class ViewerTest : public QObject {
     auto w = openWindow();
     QVERIFY(w);
     ViewerModel& m = w->model();
-    MfrViewerPlugin* panel = nullptr;
-    for (const PluginRecord& r : w->plugins().records())
-      if (r.id == "budget") panel = r.plugin;
+    MfrViewerPlugin* panel = loadedPlugin(*w, QStringLiteral("budget"));
     QVERIFY(panel);
     const QSize exportSize(320, 240);
     QVERIFY(m.imageSize() != exportSize);
@@ -1337,8 +1342,9 @@ class ViewerTest : public QObject {
              QStringLiteral("{\"difference\":[\"block\",\"drill x\"]}"));
 
     // Settings without "tree" keep the scene's tree (`--plugin-settings csg={}` cleared it: a bug hunt).
-    for (const PluginRecord& r : w->plugins().records())
-      if (r.id == "csg") r.plugin->loadSettings(QJsonObject{});
+    MfrViewerPlugin* csgPlugin = loadedPlugin(*w, QStringLiteral("csg"));
+    QVERIFY(csgPlugin);
+    csgPlugin->loadSettings(QJsonObject{});
     QCOMPARE(QString::fromStdString(mfr::csgText(m.scene().csg, m.scene())),
              QStringLiteral("{\"difference\":[\"block\",\"drill x\"]}"));
 
@@ -1498,9 +1504,7 @@ class ViewerTest : public QObject {
     auto w = openWindow(scene);
     QVERIFY(w);
     ViewerModel& m = w->model();
-    MfrViewerPlugin* ghosting = nullptr;
-    for (const PluginRecord& r : w->plugins().records())
-      if (r.id == "ghosting") ghosting = r.plugin;
+    MfrViewerPlugin* ghosting = loadedPlugin(*w, QStringLiteral("ghosting"));
     QVERIFY(ghosting);
     QStringList notes;
     connect(&m, &ViewerContext::noted, this, [&notes](const QString& text) { notes << text; });
@@ -1533,9 +1537,7 @@ class ViewerTest : public QObject {
   void volumePanelKeepsTheGivenOpacityScale() {
     auto w = openWindow(QStringLiteral("@volume"));
     QVERIFY(w);
-    MfrViewerPlugin* volume = nullptr;
-    for (const PluginRecord& r : w->plugins().records())
-      if (r.id == "hybridvolume") volume = r.plugin;
+    MfrViewerPlugin* volume = loadedPlugin(*w, QStringLiteral("hybridvolume"));
     QVERIFY(volume);
     const double unit = w->model().scene().volumes[0].transfer.unitDistance;
     for (const double scale : {2.0, 3.0, 0.37}) {
@@ -1698,11 +1700,9 @@ class ViewerTest : public QObject {
       ghost2->setChecked(false);
       for (int i = 0; i < names.size(); ++i)
         QVERIFY(std::abs(a.objectOpacity(i) - (i == ring ? 0.6 : loaded[static_cast<std::size_t>(i)])) < 1e-6);
-      const QJsonObject settings = [&] {
-        for (const PluginRecord& r : again->plugins().records())
-          if (r.id == "ghosting") return r.plugin->saveSettings();
-        return QJsonObject{};
-      }();
+      MfrViewerPlugin* ghosting = loadedPlugin(*again, QStringLiteral("ghosting"));
+      QVERIFY(ghosting);
+      const QJsonObject settings = ghosting->saveSettings();
       QCOMPARE(settings.value("ghost").toBool(true), false);
       QCOMPARE(settings.value("focus").toArray(), QJsonArray{"design"});
     }
