@@ -301,6 +301,17 @@ void BudgetPanel::showQuality() {
   flipLabel_->setText(tr("%1 (max %2)").arg(q.flipMean, 0, 'f', 4).arg(q.flipMax, 0, 'f', 3));
 }
 
+// Bytes per slot from the lowest and highest measured values (bytes are linear in the value at
+// one size), or `fallback` with fewer than two.
+namespace {
+double bytesPerSlot(const std::map<long long, std::uint64_t>& bytes, double fallback) {
+  if (bytes.size() < 2) return fallback;
+  const auto lo = bytes.begin();
+  const auto hi = std::prev(bytes.end());
+  return static_cast<double>(hi->second - lo->second) / static_cast<double>(hi->first - lo->first);
+}
+}  // namespace
+
 BudgetPanel::Model BudgetPanel::modelAt(double pixels) const {
   // Measured at the view's size; per-pixel storage scales with the pixels.
   const double viewPixels = std::max(1.0, static_cast<double>(ctx_.imageSize().width()) * ctx_.imageSize().height());
@@ -309,13 +320,8 @@ BudgetPanel::Model BudgetPanel::modelAt(double pixels) const {
   // Before the first measurement assume 8 bytes per pixel besides the pool (head pointer,
   // counter); the first frame measures the real overhead.
   m.poolOverhead = fit_.poolOverhead >= 0 ? fit_.poolOverhead * scale : 8.0 * pixels;
-  m.perSlot = 8.0 * viewPixels;  // RGBA8 + depth per slot until measured
-  if (fit_.bytes.size() >= 2) {
-    const auto lo = fit_.bytes.begin();
-    const auto hi = std::prev(fit_.bytes.end());
-    m.perSlot = static_cast<double>(hi->second - lo->second) / static_cast<double>(hi->first - lo->first);
-    m.fixed = static_cast<double>(lo->second) - m.perSlot * static_cast<double>(lo->first);
-  } else if (fit_.bytes.size() == 1) {
+  m.perSlot = bytesPerSlot(fit_.bytes, 8.0 * viewPixels);  // RGBA8 + depth per slot until measured
+  if (!fit_.bytes.empty()) {
     m.fixed =
         static_cast<double>(fit_.bytes.begin()->second) - m.perSlot * static_cast<double>(fit_.bytes.begin()->first);
   }
@@ -381,11 +387,7 @@ std::map<std::string, std::string> BudgetPanel::exportParams(QSize size,
   // kpeel's 16 made the tries swing over and under the budget; a review).
   const long long value = std::stoll(given->second);
   exportTries_[value] = measured->bytesAllocated;
-  if (exportTries_.size() >= 2) {
-    const auto lo = exportTries_.begin();
-    const auto hi = std::prev(exportTries_.end());
-    m.perSlot = static_cast<double>(hi->second - lo->second) / static_cast<double>(hi->first - lo->first);
-  }
+  m.perSlot = bytesPerSlot(exportTries_, m.perSlot);
   m.fixed = bytes - m.perSlot * static_cast<double>(value);
   std::map<std::string, std::string> next = paramsFor(d, m);
   if (bytes <= budget && std::stoll(next[d.param]) <= value) return *tried;
