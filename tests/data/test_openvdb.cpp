@@ -207,6 +207,53 @@ TEST_F(OpenVdbFiles, AnyGridOfTheFileCanBeChosen) {
   expectFieldError(points, "pts", "grid 'pts' holds ptdataidx32 values; a volume needs a float, double or vector grid");
 }
 
+// Two grids named "density" (a level set and its fog): each is a field of its own, by the unique
+// names OpenVDB gives them, with a note saying so; the name alone reads the first. Only the first
+// was readable, and OpenVDB's warning about the shared name went to stdout in colour, into the
+// middle of `mfr info`'s report (a bug hunt).
+TEST_F(OpenVdbFiles, GridsSharingANameAreEachReadable) {
+  const fs::path file = make("-sphere radius=1 voxel=0.2 name=density -ls2fog keep=1 name=density", "shared.vdb");
+  const CliResult listing = runCommand("vdb_print '" + file.string() + "'");
+  ASSERT_EQ(listing.exitCode, 0) << listing.out;
+  std::vector<glm::ivec3> printed;  // vdb_print, in the file's order: "density float (min)->(max) NxNxN ..."
+  const std::regex line(R"(density\s+float\s+\([^)]*\)->\([^)]*\)\s+(\d+)x(\d+)x(\d+))");
+  for (auto it = std::sregex_iterator(listing.out.begin(), listing.out.end(), line); it != std::sregex_iterator(); ++it)
+    printed.emplace_back(std::stoi((*it)[1]), std::stoi((*it)[2]), std::stoi((*it)[3]));
+  ASSERT_EQ(printed.size(), 2u) << listing.out;
+  ASSERT_NE(printed[0], printed[1]) << "the test needs two grids of different sizes";
+
+  const Scene scene = loadScene(file);
+  ASSERT_EQ(scene.volumes.size(), 1u);
+  const std::vector<std::string> fields = scene.volumes[0].fields;
+  ASSERT_EQ(fields.size(), 2u);
+  EXPECT_NE(fields[0], fields[1]);
+  EXPECT_EQ(fields[1], "density[1]");
+  EXPECT_EQ(scene.volumes[0].field, fields[0]);
+  EXPECT_EQ(scene.volumes[0].grid->dims, printed[0]);
+  ASSERT_EQ(scene.notes.size(), 1u);
+  EXPECT_EQ(scene.notes[0], file.string() + ": 2 grids are named 'density'; they are fields '" + fields[0] + "', '" +
+                                fields[1] + "' in the file's order");
+  for (std::size_t i = 0; i < 2; ++i) {
+    SCOPED_TRACE(fields[i]);
+    const Volume v = loadVolume(file, LoadOptions{fields[i]});
+    EXPECT_EQ(v.field, fields[i]);
+    EXPECT_EQ(v.grid->dims, printed[i]);
+  }
+  EXPECT_EQ(loadVolume(file, LoadOptions{"density"}).grid->dims, printed[0]);
+
+  // Nothing of OpenVDB's on stdout: the report is mfr's alone, the note on stderr.
+  const CliResult out =
+      runCommand("(" + std::string(MFR_CLI) + " info '" + file.string() + "' --no-histogram 2>/dev/null)");
+  ASSERT_EQ(out.exitCode, 0) << out.out;
+  EXPECT_EQ(out.out.rfind("scene ", 0), 0u) << out.out;
+  EXPECT_EQ(out.out.find("OpenVDB"), std::string::npos) << out.out;
+  EXPECT_EQ(out.out.find('\x1b'), std::string::npos) << out.out;
+  const CliResult all = runCli("info '" + file.string() + "' --field 'density[1]' --no-histogram");
+  ASSERT_EQ(all.exitCode, 0) << all.out;
+  EXPECT_NE(all.out.find("note: " + scene.notes[0]), std::string::npos) << all.out;
+  EXPECT_NE(all.out.find("[density[1]] (" + std::to_string(printed[1].x) + "x"), std::string::npos) << all.out;
+}
+
 TEST_F(OpenVdbFiles, BadFilesAreOneLineErrors) {
   const auto expectError = [](const fs::path& path, const std::string& reason) {
     expectFileError(path, reason,

@@ -102,9 +102,11 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
       scene = io::loadInvesaliusScene(path, progress);
     } else {
       scene.name = path.filename().string();
-      if (isVolumeFile(path))
-        scene.volumes.push_back(loadVolume(path, options, progress));
-      else {
+      if (isVolumeFile(path)) {
+        LoadOptions volume = options;
+        volume.notes = &scene.notes;
+        scene.volumes.push_back(loadVolume(path, volume, progress));
+      } else {
         LoadOptions model{{}, options.molecule};
         model.notes = &scene.notes;
         scene.objects = loadModel(path, model, progress);

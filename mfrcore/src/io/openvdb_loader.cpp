@@ -5,9 +5,14 @@
 #include <cstdint>
 #include <exception>
 #include <fstream>
+#include <iostream>
+#include <map>
 #include <mutex>
 #include <new>
 
+#include <log4cplus/appender.h>
+#include <log4cplus/logger.h>
+#include <log4cplus/spi/loggingevent.h>
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
@@ -19,6 +24,50 @@ namespace mfr::io {
 namespace {
 
 namespace fs = std::filesystem;
+
+// Where OpenVDB's log messages go while this thread reads a file: the load's notes; none: stderr.
+thread_local std::vector<std::string>* openVdbMessages = nullptr;
+
+// OpenVDB logs through log4cplus, and openvdb::initialize() gives its logger a console appender on
+// stdout, in colour: a warning landed in the middle of `mfr info`'s report and would have in a PNG
+// written to stdout (a bug hunt). Its messages are notes of the load instead.
+class OpenVdbMessages : public log4cplus::Appender {
+ public:
+  OpenVdbMessages() = default;
+  OpenVdbMessages(const OpenVdbMessages&) = delete;
+  OpenVdbMessages& operator=(const OpenVdbMessages&) = delete;
+  ~OpenVdbMessages() override { destructorImpl(); }
+  void close() override { closed = true; }
+
+ protected:
+  void append(const log4cplus::spi::InternalLoggingEvent& event) override {
+    const std::string message = "OpenVDB: " + event.getMessage();
+    if (openVdbMessages)
+      openVdbMessages->push_back(message);
+    else
+      std::cerr << message << "\n";
+  }
+};
+
+void initializeOpenVdb() {
+  openvdb::initialize();
+  log4cplus::Logger logger = log4cplus::Logger::getInstance("openvdb");
+  logger.removeAllAppenders();
+  logger.setAdditivity(false);
+  logger.addAppender(log4cplus::SharedAppenderPtr(new OpenVdbMessages));
+}
+
+// Sets where this thread's OpenVDB messages go until the end of the scope.
+class OpenVdbMessagesTo {
+ public:
+  explicit OpenVdbMessagesTo(std::vector<std::string>* sink) : previous_(openVdbMessages) { openVdbMessages = sink; }
+  OpenVdbMessagesTo(const OpenVdbMessagesTo&) = delete;
+  OpenVdbMessagesTo& operator=(const OpenVdbMessagesTo&) = delete;
+  ~OpenVdbMessagesTo() { openVdbMessages = previous_; }
+
+ private:
+  std::vector<std::string>* previous_;
+};
 
 // An OpenVDB file starts with the 64-bit magic number 0x56444220 ("VDB " as little-endian bytes).
 void checkMagic(const fs::path& path, const std::string& name) {
@@ -67,10 +116,11 @@ void copyDense(const GridT& grid, const openvdb::CoordBBox& box, std::vector<flo
 }  // namespace
 
 Volume readOpenVdb(const fs::path& path, const std::string& name, const std::string& field,
-                   const LoadProgress& progress) {
+                   const LoadProgress& progress, std::vector<std::string>* notes) {
   static std::once_flag initialized;
-  std::call_once(initialized, [] { openvdb::initialize(); });
+  std::call_once(initialized, initializeOpenVdb);
   checkMagic(path, name);
+  const OpenVdbMessagesTo messages(notes);
 
   // OpenVDB does not check its reads: a truncated file hands it garbage sizes, which ended as
   // "out of memory" (at 93 MB used) or another reason each run. What it throws is said as what it
@@ -89,25 +139,37 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
     file.open(false);  // no delayed loading: the file is read now, not when voxels are touched
     return file.readAllGridMetadata();
   });
+  // Grids that share a name are told apart as OpenVDB does, by the unique names the file gives them
+  // ("density[0]", "density[1]", … or "density", "density[1]", …; in the headers' order); the name
+  // alone picks the first of them. Only the first was readable before (a bug hunt).
+  std::vector<std::string> labels;
+  for (auto it = file.beginName(); it != file.endName() && labels.size() < headers->size(); ++it)
+    labels.push_back(it.gridName());
+  std::map<std::string, std::vector<std::string>> sharing;  // the labels of each name
+  for (std::size_t i = 0; i < headers->size(); ++i)
+    sharing[(*headers)[i]->getName()].push_back(i < labels.size() ? labels[i] : (*headers)[i]->getName());
   // The grid read: the one named `field`; else "density" if the file has that scalar grid, else its
   // first scalar grid, else the magnitude of its first vector grid.
   std::string chosen, list;
   std::vector<std::string> readable;
   int rank = 0;  // of the chosen grid: 3 density, 2 scalar, 1 vector, 0 none
-  for (const openvdb::GridBase::Ptr& g : *headers) {
-    list += (list.empty() ? "" : ", ") + g->getName() + " (" + g->valueType() + ")";
-    const int r = scalar(*g) ? (g->getName() == "density" ? 3 : 2) : vectorValued(*g) ? 1 : 0;
-    if (r > 0) readable.push_back(g->getName());
+  for (std::size_t i = 0; i < headers->size(); ++i) {
+    const openvdb::GridBase& g = *(*headers)[i];
+    const std::string label = i < labels.size() ? labels[i] : g.getName();
+    list += (list.empty() ? "" : ", ") + label + " (" + g.valueType() + ")";
+    const int r = scalar(g) ? (g.getName() == "density" ? 3 : 2) : vectorValued(g) ? 1 : 0;
+    if (r > 0) readable.push_back(label);
     if (!field.empty()) {
-      if (g->getName() != field || !chosen.empty()) continue;
+      const bool named = label == field || (g.getName() == field && sharing[field].front() == label);
+      if (!named || !chosen.empty()) continue;
       if (r == 0)
-        throw FieldNotFound(name, "grid '" + field + "' holds " + g->valueType() +
+        throw FieldNotFound(name, "grid '" + field + "' holds " + g.valueType() +
                                       " values; a volume needs a float, double or vector grid");
-      chosen = field;
+      chosen = label;
       rank = r;
     } else if (r > rank) {
       rank = r;
-      chosen = g->getName();
+      chosen = label;
     }
   }
   if (!field.empty() && chosen.empty())
@@ -116,8 +178,23 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
   // A valid file may hold no grid; a file cut after its header reads the same way.
   if (headers->empty()) throw Error(name, "the file has no grids (or is truncated)");
   if (rank == 0) throw Error(name, "no float, double or vector grid in the file (it has " + list + ")");
+  if (notes) {
+    for (const auto& [grid, named] : sharing) {
+      if (named.size() < 2) continue;
+      std::string fields;
+      for (const std::string& label : named) fields += (fields.empty() ? "'" : ", '") + label + "'";
+      notes->push_back(name + ": " + std::to_string(named.size()) + " grids are named '" + grid +
+                       "'; they are fields " + fields + " in the file's order");
+    }
+  }
   progress.step(0.1);
-  const openvdb::GridBase::Ptr base = reading([&] { return file.readGrid(chosen); });
+  const openvdb::GridBase::Ptr base = [&] {
+    // Reading the first of several grids of one name makes OpenVDB warn that the name is shared;
+    // the note above says so with the names that pick the others.
+    std::vector<std::string> shared;
+    const OpenVdbMessagesTo dropped(sharing.count(chosen) && sharing[chosen].size() > 1 ? &shared : notes);
+    return reading([&] { return file.readGrid(chosen); });
+  }();
   file.close();
   progress.step(0.5);
 

@@ -1301,7 +1301,7 @@ Volume loadVolume(const std::filesystem::path& path, const LoadOptions& options,
         volume = io::readInvesaliusProject(path, name, false, progress).volume;
         break;
       case io::VolumeFormat::OpenVdb:
-        volume = io::readOpenVdb(path, name, options.field, progress);
+        volume = io::readOpenVdb(path, name, options.field, progress, options.notes);
         break;
       default:
         volume = io::readVolumeWithVtk(*format, path, name, options.field, progress);

@@ -389,7 +389,7 @@ TransferFunction parseTransfer(const Reader& r, const json& t, const std::string
 }
 
 Volume parseVolume(const Reader& r, const json& j, const std::string& where, const std::filesystem::path& baseDir,
-                   const LoadProgress& progress) {
+                   std::vector<std::string>& notes, const LoadProgress& progress) {
   const json& v =
       r.object(j, where, {"file", "name", "transform", "visible", "shading", "field", "transfer", "contours"});
   if (!v.contains("file")) r.fail(where, "needs 'file' (a volume file)");
@@ -403,6 +403,7 @@ Volume parseVolume(const Reader& r, const json& j, const std::string& where, con
     options.field = r.string(v, "field", where, "");
     if (options.field.empty()) r.fail(where + ".field", "expected the name of an array or grid of the file");
   }
+  options.notes = &notes;
   Volume volume;
   try {
     volume = loadVolume(baseDir / file, options, progress);  // its errors name the volume file
@@ -694,7 +695,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     const std::size_t firstVolume = scene.volumes.size();
     for (std::size_t i = 0; i < volumes.size(); ++i) {
       const std::string where = "volumes[" + std::to_string(i) + "]";
-      Volume volume = parseVolume(r, volumes[i], where, baseDir, itemProgress(objectCount + i));
+      Volume volume = parseVolume(r, volumes[i], where, baseDir, scene.notes, itemProgress(objectCount + i));
       if (volume.visible && scene.visibleVolumes().size() >= Scene::kMaxVisibleVolumes)
         r.fail(where + ".visible", std::to_string(Scene::kMaxVisibleVolumes) +
                                        " volumes are visible already: at most that many can be drawn at once "
