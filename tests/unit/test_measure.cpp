@@ -23,6 +23,14 @@ TEST(SurfaceMeasure, BoxUnderAPlacementHasItsAreaAndVolume) {
   EXPECT_EQ(m.boundaryEdges, 0u);
   EXPECT_NEAR(m.area, 2.0 * (2 * 3 + 2 * 4 + 3 * 4), 1e-9);
   EXPECT_NEAR(m.volume, 24.0, 1e-9);  // the translation does not change it
+  // Nor does one far from the origin: summed about the origin, the tetrahedra's large terms
+  // cancelled, and a box at 10⁸ measured 4·10⁸ (a bug hunt).
+  for (const double far : {1e8, 1e12, -5.4e6}) {
+    SCOPED_TRACE(far);
+    const SurfaceMeasures away = measureSurface(box, glm::translate(place, glm::dvec3(far, far, 0.5 * far)));
+    EXPECT_NEAR(away.volume, 24.0, 1e-9);
+    EXPECT_NEAR(away.area, m.area, 1e-9);
+  }
   // A mirror keeps the part's own sign.
   const SurfaceMeasures mirrored = measureSurface(box, glm::scale(glm::dmat4(1.0), glm::dvec3(-1, 1, 1)));
   EXPECT_TRUE(mirrored.closed());
