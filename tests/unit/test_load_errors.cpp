@@ -660,6 +660,36 @@ TEST_F(LoadModel, AsciiPlyWithColors) {
                  static_cast<int>(std::lround(c.b * 255)), static_cast<int>(std::lround(c.a * 255))});
   EXPECT_EQ(seen,
             (std::set<std::vector<int>>{{255, 0, 0, 255}, {0, 255, 0, 255}, {0, 0, 255, 255}, {255, 255, 255, 51}}));
+  // The file's colours are the part's: its material is white (with the default opacity), not the light
+  // grey of a part without colours, which tinted them (pure red drew 204; a bug hunt).
+  EXPECT_EQ(objects[0].material.color, glm::vec4(1.0f, 1.0f, 1.0f, mfr::Material{}.color.a));
+  EXPECT_TRUE(objects[0].material.vertexColors);
+}
+
+// The same for the other formats with per-vertex colours; an OBJ material's Kd still tints them.
+TEST_F(LoadModel, VertexColoursAreNotTintedByTheDefaultGrey) {
+  const glm::vec4 white(1.0f, 1.0f, 1.0f, mfr::Material{}.color.a);
+  const std::string off = "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 255 0 0 255\n0 1 0 255 0 0 255\n3 0 1 2\n";
+  const std::string obj = "v 0 0 0 1 0 0\nv 1 0 0 1 0 0\nv 0 1 0 1 0 0\nf 1 2 3\n";
+  const std::string vtk =
+      "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+      "POLYGONS 1 4\n3 0 1 2\nPOINT_DATA 3\nCOLOR_SCALARS rgb 3\n1 0 0\n1 0 0\n1 0 0\n";
+  for (const auto& [name, text] :
+       std::vector<std::pair<std::string, std::string>>{{"red.off", off}, {"red.obj", obj}, {"red.vtk", vtk}}) {
+    SCOPED_TRACE(name);
+    const auto objects = mfr::loadModel(write(name, text));
+    ASSERT_EQ(objects.size(), 1u);
+    ASSERT_FALSE(objects[0].mesh->colors.empty());
+    EXPECT_EQ(objects[0].material.color, white);
+  }
+  // Without colours: the light grey.
+  EXPECT_EQ(mfr::loadModel(write("plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"))[0].material.color,
+            mfr::Material{}.color);
+  // An .mtl's Kd is the part's colour, and tints the vertex colours.
+  write("tint.mtl", "newmtl half\nKd 0.5 0.5 0.5\n");
+  const auto tinted = mfr::loadModel(write("tint.obj", "mtllib tint.mtl\nusemtl half\n" + obj));
+  ASSERT_EQ(tinted.size(), 1u);
+  EXPECT_EQ(glm::vec3(tinted[0].material.color), glm::vec3(0.5f));
 }
 
 TEST_F(LoadModel, BinaryBigEndianPly) {

@@ -124,10 +124,18 @@ std::string decompress(const fs::path& path, const std::string& name) {
   return out;
 }
 
+// A file's per-vertex colours are the part's colours ("the file's colours", docs/scene-format.md):
+// its material is white, keeping the default opacity, so that they are not tinted by the light grey
+// of parts without colours (pure red came out 204, a bug hunt).
+void takeVertexColours(Object& object) {
+  if (!object.mesh->colors.empty()) object.material.color = glm::vec4(1.0f, 1.0f, 1.0f, object.material.color.a);
+}
+
 std::vector<Object> singleObject(Mesh mesh, const std::string& partName) {
   Object object;
   object.name = partName;
   object.mesh = std::make_shared<const Mesh>(std::move(mesh));
+  takeVertexColours(object);
   return {std::move(object)};
 }
 
@@ -192,7 +200,10 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
                       : part.material.empty()                    ? stem + " (no material)"
                                                                  : part.material;
         object.mesh = std::make_shared<const Mesh>(io::meshFromSoup(part.soup, name));
-        if (part.color) object.material.color = *part.color;
+        if (part.color)
+          object.material.color = *part.color;  // a material's Kd tints the vertex colours, as OBJ viewers draw them
+        else
+          takeVertexColours(object);
         objects.push_back(std::move(object));
       }
       return objects;
