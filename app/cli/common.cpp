@@ -331,6 +331,8 @@ void ColorByOptions::apply(Scene& scene) const {
     if (!low || !high || !(*high > *low)) throw Error("--color-range " + range, "expected LO,HI with LO < HI");
     values = glm::dvec2(*low, *high);
   }
+  if (const std::optional<std::string> why = ambiguousVolumeField(scene, field))
+    throw Error("--color-by " + field, *why);
   std::vector<Object*> objects;
   for (Object& o : scene.objects) objects.push_back(&o);
   try {

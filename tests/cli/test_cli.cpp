@@ -67,6 +67,9 @@ TEST_F(Cli, SceneFileFlagsAndHugeNumbersNameTheFileAndKey) {
   const std::string sphere = R"({"primitive": {"type": "sphere"})";
   for (const auto& [json, mention] : std::vector<std::pair<std::string, std::string>>{
            {R"({"sample": "yes"})", "sample: expected true or false"},  // not "top level.sample"
+           // The whole scene's faults name the file, not the scene's "name" (a bug hunt).
+           {R"({"name": "engine study", "objects": [{"primitive": {"type": "sphere", "radius": 1e-31}}]})",
+            "is 3.4641e-31 across, below 1e-30"},
            // Views the renderers refused at the first frame without naming the file or the view.
            {R"({"objects": [)" + sphere + R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "up": [0, 0, 0]}]})",
             "views[0].up: must not be zero"},
@@ -130,7 +133,19 @@ TEST_F(Cli, SceneFileKeysThatMeanNothingAreRefused) {
            {R"({"objects": [)" + sphere + R"(}], "section": {"point": [0, 0, 0], "normal": [0, 0, 1], "cap": false}})",
             "section.cap: unknown key (expected point, normal, caps, slice)"},
            {R"({"objects": [)" + sphere + R"(, "color_by": {"field": "x", "colormap": "magma"}}]})",
-            "objects[0].color_by.colormap: unknown key (expected field, map, range)"}}) {
+            "objects[0].color_by.colormap: unknown key (expected field, map, range)"},
+           // A key given twice: the last was taken, and a second "objects" dropped the first array
+           // without a word (a bug hunt).
+           {R"({"objects": [)" + sphere + R"(}], "objects": [{"primitive": {"type": "box"}}]})",
+            "objects: given twice (the keys of a JSON object must differ)"},
+           {R"({"objects": [)" + sphere + "}, " + sphere + R"(, "opacity": 0.2, "opacity": 0.9}]})",
+            "objects[1].opacity: given twice"},
+           {R"({"objects": [)" + sphere + R"(, "transform": {"translate": [1, 0, 0], "translate": [2, 0, 0]}}]})",
+            "objects[0].transform.translate: given twice"},
+           {R"({"objects": [)" + sphere +
+                R"(}], "views": [{"name": "a", "eye": [0, 0, 5]}, [], )"
+                R"({"name": "b", "eye": [0, 0, 5], "up": [0, 1, 0], "up": [1, 0, 0]}]})",
+            "views[2].up: given twice"}}) {
     SCOPED_TRACE(json);
     const fs::path p = write("keys.mfrscene", json);
     expectCleanFailure("render " + p.string() + " --size 16x16", "keys.mfrscene: " + mention);
@@ -268,9 +283,9 @@ TEST_F(Cli, ModelsBeyondSinglePrecisionAreRefused) {
                  fine = triangle("fine.ply", "1e14");
   for (const char* method : {"oracle", "abuffer-ll"}) {
     expectCleanFailure("render " + huge.string() + " -s 16x16 -m " + method,
-                       "scene 'huge.ply': reaches beyond ±1e15 (to 1e+33): too far out to be drawn");
+                       huge.string() + ": reaches beyond ±1e15 (to 1e+33): too far out to be drawn");
     expectCleanFailure("render " + tiny.string() + " -s 16x16 -m " + method,
-                       "scene 'tiny.ply': is 1.41421e-38 across, below 1e-30: too small to be drawn");
+                       tiny.string() + ": is 1.41421e-38 across, below 1e-30: too small to be drawn");
   }
   const fs::path png = dir() / "fine.png";
   EXPECT_EQ(runCli("render " + fine.string() + " -s 16x16 -m abuffer-ll -o " + png.string()).exitCode, 0);
@@ -742,10 +757,16 @@ TEST_F(Cli, InfoListsMethodsWithTheirParameters) {
 TEST_F(Cli, InfoMeasuresEachPartsSurface) {
   const fs::path scene = write("m.mfrscene", R"({"objects": [
     {"name": "brick", "primitive": {"type": "box", "size": [1, 2, 3]}, "transform": {"scale": [2, 1, 1]}},
-    {"name": "sheet", "primitive": {"type": "plane", "width": 2, "height": 1}}]})");
+    {"name": "sheet", "primitive": {"type": "plane", "width": 2, "height": 1}},
+    {"name": "ghost", "primitive": {"type": "sphere"}, "visible": false}]})");
   const fs::path json = dir() / "info.json";
   const CliResult r = runCli("info " + scene.string() + " --no-histogram --json " + json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
+  // A hidden part is listed as hidden, and the total says it counts the visible parts (the list and
+  // the total disagreed without a word; a bug hunt).
+  EXPECT_NE(r.out.find("parts      3 (1 hidden)\ntriangles  14 (of the visible parts)\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(" 0.5, hidden)\n"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("brick (12 triangles, rgba 0.8 0.8 0.8 0.5, hidden"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("area 32, closed, volume 12\n"), std::string::npos) << r.out;  // 2 × 2 × 3
   EXPECT_NE(r.out.find("area 2, not closed (4 boundary edges): no enclosed volume"), std::string::npos) << r.out;
   std::ifstream in(json);
@@ -756,6 +777,8 @@ TEST_F(Cli, InfoMeasuresEachPartsSurface) {
   EXPECT_EQ(j["part_list"][1]["closed"], false);
   EXPECT_TRUE(j["part_list"][1]["volume"].is_null());
   EXPECT_EQ(j["part_list"][1]["boundary_edges"], 4);
+  EXPECT_EQ(j["part_list"][1]["visible"], true);
+  EXPECT_EQ(j["part_list"][2]["visible"], false);
   // With --contour, the isosurfaces are measured too.
   const CliResult c = runCli("info @volume --no-histogram --contour 0.5");
   ASSERT_EQ(c.exitCode, 0) << c.out;

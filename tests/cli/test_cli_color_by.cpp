@@ -255,6 +255,23 @@ TEST_F(CliColorBy, BadFieldsMapsAndRangesAreOneLine) {
       runCli("render " + grid.string() + " --size 16x16 --opacity 0.5 --contour 0.5 -o " + (dir() / "c.png").string())
           .exitCode,
       0);
+  // One file listed twice without names: "@grid.vtk" could mean either volume, and meant the first
+  // without a word (a bug hunt); named, each is its own field.
+  const std::string twice =
+      R"({"volumes": [{"file": "grid.vtk"}, {"file": "grid.vtk", "transform": {"translate": [5, 0, 0]}}],
+      "objects": [{"primitive": {"type": "sphere", "radius": 0.3}, "transform": {"translate": [5.5, 0.5, 0.5]})";
+  const fs::path ambiguous = write("twice.mfrscene", twice + R"(, "color_by": "@grid.vtk"}]})");
+  expectCleanFailure("render " + ambiguous.string() + " --size 16x16",
+                     "objects[0].color_by: '@grid.vtk' is the field of 2 volumes (give them names");
+  const fs::path uncoloured = write("plain.mfrscene", twice + "}]}");
+  expectCleanFailure("render " + uncoloured.string() + " --size 16x16 --color-by @grid.vtk",
+                     "--color-by @grid.vtk: '@grid.vtk' is the field of 2 volumes");
+  const fs::path named = write("named.mfrscene", R"({"volumes": [{"file": "grid.vtk", "name": "a"},
+      {"file": "grid.vtk", "name": "b", "transform": {"translate": [5, 0, 0]}}],
+      "objects": [{"primitive": {"type": "sphere", "radius": 0.3}, "transform": {"translate": [5.5, 0.5, 0.5]},
+      "color_by": "@b"}]})");
+  const CliResult ok = runCli("render " + named.string() + " --size 16x16 -o " + (dir() / "n.png").string());
+  EXPECT_EQ(ok.exitCode, 0) << ok.out;
 }
 
 }  // namespace

@@ -114,7 +114,15 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
     }
     for (const char* standard : {"front", "iso"}) scene.views.push_back({standard, *scene.standardView(standard)});
   }
-  scene.validate();
+  // The whole scene's faults name the file it came from: they named the scene's "name", which a
+  // scene file may set to anything ("scene 'engine study': is 3.4641e-31 across…", a bug hunt).
+  try {
+    scene.validate();
+  } catch (const Error& e) {
+    const std::string prefix = "scene '" + scene.name + "': ", what = e.what();
+    if (what.rfind(prefix, 0) != 0) throw;
+    throw Error(text, what.substr(prefix.size()));
+  }
   return scene;
 }
 

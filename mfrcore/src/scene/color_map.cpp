@@ -278,6 +278,14 @@ std::string volumeFieldName(const Scene& scene, std::size_t v) {
   return "@" + (volume.name.empty() ? "volume " + std::to_string(v) : volume.name);
 }
 
+std::optional<std::string> ambiguousVolumeField(const Scene& scene, const std::string& field) {
+  std::size_t named = 0;
+  for (std::size_t v = 0; v < scene.volumes.size(); ++v) named += volumeFieldName(scene, v) == field;
+  if (named < 2) return std::nullopt;
+  return "'" + field + "' is the field of " + std::to_string(named) +
+         " volumes (give them names to tell them apart; it meant the first)";
+}
+
 std::optional<VolumeFieldSampler> volumeFieldSampler(const Scene& scene, const Object& object) {
   const std::optional<FieldColors>& field = object.material.fieldColors;
   if (!field || field->field.empty() || field->field.front() != '@' || !object.mesh ||

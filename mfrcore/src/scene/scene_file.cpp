@@ -7,7 +7,9 @@
 #include <cstdint>
 #include <initializer_list>
 #include <optional>
+#include <set>
 #include <string>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
@@ -29,6 +31,53 @@ namespace mfr {
 namespace {
 
 using nlohmann::json;
+
+// A key given twice in one JSON object: nlohmann keeps the last, and a second "objects" array
+// dropped the first without a word (a bug hunt). `where` is the key's path ("objects[1].opacity").
+struct RepeatedKey {
+  std::string where;
+};
+
+// Parses `text` as JSON, throwing RepeatedKey for a key given twice in one object.
+json parseWithoutRepeatedKeys(const std::string& text) {
+  struct Level {
+    bool object = false;
+    std::set<std::string> keys;
+    std::string key;        // an object's current key
+    std::size_t index = 0;  // an array's current element
+  };
+  std::vector<Level> levels;
+  const auto path = [&levels] {
+    std::string where;
+    for (std::size_t i = 0; i + 1 < levels.size(); ++i)
+      where += levels[i].object ? (i == 0 ? "" : ".") + levels[i].key : "[" + std::to_string(levels[i].index) + "]";
+    return where;
+  };
+  return json::parse(text, [&](int, json::parse_event_t event, json& parsed) {
+    switch (event) {
+      case json::parse_event_t::object_start:
+      case json::parse_event_t::array_start:
+        levels.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
+        break;
+      case json::parse_event_t::key: {
+        Level& level = levels.back();
+        level.key = parsed.get<std::string>();
+        if (!level.keys.insert(level.key).second) {
+          const std::string outer = path();
+          throw RepeatedKey{outer.empty() ? level.key : outer + "." + level.key};
+        }
+        break;
+      }
+      case json::parse_event_t::object_end:
+      case json::parse_event_t::array_end:
+      case json::parse_event_t::value:
+        if (event != json::parse_event_t::value) levels.pop_back();
+        if (!levels.empty() && !levels.back().object) ++levels.back().index;
+        break;
+    }
+    return true;
+  });
+}
 
 class Reader {
  public:
@@ -271,8 +320,8 @@ glm::vec4 parseColor(const Reader& r, const json& o, const std::string& where, g
 
 // An object's "color_by": "field" or {"field", "map", "range"}, applied to each part whose mesh has
 // the field (colorByField); at least one must.
-void parseColorBy(const Reader& r, const json& o, const std::string& where, const std::vector<Object*>& parts,
-                  const std::string& what) {
+void parseColorBy(const Reader& r, const Scene& scene, const json& o, const std::string& where,
+                  const std::vector<Object*>& parts, const std::string& what) {
   if (!o.contains("color_by")) return;
   const std::string at = where + ".color_by";
   const json& c = o["color_by"];
@@ -292,6 +341,8 @@ void parseColorBy(const Reader& r, const json& o, const std::string& where, cons
     }
   }
   if (field.empty()) r.fail(at, "expected the name of a point-data or cell-data array of the file");
+  // "@vol.vtk" of a file listed twice without names meant the first volume, silently (a bug hunt).
+  if (const std::optional<std::string> why = ambiguousVolumeField(scene, field)) r.fail(at, *why);
   const auto& names = colorMapNames();
   if (std::find(names.begin(), names.end(), map) == names.end()) {
     std::string list;
@@ -531,7 +582,9 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
                      const LoadProgress& progress) {
   json doc;
   try {
-    doc = json::parse(text);
+    doc = parseWithoutRepeatedKeys(text);
+  } catch (const RepeatedKey& repeated) {
+    throw Error(name, repeated.where + ": given twice (the keys of a JSON object must differ)");
   } catch (const json::out_of_range&) {
     throw Error(name, "JSON number out of range (beyond double precision)");
   } catch (const json::parse_error& e) {
@@ -725,7 +778,7 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
   for (const ColorBy& c : colorBy) {
     std::vector<Object*> parts;
     for (std::size_t i = c.first; i < c.last; ++i) parts.push_back(&scene.objects[i]);
-    parseColorBy(r, *c.object, c.where, parts, c.what);
+    parseColorBy(r, scene, *c.object, c.where, parts, c.what);
   }
   if (doc.contains("csg")) {
     scene.csg.root = parseCsgNode(r, doc["csg"], "csg", scene);

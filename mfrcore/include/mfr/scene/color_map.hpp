@@ -96,6 +96,9 @@ struct VolumeFieldSampler {
 };
 // The field name "@NAME" of the scene's volume v (its name, else "volume v").
 std::string volumeFieldName(const Scene& scene, std::size_t v);
+// Why `field` ("@NAME") cannot say which volume it means — more than one has that name (a file
+// listed twice without names) —, or nothing when it can.
+std::optional<std::string> ambiguousVolumeField(const Scene& scene, const std::string& field);
 // The sampler of the volume `object` is coloured by (Material::fieldColors names one of the
 // scene's volumes and the mesh has its vertex samples, which give the default range); else null.
 std::optional<VolumeFieldSampler> volumeFieldSampler(const Scene& scene, const Object& object);
