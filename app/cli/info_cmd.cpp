@@ -210,6 +210,7 @@ void addInfo(CLI::App& app) {
       const SurfaceMeasures& m = measures[i];
       nlohmann::ordered_json part = {
           {"name", o.name},
+          {"visible", o.visible},
           {"triangles", o.mesh->triangleCount()},
           {"area", m.area},
           {"closed", m.closed()},
@@ -230,9 +231,15 @@ void addInfo(CLI::App& app) {
       parts.push_back(std::move(part));
     }
     j["part_list"] = parts;
-    std::cout << "scene      " << scene.name << "\nparts      " << scene.objects.size() << "\ntriangles  "
-              << scene.triangleCount() << "\nbounds     [" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – ["
-              << b.max.x << ", " << b.max.y << ", " << b.max.z << "]\nviews     ";
+    std::size_t hidden = 0;
+    for (const Object& o : scene.objects) hidden += o.visible ? 0 : 1;
+    // The total is of what is drawn; hidden parts are listed, marked, and said here (a bug hunt: the
+    // list and the total disagreed without a word).
+    std::cout << "scene      " << scene.name << "\nparts      " << scene.objects.size()
+              << (hidden > 0 ? " (" + std::to_string(hidden) + " hidden)" : std::string()) << "\ntriangles  "
+              << scene.triangleCount() << (hidden > 0 ? " (of the visible parts)" : "") << "\nbounds     [" << b.min.x
+              << ", " << b.min.y << ", " << b.min.z << "] – [" << b.max.x << ", " << b.max.y << ", " << b.max.z
+              << "]\nviews     ";
     for (const std::string& v : scene.viewNames()) std::cout << " " << v;
     std::cout << "\n";
     if (!bondsError.empty()) std::cout << "molecule   atoms and bonds not counted: " << bondsError << "\n";
@@ -266,7 +273,7 @@ void addInfo(CLI::App& app) {
       const Object& o = scene.objects[i];
       std::cout << "  part " << i << ": " << o.name << " (" << o.mesh->triangleCount() << " triangles, rgba "
                 << o.material.color.r << " " << o.material.color.g << " " << o.material.color.b << " "
-                << o.material.color.a << ")\n";
+                << o.material.color.a << (o.visible ? "" : ", hidden") << ")\n";
       // Its surface in the world: area, and the volume it encloses when it is closed — as cut by the
       // section, whose cap makes a cut solid closed: the volume kept, and the cut's area.
       if (outcome(i) == SectionOutcome::kRemoved)

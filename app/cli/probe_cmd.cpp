@@ -216,6 +216,11 @@ void addProbe(CLI::App& app) {
       const ProbeFragment& f = probe.fragments[i];
       const std::uint32_t object = f.fragment.objectId;
       const std::string part = object < scene.objects.size() ? scene.objects[object].name : "?";
+      // Which side of the part the ray meets, by the part's own winding: a mirroring placement
+      // reverses the winding in the world, and the outside of a mirrored sphere read "back" (a bug hunt).
+      const bool mirrored =
+          object < scene.objects.size() && glm::determinant(glm::dmat3(scene.objects[object].transform)) < 0.0;
+      const bool front = f.fragment.frontFacing != mirrored;
       if (probe.volume) mediumRow(i);
       char share[32] = "";
       if (probe.hybrid) std::snprintf(share, sizeof share, "  %7.4f %s", f.hybridWeight, f.held ? "core" : "tail");
@@ -227,7 +232,7 @@ void addProbe(CLI::App& app) {
       else if (values)
         value = "  -";
       std::snprintf(line, sizeof line, "%4zu  %12.6g  %-24.24s  %-15s  %-5s  %7.4f%s%s%s\n", i + 1, f.eyeDepth,
-                    part.c_str(), rgba(f.fragment.color).c_str(), f.fragment.frontFacing ? "front" : "back", f.weight,
+                    part.c_str(), rgba(f.fragment.color).c_str(), front ? "front" : "back", f.weight,
                     methodColumn(f.held ? "held" : "-").c_str(), share, value.c_str());
       text << line;
       nlohmann::ordered_json j;
@@ -236,7 +241,7 @@ void addProbe(CLI::App& app) {
       j["object"] = object;
       j["part"] = part;
       j["rgba"] = rgbaJson(f.fragment.color);
-      j["front_facing"] = f.fragment.frontFacing;
+      j["front_facing"] = front;
       j["weight"] = f.weight;
       if (probe.captured) j["held"] = f.held;
       if (probe.hybrid) j["hybrid_weight"] = f.hybridWeight;

@@ -84,6 +84,26 @@ TEST_F(CliProbe, FragmentsAndColoursMatchTheRenderedImages) {
   EXPECT_GE(deep, 2);
 }
 
+// The faces column says which side of its part the ray meets: a sphere's outside first, then its
+// inside — also when the sphere is placed mirrored (by a scale of -1, or of a volume's isosurface
+// the same way), which reverses its winding in the world: that read "back" then "front" (a bug hunt).
+TEST_F(CliProbe, FacesAreTheSidesOfThePartAlsoWhenMirrored) {
+  for (const std::string scale : {"[1, 1, 1]", "[-1, 1, 1]", "[1.1, -0.9, 1.3]"}) {
+    SCOPED_TRACE(scale);
+    const fs::path scene = write(
+        "ball.mfrscene", R"({"objects": [{"primitive": {"type": "sphere"}, "transform": {"scale": )" + scale + "}}]}");
+    const fs::path json = dir() / "probe.json";
+    const CliResult r = runCli("probe " + scene.string() + " --size 64x48 --pixel 32,24 --json " + json.string());
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    const nlohmann::json j = readJsonFile(json);
+    ASSERT_EQ(j["fragments"].size(), 2u) << r.out;
+    EXPECT_EQ(j["fragments"][0]["front_facing"], true);
+    EXPECT_EQ(j["fragments"][1]["front_facing"], false);
+    EXPECT_NE(r.out.find("  front   "), std::string::npos) << r.out;
+    EXPECT_LT(r.out.find("  front   "), r.out.find("  back   ")) << r.out;
+  }
+}
+
 TEST_F(CliProbe, MethodsWithoutListsShowTheirColourOnly) {
   const CliResult r = runCli(std::string("probe ") + kScene + " --pixel 32,24 -m wboit");
   ASSERT_EQ(r.exitCode, 0) << r.out;

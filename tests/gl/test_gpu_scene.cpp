@@ -105,5 +105,33 @@ TEST(GpuSceneUpload, FarFromTheOriginTheSceneKeepsItsDetail) {
   }
 }
 
+// A scene scaled by 1e-19 (about the origin, so that the fit view frames it alike) draws as the
+// scene itself on both renderers: the normal matrix's entries were 1e19, and its normals overflowed
+// in float when normalised — up to 99/255 off on the GPU at 1e-19, every covered pixel wrong on
+// both at 4e-20 (a bug hunt). Large scales alike.
+TEST(GpuSceneUpload, TinyAndHugeScalesShadeAsTheSceneItself) {
+  context();
+  const Scene unit = makeSampleScene();
+  RenderRequest gpu, oracle;
+  gpu.method = "abuffer-ll";
+  oracle.method = "oracle";
+  gpu.width = oracle.width = 96;
+  gpu.height = oracle.height = 72;
+  const Camera unitCamera = unit.view("orbit:35:25");
+  const ImageRGBA8 reference = render(unit, unitCamera, oracle).image;
+  for (const double scale : {1e-19, 4e-20, 1e14}) {
+    SCOPED_TRACE(scale);
+    Scene scaled = unit;
+    for (Object& o : scaled.objects) o.transform = glm::scale(glm::dmat4(1.0), glm::dvec3(scale)) * o.transform;
+    const Camera camera = scaled.view("orbit:35:25");
+    const ImageRGBA8 cpu = render(scaled, camera, oracle).image;
+    const ImageRGBA8 gl = render(scaled, camera, gpu).image;
+    // The oracle of the scaled scene is the unit scene's (rays and depths scale alike; edge pixels
+    // may round apart), and the GPU is within the oracle's usual 2/255.
+    EXPECT_LE(pixelsDifferingBy(cpu, reference, 2), reference.width * reference.height / 200);
+    EXPECT_LE(pixelsDifferingBy(gl, cpu, 2), reference.width * reference.height / 100);
+  }
+}
+
 }  // namespace
 }  // namespace mfr::test

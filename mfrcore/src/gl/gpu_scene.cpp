@@ -95,8 +95,8 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
     // Vertex colours only where the mesh has them (else white ones were uploaded): the shader then
     // reads the material's colour exactly, as the oracle does (common/fragment.glsl says why).
     const bool vertexColors = o.material.vertexColors && o.mesh->colors.size() == o.mesh->positions.size();
-    items_.push_back({it->second, model, glm::mat3(glm::transpose(glm::inverse(o.transform))), o.material.color,
-                      vertexColors, static_cast<std::uint32_t>(i), mapped ? colorMapIndex(field->map) : -1,
+    items_.push_back({it->second, model, glm::mat3(normalMatrix(o.transform)), o.material.color, vertexColors,
+                      static_cast<std::uint32_t>(i), mapped ? colorMapIndex(field->map) : -1,
                       mapped ? glm::vec2(field->range) : glm::vec2(0.0f, 1.0f)});
     if (const std::optional<VolumeFieldSampler> sampler = volumeFieldSampler(scene, o)) {
       DrawItem& item = items_.back();

@@ -548,7 +548,7 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
     object.mesh->validate(object.name);
     ObjectShading& shading = objects[o];
     shading.mesh = object.mesh.get();
-    shading.normalMatrix = glm::transpose(glm::inverse(glm::dmat3(object.transform)));
+    shading.normalMatrix = normalMatrix(object.transform);
     shading.materialColor = object.material.color;
     shading.vertexColors = object.material.vertexColors;
     if (const std::optional<FieldColors>& field = object.material.fieldColors;

@@ -212,4 +212,12 @@ Bounds parseClipBox(const std::string& text, const std::string& what) {
   return box;
 }
 
+glm::dmat3 normalMatrix(const glm::dmat4& transform) {
+  const glm::dmat3 m = glm::transpose(glm::inverse(glm::dmat3(transform)));
+  double largest = 0.0;
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) largest = std::max(largest, std::abs(m[c][r]));
+  return largest > 0.0 && std::isfinite(largest) ? m / largest : m;
+}
+
 }  // namespace mfr

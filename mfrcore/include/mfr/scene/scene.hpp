@@ -45,6 +45,12 @@ struct Object {
   bool visible = true;
 };
 
+// What turns an object's normals into the world's: the inverse transpose of the transform's linear
+// part, scaled so that its largest entry is 1. Only directions are taken from it, and unscaled a
+// transform of scale 1e-19 made entries of 1e19, whose normals overflowed in float when normalised
+// (shading came out wrong, and differently on the GPU and in the oracle; a bug hunt).
+glm::dmat3 normalMatrix(const glm::dmat4& transform);
+
 // A section plane (world space): what lies on the side its normal points to is kept, the rest is
 // cut away. With caps, every closed surface it cuts is closed again by the cross-section, so solids
 // look solid (the CAD section view); open surfaces are only cut. (.mfrscene "section",
