@@ -86,10 +86,17 @@ TEST_F(Cli, SceneFileFlagsAndHugeNumbersNameTheFileAndKey) {
                 R"(}], "views": [{"name": "a", "eye": [0, 0, 5]}, {"name": "a", "eye": [0, 5, 0]}]})",
             "views[1].name: 'a' is the name of views[0] too"},
            {R"({"objects": [)" + sphere + R"(, "visible": 1}]})", "objects[0].visible: expected true or false"},
+           {R"({"objects": [)" + sphere + R"(}], "views": [{"name": "", "eye": [0, 0, 5]}]})",
+            "views[0].name: must not be empty"},
+           {R"({"objects": [{"file": "a.obj\u0000.stl"}]})", "objects[0].file: contains a NUL character"},
+           {R"({"objects": [)" + sphere + R"(}], "volumes": [{"file": "v.vti\u0000"}]})",
+            "volumes[0].file: contains a NUL character"},
            {R"({"objects": [)" + sphere +
                 R"(}], "views": [{"name": "a", "eye": [0, 0, 5], "target": [0, 0, 0], "fit": null}]})",
             "views[0].fit: expected true or false"},
-           {R"({"objects": [)" + sphere + R"(, "opacity": 1e400}]})", "JSON number out of range"},
+           {R"({"objects": [)" + sphere + R"(, "opacity": 1e400}]})", "objects[0].opacity: JSON number out of range"},
+           {R"({"objects": [)" + sphere + R"(, "transform": {"translate": [0, -1e999, 0]}}]})",
+            "objects[0].transform.translate[1]: JSON number out of range"},
            // Accepted before: a background outside [0,1] was composited as it was; a rotation
            // without axis or degrees was none.
            {R"({"background": [-5, 0.5, 0.5], "objects": [)" + sphere + "}]}",

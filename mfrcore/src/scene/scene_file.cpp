@@ -37,8 +37,13 @@ using nlohmann::json;
 struct RepeatedKey {
   std::string where;
 };
+// A number beyond double precision, at `where` (it was said without saying where; a bug hunt).
+struct NumberOutOfRange {
+  std::string where;
+};
 
-// Parses `text` as JSON, throwing RepeatedKey for a key given twice in one object.
+// Parses `text` as JSON, throwing RepeatedKey for a key given twice in one object and
+// NumberOutOfRange for a number beyond a double.
 json parseWithoutRepeatedKeys(const std::string& text) {
   struct Level {
     bool object = false;
@@ -47,36 +52,39 @@ json parseWithoutRepeatedKeys(const std::string& text) {
     std::size_t index = 0;  // an array's current element
   };
   std::vector<Level> levels;
-  const auto path = [&levels] {
+  // The path of the value being read: each level's current key or element.
+  const auto here = [&levels] {
     std::string where;
-    for (std::size_t i = 0; i + 1 < levels.size(); ++i)
-      where += levels[i].object ? (i == 0 ? "" : ".") + levels[i].key : "[" + std::to_string(levels[i].index) + "]";
+    for (std::size_t i = 0; i < levels.size(); ++i)
+      where +=
+          levels[i].object ? (where.empty() ? "" : ".") + levels[i].key : "[" + std::to_string(levels[i].index) + "]";
     return where;
   };
-  return json::parse(text, [&](int, json::parse_event_t event, json& parsed) {
-    switch (event) {
-      case json::parse_event_t::object_start:
-      case json::parse_event_t::array_start:
-        levels.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
-        break;
-      case json::parse_event_t::key: {
-        Level& level = levels.back();
-        level.key = parsed.get<std::string>();
-        if (!level.keys.insert(level.key).second) {
-          const std::string outer = path();
-          throw RepeatedKey{outer.empty() ? level.key : outer + "." + level.key};
+  try {
+    return json::parse(text, [&](int, json::parse_event_t event, json& parsed) {
+      switch (event) {
+        case json::parse_event_t::object_start:
+        case json::parse_event_t::array_start:
+          levels.push_back({event == json::parse_event_t::object_start, {}, {}, 0});
+          break;
+        case json::parse_event_t::key: {
+          Level& level = levels.back();
+          level.key = parsed.get<std::string>();
+          if (!level.keys.insert(level.key).second) throw RepeatedKey{here()};
+          break;
         }
-        break;
+        case json::parse_event_t::object_end:
+        case json::parse_event_t::array_end:
+        case json::parse_event_t::value:
+          if (event != json::parse_event_t::value) levels.pop_back();
+          if (!levels.empty() && !levels.back().object) ++levels.back().index;
+          break;
       }
-      case json::parse_event_t::object_end:
-      case json::parse_event_t::array_end:
-      case json::parse_event_t::value:
-        if (event != json::parse_event_t::value) levels.pop_back();
-        if (!levels.empty() && !levels.back().object) ++levels.back().index;
-        break;
-    }
-    return true;
-  });
+      return true;
+    });
+  } catch (const json::out_of_range&) {
+    throw NumberOutOfRange{here()};
+  }
 }
 
 class Reader {
@@ -445,6 +453,7 @@ Volume parseVolume(const Reader& r, const json& j, const std::string& where, con
       r.object(j, where, {"file", "name", "transform", "visible", "shading", "field", "transfer", "contours"});
   if (!v.contains("file")) r.fail(where, "needs 'file' (a volume file)");
   const std::string file = r.string(v, "file", where, "");
+  if (file.find('\0') != std::string::npos) r.fail(where + ".file", "contains a NUL character (\\u0000)");
   const glm::dmat4 xf =
       v.contains("transform") ? parseTransform(r, v["transform"], where + ".transform") : glm::dmat4(1.0);
   if (v.contains("visible") && !v["visible"].is_boolean()) r.fail(where + ".visible", "expected true or false");
@@ -585,8 +594,9 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     doc = parseWithoutRepeatedKeys(text);
   } catch (const RepeatedKey& repeated) {
     throw Error(name, repeated.where + ": given twice (the keys of a JSON object must differ)");
-  } catch (const json::out_of_range&) {
-    throw Error(name, "JSON number out of range (beyond double precision)");
+  } catch (const NumberOutOfRange& number) {
+    throw Error(name, (number.where.empty() ? std::string() : number.where + ": ") +
+                          "JSON number out of range (beyond double precision)");
   } catch (const json::parse_error& e) {
     // Byte offset → line and column, which is what an editor shows.
     std::size_t line = 1, col = 1;
@@ -702,6 +712,8 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
       } else {
         const std::string fileName = r.string(o, "file", where, "");
         if (fileName.empty()) r.fail(where + ".file", "expected the name of a model file");
+        // A NUL ends the name the system sees: "a.obj\u0000.stl" failed as "a.obj?.stl: a.obj", no reason given.
+        if (fileName.find('\0') != std::string::npos) r.fail(where + ".file", "contains a NUL character (\\u0000)");
         const std::filesystem::path file = baseDir / fileName;
         LoadOptions options;
         if (o.contains("molecule")) {
@@ -799,6 +811,8 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
     for (std::size_t i = 0; i < views.size(); ++i) {
       const std::string where = "views[" + std::to_string(i) + "]";
       const std::string viewName = r.string(views[i], "name", where, "view " + std::to_string(i));
+      // An empty name was listed among the views and could never be chosen (a bug hunt).
+      if (viewName.empty()) r.fail(where + ".name", "must not be empty");
       if (viewName == "fit") r.fail(where + ".name", "'fit' is reserved for the fit-all view");
       // --view finds the first of a name: a second view of it could never be shown.
       for (std::size_t j = 0; j < scene.views.size(); ++j)
