@@ -424,14 +424,7 @@ void cutBySection(Scene& scene, SectionReport& report, const std::string& what) 
   if (scene.section->slice && scene.volumes.empty())
     throw Error(what, "slice: scene '" + scene.name + "' has no volume");
   scene = sectionedScene(scene, &report);
-  if (scene.section->slice && report.slices == 0)
-    std::cerr << "note: section: the plane misses every volume's box, so there is no slice\n";
-  if (report.open.empty()) return;
-  std::string names;
-  for (std::size_t i = 0; i < report.open.size() && i < 5; ++i) names += (i ? ", " : "") + report.open[i];
-  if (report.open.size() > 5) names += ", …";
-  std::cerr << "note: section: " << report.open.size() << " of " << report.cut
-            << " cut parts have no cap (not closed surfaces): " << names << "\n";
+  for (const std::string& note : sectionNotes(*scene.section, report)) std::cerr << "note: " << note << "\n";
 }
 
 }  // namespace

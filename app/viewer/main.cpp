@@ -438,9 +438,10 @@ int main(int argc, char** argv) {
         const QString message = QStringLiteral("--contour %1: %2").arg(cl.contourText, reason);
         if (scripted) fail(message, 1);
         window.statusBar()->showMessage(message);
-      } else if (cl.view.isEmpty()) {
+      } else if (cl.view.isEmpty() && cl.session.isEmpty()) {
         // The fit view of what is drawn now, as mfr render frames it (the view framed the hidden
-        // volume's box: the two programs' images differed; a bug hunt).
+        // volume's box: the two programs' images differed; a bug hunt). A session's camera stays,
+        // as with its other settings that --contour does not name (it was replaced; a bug hunt).
         model.setCamera(model.scene().view("fit"));
       }
     }
@@ -468,6 +469,11 @@ int main(int argc, char** argv) {
     }
     if (cl.clip && clipOk) model.setClipBox(*cl.clip);
     if (cl.section && sectionOk) model.setSection(*cl.section);
+    // What the section could not do as asked, on stderr as mfr render prints it (a scripted run had
+    // none of it; a bug hunt).
+    if (scripted && model.section() && model.sectionError().isEmpty())
+      for (const std::string& note : mfr::sectionNotes(*model.section(), model.sectionReport()))
+        std::cerr << "note: " << note << "\n";
     if (!cl.view.isEmpty()) {
       try {
         model.setCamera(model.scene().view(cl.view.toStdString()));

@@ -583,7 +583,10 @@ void MainWindow::openSession(const QString& path) {
           throw mfr::Error(path.toStdString(), QStringLiteral("plugins.%1: %2").arg(r.id, problem).toStdString());
       }
     const QString scene = session.scenePath;
-    model_->loadSceneAsync(scene, {}, session.molecule);
+    // The volumes' fields are read with the scene (ViewerModel::loadSceneAsync).
+    QList<QPair<QString, QString>> fields;
+    for (const Session::VolumeState& v : session.volumes) fields.append({v.name, v.field});
+    model_->loadSceneAsync(scene, {}, session.molecule, fields);
     pendingSession_ = std::move(session);  // after loadSceneAsync, which cannot finish before we return
     pendingSessionFile_ = QFileInfo(path).absoluteFilePath();
   } catch (const std::exception& e) {

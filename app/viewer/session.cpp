@@ -210,19 +210,26 @@ QStringList applySession(const Session& session, ViewerModel& model) {
   // The isosurfaces first: their parts are among the session's objects. What the viewer refuses
   // (a value outside the volume's range, too many) is a note, as for parts the scene lacks: the
   // whole set vanished without a word (a bug hunt).
-  if (session.volumes.size() == model.scene().volumes.size()) {
-    for (std::size_t i = 0; i < session.volumes.size(); ++i)
-      if (const QString reason = model.setIsosurfacesAt(static_cast<int>(i), session.volumes[i].isosurfaces,
-                                                        session.volumes[i].isosurfaceOpacity);
+  // Volumes by name, as objects: the settings of one went to another when a scene file's volumes
+  // were reordered (a bug hunt).
+  QStringList entries, names;
+  for (const Session::VolumeState& v : session.volumes) entries << v.name;
+  for (const mfr::Volume& v : model.scene().volumes) names << QString::fromStdString(v.name);
+  const std::vector<int> volumeOf = matchByName(entries, names);
+  QStringList unmatchedVolumes;
+  for (std::size_t i = 0; i < session.volumes.size(); ++i)
+    if (volumeOf[i] < 0) unmatchedVolumes << QStringLiteral("'%1'").arg(session.volumes[i].name);
+  if (!unmatchedVolumes.isEmpty())
+    notes << (unmatchedVolumes.size() == 1
+                  ? QStringLiteral("the session's volume %1 is no volume of the scene: left out")
+                  : QStringLiteral("the session's volumes %1 are no volumes of the scene: left out"))
+                 .arg(unmatchedVolumes.join(QStringLiteral(", ")));
+  for (std::size_t i = 0; i < session.volumes.size(); ++i)
+    if (volumeOf[i] >= 0)
+      if (const QString reason =
+              model.setIsosurfacesAt(volumeOf[i], session.volumes[i].isosurfaces, session.volumes[i].isosurfaceOpacity);
           !reason.isEmpty())
         notes << QStringLiteral("volumes[%1].isosurfaces: %2 (left out)").arg(i).arg(reason);
-  } else if (!session.volumes.empty()) {
-    const auto volumes = [](std::size_t n) {
-      return n == 1 ? QStringLiteral("1 volume") : QStringLiteral("%1 volumes").arg(n);
-    };
-    notes << QStringLiteral("the session holds the settings of %1, the scene has %2: left out")
-                 .arg(volumes(session.volumes.size()), volumes(model.scene().volumes.size()));
-  }
   // Objects by name: the n-th entry of a name goes to the scene's n-th part of that name, so a
   // scene file that gained, lost or reordered parts keeps the overrides of the parts it still has
   // (by index, a changed count dropped them all, and a renamed part took another's state).
@@ -247,17 +254,6 @@ QStringList applySession(const Session& session, ViewerModel& model) {
                  .arg(unmatched.join(QStringLiteral(", ")));
   model.setAllParams(session.params);
   model.setZThickness(session.thickness);
-  // A box that holds nothing of the scene drew an empty image; mfr render refuses it (a bug hunt).
-  bool clipHolds = true;
-  if (session.hasClip && session.clip) {
-    try {
-      mfr::requireClipBoxHoldsScene(model.scene(), *session.clip, "clip");
-    } catch (const mfr::Error& e) {
-      clipHolds = false;
-      notes << QString::fromUtf8(e.what()) + QStringLiteral(" (not applied)");
-    }
-  }
-  if (session.hasClip && clipHolds) model.setClipBox(session.clip);
   if (session.hasSection) {
     std::optional<mfr::SectionPlane> section = session.section;
     if (section && section->slice && model.scene().volumes.empty()) {
@@ -275,15 +271,15 @@ QStringList applySession(const Session& session, ViewerModel& model) {
     notes << QStringLiteral("color_by %1: %2 (not applied)")
                  .arg(session.colorBy ? QString::fromStdString(session.colorBy->field) : QString(),
                       model.fieldColoringError());
-  if (session.volumes.size() == model.scene().volumes.size())
-    for (std::size_t i = 0; i < session.volumes.size(); ++i) {
+  for (std::size_t i = 0; i < session.volumes.size(); ++i)
+    if (const int index = volumeOf[i]; index >= 0) {
       const Session::VolumeState& v = session.volumes[i];
-      model.setVolumeStateAt(static_cast<int>(i), v.visible, v.transfer, v.shading);
+      model.setVolumeStateAt(index, v.visible, v.transfer, v.shading);
       // Another field of the file: read in the background; the session's function follows it.
       // A field the file lacks, or any other field of a volume made in memory, is a note (it was
       // left out without a word).
-      const mfr::Volume& volume = model.scene().volumes[i];
-      if (v.field.isEmpty() || v.field.toStdString() == volume.field) continue;
+      const mfr::Volume& volume = model.scene().volumes[static_cast<std::size_t>(index)];
+      if (v.field.isEmpty() || v.field.toStdString() == volume.field) continue;  // read with the scene
       if (volume.file.empty() ||
           std::find(volume.fields.begin(), volume.fields.end(), v.field.toStdString()) == volume.fields.end()) {
         QStringList fields;
@@ -296,8 +292,27 @@ QStringList applySession(const Session& session, ViewerModel& model) {
                               : QStringLiteral("fields: ") + fields.join(QStringLiteral(", ")));
         continue;
       }
-      model.setVolumeFieldAt(static_cast<int>(i), v.field, v.transfer);
+      // Read with the scene (openSession asks loadSceneAsync for the session's fields): it failed.
+      // Left on its own field, blank under the session's function, with exit 0 (a bug hunt).
+      if (const QString why = model.volumeFieldReadError(index); !why.isEmpty()) {
+        notes << QStringLiteral("volumes[%1].field: %2 (left out)").arg(i).arg(why);
+        continue;
+      }
+      model.setVolumeFieldAt(index, v.field, v.transfer);
     }
+  // The clip box once the volumes are shown as the session shows them: one that held only a volume
+  // hidden in the scene file was refused (a bug hunt). A box that holds nothing of the scene drew
+  // an empty image; mfr render refuses it.
+  bool clipHolds = true;
+  if (session.hasClip && session.clip) {
+    try {
+      mfr::requireClipBoxHoldsScene(model.scene(), *session.clip, "clip");
+    } catch (const mfr::Error& e) {
+      clipHolds = false;
+      notes << QString::fromUtf8(e.what()) + QStringLiteral(" (not applied)");
+    }
+  }
+  if (session.hasClip && clipHolds) model.setClipBox(session.clip);
   // What only a volume uses, on a scene without one: notes (taken without a word; mfr render
   // refuses --step and --section …:slice there).
   if (model.scene().volumes.empty() && session.volumeStep > 0.0)

@@ -58,6 +58,19 @@ PaneMetrics computeMetrics(const mfr::ImageRGBA8& reference, const mfr::ImageRGB
   return m;
 }
 
+// Volume `current` of the scene read again with another field (`read`): its name, state and the
+// scene's placement stay; the grid, its own placement (a .vdb grid's box and transform) and the
+// default transfer are new.
+mfr::Volume withField(const mfr::Volume& current, mfr::Volume read) {
+  read.name = current.name;
+  read.visible = current.visible;
+  read.shading = current.shading;
+  read.sceneTransform = current.sceneTransform;
+  read.transform = current.sceneTransform * read.transform;
+  read.transfer = mfr::defaultTransfer(*read.grid, read.bounds());
+  return read;
+}
+
 }  // namespace
 
 QImage wrapImage(const mfr::ImageRGBA8& image) {
@@ -299,15 +312,7 @@ void ViewerModel::setVolumeFieldAt(int index, const QString& field,
           return;
         }
         mfr::Volume& current = scene_.volumes[static_cast<std::size_t>(index)];
-        mfr::Volume next = std::move(*read.volume);
-        // The same volume of the scene: its name, state and the scene's placement stay; the grid,
-        // its own placement (a .vdb grid's box and transform) and the default transfer are new.
-        next.name = current.name;
-        next.visible = current.visible;
-        next.shading = current.shading;
-        next.sceneTransform = current.sceneTransform;
-        next.transform = current.sceneTransform * next.transform;
-        next.transfer = mfr::defaultTransfer(*next.grid, next.bounds());
+        mfr::Volume next = withField(current, std::move(*read.volume));
         loadedTransfers_[static_cast<std::size_t>(index)] = next.transfer;
         volumeRanges_[static_cast<std::size_t>(index)] = glm::dvec2(next.grid->range());
         if (transfer) {
@@ -701,8 +706,26 @@ void ViewerModel::setMoleculeStyle(const mfr::MoleculeStyle& style) {
   requestedMoleculeStyle_ = style;
 }
 
+std::vector<int> matchByName(const QStringList& entries, const QStringList& names) {
+  std::vector<int> match;
+  std::map<QString, int> seen;  // entries of each name so far
+  for (const QString& entry : entries) {
+    int nth = seen[entry]++;
+    int index = -1;
+    for (int i = 0; i < names.size() && index < 0 && !entry.isEmpty(); ++i)
+      if (names[i] == entry && nth-- == 0) index = i;
+    match.push_back(index);
+  }
+  // An entry without a name (a hand-written session) goes by its index, if no named entry took it.
+  for (int e = 0; e < entries.size(); ++e)
+    if (entries[e].isEmpty() && e < names.size() && std::find(match.begin(), match.end(), e) == match.end())
+      match[static_cast<std::size_t>(e)] = e;
+  return match;
+}
+
 void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
-                                 const std::optional<mfr::MoleculeStyle>& molecule) {
+                                 const std::optional<mfr::MoleculeStyle>& molecule,
+                                 const QList<QPair<QString, QString>>& volumeFields) {
   keepCamera_.reset();
   requestedMoleculeStyle_.reset();
   if (load_) {
@@ -720,17 +743,60 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
     std::optional<mfr::Scene> scene;
     QString error;
     bool stopped = false;  // LoadCancelled
+    bool fieldsRead = false;  // a volume was read again with another field
+    QMap<int, QString> fieldErrors;
   };
   runInBackground<Loaded>(
       this,
-      [path, field, molecule, state]() -> Loaded {
+      [path, field, molecule, volumeFields, state]() -> Loaded {
         Loaded loaded;
         const mfr::LoadProgress progress{[state](double fraction) {
           state->fraction = fraction;
           return !state->cancel;
         }};
         try {
-          loaded.scene = mfr::loadScene(path.toStdString(), mfr::LoadOptions(field.toStdString(), molecule), progress);
+          // A volume file's field is read directly: a session of `x.vdb --field temperature` did not
+          // open when x.vdb's default grid could not be read (a bug hunt). A field that cannot be
+          // read is the session's note; the file is then read as it is.
+          const bool direct = field.isEmpty() && volumeFields.size() == 1 && !volumeFields[0].second.isEmpty() &&
+                              !path.startsWith('@') && mfr::isVolumeFile(path.toStdString());
+          try {
+            loaded.scene = mfr::loadScene(
+                path.toStdString(), mfr::LoadOptions((direct ? volumeFields[0].second : field).toStdString(), molecule),
+                progress);
+          } catch (const mfr::LoadCancelled&) {
+            throw;
+          } catch (const mfr::Error& e) {
+            if (!direct) throw;
+            loaded.fieldErrors[0] = QString::fromUtf8(e.what());
+            loaded.scene = mfr::loadScene(path.toStdString(), mfr::LoadOptions({}, molecule), progress);
+          }
+          // The fields asked for, read here rather than after the scene is shown: one read at a
+          // time after it, each cancelling the last, left all but the last volume on its own field
+          // under the transfer function of another, and isosurfaces, a clip box and the view were
+          // checked against the fields as loaded (a bug hunt).
+          std::vector<mfr::Volume>& volumes = loaded.scene->volumes;
+          QStringList entries, names;
+          for (const auto& [name, wanted] : volumeFields) entries << name;
+          for (const mfr::Volume& v : volumes) names << QString::fromStdString(v.name);
+          const std::vector<int> match = matchByName(entries, names);
+          for (int entry = 0; entry < volumeFields.size(); ++entry) {
+            const int i = match[static_cast<std::size_t>(entry)];
+            if (i < 0) continue;  // the session says so (applySession)
+            mfr::Volume& volume = volumes[static_cast<std::size_t>(i)];
+            const std::string wanted = volumeFields[entry].second.toStdString();
+            if (wanted.empty() || wanted == volume.field || volume.file.empty() ||
+                std::find(volume.fields.begin(), volume.fields.end(), wanted) == volume.fields.end())
+              continue;  // the session says why (applySession)
+            try {
+              volume = withField(volume, mfr::loadVolume(volume.file, mfr::LoadOptions(wanted), progress));
+              loaded.fieldsRead = true;
+            } catch (const mfr::LoadCancelled&) {
+              throw;
+            } catch (const std::exception& e) {
+              loaded.fieldErrors[i] = QString::fromUtf8(e.what());
+            }
+          }
         } catch (const mfr::LoadCancelled&) {
           loaded.stopped = true;
         } catch (const std::exception& e) {
@@ -766,7 +832,11 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
         moleculeStyle_.reset();
         if (!path.startsWith('@') && mfr::isMoleculeFile(path.toStdString()))
           moleculeStyle_ = molecule.value_or(mfr::MoleculeStyle{});
-        setScene(std::move(*loaded.scene), path);
+        setScene(std::move(*loaded.scene), path, [&] {
+          volumeFieldReadErrors_ = loaded.fieldErrors;
+          // The parts' "@" fields sampled from the fields read (as after the Field chooser's read).
+          if (loaded.fieldsRead) resampleVolumeFields();
+        });
         if (camera) setCamera(*camera);
       });
 }
@@ -791,7 +861,7 @@ void ViewerModel::cancelLoad() {
   emit loadCancelled();
 }
 
-void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
+void ViewerModel::setScene(mfr::Scene scene, const QString& path, const std::function<void()>& prepare) {
   scene_ = std::move(scene);
   if (fieldLoad_) fieldLoad_->cancel = true;  // a field of the old scene's volume: its read is dropped
   fieldLoad_.reset();
@@ -803,10 +873,11 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
     loadedMeshes_.push_back(o.mesh);
   }
   fieldColoringError_.clear();
+  volumeFieldReadErrors_.clear();
   scenePath_ = path;
   hasScene_ = true;
   ++sceneRevision_;
-  updateSceneGeometry();
+  updateSceneGeometry(false);  // the camera is the new scene's fit view, below
   updateDrawnScene();
   // The z-thickness is a length in the old scene's units: the new one starts at its own default.
   if (thickness_ != 0.0) {
@@ -834,15 +905,25 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path) {
   // picture than mfr render's on the same scene (a bug hunt).
   camera_ = scene_.view("fit");
   ++viewRevision_;
+  if (prepare) prepare();
   emit sceneLoaded();
   emit sceneChanged();
   emit viewChanged();
   emit volumeChanged();
 }
 
-void ViewerModel::updateSceneGeometry() {
+void ViewerModel::updateSceneGeometry(bool refitDepth) {
+  const mfr::Bounds before = bounds_;
   bounds_ = scene_.bounds();
   radius_ = bounds_.valid() ? scene_.boundingRadius() : 0.0;
+  // The near and far planes follow what is drawn: a volume or part shown, or a field read with a
+  // box of its own, lay beyond the far plane fitted to the rest and drew clipped or not at all
+  // until the camera moved (a bug hunt).
+  if (refitDepth && hasScene_ && bounds_.valid() && (before.min != bounds_.min || before.max != bounds_.max)) {
+    camera_.fitDepthRange(bounds_, radius_);
+    ++viewRevision_;
+    emit viewChanged();
+  }
 }
 
 void ViewerModel::sceneEdited() {

@@ -9,11 +9,13 @@
 // compare mode. Each side has its own method, operation and parameters per method.
 #include <QColor>
 #include <QImage>
+#include <QMap>
 #include <QSize>
 #include <QString>
 
 #include <array>
 #include <deque>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -67,6 +69,12 @@ struct PaneMetrics {
 
 // A QImage sharing the pixels of `image` (which must outlive it).
 QImage wrapImage(const mfr::ImageRGBA8& image);
+
+// Entries to things by name: the n-th entry of a name goes to the n-th thing of that name, so that a
+// session keeps its settings for what a scene file still has after it gained, lost or reordered
+// things (by index, a renamed or moved one took another's settings); an entry without a name goes by
+// its index, if no named entry took that thing. -1: no thing for the entry.
+std::vector<int> matchByName(const QStringList& entries, const QStringList& names);
 
 class ViewerModel final : public ViewerContext {
   Q_OBJECT
@@ -206,8 +214,17 @@ class ViewerModel final : public ViewerContext {
   // current scene stays until the new one has loaded (sceneLoaded) — a failure (loadFailed) or
   // cancelLoad() leaves it intact. cancelLoad also stops the loader at its next progress report.
   // `molecule`: the representations of a molecule file (mfr::LoadOptions::molecule).
+  // `volumeFields`: (volume name, field) pairs, matched to the scene's volumes by matchByName: the
+  // field to read for each (empty: its own), read
+  // with the scene, so that what depends on the fields (isosurfaces, bounds, the view) sees them —
+  // a session's; a field that cannot be read leaves the volume as loaded, the reason in
+  // volumeFieldReadError.
   void loadSceneAsync(const QString& path, const QString& field = {},
-                      const std::optional<mfr::MoleculeStyle>& molecule = {});
+                      const std::optional<mfr::MoleculeStyle>& molecule = {},
+                      const QList<QPair<QString, QString>>& volumeFields = {});
+  // Why the field loadSceneAsync was asked to read for the scene's volume `index` could not be read; empty when
+  // it was read or not asked for.
+  [[nodiscard]] QString volumeFieldReadError(int index) const { return volumeFieldReadErrors_.value(index); }
   // A molecule file's representations (PyMOL's show): the scene's own (spheres unless it was
   // loaded with others), none when the scene is not a molecule file. setMoleculeStyle re-reads
   // the file in the background with `style`, keeping the camera (sceneLoaded follows; colours and
@@ -220,7 +237,8 @@ class ViewerModel final : public ViewerContext {
   // True when the last cancelled (or superseded) load's worker stopped inside the loader
   // (LoadCancelled) rather than finishing first (its scene was then dropped).
   [[nodiscard]] bool lastCancelStoppedLoader() const { return lastCancelStoppedLoader_; }
-  void setScene(mfr::Scene scene, const QString& path);
+  // `prepare` runs once the scene is in place, before sceneLoaded (whose handlers apply a session).
+  void setScene(mfr::Scene scene, const QString& path, const std::function<void()>& prepare = {});
   [[nodiscard]] const mfr::Scene& scene() const { return scene_; }
   // What the renderers draw: scene() cut by its section plane (mfr::sectionedScene, made once per
   // scene edit, not by each renderer), or scene() itself without one. When the cut fails (it leaves
@@ -348,7 +366,9 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] ImageKey imageKey(const mfr::RenderRequest& request) const;
   [[nodiscard]] bool metricsWanted(int side) const;
   void sceneEdited();
-  void updateSceneGeometry();
+  // The drawn scene's bounds; with `refitDepth`, the view's near and far planes follow them when
+  // they change.
+  void updateSceneGeometry(bool refitDepth = true);
   void spliceIsosurfaces();  // scene_'s parts after the loaded ones: isosurfaces_'s, in volume order
   // After another field of a volume was read: the parts' "@NAME" fields sampled anew (and the
   // colouring by one of them redrawn).
@@ -416,6 +436,7 @@ class ViewerModel final : public ViewerContext {
   std::shared_ptr<LoadState> load_;
   std::shared_ptr<LoadState> fieldLoad_;  // setVolumeFieldAt's read in progress
   QString fieldError_;
+  QMap<int, QString> volumeFieldReadErrors_;  // loadSceneAsync's volumeFields that could not be read
   bool loading_ = false;
   double loadProgress_ = 0.0;
   bool lastCancelStoppedLoader_ = false;

@@ -285,13 +285,27 @@ void GhostingPanel::restoreOpacities() {
 
 // Each part's name in settings: the first part of a name by the name, the n-th (n ≥ 1) as
 // "name#n", so that parts of one name keep their own focus and opacity (by the name alone, the
-// second took the first's: a bug hunt).
+// second took the first's: a bug hunt) — or the next free number where a part is itself named
+// "name#n" (it shared the key with the second "name": a review).
 QStringList GhostingPanel::settingNames() const {
   QStringList names;
   for (int id = 0; id < parts_->count(); ++id) names << parts_->item(id)->text();
-  QStringList labels = occurrenceKeys(names);
-  for (int id = 0; id < names.size(); ++id)
-    if (labels[id].endsWith(QStringLiteral("#0"))) labels[id] = names[id];
+  QSet<QString> taken(names.begin(), names.end());
+  QMap<QString, int> last;  // the last number given to each name
+  QSet<QString> first;
+  QStringList labels;
+  for (const QString& name : names) {
+    if (!first.contains(name)) {
+      first.insert(name);
+      labels << name;
+      continue;
+    }
+    int n = last.value(name) + 1;
+    while (taken.contains(name + QLatin1Char('#') + QString::number(n))) ++n;
+    last[name] = n;
+    labels << name + QLatin1Char('#') + QString::number(n);
+    taken.insert(labels.back());
+  }
   return labels;
 }
 

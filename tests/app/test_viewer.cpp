@@ -1024,6 +1024,169 @@ class ViewerTest : public QObject {
              QStringList{"volumes[0].field: volume 'field' has no field 'nope' (it has one field; left out)"});
   }
 
+  // A session's volume fields are read with its scene, by volume name (a bug hunt): with two volumes
+  // on other fields than their own, one read cancelled the other, and the first volume drew its own
+  // field under the other's transfer function — nothing; volumes of a reordered scene file took each
+  // other's settings; a field that could not be read left a blank picture with exit 0 and no word;
+  // a session of a volume file whose default field cannot be read did not open. Each picture equals
+  // mfr render of the scene the session describes.
+  void sessionVolumeFieldsAreReadWithTheScene() {
+    QTemporaryDir dir;
+    // f.vti: arrays "bad" (NaN, so it cannot be read; the file's default), "a" in [0, 0.5] and "b" in
+    // [10, 20].
+    {
+      constexpr int n = 6;
+      const auto array = [](const QString& name, const std::function<QString(int, int, int)>& value) {
+        QString values;
+        for (int k = 0; k < n; ++k)
+          for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) values += value(i, j, k) + ' ';
+        return QStringLiteral("<DataArray type=\"Float32\" Name=\"%1\" format=\"ascii\">%2</DataArray>")
+            .arg(name, values);
+      };
+      QFile f(dir.filePath(QStringLiteral("f.vti")));
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(
+          QStringLiteral("<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" "
+                         "byte_order=\"LittleEndian\">\n<ImageData WholeExtent=\"0 5 0 5 0 5\" Origin=\"0 0 0\" "
+                         "Spacing=\"0.2 0.2 0.2\">\n<Piece Extent=\"0 5 0 5 0 5\"><PointData>%1%2%3</PointData>"
+                         "<CellData></CellData></Piece>\n</ImageData>\n</VTKFile>\n")
+              .arg(array("bad", [](int i, int, int) { return i == 2 ? QStringLiteral("nan") : QStringLiteral("1"); }),
+                   array("a", [](int i, int, int) { return QString::number(0.1 * i); }),
+                   array("b", [](int, int, int k) { return QString::number(10 + 2 * k); }))
+              .toUtf8());
+    }
+    const std::string vti = dir.filePath(QStringLiteral("f.vti")).toStdString();
+    const mfr::Volume b = mfr::loadVolume(vti, mfr::LoadOptions("b"));
+    const mfr::TransferFunction transferB = mfr::defaultTransfer(*b.grid, b.bounds());
+    const auto scene = [&](const QString& name, const QString& volumes) {
+      const QString path = dir.filePath(name);
+      QFile f(path);
+      if (f.open(QIODevice::WriteOnly)) f.write(QStringLiteral("{\"volumes\": [%1]}").arg(volumes).toUtf8());
+      return path;
+    };
+    const QString va = QStringLiteral("{\"name\": \"va\", \"file\": \"f.vti\", \"field\": \"%1\"%2}");
+    const QString vb = QStringLiteral(
+        "{\"name\": \"vb\", \"file\": \"f.vti\", \"field\": \"%1\", \"transform\": "
+        "{\"translate\": [2, 0, 0]}%2}");
+    const QString two = scene(QStringLiteral("two.mfrscene"), va.arg("a", "") + ", " + vb.arg("a", ""));
+    // The session: both volumes on field b, with b's default transfer function (as the viewer saves
+    // them after choosing b in the Field chooser), seen from the scene's fit view.
+    const auto volumeState = [&](const QString& name, const QString& field, bool visible) {
+      Session::VolumeState v;
+      v.name = name;
+      v.field = field;
+      v.visible = visible;
+      v.transfer = transferB;
+      return v;
+    };
+    Session session;
+    session.scenePath = two;
+    session.camera = mfr::loadScene(two.toStdString()).view("fit");
+    session.method = QStringLiteral("abuffer-ll");
+    session.volumes = {volumeState("va", "b", true), volumeState("vb", "b", true)};
+    const auto expectSame = [&](const Session& s, const QString& cliScene, const QStringList& cliOptions,
+                                const QString& note) {
+      const QString path = dir.filePath(QStringLiteral("s.mfrsession")), png = dir.filePath(QStringLiteral("v.png")),
+                    cliPng = dir.filePath(QStringLiteral("c.png"));
+      writeSessionFile(path, s);
+      QString out, cli;
+      QCOMPARE(runProgram(MFRVIEW, {path, "--size", "96x64", "--screenshot", png}, &out), 0);
+      QVERIFY2(note.isEmpty() ? !out.contains(QStringLiteral("note:")) : out.contains(note), qPrintable(out));
+      QCOMPARE(runProgram(MFR_CLI,
+                          QStringList{"render", cliScene, "-m", "abuffer-ll", "-s", "96x64", "-o", cliPng} + cliOptions,
+                          &cli),
+               0);
+      const int diff = maxChannelDifference(mfr::readPng(png.toStdString()), mfr::readPng(cliPng.toStdString()));
+      QVERIFY2(diff >= 0 && diff <= 1, qPrintable(QStringLiteral("%1: difference %2").arg(cliScene).arg(diff)));
+    };
+    expectSame(session, scene(QStringLiteral("twob.mfrscene"), va.arg("b", "") + ", " + vb.arg("b", "")), {}, {});
+    // The scene file's volumes reordered: the settings go by name.
+    Session swapped = session;
+    swapped.scenePath = scene(QStringLiteral("swapped.mfrscene"), vb.arg("a", "") + ", " + va.arg("a", ""));
+    swapped.volumes = {volumeState("va", "b", true), volumeState("vb", "a", true)};
+    {
+      const mfr::Volume a = mfr::loadVolume(vti, mfr::LoadOptions("a"));
+      swapped.volumes[1].transfer = mfr::defaultTransfer(*a.grid, a.bounds());
+    }
+    expectSame(swapped, scene(QStringLiteral("swappedb.mfrscene"), vb.arg("a", "") + ", " + va.arg("b", "")), {}, {});
+    // A field that cannot be read: a note naming the key and why, the volume on its own field.
+    Session bad = session;
+    bad.volumes = {volumeState("va", "bad", true), volumeState("vb", "b", true)};
+    bad.volumes[0].transfer = swapped.volumes[1].transfer;  // field a's
+    expectSame(bad, scene(QStringLiteral("bada.mfrscene"), va.arg("a", "") + ", " + vb.arg("b", "")), {},
+               QStringLiteral("note: s.mfrsession: volumes[0].field: ") + QString::fromStdString(vti) +
+                   QStringLiteral(": volume has a non-finite value"));
+    // The volume file itself, whose default field cannot be read, on field b.
+    Session file = session;
+    file.scenePath = QString::fromStdString(vti);
+    file.camera = mfr::loadScene(vti, mfr::LoadOptions("b")).view("fit");
+    file.volumes = {volumeState("f.vti", "b", true)};
+    expectSame(file, QString::fromStdString(vti), {"--field", "b"}, {});
+  }
+
+  // The view and the checks follow what is drawn (a bug hunt): a volume shown that the scene file
+  // hides lay beyond the far plane fitted to the rest and drew nothing until the camera moved; a
+  // session's clip box around that volume was refused as holding nothing; --contour replaced a
+  // session's camera with the fit view; a scripted run left out the section's notes.
+  void viewFollowsWhatIsDrawn() {
+    QTemporaryDir dir;
+    const QString hidden = dir.filePath(QStringLiteral("far.mfrscene"));
+    {
+      QFile f(hidden);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(R"({"objects": [{"name": "ball", "primitive": {"type": "sphere", "radius": 0.5}},
+                  {"name": "sheet", "primitive": {"type": "plane", "width": 1, "height": 1},
+                   "transform": {"rotate": {"axis": [1, 0, 0], "degrees": 90}}}],
+                  "volumes": [{"name": "blob", "file": "blob.vti", "visible": false,
+                               "transform": {"translate": [0, 0, -8]}}]})");
+    }
+    writeBlobScene(dir, QStringLiteral("blob.mfrscene"), blobTransfer());  // writes blob.vti
+    auto w = openWindow(hidden);
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    const double farBefore = m.camera().farPlane;
+    m.setVolumeVisibleAt(0, true);
+    // The volume's far corner, (1.9, 1.9, -6.1), lies within the far plane now.
+    const glm::dvec3 corner(1.9, 1.9, -8.0);
+    const double reach = glm::dot(corner - m.camera().eye, m.camera().forward());
+    QVERIFY2(
+        m.camera().farPlane >= reach && farBefore < reach,
+        qPrintable(
+            QStringLiteral("far %1 (before %2), corner at %3").arg(m.camera().farPlane).arg(farBefore).arg(reach)));
+    settle(m);
+    Session session = captureSession(m);
+    session.hasClip = true;
+    session.clip = mfr::Bounds{glm::dvec3(-0.5, -0.5, -8.5), glm::dvec3(2.5, 2.5, -5.5)};  // the volume alone
+    session.camera = m.scene().view("orbit:30:20");
+    const QString path = dir.filePath(QStringLiteral("s.mfrsession")), png = dir.filePath(QStringLiteral("s.png"));
+    writeSessionFile(path, session);
+    QString out;
+    QCOMPARE(runProgram(MFRVIEW, {path, "--size", "64x48", "--screenshot", png}, &out), 0);
+    QVERIFY2(!out.contains(QStringLiteral("note:")), qPrintable(out));
+    // --contour keeps the session's camera, as a session's own isosurfaces do (the volume hidden, as
+    // --contour hides it).
+    Session withIsosurfaces = session;
+    withIsosurfaces.clip.reset();
+    withIsosurfaces.volumes[0].visible = false;
+    withIsosurfaces.volumes[0].isosurfaces = {0.5};
+    const QString isoPath = dir.filePath(QStringLiteral("iso.mfrsession")),
+                  isoPng = dir.filePath(QStringLiteral("iso.png"));
+    writeSessionFile(isoPath, withIsosurfaces);
+    QCOMPARE(runProgram(MFRVIEW, {isoPath, "--size", "64x48", "--screenshot", isoPng, "-m", "abuffer-ll"}, &out), 0);
+    withIsosurfaces.volumes[0].isosurfaces.clear();
+    writeSessionFile(path, withIsosurfaces);
+    QCOMPARE(runProgram(MFRVIEW, {path, "--size", "64x48", "--screenshot", png, "-m", "abuffer-ll", "--contour", "0.5"},
+                        &out),
+             0);
+    const int diff = maxChannelDifference(mfr::readPng(png.toStdString()), mfr::readPng(isoPng.toStdString()));
+    QVERIFY2(diff >= 0 && diff <= 1, qPrintable(QStringLiteral("difference %1").arg(diff)));
+    // The section's notes, as mfr render prints them.
+    QCOMPARE(runProgram(MFRVIEW, {hidden, "--size", "64x48", "--screenshot", png, "--section", "x=0.1"}, &out), 0);
+    QVERIFY2(out.contains(QStringLiteral("note: section: 1 of 2 cut parts have no cap (not closed surfaces): sheet")),
+             qPrintable(out));
+  }
+
   // A budget in force holds for a picture of another size than the view's: the k fitted to the
   // view was used for the export, so --screenshot's picture changed with --window-size and took up
   // to 2.6 times the budget (a bug hunt). The k expected is the largest whose bytes at the
@@ -1530,6 +1693,30 @@ class ViewerTest : public QObject {
                                  "ghosting: ghosted 'dup': expected an opacity in 0 … 1 (left out)",
                                  "ghosting: ghosted 'dup#1': expected an opacity in 0 … 1 (left out)",
                                  "ghosting: ghosted: no part 'nosuch' in this scene (left out)"}));
+    // A part named "dup#1" beside two "dup"s: the second "dup" is "dup#2", and each keeps its focus.
+    // (The file spells '#' as \u0023: moc misreads a '#' inside a raw string.)
+    {
+      const QString taken = dir.filePath("taken.mfrscene");
+      QFile f(taken);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(R"({"objects": [
+        {"name": "dup", "primitive": {"type": "sphere", "radius": 0.5}, "opacity": 0.8},
+        {"name": "dup\u00231", "primitive": {"type": "sphere", "radius": 0.3}, "opacity": 0.6,
+         "transform": {"translate": [0, 1.5, 0]}},
+        {"name": "dup", "primitive": {"type": "box", "size": [1, 1, 1]}, "opacity": 0.7,
+         "transform": {"translate": [1.5, 0, 0]}}]})");
+    }
+    auto t = openWindow(dir.filePath("taken.mfrscene"));
+    QVERIFY(t);
+    MfrViewerPlugin* ghostingT = loadedPlugin(*t, QStringLiteral("ghosting"));
+    QVERIFY(ghostingT);
+    ghostingT->loadSettings(QJsonObject{{"focus", QJsonArray{"dup#2"}}, {"ghost", true}, {"ghost_opacity", 0.2}});
+    QVERIFY(std::abs(t->model().objectOpacity(0) - 0.2) < 1e-6);
+    QVERIFY(std::abs(t->model().objectOpacity(1) - 0.2) < 1e-6);  // "dup#1", the part of that name: ghosted
+    QVERIFY(std::abs(t->model().objectOpacity(2) - 0.7) < 1e-6);  // the second "dup": the focus
+    const QJsonObject savedT = ghostingT->saveSettings();
+    QCOMPARE(savedT.value("focus").toArray(), QJsonArray{"dup#2"});
+    QCOMPARE(savedT.value("ghosted").toObject().keys(), (QStringList{"dup", "dup#1"}));
   }
 
   // A loaded opacity scale is drawn as given, not at the slider's nearest step (2 drew as

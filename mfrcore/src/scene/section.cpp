@@ -824,6 +824,20 @@ Scene sectionedScene(const Scene& scene, SectionReport* report) {
   return out;
 }
 
+std::vector<std::string> sectionNotes(const SectionPlane& plane, const SectionReport& report) {
+  std::vector<std::string> notes;
+  if (plane.slice && report.slices == 0)
+    notes.emplace_back("section: the plane misses every volume's box, so there is no slice");
+  if (!report.open.empty()) {
+    std::string names;
+    for (std::size_t i = 0; i < report.open.size() && i < 5; ++i) names += (i ? ", " : "") + report.open[i];
+    if (report.open.size() > 5) names += ", …";
+    notes.push_back("section: " + std::to_string(report.open.size()) + " of " + std::to_string(report.cut) +
+                    " cut parts have no cap (not closed surfaces): " + names);
+  }
+  return notes;
+}
+
 SectionPlane parseSectionPlane(const std::string& textIn, const std::string& what) {
   std::string plane = textIn;
   SectionPlane section;

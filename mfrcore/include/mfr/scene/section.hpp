@@ -92,6 +92,10 @@ std::vector<glm::dvec3> volumeSlicePolygon(const Volume& volume, const glm::dvec
 // mfr::Error("section plane", …) when nothing visible is left.
 Scene sectionedScene(const Scene& scene, SectionReport* report = nullptr);
 
+// What a section could not do as asked, one line each, for mfr render and mfrview's scripted runs
+// to print as notes: parts cut without a cap though caps were asked for, a slice the plane misses.
+std::vector<std::string> sectionNotes(const SectionPlane& plane, const SectionReport& report);
+
 // What mfr info and the viewer's scene tree add after a part's measures (describeSurface) when a
 // section cut it: "; cut, cross-section area 4" (capped; six significant digits), "; cut, capped
 // with another part" (capped jointly, the cap on another part), "; cut" (no cap); "" when kept. A
