@@ -217,7 +217,12 @@ glm::dmat3 normalMatrix(const glm::dmat4& transform) {
   double largest = 0.0;
   for (int c = 0; c < 3; ++c)
     for (int r = 0; r < 3; ++r) largest = std::max(largest, std::abs(m[c][r]));
-  return largest > 0.0 && std::isfinite(largest) ? m / largest : m;
+  // By a power of two (exact in float), and only far from 1: a transform of ordinary scale keeps its
+  // normals bit for bit, and with them the 8-bit rounding ties of CAD colours that tail runs compare
+  // (dividing a rotation by its largest entry broke 6 runs on the machine parts).
+  if (!(largest > 0.0) || !std::isfinite(largest)) return m;
+  const int exponent = std::ilogb(largest);
+  return exponent < -20 || exponent > 20 ? m * std::ldexp(1.0, -exponent) : m;
 }
 
 }  // namespace mfr

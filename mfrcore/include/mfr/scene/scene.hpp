@@ -46,9 +46,10 @@ struct Object {
 };
 
 // What turns an object's normals into the world's: the inverse transpose of the transform's linear
-// part, scaled so that its largest entry is 1. Only directions are taken from it, and unscaled a
-// transform of scale 1e-19 made entries of 1e19, whose normals overflowed in float when normalised
-// (shading came out wrong, and differently on the GPU and in the oracle; a bug hunt).
+// part, scaled by a power of two to a largest entry in [1, 2) when that entry lies beyond 2^±20.
+// Only directions are taken from it, and unscaled a transform of scale 1e-19 made entries of 1e19,
+// whose normals overflowed in float when normalised (shading came out wrong, and differently on the
+// GPU and in the oracle; a bug hunt).
 glm::dmat3 normalMatrix(const glm::dmat4& transform);
 
 // A section plane (world space): what lies on the side its normal points to is kept, the rest is
