@@ -233,20 +233,19 @@ QStringList applySession(const Session& session, ViewerModel& model) {
   // Objects by name: the n-th entry of a name goes to the scene's n-th part of that name, so a
   // scene file that gained, lost or reordered parts keeps the overrides of the parts it still has
   // (by index, a changed count dropped them all, and a renamed part took another's state).
-  const std::vector<mfr::Object>& parts = model.scene().objects;
-  std::map<QString, int> seen;  // entries of each name so far
+  QStringList objectEntries, partNames;
+  for (const Session::ObjectState& o : session.objects) objectEntries << o.name;
+  for (const mfr::Object& part : model.scene().objects) partNames << QString::fromStdString(part.name);
+  const std::vector<int> partOf = matchByName(objectEntries, partNames);
   QStringList unmatched;
-  for (const Session::ObjectState& o : session.objects) {
-    int nth = seen[o.name]++;
-    int index = -1;
-    for (std::size_t i = 0; i < parts.size() && index < 0; ++i)
-      if (QString::fromStdString(parts[i].name) == o.name && nth-- == 0) index = static_cast<int>(i);
-    if (index < 0) {
+  for (std::size_t e = 0; e < session.objects.size(); ++e) {
+    const Session::ObjectState& o = session.objects[e];
+    if (partOf[e] < 0) {
       unmatched << QStringLiteral("'%1'").arg(o.name);
       continue;
     }
-    model.setObjectVisible(index, o.visible);
-    model.setObjectMaterial(index, o.color, o.vertexColors);
+    model.setObjectVisible(partOf[e], o.visible);
+    model.setObjectMaterial(partOf[e], o.color, o.vertexColors);
   }
   if (!unmatched.isEmpty())
     notes << (unmatched.size() == 1 ? QStringLiteral("the session's object %1 is no part of the scene: left out")

@@ -712,14 +712,10 @@ std::vector<int> matchByName(const QStringList& entries, const QStringList& name
   for (const QString& entry : entries) {
     int nth = seen[entry]++;
     int index = -1;
-    for (int i = 0; i < names.size() && index < 0 && !entry.isEmpty(); ++i)
+    for (int i = 0; i < names.size() && index < 0; ++i)
       if (names[i] == entry && nth-- == 0) index = i;
     match.push_back(index);
   }
-  // An entry without a name (a hand-written session) goes by its index, if no named entry took it.
-  for (int e = 0; e < entries.size(); ++e)
-    if (entries[e].isEmpty() && e < names.size() && std::find(match.begin(), match.end(), e) == match.end())
-      match[static_cast<std::size_t>(e)] = e;
   return match;
 }
 

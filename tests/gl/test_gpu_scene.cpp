@@ -5,6 +5,7 @@
 
 #include <initializer_list>
 #include <memory>
+#include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -17,6 +18,14 @@
 
 namespace mfr::test {
 namespace {
+
+RenderRequest request(const std::string& method, int width, int height) {
+  RenderRequest r;
+  r.method = method;
+  r.width = width;
+  r.height = height;
+  return r;
+}
 
 TEST(GpuSceneUpload, EditsShareTheMeshesAndDrawLikeAFreshUpload) {
   context();
@@ -75,11 +84,7 @@ TEST(GpuSceneUpload, EditsShareTheMeshesAndDrawLikeAFreshUpload) {
 TEST(GpuSceneUpload, FarFromTheOriginTheSceneKeepsItsDetail) {
   context();
   const Scene near = makeSampleScene();
-  RenderRequest gpu, oracle;
-  gpu.method = "abuffer-ll";
-  oracle.method = "oracle";
-  gpu.width = oracle.width = 128;
-  gpu.height = oracle.height = 96;
+  const RenderRequest gpu = request("abuffer-ll", 128, 96), oracle = request("oracle", 128, 96);
   const auto offEdges = [&](const Scene& scene) {
     const Camera camera = scene.view("orbit:35:25");  // fits each scene (the sample's own iso is near the origin)
     return pixelsDifferingBy(render(scene, camera, gpu).image, render(scene, camera, oracle).image, 2);
@@ -112,11 +117,7 @@ TEST(GpuSceneUpload, FarFromTheOriginTheSceneKeepsItsDetail) {
 TEST(GpuSceneUpload, TinyAndHugeScalesShadeAsTheSceneItself) {
   context();
   const Scene unit = makeSampleScene();
-  RenderRequest gpu, oracle;
-  gpu.method = "abuffer-ll";
-  oracle.method = "oracle";
-  gpu.width = oracle.width = 96;
-  gpu.height = oracle.height = 72;
+  const RenderRequest gpu = request("abuffer-ll", 96, 72), oracle = request("oracle", 96, 72);
   const Camera unitCamera = unit.view("orbit:35:25");
   const ImageRGBA8 reference = render(unit, unitCamera, oracle).image;
   for (const double scale : {1e-19, 4e-20, 1e14}) {
