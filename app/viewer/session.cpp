@@ -215,7 +215,7 @@ QStringList applySession(const Session& session, ViewerModel& model) {
   QStringList entries, names;
   for (const Session::VolumeState& v : session.volumes) entries << v.name;
   for (const mfr::Volume& v : model.scene().volumes) names << QString::fromStdString(v.name);
-  const std::vector<int> volumeOf = matchByName(entries, names);
+  const std::vector<int> volumeOf = matchByName(entries, names, true);
   QStringList unmatchedVolumes;
   for (std::size_t i = 0; i < session.volumes.size(); ++i)
     if (volumeOf[i] < 0) unmatchedVolumes << QStringLiteral("'%1'").arg(session.volumes[i].name);

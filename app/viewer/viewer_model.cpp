@@ -706,16 +706,20 @@ void ViewerModel::setMoleculeStyle(const mfr::MoleculeStyle& style) {
   requestedMoleculeStyle_ = style;
 }
 
-std::vector<int> matchByName(const QStringList& entries, const QStringList& names) {
+std::vector<int> matchByName(const QStringList& entries, const QStringList& names, bool unnamedByIndex) {
   std::vector<int> match;
   std::map<QString, int> seen;  // entries of each name so far
   for (const QString& entry : entries) {
     int nth = seen[entry]++;
     int index = -1;
-    for (int i = 0; i < names.size() && index < 0; ++i)
+    for (int i = 0; i < names.size() && index < 0 && !(unnamedByIndex && entry.isEmpty()); ++i)
       if (names[i] == entry && nth-- == 0) index = i;
     match.push_back(index);
   }
+  if (unnamedByIndex)
+    for (int e = 0; e < entries.size(); ++e)
+      if (entries[e].isEmpty() && e < names.size() && std::find(match.begin(), match.end(), e) == match.end())
+        match[static_cast<std::size_t>(e)] = e;
   return match;
 }
 
@@ -775,7 +779,7 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
           QStringList entries, names;
           for (const auto& [name, wanted] : volumeFields) entries << name;
           for (const mfr::Volume& v : volumes) names << QString::fromStdString(v.name);
-          const std::vector<int> match = matchByName(entries, names);
+          const std::vector<int> match = matchByName(entries, names, true);
           for (int entry = 0; entry < volumeFields.size(); ++entry) {
             const int i = match[static_cast<std::size_t>(entry)];
             if (i < 0) continue;  // the session says so (applySession)

@@ -72,9 +72,10 @@ QImage wrapImage(const mfr::ImageRGBA8& image);
 
 // Entries to things by name: the n-th entry of a name goes to the n-th thing of that name, so that a
 // session keeps its settings for what a scene file still has after it gained, lost or reordered
-// things (by index, a renamed or moved one took another's settings). -1: no thing for the entry.
-// Sessions match their objects and volumes with it.
-std::vector<int> matchByName(const QStringList& entries, const QStringList& names);
+// things (by index, a renamed or moved one took another's settings). With `unnamedByIndex` an
+// entry without a name (a hand-written session's volume) goes by its index, if no named entry took
+// that thing. -1: no thing for the entry. Sessions match their objects and volumes with it.
+std::vector<int> matchByName(const QStringList& entries, const QStringList& names, bool unnamedByIndex = false);
 
 class ViewerModel final : public ViewerContext {
   Q_OBJECT
