@@ -105,7 +105,7 @@ void addBench(CLI::App& app) {
     applyClipOption(scene, opt->clip);
     const Camera camera = scene.view(opt->view);  // fit frames the whole scene, cut or not
     applySectionOption(scene, opt->section);
-    refuseEmptyView(scene);
+    requireSomethingToDraw(scene);
     for (std::size_t i = 0; i < requests.size(); ++i) {
       if (scene.volumes.empty() && (requests[i].volumeStep > 0.0 || requests[i].volumeShading.has_value()))
         throw Error("--methods " + specs[i], "step and shade are the volume's; scene '" + scene.name + "' has none");

@@ -12,6 +12,7 @@
 
 #include "mfr/io/load.hpp"
 #include "mfr/render.hpp"
+#include "mfr/scene/clip_box.hpp"
 #include "mfr/scene/scene.hpp"
 #include "mfr/scene/section.hpp"
 
@@ -116,12 +117,6 @@ inline constexpr const char* kClipHelp =
 // because they are not closed; `report`, when given, gets sectionedScene's report (cleared when
 // there is no section). Throws mfr::Error naming --section.
 void applySectionOption(Scene& scene, const std::string& text, SectionReport* report = nullptr);
-// After applyClipOption and applySectionOption: throws mfr::Error naming the scene when the clip box
-// (the option's or the file's) and the section plane leave nothing to draw — no triangle whose box
-// meets the clip box, no visible volume whose box meets it and reaches the plane's kept side — which
-// would otherwise be an empty image and exit 0. Boxes, not shapes: it never refuses a scene that
-// draws something.
-void refuseEmptyView(const Scene& scene);
 inline constexpr const char* kSectionHelp =
     "Section plane: AXIS=VALUE (x, y, z, -x, -y, -z; keeps the side the axis points to) or "
     "px,py,pz,nx,ny,nz (point, normal of the kept side), optionally :nocaps and/or :slice (each volume's slice, "

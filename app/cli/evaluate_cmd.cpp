@@ -191,6 +191,9 @@ void addEvaluate(CLI::App& app) {
       if (spec.operation != "auto" && spec.operation != "hybrid" && spec.operation != "oit")
         throw Error("--methods " + m, "evaluate measures against the exact 'over' image; operation " + spec.operation +
                                           " draws another image (use hybrid, the default, or oit)");
+      // optimal-k's rows were each the renderer's "--op oit: …", exit 0 (a bug hunt).
+      if (spec.method == "optimal-k" && spec.operation == "oit")
+        throw Error("--methods " + m, "optimal-k is a hybrid-transparency reference: drop op=oit (it runs hybrid)");
       // Nor do hybrid and oit use a thickness, a step or shading, which would change nothing.
       RenderRequest asRun = spec;  // auto is hybrid here, whatever the method's own (see below)
       if (asRun.operation == "auto") asRun.operation = "hybrid";
@@ -253,8 +256,11 @@ void addEvaluate(CLI::App& app) {
         exactRequest.width = w;
         exactRequest.height = h;
         ImageRGBA8 gpuExact;
+        std::uint64_t referenceOverflowPixels = 0;
         try {
-          gpuExact = gpu.render(camera, exactRequest).image;
+          RenderOutput reference = gpu.render(camera, exactRequest);
+          gpuExact = std::move(reference.image);
+          referenceOverflowPixels = reference.stats.overflow ? reference.stats.overflowPixels : 0;
         } catch (const Error& e) {
           // Its refusal (a frame beyond the storage block) named "--method abuffer-ll", which the
           // user never gave: it is evaluate's own reference.
@@ -264,6 +270,15 @@ void addEvaluate(CLI::App& app) {
           throw Error("scene '" + scenes[s].name + "', view " + v + ": the exact reference (abuffer-ll)", reason);
         }
         const std::uint64_t total = lists.fragments.size();
+        // A view that sees nothing has no budget to share: every row was "below what k = 1 needs",
+        // exit 0 (a bug hunt), as mfr dataset refuses it.
+        if (total == 0) throw Error(opt->scenes[s] + " view " + v, "nothing visible (no pixel has a fragment)");
+        // The reference lost fragments (a list longer than abuffer-ll's pool or resolve holds): the
+        // rows are measured against an incomplete image, which was not said (a bug hunt).
+        if (referenceOverflowPixels > 0)
+          std::cerr << "note: " << opt->scenes[s] << " view " << v
+                    << ": the exact reference (abuffer-ll) lost fragments on " << referenceOverflowPixels
+                    << " pixels; the GPU rows' RMSE and FLIP are against that image\n";
         const std::uint64_t exactSlots = exactHybridSlots(lists),
                             exactSlotsRuns = exactHybridSlots(lists, tailRunLengths(lists));
         // --k-by-depth: n(p) of each method's own lists (the GPU's rasterisation, the oracle's rays).
@@ -329,11 +344,17 @@ void addEvaluate(CLI::App& app) {
             row["fragments_total"] = all;
             row["captured_percent"] = captured;
             row["bytes_allocated"] = r.stats.bytesAllocated;
+            // Fragments the method lost to a full structure or a cut resolve, as bench and render
+            // report them (evaluate's numbers looked as if nothing was lost; a bug hunt).
+            row["overflow"] = r.stats.overflow;
+            row["overflow_pixels"] = r.stats.overflowPixels;
+            row["reference_overflow_pixels"] = cpu ? 0 : referenceOverflowPixels;
             row["reference"] = cpu ? "oracle (exact lists, over)" : "abuffer-ll (every rasterised fragment, over)";
             row["rmse"] = e;
             row["flip_mean"] = f;
             row["rmse_vs_oracle"] = rmse(exact, r.image);
-            row["median_total_ms"] = median(times);
+            // optimal-k is not timed: null, not a time of 0 (as bench writes it).
+            row["median_total_ms"] = times.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(median(times));
             nlohmann::ordered_json p = nlohmann::ordered_json::object();
             for (const auto& [pass, ms] : passes) p[pass] = median(ms);
             row["median_pass_ms"] = p;
@@ -351,7 +372,8 @@ void addEvaluate(CLI::App& app) {
                       << (std::to_string(r.stats.kMin) + "-" + std::to_string(r.stats.kMax)) << std::setw(10)
                       << r.stats.fragmentsStored << std::setw(8) << fixed(captured, 1) << std::setw(9) << fixed(e, 5)
                       << std::setw(9) << fixed(f, 5) << std::setw(10)
-                      << (times.empty() ? std::string("cpu") : fixed(median(times), 1)) << "\n";
+                      << (times.empty() ? std::string("cpu") : fixed(median(times), 1))
+                      << (r.stats.overflow ? "  OVERFLOW" : "") << "\n";
             if (cpu) continue;  // the bound, not a competitor: wins count among the others
             flips.emplace_back(m, f);
             rmses.emplace_back(m, e);

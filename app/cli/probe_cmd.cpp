@@ -129,7 +129,7 @@ void addProbe(CLI::App& app) {
     applyClipOption(scene, opt->clip);
     const Camera camera = scene.view(opt->view);  // fit frames the whole scene, cut or not
     applySectionOption(scene, opt->section);
-    refuseEmptyView(scene);
+    requireSomethingToDraw(scene);
     if (const auto unused = unusedOperationSetting(req, scene)) throw Error("--" + unused->name, unused->reason);
     opt->contours.requireKeptVolumeDrawn(req, scene);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);

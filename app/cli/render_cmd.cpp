@@ -105,7 +105,7 @@ void addRender(CLI::App& app) {
     // mfrview's camera does.
     const Camera camera = scene.view(opt->view);
     applySectionOption(scene, opt->section);
-    refuseEmptyView(scene);
+    requireSomethingToDraw(scene);
     if (stepOption->count() > 0 && scene.volumes.empty())
       throw Error("--step", "scene '" + scene.name + "' has no volume");
     if (opt->shade) {

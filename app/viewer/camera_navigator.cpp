@@ -46,6 +46,7 @@ mfr::Camera orbit(const mfr::Camera& camera, QPointF delta, QSize view) {
   mfr::Camera c = camera;
   c.eye = c.target + rotation * (camera.eye - camera.target);
   c.up = rotation * f.up;
+  c.depthRangeGiven = false;
   return c;
 }
 
@@ -56,6 +57,7 @@ mfr::Camera pan(const mfr::Camera& camera, QPointF delta, QSize view) {
   mfr::Camera c = camera;
   c.eye += shift;
   c.target += shift;
+  c.depthRangeGiven = false;
   return c;
 }
 
@@ -74,6 +76,7 @@ mfr::Camera zoomAt(const mfr::Camera& camera, QPointF cursor, QSize view, double
   } else {
     c.eye = point + (camera.eye - point) * factor;
   }
+  c.depthRangeGiven = false;
   return c;
 }
 
@@ -89,6 +92,7 @@ mfr::Camera toggledProjection(const mfr::Camera& camera) {
     const double distance = 0.5 * camera.orthoHeight / std::tan(glm::radians(camera.fovyDegrees) * 0.5);
     c.eye = camera.target - f.forward * distance;
   }
+  c.depthRangeGiven = false;
   return c;
 }
 

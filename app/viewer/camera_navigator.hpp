@@ -1,6 +1,7 @@
 #pragma once
 // Camera navigation as pure functions of a camera and mouse input in widget pixels, so the
-// viewer's gestures are unit-testable without a window.
+// viewer's gestures are unit-testable without a window. A camera moved by them has its near and
+// far planes fitted again (a named view's given planes hold until the camera moves).
 #include <QPointF>
 #include <QSize>
 #include <QString>

@@ -39,6 +39,7 @@
 #include "clip_panel.hpp"
 #include "compare_panel.hpp"
 #include "mfr/error.hpp"
+#include "mfr/scene/clip_box.hpp"
 #include "mfr/image.hpp"
 #include "mfr/legend.hpp"
 #include "mfr/io/load.hpp"
@@ -647,6 +648,7 @@ void MainWindow::exportImage(const QString& path, QSize size, bool legend, const
                                        .arg(mfr::kMinLegendImageSize)
                                        .toStdString());
   }
+  mfr::requireSomethingToDraw(model_->drawnScene());  // as mfr render refuses it
   ExportRender render = renderForExport(size);
   if (check) {
     std::map<std::string, std::string> params = model_->params();

@@ -360,6 +360,9 @@ QJsonObject sessionToJson(const Session& s) {
                      {"ortho_height", s.camera.orthoHeight},
                      {"near", s.camera.nearPlane},
                      {"far", s.camera.farPlane}};
+  // Planes a named view gave are kept on reload; fitted ones are fitted again (the scene may have
+  // changed since).
+  if (s.camera.depthRangeGiven) camera.insert(QStringLiteral("near_far_given"), true);
   const QJsonObject compare{{"enabled", s.compare.enabled},
                             {"layout", nameOf(kLayouts, s.compare.layout)},
                             {"split", s.compare.split},
@@ -458,6 +461,7 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
   s.camera.orthoHeight = r.number(cam, "ortho_height", "camera", s.camera.orthoHeight);
   s.camera.nearPlane = r.number(cam, "near", "camera", s.camera.nearPlane);
   s.camera.farPlane = r.number(cam, "far", "camera", s.camera.farPlane);
+  s.camera.depthRangeGiven = r.boolean(cam, "near_far_given", QStringLiteral("camera"), false);
   // As a scene file's views are checked (a fovy of -40 drew the view upside down; 0 was "projection
   // is singular" naming neither the file nor the key).
   if (!(s.camera.fovyDegrees > 0.0 && s.camera.fovyDegrees < 180.0))

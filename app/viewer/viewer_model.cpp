@@ -919,7 +919,8 @@ void ViewerModel::updateSceneGeometry(bool refitDepth) {
   // The near and far planes follow what is drawn: a volume or part shown, or a field read with a
   // box of its own, lay beyond the far plane fitted to the rest and drew clipped or not at all
   // until the camera moved (a bug hunt).
-  if (refitDepth && hasScene_ && bounds_.valid() && (before.min != bounds_.min || before.max != bounds_.max)) {
+  if (refitDepth && hasScene_ && !camera_.depthRangeGiven && bounds_.valid() &&
+      (before.min != bounds_.min || before.max != bounds_.max)) {
     camera_.fitDepthRange(bounds_, radius_);
     ++viewRevision_;
     emit viewChanged();
@@ -1106,7 +1107,8 @@ bool ViewerModel::setFieldColoring(const QString& field, const QString& map, con
 
 void ViewerModel::setCamera(const mfr::Camera& camera) {
   camera_ = camera;
-  if (bounds_.valid()) camera_.fitDepthRange(bounds_, radius_);
+  // A view's given near and far planes are kept, as mfr render keeps them.
+  if (bounds_.valid() && !camera_.depthRangeGiven) camera_.fitDepthRange(bounds_, radius_);
   ++viewRevision_;
   emit viewChanged();
 }

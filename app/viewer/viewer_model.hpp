@@ -286,7 +286,8 @@ class ViewerModel final : public ViewerContext {
                         const std::optional<glm::dvec2>& range = std::nullopt);
   [[nodiscard]] const QString& fieldColoringError() const { return fieldColoringError_; }
 
-  // Camera: setCamera refits near/far around the visible objects, so navigation never clips.
+  // Camera: setCamera refits near/far around the visible objects, so navigation never clips,
+  // unless the camera's planes were given (camera.depthRangeGiven: a named view's near/far).
   [[nodiscard]] const mfr::Camera& camera() const { return camera_; }
   void setCamera(const mfr::Camera& camera);
   [[nodiscard]] const mfr::Bounds& sceneBounds() const { return bounds_; }
@@ -368,7 +369,7 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] bool metricsWanted(int side) const;
   void sceneEdited();
   // The drawn scene's bounds; with `refitDepth`, the view's near and far planes follow them when
-  // they change.
+  // they change (not when the planes were given).
   void updateSceneGeometry(bool refitDepth = true);
   void spliceIsosurfaces();  // scene_'s parts after the loaded ones: isosurfaces_'s, in volume order
   // After another field of a volume was read: the parts' "@NAME" fields sampled anew (and the

@@ -634,15 +634,21 @@ class ViewerTest : public QObject {
   void clipAndSliceRefusedAsByMfr() {
     QTemporaryDir dir;
     const QString png = dir.filePath(QStringLiteral("refused.png"));
-    // Also a thickness or step the render's operation does not use (they were kept and did nothing).
-    for (const QStringList& options :
-         {QStringList{"--clip", "5,5,5,6,6,6"}, QStringList{"--section", "z=0:slice"},
-          QStringList{"-m", "abuffer-ll", "--op", "oit", "--thickness", "0.1"},
-          QStringList{"-m", "kplus-array", "--thickness", "0.1"}, QStringList{"-m", "abuffer-ll", "--step", "0.1"}}) {
+    // Also a thickness or step the render's operation does not use (they were kept and did nothing),
+    // and a section (with a clip box) that leaves nothing to draw: mfrview wrote a blank picture,
+    // exit 0 (a bug hunt).
+    for (const auto& [scene, options] : QList<std::pair<QString, QStringList>>{
+             {"@sample", {"--clip", "5,5,5,6,6,6"}},
+             {"@sample", {"--section", "z=0:slice"}},
+             {"@sample", {"-m", "abuffer-ll", "--op", "oit", "--thickness", "0.1"}},
+             {"@sample", {"-m", "kplus-array", "--thickness", "0.1"}},
+             {"@sample", {"-m", "abuffer-ll", "--step", "0.1"}},
+             {"@volume", {"-m", "abuffer-ll", "--section", "x=5"}},
+             {"@volume", {"-m", "abuffer-ll", "--section", "x=5:slice"}},
+             {"@sample", {"-m", "abuffer-ll", "--clip", "0.5,0.5,0.5,1,1,1", "--section", "-x=0"}}}) {
       QString viewer, cli;
-      QCOMPARE(runProgram(MFRVIEW, QStringList{"@sample", "--size", "32x32", "--screenshot", png} + options, &viewer),
-               1);
-      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", "@sample", "-s", "32x32", "-o", png} + options, &cli), 1);
+      QCOMPARE(runProgram(MFRVIEW, QStringList{scene, "--size", "32x32", "--screenshot", png} + options, &viewer), 1);
+      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", scene, "-s", "32x32", "-o", png} + options, &cli), 1);
       const QString viewerLine = viewer.trimmed().split(QLatin1Char('\n')).constLast();
       const QString cliLine = cli.trimmed().split(QLatin1Char('\n')).constLast();
       QVERIFY2(viewerLine.startsWith(QStringLiteral("mfrview: ")) && cliLine.startsWith(QStringLiteral("mfr: ")),
@@ -904,6 +910,8 @@ class ViewerTest : public QObject {
         {with("camera", camera({{"projection", "orthographic"}, {"ortho_height", -3}})),
          "s.mfrsession: camera.ortho_height: must be a positive height in scene units"},
         {with("camera", camera({{"near", 2}, {"far", 1}})), "s.mfrsession: camera.far: must be greater than near"},
+        {with("camera", camera({{"near_far_given", "yes"}})),
+         "s.mfrsession: camera.near_far_given: expected true or false"},
         // A number was read as perspective, and a split of 7 was clamped to 1 without a word.
         {with("camera", camera({{"projection", 3}})),
          "s.mfrsession: camera.projection: expected perspective or orthographic"},
@@ -1185,6 +1193,62 @@ class ViewerTest : public QObject {
     QCOMPARE(runProgram(MFRVIEW, {hidden, "--size", "64x48", "--screenshot", png, "--section", "x=0.1"}, &out), 0);
     QVERIFY2(out.contains(QStringLiteral("note: section: 1 of 2 cut parts have no cap (not closed surfaces): sheet")),
              qPrintable(out));
+  }
+
+  // A named view's own near and far planes (a cut-away view) are kept, as mfr render keeps them:
+  // setCamera fitted them to the scene, so mfrview drew the whole sphere (a bug hunt). They hold
+  // until the camera moves, and a session keeps them.
+  void givenNearFarPlanesAreKept() {
+    QTemporaryDir dir;
+    const QString scene = dir.filePath(QStringLiteral("cut.mfrscene"));
+    {
+      QFile f(scene);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      // The sphere's front lies 4 from the eye: a near plane at 4.5 cuts its cap away.
+      f.write(R"({"objects": [{"name": "ball", "primitive": {"type": "sphere", "radius": 1},
+                               "color": [1, 0, 0], "opacity": 0.5}],
+                  "views": [{"name": "whole", "eye": [0, 0, 5]},
+                            {"name": "cut", "eye": [0, 0, 5], "near": 4.5}]})");
+    }
+    QString out;
+    const QString cut = dir.filePath("cut.png"), whole = dir.filePath("whole.png");
+    for (const auto& [view, png] : {std::pair{"cut", cut}, std::pair{"whole", whole}})
+      QCOMPARE(
+          runProgram(MFR_CLI, {"render", scene, "--view", view, "-m", "abuffer-ll", "-s", "64x48", "-o", png}, &out),
+          0);
+    // The cut is visible: the references differ.
+    QVERIFY(maxChannelDifference(mfr::readPng(cut.toStdString()), mfr::readPng(whole.toStdString())) > 20);
+    const QString shot = dir.filePath("shot.png");
+    QCOMPARE(runProgram(MFRVIEW, {scene, "--view", "cut", "-m", "abuffer-ll", "--size", "64x48", "--screenshot", shot},
+                        &out),
+             0);
+    int diff = maxChannelDifference(mfr::readPng(shot.toStdString()), mfr::readPng(cut.toStdString()));
+    QVERIFY2(diff >= 0 && diff <= 1, qPrintable(QStringLiteral("--view cut: difference %1").arg(diff)));
+
+    auto w = openWindow(scene);
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    m.setCamera(m.scene().view("cut"));
+    QCOMPARE(m.camera().nearPlane, 4.5);
+    // Showing what was drawn anew keeps them too.
+    m.setObjectVisible(0, false);
+    m.setObjectVisible(0, true);
+    QCOMPARE(m.camera().nearPlane, 4.5);
+    // A session keeps them; the saved file says so.
+    settle(m);
+    Session session = captureSession(m);
+    const QString path = dir.filePath(QStringLiteral("cut.mfrsession"));
+    writeSessionFile(path, session);
+    QVERIFY(readSessionFile(path).camera.depthRangeGiven);
+    QCOMPARE(runProgram(MFRVIEW, {path, "-m", "abuffer-ll", "--size", "64x48", "--screenshot", shot}, &out), 0);
+    diff = maxChannelDifference(mfr::readPng(shot.toStdString()), mfr::readPng(cut.toStdString()));
+    QVERIFY2(diff >= 0 && diff <= 1, qPrintable(QStringLiteral("session: difference %1").arg(diff)));
+    // Moving the camera fits them again, so orbiting never clips the scene.
+    m.setCamera(navigation::orbit(m.camera(), QPointF(1, 0), m.renderSize()));
+    QVERIFY(!m.camera().depthRangeGiven);
+    QVERIFY2(m.camera().nearPlane < 4.0, qPrintable(QString::number(m.camera().nearPlane)));
+    // A fitted camera's session fits again on reload.
+    QVERIFY(!captureSession(m).camera.depthRangeGiven);
   }
 
   // A budget in force holds for a picture of another size than the view's: the k fitted to the

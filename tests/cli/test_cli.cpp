@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -1301,6 +1303,84 @@ TEST_F(Cli, BudgetCommandsCheckListsFilesAndBudgetsFirst) {
   EXPECT_TRUE(std::all_of(png.out.begin(), png.out.end() - 1, [](char c) {
     return static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f;
   })) << png.out;
+}
+
+// What the budget tools could not measure was a crash, NaN or a misleading table, exit 0 (a bug
+// hunt): JSON nested deep enough to overflow nlohmann's recursive dump, a view that sees nothing,
+// a scene of degenerate triangles found after other scenes' rows, optimal-k under oit, and
+// fragments a method or the reference lost.
+TEST_F(Cli, BudgetToolsRefuseWhatTheyCannotMeasure) {
+  const auto oneLine = [](const std::string& args, const std::string& mention) {
+    const CliResult r = runCli(args);
+    EXPECT_EQ(r.exitCode, 1) << args << ": " << r.out;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << args << ": " << r.out;
+    EXPECT_EQ(r.out.rfind("mfr: ", 0), 0u) << r.out;
+    EXPECT_NE(r.out.find(mention), std::string::npos) << args << ": " << r.out;
+  };
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  // A valid weights file whose "training" record nests 100,000 arrays deep (it was SIGSEGV).
+  nlohmann::json shipped = nlohmann::json::parse(mfr::readFile(MFR_TEST_DATA_DIR "/../../resources/dkb/weights.json"));
+  shipped["training"] = "DEEP";
+  std::string text = shipped.dump();
+  text.replace(text.find("\"DEEP\""), 6, deep);
+  const fs::path weights = write("deep.json", text);
+  oneLine("allocations @sample -s 16x12 --budgets e80 --weights " + weights.string(),
+          "deep.json: not a weights file: its JSON nests 100001 levels deep (more than 256)");
+  expectCleanFailure("render @sample -s 16x12 -m dkb -p weights=" + weights.string(), "deep.json: not a weights file");
+  // A dataset whose metadata nests as deep (train printed its first epoch, then SIGSEGV).
+  const fs::path data = dir() / "d.bin";
+  ASSERT_EQ(runCli("dataset @sample --views front -s 16x12 --budgets 1,all -o " + data.string()).exitCode, 0);
+  std::string bytes = mfr::readFile(data);
+  std::uint32_t metaLength = 0;
+  std::memcpy(&metaLength, bytes.data() + 20, 4);
+  bytes.replace(24, metaLength, deep);
+  metaLength = static_cast<std::uint32_t>(deep.size());
+  std::memcpy(bytes.data() + 20, &metaLength, 4);
+  const fs::path deepData = write("deep.bin", bytes);
+  expectCleanFailure("train " + deepData.string() + " --epochs 1",
+                     "deep.bin: corrupt: its metadata nests 100000 levels deep (more than 256)");
+  // A view looking away from everything: allocations printed "-nan %" and empty allocations,
+  // evaluate "below what k = 1 needs" on every row.
+  const fs::path away = write("away.mfrscene", R"({"objects": [{"primitive": {"type": "sphere"}}],
+      "views": [{"name": "away", "eye": [0, 0, 5], "target": [0, 0, 10]}]})");
+  oneLine("allocations " + away.string() + " --views away -s 16x12 --budgets e80",
+          "away.mfrscene view away: nothing visible (no pixel has a fragment)");
+  {
+    // evaluate finds it when it reaches the view (after its table's header).
+    const CliResult r = runCli("evaluate " + away.string() + " --views away -s 16x12 -r 1 --budgets e80 -m fkb");
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    EXPECT_NE(r.out.find("\nmfr: " + away.string() + " view away: nothing visible (no pixel has a fragment)\n"),
+              std::string::npos)
+        << r.out;
+  }
+  // Degenerate triangles: refused before any row, naming the file (not the scene's name).
+  const fs::path flat = write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+  const fs::path named = write("named.mfrscene", R"({"name": "my study", "objects": [{"file": "flat.obj"}]})");
+  for (const fs::path& scene : {flat, named}) {
+    oneLine("evaluate @sample " + scene.string() + " -s 16x12 -r 1 --budgets f50 -m fkb",
+            scene.string() + ": nothing to render (its one visible triangle is degenerate: no area)");
+    oneLine("dataset @sample " + scene.string() + " -s 16x12 --budgets 1 -o " + (dir() / "x.bin").string(),
+            scene.string() + ": nothing to render");
+  }
+  // optimal-k under oit: every row was the renderer's "--op oit: …", exit 0.
+  oneLine("evaluate @sample -s 16x12 -r 1 --budgets f50 -m optimal-k:op=oit",
+          "--methods optimal-k:op=oit: optimal-k is a hybrid-transparency reference");
+  // Lists longer than a method's storage: the row says OVERFLOW and the JSON how many pixels, as
+  // bench and render say it; the reference's own loss is a note.
+  const fs::path json = dir() / "q.json";
+  const CliResult quads =
+      runCli("evaluate @quads:1100 -s 16x12 -r 1 --budgets e100 -m vkb,optimal-k --json " + json.string());
+  ASSERT_EQ(quads.exitCode, 0) << quads.out;
+  const nlohmann::json rows = nlohmann::json::parse(mfr::readFile(json)).at("results");
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_TRUE(rows[0].at("overflow").get<bool>());
+  EXPECT_GT(rows[0].at("overflow_pixels").get<std::uint64_t>(), 0u);
+  EXPECT_NE(quads.out.find("OVERFLOW"), std::string::npos) << quads.out;
+  if (rows[0].at("reference_overflow_pixels").get<std::uint64_t>() > 0) {
+    EXPECT_NE(quads.out.find("the exact reference (abuffer-ll) lost fragments on"), std::string::npos) << quads.out;
+  }
+  EXPECT_FALSE(rows[1].at("overflow").get<bool>());      // optimal-k works on the oracle's whole lists
+  EXPECT_TRUE(rows[1].at("median_total_ms").is_null());  // not timed: not 0
 }
 
 TEST_F(Cli, BudgetCommandsBadInput) {

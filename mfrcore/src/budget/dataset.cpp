@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mfr/error.hpp"
+#include "mfr/json_text.hpp"
 #include "number_text.hpp"
 #include "mfr/io_util.hpp"
 
@@ -85,6 +86,9 @@ DkbDataset readDataset(const std::filesystem::path& path) {
   d.metadata = bytes.substr(header, metaLength);
   if (!d.metadata.empty() && !nlohmann::json::accept(d.metadata))
     throw Error(where, "corrupt (its metadata is not JSON)");
+  if (const std::size_t depth = jsonNestingDepth(d.metadata); depth > kJsonNestingLimit)
+    throw Error(where, "corrupt: its metadata nests " + std::to_string(depth) + " levels deep (more than " +
+                           std::to_string(kJsonNestingLimit) + ")");
   d.rows.resize(rows * kDatasetColumns);
   std::memcpy(d.rows.data(), bytes.data() + header + metaLength, payload);
   for (std::size_t i = 0; i < d.rows.size(); ++i)

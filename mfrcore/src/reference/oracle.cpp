@@ -501,7 +501,7 @@ std::shared_ptr<const PreparedGeometry> preparedGeometry(const Scene& scene) {
 
 }  // namespace
 
-void checkDrawable(const Scene& scene, const Camera& camera, int width, int height) {
+void checkDrawable(const Scene& scene, const Camera& camera, int width, int height, const std::string& what) {
   checkImageSize(width, height);
   glm::dmat4 viewProj(1.0);
   (void)invertibleViewProjection(camera, width, height, viewProj);
@@ -521,7 +521,7 @@ void checkDrawable(const Scene& scene, const Camera& camera, int width, int heig
   }
   // "No visible triangles" was wrong for a file whose triangles are all degenerate (collinear).
   if (!drawable)
-    throw Error("scene '" + scene.name + "'",
+    throw Error(what.empty() ? "scene '" + scene.name + "'" : what,
                 flat == 0   ? std::string("nothing to render (no visible triangles)")
                 : flat == 1 ? std::string("nothing to render (its one visible triangle is degenerate: no area)")
                             : "nothing to render (its " + std::to_string(flat) +

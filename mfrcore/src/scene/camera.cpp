@@ -80,6 +80,7 @@ void Camera::fitDepthRange(const Bounds& b, double radius) {
   // (the eye inside the sphere), with no absolute floor.
   farPlane = std::max(d + 1.01 * r, 1.01 * r);
   nearPlane = std::max(d - 1.01 * r, farPlane * 1e-4);
+  depthRangeGiven = false;
 }
 
 }  // namespace mfr

@@ -194,6 +194,46 @@ void requireClipBoxHoldsScene(const Scene& scene, const Bounds& box, const std::
       what, "holds nothing of scene '" + scene.name + "' (a flat box, or one outside its bounds " + bounds.str() + ")");
 }
 
+void requireSomethingToDraw(const Scene& scene) {
+  if (!scene.clipBox && !scene.section) return;  // Scene::validate refuses a scene with nothing at all
+  const std::optional<Bounds>& clip = scene.clipBox;
+  const auto meetsClip = [&clip](const Bounds& b) {
+    for (int a = 0; clip && a < 3; ++a)
+      if (b.max[a] < clip->min[a] || b.min[a] > clip->max[a]) return false;
+    return true;
+  };
+  // Triangles: the section has cut them already (sectionedScene), so any left inside the box draws.
+  for (const Object& o : scene.objects) {
+    if (!o.visible || !o.mesh) continue;
+    const Mesh& m = *o.mesh;
+    for (std::size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+      Bounds b;
+      for (std::size_t k = 0; k < 3; ++k)
+        b.extend(glm::dvec3(o.transform * glm::dvec4(glm::dvec3(m.positions[m.indices[t + k]]), 1.0)));
+      if (meetsClip(b)) return;
+    }
+  }
+  // Volumes are cropped at render time: by the box, and to the side the plane's normal points to.
+  for (const Volume& v : scene.volumes) {
+    if (!v.visible || !v.grid) continue;
+    Bounds b = v.bounds();
+    if (!meetsClip(b)) continue;
+    if (clip) {
+      b.min = glm::max(b.min, clip->min);
+      b.max = glm::min(b.max, clip->max);
+    }
+    if (!scene.section) return;
+    for (int c = 0; c < 8; ++c) {
+      const glm::dvec3 corner((c & 1) ? b.max.x : b.min.x, (c & 2) ? b.max.y : b.min.y, (c & 4) ? b.max.z : b.min.z);
+      if (glm::dot(scene.section->normal, corner - scene.section->point) > 0.0) return;
+    }
+  }
+  const std::string where = scene.clipBox && scene.section ? "inside the clip box on the kept side of the section plane"
+                            : scene.clipBox                ? "inside the clip box"
+                                                           : "on the kept side of the section plane";
+  throw Error("scene '" + scene.name + "'", "nothing to draw " + where);
+}
+
 void requireClipBoxInFloatRange(const Bounds& box, const std::string& what) {
   for (int a = 0; a < 3; ++a)
     for (const double v : {box.min[a], box.max[a]})

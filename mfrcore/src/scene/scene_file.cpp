@@ -388,6 +388,7 @@ Camera parseView(const Reader& r, const json& v, const std::string& where, const
     c.nearPlane = r.positive(v, "near", where, c.nearPlane);
     c.farPlane = r.positive(v, "far", where, c.farPlane);
     if (c.farPlane <= c.nearPlane) r.fail(where + ".far", "must be greater than near");
+    c.depthRangeGiven = true;
   }
   // What the renderers would refuse at the first frame ("camera: projection is singular", naming
   // neither the file nor the view), said here: near 1e-30 with far 1e30, say.
@@ -570,6 +571,9 @@ json csgJson(const CsgNode& node, const Scene& scene) {
 
 CsgTree parseCsgText(const std::string& text, const Scene& scene) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) return {};
+  if (const std::size_t depth = jsonNestingDepth(text); depth > kJsonNestingLimit)
+    throw Error("CSG tree", "nests " + std::to_string(depth) + " levels deep (more than " +
+                                std::to_string(kJsonNestingLimit) + ")");
   json j;
   try {
     j = json::parse(text);
@@ -589,6 +593,10 @@ std::string csgText(const CsgTree& tree, const Scene& scene) {
 
 Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseDir, const std::string& name,
                      const LoadProgress& progress) {
+  // Readers of nested values (CSG trees) recurse.
+  if (const std::size_t depth = jsonNestingDepth(text); depth > kJsonNestingLimit)
+    throw Error(name, "its JSON nests " + std::to_string(depth) + " levels deep (more than " +
+                          std::to_string(kJsonNestingLimit) + ")");
   json doc;
   try {
     doc = parseWithoutRepeatedKeys(text);

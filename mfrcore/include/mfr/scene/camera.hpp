@@ -23,6 +23,10 @@ struct Camera {
   double orthoHeight = 2.0;    // orthographic: world extent of the view
   double nearPlane = 0.1;
   double farPlane = 100.0;
+  // Near and far were given (a scene file's view with "near"/"far", or a session that saved such
+  // a view): the viewer keeps them instead of fitting them to what is drawn, as mfr render does.
+  // Fitting (fittedTo, fitDepthRange) clears it.
+  bool depthRangeGiven = false;
 
   [[nodiscard]] glm::dmat4 viewMatrix() const;
   [[nodiscard]] glm::dmat4 projectionMatrix(double aspect) const;
@@ -49,7 +53,8 @@ struct Camera {
   [[nodiscard]] bool projectionSingular() const;
 
   [[nodiscard]] Camera fittedTo(const Bounds& b, double radius = 0.0) const;
-  // Recomputes only near/far so the sphere lies between them (camera position unchanged).
+  // Recomputes only near/far so the sphere lies between them (camera position unchanged); the
+  // planes are fitted, not given, afterwards.
   void fitDepthRange(const Bounds& b, double radius = 0.0);
 };
 
