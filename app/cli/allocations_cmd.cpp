@@ -59,7 +59,7 @@ void addAllocations(CLI::App& app) {
     checkCommandFiles(files);
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-    refuseRepeats(opt->scenes, "scenes");
+    refuseRepeatedFiles(opt->scenes, "scenes");
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
     const NeuralImportanceModel model = loadNeuralImportance(opt->weights).quantised();  // as on the GPU
     const std::vector<std::string> views = splitList(opt->views, "--views");

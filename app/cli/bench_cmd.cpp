@@ -23,6 +23,21 @@
 #include "mfr/render.hpp"
 
 namespace mfr::cli {
+
+namespace {
+// A spec's error named by the spec given: "--param budget_mib=0: …" and "--op : …" named options
+// never given (a bug hunt).
+[[noreturn]] void throwForSpec(const std::string& spec, const Error& e) {
+  std::string reason = e.what();
+  if (reason.starts_with("--param "))
+    reason.erase(0, 8);
+  else if (reason.starts_with("--op "))
+    reason.replace(0, 5, "op=");
+  else if (reason.starts_with("--method "))
+    reason.erase(0, 9);
+  throw Error("--methods " + spec, reason);
+}
+}  // namespace
 namespace {
 
 std::string mib(std::uint64_t bytes) {
@@ -92,8 +107,12 @@ void addBench(CLI::App& app) {
           if (m != "oracle" && m != "optimal-k") gpuMethods += (gpuMethods.empty() ? "" : ", ") + m;
         throw Error("--methods " + spec, "unknown method (available: " + gpuMethods + ")");
       }
-      (void)Params(info->params, req.params, req.method);
-      validateOperation(req.operation);
+      try {
+        (void)Params(info->params, req.params, req.method);
+        validateOperation(req.operation);
+      } catch (const Error& e) {
+        throwForSpec(spec, e);
+      }
       addParameterFiles(files, "--methods " + spec, req.method, req.params);  // dkb's weights are read
     }
     if (requests.empty()) throw Error("--methods", "no method given");
@@ -153,6 +172,7 @@ void addBench(CLI::App& app) {
     // --sequential runs one method at a time and frees its buffers before the next.
     struct Run {
       const RenderRequest* req = nullptr;
+      std::string spec;  // as given in --methods, for its errors
       std::unique_ptr<GpuRenderer> gpu;
       std::vector<std::pair<std::string, std::vector<double>>> perPass;
       std::vector<double> totals;
@@ -160,12 +180,20 @@ void addBench(CLI::App& app) {
     };
     std::vector<Run> runs;
     for (const RenderRequest& req : requests) {
-      Run run{&req, std::make_unique<GpuRenderer>(), {}, {}, {}};
+      Run run{&req, specs[static_cast<std::size_t>(&req - requests.data())], std::make_unique<GpuRenderer>(), {}, {},
+              {}};
       run.gpu->shareScene(gpu);
       runs.push_back(std::move(run));
     }
+    const auto render = [&](Run& run) {
+      try {
+        return run.gpu->render(camera, *run.req);
+      } catch (const Error& e) {
+        throwForSpec(run.spec, e);
+      }
+    };
     const auto frame = [&](Run& run) {
-      run.last = run.gpu->render(camera, *run.req);
+      run.last = render(run);
       run.totals.push_back(run.last.stats.totalTimeMs());
       for (const auto& [pass, ms] : run.last.stats.passTimesMs) {
         auto it = std::find_if(run.perPass.begin(), run.perPass.end(), [&](const auto& p) { return p.first == pass; });
@@ -176,7 +204,7 @@ void addBench(CLI::App& app) {
       }
     };
     const auto warmUp = [&](Run& run) {
-      for (int i = 0; i < opt->warmup; ++i) run.gpu->render(camera, *run.req);
+      for (int i = 0; i < opt->warmup; ++i) (void)render(run);
     };
     if (opt->sequential) {
       for (Run& run : runs) {

@@ -58,6 +58,9 @@ std::vector<std::string> splitList(const std::string& text, const std::string& o
 // commands that loop over such lists did the work twice and counted it twice. Throws
 // Error(option, "'item' is given twice").
 void refuseRepeats(const std::vector<std::string>& items, const std::string& option);
+// The same for files, spelt alike or not (./a.bin and a.bin, a link and its file: train took every
+// row twice, so validation rows were training rows too; a bug hunt). Built-ins (@sample) by name.
+void refuseRepeatedFiles(const std::vector<std::string>& paths, const std::string& option);
 // --field and --molecule: what to read of a file that holds several things.
 struct ReadOptions {
   std::string field;                    // --field: the array or grid of a volume file

@@ -95,6 +95,14 @@ void refuseRepeats(const std::vector<std::string>& items, const std::string& opt
       throw Error(option, "'" + items[i] + "' is given twice");
 }
 
+void refuseRepeatedFiles(const std::vector<std::string>& paths, const std::string& option) {
+  refuseRepeats(paths, option);
+  for (std::size_t i = 0; i < paths.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (!paths[i].starts_with('@') && !paths[j].starts_with('@') && sameFile(paths[i], paths[j]))
+        throw Error(option, "'" + paths[i] + "' is '" + paths[j] + "' again (one file given twice)");
+}
+
 void ReadOptions::add(CLI::App* cmd) {
   cmd->add_option("--field", field,
                   "Volume file: the point-data array (.vti, .vtk) or grid (.vdb) to read instead of the default "
@@ -254,7 +262,15 @@ std::vector<BudgetSpec> parseBudgetSpecs(const std::string& text, std::uint64_t 
   std::vector<BudgetSpec> budgets;
   const std::vector<std::string> items = splitList(text, "--budgets");
   refuseRepeats(items, "--budgets " + text);  // f50,f50 measured one case twice and counted it twice
-  for (const std::string& b : items) budgets.push_back(parseBudgetSpec(b, pixels));
+  for (const std::string& b : items) {
+    budgets.push_back(parseBudgetSpec(b, pixels));
+    // Spelt otherwise (f50 and f50.0, 2 and 2.0): the same case twice as well (a bug hunt).
+    const BudgetSpec& added = budgets.back();
+    for (std::size_t i = 0; i + 1 < budgets.size(); ++i)
+      if (budgets[i].mib == added.mib && budgets[i].bytes == added.bytes && budgets[i].of == added.of &&
+          budgets[i].fragmentPercent == added.fragmentPercent)
+        throw Error("--budgets " + text, "'" + b + "' is '" + budgets[i].label + "' again (one budget given twice)");
+  }
   if (budgets.empty()) throw Error("--budgets", "no budget given");
   return budgets;
 }

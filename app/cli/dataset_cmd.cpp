@@ -89,12 +89,18 @@ void addDataset(CLI::App& app) {
     files.push_back({"-o", opt->output, CommandFile::Role::kRequiredOutput});
     checkCommandFiles(files);
     const std::vector<double> levels = parseBudgetLevels(opt->budgets);
-    refuseRepeats(opt->scenes, "scenes");
+    refuseRepeatedFiles(opt->scenes, "scenes");
     const std::vector<std::string> views = splitList(opt->views, "--views");
     refuseRepeats(views, "--views " + opt->views);
     refuseRepeats(opt->sizes, "--size");
     std::vector<std::pair<int, int>> sizes;
-    for (const std::string& s : opt->sizes) sizes.push_back(parseSize("--size", s));
+    for (const std::string& s : opt->sizes) {
+      sizes.push_back(parseSize("--size", s));
+      // 080x060 and 80x60 wrote each frame twice (a bug hunt).
+      if (const auto first = std::find(sizes.begin(), sizes.end() - 1, sizes.back()); first != sizes.end() - 1)
+        throw Error("--size", "'" + s + "' is '" + opt->sizes[static_cast<std::size_t>(first - sizes.begin())] +
+                                  "' again (one size given twice)");
+    }
     if (!(opt->sample > 0.0)) throw Error("--sample", "must be in (0, 1]: 0 writes no rows");
     const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
     const DatasetSampling sampling = opt->sampleBy == "deep" ? DatasetSampling::DeepPixels : DatasetSampling::Pixels;

@@ -140,7 +140,7 @@ void addEvaluate(CLI::App& app) {
     checkCommandFiles(files);
     const auto [w, h] = parseSize("--size", opt->size);
     const std::uint64_t pixels = static_cast<std::uint64_t>(w) * static_cast<std::uint64_t>(h);
-    refuseRepeats(opt->scenes, "scenes");
+    refuseRepeatedFiles(opt->scenes, "scenes");
     const std::vector<BudgetSpec> budgets = parseBudgetSpecs(opt->budgets, pixels);
     const std::vector<std::string> methods = splitList(opt->methods, "--methods");
     if (methods.empty()) throw Error("--methods", "names no method");

@@ -124,6 +124,11 @@ void addInfo(CLI::App& app) {
     // The histogram's view, checked before anything is printed: a bad --view is one line.
     const std::optional<Camera> histogramView =
         opt->noHistogram ? std::nullopt : std::optional<Camera>(scene.view(opt->view));
+    // Hidden as the scene file says: the section hides the parts it removes, which were listed as
+    // hidden (a bug hunt); they are "removed by the section".
+    std::vector<bool> hiddenByScene;
+    for (const Object& o : scene.objects) hiddenByScene.push_back(!o.visible);
+    const auto hiddenPart = [&](std::size_t i) { return i < hiddenByScene.size() && hiddenByScene[i]; };
     SectionReport section;
     applySectionOption(scene, opt->section, &section);
     const bool sectioned = !section.outcomes.empty();
@@ -210,7 +215,7 @@ void addInfo(CLI::App& app) {
       const SurfaceMeasures& m = measures[i];
       nlohmann::ordered_json part = {
           {"name", o.name},
-          {"visible", o.visible},
+          {"visible", !hiddenPart(i)},
           {"triangles", o.mesh->triangleCount()},
           {"area", m.area},
           {"closed", m.closed()},
@@ -231,15 +236,14 @@ void addInfo(CLI::App& app) {
       parts.push_back(std::move(part));
     }
     j["part_list"] = parts;
-    std::size_t hidden = 0;
-    for (const Object& o : scene.objects) hidden += o.visible ? 0 : 1;
+    const auto hidden = static_cast<std::size_t>(std::count(hiddenByScene.begin(), hiddenByScene.end(), true));
     // The total is of what is drawn; hidden parts are listed, marked, and said here (a bug hunt: the
     // list and the total disagreed without a word).
     std::cout << "scene      " << scene.name << "\nparts      " << scene.objects.size()
               << (hidden > 0 ? " (" + std::to_string(hidden) + " hidden)" : std::string()) << "\ntriangles  "
-              << scene.triangleCount() << (hidden > 0 ? " (of the visible parts)" : "") << "\nbounds     [" << b.min.x
-              << ", " << b.min.y << ", " << b.min.z << "] – [" << b.max.x << ", " << b.max.y << ", " << b.max.z
-              << "]\nviews     ";
+              << scene.triangleCount() << (hidden > 0 || section.removed > 0 ? " (of the visible parts)" : "")
+              << "\nbounds     [" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – [" << b.max.x << ", "
+              << b.max.y << ", " << b.max.z << "]\nviews     ";
     for (const std::string& v : scene.viewNames()) std::cout << " " << v;
     std::cout << "\n";
     if (!bondsError.empty()) std::cout << "molecule   atoms and bonds not counted: " << bondsError << "\n";
@@ -273,7 +277,7 @@ void addInfo(CLI::App& app) {
       const Object& o = scene.objects[i];
       std::cout << "  part " << i << ": " << o.name << " (" << o.mesh->triangleCount() << " triangles, rgba "
                 << o.material.color.r << " " << o.material.color.g << " " << o.material.color.b << " "
-                << o.material.color.a << (o.visible ? "" : ", hidden") << ")\n";
+                << o.material.color.a << (hiddenPart(i) ? ", hidden" : "") << ")\n";
       // Its surface in the world: area, and the volume it encloses when it is closed — as cut by the
       // section, whose cap makes a cut solid closed: the volume kept, and the cut's area.
       if (outcome(i) == SectionOutcome::kRemoved)

@@ -77,7 +77,8 @@ void addProbe(CLI::App& app) {
   cmd->add_option("--param,-p", opt->params, "Method parameter name=value (repeatable)");
   cmd->add_option("--op", opt->op,
                   "The method's operation, as for render (auto: hybrid for fkb, vkb, dkb; zthickness for "
-                  "kbuffer-zmerge; else oit). With hybrid, "
+                  "kbuffer-zmerge; volume for a scene with a volume and a method that draws it; else oit). With "
+                  "hybrid, "
                   "each fragment's share under the method's split: the held ones the core, the rest the tail")
       ->capture_default_str();
   CLI::Option* thicknessGiven =

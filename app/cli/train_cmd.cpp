@@ -50,7 +50,7 @@ void addTrain(CLI::App& app) {
       ->capture_default_str();
   cmd->callback([opt] {
     std::vector<CommandFile> files;
-    refuseRepeats(opt->datasets, "datasets");  // every row twice: validation rows were training rows too
+    refuseRepeatedFiles(opt->datasets, "datasets");  // every row twice: validation rows were training rows too
     for (const std::string& path : opt->datasets) files.push_back({"dataset", path});
     files.push_back({"-o", opt->output, CommandFile::Role::kRequiredOutput});
     checkCommandFiles(files);

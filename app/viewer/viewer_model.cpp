@@ -1060,10 +1060,16 @@ std::optional<mfr::FieldColors> ViewerModel::fieldColoring() const {
 
 std::optional<ViewerModel::ColorLegend> ViewerModel::colorLegend() const {
   if (std::optional<mfr::FieldColors> colors = fieldColoring()) return ColorLegend{std::move(*colors), {}};
-  std::vector<double> values = isosurfaceValues();
+  // The current volume's isosurfaces, else the first volume's that has some: --contour b=… on a
+  // scene whose current volume is a had no legend, where mfr render draws b's (a bug hunt).
+  int index = volumeIndex();
+  for (int i = 0; isosurfaceValuesAt(index).empty() && i < static_cast<int>(scene_.volumes.size()); ++i) index = i;
+  std::vector<double> values = isosurfaceValuesAt(index);
   if (values.empty()) return std::nullopt;
-  const glm::dvec2 range = mfr::contourColorRange(values, volumeValueRange());
-  return ColorLegend{mfr::FieldColors{volumeName().toStdString(), "cool-warm", range}, std::move(values)};
+  const auto at = static_cast<std::size_t>(index);
+  const glm::dvec2 range =
+      mfr::contourColorRange(values, at < volumeRanges_.size() ? volumeRanges_[at] : glm::dvec2(0.0));
+  return ColorLegend{mfr::FieldColors{scene_.volumes[at].name, "cool-warm", range}, std::move(values)};
 }
 
 glm::dvec2 ViewerModel::fieldDataRange(const QString& field) const {

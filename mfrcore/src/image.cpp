@@ -23,6 +23,11 @@ namespace {
 
 struct PngErrorState {
   std::string message;
+  // Set when the image would not fit the memory available: the file is not corrupt, and the
+  // refusal reads as the other memory refusals do ("corrupt PNG (…only 0 bytes is available)"
+  // blamed a valid file; a bug hunt).
+  std::uint64_t bytesNeeded = 0;
+  std::string pixels;  // "800x800"
 };
 
 [[noreturn]] void pngError(png_structp png, png_const_charp msg) {
@@ -85,9 +90,10 @@ static bool decodePng(const std::string* bytes, ImageRGBA8* image, std::vector<p
   }
   const std::uint64_t rgba = std::uint64_t{w} * h * 4;
   if (available && rgba > *available) {
-    std::snprintf(reason, sizeof reason, "%ux%u pixels would take %s; only %s is available", w, h,
-                  formatMemory(rgba).c_str(), formatMemory(*available).c_str());
-    png_error(png, reason);
+    state->bytesNeeded = rgba;
+    std::snprintf(reason, sizeof reason, "%ux%u", w, h);
+    state->pixels = reason;
+    png_error(png, "not enough memory");
   }
   // Normalise every colour type to 8-bit RGBA.
   png_set_expand(png);
@@ -113,7 +119,14 @@ ImageRGBA8 readPng(const std::filesystem::path& path) {
   ImageRGBA8 image;
   std::vector<png_bytep> rows;
   PngErrorState state;
-  if (!decodePng(&bytes, &image, &rows, &state)) throw Error(path.string(), "corrupt PNG (" + state.message + ")");
+  if (!decodePng(&bytes, &image, &rows, &state)) {
+    if (state.bytesNeeded > 0) {
+      requireHostMemory(path.string(), "decoding its " + state.pixels + " pixels", state.bytesNeeded);
+      throw Error(path.string(), "decoding its " + state.pixels + " pixels would take " +
+                                     formatMemory(state.bytesNeeded) + ": more memory than is available");
+    }
+    throw Error(path.string(), "corrupt PNG (" + state.message + ")");
+  }
   return image;
 }
 

@@ -4007,6 +4007,20 @@ class ViewerTest : public QObject {
                    &out),
         0);
     QCOMPARE(maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString())), 0);
+    // The legend of --contour VOLUME=… on a volume other than the first: mfrview refused it ("nothing
+    // is coloured by a field … no isosurfaces"; it looked at the current volume only; a bug hunt).
+    {
+      const QString two = dir.filePath("ab.mfrscene");
+      QFile file(two);
+      QVERIFY(file.open(QIODevice::WriteOnly));
+      file.write(R"({"volumes": [{"name": "a", "file": "peak.vtk"},
+                                  {"name": "b", "file": "peak.vtk", "transform": {"translate": [3, 0, 0]}}]})");
+      file.close();
+      const QStringList contourB{"--contour", "b=0.4,0.6", "--legend"};
+      QCOMPARE(runProgram(MFRVIEW, QStringList{two, "--screenshot", viewerPng} + contourB + larger, &out), 0);
+      QCOMPARE(runProgram(MFR_CLI, QStringList{"render", two, "-o", cliPng} + contourB + larger, &out), 0);
+      QCOMPARE(maxChannelDifference(mfr::readPng(viewerPng.toStdString()), mfr::readPng(cliPng.toStdString())), 0);
+    }
     QVERIFY(runProgram(MFRVIEW, QStringList{"@volume", "--contour", "7", "--screenshot", viewerPng} + common, &out) !=
             0);
     QVERIFY2(out.contains(QStringLiteral("--contour 7: isosurfaces: 7 lies outside the open range")), qPrintable(out));

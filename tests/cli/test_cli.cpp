@@ -705,8 +705,8 @@ TEST_F(Cli, NamesInAnotherEncodingAreWrittenAsUtf8) {
 TEST_F(Cli, BenchRefusesBadSpecsBeforeAnyWork) {
   for (const auto& [methods, mention] : std::vector<std::pair<std::string, std::string>>{
            {"abuffer-ll,bogus", "mfr: --methods bogus: unknown method (available: abuffer-ll, "},
-           {"abuffer-ll,kplus-array:kk=3", "mfr: --param kk: not a parameter of kplus-array"},
-           {"abuffer-ll:op=magic", "mfr: --op magic: unknown operation"},
+           {"abuffer-ll,kplus-array:kk=3", "mfr: --methods kplus-array:kk=3: kk: not a parameter of kplus-array"},
+           {"abuffer-ll:op=magic", "mfr: --methods abuffer-ll:op=magic: op=magic: unknown operation"},
            {"oracle", "mfr: --methods oracle: the CPU reference, not a GPU method"},
            // Read past before: an empty item, a key given twice (the last won), a volume's step
            // and shade on a scene without one, a spec without a name.
@@ -718,7 +718,10 @@ TEST_F(Cli, BenchRefusesBadSpecsBeforeAnyWork) {
            {":op=oit", "(no method name)"},
            {"abuffer-ll:shade=1", "step and shade are the volume's; scene 'sample' has none"},
            {"abuffer-ll:shade=0", "step and shade are the volume's; scene 'sample' has none"},
-           {"abuffer-ll:step=0.1", "step and shade are the volume's; scene 'sample' has none"}}) {
+           {"abuffer-ll:step=0.1", "step and shade are the volume's; scene 'sample' has none"},
+           // Named --param and --op, options never given (a bug hunt).
+           {"fkb:budget_mib=0", "mfr: --methods fkb:budget_mib=0: budget_mib=0: "},
+           {"fkb:op=", "mfr: --methods fkb:op=: op=: unknown operation"}}) {
     const CliResult r = runCli("bench @sample -s 16x16 -r 1 --methods " + methods);
     EXPECT_EQ(r.exitCode, 1) << methods << ": " << r.out;
     EXPECT_EQ(r.out, r.out.substr(0, r.out.find('\n') + 1)) << "more than one line: " << r.out;
@@ -832,6 +835,10 @@ TEST_F(Cli, InfoMeasuresPartsAsTheSectionCutsThem) {
   EXPECT_EQ(j["part_list"][1]["section"], "kept");
   EXPECT_NEAR(j["part_list"][1]["area"].get<double>(), 2.0, 1e-9);
   EXPECT_EQ(j["part_list"][2]["section"], "removed");
+  // Removed, not hidden: the section hides what it removes, and info listed such parts as hidden.
+  EXPECT_TRUE(j["part_list"][2]["visible"].get<bool>());
+  EXPECT_EQ(r.out.find("hidden"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("parts      3\ntriangles"), std::string::npos) << r.out;
   EXPECT_TRUE(j["part_list"][2]["area"].is_null());
   EXPECT_TRUE(j["part_list"][2]["volume"].is_null());
   // The scene's bounds, as without the section (they were the cut meshes': the removed box gone,
@@ -1085,6 +1092,17 @@ TEST_F(Cli, MoreMemoryThanThereIsIsRefused) {
   mfr::writePng(blankB, blank);
   refused("compare " + blankA.string() + " " + blankB.string() + " --metric flip",
           "flip: FLIP of 4096x2048 pixels would take 512 MiB more memory");
+  // Decoding a valid PNG that does not fit: a memory refusal, not "corrupt PNG" (a bug hunt).
+  {
+    const CliResult r = mfr::test::runCommand("MFR_MEMORY_LIMIT_MIB=40 " + std::string(MFR_CLI) + " compare " +
+                                              blankA.string() + " " + blankB.string() + " --metric rmse");
+    EXPECT_EQ(r.exitCode, 1) << r.out;
+    EXPECT_EQ(
+        r.out.rfind("mfr: " + blankA.string() + ": decoding its 4096x2048 pixels would take 32 MiB more memory", 0), 0u)
+        << r.out;
+    EXPECT_NE(r.out.find("under MFR_MEMORY_LIMIT_MIB=40"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("corrupt"), std::string::npos) << r.out;
+  }
   // llvmpipe's buffers are main memory; a hardware driver answers GL_OUT_OF_MEMORY itself.
   const fs::path smallJson = dir() / "small.json";
   const CliResult small =
@@ -1337,6 +1355,16 @@ TEST_F(Cli, BudgetToolsRefuseWhatTheyCannotMeasure) {
   metaLength = static_cast<std::uint32_t>(deep.size());
   std::memcpy(bytes.data() + 20, &metaLength, 4);
   const fs::path deepData = write("deep.bin", bytes);
+  // A feature no weights file can hold the mean of: train wrote weights that mfr then refused.
+  {
+    std::string huge = mfr::readFile(data);
+    std::uint32_t length = 0;
+    std::memcpy(&length, huge.data() + 20, 4);
+    const float value = 3e38f;
+    std::memcpy(huge.data() + 24 + length + 4, &value, 4);  // row 0, column 1
+    expectCleanFailure("train " + write("huge.bin", huge).string() + " --epochs 1",
+                       "huge.bin: row 0, column 1: feature 3.0000000054977558e+38 beyond ±10000");
+  }
   expectCleanFailure("train " + deepData.string() + " --epochs 1",
                      "deep.bin: corrupt: its metadata nests 100000 levels deep (more than 256)");
   // A view looking away from everything: allocations printed "-nan %" and empty allocations,
@@ -1362,6 +1390,18 @@ TEST_F(Cli, BudgetToolsRefuseWhatTheyCannotMeasure) {
     oneLine("dataset @sample " + scene.string() + " -s 16x12 --budgets 1 -o " + (dir() / "x.bin").string(),
             scene.string() + ": nothing to render");
   }
+  // One file, budget or size given twice under two spellings: the same case measured (or, for
+  // train, every row taken) twice.
+  const std::string again = (dir() / "." / "d.bin").string();
+  expectCleanFailure("train " + data.string() + " " + again + " --epochs 1",
+                     "datasets: '" + again + "' is '" + data.string() + "' again (one file given twice)");
+  oneLine("evaluate " + flat.string() + " " + (dir() / ".." / dir().filename() / "flat.obj").string() +
+              " -s 16x12 --budgets k1",
+          "again (one file given twice)");
+  oneLine("evaluate @sample -s 16x12 --budgets f50,k1,f50.0", "--budgets f50,k1,f50.0: 'f50.0' is 'f50' again");
+  oneLine("allocations @sample -s 16x12 --budgets 2,2.0", "--budgets 2,2.0: '2.0' is '2' again");
+  oneLine("dataset @sample -s 080x060 -s 80x60 --budgets 1 -o " + (dir() / "y.bin").string(),
+          "--size: '80x60' is '080x060' again (one size given twice)");
   // optimal-k under oit: every row was the renderer's "--op oit: …", exit 0.
   oneLine("evaluate @sample -s 16x12 -r 1 --budgets f50 -m optimal-k:op=oit",
           "--methods optimal-k:op=oit: optimal-k is a hybrid-transparency reference");

@@ -95,6 +95,14 @@ DkbDataset readDataset(const std::filesystem::path& path) {
     if (!std::isfinite(d.rows[i]))  // with its row and column, as docs/methods.md says
       throw Error(where, "row " + std::to_string(i / kDatasetColumns) + ", column " +
                              std::to_string(i % kDatasetColumns) + ": a non-finite value");
+  // Features a weights file can hold the mean and spread of (its parameters lie within ±1e4; mfr
+  // dataset's are shares, depths and colours, within [0, 1]): a feature of 3e38 trained weights
+  // that mfr then refused (a bug hunt).
+  for (std::size_t i = 0; i < d.size(); ++i)
+    for (int f = 0; f < kDkbFeatures; ++f)
+      if (const float v = d.row(i)[f]; !(std::abs(v) <= 1e4f))
+        throw Error(where, "row " + std::to_string(i) + ", column " + std::to_string(f) + ": feature " + numberText(v) +
+                               " beyond ±10000 (mfr dataset's features lie within [0, 1])");
   // The labels as mfr dataset writes them: n(p) ≥ 1 and k(p) whole, 1 ≤ k(p) ≤ n(p), k(p)/F in
   // (0, 1]. A row outside them trained on (a label of 1e30 drove the loss to NaN).
   for (std::size_t i = 0; i < d.size(); ++i) {
