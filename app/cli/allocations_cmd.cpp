@@ -74,8 +74,7 @@ void addAllocations(CLI::App& app) {
         const FragmentLists lists = castFragments(scenes[s], scenes[s].view(v), w, h);
         // Nothing to share out: the shares below were 0/0 ("-nan %") and every allocation empty,
         // exit 0 (a bug hunt), as mfr dataset refuses it.
-        if (lists.fragments.empty())
-          throw Error(opt->scenes[s] + " view " + v, "nothing visible (no pixel has a fragment)");
+        requireSomethingVisible(lists, opt->scenes[s] + " view " + v);
         const ImageRGBA8 exact = compositeOver(lists, scenes[s].background);
         const HybridErrorTable errors = hybridErrorTable(lists, scenes[s].background);
         const std::vector<std::uint32_t> n = lists.counts();

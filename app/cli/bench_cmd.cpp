@@ -26,7 +26,7 @@ namespace mfr::cli {
 
 namespace {
 // A spec's error named by the spec given: "--param budget_mib=0: …" and "--op : …" named options
-// never given (a bug hunt).
+// never given (a bug hunt). Other errors (the machine's memory, a frame too large) go as they are.
 [[noreturn]] void throwForSpec(const std::string& spec, const Error& e) {
   std::string reason = e.what();
   if (reason.starts_with("--param "))
@@ -35,10 +35,10 @@ namespace {
     reason.replace(0, 5, "op=");
   else if (reason.starts_with("--method "))
     reason.erase(0, 9);
+  else
+    throw e;
   throw Error("--methods " + spec, reason);
 }
-}  // namespace
-namespace {
 
 std::string mib(std::uint64_t bytes) {
   std::ostringstream s;

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "mfr/io/load.hpp"
+#include "mfr/reference/oracle.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/clip_box.hpp"
 #include "mfr/scene/scene.hpp"
@@ -61,6 +62,10 @@ void refuseRepeats(const std::vector<std::string>& items, const std::string& opt
 // The same for files, spelt alike or not (./a.bin and a.bin, a link and its file: train took every
 // row twice, so validation rows were training rows too; a bug hunt). Built-ins (@sample) by name.
 void refuseRepeatedFiles(const std::vector<std::string>& paths, const std::string& option);
+// The budget commands (dataset, evaluate, allocations) on a view of nothing: there is no budget to
+// share (allocations printed "-nan %", evaluate "below what k = 1 needs" on every row, exit 0; a bug
+// hunt). Throws Error(what, "nothing visible …").
+void requireSomethingVisible(const FragmentLists& lists, const std::string& what);
 // --field and --molecule: what to read of a file that holds several things.
 struct ReadOptions {
   std::string field;                    // --field: the array or grid of a volume file

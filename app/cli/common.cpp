@@ -103,6 +103,10 @@ void refuseRepeatedFiles(const std::vector<std::string>& paths, const std::strin
         throw Error(option, "'" + paths[i] + "' is '" + paths[j] + "' again (one file given twice)");
 }
 
+void requireSomethingVisible(const FragmentLists& lists, const std::string& what) {
+  if (lists.fragments.empty()) throw Error(what, "nothing visible (no pixel has a fragment)");
+}
+
 void ReadOptions::add(CLI::App* cmd) {
   cmd->add_option("--field", field,
                   "Volume file: the point-data array (.vti, .vtk) or grid (.vdb) to read instead of the default "

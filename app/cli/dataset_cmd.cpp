@@ -125,10 +125,10 @@ void addDataset(CLI::App& app) {
       for (const std::string& v : views)
         for (const auto& [w, h] : sizes) {
           const FragmentLists lists = castFragments(scenes[s], scenes[s].view(v), w, h);
+          requireSomethingVisible(lists, opt->scenes[s] + " view " + v);
           HybridErrorTable errors = hybridErrorTable(lists, scenes[s].background);
           if (opt->labels == "class-optimal") errors = classMeanErrorTable(errors);
           const std::uint64_t nonEmpty = minimumSlots(errors);
-          if (nonEmpty == 0) throw Error(opt->scenes[s] + " view " + v, "nothing visible");
           bool allDone = false;  // levels at or above Σn all mean "every fragment": one frame of those
           std::set<std::uint64_t> written;  // budgets in slots: 1 and 1.0001 can round to one F
           const std::uint64_t exactSlots = exactHybridSlots(lists);

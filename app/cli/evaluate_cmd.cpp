@@ -272,7 +272,7 @@ void addEvaluate(CLI::App& app) {
         const std::uint64_t total = lists.fragments.size();
         // A view that sees nothing has no budget to share: every row was "below what k = 1 needs",
         // exit 0 (a bug hunt), as mfr dataset refuses it.
-        if (total == 0) throw Error(opt->scenes[s] + " view " + v, "nothing visible (no pixel has a fragment)");
+        requireSomethingVisible(lists, opt->scenes[s] + " view " + v);
         // The reference lost fragments (a list longer than abuffer-ll's pool or resolve holds): the
         // rows are measured against an incomplete image, which was not said (a bug hunt).
         if (referenceOverflowPixels > 0)

@@ -33,6 +33,7 @@
 
 #include "main_window.hpp"
 #include "mfr/error.hpp"
+#include "mfr/json_text.hpp"
 #include "mfr/host_memory.hpp"
 #include "mfr/image.hpp"
 #include "mfr/io_util.hpp"
@@ -278,6 +279,10 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
     const qsizetype eq = p.indexOf(QLatin1Char('='));
     const QJsonDocument json = eq > 0 ? QJsonDocument::fromJson(p.mid(eq + 1).toUtf8()) : QJsonDocument();
     if (!json.isObject()) fail(QStringLiteral("--plugin-settings %1: expected id={json object}").arg(p), 2);
+    if (const std::optional<std::string> repeated = mfr::repeatedJsonKey(p.mid(eq + 1).toStdString()))
+      fail(QStringLiteral("--plugin-settings %1: '%2' is given twice")
+               .arg(p.left(eq), QString::fromStdString(*repeated)),
+           2);
     // As -p: two settings of one plugin meant one of them, and the last silently won.
     if (!cl.pluginSettings.emplace(p.left(eq), json.object()).second)
       fail(QStringLiteral("--plugin-settings: plugin '%1' is given twice").arg(p.left(eq)), 2);

@@ -633,9 +633,11 @@ MainWindow::ExportRender MainWindow::renderForExport(QSize size) {
 }
 
 void MainWindow::exportImage(const QString& path, QSize size, bool legend, const ExportCheck& check) {
+  mfr::requireSomethingToDraw(model_->drawnScene());  // as mfr render refuses it, before --legend
   std::optional<ViewerModel::ColorLegend> shown;
   if (legend) {
-    // The field colouring's map, else the current volume's isosurfaces' (as mfr render --legend).
+    // The field colouring's map, else the isosurfaces' (ViewerModel::colorLegend; as mfr render
+    // --legend).
     shown = model_->colorLegend();
     if (!shown)
       throw mfr::Error("--legend",
@@ -648,7 +650,6 @@ void MainWindow::exportImage(const QString& path, QSize size, bool legend, const
                                        .arg(mfr::kMinLegendImageSize)
                                        .toStdString());
   }
-  mfr::requireSomethingToDraw(model_->drawnScene());  // as mfr render refuses it
   ExportRender render = renderForExport(size);
   if (check) {
     std::map<std::string, std::string> params = model_->params();

@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "mfr/error.hpp"
+#include "mfr/json_text.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/clip_box.hpp"
 #include "mfr/scene/color_map.hpp"
@@ -637,9 +638,14 @@ Session readSessionFile(const QString& path) {
   QFile f(path);
   if (!f.open(QIODevice::ReadOnly)) throw mfr::Error(path.toStdString(), f.errorString().toStdString());
   QJsonParseError error{};
-  const QJsonDocument doc = QJsonDocument::fromJson(f.readAll(), &error);
+  const QByteArray bytes = f.readAll();
+  const QJsonDocument doc = QJsonDocument::fromJson(bytes, &error);
   if (error.error != QJsonParseError::NoError)
     throw mfr::Error(path.toStdString(), QStringLiteral("JSON error at byte %1: %2").arg(error.offset).arg(error.errorString()).toStdString());
+  // Qt's parser keeps the last of a key given twice: a second "objects" dropped the first without
+  // a word, as scene files did before they refused it (a bug hunt).
+  if (const std::optional<std::string> repeated = mfr::repeatedJsonKey(bytes.toStdString()))
+    throw mfr::Error(path.toStdString(), *repeated + ": given twice (the keys of a JSON object must differ)");
   Session s = sessionFromJson(doc.object(), path);
   // Built-ins (@sample) and absolute paths stay; relative ones are relative to the session file.
   if (!s.scenePath.startsWith('@') && QFileInfo(s.scenePath).isRelative())

@@ -692,6 +692,8 @@ class ViewerTest : public QObject {
         {R"(hybridvolume={"window":[0,"x"]})",
          "--plugin-settings hybridvolume: 'window'[1]: a string, expected a number"},
         {R"(ghosting={"ghost":1})", "--plugin-settings ghosting: 'ghost': a number, expected a boolean"},
+        // Qt's parser kept the last of a repeated key without a word (a bug hunt).
+        {R"(budget={"budget_mib":2,"budget_mib":3})", "--plugin-settings budget: 'budget_mib' is given twice"},
     };
     for (const auto& [setting, message] : cases) {
       QString out;
@@ -944,6 +946,23 @@ class ViewerTest : public QObject {
       } catch (const mfr::Error& e) {
         QVERIFY2(QString::fromUtf8(e.what()).startsWith(message), e.what());
       }
+    }
+    // A key given twice in the file (Qt's parser kept the last: a second "objects" dropped the
+    // first without a word), as scene files refuse it.
+    QTemporaryDir dir;
+    const QString twice = dir.filePath(QStringLiteral("twice.mfrsession"));
+    {
+      QFile f(twice);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(R"({"format": "mfrview-session", "version": 1, "scene": "@sample",
+                  "camera": {"eye": [3, 2, 4], "target": [0, 0, 0], "up": [0, 1, 0], "near": 1, "near": 2}})");
+    }
+    try {
+      (void)readSessionFile(twice);
+      QFAIL("a repeated key was accepted");
+    } catch (const mfr::Error& e) {
+      QCOMPARE(QString::fromUtf8(e.what()),
+               twice + QStringLiteral(": camera.near: given twice (the keys of a JSON object must differ)"));
     }
   }
 
@@ -1243,10 +1262,20 @@ class ViewerTest : public QObject {
     QCOMPARE(runProgram(MFRVIEW, {path, "-m", "abuffer-ll", "--size", "64x48", "--screenshot", shot}, &out), 0);
     diff = maxChannelDifference(mfr::readPng(shot.toStdString()), mfr::readPng(cut.toStdString()));
     QVERIFY2(diff >= 0 && diff <= 1, qPrintable(QStringLiteral("session: difference %1").arg(diff)));
-    // Moving the camera fits them again, so orbiting never clips the scene.
-    m.setCamera(navigation::orbit(m.camera(), QPointF(1, 0), m.renderSize()));
-    QVERIFY(!m.camera().depthRangeGiven);
-    QVERIFY2(m.camera().nearPlane < 4.0, qPrintable(QString::number(m.camera().nearPlane)));
+    // Moving the camera fits them again, so navigating never clips the scene: each gesture, the
+    // projection toggled, a standard view and fit.
+    const mfr::Camera cutView = m.scene().view("cut");
+    const QSize view = m.renderSize();
+    for (const mfr::Camera& moved :
+         {navigation::orbit(cutView, QPointF(1, 0), view), navigation::pan(cutView, QPointF(1, 0), view),
+          navigation::zoomAt(cutView, QPointF(10, 10), view, 1.0), navigation::toggledProjection(cutView),
+          navigation::standardView(navigation::StandardView::Front, m.scene(), cutView), m.scene().fit(cutView)}) {
+      m.setCamera(cutView);
+      QCOMPARE(m.camera().nearPlane, 4.5);
+      m.setCamera(moved);
+      QVERIFY(!m.camera().depthRangeGiven);
+      QVERIFY2(m.camera().nearPlane < 4.0, qPrintable(QString::number(m.camera().nearPlane)));
+    }
     // A fitted camera's session fits again on reload.
     QVERIFY(!captureSession(m).camera.depthRangeGiven);
   }

@@ -4,8 +4,11 @@
 // error" after all its work.
 #include <algorithm>
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
+
+#include "mfr/error.hpp"
 
 namespace mfr {
 
@@ -16,8 +19,9 @@ std::string jsonText(const Json& json, int indent = -1) {
 
 // How deeply arrays and objects nest in a JSON text (0 for a bare value), counted without parsing:
 // nlohmann's dump and the readers of nested values (CSG trees) recurse, and a weights file whose
-// "training" nested 100,000 arrays deep overflowed the stack (a bug hunt). Files mfr reads are
-// refused beyond kJsonNestingLimit.
+// "training" nested 100,000 arrays deep overflowed the stack (a bug hunt). Weights files and
+// datasets' metadata, which mfr writes out again, are refused beyond kJsonNestingLimit (scene
+// files are read without recursion but for CSG trees, which have their own limit).
 inline constexpr std::size_t kJsonNestingLimit = 256;
 inline std::size_t jsonNestingDepth(std::string_view text) {
   std::size_t depth = 0, deepest = 0;
@@ -39,5 +43,19 @@ inline std::size_t jsonNestingDepth(std::string_view text) {
   }
   return deepest;
 }
+
+// Throws Error(what, prefix + "nests N levels deep (more than LIMIT)") beyond `limit`.
+inline void requireJsonNesting(std::string_view text, const std::string& what, const std::string& prefix,
+                               std::size_t limit = kJsonNestingLimit) {
+  if (const std::size_t depth = jsonNestingDepth(text); depth > limit)
+    throw Error(what,
+                prefix + "nests " + std::to_string(depth) + " levels deep (more than " + std::to_string(limit) + ")");
+}
+
+// Where `text` first gives a key twice in one object ("objects[1].opacity"), if it is JSON that
+// does: for JSON read by another parser (Qt's, of sessions and --plugin-settings, takes the last of
+// a repeated key without a word). nullopt for JSON without a repeated key and for text that is not
+// JSON (its parser says why).
+std::optional<std::string> repeatedJsonKey(const std::string& text);
 
 }  // namespace mfr

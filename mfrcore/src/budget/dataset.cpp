@@ -86,9 +86,9 @@ DkbDataset readDataset(const std::filesystem::path& path) {
   d.metadata = bytes.substr(header, metaLength);
   if (!d.metadata.empty() && !nlohmann::json::accept(d.metadata))
     throw Error(where, "corrupt (its metadata is not JSON)");
-  if (const std::size_t depth = jsonNestingDepth(d.metadata); depth > kJsonNestingLimit)
-    throw Error(where, "corrupt: its metadata nests " + std::to_string(depth) + " levels deep (more than " +
-                           std::to_string(kJsonNestingLimit) + ")");
+  // Room for the record mfr train nests it in (training.dataset[i]), so that its weights file stays
+  // readable (a review).
+  requireJsonNesting(d.metadata, where, "corrupt: its metadata ", kDatasetMetadataNestingLimit);
   d.rows.resize(rows * kDatasetColumns);
   std::memcpy(d.rows.data(), bytes.data() + header + metaLength, payload);
   for (std::size_t i = 0; i < d.rows.size(); ++i)

@@ -234,9 +234,7 @@ std::string printable(const std::string& s) {
 NeuralImportanceModel parseNeuralImportance(const std::string& text, const std::string& source) {
   // A number past double's range ("1e999") or a key of the wrong type is nlohmann's out_of_range
   // or type_error, not parse_error: every JSON error names the file (was "internal error").
-  if (const std::size_t depth = jsonNestingDepth(text); depth > kJsonNestingLimit)
-    throw Error(source, "not a weights file: its JSON nests " + std::to_string(depth) + " levels deep (more than " +
-                            std::to_string(kJsonNestingLimit) + ")");
+  requireJsonNesting(text, source, "not a weights file: its JSON ");
   try {
     return parseWeightsJson(text, source);
   } catch (const nlohmann::json::parse_error& e) {

@@ -557,6 +557,17 @@ CsgNode parseCsgNode(const Reader& r, const json& j, const std::string& where, c
 
 }  // namespace
 
+std::optional<std::string> repeatedJsonKey(const std::string& text) {
+  if (jsonNestingDepth(text) > kJsonNestingLimit) return std::nullopt;
+  try {
+    (void)parseWithoutRepeatedKeys(text);
+  } catch (const RepeatedKey& repeated) {
+    return repeated.where;
+  } catch (...) {  // not JSON, or a number out of range: the caller's parser says why
+  }
+  return std::nullopt;
+}
+
 namespace {
 json csgJson(const CsgNode& node, const Scene& scene) {
   if (node.op == CsgNode::Op::Primitive) return scene.objects.at(node.object).name;
@@ -571,9 +582,6 @@ json csgJson(const CsgNode& node, const Scene& scene) {
 
 CsgTree parseCsgText(const std::string& text, const Scene& scene) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) return {};
-  if (const std::size_t depth = jsonNestingDepth(text); depth > kJsonNestingLimit)
-    throw Error("CSG tree", "nests " + std::to_string(depth) + " levels deep (more than " +
-                                std::to_string(kJsonNestingLimit) + ")");
   json j;
   try {
     j = json::parse(text);
@@ -593,10 +601,6 @@ std::string csgText(const CsgTree& tree, const Scene& scene) {
 
 Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseDir, const std::string& name,
                      const LoadProgress& progress) {
-  // Readers of nested values (CSG trees) recurse.
-  if (const std::size_t depth = jsonNestingDepth(text); depth > kJsonNestingLimit)
-    throw Error(name, "its JSON nests " + std::to_string(depth) + " levels deep (more than " +
-                          std::to_string(kJsonNestingLimit) + ")");
   json doc;
   try {
     doc = parseWithoutRepeatedKeys(text);

@@ -10,6 +10,7 @@
 //   uint64    rows R
 //   uint32    metadata length L, then L bytes of UTF-8 JSON (scenes, views, budgets, command)
 //   R·C float32, row-major: features[12], k(p)/F, k(p), n(p)
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <random>
@@ -25,6 +26,9 @@
 namespace mfr {
 
 inline constexpr int kDatasetColumns = kDkbFeatures + 3;
+// How deeply a dataset's metadata JSON may nest: mfr dataset writes 3 levels; mfr train nests it 3
+// levels deeper in the weights file, which is read up to kJsonNestingLimit (256).
+inline constexpr std::size_t kDatasetMetadataNestingLimit = 64;
 inline constexpr int kDatasetLabel = kDkbFeatures;  // k(p) / F
 inline constexpr int kDatasetK = kDkbFeatures + 1;  // k(p)
 inline constexpr int kDatasetN = kDkbFeatures + 2;  // n(p)

@@ -102,8 +102,9 @@ struct FragmentLists {
 // What castFragments refuses before it casts, for the GPU renderers to refuse the same (they drew
 // nothing, or garbage, and said nothing): a singular camera (a scene scaled to infinity), a visible
 // mesh that fails Mesh::validate (a non-finite vertex), no visible triangle of non-zero world
-// area and no visible volume. The scene as given (a section is not applied). Throws mfr::Error
-// naming `what`, by default "scene 'NAME'" (a command that loaded it from a file names the file).
+// area and no visible volume. The scene as given (a section is not applied). Throws mfr::Error;
+// "nothing to render" names `what`, by default "scene 'NAME'" (a command that loaded the scene from
+// a file names the file).
 void checkDrawable(const Scene& scene, const Camera& camera, int width, int height, const std::string& what = {});
 
 // Throws mfr::Error for a zero-size image or an empty scene.

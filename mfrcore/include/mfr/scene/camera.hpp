@@ -25,7 +25,7 @@ struct Camera {
   double farPlane = 100.0;
   // Near and far were given (a scene file's view with "near"/"far", or a session that saved such
   // a view): the viewer keeps them instead of fitting them to what is drawn, as mfr render does.
-  // Fitting (fittedTo, fitDepthRange) clears it.
+  // Fitting to valid bounds (fittedTo, fitDepthRange) clears it.
   bool depthRangeGiven = false;
 
   [[nodiscard]] glm::dmat4 viewMatrix() const;
