@@ -245,6 +245,9 @@ void addEvaluate(CLI::App& app) {
       for (const std::string& v : views) {
         const Camera camera = scenes[s].view(v);
         const FragmentLists lists = castFragments(scenes[s], camera, w, h);
+        // A view that sees nothing has no budget to share: every row was "below what k = 1 needs",
+        // exit 0 (a bug hunt), as mfr dataset refuses it.
+        requireSomethingVisible(lists, opt->scenes[s] + " view " + v);
         const ImageRGBA8 exact = compositeOver(lists, scenes[s].background);
         // The GPU methods are measured against the exact image of the same rasterisation — every
         // fragment, composited with "over" (the linked-list A-buffer, exact on every
@@ -270,9 +273,6 @@ void addEvaluate(CLI::App& app) {
           throw Error("scene '" + scenes[s].name + "', view " + v + ": the exact reference (abuffer-ll)", reason);
         }
         const std::uint64_t total = lists.fragments.size();
-        // A view that sees nothing has no budget to share: every row was "below what k = 1 needs",
-        // exit 0 (a bug hunt), as mfr dataset refuses it.
-        requireSomethingVisible(lists, opt->scenes[s] + " view " + v);
         // The reference lost fragments (a list longer than abuffer-ll's pool or resolve holds): the
         // rows are measured against an incomplete image, which was not said (a bug hunt).
         if (referenceOverflowPixels > 0)

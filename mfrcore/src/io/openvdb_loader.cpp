@@ -145,9 +145,9 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
   std::vector<std::string> labels;
   for (auto it = file.beginName(); it != file.endName() && labels.size() < headers->size(); ++it)
     labels.push_back(it.gridName());
+  for (std::size_t i = labels.size(); i < headers->size(); ++i) labels.push_back((*headers)[i]->getName());
   std::map<std::string, std::vector<std::string>> sharing;  // the labels of each name
-  for (std::size_t i = 0; i < headers->size(); ++i)
-    sharing[(*headers)[i]->getName()].push_back(i < labels.size() ? labels[i] : (*headers)[i]->getName());
+  for (std::size_t i = 0; i < headers->size(); ++i) sharing[(*headers)[i]->getName()].push_back(labels[i]);
   // The grid read: the one named `field`; else "density" if the file has that scalar grid, else its
   // first scalar grid, else the magnitude of its first vector grid.
   std::string chosen, list;
@@ -155,7 +155,7 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
   int rank = 0;  // of the chosen grid: 3 density, 2 scalar, 1 vector, 0 none
   for (std::size_t i = 0; i < headers->size(); ++i) {
     const openvdb::GridBase& g = *(*headers)[i];
-    const std::string label = i < labels.size() ? labels[i] : g.getName();
+    const std::string& label = labels[i];
     list += (list.empty() ? "" : ", ") + label + " (" + g.valueType() + ")";
     const int r = scalar(g) ? (g.getName() == "density" ? 3 : 2) : vectorValued(g) ? 1 : 0;
     if (r > 0) readable.push_back(label);
