@@ -16,6 +16,7 @@
 #include <QOpenGLContext>
 #include <QStatusBar>
 #include <QSurfaceFormat>
+#include <QLayout>
 #include <QTimer>
 
 #include <algorithm>
@@ -596,6 +597,13 @@ int main(int argc, char** argv) {
   }
 
   window.show();
+  // Asked again once the docks are laid out: the first layout gives them their size hints and
+  // grew an 800-wide window to 1048 where its least width is 894 (a bug hunt).
+  if (!cl.windowSize.isEmpty())
+    QTimer::singleShot(0, &window, [&window, &cl] {
+      window.layout()->activate();
+      window.resize(cl.windowSize);
+    });
   if (!cl.session.isEmpty()) {
     window.openSession(cl.session);
     // A scripted run has no one to read the message box: a bad session file ends it.

@@ -4396,6 +4396,19 @@ class ViewerTest : public QObject {
     // widths added up).
     w->resize(1440, 900);
     QTRY_VERIFY2_WITH_TIMEOUT(w->view().width() >= 648, qPrintable(QString::number(w->view().width())), 20000);
+    // --window-size below that least size opens the window at it, not at the docks' size hints
+    // (800 × 500 opened 1048 wide: a bug hunt); one above it is the size asked for.
+    QTemporaryDir dir;
+    QString out;
+    for (const auto& [asked, widest] : {std::pair{QSize(800, 500), 1000}, std::pair{QSize(1100, 700), 1100}}) {
+      const QString png = dir.filePath(QStringLiteral("window.png"));
+      const QString size = QStringLiteral("%1x%2").arg(asked.width()).arg(asked.height());
+      QCOMPARE(runProgram(MFRVIEW, {"@sample", "-m", "vkb", "--window-size", size, "--window-screenshot", png}, &out),
+               0);
+      const mfr::ImageRGBA8 shot = mfr::readPng(png.toStdString());
+      QVERIFY2(shot.width >= asked.width() && shot.width <= widest && shot.height == asked.height(),
+               qPrintable(QStringLiteral("%1: %2 x %3").arg(size).arg(shot.width).arg(shot.height)));
+    }
   }
 
   // A control of the Clip dock changes what it shows and nothing else: a file's plane and box need
