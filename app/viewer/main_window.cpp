@@ -277,7 +277,7 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
     statusBar()->showMessage(shown.isEmpty() ? text : shown + QStringLiteral("; ") + text, 20000);
   });
   connect(model_, &ViewerModel::renderErrorChanged, this, [this](const QString& message) {
-    if (!message.isEmpty()) statusBar()->showMessage(tr("Cannot render: %1").arg(message));
+    if (!message.isEmpty()) statusBar()->showMessage(tr("Cannot render: %1").arg(model_->renderErrorShown()));
   });
 
   resize(1400, 900);

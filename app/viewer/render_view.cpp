@@ -545,7 +545,7 @@ void RenderView::updateOverlays() {
   // A frame that cannot be rendered leaves the view empty: say why there, not only in the status
   // bar, whose next message would hide it.
   if (!model_.compareEnabled() && model_.hasScene() && !model_.renderError().isEmpty()) {
-    errorNote_->setText(tr("Cannot render:\n%1").arg(model_.renderError()));
+    errorNote_->setText(tr("Cannot render:\n%1").arg(model_.renderErrorShown()));
     errorNote_->setFixedWidth(std::clamp(width() - 24, 80, 520));
     errorNote_->adjustSize();
     errorNote_->move(std::max(0, (width() - errorNote_->width()) / 2),

@@ -317,6 +317,11 @@ class ViewerModel final : public ViewerContext {
   void reportFrame(const mfr::Stats& stats) { reportFrame(0, stats); }
   void reportRenderError(const QString& message);
   [[nodiscard]] const QString& renderError() const { return renderError_; }
+  // The error as the window shows it: a parameter by its name, as the Method panel and the
+  // plugins set it, not by mfr's --param option that the user of the window never typed.
+  [[nodiscard]] QString renderErrorShown() const {
+    return renderError_.startsWith(QLatin1String("--param ")) ? renderError_.mid(8) : renderError_;
+  }
   [[nodiscard]] quint64 framesRendered() const { return framesRendered_; }
 
   // What the pane of `side` shows now, and its exact reference image (the oracle's "over", or its

@@ -22,6 +22,7 @@
 #include <QSignalSpy>
 #include <QSlider>
 #include <QSpinBox>
+#include <QStatusBar>
 #include <QStandardPaths>
 #include <QSurfaceFormat>
 #include <QTableWidget>
@@ -458,6 +459,19 @@ class ViewerTest : public QObject {
     QVERIFY(k);
     k->setValue(3);
     QTRY_VERIFY_WITH_TIMEOUT(m.stats().method == "kbuffer" && m.stats().kMax == 3, kTimeoutMs);
+    // A value that cannot render is named as the panel names it, not by mfr's --param option,
+    // which no one typed here; the model keeps mfr's words for scripted runs.
+    m.setMethod(QStringLiteral("fkb"));
+    m.setParams({{"budget_mib", "0.01"}});
+    QTRY_VERIFY_WITH_TIMEOUT(!m.renderError().isEmpty(), kTimeoutMs);
+    QVERIFY2(m.renderError().startsWith("--param budget_mib=0.01: below what k = 1 needs"),
+             qPrintable(m.renderError()));
+    const QString shown = w->statusBar()->currentMessage();
+    QVERIFY2(shown.startsWith("Cannot render: budget_mib=0.01: below what k = 1 needs"), qPrintable(shown));
+    auto* note = w->findChild<QLabel*>("renderErrorNote");
+    QVERIFY(note);
+    QTRY_VERIFY_WITH_TIMEOUT(note->isVisible(), kTimeoutMs);
+    QVERIFY2(note->text().startsWith("Cannot render:\nbudget_mib=0.01: below"), qPrintable(note->text()));
   }
 
   void budgetSliderFollowsMemory() {
