@@ -424,6 +424,17 @@ QRect RenderView::paneRect(int side) const {
   return {QPoint(side == 1 ? pane.width() : 0, 0), pane};
 }
 
+QRectF RenderView::navigationArea(QPointF point) const {
+  const double ratio = devicePixelRatioF();
+  const auto logical = [ratio](const QRect& r) {
+    return QRectF(r.x() / ratio, r.y() / ratio, r.width() / ratio, r.height() / ratio);
+  };
+  const QRectF second = logical(paneRect(1));
+  return model_.compareEnabled() && model_.compareLayout() != CompareLayout::Split && point.x() >= second.left()
+             ? second
+             : logical(paneRect(0));
+}
+
 QRect RenderView::paneVisibleRect(int side) const {
   const QRect pane = paneRect(side);
   if (!model_.compareEnabled() || model_.compareLayout() != CompareLayout::Split) return pane;
@@ -783,10 +794,11 @@ void RenderView::mouseMoveEvent(QMouseEvent* event) {
   const QPoint pos = event->position().toPoint();
   const QPointF delta = pos - lastMouse_;
   lastMouse_ = pos;
+  const QSize area = navigationArea(pos).size().toSize();
   if (drag_ == Drag::Orbit)
-    model_.setCamera(navigation::orbit(model_.camera(), delta, size()));
+    model_.setCamera(navigation::orbit(model_.camera(), delta, area));
   else
-    model_.setCamera(navigation::pan(model_.camera(), delta, size()));
+    model_.setCamera(navigation::pan(model_.camera(), delta, area));
 }
 
 void RenderView::mouseReleaseEvent(QMouseEvent*) {
@@ -800,7 +812,9 @@ void RenderView::wheelEvent(QWheelEvent* event) {
   if (steps != 0.0) {
     beginNavigation();
     endNavigation(300);  // wheel steps come apart: the motion has stopped when none follows soon
-    model_.setCamera(navigation::zoomAt(model_.camera(), event->position(), size(), steps));
+    const QRectF area = navigationArea(event->position());
+    model_.setCamera(
+        navigation::zoomAt(model_.camera(), event->position() - area.topLeft(), area.size().toSize(), steps));
   }
   event->accept();
 }

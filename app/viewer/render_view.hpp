@@ -98,6 +98,10 @@ class RenderView final : public QOpenGLWidget {
   // it that shows (the split layout shows each image only on its side of the line).
   [[nodiscard]] QRect paneRect(int side) const;
   [[nodiscard]] QRect paneVisibleRect(int side) const;
+  // The pane under `point` (logical widget coordinates), in logical coordinates: what the mouse
+  // navigates, so that side by side a drag pans and the wheel zooms at the pane's own scale and
+  // towards the point under the cursor in that pane.
+  [[nodiscard]] QRectF navigationArea(QPointF point) const;
 
   // The pixel probe at `point` (logical widget coordinates): the pane that shows it, the pixel of
   // that pane's image, the oracle's exact sorted list there and — for a GPU method keeping sorted

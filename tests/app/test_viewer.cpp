@@ -3406,6 +3406,67 @@ class ViewerTest : public QObject {
     QVERIFY(glm::length(back.eye - c.eye) < 1e-9);  // the round trip keeps the framing
   }
 
+  // Side by side, the mouse navigates the pane under it: a pan drag moves the scene as far as the
+  // cursor in either pane, and the wheel zooms towards the point under the cursor in that pane
+  // (both used the whole view's size and centre: a pan moved pane A's scene 2/3 as far as the
+  // cursor here, and the wheel zoomed towards another point: a bug hunt). Points go to pane
+  // pixels by the camera's own matrices, as the panes are rendered.
+  void sideBySideNavigationFollowsThePane() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    RenderView& view = w->view();
+    view.setFixedSize(400, 300);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(400, 300), kTimeoutMs);
+    QCOMPARE(view.devicePixelRatioF(), 1.0);
+    m.setCompareLayout(CompareLayout::SideBySide);
+    m.setCompareEnabled(true);
+    QCOMPARE(m.paneSize(), QSize(200, 300));
+    const QSizeF pane(200.0, 300.0);
+    const auto toPane = [&pane](const mfr::Camera& c, const glm::dvec3& p) {
+      const glm::dvec4 clip = c.projectionMatrix(pane.width() / pane.height()) * c.viewMatrix() * glm::dvec4(p, 1.0);
+      return QPointF((clip.x / clip.w * 0.5 + 0.5) * pane.width(), (0.5 - clip.y / clip.w * 0.5) * pane.height());
+    };
+    const auto fromPane = [&pane](const mfr::Camera& c, QPointF at) {
+      const glm::dmat4 inverse = glm::inverse(c.projectionMatrix(pane.width() / pane.height()) * c.viewMatrix());
+      const glm::dvec4 p =
+          inverse * glm::dvec4(at.x() / pane.width() * 2.0 - 1.0, 1.0 - at.y() / pane.height() * 2.0, 0.0, 1.0);
+      return glm::dvec3(p) / p.w;
+    };
+    for (const bool ortho : {false, true}) {
+      mfr::Camera start = m.scene().view("iso");
+      if (ortho) start = navigation::toggledProjection(start);
+      for (const int side : {0, 1}) {
+        m.setCamera(start);
+        const QPoint offset(side == 1 ? 200 : 0, 0);
+        // A pan drag of (40, 30) in the pane: the target under the pane's centre follows it.
+        const glm::dvec3 target = start.target;
+        const QPointF before = toPane(m.camera(), target);
+        QTest::mousePress(&view, Qt::MiddleButton, {}, offset + QPoint(100, 150));
+        QTest::mouseMove(&view, offset + QPoint(120, 165));
+        QTest::mouseMove(&view, offset + QPoint(140, 180));
+        QTest::mouseRelease(&view, Qt::MiddleButton, {}, offset + QPoint(140, 180));
+        const QPointF moved = toPane(m.camera(), target) - before;
+        QVERIFY2(
+            std::abs(moved.x() - 40.0) < 0.5 && std::abs(moved.y() - 30.0) < 0.5,
+            qPrintable(QStringLiteral("ortho %1, side %2: %3, %4").arg(ortho).arg(side).arg(moved.x()).arg(moved.y())));
+        // Three wheel steps in at (150, 60) in the pane: the point under it stays under it.
+        m.setCamera(start);
+        const QPointF cursor(150.0, 60.0);
+        const glm::dvec3 under = fromPane(m.camera(), cursor);
+        const QPointF at = QPointF(offset) + cursor;
+        QWheelEvent wheel(at, view.mapToGlobal(at), QPoint(), QPoint(0, 360), Qt::NoButton, Qt::NoModifier,
+                          Qt::NoScrollPhase, false);
+        QApplication::sendEvent(&view, &wheel);
+        const QPointF after = toPane(m.camera(), under);
+        QVERIFY2(glm::length(m.camera().eye - start.eye) > 1e-3, "the wheel did not zoom");
+        QVERIFY2(
+            std::abs(after.x() - cursor.x()) < 0.5 && std::abs(after.y() - cursor.y()) < 0.5,
+            qPrintable(QStringLiteral("ortho %1, side %2: %3, %4").arg(ortho).arg(side).arg(after.x()).arg(after.y())));
+      }
+    }
+  }
+
   // The Probe dock: Ctrl + click lists the oracle's exact fragments behind the pixel (parts in
   // depth order, shares summing to 100 %), which of them the method holds (a k-buffer's k nearest,
   // an A-buffer's all), follows the method without another click, does not orbit, and clears.
