@@ -877,6 +877,7 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path, const std::fun
   scenePath_ = path;
   hasScene_ = true;
   ++sceneRevision_;
+  ++sceneSerial_;
   updateSceneGeometry(false);  // the camera is the new scene's fit view, below
   updateDrawnScene();
   // The z-thickness is a length in the old scene's units: the new one starts at its own default.

@@ -94,6 +94,7 @@ class ViewerModel final : public ViewerContext {
   [[nodiscard]] std::map<std::string, std::string> params() const override { return paramsOf(0); }
   void setParams(const std::map<std::string, std::string>& changes) override { setParamsOf(0, changes); }
   [[nodiscard]] bool hasScene() const override { return hasScene_; }
+  [[nodiscard]] quint64 sceneSerial() const override { return sceneSerial_; }
   [[nodiscard]] const mfr::Stats& stats() const override { return stats_[0]; }
   [[nodiscard]] QSize renderSize() const { return renderSize_; }  // the whole view's pixels
   [[nodiscard]] QSize imageSize() const override { return paneSize(); }
@@ -401,6 +402,7 @@ class ViewerModel final : public ViewerContext {
   std::optional<mfr::Camera> keepCamera_;  // setMoleculeStyle's camera, for the scene it loads
   std::optional<mfr::MoleculeStyle> requestedMoleculeStyle_;  // setMoleculeStyle's, while it loads
   quint64 sceneRevision_ = 0;
+  quint64 sceneSerial_ = 0;  // scenes opened (setScene)
   mfr::Bounds bounds_;
   double radius_ = 0.0;
 

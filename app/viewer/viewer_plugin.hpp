@@ -70,6 +70,11 @@ class ViewerContext : public QObject {
   virtual void setParams(const std::map<std::string, std::string>& changes) = 0;
 
   [[nodiscard]] virtual bool hasScene() const = 0;
+  // 1.12: counts the scenes opened (a file read again counts too: a molecule's other
+  // representation). sceneChanged comes for a new scene and for an edit alike; a panel that keeps
+  // state per part tells them apart by this number, since another file's parts may have the same
+  // names (the ghosting panel kept its focus and ghosting there: a bug hunt).
+  [[nodiscard]] virtual quint64 sceneSerial() const = 0;
   // Stats of the last frame drawn in the view (empty before the first).
   [[nodiscard]] virtual const mfr::Stats& stats() const = 0;
   // Pixels of the image stats() describes: the view's, or in compare mode side by side the first
@@ -270,5 +275,6 @@ class MfrViewerPlugin {
 //      side by side is two images).
 // 1.10: note (and the signal noted): notes of a plugin for the status bar and stderr.
 // 1.11: exportParams: a plugin's parameters for an exported image of another size.
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.11"
+// 1.12: sceneSerial: a new scene told from an edit of the same one.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.12"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

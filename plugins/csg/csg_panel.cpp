@@ -86,8 +86,10 @@ CsgPanel::CsgPanel(ViewerContext& context, QWidget* parent) : QWidget(parent), c
 
 void CsgPanel::sceneChanged() {
   const QStringList names = context_.hasScene() ? context_.objectNames() : QStringList{};
-  if (names != names_) {
+  // Another scene starts with nothing checked, even where its parts have the old one's names.
+  if (names != names_ || context_.sceneSerial() != sceneSerial_) {
     names_ = names;
+    sceneSerial_ = context_.sceneSerial();
     objects_->clear();
     for (const QString& name : names) {
       auto* item = new QListWidgetItem(name, objects_);

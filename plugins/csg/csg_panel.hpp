@@ -34,4 +34,5 @@ class CsgPanel final : public QWidget {
   QPlainTextEdit* text_ = nullptr;
   QLabel* error_ = nullptr;
   QStringList names_;  // the object list's names, to rebuild it only when they change
+  quint64 sceneSerial_ = 0;  // ViewerContext::sceneSerial of the scene the list shows
 };

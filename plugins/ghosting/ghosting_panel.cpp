@@ -166,10 +166,13 @@ QStringList GhostingPanel::ownParts(const QStringList& names) const {
 
 void GhostingPanel::sceneChanged() {
   const QStringList names = context_.hasScene() ? context_.objectNames() : QStringList{};
-  if (names != names_) {
+  const quint64 serial = context_.sceneSerial();
+  if (names != names_ || serial != sceneSerial_) {
     // Isosurfaces added or removed (the scene's own parts unchanged): the parts that stay keep
-    // their focus, and ghosting goes on over the new ones. Another scene: nothing of it is ghosted.
-    const bool sameScene = !names_.isEmpty() && ownParts(names) == ownParts(names_);
+    // their focus, and ghosting goes on over the new ones. Another scene: nothing of it is ghosted,
+    // even where its parts have the old one's names.
+    const bool sameScene = serial == sceneSerial_ && !names_.isEmpty() && ownParts(names) == ownParts(names_);
+    sceneSerial_ = serial;
     QMap<QString, Qt::CheckState> focus;
     QMap<QString, double> before;  // opacities before ghosting, of the parts still ghosted
     if (sameScene) {
@@ -214,8 +217,14 @@ void GhostingPanel::setBlend(bool on) {
     showBlendState();
     return;
   }
-  if (operation != kZThickness) previousOperation_ = operation;
   const QString method = context_.method();
+  // A switch turned on anew: what an earlier one switched from is stale (the operation changed
+  // in the Method panel since), and a method that can blend is kept, so off must not bring back
+  // the older one (it did: a bug hunt).
+  if (operation != kZThickness) {
+    previousOperation_ = operation;
+    previousMethod_.clear();
+  }
   if (!context_.supportsOperation(method, kZThickness)) {
     previousMethod_ = method;
     context_.setMethod(QLatin1String(kBlendMethod));

@@ -64,6 +64,7 @@ class GhostingPanel final : public QWidget {
   QLabel* ghostValue_ = nullptr;
 
   QStringList names_;          // the part list's names, to rebuild it only when they change
+  quint64 sceneSerial_ = 0;    // ViewerContext::sceneSerial of the scene the list shows
   QString previousOperation_;  // before the blend switch went on
   QString previousMethod_;     // replaced by kBlendMethod when the switch went on, else empty
   QMap<int, double> saved_;    // ghosted parts: their opacity before ghosting, by object id

@@ -1824,6 +1824,34 @@ class ViewerTest : public QObject {
     const QJsonObject savedT = ghostingT->saveSettings();
     QCOMPARE(savedT.value("focus").toArray(), QJsonArray{"dup#2"});
     QCOMPARE(savedT.value("ghosted").toObject().keys(), (QStringList{"dup", "dup#1"}));
+    // Another file whose parts have the same names starts with nothing in focus and ghosting off:
+    // the panel kept both, and turning ghosting off then gave its parts the old file's opacities.
+    {
+      const QString other = dir.filePath("other.mfrscene");
+      QFile f(other);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(R"({"objects": [
+        {"name": "dup", "primitive": {"type": "sphere", "radius": 0.5}, "opacity": 0.5},
+        {"name": "dup\u00231", "primitive": {"type": "sphere", "radius": 0.3}, "opacity": 0.4,
+         "transform": {"translate": [0, 1.5, 0]}},
+        {"name": "dup", "primitive": {"type": "box", "size": [1, 1, 1]}, "opacity": 0.3,
+         "transform": {"translate": [1.5, 0, 0]}}]})");
+    }
+    t->openScene(dir.filePath("other.mfrscene"));
+    QTRY_COMPARE_WITH_TIMEOUT(t->model().scenePath(), dir.filePath("other.mfrscene"), kTimeoutMs);
+    auto* ghostOthers = t->findChild<QCheckBox*>("ghostOthers");
+    auto* ghostParts = t->findChild<QListWidget*>("ghostParts");
+    QVERIFY(ghostOthers && ghostParts);
+    QVERIFY(!ghostOthers->isChecked());
+    for (int i = 0; i < ghostParts->count(); ++i) QCOMPARE(ghostParts->item(i)->checkState(), Qt::Unchecked);
+    const QJsonObject savedOther = ghostingT->saveSettings();
+    QCOMPARE(savedOther.value("ghost").toBool(), false);
+    QVERIFY(savedOther.value("ghosted").toObject().isEmpty());
+    ghostOthers->setChecked(true);
+    ghostOthers->setChecked(false);
+    for (const auto& [id, opacity] : {std::pair{0, 0.5}, std::pair{1, 0.4}, std::pair{2, 0.3}})
+      QVERIFY2(std::abs(t->model().objectOpacity(id) - opacity) < 1e-6,
+               qPrintable(QStringLiteral("part %1: %2").arg(id).arg(t->model().objectOpacity(id))));
   }
 
   // A loaded opacity scale is drawn as given, not at the slider's nearest step (2 drew as
@@ -1883,6 +1911,17 @@ class ViewerTest : public QObject {
     blend->setChecked(false);
     QCOMPARE(m.operation(), QStringLiteral("oit"));
     QCOMPARE(m.method(), QStringLiteral("wboit"));
+    // On again, then the Method panel's operation clears it: the next on keeps abuffer-ll, and
+    // its off keeps it too (a stale "previous method" brought wboit back: a bug hunt).
+    blend->setChecked(true);
+    m.setOperation("oit");
+    QVERIFY(!blend->isChecked());
+    QCOMPARE(m.method(), QStringLiteral("abuffer-ll"));
+    blend->setChecked(true);
+    QCOMPARE(m.method(), QStringLiteral("abuffer-ll"));
+    blend->setChecked(false);
+    QCOMPARE(m.method(), QStringLiteral("abuffer-ll"));
+    QCOMPARE(m.operation(), QStringLiteral("oit"));
     // A method with sorted lists is kept; the operation menu's zthickness checks the switch.
     m.setMethod("kplus-array");
     blend->setChecked(true);
