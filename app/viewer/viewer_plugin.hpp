@@ -251,7 +251,9 @@ class MfrViewerPlugin {
   // the view's image size (the budget panel) keeps its promise at the export's size: an export
   // at 800x600 drew with the k fitted to the view, 2.6 times the budget (a bug hunt). `tried` and
   // `measured` are the parameters it gave last and the stats of that render at `size` (null on
-  // the first call); giving the same parameters again ends the tries.
+  // the first call); giving the same parameters again ends the tries. A plugin whose promise no
+  // parameters can keep at `size` (a budget below the least setting) throws mfr::Error with the
+  // one-line reason: no picture is written then.
   [[nodiscard]] virtual std::map<std::string, std::string> exportParams(QSize size,
                                                                         const std::map<std::string, std::string>* tried,
                                                                         const mfr::Stats* measured) const {

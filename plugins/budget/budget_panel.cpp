@@ -18,6 +18,7 @@
 #include <cmath>
 
 #include "histogram_widget.hpp"
+#include "mfr/error.hpp"
 #include "viewer_plugin.hpp"
 
 namespace {
@@ -376,11 +377,26 @@ std::map<std::string, std::string> BudgetPanel::exportParams(QSize size,
   // that fits is kept (the same parameters end the tries) unless a larger value fits too.
   const double budget = budgetMiB() * kMiB;
   const double bytes = static_cast<double>(measured->bytesAllocated);
+  // Over the budget with the least the parameter can be: no picture (the export wrote one at
+  // 5.5 times the budget: a bug hunt), as the budget_mib methods refuse a budget below k = 1.
+  const auto refuse = [&] {
+    throw mfr::Error(QStringLiteral("budget %1 MiB").arg(budgetMiB()).toStdString(),
+                     QStringLiteral("below what %1 needs at %2x%3 with %4=%5 (%6 MiB = %7 bytes)")
+                         .arg(ctx_.method())
+                         .arg(size.width())
+                         .arg(size.height())
+                         .arg(QString::fromStdString(given->first), QString::fromStdString(given->second))
+                         .arg(bytes / kMiB, 0, 'f', 3)
+                         .arg(measured->bytesAllocated)
+                         .toStdString());
+  };
   if (d.knob == Knob::Pool) {
     // The method rounds the pool to whole nodes: refitting a pool that fits crept by a node a try.
     if (bytes <= budget) return *tried;
     m.poolOverhead = bytes - std::stod(given->second) * kMiB;
-    return paramsFor(d, m);
+    std::map<std::string, std::string> next = paramsFor(d, m);
+    if (next == *tried) refuse();
+    return next;
   }
   // Slots: at one size the bytes are linear in the value, so two measured renders give the exact
   // bytes per slot (the view's model may still be its first guess, 8 bytes per pixel and slot:
@@ -391,6 +407,7 @@ std::map<std::string, std::string> BudgetPanel::exportParams(QSize size,
   m.fixed = bytes - m.perSlot * static_cast<double>(value);
   std::map<std::string, std::string> next = paramsFor(d, m);
   if (bytes <= budget && std::stoll(next[d.param]) <= value) return *tried;
+  if (bytes > budget && value <= d.minValue) refuse();
   return next;
 }
 

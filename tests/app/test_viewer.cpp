@@ -1363,6 +1363,20 @@ class ViewerTest : public QObject {
              2);
     QVERIFY2(out.contains("mfrview: -p k=7: a plugin's settings set k="), qPrintable(out));
     QVERIFY(!QFile::exists(png));
+    // A budget below the least k or pool at the export's size: no picture, rather than one over
+    // the budget (k = 1 at 800x600 takes 5.5 MiB; written with exit 0: a bug hunt).
+    for (const auto& [method, knob] : {std::pair{"kplus-array", "k=1 ("}, std::pair{"abuffer-ll", "pool_mib="}}) {
+      const QString tight = dir.filePath(QStringLiteral("tight-%1.png").arg(method));
+      QCOMPARE(runProgram(MFRVIEW,
+                          {"@sample", "-m", method, "--plugin-settings", R"(budget={"budget_mib":1,"driving":true})",
+                           "--size", "800x600", "--screenshot", tight},
+                          &out),
+               1);
+      QVERIFY2(out.contains(
+                   QStringLiteral("mfrview: budget 1 MiB: below what %1 needs at 800x600 with %2").arg(method, knob)),
+               qPrintable(out));
+      QVERIFY(!QFile::exists(tight));
+    }
   }
 
   // `mfrview --screenshot` and `mfr render` with the same scene, view, size and settings.
