@@ -249,6 +249,7 @@ void BudgetPanel::methodChanged() {
   showKnob();
   corrections_ = 0;
   showRobustness();
+  showFrame();
   if (driving_) applyBudget();
 }
 
@@ -443,6 +444,16 @@ void BudgetPanel::showFrame() {
   const mfr::Stats& s = ctx_.stats();
   const QLocale locale;
   const double budget = budgetMiB() * kMiB;
+  // The last frame is another method's (the new one's has not come, or cannot be drawn): its
+  // numbers read as this method's (fkb "fitting" at kplus-dynamic's 9.46 MiB: a bug hunt).
+  if (QString::fromStdString(s.method) != ctx_.method()) {
+    memoryBar_->setValue(0);
+    memoryBar_->setFormat(tr("no frame of %1").arg(ctx_.method()));
+    memoryBar_->setStyleSheet(QString());
+    for (QLabel* label : {memoryLabel_, capturedLabel_, kLabel_, exactLabel_}) label->setText(tr("—"));
+    histogram_->setMarker(0, false);
+    return;
+  }
   const double allocated = static_cast<double>(s.bytesAllocated);
   memoryBar_->setValue(static_cast<int>(std::min(1000.0, 1000.0 * allocated / budget)));
   memoryBar_->setFormat(tr("%1 of %2 MiB (%3 %)").arg(mib(allocated)).arg(budgetMiB()).arg(100.0 * allocated / budget, 0, 'f', 0));

@@ -472,6 +472,13 @@ class ViewerTest : public QObject {
     QVERIFY(note);
     QTRY_VERIFY_WITH_TIMEOUT(note->isVisible(), kTimeoutMs);
     QVERIFY2(note->text().startsWith("Cannot render:\nbudget_mib=0.01: below"), qPrintable(note->text()));
+    // The budget panel shows no numbers of the k-buffer's last frame as fkb's.
+    auto* bar = w->findChild<QProgressBar*>("memoryBar");
+    auto* captured = w->findChild<QLabel*>("capturedLabel");
+    QVERIFY(bar && captured);
+    QCOMPARE(m.stats().method, std::string("kbuffer"));
+    QCOMPARE(bar->format(), QStringLiteral("no frame of fkb"));
+    QCOMPARE(captured->text(), QStringLiteral("—"));
   }
 
   void budgetSliderFollowsMemory() {
