@@ -276,8 +276,16 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
     const QString shown = statusBar()->currentMessage();
     statusBar()->showMessage(shown.isEmpty() ? text : shown + QStringLiteral("; ") + text, 20000);
   });
+  // A frame that cannot be drawn: its reason in the status bar, no frame info of the last frame
+  // drawn; a frame drawn again takes the reason away (it stayed: a bug hunt).
   connect(model_, &ViewerModel::renderErrorChanged, this, [this](const QString& message) {
-    if (!message.isEmpty()) statusBar()->showMessage(tr("Cannot render: %1").arg(model_->renderErrorShown()));
+    const QString prefix = tr("Cannot render: ");
+    if (!message.isEmpty()) {
+      statusBar()->showMessage(prefix + model_->renderErrorShown());
+      frameInfo_->setText(tr("no frame"));
+    } else if (statusBar()->currentMessage().startsWith(prefix)) {
+      statusBar()->clearMessage();
+    }
   });
 
   resize(1400, 900);
@@ -522,6 +530,7 @@ void MainWindow::buildStatusBar() {
   cancelLoad_->hide();
   connect(cancelLoad_, &QPushButton::clicked, model_, &ViewerModel::cancelLoad);
   frameInfo_ = new QLabel;
+  frameInfo_->setObjectName(QStringLiteral("frameInfo"));
   statusBar()->addPermanentWidget(loadProgress_);
   statusBar()->addPermanentWidget(cancelLoad_);
   statusBar()->addPermanentWidget(frameInfo_);

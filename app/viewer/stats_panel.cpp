@@ -26,6 +26,13 @@ StatsPanel::StatsPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), m
   tree_->setAlternatingRowColors(true);
   layout->addWidget(tree_);
   connect(&model_, &ViewerModel::frameRendered, this, &StatsPanel::showStats);
+  // No numbers of the last frame drawn under a frame that cannot be drawn.
+  connect(&model_, &ViewerModel::renderErrorChanged, this, [this](const QString& message) {
+    if (message.isEmpty()) return;
+    tree_->clear();
+    auto* item = new QTreeWidgetItem(tree_, {tr("No frame"), model_.renderErrorShown()});
+    item->setToolTip(1, model_.renderErrorShown());
+  });
 }
 
 void StatsPanel::showStats() {

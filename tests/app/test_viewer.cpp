@@ -479,6 +479,20 @@ class ViewerTest : public QObject {
     QCOMPARE(m.stats().method, std::string("kbuffer"));
     QCOMPARE(bar->format(), QStringLiteral("no frame of fkb"));
     QCOMPARE(captured->text(), QStringLiteral("—"));
+    // Nor the Statistics dock or the status bar's frame info; a frame drawn again clears the reason.
+    auto* statsTree = w->findChild<QTreeWidget*>("statsTree");
+    auto* frameInfo = w->findChild<QLabel*>("frameInfo");
+    QVERIFY(statsTree && frameInfo);
+    QCOMPARE(statsTree->topLevelItemCount(), 1);
+    QCOMPARE(statsTree->topLevelItem(0)->text(0), QStringLiteral("No frame"));
+    QVERIFY(statsTree->topLevelItem(0)->text(1).startsWith("budget_mib=0.01: below"));
+    QCOMPARE(frameInfo->text(), QStringLiteral("no frame"));
+    m.setParams({{"budget_mib", "64"}});
+    QTRY_VERIFY_WITH_TIMEOUT(m.renderError().isEmpty() && m.stats().method == "fkb", kTimeoutMs);
+    QVERIFY2(!w->statusBar()->currentMessage().startsWith("Cannot render"),
+             qPrintable(w->statusBar()->currentMessage()));
+    QVERIFY(frameInfo->text().startsWith("fkb"));
+    QVERIFY(statsTree->topLevelItemCount() > 1);
   }
 
   void budgetSliderFollowsMemory() {
