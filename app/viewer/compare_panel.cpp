@@ -102,6 +102,8 @@ void ComparePanel::showSettings() {
   layout_->setCurrentIndex(layout_->findData(static_cast<int>(model_.compareLayout())));
   split_->setValue(static_cast<int>(std::lround(model_.compareSplit() * kSplitSteps)));
   split_->setEnabled(model_.compareLayout() == CompareLayout::Split);
+  // The display too (D and sessions set it; the combo kept "Images" under a heat map: a bug hunt).
+  display_->setCurrentIndex(display_->findData(static_cast<int>(model_.compareDisplay())));
 }
 
 void ComparePanel::showMetrics() {

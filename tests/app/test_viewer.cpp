@@ -3028,6 +3028,10 @@ class ViewerTest : public QObject {
     // The FLIP heat map of each side (magma of the per-pixel error), computed here from the CLI's
     // images: exactly what the view shows when those images are identical to its own.
     m.setCompareDisplay(CompareDisplay::FlipError);
+    // The Compare dock's Show follows the display however it was set (it kept "Images").
+    auto* display = w->findChild<QComboBox*>("compareDisplay");
+    QVERIFY(display);
+    QCOMPARE(display->currentData().toInt(), static_cast<int>(CompareDisplay::FlipError));
     settle(m);
     screen = fromQImage(w->view().grabFramebuffer());
     const mfr::ImageRGBA8 exactFull = exactImage(m, QSize(320, 200));
