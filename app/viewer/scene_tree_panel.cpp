@@ -11,6 +11,7 @@
 #include <QMenu>
 #include <QPixmap>
 #include <QPushButton>
+#include <QStyledItemDelegate>
 #include <QTreeWidget>
 #include <QVBoxLayout>
 
@@ -27,6 +28,23 @@
 namespace {
 
 enum Column { kName = 0, kColour = 1, kOpacity = 2, kTriangles = 3 };
+
+// The Opacity column's editor: 0 … 1 with the column's three decimals. Qt's default editor for a
+// double has two, so opening it and pressing Enter turned 0.125 into 0.13 and 0.004 into 0 (the
+// part vanished), and three decimals could not be typed (a bug hunt).
+class OpacityDelegate : public QStyledItemDelegate {
+ public:
+  using QStyledItemDelegate::QStyledItemDelegate;
+  QWidget* createEditor(QWidget* parent, const QStyleOptionViewItem&, const QModelIndex&) const override {
+    auto* box = new QDoubleSpinBox(parent);
+    box->setObjectName(QStringLiteral("opacityEditor"));
+    box->setFrame(false);
+    box->setRange(0.0, 1.0);
+    box->setDecimals(3);
+    box->setSingleStep(0.05);
+    return box;
+  }
+};
 
 QColor colourOf(const mfr::Object& o) {
   return QColor::fromRgbF(o.material.color.r, o.material.color.g, o.material.color.b);
@@ -194,6 +212,7 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   tree_->header()->setSectionResizeMode(kName, QHeaderView::Stretch);
   for (int c : {kColour, kOpacity, kTriangles}) tree_->header()->setSectionResizeMode(c, QHeaderView::ResizeToContents);
   tree_->setEditTriggers(QAbstractItemView::DoubleClicked | QAbstractItemView::EditKeyPressed);
+  tree_->setItemDelegateForColumn(kOpacity, new OpacityDelegate(tree_));
   layout->addWidget(tree_);
   connect(tree_, &QTreeWidget::itemChanged, this, &SceneTreePanel::itemChanged);
   connect(tree_, &QTreeWidget::itemClicked, this, &SceneTreePanel::itemClicked);

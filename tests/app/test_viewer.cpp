@@ -412,6 +412,26 @@ class ViewerTest : public QObject {
     // The budget plugin is found through MFR_PLUGIN_PATH and its panel is docked.
     QVERIFY2(w->findChild<QDockWidget*>("plugin-budget"), "budget plugin not loaded");
     QVERIFY(w->findChild<QSlider*>("budgetSlider"));
+    // The Opacity cell's editor keeps the column's three decimals: opened and closed with Enter
+    // it changes nothing (0.004 became 0, 0.125 became 0.13: a bug hunt), and 0.125 can be typed.
+    auto* tree = w->findChild<QTreeWidget*>("sceneTree");
+    w->findChild<QDockWidget*>("sceneDock")->raise();
+    m.setObjectOpacity(0, 0.004);
+    const auto edit = [&](const char* typed) {
+      tree->editItem(tree->topLevelItem(0), 2);
+      auto* editor = tree->findChild<QDoubleSpinBox*>();
+      QVERIFY(editor);
+      if (typed) {
+        editor->selectAll();
+        QTest::keyClicks(editor, typed);
+      }
+      QTest::keyClick(editor, Qt::Key_Return);
+      QTRY_VERIFY(!tree->findChild<QDoubleSpinBox*>());
+    };
+    edit(nullptr);
+    QVERIFY2(std::abs(m.objectOpacity(0) - 0.004) < 1e-6, qPrintable(QString::number(m.objectOpacity(0))));
+    edit("0.125");
+    QVERIFY2(std::abs(m.objectOpacity(0) - 0.125) < 1e-6, qPrintable(QString::number(m.objectOpacity(0))));
   }
 
   void switchMethods() {
