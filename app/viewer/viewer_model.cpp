@@ -1145,6 +1145,14 @@ void ViewerModel::reportRenderError(const QString& message) {
   emit renderErrorChanged(renderError_);
 }
 
+QString ViewerModel::renderErrorShown() const {
+  QString shown = renderError_;
+  for (const auto& [option, name] : {std::pair{QLatin1String("--op "), QLatin1String("operation ")},
+                                     std::pair{QLatin1String("--method "), QLatin1String("method ")}})
+    if (shown.startsWith(option)) shown = name + shown.mid(option.size());
+  return shown.replace(QLatin1String("--param "), QString());
+}
+
 ImageKey ViewerModel::imageKey(const mfr::RenderRequest& request) const {
   std::string text = request.method + ";" + request.operation;
   for (const auto& [name, value] : request.params) text += ";" + name + "=" + value;

@@ -318,11 +318,11 @@ class ViewerModel final : public ViewerContext {
   void reportFrame(const mfr::Stats& stats) { reportFrame(0, stats); }
   void reportRenderError(const QString& message);
   [[nodiscard]] const QString& renderError() const { return renderError_; }
-  // The error as the window shows it: a parameter by its name, as the Method panel and the
-  // plugins set it, not by mfr's --param option that the user of the window never typed.
-  [[nodiscard]] QString renderErrorShown() const {
-    return renderError_.startsWith(QLatin1String("--param ")) ? renderError_.mid(8) : renderError_;
-  }
+  // The error as the window shows it: a parameter, the operation and the method by the names the
+  // Method panel and the plugins give them, not by mfr's options (--param, --op, --method) that the
+  // user of the window never typed ("--op hybrid: needs --param tail=true …" reads "operation
+  // hybrid: needs tail=true …").
+  [[nodiscard]] QString renderErrorShown() const;
   [[nodiscard]] quint64 framesRendered() const { return framesRendered_; }
 
   // What the pane of `side` shows now, and its exact reference image (the oracle's "over", or its

@@ -513,6 +513,15 @@ class ViewerTest : public QObject {
              qPrintable(w->statusBar()->currentMessage()));
     QVERIFY(frameInfo->text().startsWith("fkb"));
     QVERIFY(statsTree->topLevelItemCount() > 1);
+    // An operation and the parameter it needs, by the panel's names too.
+    m.setMethod(QStringLiteral("kplus-array"));
+    m.setParams({{"tail", "false"}});
+    m.setOperation(QStringLiteral("hybrid"));
+    QTRY_VERIFY_WITH_TIMEOUT(!m.renderError().isEmpty(), kTimeoutMs);
+    QCOMPARE(m.renderError(), QStringLiteral("--op hybrid: needs --param tail=true with method kplus-array"));
+    QCOMPARE(w->statusBar()->currentMessage(),
+             QStringLiteral("Cannot render: operation hybrid: needs tail=true with method kplus-array"));
+    m.setOperation(QStringLiteral("auto"));
   }
 
   void budgetSliderFollowsMemory() {
