@@ -875,6 +875,7 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path, const std::fun
   fieldColoringError_.clear();
   volumeFieldReadErrors_.clear();
   scenePath_ = path;
+  const bool hadScene = hasScene_;
   hasScene_ = true;
   ++sceneRevision_;
   ++sceneSerial_;
@@ -906,8 +907,26 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path, const std::fun
   // picture than mfr render's on the same scene (a bug hunt).
   camera_ = scene_.view("fit");
   ++viewRevision_;
+  // An operation of the old scene that the new one cannot draw goes back to auto, with a note:
+  // File → Open Sample after @csg with operation csg drew nothing but "operation csg: scene
+  // 'sample' has no CSG tree" (a bug hunt). Only when a scene was open: the first scene of a
+  // scripted run is refused for its --op, as mfr render refuses it; a session sets its own after.
+  QStringList dropped;
+  if (hadScene)
+    for (const int side : {0, 1}) {
+      const QString operation = operations_[index(side)];
+      const bool lacks = (operation == QLatin1String("csg") && scene_.csg.empty()) ||
+                         (operation == QLatin1String("volume") && scene_.volumes.empty());
+      if (!lacks) continue;
+      dropped << (side == 0 ? QStringLiteral("operation %1") : QStringLiteral("compare operation %1")).arg(operation);
+      setOperationOf(side, QStringLiteral("auto"));
+    }
   if (prepare) prepare();
   emit sceneLoaded();
+  for (const QString& what : dropped)
+    note(QStringLiteral("%1: scene '%2' has no %3: auto is used")
+             .arg(what, QString::fromStdString(scene_.name),
+                  what.endsWith(QLatin1String("csg")) ? QStringLiteral("CSG tree") : QStringLiteral("volume")));
   emit sceneChanged();
   emit viewChanged();
   emit volumeChanged();

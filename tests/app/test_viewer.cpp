@@ -1686,6 +1686,23 @@ class ViewerTest : public QObject {
     QVERIFY(m.scene().csg.empty());
     QVERIFY(!show->isChecked());
     QCOMPARE(m.operation(), QStringLiteral("auto"));
+
+    // Another scene without a tree while the switch is on: operation auto, with a note, and a
+    // frame (the view said "operation csg: scene 'sample' has no CSG tree": a bug hunt).
+    w->openScene(QStringLiteral("@csg"));
+    QTRY_VERIFY_WITH_TIMEOUT(!m.scene().csg.empty() && m.sceneSerial() > 0, kTimeoutMs);
+    show->setChecked(true);
+    QCOMPARE(m.operation(), QStringLiteral("csg"));
+    QStringList notes;
+    connect(&m, &ViewerContext::noted, this, [&notes](const QString& note) { notes << note; });
+    const quint64 serial = m.sceneSerial();
+    w->openScene(QStringLiteral("@sample"));
+    QTRY_VERIFY_WITH_TIMEOUT(m.sceneSerial() > serial, kTimeoutMs);
+    QCOMPARE(m.operation(), QStringLiteral("auto"));
+    QVERIFY(!show->isChecked());
+    QCOMPARE(notes, QStringList{"operation csg: scene 'sample' has no CSG tree: auto is used"});
+    settle(m);
+    QVERIFY2(m.renderError().isEmpty(), qPrintable(m.renderError()));
   }
 
   // Operation "zthickness" on the intersecting-surfaces sample: `mfrview --screenshot` equals
