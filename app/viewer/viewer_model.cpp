@@ -826,7 +826,18 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
           emit loadFailed(path, QString::fromUtf8(e.what()));
           return;
         }
-        const std::optional<mfr::Camera> camera = keepCamera_;
+        // A molecule read again in other representations keeps the view as it is now, not as it
+        // was when the read began (an orbit meanwhile was undone), and the clip box, section,
+        // z-thickness and colouring by a field, which were dropped as for another file (a bug hunt).
+        struct KeptView {
+          mfr::Camera camera;
+          std::optional<mfr::Bounds> clip;
+          std::optional<mfr::SectionPlane> section;
+          double thickness = 0.0;
+          std::optional<mfr::FieldColors> coloring;
+        };
+        std::optional<KeptView> kept;
+        if (keepCamera_) kept = KeptView{camera_, scene_.clipBox, scene_.section, thickness_, fieldColoring()};
         keepCamera_.reset();
         requestedMoleculeStyle_.reset();
         moleculeStyle_.reset();
@@ -837,7 +848,15 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
           // The parts' "@" fields sampled from the fields read (as after the Field chooser's read).
           if (loaded.fieldsRead) resampleVolumeFields();
         });
-        if (camera) setCamera(*camera);
+        if (kept) {
+          setCamera(kept->camera);
+          if (kept->clip) setClipBox(kept->clip);
+          if (kept->section) setSection(kept->section);
+          if (kept->thickness != 0.0) setZThickness(kept->thickness);
+          if (kept->coloring && surfaceFields().contains(QString::fromStdString(kept->coloring->field)))
+            setFieldColoring(QString::fromStdString(kept->coloring->field), QString::fromStdString(kept->coloring->map),
+                             kept->coloring->range);
+        }
       });
 }
 

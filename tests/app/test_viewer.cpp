@@ -4947,6 +4947,36 @@ class ViewerTest : public QObject {
     QCOMPARE(names, (QStringList{"chain E sticks", "chain E cartoon", "chain E surface"}));
     cartoon->setChecked(false);
     QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks,surface", kTimeoutMs);
+    // The view is kept as it is when the read ends, with the clip box, the section, the z-thickness
+    // and the colouring by a field (an orbit during the read was undone, and the rest dropped as for
+    // another file: a bug hunt).
+    {
+      const mfr::Bounds b = m.scene().bounds();
+      const mfr::Bounds box{b.min, b.min + (b.max - b.min) * 0.8};
+      const mfr::SectionPlane plane{b.center(), {0.0, 0.0, 1.0}, true, false};
+      m.setClipBox(box);
+      m.setSection(plane);
+      m.setZThickness(0.25);
+      QVERIFY2(m.surfaceFields().contains("b_factor"), qPrintable(m.surfaceFields().join(',')));
+      QVERIFY(m.setFieldColoring("b_factor", "viridis", glm::dvec2(0.0, 50.0)));
+      cartoon->setChecked(true);
+      const mfr::Camera orbited = navigation::orbit(m.camera(), QPointF(40, 0), size);
+      m.setCamera(orbited);
+      QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks,cartoon,surface", kTimeoutMs);
+      QCOMPARE(m.camera().eye, orbited.eye);
+      QVERIFY(m.clipBox() && m.clipBox()->min == box.min && m.clipBox()->max == box.max);
+      QVERIFY(m.section() && m.section()->point == plane.point && m.section()->normal == plane.normal);
+      QCOMPARE(m.zThickness(), 0.25);
+      QVERIFY(m.fieldColoring() && m.fieldColoring()->field == "b_factor" && m.fieldColoring()->map == "viridis" &&
+              m.fieldColoring()->range == glm::dvec2(0.0, 50.0));
+      m.setClipBox(std::nullopt);
+      m.setSection(std::nullopt);
+      m.setZThickness(0.0);
+      QVERIFY(m.setFieldColoring(QString()));
+      cartoon->setChecked(false);
+      QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks,surface", kTimeoutMs);
+      m.setCamera(camera);
+    }
     // Sticks on the chain only (--molecule sticks@polymer): partly checked; a click draws them on all.
     m.setMoleculeStyle(mfr::MoleculeStyle::parse("sticks@polymer,surface", "test"));
     QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.moleculeStyle()->text() == "sticks@polymer,surface", kTimeoutMs);
