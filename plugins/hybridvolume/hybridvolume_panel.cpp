@@ -415,10 +415,34 @@ void HybridVolumePanel::volumeChanged() {
                     .arg(d.z)
                     .arg(loaded.unitDistance, 0, 'g', 17);
   for (const mfr::TransferPoint& p : loaded.points) key += QStringLiteral("|%1").arg(p.value, 0, 'g', 17);
-  // Another volume, or a function set elsewhere (a session, another plugin): Custom from it.
+  // Another volume, or a function set elsewhere (a session, another plugin): Custom from it,
+  // unless it is a volume of this scene the panel set up before and its function is still the
+  // one the panel set: then the panel's state of that volume again.
   if (key != sceneKey_ || !sameTransfer(context_.transferFunction(), applied_)) {
+    if (volumeStatesScene_ != context_.sceneSerial()) {
+      volumeStates_.clear();
+      volumeStatesScene_ = context_.sceneSerial();
+    } else if (!sceneKey_.isEmpty() && key != sceneKey_) {
+      volumeStates_.insert(sceneKey_, VolumeState{base_, applied_, preset_->currentData().toString(), windowLow_,
+                                                  windowHigh_, opacity_->value(), exactScale_});
+    }
     sceneKey_ = key;
-    resetToCurrent();
+    const auto saved = volumeStates_.constFind(key);
+    if (saved != volumeStates_.constEnd() && sameTransfer(context_.transferFunction(), saved->applied)) {
+      base_ = saved->base;
+      applied_ = saved->applied;
+      windowLow_ = saved->windowLow;
+      windowHigh_ = saved->windowHigh;
+      exactScale_ = saved->exactScale;
+      const QSignalBlocker blockPreset(preset_), blockMin(windowMin_), blockMax(windowMax_), blockOpacity(opacity_);
+      preset_->setCurrentIndex(preset_->findData(saved->preset));
+      windowMin_->setValue(windowLow_);
+      windowMax_->setValue(windowHigh_);
+      opacity_->setValue(saved->opacityPosition);
+      showScaleValue();
+    } else {
+      resetToCurrent();
+    }
   }
   {
     const QSignalBlocker blockShade(shade_);

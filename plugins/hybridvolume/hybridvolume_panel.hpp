@@ -25,6 +25,7 @@
 //   operation "Show volume" replaced come back; a refusal is shown under them.
 // - An info line: grid size, spacing, value range, and the last frame's step and GPU bytes (its
 //   stats notes "volume step" and "volume (bytes)").
+#include <QMap>
 #include <QJsonObject>
 #include <QWidget>
 
@@ -126,6 +127,18 @@ class HybridVolumePanel final : public QWidget {
   double windowHigh_ = 1.0;
   mfr::TransferFunction base_;     // Custom's points (over their own range) and the unit distance at scale 1
   mfr::TransferFunction applied_;  // what the panel last set (another function: an edit from elsewhere)
+  // The panel's state of each volume it was set up for (by sceneKey_), so that choosing another
+  // volume and back finds the preset, window and opacity scale as they were: the scaled function
+  // became the base at 1× and the next scale compounded it (a bug hunt). Kept for one scene.
+  struct VolumeState {
+    mfr::TransferFunction base, applied;
+    QString preset;
+    double windowLow = 0.0, windowHigh = 0.0;
+    int opacityPosition = 0;
+    std::optional<double> exactScale;
+  };
+  QMap<QString, VolumeState> volumeStates_;
+  quint64 volumeStatesScene_ = 0;  // ViewerContext::sceneSerial they belong to
   QString previousOperation_;      // replaced by "volume" when the switch went on, else empty
   QString previousMethod_;         // replaced by kVolumeMethod when the switch went on, else empty
 };

@@ -3861,6 +3861,24 @@ class ViewerTest : public QObject {
       QVERIFY(m.scene().volumes[0].transfer.points[i].color == firstBefore.points[i].color);
     QVERIFY(!(m.scene().volumes[1].transfer.points.front().color ==
               mfr::transferPreset("fire", 0.0, 1.0, 0.3).points.front().color));
+    // Its opacity scale is its own: the first volume and back finds the preset and scale as they
+    // were, and the same scale gives the same function (the scaled function became the base at 1×
+    // and the scale compounded: 400× at the slider's end; a bug hunt).
+    auto* opacity = w->findChild<QSlider*>("hvOpacity");
+    QVERIFY(opacity);
+    opacity->setValue(opacity->maximum());
+    const double scaledUnit = m.scene().volumes[1].transfer.unitDistance;
+    QVERIFY(std::abs(scaledUnit - 0.3 / 20.0) < 1e-9);
+    choice->setCurrentIndex(0);
+    QCOMPARE(m.currentVolume(), 0);
+    choice->setCurrentIndex(1);
+    QCOMPARE(opacity->value(), opacity->maximum());
+    QCOMPARE(preset->currentData().toString(), QStringLiteral("cool-warm"));
+    opacity->setValue(opacity->maximum() - 10);
+    opacity->setValue(opacity->maximum());
+    QCOMPARE(m.scene().volumes[1].transfer.unitDistance, scaledUnit);
+    opacity->setValue(opacity->minimum() + (opacity->maximum() - opacity->minimum()) / 2);  // 1×
+    QVERIFY(std::abs(m.scene().volumes[1].transfer.unitDistance - 0.3) < 1e-9);
     // Hiding it leaves the first drawn, still by the operation volume.
     show->setChecked(false);
     QVERIFY(!m.scene().volumes[1].visible);
