@@ -121,9 +121,17 @@ mfr::Camera standardView(StandardView view, const mfr::Scene& scene, const mfr::
     case StandardView::Iso: towardsEye = glm::normalize(glm::dvec3(1, 1, 1)); break;
   }
   mfr::Camera base = current;
+  base.up = up;
+  if (!scene.bounds().valid()) {
+    // Nothing visible to frame: turn about the current target at the current distance (the fit
+    // of nothing put the eye 1 unit from the origin, inside @sample's shell once a part was shown
+    // again: a bug hunt).
+    base.eye = current.target + towardsEye * glm::length(current.eye - current.target);
+    base.depthRangeGiven = false;
+    return base;
+  }
   base.target = glm::dvec3(0.0);
   base.eye = towardsEye;
-  base.up = up;
   return scene.fit(base);
 }
 

@@ -44,6 +44,7 @@
 #include "main_window.hpp"
 #include "probe_panel.hpp"
 #include "session.hpp"
+#include "mfr/scene/sample.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/measure.hpp"
 #include "mfr/scene/section.hpp"
@@ -3528,6 +3529,16 @@ class ViewerTest : public QObject {
     QCOMPARE(ortho.projection, mfr::Projection::Orthographic);
     const mfr::Camera back = navigation::toggledProjection(ortho);
     QVERIFY(glm::length(back.eye - c.eye) < 1e-9);  // the round trip keeps the framing
+    // A standard view of a scene with nothing visible turns about the target at its distance (the
+    // fit of nothing put the eye 1 unit from the origin: a bug hunt).
+    mfr::Scene hidden = mfr::makeSampleScene();
+    for (mfr::Object& o : hidden.objects) o.visible = false;
+    mfr::Camera far = c;
+    far.eye = {2, 3, 40};
+    far.target = {2, 3, 0};
+    const mfr::Camera right = navigation::standardView(navigation::StandardView::Right, hidden, far);
+    QVERIFY(glm::length(right.target - far.target) < 1e-12);
+    QVERIFY(glm::length(right.eye - glm::dvec3(42, 3, 0)) < 1e-9);
   }
 
   // Side by side, the mouse navigates the pane under it: a pan drag moves the scene as far as the
