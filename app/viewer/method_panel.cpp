@@ -18,6 +18,22 @@
 
 namespace {
 
+// A float parameter's editor: six significant digits in the locale's notation, exponents
+// included, instead of three decimals — mboit's moment bias of the paper, 5e-7, showed and was
+// taken as 0.000, a different setting from its default −1 (a bug hunt).
+class FloatParamBox : public QDoubleSpinBox {
+ public:
+  FloatParamBox() { setDecimals(15); }  // values are not rounded to the text's few digits
+  [[nodiscard]] QString textFromValue(double value) const override { return locale().toString(value, 'g', 6); }
+  [[nodiscard]] double valueFromText(const QString& text) const override { return locale().toDouble(text.trimmed()); }
+  QValidator::State validate(QString& text, int&) const override {
+    bool ok = false;
+    const double value = locale().toDouble(text.trimmed(), &ok);
+    if (ok && value >= minimum() && value <= maximum()) return QValidator::Acceptable;
+    return QValidator::Intermediate;  // "5e-", "-" on the way to a number
+  }
+};
+
 // Float parameters as text: round-trips the spin box value without trailing noise.
 std::string floatText(double value) { return QString::number(value, 'g', 10).toStdString(); }
 
@@ -187,8 +203,7 @@ void MethodPanel::rebuildParameters() {
         break;
       }
       case mfr::ParamSpec::Type::Float: {
-        auto* box = new QDoubleSpinBox;
-        box->setDecimals(3);
+        auto* box = new FloatParamBox;
         box->setRange(spec.min, spec.max);
         box->setSingleStep(spec.max - spec.min > 10.0 ? 1.0 : 0.05);
         box->setKeyboardTracking(false);

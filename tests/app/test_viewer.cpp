@@ -480,6 +480,20 @@ class ViewerTest : public QObject {
     QVERIFY(k);
     k->setValue(3);
     QTRY_VERIFY_WITH_TIMEOUT(m.stats().method == "kbuffer" && m.stats().kMax == 3, kTimeoutMs);
+    // A float parameter takes and shows small values and exponents: mboit's bias of the paper,
+    // 5e-7, showed and was taken as 0.000 (three decimals: a bug hunt).
+    combo->setCurrentIndex(combo->findData(QStringLiteral("mboit")));
+    auto* bias = w->findChild<QDoubleSpinBox*>("param-bias");
+    QVERIFY(bias);
+    bias->setFocus();
+    bias->selectAll();
+    QTest::keyClicks(bias, "5e-7");
+    QTest::keyClick(bias, Qt::Key_Return);
+    QCOMPARE(m.params().at("bias"), std::string("5e-07"));
+    QCOMPARE(bias->text(), QStringLiteral("5e-07"));
+    m.setParams({{"bias", "0.00000025"}});
+    QCOMPARE(bias->value(), 2.5e-7);
+    QCOMPARE(bias->text(), QStringLiteral("2.5e-07"));
     // A value that cannot render is named as the panel names it, not by mfr's --param option,
     // which no one typed here; the model keeps mfr's words for scripted runs.
     m.setMethod(QStringLiteral("fkb"));
