@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "camera_navigator.hpp"
+#include "mfr/scene/clip_box.hpp"
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
 #include "mfr/reference/metrics.hpp"
@@ -164,6 +165,11 @@ bool RenderView::uploadSceneIfChanged(int side, QStringList& errors) {
     uploadedRevision_[i] = model_.sceneRevision();
     uploadError_[i].clear();
     try {
+      // A clip box and section that leave nothing say so, as mfr render and the export refuse
+      // them (a flat box drew an empty view without a word: a bug hunt).
+      if (const std::optional<mfr::Bounds>& box = model_.scene().clipBox)
+        mfr::requireClipBoxHoldsScene(model_.scene(), *box, "clip box");
+      mfr::requireSomethingToDraw(model_.drawnScene());
       r.setScene(model_.drawnScene());
     } catch (const std::exception& e) {
       uploadError_[i] = QString::fromUtf8(e.what());  // e.g. every object hidden

@@ -3776,6 +3776,11 @@ class ViewerTest : public QObject {
     minZ->setValue(700);
     QCOMPARE(maxZ->value(), 700);
     QVERIFY(m.clipBox()->min.z <= m.clipBox()->max.z);
+    // Such a flat box holds nothing: the view says so, in mfr render's words (it drew an empty
+    // frame without a word: a bug hunt).
+    QTRY_VERIFY_WITH_TIMEOUT(!m.renderError().isEmpty(), kTimeoutMs);
+    QVERIFY2(m.renderError().startsWith("clip box: holds nothing of scene 'sample' (a flat box"),
+             qPrintable(m.renderError()));
     minZ->setValue(0);
     maxZ->setValue(650);
     settle(m);
