@@ -791,7 +791,10 @@ QJsonObject HybridVolumePanel::saveSettings() const {
   return {{QStringLiteral("volume"), context_.currentVolume()},
           {QStringLiteral("show"), show_->isChecked()},
           {QStringLiteral("preset"), preset_->currentData().toString()},
-          {QStringLiteral("window"), QJsonArray{windowLow_, windowHigh_}},
+          // A window refused (its minimum not below its maximum) is not what is drawn: the
+          // drawn function's range is (a refused one was saved, then refused on reload).
+          {QStringLiteral("window"), windowLow_ < windowHigh_ ? QJsonArray{windowLow_, windowHigh_}
+                                                              : QJsonArray{applied_.low(), applied_.high()}},
           {QStringLiteral("opacity_scale"), opacityScale()},
           {QStringLiteral("shading"), shade_->isChecked()},
           {QStringLiteral("base"), transferToJson(base_)},
