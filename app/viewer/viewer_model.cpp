@@ -654,18 +654,24 @@ void ViewerModel::volumeEdited() {
 
 void ViewerModel::setCompareEnabled(bool enabled) {
   if (enabled == compare_) return;
+  const QSize pane = paneSize();
   compare_ = enabled;
   if (!compare_) {
     cpuWanted_.erase(CpuSlot::Pane1);
     frameImage_[1].reset();
   }
   emit compareChanged();
+  // Side by side the image the statistics describe is half the view: a change of image size
+  // (the budget panel's histogram kept the whole view's until the camera moved: a bug hunt).
+  if (paneSize() != pane) emit viewChanged();
 }
 
 void ViewerModel::setCompareLayout(CompareLayout layout) {
   if (layout == layout_) return;
+  const QSize pane = paneSize();
   layout_ = layout;
   emit compareChanged();
+  if (paneSize() != pane) emit viewChanged();
 }
 
 void ViewerModel::setCompareSplit(double split) {

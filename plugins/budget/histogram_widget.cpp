@@ -9,12 +9,23 @@
 HistogramWidget::HistogramWidget(QWidget* parent) : QWidget(parent) {
   setMinimumSize(220, 150);
   setSizePolicy(QSizePolicy::Expanding, QSizePolicy::Expanding);
+  setAccessibleName(title());
 }
 
 void HistogramWidget::setHistogram(const QVector<quint64>& histogram, QSize imageSize) {
   histogram_ = histogram;
   imageSize_ = imageSize;
+  received_ = true;
+  setAccessibleName(title());  // the title, also for screen readers (the bars are painted)
   update();
+}
+
+QString HistogramWidget::title() const {
+  if (!received_) return tr("Depth complexity: computing…");
+  // An empty count: nothing to draw (every part hidden, a clip box that holds nothing); it read
+  // "computing…" for ever (a bug hunt).
+  if (histogram_.isEmpty()) return tr("Depth complexity: nothing visible");
+  return tr("Depth complexity n(p), GPU count (%1×%2)").arg(imageSize_.width()).arg(imageSize_.height());
 }
 
 void HistogramWidget::setMarker(int k, bool variable) {
@@ -37,10 +48,7 @@ void HistogramWidget::paintEvent(QPaintEvent*) {
       rect().adjusted(fm.horizontalAdvance(QString::number(largest)) + 10, 2 * fm.height() + 4, -10,
                       -2 * fm.height() - 8);
   p.setPen(pal.color(QPalette::Text));
-  p.drawText(QRect(4, 2, width() - 8, fm.height() + 4), Qt::AlignLeft | Qt::AlignVCenter,
-             histogram_.isEmpty()
-                 ? tr("Depth complexity: computing…")
-                 : tr("Depth complexity n(p), GPU count (%1×%2)").arg(imageSize_.width()).arg(imageSize_.height()));
+  p.drawText(QRect(4, 2, width() - 8, fm.height() + 4), Qt::AlignLeft | Qt::AlignVCenter, title());
   if (histogram_.size() < 2 || plot.width() < 20 || plot.height() < 20) return;
 
   // Pixels with n ≥ 1 only: empty pixels would dwarf everything and cost no memory per fragment.

@@ -15,6 +15,7 @@ class HistogramWidget final : public QWidget {
   // pixels with n ≤ k may lose fragments too: the bars are not split into kept and lost.
   void setMarker(int k, bool variable = false);
   [[nodiscard]] const QVector<quint64>& histogram() const { return histogram_; }
+  [[nodiscard]] QString title() const;  // what the widget's first line says (its accessible name)
 
  protected:
   void paintEvent(QPaintEvent* event) override;
@@ -22,6 +23,7 @@ class HistogramWidget final : public QWidget {
  private:
   QVector<quint64> histogram_;
   QSize imageSize_;
+  bool received_ = false;  // a count has come (an empty one: nothing visible)
   int marker_ = 0;
   bool variable_ = false;
 };

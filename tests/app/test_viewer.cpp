@@ -3502,6 +3502,19 @@ class ViewerTest : public QObject {
     QVERIFY(histogram.size() > 10);      // the sample is deep
     QVERIFY(distance <= 2 * ambiguous);  // only edge pixels may differ…
     QVERIFY(distance <= pixels / 100);   // …and few of them do (10 of 43,200 when measured)
+    // The budget panel's histogram follows the image it describes: side by side, the pane's, at
+    // once (it kept the whole view's size until the camera moved: a bug hunt), and says when
+    // nothing is visible (it read "computing…" for ever).
+    auto* widget = w->findChild<QWidget*>("depthHistogram");
+    QVERIFY(widget);
+    QTRY_COMPARE_WITH_TIMEOUT(widget->accessibleName(), QStringLiteral("Depth complexity n(p), GPU count (240×180)"),
+                              10000);
+    m.setCompareEnabled(true);
+    QTRY_COMPARE_WITH_TIMEOUT(widget->accessibleName(), QStringLiteral("Depth complexity n(p), GPU count (120×180)"),
+                              10000);
+    m.setCompareEnabled(false);
+    for (int i = 0; i < static_cast<int>(m.scene().objects.size()); ++i) m.setObjectVisible(i, false);
+    QTRY_COMPARE_WITH_TIMEOUT(widget->accessibleName(), QStringLiteral("Depth complexity: nothing visible"), 10000);
   }
 
   // A part given a colour of its own shows that colour instead of its file's per-vertex colours
