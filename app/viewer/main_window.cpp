@@ -282,7 +282,7 @@ MainWindow::MainWindow(Options options, QWidget* parent) : QMainWindow(parent), 
     const QString prefix = tr("Cannot render: ");
     if (!message.isEmpty()) {
       statusBar()->showMessage(prefix + model_->renderErrorShown());
-      frameInfo_->setText(tr("no frame"));
+      if (model_->mainPaneFailed()) frameInfo_->setText(tr("no frame"));
     } else if (statusBar()->currentMessage().startsWith(prefix)) {
       statusBar()->clearMessage();
     }

@@ -18,13 +18,15 @@
 
 namespace {
 
-// A float parameter's editor: six significant digits in the locale's notation, exponents
-// included, instead of three decimals — mboit's moment bias of the paper, 5e-7, showed and was
+// A float parameter's editor: the shortest text that reads back as the value, in the locale's
+// notation, exponents included, instead of three decimals — mboit's moment bias of the paper, 5e-7, showed and was
 // taken as 0.000, a different setting from its default −1 (a bug hunt).
 class FloatParamBox : public QDoubleSpinBox {
  public:
   FloatParamBox() { setDecimals(15); }  // values are not rounded to the text's few digits
-  [[nodiscard]] QString textFromValue(double value) const override { return locale().toString(value, 'g', 6); }
+  [[nodiscard]] QString textFromValue(double value) const override {
+    return locale().toString(value, 'g', QLocale::FloatingPointShortest);  // round-trips: Enter changes nothing
+  }
   [[nodiscard]] double valueFromText(const QString& text) const override { return locale().toDouble(text.trimmed()); }
   QValidator::State validate(QString& text, int&) const override {
     bool ok = false;

@@ -11,7 +11,6 @@
 #include <optional>
 
 #include "camera_navigator.hpp"
-#include "mfr/scene/clip_box.hpp"
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
 #include "mfr/reference/metrics.hpp"
@@ -167,9 +166,7 @@ bool RenderView::uploadSceneIfChanged(int side, QStringList& errors) {
     try {
       // A clip box and section that leave nothing say so, as mfr render and the export refuse
       // them (a flat box drew an empty view without a word: a bug hunt).
-      if (const std::optional<mfr::Bounds>& box = model_.scene().clipBox)
-        mfr::requireClipBoxHoldsScene(model_.scene(), *box, "clip box");
-      mfr::requireSomethingToDraw(model_.drawnScene());
+      if (const QString why = model_.drawError(); !why.isEmpty()) throw mfr::Error(why.toStdString());
       r.setScene(model_.drawnScene());
     } catch (const std::exception& e) {
       uploadError_[i] = QString::fromUtf8(e.what());  // e.g. every object hidden
@@ -265,7 +262,9 @@ void RenderView::paintPane(int side, QStringList& errors) {
 
   std::optional<mfr::ImageRGBA8> image;  // the pane's image on the CPU, when needed
   bool inTexture = false;                // `target` holds this frame (GPU methods)
-  if (model_.isCpuMethod(model_.methodOf(side))) {
+  if (const QString why = model_.drawError(); !why.isEmpty() && model_.isCpuMethod(model_.methodOf(side))) {
+    errors << prefix + why;  // as the GPU methods' upload says it
+  } else if (model_.isCpuMethod(model_.methodOf(side))) {
     const ViewerModel::CpuSlot slot = ViewerModel::paneSlot(side);
     const CpuImage* cpu = model_.cpuImage(slot, request);
     const bool current = cpu != nullptr;
@@ -695,6 +694,7 @@ mfr::RenderOutput RenderView::renderOutput(QSize size, const std::map<std::strin
   if (!model_.hasScene()) throw mfr::Error("export", "no scene loaded");
   mfr::RenderRequest request = model_.renderRequest(0, size);
   for (const auto& [name, value] : params) request.params[name] = value;
+  if (const QString why = model_.drawError(); !why.isEmpty()) throw mfr::Error(why.toStdString());
   if (model_.isCpuMethod(model_.method())) return mfr::render(model_.drawnScene(), model_.camera(), request);
   // What mfr render refuses (a scene of degenerate triangles, a singular camera) is refused here too.
   mfr::checkDrawable(model_.drawnScene(), model_.camera(), size.width(), size.height());

@@ -28,7 +28,7 @@ StatsPanel::StatsPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), m
   connect(&model_, &ViewerModel::frameRendered, this, &StatsPanel::showStats);
   // No numbers of the last frame drawn under a frame that cannot be drawn.
   connect(&model_, &ViewerModel::renderErrorChanged, this, [this](const QString& message) {
-    if (message.isEmpty()) return;
+    if (message.isEmpty() || !model_.mainPaneFailed()) return;
     tree_->clear();
     auto* item = new QTreeWidgetItem(tree_, {tr("No frame"), model_.renderErrorShown()});
     item->setToolTip(1, model_.renderErrorShown());

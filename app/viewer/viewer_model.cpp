@@ -1,5 +1,7 @@
 #include "viewer_model.hpp"
 
+#include <QRegularExpression>
+
 #include <QFutureWatcher>
 #include <QTimer>
 #include <QtConcurrent/QtConcurrentRun>
@@ -12,6 +14,7 @@
 
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
+#include "mfr/scene/clip_box.hpp"
 #include "mfr/methods/registry.hpp"
 #include "mfr/reference/composite.hpp"
 #include "mfr/reference/oracle.hpp"
@@ -663,7 +666,10 @@ void ViewerModel::setCompareEnabled(bool enabled) {
   emit compareChanged();
   // Side by side the image the statistics describe is half the view: a change of image size
   // (the budget panel's histogram kept the whole view's until the camera moved: a bug hunt).
-  if (paneSize() != pane) emit viewChanged();
+  if (paneSize() != pane) {
+    ++viewRevision_;
+    emit viewChanged();
+  }
 }
 
 void ViewerModel::setCompareLayout(CompareLayout layout) {
@@ -671,7 +677,10 @@ void ViewerModel::setCompareLayout(CompareLayout layout) {
   const QSize pane = paneSize();
   layout_ = layout;
   emit compareChanged();
-  if (paneSize() != pane) emit viewChanged();
+  if (paneSize() != pane) {
+    ++viewRevision_;
+    emit viewChanged();
+  }
 }
 
 void ViewerModel::setCompareSplit(double split) {
@@ -934,24 +943,27 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path, const std::fun
   ++viewRevision_;
   // An operation of the old scene that the new one cannot draw goes back to auto, with a note:
   // File → Open Sample after @csg with operation csg drew nothing but "operation csg: scene
-  // 'sample' has no CSG tree" (a bug hunt). Only when a scene was open: the first scene of a
-  // scripted run is refused for its --op, as mfr render refuses it; a session sets its own after.
-  QStringList dropped;
+  // 'sample' has no CSG tree" (a bug hunt). Not for the window's first scene: its --op is refused
+  // as mfr render refuses it (scripted runs exit with it); a session sets its own after.
+  std::vector<std::pair<int, QString>> dropped;  // side, "operation csg"
   if (hadScene)
     for (const int side : {0, 1}) {
       const QString operation = operations_[index(side)];
       const bool lacks = (operation == QLatin1String("csg") && scene_.csg.empty()) ||
                          (operation == QLatin1String("volume") && scene_.volumes.empty());
       if (!lacks) continue;
-      dropped << (side == 0 ? QStringLiteral("operation %1") : QStringLiteral("compare operation %1")).arg(operation);
+      dropped.emplace_back(
+          side, (side == 0 ? QStringLiteral("operation %1") : QStringLiteral("compare operation %1")).arg(operation));
       setOperationOf(side, QStringLiteral("auto"));
     }
   if (prepare) prepare();
   emit sceneLoaded();
-  for (const QString& what : dropped)
-    note(QStringLiteral("%1: scene '%2' has no %3: auto is used")
-             .arg(what, QString::fromStdString(scene_.name),
-                  what.endsWith(QLatin1String("csg")) ? QStringLiteral("CSG tree") : QStringLiteral("volume")));
+  // After sceneLoaded, whose handlers apply a session: only for a side the session left on auto.
+  for (const auto& [side, what] : dropped)
+    if (operations_[index(side)] == QLatin1String("auto"))
+      note(QStringLiteral("%1: scene '%2' has no %3: auto is used")
+               .arg(what, QString::fromStdString(scene_.name),
+                    what.endsWith(QLatin1String("csg")) ? QStringLiteral("CSG tree") : QStringLiteral("volume")));
   emit sceneChanged();
   emit viewChanged();
   emit volumeChanged();
@@ -1189,11 +1201,28 @@ void ViewerModel::reportRenderError(const QString& message) {
   emit renderErrorChanged(renderError_);
 }
 
+QString ViewerModel::drawError() const {
+  if (!drawError_ || drawError_->first != sceneRevision_) {
+    QString why;
+    try {
+      const mfr::Scene& drawn = drawnScene();
+      drawn.validate();  // every part hidden: that, not the box or plane, is the reason
+      if (scene_.clipBox) mfr::requireClipBoxHoldsScene(scene_, *scene_.clipBox, "clip box");
+      mfr::requireSomethingToDraw(drawn);
+    } catch (const std::exception& e) {
+      why = QString::fromUtf8(e.what());
+    }
+    drawError_ = std::pair{sceneRevision_, why};
+  }
+  return drawError_->second;
+}
+
 QString ViewerModel::renderErrorShown() const {
+  // Anywhere in the text: compare mode's "B: --op …", and "use --op hybrid (or auto)".
+  static const QRegularExpression op(QStringLiteral("--op (?=\\S)")), method(QStringLiteral("--method (?=\\S)"));
   QString shown = renderError_;
-  for (const auto& [option, name] : {std::pair{QLatin1String("--op "), QLatin1String("operation ")},
-                                     std::pair{QLatin1String("--method "), QLatin1String("method ")}})
-    if (shown.startsWith(option)) shown = name + shown.mid(option.size());
+  shown.replace(op, QStringLiteral("operation "));
+  shown.replace(method, QStringLiteral("method "));
   return shown.replace(QLatin1String("--param "), QString());
 }
 

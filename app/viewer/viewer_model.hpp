@@ -249,6 +249,10 @@ class ViewerModel final : public ViewerContext {
     return scene_.section && sectionError_.isEmpty() ? drawn_ : scene_;
   }
   [[nodiscard]] const mfr::SectionReport& sectionReport() const { return sectionReport_; }
+  // Why drawnScene() draws nothing, in mfr render's words (every part hidden; a clip box that
+  // holds nothing of the scene; a clip box and section that leave nothing), or empty: every
+  // method's frame and export says so instead of an empty picture. Computed once per revision.
+  [[nodiscard]] QString drawError() const;
   [[nodiscard]] const QString& sectionError() const { return sectionError_; }
   [[nodiscard]] const QString& scenePath() const { return scenePath_; }
   [[nodiscard]] quint64 sceneRevision() const { return sceneRevision_; }
@@ -323,6 +327,10 @@ class ViewerModel final : public ViewerContext {
   // user of the window never typed ("--op hybrid: needs --param tail=true …" reads "operation
   // hybrid: needs tail=true …").
   [[nodiscard]] QString renderErrorShown() const;
+  // The render error is (also) the main pane's: side by side, pane B's alone leaves A's frame.
+  [[nodiscard]] bool mainPaneFailed() const {
+    return !renderError_.isEmpty() && !renderError_.startsWith(QLatin1String("B: "));
+  }
   [[nodiscard]] quint64 framesRendered() const { return framesRendered_; }
 
   // What the pane of `side` shows now, and its exact reference image (the oracle's "over", or its
@@ -403,6 +411,7 @@ class ViewerModel final : public ViewerContext {
   std::optional<mfr::MoleculeStyle> requestedMoleculeStyle_;  // setMoleculeStyle's, while it loads
   quint64 sceneRevision_ = 0;
   quint64 sceneSerial_ = 0;  // scenes opened (setScene)
+  mutable std::optional<std::pair<quint64, QString>> drawError_;  // drawError() of a scene revision
   mfr::Bounds bounds_;
   double radius_ = 0.0;
 

@@ -408,7 +408,9 @@ void HybridVolumePanel::volumeChanged() {
   }
   const glm::ivec3 d = context_.volumeDims();
   const mfr::TransferFunction loaded = context_.loadedTransferFunction();
-  QString key = QStringLiteral("%1|%2x%3x%4|%5")
+  // The volume's index too: two volumes alike in name, grid and function keep states of their own.
+  QString key = QStringLiteral("%1|%2|%3x%4x%5|%6")
+                    .arg(context_.currentVolume())
                     .arg(context_.volumeName())
                     .arg(d.x)
                     .arg(d.y)

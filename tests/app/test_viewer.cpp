@@ -536,6 +536,13 @@ class ViewerTest : public QObject {
     QCOMPARE(m.renderError(), QStringLiteral("--op hybrid: needs --param tail=true with method kplus-array"));
     QCOMPARE(w->statusBar()->currentMessage(),
              QStringLiteral("Cannot render: operation hybrid: needs tail=true with method kplus-array"));
+    // Within the text too (a review): optimal-k's refusal of another operation.
+    m.setMethod(QStringLiteral("optimal-k"));
+    m.setOperation(QStringLiteral("oit"));
+    QTRY_VERIFY_WITH_TIMEOUT(m.renderError().contains("use --op hybrid"), kTimeoutMs);
+    QVERIFY2(w->statusBar()->currentMessage().contains("use operation hybrid (or auto)") &&
+                 !w->statusBar()->currentMessage().contains("--"),
+             qPrintable(w->statusBar()->currentMessage()));
     m.setOperation(QStringLiteral("auto"));
   }
 
@@ -3799,6 +3806,11 @@ class ViewerTest : public QObject {
     QTRY_VERIFY_WITH_TIMEOUT(!m.renderError().isEmpty(), kTimeoutMs);
     QVERIFY2(m.renderError().startsWith("clip box: holds nothing of scene 'sample' (a flat box"),
              qPrintable(m.renderError()));
+    // The CPU methods say so too (the oracle drew an empty view: a review), and an export refuses.
+    m.setMethod("oracle");
+    QTRY_VERIFY_WITH_TIMEOUT(m.renderError().startsWith("clip box: holds nothing"), kTimeoutMs);
+    QVERIFY_THROWS_EXCEPTION(mfr::Error, w->view().renderImage(QSize(40, 30)));
+    m.setMethod("abuffer-ll");
     minZ->setValue(0);
     maxZ->setValue(650);
     settle(m);

@@ -12,6 +12,7 @@
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/reference/oracle.hpp"
+#include "mfr/scene/clip_box.hpp"
 #include "mfr/scene/primitives.hpp"
 #include "test_files.hpp"
 
@@ -122,6 +123,26 @@ TEST(OracleClip, ValidationRefusesInvertedAndNonFiniteBoxes) {
   box.max = {1.0, 1.0, 1.0};
   scene.clipBox = box;
   EXPECT_NO_THROW(scene.validate());
+}
+
+// A scene flat on an axis (a plane) is held by a box that covers it there, even a flat one (the
+// viewer's Clip dock starts at the scene's bounds and refused them: a review); a flat box beside
+// it, or one on a solid scene, still holds nothing.
+TEST(ClipBoxHoldsScene, AFlatSceneIsHeldByABoxFlatWhereItIs) {
+  Scene scene;
+  scene.name = "sheet";
+  Object sheet;
+  sheet.mesh = std::make_shared<Mesh>(makePlane(2.0, 2.0));
+  scene.objects.push_back(sheet);
+  const Bounds b = scene.bounds();
+  ASSERT_EQ(b.min.z, b.max.z);
+  EXPECT_NO_THROW(requireClipBoxHoldsScene(scene, b, "clip box"));
+  EXPECT_NO_THROW(requireClipBoxHoldsScene(scene, Bounds{{-0.5, -0.5, 0.0}, {0.5, 0.5, 0.0}}, "clip box"));
+  EXPECT_NO_THROW(requireClipBoxHoldsScene(scene, Bounds{{-0.5, -0.5, -1.0}, {0.5, 0.5, 1.0}}, "clip box"));
+  EXPECT_THROW(requireClipBoxHoldsScene(scene, Bounds{{-0.5, -0.5, 0.5}, {0.5, 0.5, 0.5}}, "clip box"), Error);
+  EXPECT_THROW(requireClipBoxHoldsScene(scene, Bounds{{-0.5, 0.0, 0.0}, {0.5, 0.0, 0.0}}, "clip box"), Error);
+  scene.objects[0].mesh = std::make_shared<Mesh>(makeBox(glm::dvec3(2.0)));
+  EXPECT_THROW(requireClipBoxHoldsScene(scene, Bounds{{-0.5, -0.5, 0.0}, {0.5, 0.5, 0.0}}, "clip box"), Error);
 }
 
 using SceneFileClip = test::TempDirTest;

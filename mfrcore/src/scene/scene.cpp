@@ -184,8 +184,12 @@ Camera Scene::view(const std::string& viewName) const {
 void requireClipBoxHoldsScene(const Scene& scene, const Bounds& box, const std::string& what) {
   const Bounds b = scene.bounds();
   bool holds = b.valid();
+  // An axis on which the scene itself is flat (a plane, one slice of a volume) is held by a box
+  // that covers it, even a flat one: the viewer's Clip dock starts at the scene's bounds, and
+  // refused them on such a scene (a review).
   for (int a = 0; a < 3; ++a)
-    holds = holds && box.max[a] > box.min[a] && box.min[a] < b.max[a] && box.max[a] > b.min[a];
+    holds = holds && ((box.max[a] > box.min[a] && box.min[a] < b.max[a] && box.max[a] > b.min[a]) ||
+                      (b.max[a] == b.min[a] && box.min[a] <= b.min[a] && box.max[a] >= b.max[a]));
   if (holds) return;
   std::ostringstream bounds;
   bounds << "[" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – [" << b.max.x << ", " << b.max.y << ", "
