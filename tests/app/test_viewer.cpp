@@ -1905,17 +1905,22 @@ class ViewerTest : public QObject {
                                  "ghosting: ghosted: no part 'nosuch' in this scene (left out)"}));
     // A part named "dup#1" beside two "dup"s: the second "dup" is "dup#2", and each keeps its focus.
     // (The file spells '#' as \u0023: moc misreads a '#' inside a raw string.)
-    {
-      const QString taken = dir.filePath("taken.mfrscene");
-      QFile f(taken);
-      QVERIFY(f.open(QIODevice::WriteOnly));
-      f.write(R"({"objects": [
-        {"name": "dup", "primitive": {"type": "sphere", "radius": 0.5}, "opacity": 0.8},
-        {"name": "dup\u00231", "primitive": {"type": "sphere", "radius": 0.3}, "opacity": 0.6,
+    const auto writeDups = [&dir](const QString& name, double first, double hashed, double second) {
+      QFile f(dir.filePath(name));
+      if (!f.open(QIODevice::WriteOnly)) return false;
+      f.write(QStringLiteral(R"({"objects": [
+        {"name": "dup", "primitive": {"type": "sphere", "radius": 0.5}, "opacity": %1},
+        {"name": "dup\u00231", "primitive": {"type": "sphere", "radius": 0.3}, "opacity": %2,
          "transform": {"translate": [0, 1.5, 0]}},
-        {"name": "dup", "primitive": {"type": "box", "size": [1, 1, 1]}, "opacity": 0.7,
-         "transform": {"translate": [1.5, 0, 0]}}]})");
-    }
+        {"name": "dup", "primitive": {"type": "box", "size": [1, 1, 1]}, "opacity": %3,
+         "transform": {"translate": [1.5, 0, 0]}}]})")
+                  .arg(first)
+                  .arg(hashed)
+                  .arg(second)
+                  .toUtf8());
+      return true;
+    };
+    QVERIFY(writeDups("taken.mfrscene", 0.8, 0.6, 0.7));
     auto t = openWindow(dir.filePath("taken.mfrscene"));
     QVERIFY(t);
     MfrViewerPlugin* ghostingT = loadedPlugin(*t, QStringLiteral("ghosting"));
@@ -1929,17 +1934,7 @@ class ViewerTest : public QObject {
     QCOMPARE(savedT.value("ghosted").toObject().keys(), (QStringList{"dup", "dup#1"}));
     // Another file whose parts have the same names starts with nothing in focus and ghosting off:
     // the panel kept both, and turning ghosting off then gave its parts the old file's opacities.
-    {
-      const QString other = dir.filePath("other.mfrscene");
-      QFile f(other);
-      QVERIFY(f.open(QIODevice::WriteOnly));
-      f.write(R"({"objects": [
-        {"name": "dup", "primitive": {"type": "sphere", "radius": 0.5}, "opacity": 0.5},
-        {"name": "dup\u00231", "primitive": {"type": "sphere", "radius": 0.3}, "opacity": 0.4,
-         "transform": {"translate": [0, 1.5, 0]}},
-        {"name": "dup", "primitive": {"type": "box", "size": [1, 1, 1]}, "opacity": 0.3,
-         "transform": {"translate": [1.5, 0, 0]}}]})");
-    }
+    QVERIFY(writeDups("other.mfrscene", 0.5, 0.4, 0.3));
     t->openScene(dir.filePath("other.mfrscene"));
     QTRY_COMPARE_WITH_TIMEOUT(t->model().scenePath(), dir.filePath("other.mfrscene"), kTimeoutMs);
     auto* ghostOthers = t->findChild<QCheckBox*>("ghostOthers");
