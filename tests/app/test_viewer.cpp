@@ -3566,7 +3566,7 @@ class ViewerTest : public QObject {
     // A standard view of a scene with nothing visible turns about the target at its distance (the
     // fit of nothing put the eye 1 unit from the origin: a bug hunt).
     mfr::Scene hidden = mfr::makeSampleScene();
-    for (mfr::Object& o : hidden.objects) o.visible = false;
+    for (mfr::Object& part : hidden.objects) part.visible = false;
     mfr::Camera far = c;
     far.eye = {2, 3, 40};
     far.target = {2, 3, 0};
