@@ -82,6 +82,11 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
     if (point_) QTimer::singleShot(0, this, &ProbePanel::refreshIfChanged);
   });
   connect(&model_, &ViewerModel::sceneLoaded, this, &ProbePanel::clear);
+  // A frame that cannot be drawn (every part hidden) reports no frame: the probe says why instead
+  // of listing the fragments of what was drawn before (a bug hunt).
+  connect(&model_, &ViewerModel::renderErrorChanged, this, [this] {
+    if (point_ && model_.mainPaneFailed()) QTimer::singleShot(0, this, &ProbePanel::refresh);
+  });
 }
 
 void ProbePanel::probe(QPoint point) {

@@ -711,6 +711,7 @@ mfr::RenderOutput RenderView::renderOutput(QSize size, const std::map<std::strin
 
 ViewProbe RenderView::probeAt(QPoint point) {
   if (!model_.hasScene()) throw mfr::Error("probe", "no scene loaded");
+  if (const QString why = model_.drawError(); !why.isEmpty()) throw mfr::Error(why.toStdString());
   const double ratio = devicePixelRatioF();
   const QPoint device(static_cast<int>(std::floor(point.x() * ratio)), static_cast<int>(std::floor(point.y() * ratio)));
   ViewProbe result;

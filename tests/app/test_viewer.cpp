@@ -3755,6 +3755,15 @@ class ViewerTest : public QObject {
     QCOMPARE(oracle.count(1, 1), 0u);
     QCOMPARE(table->item(0, ProbePanel::Share)->text(), QStringLiteral("100.0 %"));
 
+    // Every part hidden: no frame, and the probe says why (it kept the last frame's list).
+    QTest::mouseClick(&view, Qt::LeftButton, Qt::ControlModifier, pixel);
+    QTRY_COMPARE_WITH_TIMEOUT(table->rowCount(), n + 1, kProbeTimeoutMs);
+    for (int i = 0; i < static_cast<int>(m.scene().objects.size()); ++i) m.setObjectVisible(i, false);
+    QTRY_COMPARE_WITH_TIMEOUT(table->rowCount(), 0, kProbeTimeoutMs);
+    QVERIFY2(summary->text().startsWith(QStringLiteral("Probe: scene 'sample': nothing to render")),
+             qPrintable(summary->text()));
+    for (int i = 0; i < static_cast<int>(m.scene().objects.size()); ++i) m.setObjectVisible(i, true);
+
     w->findChild<QPushButton*>("probeClear")->click();
     QCOMPARE(table->rowCount(), 0);
     QVERIFY(!mark->isVisible());
