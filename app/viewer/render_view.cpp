@@ -429,15 +429,23 @@ QRect RenderView::paneRect(int side) const {
   return {QPoint(side == 1 ? pane.width() : 0, 0), pane};
 }
 
-QRectF RenderView::navigationArea(QPointF point) const {
+QRectF RenderView::logicalRect(const QRect& device) const {
   const double ratio = devicePixelRatioF();
-  const auto logical = [ratio](const QRect& r) {
-    return QRectF(r.x() / ratio, r.y() / ratio, r.width() / ratio, r.height() / ratio);
-  };
-  const QRectF second = logical(paneRect(1));
-  return model_.compareEnabled() && model_.compareLayout() != CompareLayout::Split && point.x() >= second.left()
-             ? second
-             : logical(paneRect(0));
+  return {device.x() / ratio, device.y() / ratio, device.width() / ratio, device.height() / ratio};
+}
+
+int RenderView::paneAt(QPointF point) const {
+  const double ratio = devicePixelRatioF();
+  const QPoint device(static_cast<int>(std::floor(point.x() * ratio)), static_cast<int>(std::floor(point.y() * ratio)));
+  int found = -1;
+  for (int side = 0; side < model_.paneCount(); ++side)
+    if (paneVisibleRect(side).contains(device)) found = side;
+  return found;
+}
+
+QRectF RenderView::navigationArea(QPointF point) const {
+  // Off every image (an odd column side by side) the first pane's scale is as good as any.
+  return logicalRect(paneRect(std::max(paneAt(point), 0)));
 }
 
 QRect RenderView::paneVisibleRect(int side) const {
@@ -571,16 +579,12 @@ void RenderView::updateOverlays() {
   } else {
     errorNote_->hide();
   }
-  const auto logical = [ratio](const QRect& r) {
-    return QRect(static_cast<int>(r.x() / ratio), static_cast<int>(r.y() / ratio), static_cast<int>(r.width() / ratio),
-                 static_cast<int>(r.height() / ratio));
-  };
   const bool compare = model_.compareEnabled() && model_.hasScene();
   const bool split = compare && model_.compareLayout() == CompareLayout::Split;
   const bool heat = compare && model_.compareDisplay() != CompareDisplay::Images;
   for (int side = 0; side < kSides; ++side) {
     const bool shown = side < model_.paneCount() && model_.hasScene();
-    const QRect area = logical(split ? paneRect(side) : paneVisibleRect(side));
+    const QRect area = logicalRect(split ? paneRect(side) : paneVisibleRect(side)).toRect();
     // Captions: which method, and how far it is from the exact image.
     PaneCaption* caption = captions_[side];
     if (compare && shown) {
@@ -716,9 +720,7 @@ ViewProbe RenderView::probeAt(QPoint point) {
   const QPoint device(static_cast<int>(std::floor(point.x() * ratio)), static_cast<int>(std::floor(point.y() * ratio)));
   ViewProbe result;
   result.point = point;
-  result.side = -1;
-  for (int side = 0; side < model_.paneCount(); ++side)
-    if (paneVisibleRect(side).contains(device)) result.side = side;
+  result.side = paneAt(point);
   if (result.side < 0) throw mfr::Error("probe", "the point is not on an image");
   const QRect pane = paneRect(result.side);
   result.paneSize = pane.size();

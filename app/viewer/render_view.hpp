@@ -98,6 +98,10 @@ class RenderView final : public QOpenGLWidget {
   // it that shows (the split layout shows each image only on its side of the line).
   [[nodiscard]] QRect paneRect(int side) const;
   [[nodiscard]] QRect paneVisibleRect(int side) const;
+  // The side whose visible image holds `point` (logical widget coordinates), or -1 off every image.
+  [[nodiscard]] int paneAt(QPointF point) const;
+  // A framebuffer rectangle (device pixels) in logical widget coordinates.
+  [[nodiscard]] QRectF logicalRect(const QRect& device) const;
   // The pane under `point` (logical widget coordinates), in logical coordinates: what the mouse
   // navigates, so that side by side a drag pans and the wheel zooms at the pane's own scale and
   // towards the point under the cursor in that pane.

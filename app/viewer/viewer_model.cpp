@@ -715,9 +715,8 @@ void ViewerModel::setMoleculeStyle(const mfr::MoleculeStyle& style) {
   if (!moleculeStyle_ || !style.any()) return;
   // Compared with what was asked last: a change undone before its read ends is a read of its own.
   if (style == requestedMoleculeStyle_.value_or(*moleculeStyle_)) return;
-  const mfr::Camera camera = keepCamera_.value_or(camera_);
   loadSceneAsync(scenePath_, {}, style);
-  keepCamera_ = camera;
+  keepView_ = true;
   requestedMoleculeStyle_ = style;
 }
 
@@ -741,7 +740,7 @@ std::vector<int> matchByName(const QStringList& entries, const QStringList& name
 void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
                                  const std::optional<mfr::MoleculeStyle>& molecule,
                                  const QList<QPair<QString, QString>>& volumeFields) {
-  keepCamera_.reset();
+  keepView_ = false;
   requestedMoleculeStyle_.reset();
   if (load_) {
     load_->cancel = true;  // superseded: stop the previous worker early
@@ -830,7 +829,7 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
         load_.reset();
         loading_ = false;
         if (!loaded.error.isEmpty() || !loaded.scene) {
-          keepCamera_.reset();
+          keepView_ = false;
           requestedMoleculeStyle_.reset();
           emit loadFailed(path, loaded.error.isEmpty() ? tr("loading stopped") : loaded.error);
           return;
@@ -852,8 +851,8 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
           std::optional<mfr::FieldColors> coloring;
         };
         std::optional<KeptView> kept;
-        if (keepCamera_) kept = KeptView{camera_, scene_.clipBox, scene_.section, thickness_, fieldColoring()};
-        keepCamera_.reset();
+        if (keepView_) kept = KeptView{camera_, scene_.clipBox, scene_.section, thickness_, fieldColoring()};
+        keepView_ = false;
         requestedMoleculeStyle_.reset();
         moleculeStyle_.reset();
         if (!path.startsWith('@') && mfr::isMoleculeFile(path.toStdString()))
@@ -890,7 +889,7 @@ void ViewerModel::cancelLoad() {
   ++abandonedLoads_;
   loadPoll_->stop();
   loading_ = false;
-  keepCamera_.reset();
+  keepView_ = false;
   requestedMoleculeStyle_.reset();
   emit loadCancelled();
 }

@@ -407,7 +407,7 @@ class ViewerModel final : public ViewerContext {
   bool hasScene_ = false;
   QString scenePath_;
   std::optional<mfr::MoleculeStyle> moleculeStyle_;
-  std::optional<mfr::Camera> keepCamera_;  // setMoleculeStyle's camera, for the scene it loads
+  bool keepView_ = false;  // the load is setMoleculeStyle's re-read: keep the view as it is when it ends
   std::optional<mfr::MoleculeStyle> requestedMoleculeStyle_;  // setMoleculeStyle's, while it loads
   quint64 sceneRevision_ = 0;
   quint64 sceneSerial_ = 0;  // scenes opened (setScene)
