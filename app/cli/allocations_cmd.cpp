@@ -64,7 +64,7 @@ void addAllocations(CLI::App& app) {
     const NeuralImportanceModel model = loadNeuralImportance(opt->weights).quantised();  // as on the GPU
     const std::vector<std::string> views = splitList(opt->views, "--views");
     refuseRepeats(views, "--views " + opt->views);
-    const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
+    const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views, {{w, h}});
     // Every allocation gets dkb's slots (its layout also holds the weights), so all compete at one F.
     const VariableKLayout layout = variableKLayout(pixels, NeuralImportanceModel::packedBytes());
     const std::vector<float> flat(pixels, 1.0f);

@@ -78,9 +78,12 @@ struct ReadOptions {
 // (--opacity).
 Scene loadSceneWithOpacity(const std::string& path, double opacity, const ReadOptions& read = {});
 // Every scene loaded (with --opacity) and every view checked before any work, so that a bad file
-// or view fails at once; throws mfr::Error for an empty view list.
+// or view fails at once; throws mfr::Error for an empty view list. A view whose frustum holds
+// none of the scene's bounds at one of `sizes` (their aspect ratios) is refused too, as
+// requireSomethingVisible refuses it later (evaluate and dataset printed rows of other views first).
 std::vector<Scene> loadScenesWithViews(const std::vector<std::string>& paths, double opacity,
-                                       const std::vector<std::string>& views);
+                                       const std::vector<std::string>& views,
+                                       const std::vector<std::pair<int, int>>& sizes);
 // CLI::Range lets NaN through (every comparison with it is false): a closed interval that refuses
 // it, for opacities and fractions.
 inline CLI::Validator finiteRange(double low, double high) {

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
@@ -131,15 +132,42 @@ Scene loadSceneWithOpacity(const std::string& path, double opacity, const ReadOp
   return scene;
 }
 
+namespace {
+
+// Whether every corner of `box` lies beyond one plane of the camera's frustum (clip space): then
+// nothing in it can be seen. Each plane is a half-space of world space, behind the eye included,
+// so the test never refuses a box that shows; a box that straddles planes passes.
+bool outsideFrustum(const Bounds& box, const Camera& camera, double aspect) {
+  if (!box.valid()) return false;
+  const glm::dmat4 m = camera.projectionMatrix(aspect) * camera.viewMatrix();
+  std::array<bool, 6> allOutside{true, true, true, true, true, true};
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::dvec4 c = m * glm::dvec4(corner & 1 ? box.max.x : box.min.x, corner & 2 ? box.max.y : box.min.y,
+                                        corner & 4 ? box.max.z : box.min.z, 1.0);
+    const std::array<bool, 6> outside{c.x<-c.w, c.x> c.w, c.y<-c.w, c.y> c.w, c.z<-c.w, c.z> c.w};
+    for (std::size_t plane = 0; plane < 6; ++plane) allOutside[plane] = allOutside[plane] && outside[plane];
+  }
+  return std::any_of(allOutside.begin(), allOutside.end(), [](bool b) { return b; });
+}
+
+}  // namespace
+
 std::vector<Scene> loadScenesWithViews(const std::vector<std::string>& paths, double opacity,
-                                       const std::vector<std::string>& views) {
+                                       const std::vector<std::string>& views,
+                                       const std::vector<std::pair<int, int>>& sizes) {
   if (views.empty()) throw Error("--views", "no view given");
   std::vector<Scene> scenes;
   for (const std::string& path : paths) {
     scenes.push_back(loadSceneWithOpacity(path, opacity));
     // Each view, and whether there is anything to draw, before any work: a scene of degenerate
     // triangles failed after the other scenes' rows were printed (a bug hunt).
-    for (const std::string& v : views) checkDrawable(scenes.back(), scenes.back().view(v), 1, 1, path);
+    for (const std::string& v : views) {
+      const Camera camera = scenes.back().view(v);
+      checkDrawable(scenes.back(), camera, 1, 1, path);
+      for (const auto& [w, h] : sizes)
+        if (outsideFrustum(scenes.back().bounds(), camera, static_cast<double>(w) / h))
+          throw Error(path + " view " + v, "nothing visible (the scene lies outside the view)");
+    }
   }
   return scenes;
 }

@@ -102,7 +102,7 @@ void addDataset(CLI::App& app) {
                                   "' again (one size given twice)");
     }
     if (!(opt->sample > 0.0)) throw Error("--sample", "must be in (0, 1]: 0 writes no rows");
-    const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
+    const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views, sizes);
     const DatasetSampling sampling = opt->sampleBy == "deep" ? DatasetSampling::DeepPixels : DatasetSampling::Pixels;
     DkbDataset dataset;
     std::mt19937_64 rng(opt->seed);

@@ -204,7 +204,7 @@ void addEvaluate(CLI::App& app) {
     }
     const std::vector<std::string> views = splitList(opt->views, "--views");
     refuseRepeats(views, "--views " + opt->views);
-    const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views);
+    const std::vector<Scene> scenes = loadScenesWithViews(opt->scenes, opt->opacity, views, {{w, h}});
     GpuRenderer& gpu = headlessRenderer();
     const gl::ContextInfo info = gl::queryContextInfo();
     for (const std::string& m : interlockRows)  // each row was this error, with exit 0

@@ -14,6 +14,7 @@
 #include <QJsonDocument>
 #include <QJsonObject>
 #include <QOpenGLContext>
+#include <QRegularExpression>
 #include <QStatusBar>
 #include <QSurfaceFormat>
 #include <QLayout>
@@ -396,6 +397,9 @@ int main(int argc, char** argv) {
   });
   // Applied once the scene has loaded: the view and, for scripted runs, the pictures.
   bool applied = false;
+  // Method parameters that --plugin-settings set (the budget panel's budget_mib), by plugin: a
+  // render's refusal of one names those settings, not a --param the command line lacks.
+  std::map<std::string, QString> paramsOfPlugin;
   QObject::connect(&model, &ViewerModel::sceneLoaded, &window, [&] {
     if (applied) return;
     applied = true;
@@ -498,7 +502,10 @@ int main(int argc, char** argv) {
               if (first.isEmpty()) first = text;
             });
         quietNotes = scripted;
+        const std::map<std::string, std::string> before = model.params();
         r.plugin->loadSettings(cl.pluginSettings.at(r.id));
+        for (const auto& [name, value] : model.params())
+          if (!before.contains(name) || before.at(name) != value) paramsOfPlugin[name] = r.id;
         quietNotes = false;
         QObject::disconnect(noted);
         if (first.startsWith(r.id + QStringLiteral(": "))) first = first.mid(r.id.size() + 2);
@@ -527,10 +534,13 @@ int main(int argc, char** argv) {
       if (unused) refuse(QString::fromStdString("--" + unused->name + ": " + unused->reason));
     }
   });
+  // Only --screenshot: its picture is rendered at --size on its own, so the window draws nothing.
+  const bool exportOnly = !cl.screenshot.isEmpty() && cl.windowScreenshot.isEmpty();
+  window.view().setLiveFrames(!exportOnly);
   if (scripted) {
     QObject::connect(&model, &ViewerModel::loadFailed, &app, [](const QString&, const QString& message) { fail(message, 1); });
-    // Poll until the scene is loaded, a frame is drawn and background work (oracle image,
-    // depth-complexity histogram) is done, then take the pictures and quit.
+    // Poll until the scene is loaded, a frame is drawn (for --window-screenshot) and background
+    // work (oracle image, depth-complexity histogram) is done, then take the pictures and quit.
     auto* poll = new QTimer(&app);
     auto* clock = new QElapsedTimer;
     clock->start();
@@ -553,7 +563,7 @@ int main(int argc, char** argv) {
         fail(QStringLiteral("timed out waiting for the first frame (%1 s)").arg(kFirstFrameSeconds), 1);
       // The live view may fail where the screenshot does not (a budget too small for the window's
       // size): a live error ends the wait too, and --screenshot reports its own render's errors.
-      const bool drawn = model.framesRendered() > 0 || !model.renderError().isEmpty();
+      const bool drawn = exportOnly || model.framesRendered() > 0 || !model.renderError().isEmpty();
       if (!model.hasScene() || !window.view().glReady() || !drawn || model.busy()) return;
       // A whole-window picture also waits for the panels' delayed work (the budget plugin asks
       // for the depth-complexity histogram once the view has been still for a moment).
@@ -589,7 +599,14 @@ int main(int argc, char** argv) {
           mfr::writePng(cl.windowScreenshot.toStdString(), image);
         }
       } catch (const std::exception& e) {
-        fail(QString::fromUtf8(e.what()), 1);
+        QString message = QString::fromUtf8(e.what());
+        static const QRegularExpression named(QStringLiteral("^--param ([A-Za-z0-9_]+)="));
+        if (const QRegularExpressionMatch m = named.match(message); m.hasMatch()) {
+          const std::string name = m.captured(1).toStdString();
+          if (const auto it = paramsOfPlugin.find(name); it != paramsOfPlugin.end() && !cl.params.contains(name))
+            message = QStringLiteral("--plugin-settings %1: %2").arg(it->second, message.mid(8));
+        }
+        fail(message, 1);
       }
       QApplication::exit(0);
     });

@@ -185,8 +185,19 @@ void RenderView::clearToBackground() {
   glClear(GL_COLOR_BUFFER_BIT);
 }
 
+void RenderView::setLiveFrames(bool on) {
+  if (on == liveFrames_) return;
+  liveFrames_ = on;
+  update();
+}
+
 void RenderView::paintGL() {
   model_.setRenderSize(pixelSize());
+  if (!liveFrames_) {
+    clearToBackground();
+    maps_ = {};
+    return;
+  }
   QStringList errors;
   reports_ = std::make_shared<Reports>();
   const int wanted = navigationReduction();

@@ -64,6 +64,10 @@ class RenderView final : public QOpenGLWidget {
   // The same with `params` merged over the method's, and the render's stats.
   mfr::RenderOutput renderOutput(QSize size, const std::map<std::string, std::string>& params);
   [[nodiscard]] bool glReady() const { return renderers_[0] != nullptr; }
+  // Off: the view draws only its background, and no frame is rendered or reported. A run that
+  // exports at --size and quits (mfrview --screenshot) has no one to show the window to; its first
+  // frame at the window's size cost 100 s for a volume at a fine step, 60 times the export's.
+  void setLiveFrames(bool on);
   [[nodiscard]] const QString& glInfo() const { return glInfo_; }
   // The image size in device pixels.
   [[nodiscard]] QSize pixelSize() const;
@@ -209,6 +213,7 @@ class RenderView final : public QOpenGLWidget {
   QPoint lastMouse_;
   enum class Drag { None, Orbit, Pan } drag_ = Drag::None;
   bool fastNavigation_ = true;
+  bool liveFrames_ = true;
   bool navigating_ = false;
   QTimer* settle_ = nullptr;  // ends navigation a moment after the last drag or wheel step
   int lastReduction_ = 1;

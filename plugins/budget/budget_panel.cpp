@@ -365,8 +365,12 @@ std::map<std::string, std::string> BudgetPanel::exportParams(QSize size,
                                                              const mfr::Stats* measured) const {
   const Driver d = driverFor(ctx_.method());
   // The budget's own parameter (budget_mib) holds at any size; at the view's size the view's
-  // fitted parameters hold.
-  if (!driving_ || (d.knob != Knob::Pool && d.knob != Knob::Slots) || (size == ctx_.imageSize() && !tried)) return {};
+  // fitted parameters hold once a frame of this method there measured them within the budget (a
+  // view that has drawn nothing, as under mfrview --screenshot, has only a first guess).
+  const mfr::Stats& shown = ctx_.stats();
+  const bool viewFitted = size == ctx_.imageSize() && QString::fromStdString(shown.method) == ctx_.method() &&
+                          static_cast<double>(shown.bytesAllocated) <= budgetMiB() * kMiB;
+  if (!driving_ || (d.knob != Knob::Pool && d.knob != Knob::Slots) || (viewFitted && !tried)) return {};
   Model m = modelAt(static_cast<double>(size.width()) * size.height());
   if (!tried || !measured) {
     exportTries_.clear();

@@ -1368,18 +1368,31 @@ TEST_F(Cli, BudgetToolsRefuseWhatTheyCannotMeasure) {
   expectCleanFailure("train " + deepData.string() + " --epochs 1",
                      "deep.bin: corrupt: its metadata nests 100000 levels deep (more than 64)");
   // A view looking away from everything: allocations printed "-nan %" and empty allocations,
-  // evaluate "below what k = 1 needs" on every row.
+  // evaluate "below what k = 1 needs" on every row. Refused before any row (evaluate and dataset
+  // printed the rows of the views before it), as a scene of degenerate triangles is.
+  const fs::path seen = write("seen.mfrscene", R"({"objects": [{"primitive": {"type": "sphere"}}],
+      "views": [{"name": "look", "eye": [0, 0, 5], "target": [0, 0, 0]},
+                {"name": "away", "eye": [0, 0, -5], "target": [0, 0, 0]}]})");
   const fs::path away = write("away.mfrscene", R"({"objects": [{"primitive": {"type": "sphere"}}],
-      "views": [{"name": "away", "eye": [0, 0, 5], "target": [0, 0, 10]}]})");
-  oneLine("allocations " + away.string() + " --views away -s 16x12 --budgets e80",
-          "away.mfrscene view away: nothing visible (no pixel has a fragment)");
+      "views": [{"name": "look", "eye": [0, 0, 5], "target": [0, 0, 0]},
+                {"name": "away", "eye": [0, 0, 5], "target": [0, 0, 10]},
+                {"name": "corner", "eye": [0.95, 0.95, 5], "target": [0.95, 0.95, 0], "fovy": 1}]})");
+  const std::string both = seen.string() + " " + away.string() + " --views look,away";
   for (const std::string& command :
-       {"evaluate " + away.string() + " --views away -s 16x12 -r 1 --budgets e80 -m fkb",
-        "dataset " + away.string() + " --views away -s 16x12 --budgets 1 -o " + (dir() / "away.bin").string()}) {
-    // Found when the view is reached (after the table's header).
+       {"allocations " + both + " -s 16x12 --budgets e80", "evaluate " + both + " -s 16x12 -r 1 --budgets e80 -m fkb",
+        "dataset " + both + " -s 16x12 -s 12x16 --budgets 1 -o " + (dir() / "away.bin").string()}) {
+    oneLine(command, away.string() + " view away: nothing visible (the scene lies outside the view)");
+    EXPECT_FALSE(fs::exists(dir() / "away.bin"));
+  }
+  // A view into the sphere's bounding box beside the sphere: only casting finds that it sees
+  // nothing, when the view is reached.
+  for (const std::string& command :
+       {"allocations " + away.string() + " --views corner -s 16x12 --budgets e80",
+        "evaluate " + away.string() + " --views corner -s 16x12 -r 1 --budgets e80 -m fkb",
+        "dataset " + away.string() + " --views corner -s 16x12 --budgets 1 -o " + (dir() / "away.bin").string()}) {
     const CliResult r = runCli(command);
     EXPECT_EQ(r.exitCode, 1) << r.out;
-    EXPECT_NE(r.out.find("\nmfr: " + away.string() + " view away: nothing visible (no pixel has a fragment)\n"),
+    EXPECT_NE(r.out.find("mfr: " + away.string() + " view corner: nothing visible (no pixel has a fragment)\n"),
               std::string::npos)
         << r.out;
     EXPECT_FALSE(fs::exists(dir() / "away.bin"));
