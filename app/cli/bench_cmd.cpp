@@ -130,6 +130,8 @@ void addBench(CLI::App& app) {
         throw Error("--methods " + specs[i], "step and shade are the volume's; scene '" + scene.name + "' has none");
       if (const auto unused = unusedOperationSetting(requests[i], scene))
         throw Error("--methods " + specs[i], unused->name + ": " + unused->reason);
+      if (const auto unused = unusedMethodParam(requests[i]))
+        throw Error("--methods " + specs[i], unused->name + ": " + unused->reason);
       opt->contours.requireKeptVolumeDrawn(requests[i], scene, "--methods " + specs[i]);
     }
 

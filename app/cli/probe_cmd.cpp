@@ -132,6 +132,7 @@ void addProbe(CLI::App& app) {
     applySectionOption(scene, opt->section);
     requireSomethingToDraw(scene);
     if (const auto unused = unusedOperationSetting(req, scene)) throw Error("--" + unused->name, unused->reason);
+    if (const auto unused = unusedMethodParam(req)) throw Error("--" + unused->name, unused->reason);
     opt->contours.requireKeptVolumeDrawn(req, scene);
     PixelProbe probe = probePixel(scene, camera, w, h, x, y);
     // What the method (or, without one, the oracle) does with the lists: hybrid and volume are taken apart.

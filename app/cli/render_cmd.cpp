@@ -113,6 +113,7 @@ void addRender(CLI::App& app) {
       req.volumeShading = true;
     }
     if (const auto unused = unusedOperationSetting(req, scene)) throw Error("--" + unused->name, unused->reason);
+    if (const auto unused = unusedMethodParam(req)) throw Error("--" + unused->name, unused->reason);
     opt->contours.requireKeptVolumeDrawn(req, scene);
     if (opt->blend && opt->dataView.empty()) throw Error("--blend", "needs --data-view");
     if (opt->dataView == "capacity" && opt->method == "oracle")

@@ -533,6 +533,19 @@ int main(int argc, char** argv) {
       if (unused && model.compareEnabled() && !unusedOn(1)) unused.reset();
       if (unused) refuse(QString::fromStdString("--" + unused->name + ": " + unused->reason));
     }
+    // A -p value that acts only with another's value the method does not have (pool_mib without
+    // pool=fixed), refused as by mfr render: the command line's values, over the others in force.
+    if (!cl.params.empty()) {
+      mfr::RenderRequest given;
+      given.method = model.method().toStdString();
+      given.params = cl.params;
+      if (const mfr::MethodInfo* info = mfr::findMethodInfo(given.method))
+        for (const mfr::ParamSpec& spec : info->params)
+          if (spec.onlyWith.empty() && !given.params.contains(spec.name) && model.params().contains(spec.name))
+            given.params[spec.name] = model.params().at(spec.name);
+      if (const auto unusedParam = mfr::unusedMethodParam(given))
+        refuse(QString::fromStdString("--" + unusedParam->name + ": " + unusedParam->reason));
+    }
   });
   // Only --screenshot: its picture is rendered at --size on its own, so the window draws nothing.
   const bool exportOnly = !cl.screenshot.isEmpty() && cl.windowScreenshot.isEmpty();

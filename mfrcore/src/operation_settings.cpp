@@ -44,6 +44,27 @@ std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest
   return std::nullopt;
 }
 
+std::optional<UnusedOperationSetting> unusedMethodParam(const RenderRequest& request) {
+  const MethodInfo* info = findMethodInfo(request.method);
+  if (!info) return std::nullopt;
+  const auto valueOf = [&](const std::string& name) -> std::string {
+    if (const auto it = request.params.find(name); it != request.params.end()) return it->second;
+    for (const ParamSpec& spec : info->params)
+      if (spec.name == name) return spec.defaultValue;
+    return {};
+  };
+  for (const ParamSpec& spec : info->params) {
+    const auto given = request.params.find(spec.name);
+    const std::size_t eq = spec.onlyWith.find('=');
+    if (given == request.params.end() || eq == std::string::npos) continue;
+    const std::string other = spec.onlyWith.substr(0, eq), wanted = spec.onlyWith.substr(eq + 1);
+    if (const std::string value = valueOf(other); value != wanted)
+      return UnusedOperationSetting{"param " + spec.name + "=" + given->second,
+                                    "only " + spec.onlyWith + " uses it; this render's " + other + " is " + value};
+  }
+  return std::nullopt;
+}
+
 std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest& request, const Scene& scene) {
   std::optional<UnusedOperationSetting> unused = unusedOperationSetting(request, scene.hasVisibleVolume());
   if (unused && unused->name != "thickness" && !scene.volumes.empty() && !scene.hasVisibleVolume())

@@ -642,7 +642,18 @@ TEST_F(Cli, SettingsOfAnotherOperationAreRefused) {
             "mfr: --keep-volume: this render's operation is oit; only operation volume draws the volume\n"},
            {"bench @volume -s 16x16 -r 1 -m abuffer-ll,kbuffer:op=oit --contour 0.5 --keep-volume --json " + json,
             "mfr: --methods kbuffer:op=oit: --keep-volume: this render's operation is oit; only operation volume "
-            "draws the volume\n"}}) {
+            "draws the volume\n"},
+           // A method parameter that acts only with another's value: the pool's size without the
+           // fixed pool was taken and dropped (the stats said "count", a bug hunt).
+           {"render @sample -s 16x16 -o " + out + " -m abuffer-ll -p pool_mib=1",
+            "mfr: --param pool_mib=1: only pool=fixed uses it; this render's pool is count\n"},
+           {"render @sample -s 16x16 -o " + out + " -m abuffer-sbuffer -p pool=previous -p pool_mib=1",
+            "mfr: --param pool_mib=1: only pool=fixed uses it; this render's pool is previous\n"},
+           {"probe @sample -s 16x16 --pixel 8,8 -m abuffer-ll -p pool_mib=1 --json " + json,
+            "mfr: --param pool_mib=1: only pool=fixed uses it; this render's pool is count\n"},
+           {"bench @sample -s 16x16 -r 1 -m abuffer-ll:pool_mib=1 --json " + json,
+            "mfr: --methods abuffer-ll:pool_mib=1: param pool_mib=1: only pool=fixed uses it; this render's pool "
+            "is count\n"}}) {
     const CliResult r = runCli(args);
     EXPECT_TRUE(r.exitCode == 1 || r.exitCode == 2) << args << ": " << r.exitCode << " " << r.out;
     // "\n" in a row: the message ends there (no "(auto, …)" for an operation given by name).
@@ -656,6 +667,7 @@ TEST_F(Cli, SettingsOfAnotherOperationAreRefused) {
   }
   // Where the operation uses them, they are taken (and change the image).
   const std::string a = (dir() / "a.png").string(), b = (dir() / "b.png").string();
+  EXPECT_EQ(runCli("render @sample -s 16x16 -m abuffer-ll -p pool=fixed -p pool_mib=1 -o " + a).exitCode, 0);
   ASSERT_EQ(runCli("render @intersect -s 32x32 -m abuffer-ll --op zthickness --thickness 0.3 -o " + a).exitCode, 0);
   ASSERT_EQ(runCli("render @intersect -s 32x32 -m abuffer-ll --op zthickness -o " + b).exitCode, 0);
   EXPECT_GT(mfr::rmse(mfr::readPng(a), mfr::readPng(b)), 0.001);
@@ -1189,6 +1201,13 @@ TEST_F(Cli, VariableKBuffersUnderOitKeepNoExactTail) {
     EXPECT_NE(bad.out.find("exact_tail"), std::string::npos) << bad.out;
     EXPECT_EQ(bad.out.find("only operation hybrid"), std::string::npos) << bad.out;
     EXPECT_EQ(runCli(common + " -p exact_tail=false").exitCode, 0);
+    // tail_runs refines the exact tail: asked for without one it was taken and did nothing.
+    const CliResult runs = runCli(common + " -p tail_runs=on");
+    EXPECT_EQ(runs.exitCode, 1) << runs.out;
+    EXPECT_EQ(runs.out,
+              "mfr: --param tail_runs=on: refines exact_tail, which only operation hybrid uses; this "
+              "render's operation is oit\n");
+    EXPECT_EQ(runCli(common + " -p tail_runs=false").exitCode, 0);
   }
   // Under hybrid (auto) the bound stays the default.
   ASSERT_EQ(runCli("render @sample -s 96x72 --view iso -m vkb -o " + png + " --stats " + json).exitCode, 0);

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iostream>
 #include <numeric>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -429,6 +430,118 @@ TEST(FixedKUnderBudget, LargestUniformKAndTheOracleHybrid) {
         compareImages(ref.oracle, compositeHybrid(ref.oracle, k, ref.scene.background), out.image, 2);
     EXPECT_GE(c.fraction(), 0.999) << "k " << k << " max difference " << c.maxDifference;
   }
+}
+
+// Outside operation hybrid nothing reads fkb's tail: its 20 bytes a pixel go to slots unless
+// -p tail=true asks for it (under --op oit the tail took k = 3 where k = 6 fit; a bug hunt).
+TEST(FixedKUnderBudget, SpendsNoTailOutsideHybrid) {
+  context();
+  const SampleReference& ref = reference();
+  GpuRenderer gpu;
+  gpu.setScene(ref.scene);
+  KPlusArrayLayout withTail, withoutTail;
+  withTail.tail = true;
+  withoutTail.tail = false;
+  const KBufferMemoryModel tailed = kplusArrayMemoryModel(pixels(), withTail);
+  const KBufferMemoryModel plain = kplusArrayMemoryModel(pixels(), withoutTail);
+  const std::uint64_t budget = tailed.bytes(3) + 1000;
+  ASSERT_GT(largestUniformK(plain, budget), largestUniformK(tailed, budget));  // not vacuous
+  for (const char* operation : {"oit", "zthickness", "hybrid"}) {
+    for (const bool askTail : {false, true}) {
+      RenderRequest req = budgetRequest("fkb", budget);
+      req.operation = operation;
+      if (askTail) req.params["tail"] = "true";
+      const bool tail = askTail || req.operation == "hybrid";
+      const RenderOutput out = gpu.render(ref.camera, req);
+      const std::uint32_t k = largestUniformK(tail ? tailed : plain, budget);
+      EXPECT_EQ(out.stats.kMax, k) << operation << " tail " << askTail;
+      EXPECT_EQ(out.stats.bytesAllocated, (tail ? tailed : plain).bytes(k)) << operation;
+      EXPECT_LE(out.stats.bytesAllocated, budget);
+    }
+  }
+}
+
+// Per-pixel buffers bound whole as one storage block are refused beyond the context's largest
+// block, as the fragment stores are (vkb's and dkb's arena and kpeel's pixel state went past
+// llvmpipe's 128 MiB without a word; a review). The image side is made from this context's limit;
+// a GPU whose block outgrows --size's 16384 leaves the case out, and says so.
+TEST(PerPixelStorage, BuffersBeyondTheLargestStorageBlockAreRefused) {
+  context();
+  GLint64 blockBytes = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &blockBytes);
+  const auto block = static_cast<std::uint64_t>(blockBytes);
+  const Scene scene = makeQuadsScene(1);
+  std::vector<std::string> leftOut;
+  int checked = 0;
+  for (const std::string method : {"vkb", "dkb", "kpeel"}) {
+    SCOPED_TRACE(method);
+    const auto bytesAt = [&](std::uint64_t side) {
+      return method == "kpeel" ? 32 * side * side : variableKLayout(side * side, memberFixed(method)).arenaBytes();
+    };
+    auto side = static_cast<std::uint64_t>(std::sqrt(static_cast<double>(block) / 40.0));
+    while (bytesAt(side) <= block) ++side;
+    if (side > 16384) {
+      leftOut.push_back(method);
+      continue;
+    }
+    ++checked;
+    GpuRenderer gpu;
+    gpu.setScene(scene);
+    RenderRequest req;
+    req.method = method;
+    req.width = req.height = static_cast<int>(side);
+    req.params = method == "kpeel" ? std::map<std::string, std::string>{{"k", "1"}}
+                                   : std::map<std::string, std::string>{{"budget_mib", "65536"}};
+    try {
+      (void)gpu.render(scene.view("front"), req);
+      ADD_FAILURE() << side << "x" << side << " was drawn";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("--method " + method + ": its per-pixel ", 0), 0u) << what;
+      EXPECT_NE(what.find(", more than the largest shader storage block of this GL context holds"), std::string::npos)
+          << what;
+    }
+    // One side less fits.
+    req.width = req.height = static_cast<int>(side - 1);
+    EXPECT_NO_THROW((void)gpu.render(scene.view("front"), req));
+  }
+  if (!leftOut.empty()) std::cout << "left out (the block holds 16384x16384 pixels): " << leftOut.size() << "\n";
+  if (checked == 0) GTEST_SKIP() << "this context's storage block holds every per-pixel buffer at 16384x16384";
+}
+
+// kplus-dynamic's histogram pass at more than 65535 x 256 pixels: its one-dimensional dispatch
+// was GL_INVALID_VALUE at 4096x4096 (a review). The k chosen equals kplus-array's at the same
+// budget and the image is the one k = 1 quad drawn, as at a smaller size.
+TEST(KPlusDynamicLargeImage, HistogramCoversMoreThan65535Groups) {
+  context();
+  const Scene scene = makeQuadsScene(1);
+  GpuRenderer gpu;
+  gpu.setScene(scene);
+  RenderRequest req;
+  req.method = "kplus-dynamic";
+  // 65536 groups of 256: one more than a dimension holds, and at one slot a pixel exactly what
+  // llvmpipe's 128 MiB storage block holds.
+  req.width = 4096;
+  req.height = 4096;
+  req.params = {{"budget_mib", "300"}};
+  const RenderOutput out = gpu.render(scene.view("front"), req);
+  ASSERT_GT(std::uint64_t{4096} * 4096 / 256, 65535u);
+  EXPECT_EQ(out.stats.fragmentsDropped, 0u);
+  EXPECT_GT(out.stats.fragmentsStored, 0u);
+  EXPECT_EQ(out.stats.fragmentsStored, out.stats.fragmentsGenerated);
+  // The histogram saw every pixel: its k = 1 captures all of the counted fragments.
+  std::string chosen;
+  for (const auto& [key, value] : out.stats.notes)
+    if (key == "k chosen") chosen = value;
+  EXPECT_EQ(chosen.rfind("robustness: k = 1 captures 100 % of the fragments", 0), 0u) << chosen;
+  RenderRequest small = req;
+  small.width = 64;
+  small.height = 64;
+  const RenderOutput reference = gpu.render(scene.view("front"), small);
+  // The quad covers the same share of the image at both sizes.
+  const double shareLarge = static_cast<double>(out.stats.fragmentsGenerated) / (4096.0 * 4096.0);
+  const double shareSmall = static_cast<double>(reference.stats.fragmentsGenerated) / (64.0 * 64.0);
+  EXPECT_NEAR(shareLarge, shareSmall, 0.03);
 }
 
 // dkb's feature passes and network on the GPU equal the CPU features of the oracle's exact lists

@@ -15,6 +15,11 @@ struct UnusedOperationSetting {
   std::string reason;  // e.g. "only operation zthickness uses it; this render's operation is oit"
 };
 
+// The first method parameter the request gives that acts only with another's value it does not
+// have (ParamSpec::onlyWith: abuffer-ll's pool_mib without pool=fixed): name "param pool_mib=1",
+// reason "only pool=fixed uses it; this render's pool is count". nullopt for an unknown method.
+std::optional<UnusedOperationSetting> unusedMethodParam(const RenderRequest& request);
+
 // The first of the request's thickness (> 0), volumeStep (> 0) and volumeShading (set) that its
 // operation, "auto" resolved for its method on a scene with or without a visible volume, does not
 // use; nullopt when each is used or unset, and for a method or operation render() does not know

@@ -20,11 +20,25 @@ const MethodInfo& ABufferSBuffer::info() const {
       "Maule, Comba, Torchelsen, Bastos: Memory-Efficient Order-Independent Transparency with Dynamic Fragment "
       "Buffer. SIBGRAPI 2012",
       true,
-      {{"pool", "Fragment buffer sizing", ParamSpec::Type::Choice, "count", 0, 0, {"count", "previous", "fixed"},
+      {{"pool",
+        "Fragment buffer sizing",
+        ParamSpec::Type::Choice,
+        "count",
+        0,
+        0,
+        {"count", "previous", "fixed"},
         "count: this frame's scanned total (one 4-byte read-back between the scan and the store pass); previous: "
         "last frame's total + 10 % (no read-back before storing; overflow is counted); fixed: pool_mib"},
-       {"pool_mib", "Fixed fragment buffer (MiB)", ParamSpec::Type::Float, "64", 0, 65536, {},
-        "fragment buffer size when pool=fixed", true}},
+       {"pool_mib",
+        "Fixed fragment buffer (MiB)",
+        ParamSpec::Type::Float,
+        "64",
+        0,
+        65536,
+        {},
+        "fragment buffer size when pool=fixed",
+        true,
+        "pool=fixed"}},
       "oit",
       true};
   return i;

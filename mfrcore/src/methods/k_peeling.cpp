@@ -37,6 +37,9 @@ void KPeeling::configure(int width, int height, const Params& params) {
   const std::uint64_t pixels = static_cast<std::uint64_t>(width) * height;
   if (pixels * k_ > maxStorageElements(kEntryBytes))
     throw Error("--param k=" + std::to_string(k_), "k slots of 16 bytes per pixel exceed the largest shader storage block");
+  // The per-pixel state (32 bytes, more than the entries at k = 1) is one block too (a review).
+  requireStorageFits("--method kpeel", "its per-pixel state of " + std::to_string(kPixelStateBytes) + " bytes", pixels,
+                     maxStorageElements(kPixelStateBytes), kPixelStateBytes, "; a smaller --size needs less");
   if (width != width_ || height != height_) {
     width_ = width;
     height_ = height;

@@ -1,5 +1,6 @@
 #include "kplus_dynamic.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/bindings.h"
@@ -80,7 +81,11 @@ void KPlusBufferDynamic::capture(const FrameContext& ctx) {
   histogramPass_.use();
   histogramPass_.set("uPixels", static_cast<unsigned>(pixels()));
   ctx.timer.begin("histogram");
-  glDispatchCompute(static_cast<GLuint>((pixels() + 255) / 256), 1, 1);
+  // On a 2D grid: glDispatchCompute takes at most 65535 groups a dimension (GL_INVALID_VALUE at
+  // 4096x4096 and above; a review).
+  const std::uint64_t groups = (pixels() + 255) / 256;
+  const auto groupsX = static_cast<GLuint>(std::min<std::uint64_t>(groups, 65535));
+  glDispatchCompute(groupsX, static_cast<GLuint>((groups + groupsX - 1) / groupsX), 1);
   ctx.timer.end();
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   std::vector<std::uint32_t> bins(kBins);

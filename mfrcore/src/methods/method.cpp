@@ -27,7 +27,12 @@ Params::Params(const std::vector<ParamSpec>& specs, const std::map<std::string, 
         double v = 0;
         char extra = 0;
         if (!(in >> v) || (in >> extra) || !std::isfinite(v)) throw Error(where, "expected a number");
-        if (spec->type == ParamSpec::Type::Int && v != std::floor(v)) throw Error(where, "expected an integer");
+        // Digits only, as the command line's whole-number options: "k=1e2", "k=8.0", "k= 8" were
+        // taken (k = 100, 8, 8) where "k=1.5" was refused (a bug hunt).
+        const std::size_t digits = value.starts_with('-') ? 1 : 0;
+        if (spec->type == ParamSpec::Type::Int &&
+            (value.size() == digits || value.find_first_not_of("0123456789", digits) != std::string::npos))
+          throw Error(where, "expected an integer (digits only)");
         if (v < spec->min || v > spec->max) {
           std::ostringstream r;
           r << "out of range [" << spec->min << ", " << spec->max << "]";

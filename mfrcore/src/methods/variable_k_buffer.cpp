@@ -123,6 +123,9 @@ void VariableKBuffer::configure(int width, int height, const Params& params) {
                 "below what " + info().name + " needs at " + std::to_string(width) + "x" + std::to_string(height) +
                     " for its per-pixel buffers and one fragment slot (" + mibText(layout.bytes(1)) +
                     " MiB = " + std::to_string(layout.bytes(1)) + " bytes)");
+  // The arena (per-pixel words, about 28 bytes a pixel) is bound whole as one storage block (a review).
+  requireStorageFits("--method " + info().name, "its per-pixel arena", layout.arenaWords, maxStorageElements(4), 4,
+                     "; a smaller --size needs less");
   if (resized || !arena_ || layout.arenaWords != layout_.arenaWords) arena_ = gl::createBuffer(layout.arenaBytes());
   layout_ = layout;
   if (!state_) state_ = gl::createBuffer(kVariableKStateBytes);

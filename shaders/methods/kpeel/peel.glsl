@@ -18,11 +18,16 @@ layout(std430, binding = MFR_SSBO_NODES) KP_ACCESS buffer KPeelEntries { uvec4 k
 
 // Per pixel: the last composited key (depth bits, object, primitive) and the number of fragments
 // composited so far (w; 0: no threshold yet); the OIT state carried between iterations (colour,
-// opacity = 1 - transmittance). All-zero is the initial state, so one buffer clear resets it.
+// transmittance). All-zero is the initial state, so one buffer clear resets it.
 struct KPeelPixel {
   uvec4 threshold;
   vec4 accum;
 };
+
+// The transmittance carried in accum.a, as the operation left it: carried as opacity 1 - T, its
+// float rounding there and back put a few pixels 1/255 off the A-buffers' image (a review). Before
+// any fragment is composited (w = 0, the cleared state) it is 1.
+float kpTransmittance(KPeelPixel pixelState) { return pixelState.threshold.w == 0u ? 1.0 : pixelState.accum.a; }
 layout(std430, binding = MFR_SSBO_AUX) buffer KPeelPixels { KPeelPixel kpPixels[]; };
 
 layout(std430, binding = MFR_SSBO_COUNTER) buffer KPeelCounters {

@@ -40,9 +40,9 @@ void main() {
 #ifdef MFR_KPEEL_CARRY
   OpState s;
   s.color = state.accum.rgb;
-  s.transmittance = 1.0 - state.accum.a;
+  s.transmittance = kpTransmittance(state);
   for (uint i = 0u; i < m; ++i) opFragment(s, MfrFragment(gLocal[i].x, uintBitsToFloat(gLocal[i].y)), emitted + i);
-  state.accum = vec4(s.color, 1.0 - s.transmittance);
+  state.accum = vec4(s.color, s.transmittance);
 #else
   if (m > 0u || uIteration == 0u) {
     OpState s;

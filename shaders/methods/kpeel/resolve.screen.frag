@@ -1,6 +1,6 @@
 // k-peeling (Bavoil et al., I3D 2007, multi-pass k-buffer): final pass of the "oit" operation. The
 // iterations composited every fragment front to back into the pixel's accum (colour,
-// opacity); the operation's opEnd adds the background.
+// transmittance); the operation's opEnd adds the background.
 #define KP_ACCESS readonly
 #include "methods/kpeel/peel.glsl"
 #include MFR_OP_FILE
@@ -12,6 +12,6 @@ void main() {
   KPeelPixel state = kpPixels[kpPixel(p)];
   OpState s;
   s.color = state.accum.rgb;
-  s.transmittance = 1.0 - state.accum.a;
+  s.transmittance = kpTransmittance(state);
   outColor = opEnd(s, p, state.threshold.w);
 }

@@ -16,7 +16,8 @@ shared uint sBins[KD_BINS];
 void main() {
   for (uint b = gl_LocalInvocationIndex; b < uint(KD_BINS); b += 256u) sBins[b] = 0u;
   barrier();
-  uint i = gl_GlobalInvocationID.x;
+  // Groups on a 2D grid: one dimension holds 65535 groups, 16.7 million pixels (4096x4096 failed).
+  uint i = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 256u + gl_LocalInvocationIndex;
   if (i < uPixels) atomicAdd(sBins[min(kdCounts[i], uint(KD_BINS) - 1u)], 1u);
   barrier();
   for (uint b = gl_LocalInvocationIndex; b < uint(KD_BINS); b += 256u)

@@ -32,6 +32,9 @@ struct ParamSpec {
   // A memory amount for the whole image (MiB): a frame of fewer pixels that should look like this
   // one (the viewer's reduced frames while navigating) gets the same share of it per pixel.
   bool perImage = false;
+  // "pool=fixed": the parameter acts only while another has that value. Given with another value
+  // it would be ignored without a word; the command lines refuse it (unusedMethodParam).
+  std::string onlyWith{};
 };
 
 // Values of a method's parameters, validated against its specs.
