@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -68,6 +70,30 @@ Camera Camera::fittedTo(const Bounds& b, double radius) const {
   c.orthoHeight = 2.1 * r;
   c.fitDepthRange(b, r);
   return c;
+}
+
+std::optional<std::string> Camera::depthPrecisionNote(const Bounds& drawn) const {
+  if (!depthRangeGiven || !drawn.valid()) return std::nullopt;
+  const double n = nearPlane, f = farPlane;
+  // The farthest drawn depth the planes keep: where window depth is coarsest.
+  double zMax = n;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::dvec3 p(corner & 1 ? drawn.max.x : drawn.min.x, corner & 2 ? drawn.max.y : drawn.min.y,
+                       corner & 4 ? drawn.max.z : drawn.min.z);
+    zMax = std::max(zMax, glm::dot(p - eye, forward()));
+  }
+  zMax = std::clamp(zMax, n, f);
+  // A float's spacing in [0.5, 1), where window depth lies but near the near plane, times dz/dd.
+  const double spacing = std::ldexp(1.0, -24);
+  const double resolution =
+      projection == Projection::Perspective ? spacing * (f - n) * zMax * zMax / (f * n) : spacing * (f - n);
+  const double diagonal = glm::length(drawn.max - drawn.min);
+  if (!(resolution > 1e-3 * diagonal)) return std::nullopt;
+  std::ostringstream text;
+  text << std::setprecision(3) << "near " << n << " and far " << f << " resolve depths only " << resolution
+       << " apart at the far side of what is drawn (32-bit window depth): the GPU methods may misorder fragments "
+          "closer than that (a larger near plane resolves them)";
+  return text.str();
 }
 
 void Camera::fitDepthRange(const Bounds& b, double radius) {
