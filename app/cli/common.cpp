@@ -142,8 +142,7 @@ bool outsideFrustum(const Bounds& box, const Camera& camera, double aspect) {
   const glm::dmat4 m = camera.projectionMatrix(aspect) * camera.viewMatrix();
   std::array<bool, 6> allOutside{true, true, true, true, true, true};
   for (int corner = 0; corner < 8; ++corner) {
-    const glm::dvec4 c = m * glm::dvec4(corner & 1 ? box.max.x : box.min.x, corner & 2 ? box.max.y : box.min.y,
-                                        corner & 4 ? box.max.z : box.min.z, 1.0);
+    const glm::dvec4 c = m * glm::dvec4(box.corner(corner), 1.0);
     const std::array<bool, 6> outside{c.x<-c.w, c.x> c.w, c.y<-c.w, c.y> c.w, c.z<-c.w, c.z> c.w};
     for (std::size_t plane = 0; plane < 6; ++plane) allOutside[plane] = allOutside[plane] && outside[plane];
   }

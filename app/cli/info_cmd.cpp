@@ -40,6 +40,10 @@ nlohmann::ordered_json methodsJson() {
                                         {"help", p.help.empty() ? p.label : p.help}};
         if (p.type == ParamSpec::Type::Int || p.type == ParamSpec::Type::Float) param["range"] = {p.min, p.max};
         if (p.type == ParamSpec::Type::Choice) param["choices"] = p.choices;
+        // fkb's tail and the exact tail: another default where no tail is composited.
+        if (const std::string other = defaultValueFor(p, "oit"); other != p.defaultValue)
+          param["default_outside_hybrid"] = other;
+        if (!p.onlyWith.empty()) param["only_with"] = p.onlyWith;
         params.push_back(param);
       }
     const bool gpu = info && name != "optimal-k";
@@ -71,8 +75,12 @@ void printMethods(const nlohmann::ordered_json& methods) {
         values = numberText(p["range"][0].get<double>()) + ".." + numberText(p["range"][1].get<double>());
       else if (p["type"] == "bool")
         values = "true|false";
+      std::string notes = values;
+      if (p.contains("default_outside_hybrid"))
+        notes += "; " + p["default_outside_hybrid"].get<std::string>() + " outside hybrid";
+      if (p.contains("only_with")) notes += "; only with " + p["only_with"].get<std::string>();
       line += (line.empty() ? "" : ", ") + p["name"].get<std::string>() + "=" + p["default"].get<std::string>() +
-              (values.empty() ? "" : " (" + values + ")");
+              (notes.empty() ? "" : " (" + notes + ")");
     }
     if (!line.empty()) std::cout << "    -p " << line << "\n";
   }

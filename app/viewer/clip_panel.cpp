@@ -152,7 +152,7 @@ namespace {
 std::pair<double, double> extentAlong(const mfr::Bounds& b, const glm::dvec3& n) {
   double lo = 1e300, hi = -1e300;
   for (int c = 0; c < 8; ++c) {
-    const glm::dvec3 corner((c & 1) ? b.max.x : b.min.x, (c & 2) ? b.max.y : b.min.y, (c & 4) ? b.max.z : b.min.z);
+    const glm::dvec3 corner = b.corner(c);
     lo = std::min(lo, glm::dot(n, corner));
     hi = std::max(hi, glm::dot(n, corner));
   }

@@ -614,10 +614,18 @@ int main(int argc, char** argv) {
       } catch (const std::exception& e) {
         QString message = QString::fromUtf8(e.what());
         static const QRegularExpression named(QStringLiteral("^--param ([A-Za-z0-9_]+)="));
+        // A --param the command line lacks is never named: the value came from --plugin-settings,
+        // else from the session (its params or its plugins' settings; a review), else a default.
         if (const QRegularExpressionMatch m = named.match(message); m.hasMatch()) {
           const std::string name = m.captured(1).toStdString();
-          if (const auto it = paramsOfPlugin.find(name); it != paramsOfPlugin.end() && !cl.params.contains(name))
-            message = QStringLiteral("--plugin-settings %1: %2").arg(it->second, message.mid(8));
+          if (!cl.params.contains(name)) {
+            if (const auto it = paramsOfPlugin.find(name); it != paramsOfPlugin.end())
+              message = QStringLiteral("--plugin-settings %1: %2").arg(it->second, message.mid(8));
+            else if (!cl.session.isEmpty())
+              message = QStringLiteral("%1: %2").arg(cl.session, message.mid(8));
+            else
+              message = message.mid(8);
+          }
         }
         fail(message, 1);
       }

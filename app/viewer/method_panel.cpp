@@ -131,6 +131,7 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
   connect(&model_, &ViewerModel::volumeChanged, this, [this] {
     syncMethodCombo();  // what "auto" runs follows the volume's visibility
     showStep();
+    showParameterValues();  // and so do the defaults that depend on it
   });
   connect(&model_, &ViewerModel::zThicknessChanged, this, &MethodPanel::showThickness);
   connect(&model_, &ViewerModel::sceneChanged, this, &MethodPanel::showThickness);  // the default follows the scene
@@ -252,7 +253,9 @@ void MethodPanel::showParameterValues() {
   const auto values = model_.paramsOf(side_);
   for (const mfr::ParamSpec& spec : info->params) {
     const auto it = values.find(spec.name);
-    const QString value = QString::fromStdString(it != values.end() ? it->second : spec.defaultValue);
+    // The default of the operation in force (fkb's tail and the exact tail are off outside hybrid).
+    const QString value = QString::fromStdString(
+        it != values.end() ? it->second : mfr::defaultValueFor(spec, model_.effectiveOperationOf(side_).toStdString()));
     const auto found = editors_.find(spec.name);
     if (found == editors_.end()) continue;
     QWidget* editor = found->second;

@@ -1,5 +1,6 @@
 #include "render_view.hpp"
 
+#include <QLoggingCategory>
 #include <QMouseEvent>
 #include <QOpenGLContext>
 #include <QTimer>
@@ -185,6 +186,10 @@ void RenderView::clearToBackground() {
   glClear(GL_COLOR_BUFFER_BIT);
 }
 
+// Each frame the window draws, for whoever asks (QT_LOGGING_RULES="mfr.view.frames.debug=true"):
+// what a slow interaction or a scripted run spends its time on.
+Q_LOGGING_CATEGORY(lcViewFrames, "mfr.view.frames", QtWarningMsg)
+
 void RenderView::setLiveFrames(bool on) {
   if (on == liveFrames_) return;
   liveFrames_ = on;
@@ -221,6 +226,7 @@ void RenderView::paintGL() {
         this, [this, reduction] { emit frameReductionChanged(reduction); }, Qt::QueuedConnection);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, defaultFramebufferObject());
+  qCDebug(lcViewFrames, "frame %dx%d, 1/%d", pixelSize().width(), pixelSize().height(), reduction);
   errors.removeDuplicates();
   reports_->error = errors.join(QStringLiteral("; "));
   reports_->reportError = renderers_[0] != nullptr;
@@ -455,8 +461,15 @@ int RenderView::paneAt(QPointF point) const {
 }
 
 QRectF RenderView::navigationArea(QPointF point) const {
-  // Off every image (an odd column side by side) the first pane's scale is as good as any.
-  return logicalRect(paneRect(std::max(paneAt(point), 0)));
+  int side = paneAt(point);
+  // Off every image (the odd last column side by side, a point dragged past the edge): the pane
+  // on that side of the middle.
+  if (side < 0)
+    side = model_.compareEnabled() && model_.compareLayout() != CompareLayout::Split &&
+                   point.x() >= logicalRect(paneRect(1)).left()
+               ? 1
+               : 0;
+  return logicalRect(paneRect(side));
 }
 
 QRect RenderView::paneVisibleRect(int side) const {
@@ -563,15 +576,15 @@ QString RenderView::differingParams(int side) const {
   const mfr::MethodInfo* info = model_.methodInfo(method);
   if (!info || model_.methodOf(1 - side) != method) return {};
   const std::map<std::string, std::string> mine = model_.paramsOf(side), other = model_.paramsOf(1 - side);
-  const auto value = [](const std::map<std::string, std::string>& set, const mfr::ParamSpec& spec) {
+  const auto value = [this](int of, const std::map<std::string, std::string>& set, const mfr::ParamSpec& spec) {
     const auto it = set.find(spec.name);
-    return it == set.end() ? spec.defaultValue : it->second;
+    return it == set.end() ? mfr::defaultValueFor(spec, model_.effectiveOperationOf(of).toStdString()) : it->second;
   };
   QString text;
   for (const mfr::ParamSpec& spec : info->params)
-    if (value(mine, spec) != value(other, spec))
-      text +=
-          QStringLiteral(" %1=%2").arg(QString::fromStdString(spec.name), QString::fromStdString(value(mine, spec)));
+    if (value(side, mine, spec) != value(1 - side, other, spec))
+      text += QStringLiteral(" %1=%2").arg(QString::fromStdString(spec.name),
+                                           QString::fromStdString(value(side, mine, spec)));
   return text;
 }
 
@@ -595,7 +608,9 @@ void RenderView::updateOverlays() {
   const bool heat = compare && model_.compareDisplay() != CompareDisplay::Images;
   for (int side = 0; side < kSides; ++side) {
     const bool shown = side < model_.paneCount() && model_.hasScene();
-    const QRect area = logicalRect(split ? paneRect(side) : paneVisibleRect(side)).toRect();
+    const QRectF logical = logicalRect(split ? paneRect(side) : paneVisibleRect(side));
+    const QRect area(static_cast<int>(logical.x()), static_cast<int>(logical.y()), static_cast<int>(logical.width()),
+                     static_cast<int>(logical.height()));  // truncated, as the captions were placed
     // Captions: which method, and how far it is from the exact image.
     PaneCaption* caption = captions_[side];
     if (compare && shown) {

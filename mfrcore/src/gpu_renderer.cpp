@@ -151,15 +151,11 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
     if (const auto it = given.find("tail_runs"); it != given.end() && asGiven.flag("tail_runs"))
       throw Error("--param tail_runs=" + it->second,
                   "refines exact_tail, which only operation hybrid uses; this render's operation is " + operation_);
-    given["exact_tail"] = "false";
   }
-  // fkb's tail is on by default, since hybrid transparency is what a budget is for; under another
-  // operation nothing reads it and its 20 bytes a pixel cost slots (--op oit at 1 MiB drew k = 3
-  // where k = 6 fit, RMSE 0.074 against 0.009; a bug hunt): off there unless asked for.
-  if (operation_ != "hybrid" && !given.contains("tail") &&
-      std::any_of(specs.begin(), specs.end(),
-                  [](const ParamSpec& p) { return p.name == "tail" && p.defaultValue == "true"; }))
-    given["tail"] = "false";
+  // Defaults of this operation (defaultValueFor: fkb's tail and the exact tail are off outside hybrid).
+  for (const ParamSpec& spec : specs)
+    if (!given.contains(spec.name) && defaultValueFor(spec, operation_) != spec.defaultValue)
+      given[spec.name] = defaultValueFor(spec, operation_);
   const Params params(specs, given, request.method);
   method_->configure(request.width, request.height, params);
   if (operation_ == "hybrid") {

@@ -47,16 +47,23 @@ std::optional<UnusedOperationSetting> unusedOperationSetting(const RenderRequest
 std::optional<UnusedOperationSetting> unusedMethodParam(const RenderRequest& request) {
   const MethodInfo* info = findMethodInfo(request.method);
   if (!info) return std::nullopt;
+  // A flag in its one spelling ("on", "1" → "true"), as Params reads it.
+  const auto asFlag = [](const std::string& v) { return v == "true" || v == "1" || v == "on" ? "true" : "false"; };
   const auto valueOf = [&](const std::string& name) -> std::string {
-    if (const auto it = request.params.find(name); it != request.params.end()) return it->second;
     for (const ParamSpec& spec : info->params)
-      if (spec.name == name) return spec.defaultValue;
+      if (spec.name == name) {
+        const auto it = request.params.find(name);
+        const std::string& value = it != request.params.end() ? it->second : spec.defaultValue;
+        return spec.type == ParamSpec::Type::Bool ? asFlag(value) : value;
+      }
     return {};
   };
   for (const ParamSpec& spec : info->params) {
     const auto given = request.params.find(spec.name);
     const std::size_t eq = spec.onlyWith.find('=');
     if (given == request.params.end() || eq == std::string::npos) continue;
+    // A flag turned off asks for nothing (tail_runs=false beside exact_tail=false).
+    if (spec.type == ParamSpec::Type::Bool && std::string(asFlag(given->second)) == "false") continue;
     const std::string other = spec.onlyWith.substr(0, eq), wanted = spec.onlyWith.substr(eq + 1);
     if (const std::string value = valueOf(other); value != wanted)
       return UnusedOperationSetting{"param " + spec.name + "=" + given->second,

@@ -1507,6 +1507,33 @@ class ViewerTest : public QObject {
                         {"@sample", "-m", "fkb", "-p", "budget_mib=1", "--size", "800x600", "--screenshot", png}, &out),
              1);
     QVERIFY2(out.contains("mfrview: --param budget_mib=1: below what k = 1 needs at 800x600"), qPrintable(out));
+    // Set by a session: the session is named (it said "--param budget_mib=0.5"; a review).
+    const QString sessionPath = dir.filePath("fkb.mfrsession");
+    {
+      auto s = openWindow();
+      QVERIFY(s);
+      s->model().setMethod(QStringLiteral("fkb"));
+      s->model().setParams({{"budget_mib", "0.5"}});
+      writeSessionFile(sessionPath, captureSession(s->model()));
+    }
+    QCOMPARE(runProgram(MFRVIEW, {sessionPath, "--size", "800x600", "--screenshot", png}, &out), 1);
+    QVERIFY2(
+        out.contains(QStringLiteral("mfrview: %1: budget_mib=0.5: below what k = 1 needs at 800x600").arg(sessionPath)),
+        qPrintable(out));
+    QVERIFY(!out.contains("--param"));
+    // The window itself draws no frame for --screenshot, and does for --window-screenshot (the
+    // frames Qt's logging category reports).
+    qputenv("QT_LOGGING_RULES", "mfr.view.frames.debug=true");
+    QCOMPARE(runProgram(MFRVIEW, {"@sample", "-m", "abuffer-ll", "--size", "64x48", "--screenshot", png}, &out), 0);
+    const bool framesWithScreenshot = out.contains("mfr.view.frames: frame ");
+    const QString window = dir.filePath("window.png");
+    QCOMPARE(
+        runProgram(MFRVIEW, {"@sample", "-m", "abuffer-ll", "--window-size", "900x600", "--window-screenshot", window},
+                   &out),
+        0);
+    qunsetenv("QT_LOGGING_RULES");
+    QVERIFY2(!framesWithScreenshot, "--screenshot drew window frames");
+    QVERIFY2(out.contains("mfr.view.frames: frame "), qPrintable(out));
   }
 
   // `mfrview --screenshot` and `mfr render` with the same scene, view, size and settings.

@@ -807,6 +807,20 @@ TEST_F(Cli, InfoListsMethodsWithTheirParameters) {
   EXPECT_EQ(k["default"], "8");
   EXPECT_EQ(k["range"], nlohmann::json::array({1.0, 256.0}));
   EXPECT_EQ(byName["wboit"]["params"][1]["choices"], nlohmann::json::array({"r8", "r16f"}));
+  // Defaults that depend on the operation, and parameters that act only with another's value.
+  const auto param = [&](const std::string& method, const std::string& name) {
+    for (const auto& p : byName[method]["params"])
+      if (p["name"] == name) return p;
+    return nlohmann::json();
+  };
+  EXPECT_EQ(param("fkb", "tail")["default"], "true");
+  EXPECT_EQ(param("fkb", "tail")["default_outside_hybrid"], "false");
+  EXPECT_EQ(param("vkb", "exact_tail")["default_outside_hybrid"], "false");
+  EXPECT_FALSE(param("kplus-array", "tail").contains("default_outside_hybrid"));  // off everywhere
+  EXPECT_EQ(param("abuffer-ll", "pool_mib")["only_with"], "pool=fixed");
+  EXPECT_EQ(param("dkb", "tail_runs")["only_with"], "exact_tail=true");
+  EXPECT_NE(r.out.find("tail=true (true|false; false outside hybrid)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("pool_mib=64 (0..65536; only with pool=fixed)"), std::string::npos) << r.out;
 }
 
 // Each part's area and, when it is closed, the volume it encloses — in the world (the transform's

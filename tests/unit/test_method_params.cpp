@@ -57,8 +57,36 @@ TEST(MethodParams, AParameterWithoutTheValueItActsWithIsNamed) {
   EXPECT_FALSE(unusedMethodParam(req));
   req.params = {{"pool", "previous"}};  // pool_mib not given: nothing to refuse
   EXPECT_FALSE(unusedMethodParam(req));
+  // A flag that refines another: asked for without it (dkb's tail runs without the exact tail);
+  // turned off it asks for nothing.
+  req.method = "dkb";
+  req.params = {{"exact_tail", "off"}, {"tail_runs", "on"}};
+  unused = unusedMethodParam(req);
+  ASSERT_TRUE(unused);
+  EXPECT_EQ(unused->name, "param tail_runs=on");
+  EXPECT_EQ(unused->reason, "only exact_tail=true uses it; this render's exact_tail is false");
+  req.params = {{"exact_tail", "1"}, {"tail_runs", "on"}};
+  EXPECT_FALSE(unusedMethodParam(req));
+  req.params = {{"exact_tail", "false"}, {"tail_runs", "false"}};
+  EXPECT_FALSE(unusedMethodParam(req));
   req.method = "no-such-method";
   EXPECT_FALSE(unusedMethodParam(req));
+}
+
+// Defaults by operation: what only hybrid transparency reads is off elsewhere.
+TEST(MethodParams, TailDefaultsFollowTheOperation) {
+  const auto spec = [](const std::string& method, const std::string& name) {
+    for (const ParamSpec& s : findMethodInfo(method)->params)
+      if (s.name == name) return s;
+    return ParamSpec{};
+  };
+  EXPECT_EQ(defaultValueFor(spec("fkb", "tail"), "hybrid"), "true");
+  for (const char* op : {"oit", "zthickness", "volume", "csg"}) {
+    EXPECT_EQ(defaultValueFor(spec("fkb", "tail"), op), "false") << op;
+    EXPECT_EQ(defaultValueFor(spec("vkb", "exact_tail"), op), "false") << op;
+    EXPECT_EQ(defaultValueFor(spec("dkb", "tail_runs"), op), "true") << op;  // inert without the exact tail
+    EXPECT_EQ(defaultValueFor(spec("kplus-array", "k"), op), "8") << op;
+  }
 }
 
 }  // namespace

@@ -71,6 +71,11 @@ void KBufferFamily::configureCommon(int width, int height, const Params& params,
   if (ownLocks && !locks_) locks_ = gl::createTexture2D(GL_R32UI, width_, height_);
   if (!ownLocks) locks_.reset();
   const bool ownTail = tail_ && !externalPixelState_;
+  // The tail (20 bytes a pixel, more than one 8-byte slot) is one storage block too (a review).
+  if (ownTail)
+    requireStorageFits("--method " + info().name,
+                       "its per-pixel tail of " + std::to_string(kTailBytesPerPixel) + " bytes", pixels(),
+                       maxStorageElements(kTailBytesPerPixel), kTailBytesPerPixel, "; a smaller --size needs less");
   if (ownTail && !tailBuffer_) tailBuffer_ = gl::createBuffer(pixels() * kTailBytesPerPixel);
   if (!ownTail) tailBuffer_.reset();
   if (!counters_) counters_ = gl::createBuffer(kCounterBytes);

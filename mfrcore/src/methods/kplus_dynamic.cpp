@@ -92,7 +92,8 @@ void KPlusBufferDynamic::capture(const FrameContext& ctx) {
   glGetNamedBufferSubData(histogram_.id(), 0, kBins * 4, bins.data());
   std::uint32_t total = 0;
   glGetNamedBufferSubData(counters_.id(), 0, 4, &total);
-  const std::vector<std::uint64_t> histogram(bins.begin(), bins.end());
+  histogramRead_.assign(bins.begin(), bins.end());
+  const std::vector<std::uint64_t>& histogram = histogramRead_;
 
   // 3. k from the histogram, the budget and R_h (eqs. 4-7).
   choice_ = selectDynamicK(histogram, total, budgetBytes_, robustness_, memoryModel(), 256);

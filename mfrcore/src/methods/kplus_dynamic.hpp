@@ -19,6 +19,8 @@ class KPlusBufferDynamic final : public KBufferFamily {
   void capture(const FrameContext& ctx) override;
   // The memory model the budget is checked against (equals what capture allocates).
   [[nodiscard]] KBufferMemoryModel memoryModel() const;
+  // The last frame's depth-complexity histogram as read back (kBins bins; tests check it).
+  [[nodiscard]] const std::vector<std::uint64_t>& lastHistogram() const { return histogramRead_; }
 
  private:
   bool culling_ = true;
@@ -29,6 +31,7 @@ class KPlusBufferDynamic final : public KBufferFamily {
   gl::Buffer counts_, histogram_;
   gl::Program count_, histogramPass_;
   DynamicKChoice choice_;
+  std::vector<std::uint64_t> histogramRead_;
 };
 
 }  // namespace mfr

@@ -62,6 +62,12 @@ Params::Params(const std::vector<ParamSpec>& specs, const std::map<std::string, 
   }
 }
 
+std::string defaultValueFor(const ParamSpec& spec, const std::string& operation) {
+  if (operation != "hybrid" && (spec.name == "tail" || spec.name == "exact_tail") && spec.defaultValue == "true")
+    return "false";
+  return spec.defaultValue;
+}
+
 long long Params::integer(const std::string& name) const { return std::llround(std::stod(text(name))); }
 double Params::real(const std::string& name) const { return std::stod(text(name)); }
 bool Params::flag(const std::string& name) const {

@@ -96,7 +96,9 @@ std::vector<ParamSpec> VariableKBuffer::budgetParams() {
            0,
            {},
            "with exact_tail: k(p) <= max(1, n - m) for the m farthest fragments of one RGBA, a tail hybrid "
-           "transparency composites exactly (three more geometry passes find m)"}};
+           "transparency composites exactly (three more geometry passes find m)",
+           false,
+           "exact_tail=true"}};
 }
 
 void VariableKBuffer::configure(int width, int height, const Params& params) {

@@ -78,9 +78,7 @@ std::optional<std::string> Camera::depthPrecisionNote(const Bounds& drawn) const
   // The farthest drawn depth the planes keep: where window depth is coarsest.
   double zMax = n;
   for (int corner = 0; corner < 8; ++corner) {
-    const glm::dvec3 p(corner & 1 ? drawn.max.x : drawn.min.x, corner & 2 ? drawn.max.y : drawn.min.y,
-                       corner & 4 ? drawn.max.z : drawn.min.z);
-    zMax = std::max(zMax, glm::dot(p - eye, forward()));
+    zMax = std::max(zMax, glm::dot(drawn.corner(corner) - eye, forward()));
   }
   zMax = std::clamp(zMax, n, f);
   // A float's spacing in [0.5, 1), where window depth lies but near the near plane, times dz/dd.

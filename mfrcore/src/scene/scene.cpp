@@ -25,8 +25,7 @@ Bounds Scene::bounds() const {
     if (!mb.valid()) continue;
     // Transform the 8 corners: exact enough for framing and depth range.
     for (int i = 0; i < 8; ++i) {
-      const glm::dvec3 corner((i & 1) ? mb.max.x : mb.min.x, (i & 2) ? mb.max.y : mb.min.y,
-                              (i & 4) ? mb.max.z : mb.min.z);
+      const glm::dvec3 corner = mb.corner(i);
       b.extend(glm::dvec3(o.transform * glm::dvec4(corner, 1.0)));
     }
   }
@@ -228,7 +227,7 @@ void requireSomethingToDraw(const Scene& scene) {
     }
     if (!scene.section) return;
     for (int c = 0; c < 8; ++c) {
-      const glm::dvec3 corner((c & 1) ? b.max.x : b.min.x, (c & 2) ? b.max.y : b.min.y, (c & 4) ? b.max.z : b.min.z);
+      const glm::dvec3 corner = b.corner(c);
       if (glm::dot(scene.section->normal, corner - scene.section->point) > 0.0) return;
     }
   }

@@ -37,6 +37,13 @@ struct ParamSpec {
   std::string onlyWith{};
 };
 
+// A parameter's default for the operation a render runs ("auto" resolved). What only hybrid
+// transparency reads is off by default under another operation, so that it costs no memory and
+// bounds nothing there: fkb's tail (its 20 bytes a pixel went to the tail, not slots, under
+// --op oit; a bug hunt) and vkb's and dkb's exact_tail. Renders, the viewer's parameter widgets and
+// mfr info show the same.
+[[nodiscard]] std::string defaultValueFor(const ParamSpec& spec, const std::string& operation);
+
 // Values of a method's parameters, validated against its specs.
 class Params {
  public:

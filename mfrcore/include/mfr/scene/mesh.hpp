@@ -22,6 +22,10 @@ struct Bounds {
       extend(b.max);
     }
   }
+  // Corner i of 8: bit 0 picks max.x over min.x, bit 1 max.y, bit 2 max.z.
+  [[nodiscard]] glm::dvec3 corner(int i) const {
+    return {(i & 1) ? max.x : min.x, (i & 2) ? max.y : min.y, (i & 4) ? max.z : min.z};
+  }
   [[nodiscard]] glm::dvec3 center() const { return 0.5 * (min + max); }
   [[nodiscard]] double radius() const { return 0.5 * glm::length(max - min); }
 };
