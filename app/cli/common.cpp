@@ -323,6 +323,17 @@ std::string BudgetSpec::paramText() const {
   // At the methods' largest budget_mib the half byte would cross it (every row refused, a review):
   // there the exact MiB, which floors to the same bytes.
   const double bytesNow = static_cast<double>(byteCount());
+  // The shortest text that floors back to the bytes (8 MiB reads "8", not the "8.0000004768" the
+  // methods' messages then showed; a bug hunt).
+  for (int digits = 1; digits <= 17; ++digits)
+    for (const double candidate : {bytesNow / (1024.0 * 1024.0), (bytesNow + 0.5) / (1024.0 * 1024.0)}) {
+      std::ostringstream shortest;
+      shortest << std::setprecision(digits) << candidate;
+      const double read = std::stod(shortest.str());
+      if (read <= kLargestBudgetMiB && std::floor(read * 1024.0 * 1024.0) == bytesNow &&
+          shortest.str().find_first_of("eE") == std::string::npos)
+        return shortest.str();
+    }
   double mibText = (bytesNow + 0.5) / (1024.0 * 1024.0);
   if (mibText > kLargestBudgetMiB) mibText = bytesNow / (1024.0 * 1024.0);
   std::ostringstream s;

@@ -1365,7 +1365,11 @@ void ViewerModel::requestFrameQuality() {
 FrameQuality ViewerModel::frameQuality() const {
   FrameQuality q;
   const PaneMetrics& m = metrics_[0];
-  if (!metricsCurrent(0) || !m.valid) return q;
+  if (!metricsCurrent(0)) return q;
+  if (!m.valid) {
+    q.error = m.error;
+    return q;
+  }
   q.valid = true;
   q.method = m.method;
   q.rmse = m.rmse;
@@ -1388,6 +1392,10 @@ void ViewerModel::updateMetrics() {
       failed.error = reference->error;
       metrics_[index(side)] = std::move(failed);
       emit metricsReady(side);
+      if (side == 0 && qualityWanted_) {  // the answer is the reason (FrameQuality::error)
+        qualityWanted_ = false;
+        emit frameQualityReady();
+      }
       continue;
     }
     startMetrics(side, reference->image);

@@ -45,6 +45,9 @@ struct FrameQuality {
   double rmse = 0.0;      // mfr::rmse over RGB, 8-bit values scaled to [0,1]
   double flipMean = 0.0;  // mean LDR-FLIP error, 67 pixels per degree
   double flipMax = 0.0;
+  // 1.13: why there are no numbers for the frame now shown (the exact image or FLIP refused, e.g.
+  // for memory): the budget panel read "computing…" for ever (a bug hunt). Empty otherwise.
+  QString error;
 };
 
 class ViewerContext : public QObject {
@@ -278,5 +281,6 @@ class MfrViewerPlugin {
 // 1.10: note (and the signal noted): notes of a plugin for the status bar and stderr.
 // 1.11: exportParams: a plugin's parameters for an exported image of another size.
 // 1.12: sceneSerial: a new scene told from an edit of the same one.
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.12"
+// 1.13: FrameQuality::error, and frameQualityReady when the numbers cannot be computed.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.13"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

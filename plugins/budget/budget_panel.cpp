@@ -135,6 +135,7 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   rmseLabel_ = new QLabel(tr("—"));
   rmseLabel_->setObjectName(QStringLiteral("budgetRmse"));
   flipLabel_ = new QLabel(tr("—"));
+  flipLabel_->setWordWrap(true);  // it may hold why the numbers were not computed
   flipLabel_->setObjectName(QStringLiteral("budgetFlip"));
   rmseLabel_->setToolTip(tr("Root-mean-square RGB error against the exact image (oracle), 0 … 1"));
   flipLabel_->setToolTip(tr("Mean (max) LDR-FLIP error against the exact image: 0 identical … 1 most different"));
@@ -294,9 +295,13 @@ void BudgetPanel::showRobustness() {
 
 void BudgetPanel::showQuality() {
   const FrameQuality q = ctx_.frameQuality();
+  rmseLabel_->setToolTip(q.error);
+  flipLabel_->setToolTip(q.error);
   if (!q.valid) {
-    rmseLabel_->setText(tr("computing…"));
-    flipLabel_->setText(tr("computing…"));
+    // Not computed for this frame: say why (the exact image may not fit in memory), not
+    // "computing…" for ever.
+    rmseLabel_->setText(q.error.isEmpty() ? tr("computing…") : tr("not computed"));
+    flipLabel_->setText(q.error.isEmpty() ? tr("computing…") : q.error);
     return;
   }
   rmseLabel_->setText(QString::number(q.rmse, 'f', 5));

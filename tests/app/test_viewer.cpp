@@ -19,6 +19,7 @@
 #include <QScrollArea>
 #include <QScrollBar>
 #include <QPushButton>
+#include <QScopeGuard>
 #include <QSignalSpy>
 #include <QSlider>
 #include <QSpinBox>
@@ -39,6 +40,9 @@
 #include <cstring>
 #include <optional>
 #include <vector>
+#include <fstream>
+
+#include <unistd.h>
 
 #include "camera_navigator.hpp"
 #include "main_window.hpp"
@@ -3387,6 +3391,37 @@ class ViewerTest : public QObject {
   }
 
   // The budget panel: methods from the registry, quality against the exact image, R_h.
+  // The exact image of a frame refused for memory: the Memory budget panel read "computing…" for
+  // ever and the plugin heard nothing (a bug hunt). frameQualityReady comes with the reason, and
+  // the panel shows it. MFR_MEMORY_LIMIT_MIB a little above what the process holds lets WBOIT draw
+  // and refuses the oracle's lists.
+  void frameQualityThatCannotBeComputedSaysWhy() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    m.setMethod(QStringLiteral("wboit"));
+    settle(m);
+    long pages = 0, residentPages = 0;
+    {
+      std::ifstream statm("/proc/self/statm");
+      statm >> pages >> residentPages;
+    }
+    const long residentMiB = residentPages * sysconf(_SC_PAGESIZE) / (1024 * 1024);
+    qputenv("MFR_MEMORY_LIMIT_MIB", QByteArray::number(static_cast<qlonglong>(residentMiB + 24)));
+    const auto unset = qScopeGuard([] { qunsetenv("MFR_MEMORY_LIMIT_MIB"); });
+    QSignalSpy ready(&m, &ViewerContext::frameQualityReady);
+    m.setCamera(navigation::orbit(m.camera(), QPointF(3, 0), m.renderSize()));  // a frame not yet measured
+    QTRY_VERIFY_WITH_TIMEOUT(m.framesRendered() > 0 && m.renderError().isEmpty(), kTimeoutMs);
+    settle(m);
+    m.requestFrameQuality();
+    QTRY_VERIFY_WITH_TIMEOUT(ready.count() > 0, kTimeoutMs);
+    const FrameQuality q = m.frameQuality();
+    QVERIFY(!q.valid);
+    QVERIFY2(q.error.contains("MFR_MEMORY_LIMIT_MIB"), qPrintable(q.error));
+    QTRY_COMPARE_WITH_TIMEOUT(w->findChild<QLabel*>("budgetRmse")->text(), QStringLiteral("not computed"), kTimeoutMs);
+    QCOMPARE(w->findChild<QLabel*>("budgetFlip")->text(), q.error);
+  }
+
   void budgetPanelQualityAndRobustness() {
     auto w = openWindow();
     QVERIFY(w);

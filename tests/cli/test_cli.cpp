@@ -1057,6 +1057,16 @@ TEST_F(Cli, AllocationsCompareAtOneBudget) {
 // Σ max(1, n − m), both counted on the oracle's lists and written to the JSON. Two boxes of one
 // colour behind a red one, seen face on: every face of a box is shaded alike (|n·l| = 1), so the
 // lists end in runs of 2 or 4 fragments of one colour and the two thresholds differ.
+// A budget row the method refuses names the budget as given: "8", not the "8.0000004768" that
+// evaluate passed so that the methods floor it back to the same bytes (a bug hunt). A kN budget,
+// a byte count, is passed in as few digits as floor back to it.
+TEST_F(Cli, EvaluateNamesTheBudgetAsGiven) {
+  const CliResult r = runCli("evaluate @sample -s 160x120 --budgets 0.25,k1 -r 1 -m fkb,vkb");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("--param budget_mib=0.25: below what k = 1 needs at 160x120"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("0.2500000"), std::string::npos) << r.out;
+}
+
 TEST_F(Cli, EvaluateBudgetsRelativeToTheExactThresholds) {
   const fs::path scene = write("boxes.mfrscene", R"({"objects": [
     {"primitive": {"type": "box", "size": [1.6, 1.6, 1.0]}, "color": [0.2, 0.4, 0.9], "opacity": 0.3},
@@ -1161,6 +1171,26 @@ TEST_F(Cli, MoreMemoryThanThereIsIsRefused) {
         << r.out;
     EXPECT_NE(r.out.find("under MFR_MEMORY_LIMIT_MIB=40"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("corrupt"), std::string::npos) << r.out;
+  }
+  // Files read whole, asked of the memory first: a 2 GB scene file took 4.2 GB at a 500 MiB
+  // limit, or ended in "internal error: std::bad_alloc" (a bug hunt). Sparse: no disk is used.
+  for (const char* name : {"huge.mfrscene", "huge.obj", "huge.bin"}) {
+    const fs::path huge = write(name, "{");
+    fs::resize_file(huge, std::uintmax_t{300} << 20);
+    const std::string command = std::string(name) == "huge.bin"
+                                    ? "train " + huge.string() + " --epochs 1 -o " + (dir() / "w.json").string()
+                                    : "info " + huge.string() + " --no-histogram";
+    const CliResult r = refused(command, "mfr: " + huge.string() + ": reading the file (300 MiB) would take 300 MiB");
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  }
+  // A gzip bomb: 300 MB of zeros in 300 KB, decompressed whole (an 8.7 MB .ply.gz held 2.2 GB at
+  // a 500 MiB limit; a bug hunt).
+  {
+    const fs::path bomb = dir() / "bomb.ply.gz";
+    ASSERT_EQ(mfr::test::runCommand("head -c 300000000 /dev/zero | gzip -1 > " + bomb.string()).exitCode, 0);
+    const CliResult r =
+        refused("info " + bomb.string() + " --no-histogram", "mfr: " + bomb.string() + ": decompressing (");
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
   }
   // llvmpipe's buffers are main memory; a hardware driver answers GL_OUT_OF_MEMORY itself.
   const fs::path smallJson = dir() / "small.json";

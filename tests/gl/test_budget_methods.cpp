@@ -462,9 +462,44 @@ TEST(FixedKUnderBudget, SpendsNoTailOutsideHybrid) {
   }
 }
 
+// fkb's k is held to what the largest storage block holds a pixel, below what the budget allows:
+// it was refused ("800x600 pixels need 24480000 slots … more than the largest shader storage
+// block") where vkb ran at the same budget (a bug hunt). The size is made from this context's
+// block, so that it holds 10 slots a pixel.
+TEST(FixedKUnderBudget, KIsHeldToTheLargestStorageBlock) {
+  context();
+  GLint64 blockBytes = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &blockBytes);
+  const std::uint64_t blockSlots = std::min<std::uint64_t>(static_cast<std::uint64_t>(blockBytes) / 8, 0xFFFFFFFFull);
+  const auto side = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(blockSlots) / 10.5)));
+  if (side > 16384) GTEST_SKIP() << "this context's block holds 10 slots a pixel beyond --size's 16384";
+  const std::uint64_t pixelCount = static_cast<std::uint64_t>(side) * static_cast<std::uint64_t>(side);
+  const std::uint64_t blockK = blockSlots / pixelCount;
+  ASSERT_EQ(blockK, 10u);
+  const Scene scene = makeQuadsScene(2);
+  GpuRenderer gpu;
+  gpu.setScene(scene);
+  RenderRequest req;
+  req.method = "fkb";
+  req.operation = "hybrid";
+  req.width = req.height = side;
+  const KBufferMemoryModel model = kplusArrayMemoryModel(pixelCount);
+  const std::uint64_t budget = model.bytes(14);  // the budget allows k = 14
+  req.params = {{"budget_mib", std::to_string((static_cast<double>(budget) + 0.5) / kMiB)}};
+  const RenderOutput out = gpu.render(scene.view("front"), req);
+  EXPECT_EQ(out.stats.kMax, blockK);
+  EXPECT_EQ(out.stats.bytesAllocated, model.bytes(blockK));
+  EXPECT_LE(out.stats.bytesAllocated, budget);
+  std::string chosen;
+  for (const auto& [key, value] : out.stats.notes)
+    if (key == "k chosen") chosen = value;
+  EXPECT_EQ(chosen, "largest uniform k the GL context's largest storage block holds: 10 (the budget would allow more)");
+  EXPECT_EQ(out.stats.fragmentsStored, out.stats.fragmentsGenerated);  // two layers fit in ten slots
+}
+
 // Per-pixel buffers bound whole as one storage block are refused beyond the context's largest
-// block, as the fragment stores are (vkb's and dkb's arena and kpeel's pixel state went past
-// llvmpipe's 128 MiB without a word; a review). The image side is made from this context's limit;
+// block, as the fragment stores are (vkb's and dkb's arena, kpeel's pixel state and the k-buffers'
+// hybrid tail went past llvmpipe's 128 MiB without a word; reviews). The image side is made from this context's limit;
 // a GPU whose block outgrows --size's 16384 leaves the case out, and says so.
 TEST(PerPixelStorage, BuffersBeyondTheLargestStorageBlockAreRefused) {
   context();
@@ -474,10 +509,12 @@ TEST(PerPixelStorage, BuffersBeyondTheLargestStorageBlockAreRefused) {
   const Scene scene = makeQuadsScene(1);
   std::vector<std::string> leftOut;
   int checked = 0;
-  for (const std::string method : {"vkb", "dkb", "kpeel"}) {
+  for (const std::string method : {"vkb", "dkb", "kpeel", "kplus-array"}) {
     SCOPED_TRACE(method);
     const auto bytesAt = [&](std::uint64_t side) {
-      return method == "kpeel" ? 32 * side * side : variableKLayout(side * side, memberFixed(method)).arenaBytes();
+      if (method == "kpeel") return 32 * side * side;        // the pixel state
+      if (method == "kplus-array") return 20 * side * side;  // the hybrid tail (more than k = 1's slots)
+      return variableKLayout(side * side, memberFixed(method)).arenaBytes();
     };
     auto side = static_cast<std::uint64_t>(std::sqrt(static_cast<double>(block) / 40.0));
     while (bytesAt(side) <= block) ++side;
@@ -491,8 +528,10 @@ TEST(PerPixelStorage, BuffersBeyondTheLargestStorageBlockAreRefused) {
     RenderRequest req;
     req.method = method;
     req.width = req.height = static_cast<int>(side);
-    req.params = method == "kpeel" ? std::map<std::string, std::string>{{"k", "1"}}
-                                   : std::map<std::string, std::string>{{"budget_mib", "65536"}};
+    req.params = method == "kpeel"         ? std::map<std::string, std::string>{{"k", "1"}}
+                 : method == "kplus-array" ? std::map<std::string, std::string>{{"k", "1"}, {"tail", "true"}}
+                                           : std::map<std::string, std::string>{{"budget_mib", "65536"}};
+    if (method == "kplus-array") req.operation = "hybrid";
     try {
       (void)gpu.render(scene.view("front"), req);
       ADD_FAILURE() << side << "x" << side << " was drawn";

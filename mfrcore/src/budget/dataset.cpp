@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mfr/error.hpp"
+#include "mfr/host_memory.hpp"
 #include "mfr/json_text.hpp"
 #include "number_text.hpp"
 #include "mfr/io_util.hpp"
@@ -89,6 +90,8 @@ DkbDataset readDataset(const std::filesystem::path& path) {
   // Room for the record mfr train nests it in (training.dataset[i]), so that its weights file stays
   // readable (a review).
   requireJsonNesting(d.metadata, where, "corrupt: its metadata ", kDatasetMetadataNestingLimit);
+  // The rows beside the file's bytes, asked of the host's memory first (a bug hunt).
+  requireHostMemory(where, "its " + std::to_string(rows) + " rows (" + formatMemory(payload) + ")", payload);
   d.rows.resize(rows * kDatasetColumns);
   std::memcpy(d.rows.data(), bytes.data() + header + metaLength, payload);
   for (std::size_t i = 0; i < d.rows.size(); ++i)

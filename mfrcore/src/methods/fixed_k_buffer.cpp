@@ -6,6 +6,7 @@
 
 #include "mfr/budget/memory_model.hpp"
 #include "mfr/error.hpp"
+#include "method_util.hpp"
 
 namespace mfr {
 
@@ -52,7 +53,15 @@ void FixedKBuffer::configure(int width, int height, const Params& params) {
         << static_cast<double>(model.bytes(1)) / (1024.0 * 1024.0) << " MiB = " << model.bytes(1) << " bytes)";
     throw Error("--param budget_mib=" + budgetText_, why.str());
   }
-  k_ = k;
+  // At most what the largest storage block holds a pixel: the budget's k at 800x600 and 200 MiB
+  // (51) was refused there where k = 34 fits, as vkb runs (a bug hunt).
+  const std::uint64_t blockK =
+      std::min<std::uint64_t>(maxStorageElements(8), 0xFFFFFFFFull) / std::max<std::uint64_t>(pixels, 1);
+  if (blockK == 0)
+    throw Error("--method fkb", "one slot a pixel at " + std::to_string(width) + "x" + std::to_string(height) +
+                                    " is more than the largest shader storage block of this GL context holds");
+  blockCapped_ = k > blockK;
+  k_ = static_cast<std::uint32_t>(std::min<std::uint64_t>(k, blockK));
   gl::Defines defines;
   if (culling_) defines.emplace("MFR_KB_CULLING", "1");
   configureCommon(width, height, params, "kplus-array", "fkb", defines);
@@ -64,7 +73,10 @@ void FixedKBuffer::capture(const FrameContext& ctx) {
   drawStore(ctx);
   finishStore();
   stats_.notes.emplace_back("budget", budgetText_ + " MiB = " + std::to_string(budgetBytes_) + " bytes");
-  stats_.notes.emplace_back("k chosen", "largest uniform k that fits: " + std::to_string(k_));
+  stats_.notes.emplace_back("k chosen", blockCapped_
+                                            ? "largest uniform k the GL context's largest storage block holds: " +
+                                                  std::to_string(k_) + " (the budget would allow more)"
+                                            : "largest uniform k that fits: " + std::to_string(k_));
   stats_.notes.emplace_back("culling", culling_ ? "on" : "off");
 }
 

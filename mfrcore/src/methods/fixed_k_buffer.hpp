@@ -18,6 +18,7 @@ class FixedKBuffer final : public KBufferFamily {
   bool culling_ = true;
   std::string budgetText_;
   std::uint64_t budgetBytes_ = 0;
+  bool blockCapped_ = false;  // k held to what the largest storage block holds, below the budget's
 };
 
 }  // namespace mfr
