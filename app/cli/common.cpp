@@ -143,7 +143,7 @@ bool outsideFrustum(const Bounds& box, const Camera& camera, double aspect) {
   std::array<bool, 6> allOutside{true, true, true, true, true, true};
   for (int corner = 0; corner < 8; ++corner) {
     const glm::dvec4 c = m * glm::dvec4(box.corner(corner), 1.0);
-    const std::array<bool, 6> outside{c.x<-c.w, c.x> c.w, c.y<-c.w, c.y> c.w, c.z<-c.w, c.z> c.w};
+    const std::array<bool, 6> outside{(c.x < -c.w), (c.x > c.w), (c.y < -c.w), (c.y > c.w), (c.z < -c.w), (c.z > c.w)};
     for (std::size_t plane = 0; plane < 6; ++plane) allOutside[plane] = allOutside[plane] && outside[plane];
   }
   return std::any_of(allOutside.begin(), allOutside.end(), [](bool b) { return b; });
