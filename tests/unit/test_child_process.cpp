@@ -152,7 +152,7 @@ TEST(ChildProcess, ProgressReachesThisProcessAndCancelKillsTheChild) {
 }
 
 TEST(ChildProcess, BadTimeLimitsAreRefused) {
-  for (const char* value : {"0", "-1", "86401", "1.5", "x", "99999999999999999999"}) {
+  for (const char* value : {"0", "-1", "86401", "1.5", "x", "99999999999999999999", " 5", "+5", "5 "}) {
     const ScopedEnv limit("MFR_IMPORT_TIMEOUT_S", value);
     EXPECT_EQ(errorOf([](const LoadProgress&) { return std::string(); }),
               std::string("in.fmt: MFR_IMPORT_TIMEOUT_S=") + value + ": expected whole seconds, 1 to 86400");

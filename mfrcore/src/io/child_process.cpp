@@ -149,6 +149,10 @@ constexpr std::size_t kRecordHeader = 1 + sizeof(std::uint64_t);
 int importSeconds(const std::string& name) {
   const char* text = std::getenv("MFR_IMPORT_TIMEOUT_S");
   if (text == nullptr || *text == '\0') return 120;
+  // Digits only, as MFR_MEMORY_LIMIT_MIB: strtol took " 5" and "+5" where that one is refused (a bug hunt).
+  const std::string given(text);
+  if (given.find_first_not_of("0123456789") != std::string::npos)
+    throw Error(name, "MFR_IMPORT_TIMEOUT_S=" + given + ": expected whole seconds, 1 to 86400");
   char* end = nullptr;
   errno = 0;
   const long seconds = std::strtol(text, &end, 10);
