@@ -197,7 +197,9 @@ void addBench(CLI::App& app) {
     const auto frame = [&](Run& run) {
       run.last = render(run);
       run.totals.push_back(run.last.stats.totalTimeMs());
-      for (const auto& [pass, ms] : run.last.stats.passTimesMs) {
+      for (const auto& timed : run.last.stats.passTimesMs) {
+        const auto& pass = timed.first;  // a name, not a binding: the lambda below captures it
+        const auto ms = timed.second;
         auto it = std::find_if(run.perPass.begin(), run.perPass.end(), [&](const auto& p) { return p.first == pass; });
         if (it == run.perPass.end())
           run.perPass.push_back({pass, {ms}});

@@ -11,7 +11,9 @@
 #include "mfr/error.hpp"
 #include "mfr/host_memory.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+int runMfr(int argc, char** argv) {
   CLI::App app{"mfr: multifragment rendering — capture, sort and operate on many fragments per pixel", "mfr"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "mfr " MFR_VERSION);
@@ -73,4 +75,18 @@ int main(int argc, char** argv) {
     return 3;
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // What escapes the commands' own handling (the options' set-up: out of memory) is still one line.
+  try {
+    return runMfr(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "mfr: internal error: " << e.what() << "\n";
+  } catch (...) {
+    std::cerr << "mfr: internal error\n";
+  }
+  return 3;
 }

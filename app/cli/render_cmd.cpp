@@ -154,7 +154,7 @@ void addRender(CLI::App& app) {
       const bool depth = opt->dataView == "depth-complexity";
       std::vector<std::uint32_t> counts;
       if (depth && cpu) {
-        counts = castFragments(scene, camera, w, h).counts();
+        counts = std::move(out.depthComplexity);
       } else if (depth) {
         counts = headlessRenderer().depthComplexity(camera, w, h);
       } else {

@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "mfr/error.hpp"
+#include "mfr/io_util.hpp"
 #include "mfr/json_text.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/clip_box.hpp"
@@ -144,14 +145,14 @@ class Reader {
   }
   // A method the viewer draws with, or an operation (empty: not given).
   QString method(const QJsonObject& o, const QString& key, const QString& where) const {
-    const QString name = string(o, key, where);
+    QString name = string(o, key, where);
     const std::vector<std::string> known = mfr::availableMethods();  // the oracle and optimal-k too
     if (!name.isEmpty() && std::find(known.begin(), known.end(), name.toStdString()) == known.end())
       fail(where.isEmpty() ? key : where + "." + key, QStringLiteral("unknown method '%1'").arg(name));
     return name;
   }
   QString operation(const QJsonObject& o, const QString& key, const QString& where) const {
-    const QString name = string(o, key, where);
+    QString name = string(o, key, where);
     if (!name.isEmpty()) try {
         mfr::validateOperation(name.toStdString());
       } catch (const mfr::Error&) {
@@ -654,7 +655,8 @@ Session readSessionFile(const QString& path) {
 }
 
 void writeSessionFile(const QString& path, const Session& session) {
-  QSaveFile f(path);  // temporary + rename: never a half-written session
+  const mfr::TerminationSignalsHeld held;  // Ctrl-C mid-write leaves no temporary
+  QSaveFile f(path);                       // temporary + rename: never a half-written session
   if (!f.open(QIODevice::WriteOnly)) throw mfr::Error(path.toStdString(), f.errorString().toStdString());
   f.write(QJsonDocument(sessionToJson(session)).toJson(QJsonDocument::Indented));
   if (!f.commit()) throw mfr::Error(path.toStdString(), f.errorString().toStdString());

@@ -1147,6 +1147,7 @@ bool ViewerModel::setFieldColoring(const QString& field, const QString& map, con
   }
   if (!field.isEmpty()) {
     std::vector<mfr::Object*> pointers;
+    pointers.reserve(parts.size());
     for (mfr::Object& o : parts) pointers.push_back(&o);
     try {
       mfr::colorObjectsByField(pointers, field.toStdString(), map.toStdString(), range, scene_.name);

@@ -3,8 +3,11 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
+#include <mutex>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -50,7 +53,7 @@ namespace {
 std::filesystem::path outputTarget(const std::filesystem::path& path) {
   std::error_code ec;
   if (!std::filesystem::is_symlink(std::filesystem::symlink_status(path, ec))) return path;
-  const std::filesystem::path target = std::filesystem::canonical(path, ec);
+  std::filesystem::path target = std::filesystem::canonical(path, ec);
   if (ec) throw Error(path.string(), "a link to a missing file or a loop of links (" + ec.message() + ")");
   return target;
 }
@@ -81,6 +84,41 @@ void checkOutputPath(const std::filesystem::path& given) {
   const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   if (!std::filesystem::is_directory(dir, ec)) throw Error(given.string(), "folder does not exist");
   checkFolderTakesFiles(dir, given);
+}
+
+namespace {
+
+constexpr std::array<int, 3> kHeldSignals{SIGINT, SIGTERM, SIGHUP};
+// The first signal caught while held (0: none). A handler may only store to a lock-free atomic.
+volatile std::sig_atomic_t heldSignal = 0;
+extern "C" void holdSignal(int signal) {
+  if (heldSignal == 0) heldSignal = signal;
+}
+std::mutex heldMutex;
+int heldDepth = 0;                                                    // guarded by heldMutex
+std::array<struct sigaction, kHeldSignals.size()> previousActions{};  // guarded by heldMutex
+
+}  // namespace
+
+TerminationSignalsHeld::TerminationSignalsHeld() {
+  const std::lock_guard lock(heldMutex);
+  if (heldDepth++ > 0) return;
+  heldSignal = 0;
+  struct sigaction hold {};
+  hold.sa_handler = holdSignal;
+  sigemptyset(&hold.sa_mask);
+  hold.sa_flags = SA_RESTART;  // a write or rename interrupted goes on
+  for (std::size_t i = 0; i < kHeldSignals.size(); ++i) ::sigaction(kHeldSignals[i], &hold, &previousActions[i]);
+}
+
+TerminationSignalsHeld::~TerminationSignalsHeld() {
+  const std::lock_guard lock(heldMutex);
+  if (--heldDepth > 0) return;
+  for (std::size_t i = 0; i < kHeldSignals.size(); ++i) ::sigaction(kHeldSignals[i], &previousActions[i], nullptr);
+  if (const int signal = heldSignal; signal != 0) {
+    heldSignal = 0;
+    std::raise(signal);  // as if it had come now: the default ends the process
+  }
 }
 
 namespace {
@@ -121,10 +159,14 @@ void commit(const Temporary& t) {
 }  // namespace
 
 void writeFileAtomically(const std::filesystem::path& given, std::string_view bytes) {
+  const TerminationSignalsHeld held;  // Ctrl-C mid-write left the temporary (a bug hunt)
   commit(writeTemporary(given, bytes));
 }
 
 void writeFilesAtomically(const std::vector<std::pair<std::filesystem::path, std::string>>& files) {
+  // Held until every output is renamed: a signal between two renames left the new PNG beside a
+  // temporary and the old JSON (a bug hunt).
+  const TerminationSignalsHeld held;
   std::vector<Temporary> written;
   try {
     for (const auto& [path, bytes] : files) written.push_back(writeTemporary(path, bytes));

@@ -108,6 +108,7 @@ LegendLayout drawColorLegend(ImageRGBA8& image, const FieldColors& colors, const
   std::erase_if(values, [&](double v) { return !(v >= low && v <= high); });
   std::sort(values.begin(), values.end(), std::greater<>());
   std::vector<Glyphs> labels;
+  labels.reserve(values.size());
   for (const double v : values) labels.push_back(renderText(legendValueText(v), font));
   const Glyphs title = renderText(colors.field, font);
   int labelWidth = 0;

@@ -140,7 +140,7 @@ double volumeStepOf(const RenderRequest& request, std::span<const Volume> volume
 
 std::string effectiveOperation(const std::string& operation, const MethodInfo* info, bool sceneHasVolume) {
   if (operation != "auto") return operation;
-  const std::string preferred = info ? info->preferredOperation : "oit";
+  std::string preferred = info ? info->preferredOperation : "oit";
   if (sceneHasVolume && preferred == "oit" && (!info || info->sortedLists)) return "volume";
   return preferred;
 }
@@ -234,6 +234,7 @@ RenderOutput renderOptimalK(const Scene& scene, const Camera& camera, const Rend
   // As the oracle and the GPU methods say it: hybrid composites the surfaces only.
   if (scene.hasVisibleVolume()) s.notes.emplace_back("volume", "not drawn (operation hybrid)");
   out.kMap = best.k;
+  out.depthComplexity = lists.counts();
   return out;
 }
 
@@ -323,6 +324,7 @@ RenderOutput render(const Scene& scene, const Camera& camera, const RenderReques
   out.stats.bytesUsed = out.stats.bytesAllocated;
   out.stats.kMax = lists.maxCount();
   out.stats.notes.emplace_back("device", "CPU ray casting (double precision)");
+  out.depthComplexity = lists.counts();
   return out;
 }
 

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <string>
@@ -69,6 +72,77 @@ TEST_F(OutputFiles, SeveralOutputsAreWrittenAllOrNone) {
   // A bad second path is refused before the first is written.
   EXPECT_THROW(mfr::writeFilesAtomically({{png2, "x"}, {dir() / "no" / "b.json", "y"}}), mfr::Error);
   EXPECT_FALSE(fs::exists(png2));
+}
+
+// A signal that arrives while outputs are written is held until the last rename: the process still
+// ends by it, but leaves every output whole and no temporary (a bug hunt: SIGTERM between the
+// renames left the new PNG, the old JSON and a .tmp- file).
+TEST_F(OutputFiles, ASignalWaitsForTheLastRename) {
+  const fs::path png = dir() / "c.png", json = dir() / "c.json";
+  mfr::writeFilesAtomically({{png, "old"}, {json, "old"}});
+  const std::string big(48u << 20, 'n');  // long enough to be caught mid-write
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    try {
+      mfr::writeFilesAtomically({{png, big}, {json, big}});
+    } catch (...) {
+      ::_exit(3);
+    }
+    ::_exit(0);
+  }
+  // Signal as soon as the first temporary appears.
+  bool seen = false;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  while (!seen && std::chrono::steady_clock::now() < until)
+    for (const std::string& name : namesIn(dir()))
+      if (name.find(".tmp-") != std::string::npos) seen = true;
+  ASSERT_EQ(::kill(child, SIGTERM), 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(seen) << "no temporary was seen: the test could not signal mid-write";
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the writer ended before the signal reached it (status " << status << ")";
+  EXPECT_EQ(WTERMSIG(status), SIGTERM) << "the signal still ends the process";
+  EXPECT_EQ(fs::file_size(png), big.size());
+  EXPECT_EQ(fs::file_size(json), big.size());
+  std::vector<std::string> names = namesIn(dir());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"c.json", "c.png"}));
+}
+
+// Held signals: nothing happens while held; the last holder raises what came, once.
+TEST(TerminationSignalsHeld, RaisesWhatArrivedWhenTheLastEnds) {
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::close(fds[0]);
+    {
+      const mfr::TerminationSignalsHeld outer;
+      {
+        const mfr::TerminationSignalsHeld inner;
+        std::raise(SIGINT);
+        std::raise(SIGTERM);  // the first one is kept
+      }
+      // Still held by the outer one: alive here, and says so.
+      if (::write(fds[1], "x", 1) != 1) ::_exit(4);
+    }
+    ::_exit(5);  // not reached: SIGINT ends the process
+  }
+  ::close(fds[1]);
+  char got = 0;
+  const ssize_t n = ::read(fds[0], &got, 1);
+  ::close(fds[0]);
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  EXPECT_EQ(n, 1) << "the inner holder's end raised the signal while the outer one still held it";
+  ASSERT_TRUE(WIFSIGNALED(status)) << "status " << status;
+  EXPECT_EQ(WTERMSIG(status), SIGINT);
+  // Without a signal, nothing is raised and the handlers are back as they were.
+  const auto before = std::signal(SIGHUP, SIG_IGN);
+  { const mfr::TerminationSignalsHeld held; }
+  EXPECT_EQ(std::signal(SIGHUP, before), SIG_IGN);
 }
 
 }  // namespace

@@ -10,11 +10,14 @@
 namespace mfr {
 
 // Writes bytes to path.tmp-XXXX then renames over path; a symbolic link's file is written, and the
-// link kept. Throws mfr::Error naming path (and first checkOutputPath's refusals).
+// link kept. Throws mfr::Error naming path (and first checkOutputPath's refusals). An interrupt or
+// termination signal (SIGINT, SIGTERM, SIGHUP) that arrives meanwhile is held until the write is
+// done (TerminationSignalsHeld), so that it leaves no temporary behind.
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 // Several outputs of one command, all or none: every temporary is written before any is renamed,
 // so a second output that fails (disk full) leaves no first one behind (a bug hunt: mfr render's
-// PNG stayed when its --stats failed). Throws as writeFileAtomically.
+// PNG stayed when its --stats failed), and a signal waits for the last rename, so that it leaves
+// neither a temporary nor a new PNG beside an old JSON. Throws as writeFileAtomically.
 void writeFilesAtomically(const std::vector<std::pair<std::filesystem::path, std::string>>& files);
 // Whether an output could be written there, before anything is: its folder exists and takes a new
 // file (one is created and removed), the path is not something other than a regular file (a
@@ -22,6 +25,18 @@ void writeFilesAtomically(const std::vector<std::pair<std::filesystem::path, std
 // file. Commands with several outputs check them all first, so that a bad second
 // path leaves no first file behind. Throws mfr::Error naming path.
 void checkOutputPath(const std::filesystem::path& path);
+
+// While one lives, SIGINT, SIGTERM and SIGHUP are caught and remembered instead of acted on; the
+// last one alive puts the previous handlers back and raises what arrived, so the process then ends
+// as it would have (or runs its own handler). Process-wide, whichever thread the signal reaches;
+// nests and may be used from several threads. Not for long work: Ctrl-C waits for it.
+class TerminationSignalsHeld {
+ public:
+  TerminationSignalsHeld();
+  ~TerminationSignalsHeld();
+  TerminationSignalsHeld(const TerminationSignalsHeld&) = delete;
+  TerminationSignalsHeld& operator=(const TerminationSignalsHeld&) = delete;
+};
 
 // Reads a whole regular file. Throws mfr::Error naming path when missing, not a regular file (a
 // device, a pipe) or unreadable.

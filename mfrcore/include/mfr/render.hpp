@@ -75,6 +75,9 @@ struct RenderOutput {
   // optimal-k only: its k(p), indexed like the oracle's lists (FragmentLists::index). The GPU
   // methods' k(p) comes from GpuRenderer::kMap().
   std::vector<std::uint32_t> kMap;
+  // oracle and optimal-k only: n(p) of the lists they cast, indexed like kMap (so a depth-complexity
+  // view of a CPU method casts once).
+  std::vector<std::uint32_t> depthComplexity;
 };
 
 // Throws mfr::Error for an unknown method or operation, a bad size or an empty scene.

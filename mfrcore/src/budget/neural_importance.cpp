@@ -127,7 +127,7 @@ NeuralImportanceModel NeuralImportanceModel::quantised() const {
       float maxAbs = 0.0f;
       for (int c = 0; c < cols; ++c) maxAbs = std::max(maxAbs, std::abs(w[c]));
       const float scale = maxAbs / 127.0f;
-      m.rowScales[static_cast<std::size_t>(kLayerRows[l] + r)] = scale;
+      m.rowScales[static_cast<std::size_t>(kLayerRows[l]) + static_cast<std::size_t>(r)] = scale;
       for (int c = 0; c < cols; ++c) {
         q[c] = static_cast<std::int8_t>(scale > 0.0f ? std::clamp(std::round(w[c] / scale), -127.0f, 127.0f) : 0.0f);
         w[c] = scale * static_cast<float>(q[c]);

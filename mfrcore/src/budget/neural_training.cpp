@@ -36,13 +36,13 @@ using DkbNet = dlib::loss_mean_squared<
 template <class Layer>
 void exportFc(const Layer& layer, int inputs, int outputs, int weightBase, int biasBase, std::vector<float>& out) {
   const dlib::tensor& params = layer.layer_details().get_layer_params();
-  if (params.size() != static_cast<std::size_t>((inputs + 1) * outputs))
+  if (params.size() != (static_cast<std::size_t>(inputs) + 1) * static_cast<std::size_t>(outputs))
     throw Error("dkb training", "unexpected dlib fc layer size");
   const float* p = params.host();
-  for (int o = 0; o < outputs; ++o) {
-    for (int i = 0; i < inputs; ++i)
-      out[static_cast<std::size_t>(weightBase + o * inputs + i)] = p[static_cast<std::size_t>(i * outputs + o)];
-    out[static_cast<std::size_t>(biasBase + o)] = p[static_cast<std::size_t>(inputs * outputs + o)];
+  const auto in = static_cast<std::size_t>(inputs), outs = static_cast<std::size_t>(outputs);
+  for (std::size_t o = 0; o < outs; ++o) {
+    for (std::size_t i = 0; i < in; ++i) out[static_cast<std::size_t>(weightBase) + o * in + i] = p[i * outs + o];
+    out[static_cast<std::size_t>(biasBase) + o] = p[in * outs + o];
   }
 }
 

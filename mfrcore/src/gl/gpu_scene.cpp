@@ -23,7 +23,7 @@ Texture colorMapTexture() {
   const std::vector<std::string>& names = colorMapNames();
   const int width = MFR_COLOR_MAP_SIZE + 1, height = static_cast<int>(names.size());
   std::vector<glm::vec4> texels;
-  texels.reserve(static_cast<std::size_t>(width * height));
+  texels.reserve(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
   for (const std::string& name : names) {
     const ColorMap& map = colorMap(name);
     for (const glm::vec3& c : map.table) texels.emplace_back(c, 1.0f);

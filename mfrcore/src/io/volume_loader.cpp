@@ -998,7 +998,8 @@ Volume readVolumeWithVtk(VolumeFormat format, const fs::path& path, const std::s
                                  ? std::max(1, scalars->Get(vtkDataObject::FIELD_NUMBER_OF_COMPONENTS()))
                                  : 1;
       sampleBytes = static_cast<std::uint64_t>(
-          std::max(1, vtkDataArray::GetDataTypeSize(scalars->Get(vtkDataObject::FIELD_ARRAY_TYPE()))) * components);
+                        std::max(1, vtkDataArray::GetDataTypeSize(scalars->Get(vtkDataObject::FIELD_ARRAY_TYPE())))) *
+                    static_cast<std::uint64_t>(components);
     }
     requireHostMemory(name, "its " + dimsText(declared) + " samples", points * (sampleBytes + sizeof(float)));
   }

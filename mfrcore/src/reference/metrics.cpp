@@ -123,13 +123,15 @@ void checkSameSize(const char* metric, const ImageRGBA8& reference, const ImageR
   }
 }
 
-std::uint8_t toByte(float c) { return static_cast<std::uint8_t>(std::clamp(c, 0.0f, 1.0f) * 255.0f + 0.5f); }
+std::uint8_t toByte(float c) {
+  return static_cast<std::uint8_t>(std::lround(std::clamp(c, 0.0f, 1.0f) * 255.0f));
+}
 
 // Colour-map index as FLIP's tool computes it (round(v·255)); NaN and out-of-range values clamp.
 int magmaIndex(float v) {
   if (!(v > 0.0f)) return 0;  // also catches NaN
   if (v >= 1.0f) return 255;
-  return static_cast<int>(v * 255.0f + 0.5f);
+  return static_cast<int>(std::lround(v * 255.0f));
 }
 
 void checkScalar(const char* what, const ImageF& values) {

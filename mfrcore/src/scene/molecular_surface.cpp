@@ -318,6 +318,7 @@ Mesh groupSurface(const std::vector<SurfaceAtom>& atoms, const MolecularSurfaceO
   // h/2 along the circle. Any sphere that covers a point of atom a's circle has its centre within
   // R_a + R_max of a's.
   std::vector<glm::dvec3> centres;
+  centres.reserve(atoms.size());
   for (const SurfaceAtom& a : atoms) centres.push_back(a.centre);
   const PointGrid atomGrid(centres, 2.0 * largest);
   std::vector<std::size_t> candidates;

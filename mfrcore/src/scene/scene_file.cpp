@@ -182,7 +182,8 @@ glm::dmat4 parseTransform(const Reader& r, const json& t, const std::string& whe
     glm::dmat4 out(1.0);
     for (int row = 0; row < 4; ++row)
       for (int col = 0; col < 4; ++col)
-        out[col][row] = r.number(m[static_cast<std::size_t>(row * 4 + col)], where + ".matrix");
+        out[col][row] =
+            r.number(m[static_cast<std::size_t>(row) * 4 + static_cast<std::size_t>(col)], where + ".matrix");
     checkTransform(r, out, where + ".matrix");
     return out;
   }

@@ -547,7 +547,8 @@ std::vector<bool> capJointly(std::vector<Object>& objects, std::vector<OpenCut>&
 
   std::map<std::size_t, std::vector<std::size_t>> members;
   for (std::size_t i = 0; i < open.size(); ++i) members[find(i)].push_back(i);
-  for (const auto& [root, parts] : members) {
+  for (const auto& member : members) {
+    const std::vector<std::size_t>& parts = member.second;  // a name, not a binding: lambdas capture it
     if (parts.size() < 2) continue;
     // The group's cut lines as one, in world space; where each point came from.
     std::vector<glm::vec3> positions;

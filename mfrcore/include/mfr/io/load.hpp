@@ -73,7 +73,7 @@ struct MoleculeStyle {
 struct LoadOptions {
   LoadOptions() = default;
   explicit LoadOptions(std::string field_, std::optional<MoleculeStyle> molecule_ = {})
-      : field(std::move(field_)), molecule(std::move(molecule_)) {}
+      : field(std::move(field_)), molecule(molecule_) {}
 
   // Volume files: the point-data array (.vti, legacy .vtk) or grid (.vdb) to read; empty: the
   // default (see loadVolume). Given for any other file, loading fails.
