@@ -165,6 +165,9 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
   parser.addOptions({method,     op,      thickness, step,          field, molecule, colorBy,    colorMap,
                      colorRange, contour, legend,    param,         view,  size,     screenshot, windowScreenshot,
                      windowSize, clip,    section,   pluginSettings});
+  // Unknown options and missing values are command-line errors, exit 2 as every other (process()
+  // exits 1 for them); process() then does only what parse() does not: -h, --help-all, --version.
+  if (!parser.parse(QCoreApplication::arguments())) fail(parser.errorText(), 2);
   parser.process(app);
   // An empty value is refused, as mfr refuses it: read as "not given", --screenshot '' opened the
   // interactive window and never quit.
@@ -613,11 +616,16 @@ int main(int argc, char** argv) {
         }
       } catch (const std::exception& e) {
         QString message = QString::fromUtf8(e.what());
-        static const QRegularExpression named(QStringLiteral("^--param ([A-Za-z0-9_]+)="));
+        static const QRegularExpression named(QStringLiteral("^--param ([A-Za-z0-9_]+)=(.*?): "));
         // A --param the command line lacks is never named: the value came from --plugin-settings,
         // else from the session (its params or its plugins' settings; a review), else a default.
         if (const QRegularExpressionMatch m = named.match(message); m.hasMatch()) {
           const std::string name = m.captured(1).toStdString();
+          // Nor one it gives with another value: a plugin's settings replaced it, which is refused
+          // as for a picture drawn (-p budget_mib=20 read "--param budget_mib=1: below …"; a bug hunt).
+          if (const auto given = cl.params.find(name);
+              given != cl.params.end() && given->second != m.captured(2).toStdString())
+            requireGiven({{name, m.captured(2).toStdString()}});
           if (!cl.params.contains(name)) {
             if (const auto it = paramsOfPlugin.find(name); it != paramsOfPlugin.end())
               message = QStringLiteral("--plugin-settings %1: %2").arg(it->second, message.mid(8));

@@ -1199,6 +1199,7 @@ void ViewerModel::reportRenderError(const QString& message) {
   if (message == renderError_) return;
   renderError_ = message;
   emit renderErrorChanged(renderError_);
+  emit frameErrorChanged();
 }
 
 QString ViewerModel::drawError() const {

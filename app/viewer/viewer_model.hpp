@@ -95,6 +95,7 @@ class ViewerModel final : public ViewerContext {
   void setParams(const std::map<std::string, std::string>& changes) override { setParamsOf(0, changes); }
   [[nodiscard]] bool hasScene() const override { return hasScene_; }
   [[nodiscard]] quint64 sceneSerial() const override { return sceneSerial_; }
+  [[nodiscard]] QString frameError() const override { return mainPaneFailed() ? renderErrorShown() : QString(); }
   [[nodiscard]] const mfr::Stats& stats() const override { return stats_[0]; }
   [[nodiscard]] QSize renderSize() const { return renderSize_; }  // the whole view's pixels
   [[nodiscard]] QSize imageSize() const override { return paneSize(); }

@@ -80,6 +80,11 @@ class ViewerContext : public QObject {
   [[nodiscard]] virtual quint64 sceneSerial() const = 0;
   // Stats of the last frame drawn in the view (empty before the first).
   [[nodiscard]] virtual const mfr::Stats& stats() const = 0;
+  // 1.14: why the view shows no frame of the current settings (the window's one line, e.g. a
+  // budget below the least setting of the method), empty while it shows one; frameErrorChanged
+  // follows each change. While it is set, stats() still holds the last frame drawn, which is no
+  // longer on screen (the budget panel showed its numbers beside the new budget: a bug hunt).
+  [[nodiscard]] virtual QString frameError() const = 0;
   // Pixels of the image stats() describes: the view's, or in compare mode side by side the first
   // pane's (half the view's width).
   [[nodiscard]] virtual QSize imageSize() const = 0;
@@ -224,6 +229,7 @@ class ViewerContext : public QObject {
   void methodChanged(const QString& method);
   void paramsChanged();
   void frameRendered();  // stats() describes the new frame
+  void frameErrorChanged();  // 1.14: frameError()
   // histogram[n] = pixels with exactly n fragments; the image size it was computed at.
   void depthComplexityReady(const QVector<quint64>& histogram, QSize size);
   void frameQualityReady();
@@ -282,5 +288,6 @@ class MfrViewerPlugin {
 // 1.11: exportParams: a plugin's parameters for an exported image of another size.
 // 1.12: sceneSerial: a new scene told from an edit of the same one.
 // 1.13: FrameQuality::error, and frameQualityReady when the numbers cannot be computed.
-#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.13"
+// 1.14: frameError and frameErrorChanged: the view's frame could not be drawn.
+#define MfrViewerPlugin_iid "org.mfr.ViewerPlugin/1.14"
 Q_DECLARE_INTERFACE(MfrViewerPlugin, MfrViewerPlugin_iid)

@@ -165,6 +165,10 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   });
   connect(&ctx_, &ViewerContext::methodChanged, this, &BudgetPanel::methodChanged);
   connect(&ctx_, &ViewerContext::frameRendered, this, &BudgetPanel::frameRendered);
+  connect(&ctx_, &ViewerContext::frameErrorChanged, this, [this] {
+    showFrame();
+    showQuality();
+  });
 
   qualityTimer_ = new QTimer(this);
   qualityTimer_->setSingleShot(true);
@@ -294,6 +298,13 @@ void BudgetPanel::showRobustness() {
 }
 
 void BudgetPanel::showQuality() {
+  if (!ctx_.frameError().isEmpty()) {  // no frame on screen to measure
+    for (QLabel* label : {rmseLabel_, flipLabel_}) {
+      label->setText(tr("—"));
+      label->setToolTip(ctx_.frameError());
+    }
+    return;
+  }
   const FrameQuality q = ctx_.frameQuality();
   rmseLabel_->setToolTip(q.error);
   flipLabel_->setToolTip(q.error);
@@ -454,10 +465,14 @@ void BudgetPanel::showFrame() {
   const QLocale locale;
   const double budget = budgetMiB() * kMiB;
   // The last frame is another method's (the new one's has not come, or cannot be drawn): its
-  // numbers read as this method's (fkb "fitting" at kplus-dynamic's 9.46 MiB: a bug hunt).
-  if (QString::fromStdString(s.method) != ctx_.method()) {
+  // numbers read as this method's (fkb "fitting" at kplus-dynamic's 9.46 MiB: a bug hunt). Or the
+  // current settings drew none (a budget below the least setting): the last frame's numbers are
+  // not on screen, and read beside the new budget ("15.3 of 16 MiB" at 1 MiB: a bug hunt).
+  const QString error = ctx_.frameError();
+  memoryBar_->setToolTip(error);
+  if (QString::fromStdString(s.method) != ctx_.method() || !error.isEmpty()) {
     memoryBar_->setValue(0);
-    memoryBar_->setFormat(tr("no frame of %1").arg(ctx_.method()));
+    memoryBar_->setFormat(tr("no frame of %1").arg(ctx_.method()));  // the reason in its tooltip
     memoryBar_->setStyleSheet(QString());
     for (QLabel* label : {memoryLabel_, capturedLabel_, kLabel_, exactLabel_}) label->setText(tr("—"));
     histogram_->setMarker(0, false);

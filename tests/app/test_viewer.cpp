@@ -606,6 +606,42 @@ class ViewerTest : public QObject {
     }
   }
 
+  // A budget the method cannot draw at: the panel shows no numbers of the last frame, which is no
+  // longer on screen ("15.3 of 16 MiB", its k, RMSE and FLIP beside a budget of 1 MiB: a bug
+  // hunt), and says why in the bar's tooltip (plugin interface 1.14: frameError); a budget that
+  // draws brings them back.
+  void budgetPanelShowsNoFrameItCouldNotDraw() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    auto* slider = w->findChild<QSlider*>("budgetSlider");
+    auto* bar = w->findChild<QProgressBar*>("memoryBar");
+    auto* captured = w->findChild<QLabel*>("capturedLabel");
+    auto* rmse = w->findChild<QLabel*>("budgetRmse");
+    QVERIFY(slider && bar && captured && rmse);
+    m.setMethod(QStringLiteral("vkb"));
+    slider->setValue(16);
+    settle(m);
+    QTRY_VERIFY_WITH_TIMEOUT(rmse->text() != QStringLiteral("—") && rmse->text() != QStringLiteral("computing…"),
+                             kTimeoutMs);
+    QVERIFY(m.frameError().isEmpty());
+    QVERIFY2(bar->format().contains(QStringLiteral(" of 16 MiB (")), qPrintable(bar->format()));
+    slider->setValue(1);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.frameError().isEmpty(), kTimeoutMs);
+    QVERIFY2(m.frameError().startsWith("budget_mib=1: below what vkb needs"), qPrintable(m.frameError()));
+    QCOMPARE(m.stats().method, std::string("vkb"));  // the last frame's, still
+    QCOMPARE(bar->format(), QStringLiteral("no frame of vkb"));
+    QCOMPARE(bar->toolTip(), m.frameError());
+    QCOMPARE(bar->value(), 0);
+    QCOMPARE(captured->text(), QStringLiteral("—"));
+    QCOMPARE(rmse->text(), QStringLiteral("—"));
+    slider->setValue(16);
+    QTRY_VERIFY_WITH_TIMEOUT(m.frameError().isEmpty() && bar->format().contains(QStringLiteral(" of 16 MiB (")),
+                             kTimeoutMs);
+    QVERIFY(captured->text() != QStringLiteral("—"));
+    QVERIFY(bar->toolTip().isEmpty());
+  }
+
   void badFileKeepsScene() {
     auto w = openWindow();
     QVERIFY(w);
@@ -716,6 +752,15 @@ class ViewerTest : public QObject {
     QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(),
              QStringLiteral("mfrview: --param k=2: 'k' is given twice"));
     QVERIFY(!QFile::exists(png));
+    // An unknown option and a missing value are command-line errors too: exit 2, as the docs say
+    // (Qt's parser exited 1 for them; a bug hunt).
+    for (const auto& [args, line] : QList<std::pair<QStringList, QString>>{
+             {{"@sample", "--bogus", "--screenshot", png}, "mfrview: Unknown option 'bogus'."},
+             {{"@sample", "--screenshot", png, "--size"}, "mfrview: Missing value after '--size'."}}) {
+      QCOMPARE(runProgram(MFRVIEW, args, &out), 2);
+      QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(), line);
+      QVERIFY(!QFile::exists(png));
+    }
   }
 
   // mfrview took a --clip box that holds nothing of the scene (an empty image, exit 0) and
@@ -1438,6 +1483,18 @@ class ViewerTest : public QObject {
                         &out),
              2);
     QVERIFY2(out.contains("mfrview: -p k=7: a plugin's settings set k="), qPrintable(out));
+    QVERIFY(!QFile::exists(png));
+    // The same when the render of the plugin's value fails: the -p given is named, not the value
+    // the plugin put in its place (dkb -p budget_mib=20 read "--param budget_mib=1: below what dkb
+    // needs", exit 1; a bug hunt).
+    QCOMPARE(runProgram(MFRVIEW,
+                        {"@sample", "-m", "dkb", "-p", "budget_mib=20", "--plugin-settings",
+                         R"(budget={"budget_mib":1,"driving":true})", "--size", "320x240", "--screenshot", png},
+                        &out),
+             2);
+    QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(),
+             QStringLiteral("mfrview: -p budget_mib=20: a plugin's settings set budget_mib=1 in its place (the budget "
+                            "panel drives it); give one of the two"));
     QVERIFY(!QFile::exists(png));
     // A budget below the least k or pool at the export's size: no picture, rather than one over
     // the budget (k = 1 at 800x600 takes 5.5 MiB; written with exit 0: a bug hunt).
