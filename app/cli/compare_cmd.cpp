@@ -29,9 +29,12 @@ void addCompare(CLI::App& app) {
   cmd->callback([opt] {
     bool wantRmse = false, wantFlip = false;
     for (const std::string& m : splitList(opt->metrics, "--metric")) {
-      if (m == "rmse") wantRmse = true;
-      else if (m == "flip") wantFlip = true;
-      else throw Error("--metric " + m, "unknown metric (rmse, flip)");
+      if (m == "rmse")
+        wantRmse = true;
+      else if (m == "flip")
+        wantFlip = true;
+      else
+        throw Error("--metric " + m, "unknown metric (rmse, flip)");
     }
     if (!wantRmse && !wantFlip) throw Error("--metric " + opt->metrics, "names no metric (rmse, flip)");
     // Below 0.01 FLIP's filters are degenerate: at 1e-30 every value came out NaN.
@@ -46,7 +49,8 @@ void addCompare(CLI::App& app) {
     const ImageRGBA8 test = readPng(opt->test);
     if (ref.width != test.width || ref.height != test.height)
       throw Error(opt->test, "size " + std::to_string(test.width) + "x" + std::to_string(test.height) +
-                                 " differs from reference " + std::to_string(ref.width) + "x" + std::to_string(ref.height));
+                                 " differs from reference " + std::to_string(ref.width) + "x" +
+                                 std::to_string(ref.height));
     nlohmann::ordered_json j;
     std::cout << std::setprecision(6) << std::fixed;
     ImageRGBA8 heat;

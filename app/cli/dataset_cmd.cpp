@@ -129,7 +129,7 @@ void addDataset(CLI::App& app) {
           HybridErrorTable errors = hybridErrorTable(lists, scenes[s].background);
           if (opt->labels == "class-optimal") errors = classMeanErrorTable(errors);
           const std::uint64_t nonEmpty = minimumSlots(errors);
-          bool allDone = false;  // levels at or above Σn all mean "every fragment": one frame of those
+          bool allDone = false;             // levels at or above Σn all mean "every fragment": one frame of those
           std::set<std::uint64_t> written;  // budgets in slots: 1 and 1.0001 can round to one F
           const std::uint64_t exactSlots = exactHybridSlots(lists);
           for (double level : levels) {

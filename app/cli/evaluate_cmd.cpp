@@ -145,8 +145,8 @@ void addEvaluate(CLI::App& app) {
     const std::vector<std::string> methods = splitList(opt->methods, "--methods");
     if (methods.empty()) throw Error("--methods", "names no method");
     refuseRepeats(methods, "--methods " + opt->methods);  // "vkb,vkb" printed a row twice and "tie vkb=vkb"
-    std::map<std::string, RenderRequest> specs;  // each method spec's request, without size and budget
-    std::vector<std::string> interlockRows;      // specs asking for sync=interlock: checked on the context
+    std::map<std::string, RenderRequest> specs;           // each method spec's request, without size and budget
+    std::vector<std::string> interlockRows;               // specs asking for sync=interlock: checked on the context
     std::size_t methodWidth = 11;
     // A weights file that cannot be read is the user's mistake, not one row's failure: refused
     // before anything runs (it was only a row's error, and exit 0).

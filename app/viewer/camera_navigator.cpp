@@ -98,13 +98,20 @@ mfr::Camera toggledProjection(const mfr::Camera& camera) {
 
 QString standardViewName(StandardView view) {
   switch (view) {
-    case StandardView::Front: return QStringLiteral("Front");
-    case StandardView::Back: return QStringLiteral("Back");
-    case StandardView::Left: return QStringLiteral("Left");
-    case StandardView::Right: return QStringLiteral("Right");
-    case StandardView::Top: return QStringLiteral("Top");
-    case StandardView::Bottom: return QStringLiteral("Bottom");
-    case StandardView::Iso: return QStringLiteral("Isometric");
+    case StandardView::Front:
+      return QStringLiteral("Front");
+    case StandardView::Back:
+      return QStringLiteral("Back");
+    case StandardView::Left:
+      return QStringLiteral("Left");
+    case StandardView::Right:
+      return QStringLiteral("Right");
+    case StandardView::Top:
+      return QStringLiteral("Top");
+    case StandardView::Bottom:
+      return QStringLiteral("Bottom");
+    case StandardView::Iso:
+      return QStringLiteral("Isometric");
   }
   return {};
 }
@@ -112,13 +119,28 @@ QString standardViewName(StandardView view) {
 mfr::Camera standardView(StandardView view, const mfr::Scene& scene, const mfr::Camera& current) {
   glm::dvec3 towardsEye{0, 0, 1}, up{0, 1, 0};  // front: looking down −Z, +Y up
   switch (view) {
-    case StandardView::Front: break;
-    case StandardView::Back: towardsEye = {0, 0, -1}; break;
-    case StandardView::Left: towardsEye = {-1, 0, 0}; break;
-    case StandardView::Right: towardsEye = {1, 0, 0}; break;
-    case StandardView::Top: towardsEye = {0, 1, 0}; up = {0, 0, -1}; break;
-    case StandardView::Bottom: towardsEye = {0, -1, 0}; up = {0, 0, 1}; break;
-    case StandardView::Iso: towardsEye = glm::normalize(glm::dvec3(1, 1, 1)); break;
+    case StandardView::Front:
+      break;
+    case StandardView::Back:
+      towardsEye = {0, 0, -1};
+      break;
+    case StandardView::Left:
+      towardsEye = {-1, 0, 0};
+      break;
+    case StandardView::Right:
+      towardsEye = {1, 0, 0};
+      break;
+    case StandardView::Top:
+      towardsEye = {0, 1, 0};
+      up = {0, 0, -1};
+      break;
+    case StandardView::Bottom:
+      towardsEye = {0, -1, 0};
+      up = {0, 0, 1};
+      break;
+    case StandardView::Iso:
+      towardsEye = glm::normalize(glm::dvec3(1, 1, 1));
+      break;
   }
   mfr::Camera base = current;
   base.up = up;

@@ -68,5 +68,5 @@ class ClipPanel final : public QWidget {
   QPushButton* sectionAlign_ = nullptr;
   QLabel* sectionReport_ = nullptr;         // how many cut parts are capped; the others' names in its tooltip
   glm::dvec3 customNormal_{0.0, 0.0, 1.0};  // unit; the "Custom" entry's axis
-  bool showing_ = false;  // controls being set from the model: no apply()
+  bool showing_ = false;                    // controls being set from the model: no apply()
 };

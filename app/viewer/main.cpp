@@ -98,8 +98,10 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
   parser.setApplicationDescription(QStringLiteral("Multifragment rendering viewer"));
   parser.addHelpOption();
   parser.addVersionOption();
-  parser.addPositionalArgument(QStringLiteral("scene"), QStringLiteral("Model file, .mfrscene, .mfrsession or @sample (default)"));
-  const QCommandLineOption method({QStringLiteral("m"), QStringLiteral("method")}, QStringLiteral("Render method."), QStringLiteral("name"));
+  parser.addPositionalArgument(QStringLiteral("scene"),
+                               QStringLiteral("Model file, .mfrscene, .mfrsession or @sample (default)"));
+  const QCommandLineOption method({QStringLiteral("m"), QStringLiteral("method")}, QStringLiteral("Render method."),
+                                  QStringLiteral("name"));
   const QCommandLineOption op(
       QStringLiteral("op"),
       QStringLiteral("Operation: auto (the method's own; volume on a scene with a volume), oit, hybrid, "
@@ -143,12 +145,21 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
   const QCommandLineOption legend(
       QStringLiteral("legend"),
       QStringLiteral("--screenshot: draw the field colouring's colour map with its values into it (as mfr render)."));
-  const QCommandLineOption param({QStringLiteral("p"), QStringLiteral("param")}, QStringLiteral("Method parameter (repeatable)."), QStringLiteral("name=value"));
-  const QCommandLineOption view(QStringLiteral("view"), QStringLiteral("Named view of the scene, or 'fit'."), QStringLiteral("name"));
-  const QCommandLineOption size({QStringLiteral("s"), QStringLiteral("size")}, QStringLiteral("Image size for --screenshot (default 800x600)."), QStringLiteral("WxH"));
-  const QCommandLineOption screenshot(QStringLiteral("screenshot"), QStringLiteral("Render the view at --size, write this PNG and quit."), QStringLiteral("file.png"));
-  const QCommandLineOption windowScreenshot(QStringLiteral("window-screenshot"), QStringLiteral("Grab the whole window once drawn, write this PNG and quit."), QStringLiteral("file.png"));
-  const QCommandLineOption windowSize(QStringLiteral("window-size"), QStringLiteral("Window size."), QStringLiteral("WxH"));
+  const QCommandLineOption param({QStringLiteral("p"), QStringLiteral("param")},
+                                 QStringLiteral("Method parameter (repeatable)."), QStringLiteral("name=value"));
+  const QCommandLineOption view(QStringLiteral("view"), QStringLiteral("Named view of the scene, or 'fit'."),
+                                QStringLiteral("name"));
+  const QCommandLineOption size({QStringLiteral("s"), QStringLiteral("size")},
+                                QStringLiteral("Image size for --screenshot (default 800x600)."),
+                                QStringLiteral("WxH"));
+  const QCommandLineOption screenshot(QStringLiteral("screenshot"),
+                                      QStringLiteral("Render the view at --size, write this PNG and quit."),
+                                      QStringLiteral("file.png"));
+  const QCommandLineOption windowScreenshot(
+      QStringLiteral("window-screenshot"), QStringLiteral("Grab the whole window once drawn, write this PNG and quit."),
+      QStringLiteral("file.png"));
+  const QCommandLineOption windowSize(QStringLiteral("window-size"), QStringLiteral("Window size."),
+                                      QStringLiteral("WxH"));
   const QCommandLineOption clip(
       QStringLiteral("clip"),
       QStringLiteral(
@@ -160,8 +171,8 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
                      "to) or px,py,pz,nx,ny,nz, optionally :nocaps and/or :slice; 'none' removes the scene's own."),
       QStringLiteral("plane"));
   const QCommandLineOption pluginSettings(QStringLiteral("plugin-settings"),
-                                         QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
-                                         QStringLiteral("id={json}"));
+                                          QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
+                                          QStringLiteral("id={json}"));
   parser.addOptions({method,     op,      thickness, step,          field, molecule, colorBy,    colorMap,
                      colorRange, contour, legend,    param,         view,  size,     screenshot, windowScreenshot,
                      windowSize, clip,    section,   pluginSettings});
@@ -178,7 +189,8 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
       if (value.isEmpty()) fail(QStringLiteral("--%1: an empty value").arg(option.names().constLast()), 2);
 
   CommandLine cl;
-  if (parser.positionalArguments().size() > 1) fail(QStringLiteral("expected one scene, got %1").arg(parser.positionalArguments().size()), 2);
+  if (parser.positionalArguments().size() > 1)
+    fail(QStringLiteral("expected one scene, got %1").arg(parser.positionalArguments().size()), 2);
   if (!parser.positionalArguments().isEmpty()) cl.scene = parser.positionalArguments().first();
   if (cl.scene.endsWith(QStringLiteral(".mfrsession"), Qt::CaseInsensitive)) cl.session = cl.scene;
   cl.method = parser.value(method);
@@ -386,7 +398,8 @@ int main(int argc, char** argv) {
   if (!cl.windowSize.isEmpty()) window.resize(cl.windowSize);
   if (!cl.method.isEmpty()) {
     if (!model.methodNames().contains(cl.method))
-      fail(QStringLiteral("--method %1: unknown method (available: %2)").arg(cl.method, model.methodNames().join(", ")), 2);
+      fail(QStringLiteral("--method %1: unknown method (available: %2)").arg(cl.method, model.methodNames().join(", ")),
+           2);
     model.setMethod(cl.method);
   }
   if (!cl.op.isEmpty()) model.setOperation(cl.op);
@@ -554,7 +567,8 @@ int main(int argc, char** argv) {
   const bool exportOnly = !cl.screenshot.isEmpty() && cl.windowScreenshot.isEmpty();
   window.view().setLiveFrames(!exportOnly);
   if (scripted) {
-    QObject::connect(&model, &ViewerModel::loadFailed, &app, [](const QString&, const QString& message) { fail(message, 1); });
+    QObject::connect(&model, &ViewerModel::loadFailed, &app,
+                     [](const QString&, const QString& message) { fail(message, 1); });
     // Poll until the scene is loaded, a frame is drawn (for --window-screenshot) and background
     // work (oracle image, depth-complexity histogram) is done, then take the pictures and quit.
     auto* poll = new QTimer(&app);

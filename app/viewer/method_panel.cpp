@@ -37,7 +37,9 @@ class FloatParamBox : public QDoubleSpinBox {
 };
 
 // Float parameters as text: round-trips the spin box value without trailing noise.
-std::string floatText(double value) { return QString::number(value, 'g', 10).toStdString(); }
+std::string floatText(double value) {
+  return QString::number(value, 'g', 10).toStdString();
+}
 
 }  // namespace
 
@@ -138,8 +140,10 @@ MethodPanel::MethodPanel(ViewerModel& model, int side, QWidget* parent) : QWidge
   connect(&model_, &ViewerModel::sideChanged, this, [this](int changed) {
     if (changed != side_) return;
     syncMethodCombo();
-    if (model_.methodOf(side_) != shownMethod_) rebuildParameters();
-    else showParameterValues();
+    if (model_.methodOf(side_) != shownMethod_)
+      rebuildParameters();
+    else
+      showParameterValues();
   });
   syncMethodCombo();
   rebuildParameters();
@@ -260,10 +264,15 @@ void MethodPanel::showParameterValues() {
     if (found == editors_.end()) continue;
     QWidget* editor = found->second;
     const QSignalBlocker block(editor);
-    if (auto* i = qobject_cast<QSpinBox*>(editor)) i->setValue(value.toInt());
-    else if (auto* d = qobject_cast<QDoubleSpinBox*>(editor)) d->setValue(value.toDouble());
-    else if (auto* b = qobject_cast<QCheckBox*>(editor)) b->setChecked(value == QLatin1String("true") || value == QLatin1String("1"));
-    else if (auto* c = qobject_cast<QComboBox*>(editor)) c->setCurrentText(value);
-    else if (auto* t = qobject_cast<QLineEdit*>(editor)) t->setText(value);
+    if (auto* i = qobject_cast<QSpinBox*>(editor))
+      i->setValue(value.toInt());
+    else if (auto* d = qobject_cast<QDoubleSpinBox*>(editor))
+      d->setValue(value.toDouble());
+    else if (auto* b = qobject_cast<QCheckBox*>(editor))
+      b->setChecked(value == QLatin1String("true") || value == QLatin1String("1"));
+    else if (auto* c = qobject_cast<QComboBox*>(editor))
+      c->setCurrentText(value);
+    else if (auto* t = qobject_cast<QLineEdit*>(editor))
+      t->setText(value);
   }
 }

@@ -63,7 +63,8 @@ QStringList PluginManager::searchPaths() {
   const QString env = qEnvironmentVariable("MFR_PLUGIN_PATH");
   for (const QString& p : env.split(QLatin1Char(':'), Qt::SkipEmptyParts)) paths << QDir(p).absolutePath();
   const QDir exe(QCoreApplication::applicationDirPath());
-  paths << exe.absoluteFilePath(QStringLiteral("plugins")) << exe.absoluteFilePath(QStringLiteral("../lib/mfrview/plugins"));
+  paths << exe.absoluteFilePath(QStringLiteral("plugins"))
+        << exe.absoluteFilePath(QStringLiteral("../lib/mfrview/plugins"));
   paths.removeDuplicates();
   return paths;
 }
@@ -83,10 +84,12 @@ void PluginManager::loadAll() {
       if (!instance) {
         record.error = loader.errorString();
       } else if (!plugin) {
-        record.error = QCoreApplication::translate("PluginManager", "not an mfrview plugin (interface %1)").arg(MfrViewerPlugin_iid);
+        record.error = QCoreApplication::translate("PluginManager", "not an mfrview plugin (interface %1)")
+                           .arg(MfrViewerPlugin_iid);
       } else if (seenIds.contains(plugin->id())) {
         // The same plugin in two folders: the first one found (MFR_PLUGIN_PATH) wins.
-        record.error = QCoreApplication::translate("PluginManager", "duplicate of plugin '%1' loaded earlier").arg(plugin->id());
+        record.error =
+            QCoreApplication::translate("PluginManager", "duplicate of plugin '%1' loaded earlier").arg(plugin->id());
       } else {
         record.plugin = plugin;
         record.id = plugin->id();

@@ -43,7 +43,7 @@ class SceneTreePanel final : public QWidget {
   QTreeWidget* tree_ = nullptr;
   QWidget* moleculeRow_ = nullptr;        // shown for a molecule file
   std::array<QCheckBox*, 5> molecule_{};  // spheres, ball-and-stick, sticks, cartoon, surface
-  QWidget* fieldRow_ = nullptr;  // hidden when no part has a field
+  QWidget* fieldRow_ = nullptr;           // hidden when no part has a field
   QComboBox* colorBy_ = nullptr;
   QComboBox* colorMap_ = nullptr;
   QDoubleSpinBox* rangeLow_ = nullptr;

@@ -20,7 +20,9 @@
 
 namespace {
 
-QJsonArray vec3(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+QJsonArray vec3(const glm::dvec3& v) {
+  return {v.x, v.y, v.z};
+}
 
 using ParamsByMethod = std::map<std::string, std::map<std::string, std::string>>;
 
@@ -354,14 +356,15 @@ QStringList applySession(const Session& session, ViewerModel& model) {
 }
 
 QJsonObject sessionToJson(const Session& s) {
-  QJsonObject camera{{"eye", vec3(s.camera.eye)},
-                     {"target", vec3(s.camera.target)},
-                     {"up", vec3(s.camera.up)},
-                     {"projection", s.camera.projection == mfr::Projection::Orthographic ? "orthographic" : "perspective"},
-                     {"fovy_degrees", s.camera.fovyDegrees},
-                     {"ortho_height", s.camera.orthoHeight},
-                     {"near", s.camera.nearPlane},
-                     {"far", s.camera.farPlane}};
+  QJsonObject camera{
+      {"eye", vec3(s.camera.eye)},
+      {"target", vec3(s.camera.target)},
+      {"up", vec3(s.camera.up)},
+      {"projection", s.camera.projection == mfr::Projection::Orthographic ? "orthographic" : "perspective"},
+      {"fovy_degrees", s.camera.fovyDegrees},
+      {"ortho_height", s.camera.orthoHeight},
+      {"near", s.camera.nearPlane},
+      {"far", s.camera.farPlane}};
   // Planes a named view gave are kept on reload; fitted ones are fitted again (the scene may have
   // changed since).
   if (s.camera.depthRangeGiven) camera.insert(QStringLiteral("near_far_given"), true);
@@ -432,7 +435,8 @@ QJsonObject sessionToJson(const Session& s) {
 Session sessionFromJson(const QJsonObject& json, const QString& file) {
   const Reader r(file);
   if (json.value("format").toString() != QLatin1String("mfrview-session"))
-    r.fail(QStringLiteral("format"), QStringLiteral("not an mfrview session (expected \"format\": \"mfrview-session\")"));
+    r.fail(QStringLiteral("format"),
+           QStringLiteral("not an mfrview session (expected \"format\": \"mfrview-session\")"));
   // Version 1 is the only one yet; a later one may mean keys that this viewer would misread.
   if (json.contains("version") && json.value("version") != QJsonValue(1))
     r.fail(QStringLiteral("version"), QStringLiteral("expected 1 (a session of a newer mfrview, or not a number)"));
@@ -458,7 +462,8 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
                                  : cam.value("projection").toString(QStringLiteral("perspective"));
   if (projection != QLatin1String("perspective") && projection != QLatin1String("orthographic"))
     r.fail(QStringLiteral("camera.projection"), QStringLiteral("expected perspective or orthographic"));
-  s.camera.projection = projection == QLatin1String("orthographic") ? mfr::Projection::Orthographic : mfr::Projection::Perspective;
+  s.camera.projection =
+      projection == QLatin1String("orthographic") ? mfr::Projection::Orthographic : mfr::Projection::Perspective;
   s.camera.fovyDegrees = r.number(cam, "fovy_degrees", "camera", s.camera.fovyDegrees);
   s.camera.orthoHeight = r.number(cam, "ortho_height", "camera", s.camera.orthoHeight);
   s.camera.nearPlane = r.number(cam, "near", "camera", s.camera.nearPlane);
@@ -642,7 +647,9 @@ Session readSessionFile(const QString& path) {
   const QByteArray bytes = f.readAll();
   const QJsonDocument doc = QJsonDocument::fromJson(bytes, &error);
   if (error.error != QJsonParseError::NoError)
-    throw mfr::Error(path.toStdString(), QStringLiteral("JSON error at byte %1: %2").arg(error.offset).arg(error.errorString()).toStdString());
+    throw mfr::Error(
+        path.toStdString(),
+        QStringLiteral("JSON error at byte %1: %2").arg(error.offset).arg(error.errorString()).toStdString());
   // Qt's parser keeps the last of a key given twice: a second "objects" dropped the first without
   // a word, as scene files did before they refused it (a bug hunt).
   if (const std::optional<std::string> repeated = mfr::repeatedJsonKey(bytes.toStdString()))

@@ -20,7 +20,7 @@ struct Session {
   struct ObjectState {
     QString name;
     bool visible = true;
-    glm::vec4 color{1.0f};  // RGB + opacity, the material's floats exactly
+    glm::vec4 color{1.0f};     // RGB + opacity, the material's floats exactly
     bool vertexColors = true;  // Material::vertexColors: false once a colour was chosen for the part
   };
   QString scenePath;
@@ -29,7 +29,7 @@ struct Session {
   mfr::Camera camera;
   QString method;
   QString operation;
-  double thickness = 0.0;  // operation zthickness, scene units, both sides; 0 = the scene's default
+  double thickness = 0.0;   // operation zthickness, scene units, both sides; 0 = the scene's default
   double volumeStep = 0.0;  // operation volume, scene units, both sides; 0 = the volume's default
   // The clip box ("clip": null or {min, max}); hasClip false: the session has no "clip" key (written
   // before it existed), so the scene keeps its own.
@@ -47,8 +47,8 @@ struct Session {
     QString name;
     bool visible = true;
     mfr::TransferFunction transfer;
-    bool shading = false;  // Volume::shading
-    QString field;         // Volume::field: the array or grid read ("" for formats without names)
+    bool shading = false;             // Volume::shading
+    QString field;                    // Volume::field: the array or grid read ("" for formats without names)
     std::vector<double> isosurfaces;  // the values of the isosurfaces made in the viewer (none: empty)
     double isosurfaceOpacity = 0.5;
   };

@@ -59,17 +59,25 @@ void StatsPanel::showStats() {
   row(frame, tr("Image"), QStringLiteral("%1 × %2").arg(model_.paneSize().width()).arg(model_.paneSize().height()));
   row(frame, tr("Synchronisation"), QString::fromStdString(s.sync));
   row(frame, tr("Geometry passes"), QString::number(s.passes));
-  if (s.kMax > 0) row(frame, tr("k range"), s.kMin == s.kMax ? QString::number(s.kMax) : QStringLiteral("%1 … %2").arg(s.kMin).arg(s.kMax));
+  if (s.kMax > 0)
+    row(frame, tr("k range"),
+        s.kMin == s.kMax ? QString::number(s.kMax) : QStringLiteral("%1 … %2").arg(s.kMin).arg(s.kMax));
 
   QTreeWidgetItem* memory = group(tr("Memory"));
   row(memory, tr("Allocated"), formatBytes(s.bytesAllocated));
-  row(memory, tr("Used"), s.bytesAllocated ? QStringLiteral("%1 (%2 %)").arg(formatBytes(s.bytesUsed)).arg(100.0 * s.bytesUsed / s.bytesAllocated, 0, 'f', 1)
-                                           : formatBytes(s.bytesUsed));
+  row(memory, tr("Used"),
+      s.bytesAllocated ? QStringLiteral("%1 (%2 %)")
+                             .arg(formatBytes(s.bytesUsed))
+                             .arg(100.0 * s.bytesUsed / s.bytesAllocated, 0, 'f', 1)
+                       : formatBytes(s.bytesUsed));
 
   QTreeWidgetItem* fragments = group(tr("Fragments"));
   row(fragments, tr("Generated"), count(s.fragmentsGenerated));
-  row(fragments, tr("Stored"), s.fragmentsGenerated ? QStringLiteral("%1 (%2 %)").arg(count(s.fragmentsStored)).arg(100.0 * s.fragmentsStored / s.fragmentsGenerated, 0, 'f', 1)
-                                                    : count(s.fragmentsStored));
+  row(fragments, tr("Stored"),
+      s.fragmentsGenerated ? QStringLiteral("%1 (%2 %)")
+                                 .arg(count(s.fragmentsStored))
+                                 .arg(100.0 * s.fragmentsStored / s.fragmentsGenerated, 0, 'f', 1)
+                           : count(s.fragmentsStored));
   row(fragments, tr("Dropped"), count(s.fragmentsDropped));
   row(fragments, tr("Overflow"), s.overflow ? tr("yes — %1 pixels").arg(count(s.overflowPixels)) : tr("no"));
   row(fragments, tr("Lock failures"), count(s.lockFailures));

@@ -756,7 +756,7 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
   struct Loaded {
     std::optional<mfr::Scene> scene;
     QString error;
-    bool stopped = false;  // LoadCancelled
+    bool stopped = false;     // LoadCancelled
     bool fieldsRead = false;  // a volume was read again with another field
     QMap<int, QString> fieldErrors;
   };

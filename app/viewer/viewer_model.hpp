@@ -368,9 +368,9 @@ class ViewerModel final : public ViewerContext {
   void sceneLoaded();  // followed by sceneChanged
   void loadFailed(const QString& path, const QString& message);
   void loadCancelled();
-  void sideChanged(int side);                       // method, operation or parameters of a side
-  void compareChanged();                            // enabled, layout, split or display
-  void secondaryFrameRendered();                    // statsOf(1) describes the new frame
+  void sideChanged(int side);     // method, operation or parameters of a side
+  void compareChanged();          // enabled, layout, split or display
+  void secondaryFrameRendered();  // statsOf(1) describes the new frame
   void cpuImageReady();
   void metricsReady(int side);
   void frameImageWanted();       // a frame quality was requested: the view reads back what it shows
@@ -411,7 +411,7 @@ class ViewerModel final : public ViewerContext {
   bool keepView_ = false;  // the load is setMoleculeStyle's re-read: keep the view as it is when it ends
   std::optional<mfr::MoleculeStyle> requestedMoleculeStyle_;  // setMoleculeStyle's, while it loads
   quint64 sceneRevision_ = 0;
-  quint64 sceneSerial_ = 0;  // scenes opened (setScene)
+  quint64 sceneSerial_ = 0;                                       // scenes opened (setScene)
   mutable std::optional<std::pair<quint64, QString>> drawError_;  // drawError() of a scene revision
   mfr::Bounds bounds_;
   double radius_ = 0.0;
@@ -423,7 +423,7 @@ class ViewerModel final : public ViewerContext {
   std::array<QString, kSides> methods_{QStringLiteral("abuffer-ll"), QStringLiteral("kplus-array")};
   std::array<QString, kSides> operations_{QStringLiteral("auto"), QStringLiteral("auto")};
   std::array<ParamsByMethod, kSides> params_;
-  double thickness_ = 0.0;  // operation zthickness, scene units; 0 = mfr::zThicknessDefault
+  double thickness_ = 0.0;                              // operation zthickness, scene units; 0 = mfr::zThicknessDefault
   double volumeStep_ = 0.0;                             // operation volume, scene units; 0 = the volume's defaultStep()
   int currentVolume_ = 0;                               // volumeIndex() of the scene's volumes
   void showVolume(int index, bool visible);             // keeps at most kMaxVisibleVolumes shown

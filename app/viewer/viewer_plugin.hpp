@@ -228,7 +228,7 @@ class ViewerContext : public QObject {
   void viewChanged();   // camera or image size
   void methodChanged(const QString& method);
   void paramsChanged();
-  void frameRendered();  // stats() describes the new frame
+  void frameRendered();      // stats() describes the new frame
   void frameErrorChanged();  // 1.14: frameError()
   // histogram[n] = pixels with exactly n fragments; the image size it was computed at.
   void depthComplexityReady(const QVector<quint64>& histogram, QSize size);

@@ -227,35 +227,33 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
   } else if (operation_ == "volume") {
     const VolumeRaySetup setup =
         volumeRaySetup(drawnVolumes_, camera, request.width, request.height, volumeStep_, clipBox_, section_);
-    method.resolve(ctx, Operation{"volume", "ops/volume.glsl", [&](const gl::Program& p) {
-                                    p.set("uInvViewProj", setup.invViewProj);
-                                    p.set("uViewport", setup.viewport);
-                                    p.set("uVolumeStep", setup.step);
-                                    p.set("uVolumeCount", static_cast<int>(setup.media.size()));
-                                    for (std::size_t i = 0; i < setup.media.size(); ++i) {
-                                      const VolumeMedium& m = setup.media[i];
-                                      const std::string at = "[" + std::to_string(i) + "]";
-                                      p.set(("uWorldToGrid" + at).c_str(), m.worldToGrid);
-                                      p.set(("uGridDims" + at).c_str(), m.dims);
-                                      // Scaled as the texture's samples are (gl::uploadGrid).
-                                      const double scale = volumes_[i]->valueScale;
-                                      const TransferFunction& tf = drawnVolumes_[i].transfer;
-                                      p.set(("uTfLow" + at).c_str(),
-                                            scale == 1.0 ? m.tfLow : static_cast<float>(tf.low() * scale));
-                                      p.set(("uTfHigh" + at).c_str(),
-                                            scale == 1.0 ? m.tfHigh : static_cast<float>(tf.high() * scale));
-                                      p.set(("uVolumeShading" + at).c_str(), m.shading ? 1 : 0);
-                                      glBindTextureUnit(MFR_TEX_VOLUME + static_cast<GLuint>(i),
-                                                        volumes_[i]->grid->id());
-                                      glBindTextureUnit(MFR_TEX_VOLUME_TF + static_cast<GLuint>(i),
-                                                        volumes_[i]->transfer.id());
-                                    }
-                                    p.set("uClip", setup.clip ? 1 : 0);
-                                    p.set("uClipMin", setup.clipMin);
-                                    p.set("uClipMax", setup.clipMax);
-                                    p.set("uSection", setup.section ? 1 : 0);
-                                    p.set("uSectionPlane", setup.sectionPlane);
-                                  }});
+    method.resolve(
+        ctx,
+        Operation{"volume", "ops/volume.glsl", [&](const gl::Program& p) {
+                    p.set("uInvViewProj", setup.invViewProj);
+                    p.set("uViewport", setup.viewport);
+                    p.set("uVolumeStep", setup.step);
+                    p.set("uVolumeCount", static_cast<int>(setup.media.size()));
+                    for (std::size_t i = 0; i < setup.media.size(); ++i) {
+                      const VolumeMedium& m = setup.media[i];
+                      const std::string at = "[" + std::to_string(i) + "]";
+                      p.set(("uWorldToGrid" + at).c_str(), m.worldToGrid);
+                      p.set(("uGridDims" + at).c_str(), m.dims);
+                      // Scaled as the texture's samples are (gl::uploadGrid).
+                      const double scale = volumes_[i]->valueScale;
+                      const TransferFunction& tf = drawnVolumes_[i].transfer;
+                      p.set(("uTfLow" + at).c_str(), scale == 1.0 ? m.tfLow : static_cast<float>(tf.low() * scale));
+                      p.set(("uTfHigh" + at).c_str(), scale == 1.0 ? m.tfHigh : static_cast<float>(tf.high() * scale));
+                      p.set(("uVolumeShading" + at).c_str(), m.shading ? 1 : 0);
+                      glBindTextureUnit(MFR_TEX_VOLUME + static_cast<GLuint>(i), volumes_[i]->grid->id());
+                      glBindTextureUnit(MFR_TEX_VOLUME_TF + static_cast<GLuint>(i), volumes_[i]->transfer.id());
+                    }
+                    p.set("uClip", setup.clip ? 1 : 0);
+                    p.set("uClipMin", setup.clipMin);
+                    p.set("uClipMax", setup.clipMax);
+                    p.set("uSection", setup.section ? 1 : 0);
+                    p.set("uSectionPlane", setup.sectionPlane);
+                  }});
   } else if (operation_ == "zthickness") {
     method.resolve(ctx, Operation{"zthickness", "ops/zthickness.glsl", [&](const gl::Program& p) {
                                     p.set("uZThickness", ctx.zThickness);

@@ -132,7 +132,8 @@ ImageRGBA8 readPng(const std::filesystem::path& path) {
 
 // Encodes with libpng; only trivially destructible locals live across setjmp (longjmp safety).
 // Returns false with state.message set on failure.
-static bool encodePng(const ImageRGBA8& image, const png_const_bytep* rows, std::string* encoded, PngErrorState* state) {
+static bool encodePng(const ImageRGBA8& image, const png_const_bytep* rows, std::string* encoded,
+                      PngErrorState* state) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, state, pngError, pngWarning);
   png_infop info = png ? png_create_info_struct(png) : nullptr;
   if (!png || !info) {
@@ -161,7 +162,8 @@ std::string encodePng(const std::filesystem::path& path, const ImageRGBA8& image
   for (int y = 0; y < image.height; ++y) rows[static_cast<std::size_t>(y)] = image.at(0, y);
   std::string encoded;
   PngErrorState state;
-  if (!encodePng(image, rows.data(), &encoded, &state)) throw Error(path.string(), "PNG encoding failed (" + state.message + ")");
+  if (!encodePng(image, rows.data(), &encoded, &state))
+    throw Error(path.string(), "PNG encoding failed (" + state.message + ")");
   return encoded;
 }
 

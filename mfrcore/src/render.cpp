@@ -26,7 +26,8 @@
 namespace mfr {
 
 void validateImageSize(const std::string& what, int width, int height) {
-  if (width <= 0 || height <= 0) throw Error(what, "image size must be positive (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
+  if (width <= 0 || height <= 0)
+    throw Error(what, "image size must be positive (got " + std::to_string(width) + "x" + std::to_string(height) + ")");
   if (width > 16384 || height > 16384) throw Error(what, "image size above 16384 pixels per side");
 }
 
@@ -159,8 +160,15 @@ const MethodInfo& optimalKInfo() {
       "Tsopouridis, Fudos, Vasilakis: Deep hybrid order-independent transparency. The Visual Computer 2022 (Alg. 1, "
       "eq. 2); the better of its backward greedy and an exact-on-the-convex-hull Lagrangian allocation",
       false,
-      {{"budget_mib", "Memory budget M (MiB)", ParamSpec::Type::Float, "16", 0, 65536, {},
-        "the budget of the variable-k buffers' layout (vkb without a network): F(M) slots to allocate", true}},
+      {{"budget_mib",
+        "Memory budget M (MiB)",
+        ParamSpec::Type::Float,
+        "16",
+        0,
+        65536,
+        {},
+        "the budget of the variable-k buffers' layout (vkb without a network): F(M) slots to allocate",
+        true}},
       "hybrid"};
   return i;
 }

@@ -45,7 +45,9 @@ const mfr::ParamSpec* findParam(const ViewerContext& ctx, const QString& method,
   return nullptr;
 }
 
-QString mib(double bytes) { return QString::number(bytes / kMiB, 'f', bytes < 10 * kMiB ? 2 : 1); }
+QString mib(double bytes) {
+  return QString::number(bytes / kMiB, 'f', bytes < 10 * kMiB ? 2 : 1);
+}
 
 std::string parameterValue(const ViewerContext& ctx, const std::string& name) {
   const auto values = ctx.params();
@@ -160,9 +162,8 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
 
   connect(slider_, &QSlider::valueChanged, this, [this](int v) { setBudget(v); });
   connect(spin_, &QSpinBox::valueChanged, this, [this](int v) { setBudget(v); });
-  connect(methodCombo_, &QComboBox::activated, this, [this](int index) {
-    ctx_.setMethod(methodCombo_->itemData(index).toString());
-  });
+  connect(methodCombo_, &QComboBox::activated, this,
+          [this](int index) { ctx_.setMethod(methodCombo_->itemData(index).toString()); });
   connect(&ctx_, &ViewerContext::methodChanged, this, &BudgetPanel::methodChanged);
   connect(&ctx_, &ViewerContext::frameRendered, this, &BudgetPanel::frameRendered);
   connect(&ctx_, &ViewerContext::frameErrorChanged, this, [this] {
@@ -197,7 +198,9 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   methodChanged();
 }
 
-int BudgetPanel::budgetMiB() const { return spin_->value(); }
+int BudgetPanel::budgetMiB() const {
+  return spin_->value();
+}
 
 BudgetPanel::Driver BudgetPanel::driverFor(const QString& method) const {
   Driver d;
@@ -480,7 +483,8 @@ void BudgetPanel::showFrame() {
   }
   const double allocated = static_cast<double>(s.bytesAllocated);
   memoryBar_->setValue(static_cast<int>(std::min(1000.0, 1000.0 * allocated / budget)));
-  memoryBar_->setFormat(tr("%1 of %2 MiB (%3 %)").arg(mib(allocated)).arg(budgetMiB()).arg(100.0 * allocated / budget, 0, 'f', 0));
+  memoryBar_->setFormat(
+      tr("%1 of %2 MiB (%3 %)").arg(mib(allocated)).arg(budgetMiB()).arg(100.0 * allocated / budget, 0, 'f', 0));
   // Red only when the budget is in force: before the slider is used it is a reference line.
   memoryBar_->setStyleSheet(
       driving_ && allocated > budget ? QStringLiteral("QProgressBar::chunk { background: #d04030; }") : QString());
@@ -496,7 +500,7 @@ void BudgetPanel::showFrame() {
                      1)
                 .arg(locale.toString(s.fragmentsStored), locale.toString(s.fragmentsGenerated))
           : tr("—"));
-  kLabel_->setText(s.kMax == 0 ? tr("— (no per-pixel capacity)")
+  kLabel_->setText(s.kMax == 0        ? tr("— (no per-pixel capacity)")
                    : s.kMin == s.kMax ? QString::number(s.kMax)
                                       : QStringLiteral("%1 … %2").arg(s.kMin).arg(s.kMax));
   const std::string* exactAt = s.note("exact at");
@@ -505,7 +509,9 @@ void BudgetPanel::showFrame() {
   histogram_->setMarker(driverFor(ctx_.method()).knob == Knob::Pool ? 0 : static_cast<int>(s.kMax), s.kMin != s.kMax);
 }
 
-QJsonObject BudgetPanel::saveSettings() const { return {{"budget_mib", budgetMiB()}, {"driving", driving_}}; }
+QJsonObject BudgetPanel::saveSettings() const {
+  return {{"budget_mib", budgetMiB()}, {"driving", driving_}};
+}
 
 void BudgetPanel::loadSettings(const QJsonObject& settings) {
   // A number that is not a whole MiB in the spin box's range was the default, or clamped, silently.

@@ -36,7 +36,7 @@ class ViewerContext;
 namespace mfr {
 struct MethodInfo;
 struct Stats;
-}
+}  // namespace mfr
 
 class BudgetPanel final : public QWidget {
   Q_OBJECT
@@ -55,7 +55,7 @@ class BudgetPanel final : public QWidget {
   enum class Knob { None, Budget, Pool, Slots };
   struct Driver {
     Knob knob = Knob::None;
-    std::string param;        // budget_mib, pool_mib, k or slots
+    std::string param;  // budget_mib, pool_mib, k or slots
     long long minValue = 1, maxValue = 1;
   };
   [[nodiscard]] Driver driverFor(const QString& method) const;
@@ -97,13 +97,13 @@ class BudgetPanel final : public QWidget {
   QTimer* qualityTimer_ = nullptr;
   QCheckBox* kMapOverlay_ = nullptr;
 
-  bool driving_ = false;   // the slider has been used: the budget owns the method's parameter
-  int corrections_ = 0;    // refits after an over-budget frame, per budget change
+  bool driving_ = false;  // the slider has been used: the budget owns the method's parameter
+  int corrections_ = 0;   // refits after an over-budget frame, per budget change
   // Memory model of the current method and image size, from measured frames.
   struct Fit {
-    std::string key;                          // method@WxH
-    std::map<long long, std::uint64_t> bytes; // parameter value → bytes allocated
-    double poolOverhead = -1;                 // bytes besides the pool (A-buffers)
+    std::string key;                           // method@WxH
+    std::map<long long, std::uint64_t> bytes;  // parameter value → bytes allocated
+    double poolOverhead = -1;                  // bytes besides the pool (A-buffers)
   } fit_;
   // Bytes measured by the renders of one export, by the driven parameter's value (exportParams).
   mutable std::map<long long, std::uint64_t> exportTries_;

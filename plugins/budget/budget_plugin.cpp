@@ -3,8 +3,9 @@
 #include "budget_panel.hpp"
 
 QString BudgetPlugin::description() const {
-  return tr("Variable-k budget panel: a memory slider driving the method's memory parameter, "
-            "memory used against the budget, fragments captured and the depth-complexity histogram.");
+  return tr(
+      "Variable-k budget panel: a memory slider driving the method's memory parameter, "
+      "memory used against the budget, fragments captured and the depth-complexity histogram.");
 }
 
 QWidget* BudgetPlugin::createPanel(ViewerContext& context, QWidget* parent) {
@@ -12,7 +13,9 @@ QWidget* BudgetPlugin::createPanel(ViewerContext& context, QWidget* parent) {
   return panel_;
 }
 
-QJsonObject BudgetPlugin::saveSettings() const { return panel_ ? panel_->saveSettings() : QJsonObject{}; }
+QJsonObject BudgetPlugin::saveSettings() const {
+  return panel_ ? panel_->saveSettings() : QJsonObject{};
+}
 
 std::map<std::string, std::string> BudgetPlugin::exportParams(QSize size,
                                                               const std::map<std::string, std::string>* tried,

@@ -33,6 +33,6 @@ class CsgPanel final : public QWidget {
   QListWidget* objects_ = nullptr;
   QPlainTextEdit* text_ = nullptr;
   QLabel* error_ = nullptr;
-  QStringList names_;  // the object list's names, to rebuild it only when they change
+  QStringList names_;        // the object list's names, to rebuild it only when they change
   quint64 sceneSerial_ = 0;  // ViewerContext::sceneSerial of the scene the list shows
 };

@@ -119,8 +119,8 @@ class HybridVolumePanel final : public QWidget {
   QString isoError_;  // why the last Apply was refused
   QWidget* controls_ = nullptr;
 
-  QString sceneKey_;               // the volume the panel was set up for
-  QString histogramKey_;           // the volume and range of the editor's histogram
+  QString sceneKey_;      // the volume the panel was set up for
+  QString histogramKey_;  // the volume and range of the editor's histogram
   // The window, exact (the spin boxes show it rounded to their decimals): the function's own range
   // after resetToCurrent, so Custom applies it unchanged and sessions restore it to the bit.
   double windowLow_ = 0.0;

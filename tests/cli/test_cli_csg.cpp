@@ -74,8 +74,8 @@ TEST_F(CliCsg, SceneFileTreeRenders) {
 // (against its "over" image the bores would count as errors), the plain row against "over".
 TEST_F(CliCsg, BenchMeasuresCsgRowsAgainstTheOraclesCsg) {
   const fs::path json = dir() / "bench.json";
-  const CliResult r = runCli("bench @csg --view iso --size 96x80 -r 1 -m abuffer-ll,abuffer-ll:op=csg --json " +
-                             json.string());
+  const CliResult r =
+      runCli("bench @csg --view iso --size 96x80 -r 1 -m abuffer-ll,abuffer-ll:op=csg --json " + json.string());
   ASSERT_EQ(r.exitCode, 0) << r.out;
   std::ifstream in(json);
   const nlohmann::json j = nlohmann::json::parse(in);

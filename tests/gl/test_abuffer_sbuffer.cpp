@@ -11,14 +11,17 @@ namespace mfr::test {
 
 INSTANTIATE_TEST_SUITE_P(ABufferSBuffer, ExactMethod,
                          ::testing::Values(ExactCase{"abuffer-sbuffer", {}, "count"},
-                                           ExactCase{"abuffer-sbuffer", {{"pool", "fixed"}, {"pool_mib", "16"}}, "fixed"}),
+                                           ExactCase{
+                                               "abuffer-sbuffer", {{"pool", "fixed"}, {"pool_mib", "16"}}, "fixed"}),
                          exactCaseName);
 
 namespace {
 
 // Scan-scratch uints for n elements, computed by hand for the sizes below (blocks of 1024):
 // n ≤ 1024 → 1 (the total); 1024 < n ≤ 1024² → ⌈n/1024⌉ block totals + 1.
-std::uint64_t scratchFor(std::uint64_t n) { return n <= 1024 ? 1 : (n + 1023) / 1024 + 1; }
+std::uint64_t scratchFor(std::uint64_t n) {
+  return n <= 1024 ? 1 : (n + 1023) / 1024 + 1;
+}
 
 }  // namespace
 
@@ -73,7 +76,8 @@ TEST(ABufferSBuffer, FixedPoolOverflowKeepsTheRangesThatFit) {
   EXPECT_EQ(s.fragmentsGenerated, exactStats.fragmentsGenerated);
   EXPECT_EQ(s.fragmentsStored, capacity);
   EXPECT_EQ(s.fragmentsDropped, s.fragmentsGenerated - capacity);
-  EXPECT_EQ(s.bytesAllocated, 8 * (static_cast<std::uint64_t>(w) * h + 1) + 4 * scratchFor(w * h + 1) + 8 * capacity + 8);
+  EXPECT_EQ(s.bytesAllocated,
+            8 * (static_cast<std::uint64_t>(w) * h + 1) + 4 * scratchFor(w * h + 1) + 8 * capacity + 8);
 
   std::uint64_t offset = 0, overflowPixels = 0, wrong = 0, fragmentsWrong = 0;
   std::string first;
@@ -85,8 +89,8 @@ TEST(ABufferSBuffer, FixedPoolOverflowKeepsTheRangesThatFit) {
       overflowPixels += fits < n;
       if (cut.count(x, y) != fits) {
         if (first.empty())
-          first = "pixel (" + std::to_string(x) + "," + std::to_string(y) + "): holds " + std::to_string(cut.count(x, y)) +
-                  ", expected " + std::to_string(fits) + " of " + std::to_string(n);
+          first = "pixel (" + std::to_string(x) + "," + std::to_string(y) + "): holds " +
+                  std::to_string(cut.count(x, y)) + ", expected " + std::to_string(fits) + " of " + std::to_string(n);
         ++wrong;
       } else if (fits == n) {
         // Depths only: fragments of equal depth may swap colours between frames.

@@ -26,7 +26,7 @@ namespace {
 struct Plane {
   double z;
   glm::vec4 color;
-  double x = 0.0;       // centre
+  double x = 0.0;  // centre
   double size = 1.2;
   double tiltDegrees = 0.0;  // about the Y axis
 };
@@ -139,8 +139,8 @@ void expectMatches(const FragmentLists& oracle, const ImageRGBA8& expected, cons
                    double fraction) {
   const ImageComparison ic = compareImages(oracle, expected, actual, tolerance);
   EXPECT_GT(ic.compared, static_cast<std::size_t>(oracle.width * oracle.height) * 7 / 10);
-  EXPECT_GE(ic.fraction(), fraction) << (ic.compared - ic.within) << " of " << ic.compared << " pixels differ by more than "
-                                     << tolerance << "/255; max " << ic.maxDifference;
+  EXPECT_GE(ic.fraction(), fraction) << (ic.compared - ic.within) << " of " << ic.compared
+                                     << " pixels differ by more than " << tolerance << "/255; max " << ic.maxDifference;
 }
 
 // ---- Every variant of both methods -------------------------------------------------------------
@@ -154,24 +154,27 @@ struct ApproxCase {
 
 class ApproximateOit : public ::testing::TestWithParam<ApproxCase> {};
 
-std::string approxCaseName(const ::testing::TestParamInfo<ApproxCase>& p) { return p.param.method + "_" + p.param.label; }
+std::string approxCaseName(const ::testing::TestParamInfo<ApproxCase>& p) {
+  return p.param.method + "_" + p.param.label;
+}
 
-INSTANTIATE_TEST_SUITE_P(
-    Methods, ApproximateOit,
-    ::testing::Values(ApproxCase{"wboit", {}, "default", 9}, ApproxCase{"wboit", {{"weight", "eq8"}}, "eq8", 9},
-                      ApproxCase{"wboit", {{"weight", "eq9"}}, "eq9", 9},
-                      ApproxCase{"wboit", {{"weight", "eq10"}}, "eq10", 9},
-                      ApproxCase{"wboit", {{"weight", "none"}}, "none", 9},
-                      ApproxCase{"wboit", {{"revealage", "r16f"}}, "r16f", 10},
-                      ApproxCase{"mboit", {}, "default", 28}, ApproxCase{"mboit", {{"moments", "6"}}, "moments6", 36},
-                      ApproxCase{"mboit", {{"warp", "linear"}}, "linear", 28}),
-    approxCaseName);
+INSTANTIATE_TEST_SUITE_P(Methods, ApproximateOit,
+                         ::testing::Values(ApproxCase{"wboit", {}, "default", 9},
+                                           ApproxCase{"wboit", {{"weight", "eq8"}}, "eq8", 9},
+                                           ApproxCase{"wboit", {{"weight", "eq9"}}, "eq9", 9},
+                                           ApproxCase{"wboit", {{"weight", "eq10"}}, "eq10", 9},
+                                           ApproxCase{"wboit", {{"weight", "none"}}, "none", 9},
+                                           ApproxCase{"wboit", {{"revealage", "r16f"}}, "r16f", 10},
+                                           ApproxCase{"mboit", {}, "default", 28},
+                                           ApproxCase{"mboit", {{"moments", "6"}}, "moments6", 36},
+                                           ApproxCase{"mboit", {{"warp", "linear"}}, "linear", 28}),
+                         approxCaseName);
 
 // One transparent layer per pixel (two tilted planes side by side, no overlap): "over" exactly.
 TEST_P(ApproximateOit, SingleLayerMatchesOracle) {
-  const Scene scene = planeScene({{0.0, {0.9f, 0.3f, 0.2f, 0.5f}, -0.55, 0.9, 30.0},
-                                  {-0.3, {0.2f, 0.6f, 0.9f, 0.8f}, 0.55, 0.9, -20.0}},
-                                 {0.1f, 0.2f, 0.3f});
+  const Scene scene = planeScene(
+      {{0.0, {0.9f, 0.3f, 0.2f, 0.5f}, -0.55, 0.9, 30.0}, {-0.3, {0.2f, 0.6f, 0.9f, 0.8f}, 0.55, 0.9, -20.0}},
+      {0.1f, 0.2f, 0.3f});
   for (const Camera& camera : {perspectiveCamera(), orthoCamera()}) {
     SCOPED_TRACE(camera.projection == Projection::Orthographic ? "orthographic" : "perspective");
     const FragmentLists oracle = castFragments(scene, camera, 96, 72);
@@ -196,7 +199,8 @@ TEST_P(ApproximateOit, SampleErrorIsBounded) {
     for (int x = 0; x < out.image.width; ++x) {
       const std::uint8_t* p = out.image.at(x, y);
       int d = 0;
-      for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(p[c] - static_cast<int>(std::round(scene.background[c] * 255.0f))));
+      for (int c = 0; c < 3; ++c)
+        d = std::max(d, std::abs(p[c] - static_cast<int>(std::round(scene.background[c] * 255.0f))));
       drawn += d > 8 ? 1 : 0;
     }
   EXPECT_GT(drawn, static_cast<std::size_t>(160 * 120) / 5) << "the image is (almost) only background";
@@ -268,8 +272,8 @@ TEST(WeightedBlendedOit, TwoLayersOrthographicMatchEquation6) {
 // Perspective: the depth weights use |z_eye| reconstructed from the view-projection matrix.
 TEST(WeightedBlendedOit, TwoLayersPerspectiveMatchEquation6) {
   const glm::vec3 background(0.2f, 0.2f, 0.2f);
-  const Scene scene = planeScene({{1.5, {0.9f, 0.8f, 0.1f, 0.4f}, 0.0, 1.2, 25.0}, {-3.0, {0.1f, 0.3f, 0.9f, 0.5f}, 0.0, 4.0}},
-                                 background);
+  const Scene scene = planeScene(
+      {{1.5, {0.9f, 0.8f, 0.1f, 0.4f}, 0.0, 1.2, 25.0}, {-3.0, {0.1f, 0.3f, 0.9f, 0.5f}, 0.0, 4.0}}, background);
   const Camera camera = perspectiveCamera();
   const FragmentLists oracle = castFragments(scene, camera, 64, 48);
   ASSERT_EQ(oracle.maxCount(), 2u);
@@ -291,8 +295,8 @@ TEST(WeightedBlendedOit, SampleMatchesEquation6) {
   for (const std::string weight : {"none", "eq7", "eq10"}) {
     SCOPED_TRACE(weight);
     const RenderOutput out = renderWith(scene, camera, "wboit", {{"weight", weight}, {"revealage", "r16f"}}, 120, 90);
-    const ImageRGBA8 expected =
-        modelImage(oracle, [&](std::span<const Fragment> f) { return wboitPixel(f, weight, camera, scene.background); });
+    const ImageRGBA8 expected = modelImage(
+        oracle, [&](std::span<const Fragment> f) { return wboitPixel(f, weight, camera, scene.background); });
     expectMatches(oracle, expected, out.image, 3, 0.99);
   }
 }

@@ -50,7 +50,9 @@ FragmentLists keepEnds(const FragmentLists& oracle, std::uint32_t front, std::ui
   return out;
 }
 
-std::uint32_t maxCount(const CapturedLists& lists) { return *std::max_element(lists.counts.begin(), lists.counts.end()); }
+std::uint32_t maxCount(const CapturedLists& lists) {
+  return *std::max_element(lists.counts.begin(), lists.counts.end());
+}
 
 std::uint32_t maxUnambiguousCount(const FragmentLists& oracle) {
   std::uint32_t m = 0;
@@ -252,7 +254,8 @@ TEST(DepthPeeling, MemoryIsPerPixelOnly) {
   context();
   const Scene sample = makeSampleScene();
   Scene sphere;
-  sphere.objects.push_back(Object{"sphere", std::make_shared<Mesh>(makeSphere(1.0)), glm::dmat4(1.0), Material{}, true});
+  sphere.objects.push_back(
+      Object{"sphere", std::make_shared<Mesh>(makeSphere(1.0)), glm::dmat4(1.0), Material{}, true});
   for (const char* method : {"peel-f2b", "peel-dual"}) {
     const std::uint64_t perPixel = std::string(method) == "peel-f2b" ? 36 : 64;
     for (const Scene* scene : std::initializer_list<const Scene*>{&sample, &sphere})
@@ -274,7 +277,8 @@ TEST(DepthPeeling, MemoryIsPerPixelOnly) {
 TEST(DepthPeeling, SphereNeedsTwoLayers) {
   context();
   Scene sphere;
-  sphere.objects.push_back(Object{"sphere", std::make_shared<Mesh>(makeSphere(1.0)), glm::dmat4(1.0), Material{}, true});
+  sphere.objects.push_back(
+      Object{"sphere", std::make_shared<Mesh>(makeSphere(1.0)), glm::dmat4(1.0), Material{}, true});
   GpuRenderer gpu;
   gpu.setScene(sphere);
   const Camera camera = sphere.view("fit");

@@ -299,7 +299,7 @@ TEST(FieldColorsGpu, SectionCapsShowTheVolumeInside) {
   for (const glm::ivec2 px : {glm::ivec2(30, 30), glm::ivec2(52, 28), glm::ivec2(47, 50), glm::ivec2(28, 47)}) {
     SCOPED_TRACE(::testing::Message() << "pixel " << px.x << "," << px.y);
     const glm::dvec3 hit = pixelRayHitAtZ(camera, w, h, px, 0.0);
-    ASSERT_LT(glm::length(glm::dvec2(hit)), 1.0);              // well inside the cap
+    ASSERT_LT(glm::length(glm::dvec2(hit)), 1.0);  // well inside the cap
     const PixelProbe probe = probePixel(cut, camera, w, h, px.x, px.y);
     ASSERT_FALSE(probe.fragments.empty());
     const ProbeFragment& front = probe.fragments.front();  // the cap, nearest the camera

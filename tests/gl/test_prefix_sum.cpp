@@ -90,9 +90,13 @@ TEST(PrefixSum, InPlace) {
 }
 
 // More than 1024² elements: three levels of block totals.
-TEST(PrefixSum, ThreeLevels) { checkScan((1u << 20) + 1000, 7, false, 7); }
+TEST(PrefixSum, ThreeLevels) {
+  checkScan((1u << 20) + 1000, 7, false, 7);
+}
 
-TEST(PrefixSum, WrapsModulo2To32LikeUnsignedArithmetic) { checkScan(3000, 0xFFFFFFFFu, false, 11); }
+TEST(PrefixSum, WrapsModulo2To32LikeUnsignedArithmetic) {
+  checkScan(3000, 0xFFFFFFFFu, false, 11);
+}
 
 TEST(PrefixSum, EmptyInputHasTotalZero) {
   context();

@@ -85,7 +85,7 @@ TEST_F(FlipConformance, MagmaMapMatchesReferenceToolOutput) {
   ASSERT_EQ(actual.width, expected.width);
   ASSERT_EQ(actual.height, expected.height);
   int maxDiff = 0;
-  long differing = 0;     // any channel differs at all
+  long differing = 0;    // any channel differs at all
   long outOfBounds = 0;  // some channel differs by more than 3
   for (int y = 0; y < expected.height; ++y) {
     for (int x = 0; x < expected.width; ++x) {

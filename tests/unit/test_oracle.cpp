@@ -44,7 +44,9 @@ Camera frontCamera(Projection projection, double orthoHeight = 8.0) {
   return c;
 }
 
-glm::dmat4 translate(double x, double y, double z) { return glm::translate(glm::dmat4(1.0), glm::dvec3(x, y, z)); }
+glm::dmat4 translate(double x, double y, double z) {
+  return glm::translate(glm::dmat4(1.0), glm::dvec3(x, y, z));
+}
 
 // Concentric spheres of radius 1, 2, 3 (object ids 0, 1, 2), 64×64 pixels.
 Scene nestedSpheres() {
@@ -71,7 +73,7 @@ TEST(OracleSpheres, OrthographicCountsDepthsAndFacing) {
   const bool front[6] = {true, true, true, false, false, false};
   // Orthographic depth is linear: (distance − near)/(far − near), distance = 10 − z with the hit at
   // z = ±sqrt(r² − ρ²).
-  const double z[6] = {std::sqrt(9 - 0.1015625), std::sqrt(4 - 0.1015625), std::sqrt(1 - 0.1015625),
+  const double z[6] = {std::sqrt(9 - 0.1015625),  std::sqrt(4 - 0.1015625),  std::sqrt(1 - 0.1015625),
                        -std::sqrt(1 - 0.1015625), -std::sqrt(4 - 0.1015625), -std::sqrt(9 - 0.1015625)};
   for (int i = 0; i < 6; ++i) {
     SCOPED_TRACE(i);
@@ -129,7 +131,7 @@ TEST(OracleSpheres, PerspectiveCountsAndFacing) {
 Scene overlappingQuads() {
   Scene s;
   s.name = "quads";
-  addObject(s, makePlane(2.0, 2.0), glm::dmat4(1.0), {1.0f, 0.6f, 0.2f, 0.4f});        // A
+  addObject(s, makePlane(2.0, 2.0), glm::dmat4(1.0), {1.0f, 0.6f, 0.2f, 0.4f});           // A
   addObject(s, makePlane(2.0, 2.0), translate(1.0, 0.0, 1.0), {0.2f, 0.4f, 1.0f, 0.6f});  // B, in front
   return s;
 }
@@ -313,7 +315,8 @@ TEST(OracleDepth, MirroredTransformFlipsFacing) {
   // Mirroring x reverses the winding GL sees: the +Z-facing plane becomes a back face.
   Scene scene;
   scene.name = "mirror";
-  addObject(scene, makePlane(4.0, 4.0), glm::scale(glm::dmat4(1.0), glm::dvec3(-1.0, 1.0, 1.0)), {1.0f, 1.0f, 1.0f, 1.0f});
+  addObject(scene, makePlane(4.0, 4.0), glm::scale(glm::dmat4(1.0), glm::dvec3(-1.0, 1.0, 1.0)),
+            {1.0f, 1.0f, 1.0f, 1.0f});
   const FragmentLists lists = castFragments(scene, frontCamera(Projection::Perspective), 32, 32);
   ASSERT_FALSE(lists.isAmbiguous(10, 12));
   ASSERT_EQ(lists.count(10, 12), 1u);
@@ -459,7 +462,7 @@ TEST(OracleDegenerate, ZeroAreaTrianglesAreSkippedAndCoplanarOnesTie) {
   Mesh m;
   m.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}, {0, 0, 0}, {0.5f, 0.5f, 0}};
   m.normals.assign(m.positions.size(), glm::vec3(0, 0, 1));
-  m.indices = {0, 0, 2,  0, 4, 2,  0, 1, 2,  0, 2, 3};  // degenerate, collinear, then the quad
+  m.indices = {0, 0, 2, 0, 4, 2, 0, 1, 2, 0, 2, 3};  // degenerate, collinear, then the quad
   Scene scene;
   scene.name = "degenerate";
   addObject(scene, m, glm::dmat4(1.0), {1.0f, 0.0f, 0.0f, 0.5f});

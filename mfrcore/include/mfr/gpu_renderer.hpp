@@ -95,9 +95,9 @@ class GpuRenderer {
   std::uint32_t csgMirrored_ = 0;  // csgMirroredPrimitives of the scene
   std::string sceneName_;
   Bounds sceneBounds_;
-  std::optional<Bounds> clipBox_;  // Scene::clipBox
+  std::optional<Bounds> clipBox_;        // Scene::clipBox
   std::optional<SectionPlane> section_;  // Scene::section (the surfaces come cut; the volume march is cropped)
-  double thickness_ = 0.0;  // operation "zthickness" of the prepared request (scene units)
+  double thickness_ = 0.0;               // operation "zthickness" of the prepared request (scene units)
   // Operation "volume": the scene's visible volumes on the GPU (shared with shareScene; a new
   // scene with the same grids keeps their textures and uploads only the transfer tables).
   struct GpuVolume;

@@ -46,12 +46,12 @@ DynamicKChoice selectDynamicK(std::span<const std::uint64_t> histogram, std::uin
     c.bytes = model.bytes(c.k);
     c.capturedFraction = f > 0 ? static_cast<double>(captured(c.k)) / static_cast<double>(f) : 1.0;
     if (c.kRobust <= c.kMemory)
-      why << "robustness: k = " << c.k << " captures " << c.capturedFraction * 100.0 << " % of the fragments (R_h = "
-          << robustness * 100.0 << " %); the budget would allow k = " << c.kMemory;
+      why << "robustness: k = " << c.k << " captures " << c.capturedFraction * 100.0
+          << " % of the fragments (R_h = " << robustness * 100.0 << " %); the budget would allow k = " << c.kMemory;
     else
       why << "memory budget: k = " << c.k << " (" << c.bytes << " of " << budgetBytes << " B) captures "
-          << c.capturedFraction * 100.0 << " % of the fragments; R_h = " << robustness * 100.0 << " % needs k = "
-          << c.kRobust;
+          << c.capturedFraction * 100.0 << " % of the fragments; R_h = " << robustness * 100.0
+          << " % needs k = " << c.kRobust;
   }
   c.reason = why.str();
   return c;

@@ -13,8 +13,8 @@ KBufferMemoryModel kplusArrayMemoryModel(std::uint64_t pixels, const KPlusArrayL
   KBufferMemoryModel m;
   m.pixels = pixels;
   m.bytesPerSlot = KBufferFamily::kEntryBytes;
-  m.bytesPerPixel = (layout.spinLock ? 4 : 0) + (layout.tail ? KBufferFamily::kTailBytesPerPixel : 0) +
-                    (layout.revised ? 8 : 0);
+  m.bytesPerPixel =
+      (layout.spinLock ? 4 : 0) + (layout.tail ? KBufferFamily::kTailBytesPerPixel : 0) + (layout.revised ? 8 : 0);
   m.fixedBytes = KBufferFamily::kCounterBytes;
   return m;
 }

@@ -27,16 +27,26 @@ bool hasExtension(const char* list, const char* name) {
 
 std::string eglErrorName(EGLint e) {
   switch (e) {
-    case EGL_NOT_INITIALIZED: return "EGL_NOT_INITIALIZED";
-    case EGL_BAD_ACCESS: return "EGL_BAD_ACCESS";
-    case EGL_BAD_ALLOC: return "EGL_BAD_ALLOC";
-    case EGL_BAD_ATTRIBUTE: return "EGL_BAD_ATTRIBUTE";
-    case EGL_BAD_CONFIG: return "EGL_BAD_CONFIG";
-    case EGL_BAD_CONTEXT: return "EGL_BAD_CONTEXT";
-    case EGL_BAD_DISPLAY: return "EGL_BAD_DISPLAY";
-    case EGL_BAD_MATCH: return "EGL_BAD_MATCH";
-    case EGL_BAD_PARAMETER: return "EGL_BAD_PARAMETER";
-    default: return "EGL error " + std::to_string(e);
+    case EGL_NOT_INITIALIZED:
+      return "EGL_NOT_INITIALIZED";
+    case EGL_BAD_ACCESS:
+      return "EGL_BAD_ACCESS";
+    case EGL_BAD_ALLOC:
+      return "EGL_BAD_ALLOC";
+    case EGL_BAD_ATTRIBUTE:
+      return "EGL_BAD_ATTRIBUTE";
+    case EGL_BAD_CONFIG:
+      return "EGL_BAD_CONFIG";
+    case EGL_BAD_CONTEXT:
+      return "EGL_BAD_CONTEXT";
+    case EGL_BAD_DISPLAY:
+      return "EGL_BAD_DISPLAY";
+    case EGL_BAD_MATCH:
+      return "EGL_BAD_MATCH";
+    case EGL_BAD_PARAMETER:
+      return "EGL_BAD_PARAMETER";
+    default:
+      return "EGL error " + std::to_string(e);
   }
 }
 
@@ -55,7 +65,8 @@ void GLAPIENTRY debugCallback(GLenum, GLenum type, GLuint, GLenum severity, GLsi
   if (type != GL_DEBUG_TYPE_ERROR) return;  // compiler warnings and performance notes are not errors
   auto& s = debugState();
   std::lock_guard lock(s.mutex);
-  if (s.firstError.empty()) s.firstError.assign(message, length >= 0 ? static_cast<std::size_t>(length) : std::strlen(message));
+  if (s.firstError.empty())
+    s.firstError.assign(message, length >= 0 ? static_cast<std::size_t>(length) : std::strlen(message));
 }
 
 }  // namespace
@@ -73,7 +84,8 @@ HeadlessContext::HeadlessContext(bool debug) : impl_(std::make_unique<Impl>()) {
   const bool wantSurfaceless = !forced || std::string(forced) == "surfaceless";
   const bool wantDevice = !forced || std::string(forced) == "device";
   if (wantSurfaceless && hasExtension(clientExts, "EGL_MESA_platform_surfaceless"))
-    candidates.emplace_back("surfaceless", eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr));
+    candidates.emplace_back("surfaceless",
+                            eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr));
   if (wantDevice && hasExtension(clientExts, "EGL_EXT_platform_device")) {
     EGLDeviceEXT devices[16];
     EGLint count = 0;
@@ -81,7 +93,8 @@ HeadlessContext::HeadlessContext(bool debug) : impl_(std::make_unique<Impl>()) {
       for (EGLint i = 0; i < count; ++i)
         candidates.emplace_back("device", eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, devices[i], nullptr));
   }
-  std::string lastError = "no EGL platform for headless rendering (need EGL_MESA_platform_surfaceless or EGL_EXT_platform_device)";
+  std::string lastError =
+      "no EGL platform for headless rendering (need EGL_MESA_platform_surfaceless or EGL_EXT_platform_device)";
   for (auto& [platform, display] : candidates) {
     if (display == EGL_NO_DISPLAY) continue;
     EGLint major = 0, minor = 0;
@@ -94,9 +107,15 @@ HeadlessContext::HeadlessContext(bool debug) : impl_(std::make_unique<Impl>()) {
       eglTerminate(display);
       continue;
     }
-    const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                              EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                              EGL_CONTEXT_OPENGL_DEBUG, debug ? EGL_TRUE : EGL_FALSE, EGL_NONE};
+    const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                              4,
+                              EGL_CONTEXT_MINOR_VERSION,
+                              5,
+                              EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                              EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                              EGL_CONTEXT_OPENGL_DEBUG,
+                              debug ? EGL_TRUE : EGL_FALSE,
+                              EGL_NONE};
     // EGL_KHR_no_config_context: no config needed when rendering only into FBOs.
     EGLContext ctx = eglCreateContext(display, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attribs);
     if (ctx == EGL_NO_CONTEXT) {
@@ -141,7 +160,9 @@ void HeadlessContext::makeCurrent() {
     throw Error("OpenGL", "eglMakeCurrent failed (" + eglErrorName(eglGetError()) + ")");
 }
 
-const ContextInfo& HeadlessContext::info() const { return impl_->info; }
+const ContextInfo& HeadlessContext::info() const {
+  return impl_->info;
+}
 
 void installDebugOutput() {
   glEnable(GL_DEBUG_OUTPUT);
@@ -158,11 +179,12 @@ void checkErrors(const char* where) {
     message.swap(s.firstError);
   }
   GLenum err = glGetError();
-  if (message.empty() && err != GL_NO_ERROR) message = "glGetError 0x" + [&] {
-    char buf[16];
-    std::snprintf(buf, sizeof buf, "%04X", err);
-    return std::string(buf);
-  }();
+  if (message.empty() && err != GL_NO_ERROR)
+    message = "glGetError 0x" + [&] {
+      char buf[16];
+      std::snprintf(buf, sizeof buf, "%04X", err);
+      return std::string(buf);
+    }();
   while (err != GL_NO_ERROR) err = glGetError();
   if (!message.empty()) throw Error("OpenGL", std::string(where) + ": " + message);
 }

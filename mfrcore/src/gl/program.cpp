@@ -53,9 +53,11 @@ void expand(const std::string& path, const Defines& defines, std::vector<std::st
       std::string target = m[1].str();
       if (target.empty()) {
         const auto d = defines.find(m[2].str());
-        if (d == defines.end()) throw Error("shaders/" + path + ":" + std::to_string(lineNo), "#include of undefined name " + m[2].str());
+        if (d == defines.end())
+          throw Error("shaders/" + path + ":" + std::to_string(lineNo), "#include of undefined name " + m[2].str());
         target = d->second;
-        if (target.size() >= 2 && target.front() == '"' && target.back() == '"') target = target.substr(1, target.size() - 2);
+        if (target.size() >= 2 && target.front() == '"' && target.back() == '"')
+          target = target.substr(1, target.size() - 2);
       }
       expand(target, defines, files, included, out, depth + 1);
       out += "#line " + std::to_string(lineNo + 1) + " " + std::to_string(index) + "\n";
@@ -161,17 +163,35 @@ Program::~Program() {
   if (id_ != 0) glDeleteProgram(id_);
 }
 
-void Program::use() const { glUseProgram(id_); }
+void Program::use() const {
+  glUseProgram(id_);
+}
 
-GLint Program::location(const char* name) const { return glGetUniformLocation(id_, name); }
+GLint Program::location(const char* name) const {
+  return glGetUniformLocation(id_, name);
+}
 
-void Program::set(const char* name, int v) const { glProgramUniform1i(id_, location(name), v); }
-void Program::set(const char* name, unsigned v) const { glProgramUniform1ui(id_, location(name), v); }
-void Program::set(const char* name, float v) const { glProgramUniform1f(id_, location(name), v); }
-void Program::set(const char* name, const glm::vec2& v) const { glProgramUniform2fv(id_, location(name), 1, glm::value_ptr(v)); }
-void Program::set(const char* name, const glm::vec3& v) const { glProgramUniform3fv(id_, location(name), 1, glm::value_ptr(v)); }
-void Program::set(const char* name, const glm::vec4& v) const { glProgramUniform4fv(id_, location(name), 1, glm::value_ptr(v)); }
-void Program::set(const char* name, const glm::ivec2& v) const { glProgramUniform2iv(id_, location(name), 1, glm::value_ptr(v)); }
+void Program::set(const char* name, int v) const {
+  glProgramUniform1i(id_, location(name), v);
+}
+void Program::set(const char* name, unsigned v) const {
+  glProgramUniform1ui(id_, location(name), v);
+}
+void Program::set(const char* name, float v) const {
+  glProgramUniform1f(id_, location(name), v);
+}
+void Program::set(const char* name, const glm::vec2& v) const {
+  glProgramUniform2fv(id_, location(name), 1, glm::value_ptr(v));
+}
+void Program::set(const char* name, const glm::vec3& v) const {
+  glProgramUniform3fv(id_, location(name), 1, glm::value_ptr(v));
+}
+void Program::set(const char* name, const glm::vec4& v) const {
+  glProgramUniform4fv(id_, location(name), 1, glm::value_ptr(v));
+}
+void Program::set(const char* name, const glm::ivec2& v) const {
+  glProgramUniform2iv(id_, location(name), 1, glm::value_ptr(v));
+}
 void Program::set(const char* name, const glm::ivec3& v) const {
   glProgramUniform3iv(id_, location(name), 1, glm::value_ptr(v));
 }

@@ -25,7 +25,8 @@ void PassTimer::end() {
   if (!open_) return;
   if (finishMode_) {
     glFinish();
-    entries_.back().cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cpuStart_).count();
+    entries_.back().cpuMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cpuStart_).count();
     open_ = false;
     return;
   }
@@ -45,8 +46,10 @@ std::vector<std::pair<std::string, double>> PassTimer::collect() {
       ms = t1 > t0 ? static_cast<double>(t1 - t0) * 1e-6 : 0.0;
     }
     auto it = std::find_if(out.begin(), out.end(), [&](const auto& p) { return p.first == e.pass; });
-    if (it == out.end()) out.emplace_back(e.pass, ms);
-    else it->second += ms;
+    if (it == out.end())
+      out.emplace_back(e.pass, ms);
+    else
+      it->second += ms;
   }
   entries_.clear();
   return out;

@@ -35,7 +35,9 @@
 namespace mfr::io {
 namespace {
 
-bool finite(const aiVector3D& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+bool finite(const aiVector3D& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 // assimp matrices are row-major with the translation in the last column; glm is column-major.
 glm::dmat4 toGlm(const aiMatrix4x4& m) {
@@ -372,8 +374,8 @@ std::vector<Object> readWithAssimp(const std::filesystem::path& path, const std:
 std::vector<std::string> assimpExtensions() {
   // Formats with loaders of their own, STEP (assimp reads only IFC-style STEP, not CAD B-rep),
   // motion/camera-only formats, and the over-generic ".xml".
-  static const std::set<std::string> excluded = {".stl",       ".ply",        ".obj", ".off",  ".step", ".stp",
-                                                 ".md5anim",   ".md5camera",  ".bvh", ".xml"};
+  static const std::set<std::string> excluded = {".stl", ".ply",     ".obj",       ".off", ".step",
+                                                 ".stp", ".md5anim", ".md5camera", ".bvh", ".xml"};
   Assimp::Importer importer;
   std::string list;
   importer.GetExtensionList(list);  // "*.3d;*.3ds;…"

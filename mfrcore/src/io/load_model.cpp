@@ -90,7 +90,8 @@ std::string readAll(const fs::path& path, const std::string& name) {
     requireHostMemory(name, "reading the file (" + formatMemory(size) + ")", size);
   data.resize(static_cast<std::size_t>(size));
   in.read(data.data(), static_cast<std::streamsize>(data.size()));
-  if (in.gcount() != static_cast<std::streamsize>(data.size())) throw Error(name, "read error (file changed while reading?)");
+  if (in.gcount() != static_cast<std::streamsize>(data.size()))
+    throw Error(name, "read error (file changed while reading?)");
   return data;
 }
 
@@ -101,7 +102,8 @@ std::string decompress(const fs::path& path, const std::string& name) {
     std::ifstream in(path, std::ios::binary);
     unsigned char magic[2] = {0, 0};
     in.read(reinterpret_cast<char*>(magic), 2);
-    if (in.gcount() != 2 || magic[0] != 0x1f || magic[1] != 0x8b) throw Error(name, "not a gzip file (bad magic bytes)");
+    if (in.gcount() != 2 || magic[0] != 0x1f || magic[1] != 0x8b)
+      throw Error(name, "not a gzip file (bad magic bytes)");
   }
   gzFile gz = gzopen(path.c_str(), "rb");
   if (gz == nullptr) throw Error(name, "cannot open gzip file");
@@ -161,8 +163,7 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
   const auto found = match(fileName);
   if (!found) {
     const std::string ext = path.extension().string();
-    if (gz)
-      throw Error(name, "unsupported compressed file type: name it after its contents, e.g. model.ply.gz");
+    if (gz) throw Error(name, "unsupported compressed file type: name it after its contents, e.g. model.ply.gz");
     throw Error(
         name,
         "unsupported file type '" + (ext.empty() ? path.filename().string() : lower(ext)) +
@@ -184,7 +185,8 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
   }
 
   switch (format.family) {
-    case Family::Vtk: return singleObject(io::readWithVtk(format.vtk, path, contents, name), stem);
+    case Family::Vtk:
+      return singleObject(io::readWithVtk(format.vtk, path, contents, name), stem);
     case Family::Ply:
     case Family::Off:
     case Family::VtkLegacy: {
@@ -217,7 +219,8 @@ std::vector<Object> load(const fs::path& path, const std::string& name, const Lo
       }
       return objects;
     }
-    case Family::Assimp: return io::readWithAssimp(path, contents, ext, name, progress.part(gz ? 0.3 : 0.0, 0.95));
+    case Family::Assimp:
+      return io::readWithAssimp(path, contents, ext, name, progress.part(gz ? 0.3 : 0.0, 0.95));
     case Family::Step:
       return io::readStep(path, contents, stem, name, progress.part(gz ? 0.3 : 0.0, 0.95), options.notes);
     case Family::Molecule: {
@@ -295,8 +298,8 @@ std::vector<std::string> supportedModelExtensions() {
   std::set<std::string> out;
   for (const auto& [ext, format] : formats()) out.insert(ext);
   // Compressed variants that parse from memory without side files.
-  for (const char* ext : {".stl", ".ply", ".obj", ".off", ".vtp", ".vtk", ".glb", ".step", ".stp", ".pdb", ".ent", ".cif",
-                          ".mmcif"})
+  for (const char* ext :
+       {".stl", ".ply", ".obj", ".off", ".vtp", ".vtk", ".glb", ".step", ".stp", ".pdb", ".ent", ".cif", ".mmcif"})
     out.insert(std::string(ext) + ".gz");
   return {out.begin(), out.end()};
 }

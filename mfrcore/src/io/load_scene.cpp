@@ -93,7 +93,8 @@ Scene loadSceneWithoutEndReport(const std::filesystem::path& path, const LoadOpt
   if (!text.empty() && text[0] == '@')
     throw Error(text, "unknown built-in scene (@sample, @csg, @intersect, @volume, @quads:N[:density[:seed]])");
   std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   Scene scene;
   if (ext == ".mfrscene" || ext == ".json") {
     scene = readSceneFile(path, progress);

@@ -127,7 +127,7 @@ std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory,
   std::vector<RawPart> parts(1);
   std::map<std::string, std::size_t> partOf{{"", 0}};
   std::size_t notSurfaces = 0;  // l and p elements, and faces of fewer than 3 corners
-  bool libraryNamed = false;  // no mtllib: material names are only names, and no note is due
+  bool libraryNamed = false;    // no mtllib: material names are only names, and no note is due
   bool libraryUnread = false;
   std::size_t current = 0;
   std::map<std::string, glm::vec4> materials;
@@ -171,7 +171,8 @@ std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory,
         const std::string_view t = w[k];
         const std::size_t s1 = t.find('/');
         std::int64_t v = 0;
-        if (!parseInt(t.substr(0, s1), v) || v == 0) fail("malformed face corner '" + std::string(t.substr(0, 32)) + "'");
+        if (!parseInt(t.substr(0, s1), v) || v == 0)
+          fail("malformed face corner '" + std::string(t.substr(0, 32)) + "'");
         // Negative indices count back from the last vertex defined so far.
         const std::int64_t vi = v < 0 ? static_cast<std::int64_t>(positions.size()) + v : v - 1;
         if (vi < 0 || vi >= static_cast<std::int64_t>(positions.size()))
@@ -182,7 +183,8 @@ std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory,
           const std::size_t s2 = t.find('/', s1 + 1);
           if (s2 != std::string_view::npos && s2 + 1 < t.size()) {
             std::int64_t n = 0;
-            if (!parseInt(t.substr(s2 + 1), n) || n == 0) fail("malformed face corner '" + std::string(t.substr(0, 32)) + "'");
+            if (!parseInt(t.substr(s2 + 1), n) || n == 0)
+              fail("malformed face corner '" + std::string(t.substr(0, 32)) + "'");
             ni = n < 0 ? static_cast<std::int64_t>(normals.size()) + n : n - 1;
             // Normals are optional: an index that leads nowhere loses the normal, not the face.
             if (ni < 0) ni = -1;

@@ -146,7 +146,8 @@ std::size_t checkHeader(std::string_view bytes, const std::string& name, std::ui
     faceBytes = 4;
   } else {
     for (std::uint64_t& c : counts)
-      if (!toCount(nextToken(bytes, pos), c)) throw Error(name, "bad OFF header: expected vertex, face and edge counts");
+      if (!toCount(nextToken(bytes, pos), c))
+        throw Error(name, "bad OFF header: expected vertex, face and edge counts");
   }
   vertices = counts[0];
   faces = counts[1];

@@ -34,13 +34,17 @@ std::optional<Type> parseType(std::string_view s) {
 std::size_t sizeOf(Type t) {
   switch (t) {
     case Type::Int8:
-    case Type::UInt8: return 1;
+    case Type::UInt8:
+      return 1;
     case Type::Int16:
-    case Type::UInt16: return 2;
+    case Type::UInt16:
+      return 2;
     case Type::Int32:
     case Type::UInt32:
-    case Type::Float32: return 4;
-    case Type::Float64: return 8;
+    case Type::Float32:
+      return 4;
+    case Type::Float64:
+      return 8;
   }
   return 1;
 }
@@ -49,10 +53,13 @@ std::size_t sizeOf(Type t) {
 double colorScale(Type t) {
   switch (t) {
     case Type::Int8:
-    case Type::UInt8: return 1.0 / 255.0;
+    case Type::UInt8:
+      return 1.0 / 255.0;
     case Type::Int16:
-    case Type::UInt16: return 1.0 / 65535.0;
-    default: return 1.0;
+    case Type::UInt16:
+      return 1.0 / 65535.0;
+    default:
+      return 1.0;
   }
 }
 
@@ -97,8 +104,8 @@ class Reader {
   double read(Type t) { return encoding_ == Encoding::Ascii ? readAscii() : readBinary(t); }
 
   [[noreturn]] void fail(const std::string& what) const {
-    throw Error(name_, what + " in PLY element '" + (element_ ? *element_ : std::string("?")) + "' " +
-                           std::to_string(item_));
+    throw Error(name_,
+                what + " in PLY element '" + (element_ ? *element_ : std::string("?")) + "' " + std::to_string(item_));
   }
 
  private:
@@ -129,14 +136,22 @@ class Reader {
     const bool swap = (encoding_ == Encoding::BinaryBigEndian) != (std::endian::native == std::endian::big);
     if (swap) std::reverse(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(n));
     switch (t) {
-      case Type::Int8: return static_cast<double>(std::bit_cast<std::int8_t>(b[0]));
-      case Type::UInt8: return static_cast<double>(b[0]);
-      case Type::Int16: return static_cast<double>(load<std::int16_t>(b));
-      case Type::UInt16: return static_cast<double>(load<std::uint16_t>(b));
-      case Type::Int32: return static_cast<double>(load<std::int32_t>(b));
-      case Type::UInt32: return static_cast<double>(load<std::uint32_t>(b));
-      case Type::Float32: return static_cast<double>(load<float>(b));
-      case Type::Float64: return load<double>(b);
+      case Type::Int8:
+        return static_cast<double>(std::bit_cast<std::int8_t>(b[0]));
+      case Type::UInt8:
+        return static_cast<double>(b[0]);
+      case Type::Int16:
+        return static_cast<double>(load<std::int16_t>(b));
+      case Type::UInt16:
+        return static_cast<double>(load<std::uint16_t>(b));
+      case Type::Int32:
+        return static_cast<double>(load<std::int32_t>(b));
+      case Type::UInt32:
+        return static_cast<double>(load<std::uint32_t>(b));
+      case Type::Float32:
+        return static_cast<double>(load<float>(b));
+      case Type::Float64:
+        return load<double>(b);
     }
     return 0.0;
   }
@@ -241,14 +256,12 @@ Header parseHeader(std::string_view bytes, const std::string& name) {
 // allocated or looped over.
 std::size_t minimumItemBytes(const Element& e, Encoding encoding) {
   std::size_t n = 0;
-  for (const Property& p : e.properties)
-    n += encoding == Encoding::Ascii ? 2 : sizeOf(p.list ? p.countType : p.type);
+  for (const Property& p : e.properties) n += encoding == Encoding::Ascii ? 2 : sizeOf(p.list ? p.countType : p.type);
   return n;
 }
 
 std::uint32_t toIndex(double v, Reader& reader) {
-  if (!(v >= 0.0) || v > 4294967295.0 || v != std::floor(v))
-    reader.fail("bad vertex index " + std::to_string(v));
+  if (!(v >= 0.0) || v > 4294967295.0 || v != std::floor(v)) reader.fail("bad vertex index " + std::to_string(v));
   return static_cast<std::uint32_t>(v);
 }
 
@@ -308,8 +321,7 @@ PolygonSoup parsePly(std::string_view bytes, const std::string& name) {
     }
     if (faceList < 0) throw Error(name, "PLY face element has no vertex_indices list");
   }
-  if (faceElement == nullptr || faceElement->count == 0)
-    throw Error(name, "no triangles (the PLY file has no faces)");
+  if (faceElement == nullptr || faceElement->count == 0) throw Error(name, "no triangles (the PLY file has no faces)");
   for (std::size_t i = 0; i < faceElement->properties.size(); ++i)
     if (!faceElement->properties[i].list) {
       faceFields.push_back({i, soup.fields.size()});

@@ -36,15 +36,19 @@ std::optional<Scalar> parseType(std::string_view t) {
 std::size_t sizeOf(Scalar s) {
   switch (s) {
     case Scalar::Int8:
-    case Scalar::UInt8: return 1;
+    case Scalar::UInt8:
+      return 1;
     case Scalar::Int16:
-    case Scalar::UInt16: return 2;
+    case Scalar::UInt16:
+      return 2;
     case Scalar::Int32:
     case Scalar::UInt32:
-    case Scalar::Float32: return 4;
+    case Scalar::Float32:
+      return 4;
     case Scalar::Int64:
     case Scalar::UInt64:
-    case Scalar::Float64: return 8;
+    case Scalar::Float64:
+      return 8;
   }
   return 1;
 }
@@ -115,18 +119,29 @@ class Parser {
     std::array<unsigned char, 8> b{};
     std::memcpy(b.data(), s_.data() + pos_, n);
     pos_ += n;
-    if constexpr (std::endian::native == std::endian::little) std::reverse(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(n));
+    if constexpr (std::endian::native == std::endian::little)
+      std::reverse(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(n));
     switch (type) {
-      case Scalar::Int8: return static_cast<double>(std::bit_cast<std::int8_t>(b[0]));
-      case Scalar::UInt8: return static_cast<double>(b[0]);
-      case Scalar::Int16: return static_cast<double>(load<std::int16_t>(b));
-      case Scalar::UInt16: return static_cast<double>(load<std::uint16_t>(b));
-      case Scalar::Int32: return static_cast<double>(load<std::int32_t>(b));
-      case Scalar::UInt32: return static_cast<double>(load<std::uint32_t>(b));
-      case Scalar::Int64: return static_cast<double>(load<std::int64_t>(b));
-      case Scalar::UInt64: return static_cast<double>(load<std::uint64_t>(b));
-      case Scalar::Float32: return static_cast<double>(load<float>(b));
-      case Scalar::Float64: return load<double>(b);
+      case Scalar::Int8:
+        return static_cast<double>(std::bit_cast<std::int8_t>(b[0]));
+      case Scalar::UInt8:
+        return static_cast<double>(b[0]);
+      case Scalar::Int16:
+        return static_cast<double>(load<std::int16_t>(b));
+      case Scalar::UInt16:
+        return static_cast<double>(load<std::uint16_t>(b));
+      case Scalar::Int32:
+        return static_cast<double>(load<std::int32_t>(b));
+      case Scalar::UInt32:
+        return static_cast<double>(load<std::uint32_t>(b));
+      case Scalar::Int64:
+        return static_cast<double>(load<std::int64_t>(b));
+      case Scalar::UInt64:
+        return static_cast<double>(load<std::uint64_t>(b));
+      case Scalar::Float32:
+        return static_cast<double>(load<float>(b));
+      case Scalar::Float64:
+        return load<double>(b);
     }
     return 0.0;
   }
@@ -230,7 +245,8 @@ void readCells(Parser& p, bool binary, PolygonSoup& soup, CellSources& sources, 
       const double n = p.value(Scalar::Int32, binary);
       ++read;
       if (!(n >= 0.0) || n > static_cast<double>(b - read)) p.fail("bad cell size");
-      for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k) conn.push_back(toId(p.value(Scalar::Int32, binary), p));
+      for (std::uint64_t k = 0; k < static_cast<std::uint64_t>(n); ++k)
+        conn.push_back(toId(p.value(Scalar::Int32, binary), p));
       read += static_cast<std::uint64_t>(n);
       offsets.push_back(conn.size());
     }

@@ -189,8 +189,8 @@ void checkStl(std::string_view head, std::uintmax_t size, const std::string& nam
 
   if (size >= 84) {
     const auto* b = reinterpret_cast<const unsigned char*>(head.data() + 80);
-    const std::uint64_t n = std::uint64_t{b[0]} | std::uint64_t{b[1]} << 8 | std::uint64_t{b[2]} << 16 |
-                            std::uint64_t{b[3]} << 24;
+    const std::uint64_t n =
+        std::uint64_t{b[0]} | std::uint64_t{b[1]} << 8 | std::uint64_t{b[2]} << 16 | std::uint64_t{b[3]} << 24;
     const std::uint64_t expected = 84 + 50 * n;
     if (expected == size) {
       if (n == 0) throw Error(name, "no triangles (binary STL with a triangle count of 0)");
@@ -203,11 +203,14 @@ void checkStl(std::string_view head, std::uintmax_t size, const std::string& nam
     return;  // binary with trailing bytes, which readers ignore
   }
   if (solid) return;
-  throw Error(name, "not an STL file (" + std::to_string(size) + " bytes: too short for a binary STL header and not ASCII 'solid')");
+  throw Error(name, "not an STL file (" + std::to_string(size) +
+                        " bytes: too short for a binary STL header and not ASCII 'solid')");
 }
 
 // ---------------------------------------------------------------------------------------------
-bool finite3(const double p[3]) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+bool finite3(const double p[3]) {
+  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+}
 
 // Readers do not check what they read: ids can be out of range (which would crash the filters)
 // and coordinates NaN.
@@ -230,8 +233,7 @@ void checkPolyData(vtkPolyData* pd, const std::string& name) {
                                 " but there are " + std::to_string(np) + " vertices");
   }
   if (pd->GetNumberOfPolys() + pd->GetNumberOfStrips() == 0) {
-    if (pd->GetNumberOfLines() + pd->GetNumberOfVerts() > 0)
-      throw Error(name, "no triangles (only points or lines)");
+    if (pd->GetNumberOfLines() + pd->GetNumberOfVerts() > 0) throw Error(name, "no triangles (only points or lines)");
     throw Error(name, "no triangles");
   }
 }
@@ -511,13 +513,12 @@ std::string readHead(const fs::path& path, std::size_t count) {
 
 // Runs a reader and throws with VTK's reason when it failed or produced nothing.
 template <typename Reader>
-vtkSmartPointer<vtkPolyData> runReader(Reader* reader, VtkMessages& messages, bool warningsFail,
-                                       const char* format, const std::string& name,
-                                       const std::string& tempPath = {}) {
+vtkSmartPointer<vtkPolyData> runReader(Reader* reader, VtkMessages& messages, bool warningsFail, const char* format,
+                                       const std::string& name, const std::string& tempPath = {}) {
   reader->Update();
   vtkPolyData* out = reader->GetOutput();
-  const bool failed = reader->GetErrorCode() != 0 || messages.hasError() ||
-                      (warningsFail && messages.hasWarning()) || out == nullptr;
+  const bool failed =
+      reader->GetErrorCode() != 0 || messages.hasError() || (warningsFail && messages.hasWarning()) || out == nullptr;
   if (failed) {
     std::string reason = messages.reason();
     replaceAll(reason, tempPath, name);

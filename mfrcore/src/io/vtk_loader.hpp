@@ -19,9 +19,9 @@ inline constexpr double kFeatureAngleDegrees = 30.0;
 // Polygons of any size as the simple parsers (PLY, OFF) produce them.
 struct PolygonSoup {
   std::vector<glm::vec3> points;
-  std::vector<glm::vec3> normals;          // empty or one per point
-  std::vector<glm::vec4> colors;           // empty or one RGBA in [0,1] per point
-  std::vector<std::uint32_t> offsets{0};   // polygon i is ids[offsets[i] .. offsets[i+1])
+  std::vector<glm::vec3> normals;         // empty or one per point
+  std::vector<glm::vec4> colors;          // empty or one RGBA in [0,1] per point
+  std::vector<std::uint32_t> offsets{0};  // polygon i is ids[offsets[i] .. offsets[i+1])
   std::vector<std::uint32_t> ids;
   // The file's data arrays (Mesh::fields): point fields one tuple per point, cell fields one per
   // polygon of the soup (MeshField::cellData marks them).

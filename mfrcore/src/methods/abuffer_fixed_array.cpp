@@ -12,7 +12,9 @@ namespace {
 constexpr std::uint32_t kMaxSlots = 1024;
 
 // Fragments one array may hold: the largest storage block, and 32-bit slot addresses.
-std::uint64_t maxFragments() { return std::min<std::uint64_t>(maxStorageElements(8), 0xFFFFFFFFull); }
+std::uint64_t maxFragments() {
+  return std::min<std::uint64_t>(maxStorageElements(8), 0xFFFFFFFFull);
+}
 
 }  // namespace
 
@@ -23,7 +25,13 @@ const MethodInfo& ABufferFixedArray::info() const {
       "Liu, Huang, Liu, Wu: FreePipe: a Programmable Parallel Rendering Architecture for Efficient Multi-Fragment "
       "Effects. I3D 2010; Crassin: Fast and Accurate Single-Pass A-Buffer using OpenGL 4.0+ (2010)",
       true,
-      {{"slots", "Fragments per pixel", ParamSpec::Type::Int, "32", 0, kMaxSlots, {},
+      {{"slots",
+        "Fragments per pixel",
+        ParamSpec::Type::Int,
+        "32",
+        0,
+        kMaxSlots,
+        {},
         "array capacity per pixel; fragments beyond it are dropped and counted. 0: size from a count pass to the "
         "largest per-pixel count"}},
       "oit",
@@ -42,8 +50,10 @@ void ABufferFixedArray::configure(int width, int height, const Params& params) {
   }
   if (!statsBuffer_) statsBuffer_ = gl::createBuffer(kStatsBytes);
   if (!store_.id()) {
-    count_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-array/count.geom.frag"}});
-    store_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-array/store.geom.frag"}});
+    count_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-array/count.geom.frag"}});
+    store_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-array/store.geom.frag"}});
     reduce_ = gl::Program({{GL_COMPUTE_SHADER, "methods/abuffer-array/stats.comp"}});
   }
   if (requestedSlots_ > 0) {

@@ -54,8 +54,10 @@ void ABufferLinkedList::configure(int width, int height, const Params& params) {
   }
   if (!counter_) counter_ = gl::createBuffer(2 * sizeof(std::uint32_t));
   if (!store_.id()) {
-    count_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-ll/count.geom.frag"}});
-    store_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-ll/store.geom.frag"}});
+    count_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-ll/count.geom.frag"}});
+    store_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-ll/store.geom.frag"}});
   }
 }
 

@@ -9,7 +9,9 @@
 namespace mfr {
 namespace {
 // Fragments one buffer may hold: the largest storage block, and 32-bit offsets.
-std::uint64_t maxFragments() { return std::min<std::uint64_t>(maxStorageElements(8), 0xFFFFFFFFull); }
+std::uint64_t maxFragments() {
+  return std::min<std::uint64_t>(maxStorageElements(8), 0xFFFFFFFFull);
+}
 }  // namespace
 
 const MethodInfo& ABufferSBuffer::info() const {
@@ -60,8 +62,10 @@ void ABufferSBuffer::configure(int width, int height, const Params& params) {
   }
   if (!counter_) counter_ = gl::createBuffer(kCounterBytes);
   if (!store_.id()) {
-    count_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-sbuffer/count.geom.frag"}});
-    store_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-sbuffer/store.geom.frag"}});
+    count_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-sbuffer/count.geom.frag"}});
+    store_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/abuffer-sbuffer/store.geom.frag"}});
   }
 }
 

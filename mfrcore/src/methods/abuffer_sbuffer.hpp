@@ -27,8 +27,8 @@ class ABufferSBuffer final : public Method {
   std::uint64_t fixedCapacity_ = 0;
   std::uint64_t capacity_ = 0;       // fragments the fragment buffer holds
   std::uint64_t previousTotal_ = 0;  // last frame's fragment count (sizing=previous)
-  gl::Buffer counts_;    // width·height + 1 uints: counts, then store cursors
-  gl::Buffer offsets_;   // width·height + 1 uints: exclusive scan of counts
+  gl::Buffer counts_;                // width·height + 1 uints: counts, then store cursors
+  gl::Buffer offsets_;               // width·height + 1 uints: exclusive scan of counts
   gl::Buffer fragments_;
   gl::Buffer counter_;
   PrefixSum scan_;

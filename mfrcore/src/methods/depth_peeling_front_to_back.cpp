@@ -48,13 +48,18 @@ void DepthPeelingFrontToBack::configure(int width, int height, const Params& par
   }
   if (!emptyVao_) emptyVao_ = gl::createVertexArray();
   if (!peel_.id()) {
-    peel_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-f2b/peel.geom.frag"}});
-    blend_ = gl::Program({{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-f2b/blend.screen.frag"}});
-    final_ = gl::Program({{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-f2b/final.screen.frag"}});
+    peel_ =
+        gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-f2b/peel.geom.frag"}});
+    blend_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-f2b/blend.screen.frag"}});
+    final_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-f2b/final.screen.frag"}});
   }
 }
 
-void DepthPeelingFrontToBack::capture(const FrameContext&) { stats_ = Stats{}; }
+void DepthPeelingFrontToBack::capture(const FrameContext&) {
+  stats_ = Stats{};
+}
 
 void DepthPeelingFrontToBack::resolve(const FrameContext& ctx, const Operation& op) {
   const bool dump = op.name == "dump";

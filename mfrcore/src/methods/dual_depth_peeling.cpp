@@ -67,15 +67,20 @@ void DualDepthPeeling::configure(int width, int height, const Params& params) {
   }
   if (!emptyVao_) emptyVao_ = gl::createVertexArray();
   if (!peel_.id()) {
-    peel_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-dual/peel.geom.frag"}});
-    blend_ = gl::Program({{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-dual/blend.screen.frag"}});
-    remaining_ = gl::Program(
-        {{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-dual/remaining.screen.frag"}});
-    final_ = gl::Program({{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-dual/final.screen.frag"}});
+    peel_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-dual/peel.geom.frag"}});
+    blend_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-dual/blend.screen.frag"}});
+    remaining_ = gl::Program({{GL_VERTEX_SHADER, "common/fullscreen.vert"},
+                              {GL_FRAGMENT_SHADER, "methods/peel-dual/remaining.screen.frag"}});
+    final_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/peel-dual/final.screen.frag"}});
   }
 }
 
-void DualDepthPeeling::capture(const FrameContext&) { stats_ = Stats{}; }
+void DualDepthPeeling::capture(const FrameContext&) {
+  stats_ = Stats{};
+}
 
 void DualDepthPeeling::resolve(const FrameContext& ctx, const Operation& op) {
   const bool dump = op.name == "dump";
@@ -108,7 +113,8 @@ void DualDepthPeeling::resolve(const FrameContext& ctx, const Operation& op) {
   glClearTexImage(range_[0].id(), 0, GL_RG, GL_FLOAT, kEmptyRange);
   const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   if (dump) glClearTexImage(front_.id(), 0, GL_RGBA, GL_FLOAT, zero);
-  const GLenum initBuffers[2] = {GL_COLOR_ATTACHMENT0, dump ? static_cast<GLenum>(GL_COLOR_ATTACHMENT1) : static_cast<GLenum>(GL_NONE)};
+  const GLenum initBuffers[2] = {GL_COLOR_ATTACHMENT0,
+                                 dump ? static_cast<GLenum>(GL_COLOR_ATTACHMENT1) : static_cast<GLenum>(GL_NONE)};
   glNamedFramebufferDrawBuffers(initFbo_.id(), 2, initBuffers);
   glBindFramebuffer(GL_FRAMEBUFFER, initFbo_.id());
   peel_.set("uInit", 1);

@@ -32,10 +32,10 @@ class DualDepthPeeling final : public Method {
   gl::Texture range_[2];
   gl::Texture layers_;
   gl::Texture front_, back_;
-  gl::Framebuffer initFbo_;     // range_[0] + front_ (the per-pixel count in dump frames)
-  gl::Framebuffer peelFbo_[2];  // range_[i] + layers_
-  gl::Framebuffer accumFbo_;    // front_ + back_
-  gl::Framebuffer noAttachFbo_; // side-effect and query-only passes
+  gl::Framebuffer initFbo_;      // range_[0] + front_ (the per-pixel count in dump frames)
+  gl::Framebuffer peelFbo_[2];   // range_[i] + layers_
+  gl::Framebuffer accumFbo_;     // front_ + back_
+  gl::Framebuffer noAttachFbo_;  // side-effect and query-only passes
   gl::VertexArray emptyVao_;
   gl::Program peel_, blend_, remaining_, final_;
   ResolveProgramCache dumpPrograms_;  // the dump pass, per operation file

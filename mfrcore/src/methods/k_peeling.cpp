@@ -13,7 +13,13 @@ const MethodInfo& KPeeling::info() const {
   static const MethodInfo i = [] {
     std::vector<ParamSpec> params = kbufferParams(false, false);
     std::erase_if(params, [](const ParamSpec& p) { return p.name == "tail"; });  // exact: no tail
-    params.push_back({"max_iterations", "Most peeling iterations", ParamSpec::Type::Int, "1024", 1, 65535, {},
+    params.push_back({"max_iterations",
+                      "Most peeling iterations",
+                      ParamSpec::Type::Int,
+                      "1024",
+                      1,
+                      65535,
+                      {},
                       "bound on the geometry passes; beyond ceil(max n(p) / k) > this, the farthest fragments are "
                       "dropped and reported as overflow"});
     return MethodInfo{"kpeel",
@@ -36,7 +42,8 @@ void KPeeling::configure(int width, int height, const Params& params) {
   maxIterations_ = static_cast<std::uint32_t>(params.integer("max_iterations"));
   const std::uint64_t pixels = static_cast<std::uint64_t>(width) * height;
   if (pixels * k_ > maxStorageElements(kEntryBytes))
-    throw Error("--param k=" + std::to_string(k_), "k slots of 16 bytes per pixel exceed the largest shader storage block");
+    throw Error("--param k=" + std::to_string(k_),
+                "k slots of 16 bytes per pixel exceed the largest shader storage block");
   // The per-pixel state (32 bytes, more than the entries at k = 1) is one block too (a review).
   requireStorageFits("--method kpeel", "its per-pixel state of " + std::to_string(kPixelStateBytes) + " bytes", pixels,
                      maxStorageElements(kPixelStateBytes), kPixelStateBytes, "; a smaller --size needs less");
@@ -53,7 +60,8 @@ void KPeeling::configure(int width, int height, const Params& params) {
   }
   if (!counters_) counters_ = gl::createBuffer(kCounterBytes);
   if (!count_.id())
-    count_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/kpeel/count.geom.frag"}});
+    count_ =
+        gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/kpeel/count.geom.frag"}});
   std::string key = "store";
   for (const auto& [n, v] : sync_.defines) key += ";" + n + "=" + v;
   auto it = programs_.find(key);
@@ -188,10 +196,9 @@ void KPeeling::resolve(const FrameContext& ctx, const Operation& op) {
   stats_.bytesAllocated = pixels * (k_ * kEntryBytes + kPixelStateBytes + kCountBytes) + kCounterBytes;
   stats_.bytesUsed = stats_.bytesAllocated;
   stats_.notes.emplace_back("k", std::to_string(k_));
-  stats_.notes.emplace_back("iterations", std::to_string(iterations) +
-                                              (iterations < needed ? " (max_iterations; " + std::to_string(needed) +
-                                                                         " needed)"
-                                                                   : ""));
+  stats_.notes.emplace_back(
+      "iterations", std::to_string(iterations) +
+                        (iterations < needed ? " (max_iterations; " + std::to_string(needed) + " needed)" : ""));
   stats_.notes.emplace_back("max depth complexity", std::to_string(maxCount_));
   stats_.notes.emplace_back("ties", "ordered by (depth, object id, primitive id): exact at equal depths");
 }

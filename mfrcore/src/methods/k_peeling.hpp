@@ -14,9 +14,9 @@ namespace mfr {
 
 class KPeeling final : public Method {
  public:
-  static constexpr std::uint64_t kEntryBytes = 16;     // colour, depth, object id, primitive id
+  static constexpr std::uint64_t kEntryBytes = 16;       // colour, depth, object id, primitive id
   static constexpr std::uint64_t kPixelStateBytes = 32;  // threshold key + count, OIT state
-  static constexpr std::uint64_t kCountBytes = 4;      // count pass, then spin-lock semaphore
+  static constexpr std::uint64_t kCountBytes = 4;        // count pass, then spin-lock semaphore
   static constexpr std::uint64_t kCounterBytes = 32;
 
   [[nodiscard]] const MethodInfo& info() const override;

@@ -29,21 +29,57 @@ KBufferSync kbufferSync(const std::string& choice) {
 
 std::vector<ParamSpec> kbufferParams(bool culling, bool revised, const std::string& kDefault) {
   std::vector<ParamSpec> p{
-      {"k", "Fragments per pixel (k)", ParamSpec::Type::Int, kDefault, 1, 256, {},
+      {"k",
+       "Fragments per pixel (k)",
+       ParamSpec::Type::Int,
+       kDefault,
+       1,
+       256,
+       {},
        "capacity per pixel: the k nearest fragments are kept"},
-      {"sync", "Per-pixel synchronisation", ParamSpec::Type::Choice, "spinlock", 0, 0, {"spinlock", "interlock"},
+      {"sync",
+       "Per-pixel synchronisation",
+       ParamSpec::Type::Choice,
+       "spinlock",
+       0,
+       0,
+       {"spinlock", "interlock"},
        "spinlock: semaphore image + imageAtomicExchange, bounded retries; interlock: "
        "ARB_fragment_shader_interlock where the driver has it"},
-      {"spin_limit", "Spin-lock attempts", ParamSpec::Type::Int, "1024", 1, 4096, {},
+      {"spin_limit",
+       "Spin-lock attempts",
+       ParamSpec::Type::Int,
+       "1024",
+       1,
+       4096,
+       {},
        "lock attempts per fragment before it is dropped (counted in lockFailures)"},
-      {"tail", "Accumulate the tail", ParamSpec::Type::Bool, "false", 0, 0, {},
+      {"tail",
+       "Accumulate the tail",
+       ParamSpec::Type::Bool,
+       "false",
+       0,
+       0,
+       {},
        "accumulate the fragments beyond the k nearest per pixel (Σ colour·α, Σ α, count) for hybrid "
        "transparency"}};
   if (culling)
-    p.push_back({"culling", "Cull against the maximum", ParamSpec::Type::Bool, "true", 0, 0, {},
+    p.push_back({"culling",
+                 "Cull against the maximum",
+                 ParamSpec::Type::Bool,
+                 "true",
+                 0,
+                 0,
+                 {},
                  "reject fragments behind the pixel's current k-th nearest before taking the lock"});
   if (revised)
-    p.push_back({"revised", "Direct insertion of the first k-1", ParamSpec::Type::Bool, "false", 0, 0, {},
+    p.push_back({"revised",
+                 "Direct insertion of the first k-1",
+                 ParamSpec::Type::Bool,
+                 "false",
+                 0,
+                 0,
+                 {},
                  "k+-buffer §3.2.1: the first k-1 fragments of a pixel take slots from a per-pixel atomic "
                  "counter, without the lock or a maximum search"});
   return p;

@@ -24,8 +24,8 @@ struct KBufferTail {
 
 // The per-pixel critical section a store pass runs under.
 struct KBufferSync {
-  std::string name;      // "spinlock" or "interlock" (Stats::sync)
-  gl::Defines defines;   // for the store pass
+  std::string name;     // "spinlock" or "interlock" (Stats::sync)
+  gl::Defines defines;  // for the store pass
 };
 // choice "spinlock" or "interlock"; throws Error("--param sync=interlock", "not supported by this
 // OpenGL driver") when the context has no fragment shader interlock/ordering extension.

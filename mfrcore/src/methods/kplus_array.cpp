@@ -26,8 +26,8 @@ void KPlusBufferMaxArray::capture(const FrameContext& ctx) {
   beginStore();
   drawStore(ctx);
   finishStore();
-  stats_.notes.emplace_back("structure", revised_ ? "max-array, revised (direct insertion of the first k-1)"
-                                                  : "max-array");
+  stats_.notes.emplace_back("structure",
+                            revised_ ? "max-array, revised (direct insertion of the first k-1)" : "max-array");
   stats_.notes.emplace_back("culling", culling_ ? "on" : "off");
 }
 

@@ -13,12 +13,31 @@ const MethodInfo& KPlusBufferDynamic::info() const {
   static const MethodInfo i = [] {
     std::vector<ParamSpec> params = kbufferParams(true, false);
     std::erase_if(params, [](const ParamSpec& p) { return p.name == "k"; });  // chosen per frame
-    params.push_back({"budget_mib", "Memory budget M_b (MiB)", ParamSpec::Type::Float, "64", 0, 65536, {},
-                      "GPU memory the method may allocate for a frame (all its buffers)", true});
-    params.push_back({"robustness", "Robustness ratio R_h", ParamSpec::Type::Float, "0.95", 0, 1, {},
+    params.push_back({"budget_mib",
+                      "Memory budget M_b (MiB)",
+                      ParamSpec::Type::Float,
+                      "64",
+                      0,
+                      65536,
+                      {},
+                      "GPU memory the method may allocate for a frame (all its buffers)",
+                      true});
+    params.push_back({"robustness",
+                      "Robustness ratio R_h",
+                      ParamSpec::Type::Float,
+                      "0.95",
+                      0,
+                      1,
+                      {},
                       "fraction of the frame's fragments to capture: k is the smallest that captures it, "
                       "unless the budget allows less"});
-    params.push_back({"structure", "Per-pixel structure", ParamSpec::Type::Choice, "array", 0, 0, {"array", "heap"},
+    params.push_back({"structure",
+                      "Per-pixel structure",
+                      ParamSpec::Type::Choice,
+                      "array",
+                      0,
+                      0,
+                      {"array", "heap"},
                       "max-array or max-heap"});
     return MethodInfo{"kplus-dynamic", "k+-buffer, dynamic k from the depth-complexity histogram",
                       "Vasilakis, Papaioannou, Fudos: k+-buffer: An Efficient, Memory-Friendly and Dynamic k-buffer "
@@ -37,13 +56,12 @@ void KPlusBufferDynamic::configure(int width, int height, const Params& params) 
   gl::Defines defines;
   if (culling_) defines.emplace("MFR_KB_CULLING", "1");
   const bool resized = width != width_ || height != height_;
-  configureCommon(width, height, params, structure_ == "heap" ? "kplus-heap" : "kplus-array", "kplus-dynamic",
-                  defines);
+  configureCommon(width, height, params, structure_ == "heap" ? "kplus-heap" : "kplus-array", "kplus-dynamic", defines);
   if (resized || !counts_) counts_ = gl::createBuffer(pixels() * 4);
   if (!histogram_) histogram_ = gl::createBuffer(kBins * 4);
   if (!count_.id()) {
-    count_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"},
-                          {GL_FRAGMENT_SHADER, "methods/kplus-dynamic/count.geom.frag"}});
+    count_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/kplus-dynamic/count.geom.frag"}});
     histogramPass_ = gl::Program({{GL_COMPUTE_SHADER, "methods/kplus-dynamic/histogram.comp"}},
                                  {{"KD_BINS", std::to_string(kBins)}});
   }

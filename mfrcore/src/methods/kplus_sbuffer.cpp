@@ -8,7 +8,13 @@ namespace mfr {
 const MethodInfo& KPlusBufferSBuffer::info() const {
   static const MethodInfo i = [] {
     std::vector<ParamSpec> params = kbufferParams(true, false);
-    params.push_back({"structure", "Per-pixel structure", ParamSpec::Type::Choice, "array", 0, 0, {"array", "heap"},
+    params.push_back({"structure",
+                      "Per-pixel structure",
+                      ParamSpec::Type::Choice,
+                      "array",
+                      0,
+                      0,
+                      {"array", "heap"},
                       "max-array or max-heap over the pixel's min(n, k) slots"});
     return MethodInfo{"kplus-sbuffer", "k+-buffer on S-buffer storage (memory-aware)",
                       "Vasilakis, Papaioannou, Fudos: k+-buffer: An Efficient, Memory-Friendly and Dynamic k-buffer "
@@ -26,15 +32,14 @@ void KPlusBufferSBuffer::configure(int width, int height, const Params& params) 
   if (culling_) defines.emplace("MFR_KB_CULLING", "1");
   resolveDefines_ = {{"MFR_KB_VARIABLE", "1"}};
   const bool resized = width != width_ || height != height_;
-  configureCommon(width, height, params, structure_ == "heap" ? "kplus-heap" : "kplus-array", "kplus-sbuffer",
-                  defines);
+  configureCommon(width, height, params, structure_ == "heap" ? "kplus-heap" : "kplus-array", "kplus-sbuffer", defines);
   if (resized || !counts_) {
     counts_ = gl::createBuffer((pixels() + 1) * 4);
     offsets_ = gl::createBuffer((pixels() + 1) * 4);
   }
   if (!count_.id())
-    count_ = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"},
-                          {GL_FRAGMENT_SHADER, "methods/kplus-sbuffer/count.geom.frag"}});
+    count_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/kplus-sbuffer/count.geom.frag"}});
 }
 
 void KPlusBufferSBuffer::capture(const FrameContext& ctx) {

@@ -17,7 +17,8 @@ Params::Params(const std::vector<ParamSpec>& specs, const std::map<std::string, 
     if (!spec) {
       std::string list;
       for (const ParamSpec& s : specs) list += (list.empty() ? "" : ", ") + s.name;
-      throw Error("--param " + name, "not a parameter of " + method + (list.empty() ? " (it has none)" : " (has: " + list + ")"));
+      throw Error("--param " + name,
+                  "not a parameter of " + method + (list.empty() ? " (it has none)" : " (has: " + list + ")"));
     }
     const std::string where = "--param " + name + "=" + value;
     switch (spec->type) {
@@ -68,8 +69,12 @@ std::string defaultValueFor(const ParamSpec& spec, const std::string& operation)
   return spec.defaultValue;
 }
 
-long long Params::integer(const std::string& name) const { return std::llround(std::stod(text(name))); }
-double Params::real(const std::string& name) const { return std::stod(text(name)); }
+long long Params::integer(const std::string& name) const {
+  return std::llround(std::stod(text(name)));
+}
+double Params::real(const std::string& name) const {
+  return std::stod(text(name));
+}
 bool Params::flag(const std::string& name) const {
   const std::string& v = text(name);
   return v == "true" || v == "1" || v == "on";
@@ -80,8 +85,8 @@ const std::string& Params::text(const std::string& name) const {
   return it->second;
 }
 
-const gl::Program& ResolveProgramCache::get(const std::string& methodFolder, const Operation& op, const gl::Defines& extra,
-                                            const std::string& passFile) {
+const gl::Program& ResolveProgramCache::get(const std::string& methodFolder, const Operation& op,
+                                            const gl::Defines& extra, const std::string& passFile) {
   std::string key = passFile + ";" + op.glslFile;
   for (const auto& [k, v] : extra) key += ";" + k + "=" + v;
   auto it = programs_.find(key);

@@ -11,8 +11,10 @@ GeometryPassState::GeometryPassState(bool colorWrites, bool depthTest) {
   blend_ = glIsEnabled(GL_BLEND);
   glGetBooleanv(GL_COLOR_WRITEMASK, colorMask_);
   glGetBooleanv(GL_DEPTH_WRITEMASK, &depthMask_);
-  if (depthTest) glEnable(GL_DEPTH_TEST);
-  else glDisable(GL_DEPTH_TEST);
+  if (depthTest)
+    glEnable(GL_DEPTH_TEST);
+  else
+    glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
   const GLboolean c = colorWrites ? GL_TRUE : GL_FALSE;
@@ -20,12 +22,18 @@ GeometryPassState::GeometryPassState(bool colorWrites, bool depthTest) {
 }
 
 GeometryPassState::~GeometryPassState() {
-  if (depthTest_) glEnable(GL_DEPTH_TEST);
-  else glDisable(GL_DEPTH_TEST);
-  if (cull_) glEnable(GL_CULL_FACE);
-  else glDisable(GL_CULL_FACE);
-  if (blend_) glEnable(GL_BLEND);
-  else glDisable(GL_BLEND);
+  if (depthTest_)
+    glEnable(GL_DEPTH_TEST);
+  else
+    glDisable(GL_DEPTH_TEST);
+  if (cull_)
+    glEnable(GL_CULL_FACE);
+  else
+    glDisable(GL_CULL_FACE);
+  if (blend_)
+    glEnable(GL_BLEND);
+  else
+    glDisable(GL_BLEND);
   glColorMask(colorMask_[0], colorMask_[1], colorMask_[2], colorMask_[3]);
   glDepthMask(depthMask_);
 }

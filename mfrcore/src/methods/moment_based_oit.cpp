@@ -63,9 +63,13 @@ const MethodInfo& MomentBasedOit::info() const {
   return i;
 }
 
-std::uint64_t MomentBasedOit::bytesPerPixel(int moments) { return 4 + 16 + (moments == 6 ? 8 : 0) + 8; }
+std::uint64_t MomentBasedOit::bytesPerPixel(int moments) {
+  return 4 + 16 + (moments == 6 ? 8 : 0) + 8;
+}
 
-double MomentBasedOit::paperBias(int moments) { return moments == 6 ? 5e-6 : 5e-7; }
+double MomentBasedOit::paperBias(int moments) {
+  return moments == 6 ? 5e-6 : 5e-7;
+}
 
 void MomentBasedOit::configure(int width, int height, const Params& params) {
   const int moments = params.text("moments") == "6" ? 6 : 4;
@@ -96,8 +100,8 @@ void MomentBasedOit::configure(int width, int height, const Params& params) {
   }
   if (!samples_) samples_ = gl::createQuery(GL_SAMPLES_PASSED);
   if (!composite_.id())
-    composite_ = gl::Program({{GL_VERTEX_SHADER, "common/fullscreen.vert"},
-                              {GL_FRAGMENT_SHADER, "methods/mboit/composite.screen.frag"}});
+    composite_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/mboit/composite.screen.frag"}});
   programs();  // compile errors surface in configure, not mid-frame
 }
 
@@ -106,12 +110,10 @@ MomentBasedOit::Programs& MomentBasedOit::programs() {
   if (it == programs_.end()) {
     const gl::Defines defines{{"MFR_MBOIT_M", std::to_string(moments_ / 2)}};
     Programs p;
-    p.moments = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"},
-                             {GL_FRAGMENT_SHADER, "methods/mboit/moments.geom.frag"}},
-                            defines);
-    p.accumulate = gl::Program({{GL_VERTEX_SHADER, "common/scene.vert"},
-                                {GL_FRAGMENT_SHADER, "methods/mboit/accumulate.geom.frag"}},
-                               defines);
+    p.moments = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/mboit/moments.geom.frag"}}, defines);
+    p.accumulate = gl::Program(
+        {{GL_VERTEX_SHADER, "common/scene.vert"}, {GL_FRAGMENT_SHADER, "methods/mboit/accumulate.geom.frag"}}, defines);
     it = programs_.emplace(moments_, std::move(p)).first;
   }
   return it->second;
@@ -178,13 +180,15 @@ void MomentBasedOit::capture(const FrameContext& ctx) {
   stats_.notes.emplace_back("moments", std::to_string(moments_));
   stats_.notes.emplace_back("moment bias", number(bias_));
   stats_.notes.emplace_back("overestimation", number(overestimation_));
-  stats_.notes.emplace_back("depth warp", logWarp ? "log |z_eye|" : depth.perspective ? "linear |z_eye|"
-                                                                                     : "linear (orthographic)");
+  stats_.notes.emplace_back("depth warp", logWarp             ? "log |z_eye|"
+                                          : depth.perspective ? "linear |z_eye|"
+                                                              : "linear (orthographic)");
 }
 
 void MomentBasedOit::resolve(const FrameContext& ctx, const Operation& op) {
   if (op.name != "oit")
-    throw Error("--op " + op.name, "not supported by mboit (approximate moment-based OIT keeps no fragment lists; only oit)");
+    throw Error("--op " + op.name,
+                "not supported by mboit (approximate moment-based OIT keeps no fragment lists; only oit)");
   glBindTextureUnit(MFR_TEX_AUX0, b0_.id());
   glBindTextureUnit(MFR_TEX_AUX1, accum_.id());
   runResolvePass(ctx, composite_, op);

@@ -7,7 +7,9 @@
 
 namespace mfr {
 namespace {
-std::uint64_t blocksOf(std::uint64_t n) { return (n + PrefixSum::kBlock - 1) / PrefixSum::kBlock; }
+std::uint64_t blocksOf(std::uint64_t n) {
+  return (n + PrefixSum::kBlock - 1) / PrefixSum::kBlock;
+}
 }  // namespace
 
 std::uint64_t PrefixSum::scratchElements(std::uint64_t n) {
@@ -38,7 +40,9 @@ void PrefixSum::dispatch(const gl::Program& program, std::uint32_t count, std::u
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
-void PrefixSum::scan(GLuint input, GLuint output, std::uint32_t n) { scan(input, 0, output, 0, n); }
+void PrefixSum::scan(GLuint input, GLuint output, std::uint32_t n) {
+  scan(input, 0, output, 0, n);
+}
 
 void PrefixSum::scan(GLuint input, std::uint32_t inBase, GLuint output, std::uint32_t outBase, std::uint32_t n) {
   if (!blockScan_.id()) {

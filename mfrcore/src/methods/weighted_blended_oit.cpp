@@ -90,8 +90,8 @@ void WeightedBlendedOit::configure(int width, int height, const Params& params) 
   }
   if (!samples_) samples_ = gl::createQuery(GL_SAMPLES_PASSED);
   if (!composite_.id())
-    composite_ = gl::Program({{GL_VERTEX_SHADER, "common/fullscreen.vert"},
-                              {GL_FRAGMENT_SHADER, "methods/wboit/composite.screen.frag"}});
+    composite_ = gl::Program(
+        {{GL_VERTEX_SHADER, "common/fullscreen.vert"}, {GL_FRAGMENT_SHADER, "methods/wboit/composite.screen.frag"}});
   accumulateProgram();  // compile errors surface in configure, not mid-frame
 }
 
@@ -147,13 +147,14 @@ void WeightedBlendedOit::capture(const FrameContext& ctx) {
   stats_.notes.emplace_back("weight", weight_);
   stats_.notes.emplace_back("revealage", revealageFormat_);
   if (weight_ == "eq7" || weight_ == "eq8" || weight_ == "eq9")
-    stats_.notes.emplace_back("view depth", depth.perspective ? "|z_eye| (perspective)"
-                                                              : "distance behind the near plane (orthographic)");
+    stats_.notes.emplace_back(
+        "view depth", depth.perspective ? "|z_eye| (perspective)" : "distance behind the near plane (orthographic)");
 }
 
 void WeightedBlendedOit::resolve(const FrameContext& ctx, const Operation& op) {
   if (op.name != "oit")
-    throw Error("--op " + op.name, "not supported by wboit (approximate blended OIT keeps no fragment lists; only oit)");
+    throw Error("--op " + op.name,
+                "not supported by wboit (approximate blended OIT keeps no fragment lists; only oit)");
   glBindTextureUnit(MFR_TEX_AUX0, accum_.id());
   glBindTextureUnit(MFR_TEX_AUX1, revealage_.id());
   runResolvePass(ctx, composite_, op);

@@ -25,9 +25,7 @@ struct DepthMapping {
   bool perspective = true;
   float a = 1.0f, b = 1.0f;
   float nearDepth = 0.0f, farDepth = 1.0f;  // viewDepth at ndc = −1 and +1
-  [[nodiscard]] float viewDepth(float ndc) const {
-    return perspective ? b / (ndc + a) : (ndc + 1.0f) / a;
-  }
+  [[nodiscard]] float viewDepth(float ndc) const { return perspective ? b / (ndc + a) : (ndc + 1.0f) / a; }
   void bind(const gl::Program& program) const;
 };
 DepthMapping depthMapping(const glm::mat4& viewProj);

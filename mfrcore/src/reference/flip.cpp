@@ -37,10 +37,9 @@ struct Vec3 {
 };
 
 // Linear RGB -> XYZ, the sRGB matrix in its exact rational form.
-constexpr float kRgbToXyz[3][3] = {
-    {10135552.0f / 24577794.0f, 8788810.0f / 24577794.0f, 4435075.0f / 24577794.0f},
-    {2613072.0f / 12288897.0f, 8788810.0f / 12288897.0f, 887015.0f / 12288897.0f},
-    {1425312.0f / 73733382.0f, 8788810.0f / 73733382.0f, 70074185.0f / 73733382.0f}};
+constexpr float kRgbToXyz[3][3] = {{10135552.0f / 24577794.0f, 8788810.0f / 24577794.0f, 4435075.0f / 24577794.0f},
+                                   {2613072.0f / 12288897.0f, 8788810.0f / 12288897.0f, 887015.0f / 12288897.0f},
+                                   {1425312.0f / 73733382.0f, 8788810.0f / 73733382.0f, 70074185.0f / 73733382.0f}};
 // Its inverse (XYZ -> linear RGB), to the precision published with the sRGB standard.
 constexpr float kXyzToRgb[3][3] = {{3.241003275f, -1.537398934f, -0.498615861f},
                                    {-0.969224334f, 1.875930071f, 0.041554224f},
@@ -54,7 +53,9 @@ Vec3 mul(const float (&m)[3][3], Vec3 v) {
           m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
 }
 
-float srgbToLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+float srgbToLinear(float c) {
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
 
 // YCxCz, the paper's opponent space: L*a*b* without its cube root, so it is linear in XYZ and
 // spatial filtering in it is meaningful.
@@ -86,10 +87,14 @@ Vec3 xyzToLab(Vec3 xyz) {
 }
 
 // Hunt adjustment: chroma shrinks with lightness, as perceived colourfulness does.
-Vec3 hunt(Vec3 lab) { return {lab.x, 0.01f * lab.x * lab.y, 0.01f * lab.x * lab.z}; }
+Vec3 hunt(Vec3 lab) {
+  return {lab.x, 0.01f * lab.x * lab.y, 0.01f * lab.x * lab.z};
+}
 
 // Linear RGB in [0,1] -> Hunt-adjusted L*a*b*, the space where colour distances are taken.
-Vec3 linearRgbToHuntLab(Vec3 rgb) { return hunt(xyzToLab(mul(kRgbToXyz, rgb))); }
+Vec3 linearRgbToHuntLab(Vec3 rgb) {
+  return hunt(xyzToLab(mul(kRgbToXyz, rgb)));
+}
 
 // HyAB distance: city-block in lightness plus Euclidean in chroma; behaves better than
 // ΔE*ab for large differences.
@@ -126,7 +131,8 @@ struct Plane {
 
   Plane() = default;
   Plane(int w, int h)
-      : width(w), height(h),
+      : width(w),
+        height(h),
         v(std::make_unique_for_overwrite<float[]>(static_cast<std::size_t>(w) * static_cast<std::size_t>(h))) {}
   [[nodiscard]] std::size_t size() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
   [[nodiscard]] float* row(int y) { return v.get() + static_cast<std::size_t>(y) * static_cast<std::size_t>(width); }
@@ -174,7 +180,8 @@ std::array<Plane, N> filterRows(const Plane& src, const std::array<const Kernel*
     const float* in = src.row(y);
     for (int i = 0; i < w + 2 * r; ++i) padded[static_cast<std::size_t>(i)] = in[std::clamp(i - r, 0, w - 1)];
     for (std::size_t n = 0; n < N; ++n) {
-      convolve(w, *kernels[n], [&](std::size_t k) { return padded.data() + k; }, out[n].row(y));
+      convolve(
+          w, *kernels[n], [&](std::size_t k) { return padded.data() + k; }, out[n].row(y));
     }
   }
   return out;
@@ -213,7 +220,9 @@ int csfRadius(float ppd) {
   return static_cast<int>(std::ceil(3.0f * std::sqrt(bMax / (2.0f * kPi * kPi)) * ppd));
 }
 
-float gaussianTerm(float x2, float a, float b) { return a * std::sqrt(kPi / b) * std::exp(-kPi * kPi * x2 / b); }
+float gaussianTerm(float x2, float a, float b) {
+  return a * std::sqrt(kPi / b) * std::exp(-kPi * kPi * x2 / b);
+}
 
 struct CsfKernels {
   Kernel achromatic, redGreen, blueYellow1, blueYellow2;
@@ -358,7 +367,8 @@ FeatureKernels featureKernels(float ppd) {
 class FeatureFiltered {
  public:
   FeatureFiltered(const Plane& ycxczY, const FeatureKernels& k)
-      : kernels_(k), rows_(filterRows<3>(normalised(ycxczY), {&k.g, &k.dg, &k.ddg})),
+      : kernels_(k),
+        rows_(filterRows<3>(normalised(ycxczY), {&k.g, &k.dg, &k.ddg})),
         buffer_(static_cast<std::size_t>(ycxczY.width) * 4) {}
 
   // Edge and point detector magnitudes for row y.

@@ -353,8 +353,7 @@ bool intersect(const glm::dvec3& origin, const glm::dvec3& dir, const WorldTrian
   return true;
 }
 
-std::uint32_t shade(const WorldTriangle& tri, const ObjectShading& obj, double u, double v,
-                    const glm::vec3& viewDir) {
+std::uint32_t shade(const WorldTriangle& tri, const ObjectShading& obj, double u, double v, const glm::vec3& viewDir) {
   const double w[3] = {1.0 - u - v, u, v};
   const Mesh& mesh = *obj.mesh;
   // A mesh without normals gets object-space +Z, as the GPU upload (gl/gpu_scene.cpp) does.

@@ -10,7 +10,9 @@
 
 namespace mfr {
 
-glm::dmat4 Camera::viewMatrix() const { return glm::lookAt(eye, target, up); }
+glm::dmat4 Camera::viewMatrix() const {
+  return glm::lookAt(eye, target, up);
+}
 
 glm::dmat4 Camera::projectionMatrix(double aspect) const {
   // The field of view (orthoHeight) spans the image's shorter side: a portrait image shows as much

@@ -17,8 +17,7 @@ void Mesh::validate(const std::string& name) const {
   if (indices.size() % 3 != 0) throw Error(name, "index count is not a multiple of 3");
   if (!normals.empty() && normals.size() != positions.size())
     throw Error(name, "normal count differs from vertex count");
-  if (!colors.empty() && colors.size() != positions.size())
-    throw Error(name, "colour count differs from vertex count");
+  if (!colors.empty() && colors.size() != positions.size()) throw Error(name, "colour count differs from vertex count");
   if (!scalars.empty() && scalars.size() != positions.size())
     throw Error(name, "scalar count differs from vertex count");
   for (const MeshField& f : fields) {
@@ -29,8 +28,8 @@ void Mesh::validate(const std::string& name) const {
   }
   for (std::uint32_t i : indices)
     if (i >= positions.size())
-      throw Error(name, "vertex index " + std::to_string(i) + " out of range (" +
-                            std::to_string(positions.size()) + " vertices)");
+      throw Error(name, "vertex index " + std::to_string(i) + " out of range (" + std::to_string(positions.size()) +
+                            " vertices)");
   for (const glm::vec3& p : positions)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
       throw Error(name, "non-finite vertex coordinate");

@@ -79,9 +79,9 @@ Mesh makeBox(const glm::dvec3& size) {
   Mesh m;
   const glm::dvec3 h = 0.5 * size;
   // Each face: normal n, in-face axes u, v with u × v = n (so u, v order is counter-clockwise).
-  const glm::dvec3 faces[6][3] = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}},  {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
-                                  {{0, 1, 0}, {0, 0, 1}, {1, 0, 0}},  {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
-                                  {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}},  {{0, 0, -1}, {0, 1, 0}, {1, 0, 0}}};
+  const glm::dvec3 faces[6][3] = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {{-1, 0, 0}, {0, 0, 1}, {0, 1, 0}},
+                                  {{0, 1, 0}, {0, 0, 1}, {1, 0, 0}}, {{0, -1, 0}, {1, 0, 0}, {0, 0, 1}},
+                                  {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}}, {{0, 0, -1}, {0, 1, 0}, {1, 0, 0}}};
   for (const auto& f : faces) {
     const glm::dvec3 n = f[0], u = f[1], v = f[2];
     const std::uint32_t base = static_cast<std::uint32_t>(m.positions.size());
@@ -117,8 +117,10 @@ Mesh makeCylinder(double radius, double height, int slices) {
       const std::uint32_t a = ring + static_cast<std::uint32_t>(c);
       const std::uint32_t b = ring + static_cast<std::uint32_t>((c + 1) % slices);
       // Angle increases counter-clockwise seen from +Y: top cap (a, b) order, bottom reversed.
-      if (capSide == 1) addTriangle(m, centre, a, b);
-      else addTriangle(m, centre, b, a);
+      if (capSide == 1)
+        addTriangle(m, centre, a, b);
+      else
+        addTriangle(m, centre, b, a);
     }
   }
   return m;
@@ -163,7 +165,8 @@ Mesh makeTube(const std::vector<glm::dvec3>& path, double radius, int sides) {
     if (glm::length(d) <= 0.0) throw Error("tube", "repeated path point");
     tangents[i] = glm::normalize(d);
   }
-  glm::dvec3 normal = glm::cross(tangents[0], std::abs(tangents[0].y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0));
+  glm::dvec3 normal =
+      glm::cross(tangents[0], std::abs(tangents[0].y) < 0.9 ? glm::dvec3(0, 1, 0) : glm::dvec3(1, 0, 0));
   normal = glm::normalize(normal);
   const std::uint32_t base = static_cast<std::uint32_t>(m.positions.size());
   std::vector<std::pair<glm::dvec3, glm::dvec3>> frames;
@@ -197,8 +200,10 @@ Mesh makeTube(const std::vector<glm::dvec3>& path, double radius, int sides) {
       const std::uint32_t a = ring + static_cast<std::uint32_t>(s);
       const std::uint32_t b = ring + static_cast<std::uint32_t>((s + 1) % sides);
       // The angle runs counter-clockwise around +t (n → b = t × n), so seen from +t: (a, b).
-      if (end == 1) addTriangle(m, centre, a, b);
-      else addTriangle(m, centre, b, a);
+      if (end == 1)
+        addTriangle(m, centre, a, b);
+      else
+        addTriangle(m, centre, b, a);
     }
   }
   return m;

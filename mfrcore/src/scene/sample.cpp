@@ -201,8 +201,9 @@ Scene makeQuadsScene(int layers, double density, std::uint32_t seed) {
     // Depths spread over (−0.95, 0.95) in strata with jitter: random order, no exact ties.
     const double z = -0.95 + 1.9 * (i + 0.1 + 0.8 * uniform()) / layers;
     o.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 0.0, z));
-    o.material.color = glm::vec4(0.2f + 0.8f * static_cast<float>(uniform()), 0.2f + 0.8f * static_cast<float>(uniform()),
-                                 0.2f + 0.8f * static_cast<float>(uniform()), 0.15f + 0.35f * static_cast<float>(uniform()));
+    o.material.color =
+        glm::vec4(0.2f + 0.8f * static_cast<float>(uniform()), 0.2f + 0.8f * static_cast<float>(uniform()),
+                  0.2f + 0.8f * static_cast<float>(uniform()), 0.15f + 0.35f * static_cast<float>(uniform()));
     s.objects.push_back(std::move(o));
   }
   // Draw order must not follow depth order: shuffle (Fisher–Yates with the same generator).

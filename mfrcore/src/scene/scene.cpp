@@ -58,7 +58,9 @@ double Scene::boundingRadius() const {
   return std::sqrt(r2);
 }
 
-Camera Scene::fit(const Camera& base) const { return base.fittedTo(bounds(), boundingRadius()); }
+Camera Scene::fit(const Camera& base) const {
+  return base.fittedTo(bounds(), boundingRadius());
+}
 
 std::size_t Scene::triangleCount() const {
   std::size_t n = 0;

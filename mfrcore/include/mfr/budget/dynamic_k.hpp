@@ -25,16 +25,18 @@ struct KBufferMemoryModel {
   std::uint64_t bytesPerSlot = 8;
   std::uint64_t bytesPerPixel = 0;
   std::uint64_t fixedBytes = 0;
-  [[nodiscard]] std::uint64_t bytes(std::uint64_t k) const { return pixels * (bytesPerSlot * k + bytesPerPixel) + fixedBytes; }
+  [[nodiscard]] std::uint64_t bytes(std::uint64_t k) const {
+    return pixels * (bytesPerSlot * k + bytesPerPixel) + fixedBytes;
+  }
 };
 
 struct DynamicKChoice {
-  std::uint32_t k = 0;               // chosen; 0: the budget does not hold k = 1
-  std::uint32_t kMemory = 0;         // k_M, capped at kMax
-  std::uint32_t kRobust = 0;         // k_R, capped at kMax
-  double capturedFraction = 1.0;     // C(k) / F with the chosen k (1 for an empty frame)
-  std::uint64_t bytes = 0;           // M(k) for the chosen k
-  std::string reason;                // which bound decided, in words (for Stats::notes)
+  std::uint32_t k = 0;            // chosen; 0: the budget does not hold k = 1
+  std::uint32_t kMemory = 0;      // k_M, capped at kMax
+  std::uint32_t kRobust = 0;      // k_R, capped at kMax
+  double capturedFraction = 1.0;  // C(k) / F with the chosen k (1 for an empty frame)
+  std::uint64_t bytes = 0;        // M(k) for the chosen k
+  std::string reason;             // which bound decided, in words (for Stats::notes)
 };
 
 // histogram[n]: pixels with exactly n fragments, except the last bin, which counts the pixels with

@@ -16,9 +16,9 @@
 namespace mfr {
 
 struct KPlusArrayLayout {
-  bool tail = true;       // --param tail
-  bool spinLock = true;   // --param sync=spinlock (the interlock needs no semaphore image)
-  bool revised = false;   // --param revised (two per-pixel counters)
+  bool tail = true;      // --param tail
+  bool spinLock = true;  // --param sync=spinlock (the interlock needs no semaphore image)
+  bool revised = false;  // --param revised (two per-pixel counters)
 };
 
 // x, y, z of the kplus-array method for `pixels` pixels.

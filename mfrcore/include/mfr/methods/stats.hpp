@@ -10,16 +10,16 @@ namespace mfr {
 struct Stats {
   std::string method;
   std::string operation;
-  std::string sync;                       // "none", "spinlock", "interlock", …
-  std::uint64_t bytesAllocated = 0;       // GPU memory the method allocated for this frame
-  std::uint64_t bytesUsed = 0;            // of which holding fragments or per-pixel state in use
-  std::uint64_t fragmentsGenerated = 0;   // fragments rasterised (all passes' capture of unique ones)
-  std::uint64_t fragmentsStored = 0;      // fragments kept in the structure
-  std::uint64_t fragmentsDropped = 0;     // fragments lost to a full structure (overflow)
-  std::uint64_t overflowPixels = 0;       // pixels that lost fragments to a full structure
-  std::uint64_t lockFailures = 0;         // spin-lock retries exhausted
-  std::uint32_t passes = 0;               // geometry passes (peeling iterations, …)
-  std::uint32_t kMin = 0, kMax = 0;       // per-pixel capacity range where meaningful
+  std::string sync;                      // "none", "spinlock", "interlock", …
+  std::uint64_t bytesAllocated = 0;      // GPU memory the method allocated for this frame
+  std::uint64_t bytesUsed = 0;           // of which holding fragments or per-pixel state in use
+  std::uint64_t fragmentsGenerated = 0;  // fragments rasterised (all passes' capture of unique ones)
+  std::uint64_t fragmentsStored = 0;     // fragments kept in the structure
+  std::uint64_t fragmentsDropped = 0;    // fragments lost to a full structure (overflow)
+  std::uint64_t overflowPixels = 0;      // pixels that lost fragments to a full structure
+  std::uint64_t lockFailures = 0;        // spin-lock retries exhausted
+  std::uint32_t passes = 0;              // geometry passes (peeling iterations, …)
+  std::uint32_t kMin = 0, kMax = 0;      // per-pixel capacity range where meaningful
   bool overflow = false;
   std::vector<std::pair<std::string, double>> passTimesMs;  // per-pass GPU time
   std::vector<std::pair<std::string, std::string>> notes;   // e.g. ("k chosen", "eq. 6 with R_h=0.9")

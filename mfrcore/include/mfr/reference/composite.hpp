@@ -101,11 +101,11 @@ glm::vec3 compositeVolume(std::span<const Fragment> sorted, int glX, int glY, co
 // T_in·(1 − its own transmittance), also split by volume (each interval's absorbed share divided
 // in proportion to σ_i). The shares and the background's add up to 1.
 struct VolumeBreakdown {
-  std::vector<float> surfaceWeight;    // per fragment
-  std::vector<glm::vec3> mediumColor;  // n + 1: added to the pixel (already weighted)
-  std::vector<float> mediumWeight;     // n + 1
+  std::vector<float> surfaceWeight;                      // per fragment
+  std::vector<glm::vec3> mediumColor;                    // n + 1: added to the pixel (already weighted)
+  std::vector<float> mediumWeight;                       // n + 1
   std::vector<std::vector<float>> mediumWeightByVolume;  // n + 1, each one per medium of the setup
-  glm::vec3 color{0.0f};               // = compositeVolume
+  glm::vec3 color{0.0f};                                 // = compositeVolume
   float backgroundWeight = 1.0f;
 };
 VolumeBreakdown compositeVolumeBreakdown(std::span<const Fragment> sorted, int glX, int glY,

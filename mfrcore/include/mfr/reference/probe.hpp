@@ -20,12 +20,12 @@ namespace mfr {
 struct RenderRequest;
 
 struct ProbeFragment {
-  Fragment fragment;      // as the oracle casts it (window depth, shaded colour, object, facing)
-  double eyeDepth = 0.0;  // distance along the view axis (world units), Camera::depthToEye
-  double weight = 0.0;    // α_i·Π_{j<i}(1 − α_j): the fraction of the pixel's colour it gives
-  bool held = false;      // the method's capture holds it (matchCapture)
-  double hybridWeight = 0.0;  // its share of the hybrid colour under the method's core/tail split (splitHybrid)
-  double volumeWeight = 0.0;  // its share of the "volume" colour: α·T through surfaces and medium (splitVolume)
+  Fragment fragment;              // as the oracle casts it (window depth, shaded colour, object, facing)
+  double eyeDepth = 0.0;          // distance along the view axis (world units), Camera::depthToEye
+  double weight = 0.0;            // α_i·Π_{j<i}(1 − α_j): the fraction of the pixel's colour it gives
+  bool held = false;              // the method's capture holds it (matchCapture)
+  double hybridWeight = 0.0;      // its share of the hybrid colour under the method's core/tail split (splitHybrid)
+  double volumeWeight = 0.0;      // its share of the "volume" colour: α·T through surfaces and medium (splitVolume)
   double zthicknessWeight = 0.0;  // its share of the "zthickness" colour, blended with the slabs it overlaps
   // Its part coloured by a field (Material::fieldColors): the field's value where the pixel's ray
   // meets the surface, as the colour was made (Mesh::scalars interpolated at the hit; a volume's
@@ -36,8 +36,8 @@ struct ProbeFragment {
 
 // A stretch of the volumes' medium along the pixel's ray (splitVolume).
 struct ProbeMedium {
-  glm::vec3 color{0.0f};  // what it adds to the pixel's colour
-  double weight = 0.0;    // its share of the colour: the light reaching it times what it absorbs
+  glm::vec3 color{0.0f};               // what it adds to the pixel's colour
+  double weight = 0.0;                 // its share of the colour: the light reaching it times what it absorbs
   std::vector<double> weightByVolume;  // weight split by volume (PixelProbe::volumeNames), σ_i/σ per step
 };
 
@@ -66,9 +66,9 @@ struct PixelProbe {
 
   // Set by splitVolume.
   bool volume = false;
-  std::vector<ProbeMedium> medium;  // fragments.size() + 1: in front of fragment i; the last behind them all
+  std::vector<ProbeMedium> medium;       // fragments.size() + 1: in front of fragment i; the last behind them all
   std::vector<std::string> volumeNames;  // the volumes drawn, in the order of weightByVolume
-  glm::vec3 volumeColor{0.0f};      // the exact colour under the operation "volume"
+  glm::vec3 volumeColor{0.0f};           // the exact colour under the operation "volume"
   double volumeBackground = 0.0;
 
   // Set by splitZThickness.

@@ -19,8 +19,8 @@ struct Camera {
   Projection projection = Projection::Perspective;
   // Both span the image's shorter side (its height when it is landscape or square, its width when
   // it is portrait), so the fit-all view frames the scene whatever the image's shape.
-  double fovyDegrees = 40.0;   // perspective
-  double orthoHeight = 2.0;    // orthographic: world extent of the view
+  double fovyDegrees = 40.0;  // perspective
+  double orthoHeight = 2.0;   // orthographic: world extent of the view
   double nearPlane = 0.1;
   double farPlane = 100.0;
   // Near and far were given (a scene file's view with "near"/"far", or a session that saved such

@@ -34,7 +34,7 @@ struct CartoonOptions {
   double loopRadius = 0.2;
   double helixHalfWidth = 1.35, helixHalfThickness = 0.25;
   double strandHalfWidth = 1.4, strandHalfThickness = 0.4;
-  double arrowScale = 1.5;  // the arrowhead's base, as a multiple of the strand's width
+  double arrowScale = 1.5;                          // the arrowhead's base, as a multiple of the strand's width
   double nucleicRadius = 0.5, ladderRadius = 0.25;  // PyMOL's cartoon_tube_radius, cartoon_ladder_radius
   std::vector<std::string> fieldNames;
 };
