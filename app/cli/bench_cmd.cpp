@@ -67,8 +67,12 @@ void addBench(CLI::App& app) {
   cmd->add_option("--methods,-m", opt->methods, "Comma-separated methods, each name[:key=value…]")->required();
   cmd->add_option("--repeat,-r", opt->repeat, "Timed frames per method")
       ->capture_default_str()
+      ->check(wholeNumber())
       ->check(CLI::Range(1, 1000));
-  cmd->add_option("--warmup", opt->warmup, "Untimed frames first")->capture_default_str()->check(CLI::Range(0, 100));
+  cmd->add_option("--warmup", opt->warmup, "Untimed frames first")
+      ->capture_default_str()
+      ->check(wholeNumber())
+      ->check(CLI::Range(0, 100));
   cmd->add_option("--size,-s", opt->size, "Image size WxH")->capture_default_str();
   cmd->add_option("--view", opt->view, "Named view")->capture_default_str();
   cmd->add_option("--clip", opt->clip, kClipHelp);
@@ -123,7 +127,7 @@ void addBench(CLI::App& app) {
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     const Camera camera = scene.view(opt->view);  // fit frames the whole scene, cut or not
-    applySectionOption(scene, opt->section);
+    applySectionOption(scene, opt->section, opt->scene);
     requireSomethingToDraw(scene);
     for (std::size_t i = 0; i < requests.size(); ++i) {
       if (scene.volumes.empty() && (requests[i].volumeStep > 0.0 || requests[i].volumeShading.has_value()))
@@ -268,6 +272,7 @@ void addBench(CLI::App& app) {
       row["sync"] = last.stats.sync;
       row["lock_failures"] = last.stats.lockFailures;
       row["overflow"] = last.stats.overflow;
+      row["overflow_pixels"] = last.stats.overflowPixels;  // as render's stats and evaluate's rows
       row["passes"] = last.stats.passes;
       std::string rmseText = "-", flipText = "-";
       if (!opt->noQuality) {

@@ -126,8 +126,10 @@ inline constexpr const char* kClipHelp =
 // empty text leaves the scene as it is. Then the scene is cut by its section (the option's or the scene file's; once,
 // so that every renderer gets the cut scene), with a one-line note on stderr naming cut parts left without a cap
 // because they are not closed; `report`, when given, gets sectionedScene's report (cleared when
-// there is no section). Throws mfr::Error naming --section.
-void applySectionOption(Scene& scene, const std::string& text, SectionReport* report = nullptr);
+// there is no section). Throws mfr::Error naming --section, or for the scene file's own section
+// `sceneFile` and its key ("engine.mfrscene: section: cuts away every visible surface …").
+void applySectionOption(Scene& scene, const std::string& text, const std::string& sceneFile,
+                        SectionReport* report = nullptr);
 inline constexpr const char* kSectionHelp =
     "Section plane: AXIS=VALUE (x, y, z, -x, -y, -z; keeps the side the axis points to) or "
     "px,py,pz,nx,ny,nz (point, normal of the kept side), optionally :nocaps and/or :slice (each volume's slice, "

@@ -478,19 +478,28 @@ void ContourOptions::requireKeptVolumeDrawn(const RenderRequest& request, const 
 
 namespace {
 
-// `what`: the option that asked for the section, or "section" for the scene file's own.
+// `what`: the option that asked for the section, or the scene file and its key for the file's own.
 void cutBySection(Scene& scene, SectionReport& report, const std::string& what) {
   report = {};
   if (!scene.section || scene.sectionCut) return;
   if (scene.section->slice && scene.volumes.empty())
     throw Error(what, "slice: scene '" + scene.name + "' has no volume");
-  scene = sectionedScene(scene, &report);
+  try {
+    scene = sectionedScene(scene, &report);
+  } catch (const Error& e) {
+    // mfrcore names the component ("section plane: cuts away every visible surface …"); here the
+    // argument or the file that gave the plane is known (neither was named: a bug hunt).
+    static const std::string component = "section plane: ";
+    const std::string message = e.what();
+    if (message.rfind(component, 0) != 0) throw;
+    throw Error(what, message.substr(component.size()));
+  }
   for (const std::string& note : sectionNotes(*scene.section, report)) std::cerr << "note: " << note << "\n";
 }
 
 }  // namespace
 
-void applySectionOption(Scene& scene, const std::string& text, SectionReport* report) {
+void applySectionOption(Scene& scene, const std::string& text, const std::string& sceneFile, SectionReport* report) {
   SectionReport local;
   SectionReport& out = report ? *report : local;
   if (text == "none") {
@@ -499,7 +508,7 @@ void applySectionOption(Scene& scene, const std::string& text, SectionReport* re
     return;
   }
   if (text.empty()) {
-    cutBySection(scene, out, "section");
+    cutBySection(scene, out, sceneFile + ": section");
     return;
   }
   const std::string what = "--section " + text;

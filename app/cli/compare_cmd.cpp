@@ -1,6 +1,7 @@
 #include <iomanip>
 #include <iostream>
 #include <memory>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -51,19 +52,22 @@ void addCompare(CLI::App& app) {
       throw Error(opt->test, "size " + std::to_string(test.width) + "x" + std::to_string(test.height) +
                                  " differs from reference " + std::to_string(ref.width) + "x" +
                                  std::to_string(ref.height));
+    // Every number is computed before any is printed: a FLIP refused (memory) printed the rmse line
+    // first, as if the command had half worked (a bug hunt).
     nlohmann::ordered_json j;
-    std::cout << std::setprecision(6) << std::fixed;
+    std::ostringstream text;
+    text << std::setprecision(6) << std::fixed;
     ImageRGBA8 heat;
     if (wantRmse) {
       const double v = rmse(ref, test);
       j["rmse"] = v;
-      std::cout << "rmse " << v << "\n";
+      text << "rmse " << v << "\n";
     }
     if (wantFlip) {
       const FlipResult f = flip(ref, test, opt->ppd);
       j["flip"] = {{"mean", f.stats.mean}, {"p25", f.stats.p25}, {"median", f.stats.p50},
                    {"p75", f.stats.p75},   {"min", f.stats.min}, {"max", f.stats.max}};
-      std::cout << "flip mean " << f.stats.mean << " median " << f.stats.p50 << " max " << f.stats.max << "\n";
+      text << "flip mean " << f.stats.mean << " median " << f.stats.p50 << " max " << f.stats.max << "\n";
       if (!opt->heatmap.empty()) heat = magma(f.errorMap);
     }
     if (!opt->heatmap.empty() && heat.empty()) heat = heatmap(absoluteDifference(ref, test), 1.0f);
@@ -71,6 +75,7 @@ void addCompare(CLI::App& app) {
     if (!opt->heatmap.empty()) outputs.emplace_back(opt->heatmap, encodePng(opt->heatmap, heat));
     if (!opt->json.empty()) outputs.emplace_back(opt->json, jsonText(j, 2) + "\n");
     writeFilesAtomically(outputs);
+    std::cout << text.str();
   });
 }
 

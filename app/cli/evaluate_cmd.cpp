@@ -127,6 +127,7 @@ void addEvaluate(CLI::App& app) {
   cmd->add_option("--weights", opt->weights, "dkb weights file (default: the built-in weights)");
   cmd->add_option("--repeat,-r", opt->repeat, "Timed frames per GPU method")
       ->capture_default_str()
+      ->check(wholeNumber())
       ->check(CLI::Range(1, 100));
   cmd->add_option("--opacity", opt->opacity, "Override every object's opacity (0..1)")->check(finiteRange(0.0, 1.0));
   cmd->add_option("--json", opt->json, "Write all results as JSON");

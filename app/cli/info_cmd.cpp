@@ -99,8 +99,9 @@ void addInfo(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("info", "Describe a scene: parts, triangles, bounds, depth-complexity histogram");
   cmd->add_option("scene", opt->scene, "Scene: model file, .mfrscene, or @sample");
   cmd->add_flag("--methods", opt->methods, "List the available methods");
-  cmd->add_option("--size,-s", opt->size, "Image size for the depth-complexity histogram")->capture_default_str();
-  cmd->add_option("--view", opt->view, "View for the histogram")->capture_default_str();
+  CLI::Option* sizeOption =
+      cmd->add_option("--size,-s", opt->size, "Image size for the depth-complexity histogram")->capture_default_str();
+  CLI::Option* viewOption = cmd->add_option("--view", opt->view, "View for the histogram")->capture_default_str();
   cmd->add_flag("--no-histogram", opt->noHistogram, "Skip the oracle pass");
   opt->read.add(cmd);
   opt->contours.add(cmd);
@@ -109,9 +110,15 @@ void addInfo(CLI::App& app) {
                       "; parts are then measured as cut (a capped solid's kept volume "
                       "and its cross-section area)");
   cmd->add_option("--json", opt->json, "Also write the information as JSON");
-  cmd->callback([opt] {
+  cmd->callback([opt, sizeOption, viewOption] {
     checkCommandFiles(
         {{"scene", opt->scene, CommandFile::Role::kScene}, {"--json", opt->json, CommandFile::Role::kOutput}});
+    // Only the histogram uses them: given without one, they were dropped without a word (a bug hunt).
+    for (const auto& [option, name] : {std::pair{sizeOption, "--size"}, std::pair{viewOption, "--view"}}) {
+      if (option->count() == 0) continue;
+      if (opt->noHistogram) throw Error(name, "only the histogram uses it, and --no-histogram skips it");
+      if (opt->scene.empty()) throw Error(name, "only a scene's histogram uses it (mfr info SCENE)");
+    }
     if (opt->methods) {
       const nlohmann::ordered_json methods = methodsJson();
       printMethods(methods);
@@ -138,7 +145,7 @@ void addInfo(CLI::App& app) {
     for (const Object& o : scene.objects) hiddenByScene.push_back(!o.visible);
     const auto hiddenPart = [&](std::size_t i) { return i < hiddenByScene.size() && hiddenByScene[i]; };
     SectionReport section;
-    applySectionOption(scene, opt->section, &section);
+    applySectionOption(scene, opt->section, opt->scene, &section);
     const bool sectioned = !section.outcomes.empty();
     const auto outcome = [&](std::size_t i) { return sectioned ? section.outcomes[i] : SectionOutcome::kKept; };
     // The oracle's pass before anything is printed too: a scene it refuses (only degenerate

@@ -129,7 +129,7 @@ void addProbe(CLI::App& app) {
     opt->colorBy.apply(scene);
     applyClipOption(scene, opt->clip);
     const Camera camera = scene.view(opt->view);  // fit frames the whole scene, cut or not
-    applySectionOption(scene, opt->section);
+    applySectionOption(scene, opt->section, opt->scene);
     requireSomethingToDraw(scene);
     if (const auto unused = unusedOperationSetting(req, scene)) throw Error("--" + unused->name, unused->reason);
     if (const auto unused = unusedMethodParam(req)) throw Error("--" + unused->name, unused->reason);

@@ -104,7 +104,7 @@ void addRender(CLI::App& app) {
     // fit and orbit:… frame the whole scene, cut or not (Scene::fit ignores the section), as
     // mfrview's camera does.
     const Camera camera = scene.view(opt->view);
-    applySectionOption(scene, opt->section);
+    applySectionOption(scene, opt->section, opt->scene);
     requireSomethingToDraw(scene);
     if (stepOption->count() > 0 && scene.volumes.empty())
       throw Error("--step", "scene '" + scene.name + "' has no volume");

@@ -25,13 +25,17 @@ void addTrain(CLI::App& app) {
   cmd->add_option("-o,--output", opt->output, "Output weights file (JSON)")->required();
   cmd->add_option("--target", opt->training.target, "What the network predicts: k_over_n or k_over_budget")
       ->capture_default_str();
-  cmd->add_option("--epochs", opt->training.epochs, "Epochs")->capture_default_str()->check(CLI::Range(1, 100000));
+  cmd->add_option("--epochs", opt->training.epochs, "Epochs")
+      ->capture_default_str()
+      ->check(wholeNumber())
+      ->check(CLI::Range(1, 100000));
   // dlib asserts on a rate of 0 and trains to NaN on NaN decay or momentum: checked here.
   cmd->add_option("--learning-rate", opt->training.learningRate, "SGD learning rate")
       ->capture_default_str()
       ->check(finiteRange(1e-12, 10.0));
   cmd->add_option("--batch", opt->training.batchSize, "Mini-batch size")
       ->capture_default_str()
+      ->check(wholeNumber())
       ->check(CLI::Range(1, 1 << 20));
   cmd->add_option("--weight-decay", opt->training.weightDecay, "L2 weight decay")
       ->capture_default_str()

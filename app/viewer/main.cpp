@@ -283,6 +283,17 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
       fail(QString::fromUtf8(e.what()), 2);
     }
   }
+  // Only --screenshot's picture uses them: with --window-screenshot alone, or in the window, they
+  // were taken without a word (a bug hunt).
+  if (cl.screenshot.isEmpty())
+    for (const auto& [option, name] : {std::pair{&size, "--size"}, std::pair{&legend, "--legend"}})
+      if (parser.isSet(*option))
+        fail(QStringLiteral("%1: only --screenshot uses it%2")
+                 .arg(QLatin1String(name),
+                      cl.windowScreenshot.isEmpty()
+                          ? QString()
+                          : QStringLiteral(" (--window-screenshot grabs the window at --window-size)")),
+             2);
   if (parser.isSet(size)) cl.size = parseSize(QStringLiteral("--size"), parser.value(size));
   if (parser.isSet(windowSize)) cl.windowSize = parseSize(QStringLiteral("--window-size"), parser.value(windowSize));
   for (const QString& p : parser.values(param)) {

@@ -294,6 +294,13 @@ void SceneTreePanel::showFieldColoring() {
     colorMap_->setCurrentText(QString::fromStdString(shown->map));
     rangeLow_->setValue(shown->range.x);
     rangeHigh_->setValue(shown->range.y);
+  } else {
+    // Nothing coloured: no range of an earlier colouring (another file's B-factors stayed in the
+    // greyed boxes; a bug hunt). Choosing a field starts from its data range.
+    for (QDoubleSpinBox* box : {rangeLow_, rangeHigh_}) {
+      box->setDecimals(6);
+      box->setValue(0.0);
+    }
   }
   for (QWidget* w : std::initializer_list<QWidget*>{colorMap_, rangeLow_, rangeHigh_, dataRange_})
     w->setEnabled(shown.has_value());

@@ -141,6 +141,13 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
   // operation there is none, and their notes said "every pixel exact" over a wrong image (a bug
   // hunt). There the bound is off by default, and refused when asked for.
   const auto& specs = method_->info().params;
+  // A k-buffer's tail, too: only hybrid reads it, and elsewhere its 20 bytes a pixel were spent on
+  // nothing (kplus-array -p tail=true under oit, the same image; a bug hunt).
+  if (operation_ != "hybrid" &&
+      std::any_of(specs.begin(), specs.end(), [](const ParamSpec& p) { return p.name == "tail"; }))
+    if (const auto it = given.find("tail"); it != given.end() && Params(specs, given, request.method).flag("tail"))
+      throw Error("--param tail=" + it->second,
+                  "only operation hybrid reads the tail (--op hybrid); this render's operation is " + operation_);
   if (operation_ != "hybrid" &&
       std::any_of(specs.begin(), specs.end(), [](const ParamSpec& p) { return p.name == "exact_tail"; })) {
     const Params asGiven(specs, given, request.method);  // a value that is no flag is named as such first

@@ -171,23 +171,17 @@ void checkPngOutputName(const std::string& option, const std::filesystem::path& 
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  static const std::array<std::pair<const char*, const char*>, 17> kOtherFormats{{{".jpg", "JPEG"},
-                                                                                  {".jpeg", "JPEG"},
-                                                                                  {".jpe", "JPEG"},
-                                                                                  {".jfif", "JPEG"},
-                                                                                  {".bmp", "BMP"},
-                                                                                  {".gif", "GIF"},
-                                                                                  {".tif", "TIFF"},
-                                                                                  {".tiff", "TIFF"},
-                                                                                  {".webp", "WebP"},
-                                                                                  {".ppm", "PPM"},
-                                                                                  {".pgm", "PGM"},
-                                                                                  {".pnm", "PNM"},
-                                                                                  {".exr", "OpenEXR"},
-                                                                                  {".hdr", "Radiance HDR"},
-                                                                                  {".tga", "TGA"},
-                                                                                  {".svg", "SVG"},
-                                                                                  {".pdf", "PDF"}}};
+  // Suffixes of other raster and page formats an image could be asked in (.jp2, .heic, .avif and
+  // others were taken and given PNG bytes; a bug hunt).
+  static constexpr std::pair<const char*, const char*> kOtherFormats[] = {
+      {".jpg", "JPEG"},         {".jpeg", "JPEG"},     {".jpe", "JPEG"},    {".jfif", "JPEG"},
+      {".jp2", "JPEG 2000"},    {".j2k", "JPEG 2000"}, {".jxl", "JPEG XL"}, {".bmp", "BMP"},
+      {".gif", "GIF"},          {".tif", "TIFF"},      {".tiff", "TIFF"},   {".webp", "WebP"},
+      {".heic", "HEIF"},        {".heif", "HEIF"},     {".avif", "AVIF"},   {".ppm", "PPM"},
+      {".pgm", "PGM"},          {".pbm", "PBM"},       {".pnm", "PNM"},     {".exr", "OpenEXR"},
+      {".hdr", "Radiance HDR"}, {".tga", "TGA"},       {".dds", "DDS"},     {".ico", "ICO"},
+      {".psd", "Photoshop"},    {".svg", "SVG"},       {".pdf", "PDF"},     {".eps", "PostScript"},
+      {".ps", "PostScript"}};
   for (const auto& [suffix, format] : kOtherFormats)
     if (ext == suffix)
       throw Error(option + " " + path.string(), std::string("the name says ") + format +

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
 #include <cerrno>
 #include <csignal>
 #include <cstring>
@@ -89,36 +90,47 @@ void checkOutputPath(const std::filesystem::path& given) {
 namespace {
 
 constexpr std::array<int, 3> kHeldSignals{SIGINT, SIGTERM, SIGHUP};
-// The first signal caught while held (0: none). A handler may only store to a lock-free atomic.
-volatile std::sig_atomic_t heldSignal = 0;
+// Bit i: kHeldSignals[i] arrived while held. Every one is kept, not the first only: a SIGHUP that
+// nohup ignores, then a SIGTERM, lost the SIGTERM (a review). A handler may store to a lock-free
+// atomic only, and another thread's destructor reads it.
+std::atomic<unsigned> heldSignals{0};
+static_assert(std::atomic<unsigned>::is_always_lock_free);
 extern "C" void holdSignal(int signal) {
-  if (heldSignal == 0) heldSignal = signal;
+  for (std::size_t i = 0; i < kHeldSignals.size(); ++i)
+    if (kHeldSignals[i] == signal) heldSignals.fetch_or(1u << i, std::memory_order_relaxed);
 }
 std::mutex heldMutex;
 int heldDepth = 0;                                                    // guarded by heldMutex
 std::array<struct sigaction, kHeldSignals.size()> previousActions{};  // guarded by heldMutex
+std::array<bool, kHeldSignals.size()> caught{};                       // guarded by heldMutex
 
 }  // namespace
 
 TerminationSignalsHeld::TerminationSignalsHeld() {
   const std::lock_guard lock(heldMutex);
   if (heldDepth++ > 0) return;
-  heldSignal = 0;
+  heldSignals.store(0);
   struct sigaction hold {};
   hold.sa_handler = holdSignal;
   sigemptyset(&hold.sa_mask);
   hold.sa_flags = SA_RESTART;  // a write or rename interrupted goes on
-  for (std::size_t i = 0; i < kHeldSignals.size(); ++i) ::sigaction(kHeldSignals[i], &hold, &previousActions[i]);
+  for (std::size_t i = 0; i < kHeldSignals.size(); ++i) {
+    ::sigaction(kHeldSignals[i], nullptr, &previousActions[i]);
+    // An ignored signal stays ignored (nohup's SIGHUP, a background job's SIGINT).
+    caught[i] = previousActions[i].sa_handler != SIG_IGN;
+    if (caught[i]) ::sigaction(kHeldSignals[i], &hold, nullptr);
+  }
 }
 
 TerminationSignalsHeld::~TerminationSignalsHeld() {
   const std::lock_guard lock(heldMutex);
   if (--heldDepth > 0) return;
-  for (std::size_t i = 0; i < kHeldSignals.size(); ++i) ::sigaction(kHeldSignals[i], &previousActions[i], nullptr);
-  if (const int signal = heldSignal; signal != 0) {
-    heldSignal = 0;
-    std::raise(signal);  // as if it had come now: the default ends the process
-  }
+  for (std::size_t i = 0; i < kHeldSignals.size(); ++i)
+    if (caught[i]) ::sigaction(kHeldSignals[i], &previousActions[i], nullptr);
+  const unsigned arrived = heldSignals.exchange(0);
+  // As if each had come now: the first whose action is the default ends the process.
+  for (std::size_t i = 0; i < kHeldSignals.size(); ++i)
+    if ((arrived & (1u << i)) != 0) std::raise(kHeldSignals[i]);
 }
 
 namespace {

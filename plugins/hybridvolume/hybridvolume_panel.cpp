@@ -322,6 +322,7 @@ HybridVolumePanel::HybridVolumePanel(ViewerContext& context, QWidget* parent) : 
   connect(&context_, &ViewerContext::methodChanged, this, &HybridVolumePanel::showState);
   connect(&context_, &ViewerContext::volumeChanged, this, &HybridVolumePanel::volumeChanged);
   connect(&context_, &ViewerContext::frameRendered, this, &HybridVolumePanel::showInfo);
+  connect(&context_, &ViewerContext::frameErrorChanged, this, &HybridVolumePanel::showInfo);
   connect(&context_, &ViewerContext::sceneChanged, this, &HybridVolumePanel::showIsosurfaces);
   connect(preset_, &QComboBox::currentIndexChanged, this, &HybridVolumePanel::applyTransfer);
   connect(windowMin_, &QDoubleSpinBox::valueChanged, this, [this](double v) {
@@ -402,6 +403,13 @@ void HybridVolumePanel::volumeChanged() {
     editor_->setHistogram({});
     histogramKey_.clear();
     showSelectedPoint();
+    // No step or transfer strip of a volume no longer there (the last one's stayed; a bug hunt).
+    {
+      const QSignalBlocker block(step_);
+      step_->setSpecialValueText(tr("—"));
+      step_->setValue(step_->minimum());
+    }
+    preview_->clear();
     info_->setText(tr("The scene has no volume: open a .vti, .vtk, .mhd/.mha, .nrrd, .inr or .vdb file, or @volume."));
     showState();
     return;
@@ -726,6 +734,7 @@ void HybridVolumePanel::showStep() {
   const QSignalBlocker blockSlider(stepSlider_), blockBox(step_);
   if (fallback > 0.0) stepSlider_->setValue(logPosition(value / fallback, kMinStepFactor, kMaxStepFactor));
   step_->setSingleStep(std::max(1.0e-6, fallback / 10.0));
+  step_->setSpecialValueText(QString());
   step_->setValue(value);
 }
 
@@ -751,6 +760,12 @@ void HybridVolumePanel::showInfo() {
   if (const QStringList fields = context_.volumeFields(); !fields.isEmpty())
     lines << tr("field %1 (of %2)").arg(context_.volumeField(), fields.join(QStringLiteral(", ")));
   lines << tr("values %1 … %2").arg(r.x, 0, 'g', 6).arg(r.y, 0, 'g', 6);  // as the isosurface hint shows them
+  // No frame on screen: not the numbers of the last one drawn (a review of interface 1.14).
+  if (!context_.frameError().isEmpty()) {
+    lines << tr("last frame: none (the view could not draw)");
+    info_->setText(lines.join(QLatin1Char('\n')));
+    return;
+  }
   QString step, bytes, sharedBytes;
   for (const auto& [name, value] : context_.stats().notes) {
     if (name == "volume step") step = QString::fromStdString(value);

@@ -756,7 +756,13 @@ class ViewerTest : public QObject {
     // (Qt's parser exited 1 for them; a bug hunt).
     for (const auto& [args, line] : QList<std::pair<QStringList, QString>>{
              {{"@sample", "--bogus", "--screenshot", png}, "mfrview: Unknown option 'bogus'."},
-             {{"@sample", "--screenshot", png, "--size"}, "mfrview: Missing value after '--size'."}}) {
+             {{"@sample", "--screenshot", png, "--size"}, "mfrview: Missing value after '--size'."},
+             // Options of --screenshot alone were taken without a word (a bug hunt).
+             {{"@sample", "--window-screenshot", png, "-s", "320x240"},
+              "mfrview: --size: only --screenshot uses it (--window-screenshot grabs the window at --window-size)"},
+             {{"@sample", "--window-screenshot", png, "--legend"},
+              "mfrview: --legend: only --screenshot uses it (--window-screenshot grabs the window at "
+              "--window-size)"}}) {
       QCOMPARE(runProgram(MFRVIEW, args, &out), 2);
       QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(), line);
       QVERIFY(!QFile::exists(png));
@@ -2824,6 +2830,14 @@ class ViewerTest : public QObject {
     tree->topLevelItem(row)->setCheckState(0, Qt::Unchecked);
     QVERIFY(!m.volumeVisible());
     QVERIFY(!show->isChecked());
+
+    // A scene without a volume: no step or transfer strip of the last one stays (a bug hunt).
+    QVERIFY(!preview->pixmap().isNull());
+    w->openScene(QStringLiteral("@sample"));
+    QTRY_VERIFY_WITH_TIMEOUT(m.hasScene() && !m.hasVolume() && !m.isLoading(), kTimeoutMs);
+    QVERIFY(!step->isEnabled());
+    QCOMPARE(step->text(), QStringLiteral("—"));
+    QVERIFY(preview->pixmap().isNull());
   }
 
   // The Volume panel's transfer-function editor on a small .vti scene, driven by synthesised mouse
@@ -4723,6 +4737,10 @@ class ViewerTest : public QObject {
     QVERIFY(!m.fieldColoring());
     QCOMPARE(maxChannelDifference(plain, w->view().renderImage(size)), 0);
     QVERIFY(!legend->isVisible());
+    // The greyed range keeps no earlier colouring's values (another file's B-factors stayed; a bug hunt).
+    QVERIFY(!low->isEnabled());
+    QCOMPARE(low->value(), 0.0);
+    QCOMPARE(high->value(), 0.0);
 
     // mfrview --color-by: the pixels of mfr render --color-by; a field the parts lack is one line.
     const QString viewerPng = dir.filePath("viewer.png"), cliPng = dir.filePath("cli-options.png");

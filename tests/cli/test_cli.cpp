@@ -87,6 +87,9 @@ TEST_F(Cli, SceneFileFlagsAndHugeNumbersNameTheFileAndKey) {
            {R"({"objects": [)" + sphere +
                 R"(}], "views": [{"name": "a", "eye": [0, 0, 5]}, {"name": "a", "eye": [0, 5, 0]}]})",
             "views[1].name: 'a' is the name of views[0] too"},
+           // A view named like the orbit syntax hid it (a bug hunt).
+           {R"({"objects": [)" + sphere + R"(}], "views": [{"name": "orbit:90:0", "eye": [0, 0, 5]}]})",
+            "views[0].name: 'orbit:90:0': names beginning 'orbit:' are --view's orbit syntax"},
            {R"({"objects": [)" + sphere + R"(, "visible": 1}]})", "objects[0].visible: expected true or false"},
            {R"({"objects": [)" + sphere + R"(}], "views": [{"name": "", "eye": [0, 0, 5]}]})",
             "views[0].name: must not be empty"},
@@ -567,8 +570,28 @@ TEST_F(Cli, BenchRowsAndOrders) {
               rows[1].at("fragments_stored").get<std::uint64_t>() +
                   rows[1].at("fragments_dropped").get<std::uint64_t>() +
                   rows[1].at("lock_failures").get<std::uint64_t>());
+    // How many pixels lost fragments to a full structure (a k-buffer's k nearest are no overflow).
+    for (const nlohmann::json& row : rows) EXPECT_EQ(row.at("overflow_pixels").get<std::uint64_t>(), 0u);
     EXPECT_LT(rows[0].at("rmse").get<double>(), 0.01);                                     // every fragment
     EXPECT_GT(rows[1].at("rmse").get<double>(), rows[0].at("rmse").get<double>() + 0.01);  // two of them
+  }
+  // A row that overflows says in how many pixels, as render's --stats does (the rows had only
+  // "overflow"; a bug hunt).
+  {
+    const fs::path json = dir() / "overflow.json", stats = dir() / "overflow-stats.json";
+    ASSERT_EQ(
+        runCli("bench @sample -s 32x32 -r 1 --no-quality -m abuffer-array:slots=2 --json " + json.string()).exitCode,
+        0);
+    ASSERT_EQ(runCli("render @sample -s 32x32 -m abuffer-array -p slots=2 -o " + (dir() / "o.png").string() +
+                     " --stats " + stats.string())
+                  .exitCode,
+              0);
+    std::ifstream benchIn(json), statsIn(stats);
+    const nlohmann::json row = nlohmann::json::parse(benchIn).at("results")[0];
+    const nlohmann::json rendered = nlohmann::json::parse(statsIn);
+    EXPECT_TRUE(row.at("overflow").get<bool>());
+    EXPECT_GT(row.at("overflow_pixels").get<std::uint64_t>(), 0u);
+    EXPECT_EQ(row.at("overflow_pixels"), rendered.at("overflow_pixels"));
   }
   for (std::size_t i = 0; i < 2; ++i)
     for (const char* key : {"bytes_allocated", "fragments_stored", "rmse", "flip_mean"})
@@ -603,6 +626,17 @@ TEST_F(Cli, EmptyValuesAndOutOfRangeNumbersAreRefused) {
            {"compare " + a + " " + a + " --ppd 1e-30", "mfr: --ppd: must be in [0.01, 10000]"},
            {"train " + a + " -o " + out + " --seed -1", "mfr: --seed: '-1' is not a whole number"},
            {"dataset @sample -o " + out + " --seed ''", "mfr: --seed: '' is not a whole number"},
+           // Counts took hex and a sign (-r 0x2, --warmup +1), and 1e1 read "not in range 1 to
+           // 100000" (a bug hunt): digits only, as --seed.
+           {"bench @sample -m abuffer-ll -r 0x2", "mfr: --repeat: '0x2' is not a whole number"},
+           {"bench @sample -m abuffer-ll --warmup +1", "mfr: --warmup: '+1' is not a whole number"},
+           {"evaluate @sample --budgets k1 -r 0x2", "mfr: --repeat: '0x2' is not a whole number"},
+           {"train " + a + " -o " + out + " --epochs 1e1", "mfr: --epochs: '1e1' is not a whole number"},
+           {"train " + a + " -o " + out + " --batch +2", "mfr: --batch: '+2' is not a whole number"},
+           // Only the histogram reads --size and --view: without one they were dropped (a bug hunt).
+           {"info @sample --no-histogram -s 64x64", "mfr: --size: only the histogram uses it, and --no-histogram"},
+           {"info @sample --no-histogram --view iso", "mfr: --view: only the histogram uses it, and --no-histogram"},
+           {"info --methods -s 16x16", "mfr: --size: only a scene's histogram uses it (mfr info SCENE)"},
            {"dataset @sample -o " + out + " --sample 0", "mfr: --sample: must be in (0, 1]: 0 writes no rows"},
            // A slab below the float depth precision drew nothing (the oracle too), one of 3.4e38
            // was infinite: found by a bug hunt.
@@ -1383,7 +1417,9 @@ TEST_F(Cli, BudgetCommandsCheckListsFilesAndBudgetsFirst) {
            {"render @sample -s 16x16 -m dkb -p weights=/dev/zero -o " + (dir() / "x.png").string(),
             "/dev/zero: not a regular file (a device or pipe)"},
            {"render @sample -s 16x16 -o " + (dir() / "x.JPG").string(),
-            "x.JPG: the name says JPEG, but the image is written as PNG, the one format mfr writes: name it .png"}}) {
+            "x.JPG: the name says JPEG, but the image is written as PNG, the one format mfr writes: name it .png"},
+           {"render @sample -s 16x16 -o " + (dir() / "x.avif").string(), "x.avif: the name says AVIF, but"},
+           {"render @sample -s 16x16 -o " + (dir() / "x.jp2").string(), "x.jp2: the name says JPEG 2000, but"}}) {
     const CliResult bad = runCli(args);
     EXPECT_TRUE(bad.exitCode == 1 || bad.exitCode == 2) << args << ": " << bad.out;
     EXPECT_EQ(std::count(bad.out.begin(), bad.out.end(), '\n'), 1) << bad.out;

@@ -157,7 +157,22 @@ TEST_F(CliSection, BadPlanesAreRefused) {
   expectCleanFailure("render @sample --size 16x16 --section 0,0,0,,1,0,0", "expected AXIS=VALUE or six numbers");
   expectCleanFailure("render @sample --size 16x16 --section x=0:slice",
                      "--section x=0:slice: slice: scene 'sample' has no volume");
-  expectCleanFailure("render @sample --size 16x16 --section x=100", "section plane: cuts away every visible surface");
+  // The argument or the scene file that gave the plane is named (they read "section plane: …" or
+  // "section: slice: …", naming neither; a bug hunt).
+  expectCleanFailure("render @sample --size 16x16 --section x=100",
+                     "mfr: --section x=100: cuts away every visible surface of scene 'sample'");
+  const std::string away =
+      write("away.mfrscene",
+            R"({"sample": true, "name": "study", "section": {"point": [0, 0, 5], "normal": [0, 0, 1]}})")
+          .string();
+  expectCleanFailure("render " + away + " --size 16x16",
+                     "mfr: " + away + ": section: cuts away every visible surface of scene 'study'");
+  const std::string slice =
+      write("slice.mfrscene",
+            R"({"sample": true, "name": "study", "section": {"point": [0, 0, 0], "normal": [0, 0, 1], "slice": true}})")
+          .string();
+  expectCleanFailure("render " + slice + " --size 16x16",
+                     "mfr: " + slice + ": section: slice: scene 'study' has no volume");
   // CSG on solids a section without caps cut open: the message said only "object 'a': not a
   // closed surface", as if the file were at fault (a bug hunt).
   expectCleanFailure("render @csg --size 16x16 --section x=0:nocaps --op csg",

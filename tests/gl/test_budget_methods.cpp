@@ -433,8 +433,9 @@ TEST(FixedKUnderBudget, LargestUniformKAndTheOracleHybrid) {
   }
 }
 
-// Outside operation hybrid nothing reads fkb's tail: its 20 bytes a pixel go to slots unless
-// -p tail=true asks for it (under --op oit the tail took k = 3 where k = 6 fit; a bug hunt).
+// Outside operation hybrid nothing reads fkb's tail: its 20 bytes a pixel go to slots (under --op
+// oit the tail took k = 3 where k = 6 fit; a bug hunt), and -p tail=true is refused there (it was
+// taken and spent the bytes on nothing; a bug hunt).
 TEST(FixedKUnderBudget, SpendsNoTailOutsideHybrid) {
   context();
   const SampleReference& ref = reference();
@@ -452,7 +453,19 @@ TEST(FixedKUnderBudget, SpendsNoTailOutsideHybrid) {
       RenderRequest req = budgetRequest("fkb", budget);
       req.operation = operation;
       if (askTail) req.params["tail"] = "true";
-      const bool tail = askTail || req.operation == "hybrid";
+      const bool tail = req.operation == "hybrid";
+      if (askTail && !tail) {
+        try {
+          (void)gpu.render(ref.camera, req);
+          ADD_FAILURE() << operation << ": tail=true was taken";
+        } catch (const Error& e) {
+          EXPECT_EQ(std::string(e.what()),
+                    "--param tail=true: only operation hybrid reads the tail (--op hybrid); "
+                    "this render's operation is " +
+                        std::string(operation));
+        }
+        continue;
+      }
       const RenderOutput out = gpu.render(ref.camera, req);
       const std::uint32_t k = largestUniformK(tail ? tailed : plain, budget);
       EXPECT_EQ(out.stats.kMax, k) << operation << " tail " << askTail;

@@ -81,27 +81,33 @@ TEST_F(OutputFiles, ASignalWaitsForTheLastRename) {
   const fs::path png = dir() / "c.png", json = dir() / "c.json";
   mfr::writeFilesAtomically({{png, "old"}, {json, "old"}});
   const std::string big(48u << 20, 'n');  // long enough to be caught mid-write
-  const pid_t child = ::fork();
-  ASSERT_GE(child, 0);
-  if (child == 0) {
-    try {
-      mfr::writeFilesAtomically({{png, big}, {json, big}});
-    } catch (...) {
-      ::_exit(3);
-    }
-    ::_exit(0);
-  }
-  // Signal as soon as the first temporary appears.
-  bool seen = false;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (!seen && std::chrono::steady_clock::now() < until)
-    for (const std::string& name : namesIn(dir()))
-      if (name.find(".tmp-") != std::string::npos) seen = true;
-  ASSERT_EQ(::kill(child, SIGTERM), 0);
+  // A loaded machine may let the writer finish before the signal reaches it: that try proves
+  // nothing, and is made again (at most three times).
   int status = 0;
-  ASSERT_EQ(::waitpid(child, &status, 0), child);
-  ASSERT_TRUE(seen) << "no temporary was seen: the test could not signal mid-write";
-  ASSERT_TRUE(WIFSIGNALED(status)) << "the writer ended before the signal reached it (status " << status << ")";
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      try {
+        mfr::writeFilesAtomically({{png, big}, {json, big}});
+      } catch (...) {
+        ::_exit(3);
+      }
+      ::_exit(0);
+    }
+    // Signal as soon as the first temporary appears.
+    bool seen = false;
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (!seen && std::chrono::steady_clock::now() < until)
+      for (const std::string& name : namesIn(dir()))
+        if (name.find(".tmp-") != std::string::npos) seen = true;
+    ASSERT_EQ(::kill(child, SIGTERM), 0);
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(seen) << "no temporary was seen: the test could not signal mid-write";
+    if (!(WIFEXITED(status) && WEXITSTATUS(status) == 0)) break;
+  }
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the writer ended before the signal reached it three times (status " << status
+                                   << ")";
   EXPECT_EQ(WTERMSIG(status), SIGTERM) << "the signal still ends the process";
   EXPECT_EQ(fs::file_size(png), big.size());
   EXPECT_EQ(fs::file_size(json), big.size());
@@ -139,6 +145,22 @@ TEST(TerminationSignalsHeld, RaisesWhatArrivedWhenTheLastEnds) {
   EXPECT_EQ(n, 1) << "the inner holder's end raised the signal while the outer one still held it";
   ASSERT_TRUE(WIFSIGNALED(status)) << "status " << status;
   EXPECT_EQ(WTERMSIG(status), SIGINT);
+  // A signal the process ignores stays ignored, and one after it is not lost (nohup's SIGHUP, then
+  // a SIGTERM, ended in exit 0; a review).
+  const pid_t ignoring = ::fork();
+  ASSERT_GE(ignoring, 0);
+  if (ignoring == 0) {
+    std::signal(SIGHUP, SIG_IGN);
+    {
+      const mfr::TerminationSignalsHeld held;
+      std::raise(SIGHUP);
+      std::raise(SIGTERM);
+    }
+    ::_exit(6);  // not reached: SIGTERM ends the process
+  }
+  ASSERT_EQ(::waitpid(ignoring, &status, 0), ignoring);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "status " << status;
+  EXPECT_EQ(WTERMSIG(status), SIGTERM);
   // Without a signal, nothing is raised and the handlers are back as they were.
   const auto before = std::signal(SIGHUP, SIG_IGN);
   { const mfr::TerminationSignalsHeld held; }

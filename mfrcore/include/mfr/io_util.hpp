@@ -26,10 +26,11 @@ void writeFilesAtomically(const std::vector<std::pair<std::filesystem::path, std
 // path leaves no first file behind. Throws mfr::Error naming path.
 void checkOutputPath(const std::filesystem::path& path);
 
-// While one lives, SIGINT, SIGTERM and SIGHUP are caught and remembered instead of acted on; the
-// last one alive puts the previous handlers back and raises what arrived, so the process then ends
-// as it would have (or runs its own handler). Process-wide, whichever thread the signal reaches;
-// nests and may be used from several threads. Not for long work: Ctrl-C waits for it.
+// While one lives, SIGINT, SIGTERM and SIGHUP are caught and remembered instead of acted on (one
+// the process ignores stays ignored); the last one alive puts the previous handlers back and
+// raises each that arrived, so the process then ends as it would have (or runs its own handler).
+// Process-wide, whichever thread the signal reaches; nests and may be used from several threads.
+// Not for long work: Ctrl-C waits for it.
 class TerminationSignalsHeld {
  public:
   TerminationSignalsHeld();

@@ -827,6 +827,9 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
       // An empty name was listed among the views and could never be chosen (a bug hunt).
       if (viewName.empty()) r.fail(where + ".name", "must not be empty");
       if (viewName == "fit") r.fail(where + ".name", "'fit' is reserved for the fit-all view");
+      // --view orbit:A:E is the orbit syntax: a view of such a name hid it (a bug hunt).
+      if (viewName.rfind("orbit:", 0) == 0)
+        r.fail(where + ".name", "'" + viewName + "': names beginning 'orbit:' are --view's orbit syntax");
       // --view finds the first of a name: a second view of it could never be shown.
       for (std::size_t j = 0; j < scene.views.size(); ++j)
         if (scene.views[j].name == viewName)
