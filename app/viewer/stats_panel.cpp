@@ -27,11 +27,12 @@ StatsPanel::StatsPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), m
   layout->addWidget(tree_);
   connect(&model_, &ViewerModel::frameRendered, this, &StatsPanel::showStats);
   // No numbers of the last frame drawn under a frame that cannot be drawn.
-  connect(&model_, &ViewerModel::renderErrorChanged, this, [this](const QString& message) {
-    if (message.isEmpty() || !model_.mainPaneFailed()) return;
+  connect(&model_, &ViewerContext::frameErrorChanged, this, [this] {
+    const QString error = model_.frameError();
+    if (error.isEmpty()) return;
     tree_->clear();
-    auto* item = new QTreeWidgetItem(tree_, {tr("No frame"), model_.renderErrorShown()});
-    item->setToolTip(1, model_.renderErrorShown());
+    auto* item = new QTreeWidgetItem(tree_, {tr("No frame"), error});
+    item->setToolTip(1, error);
   });
 }
 

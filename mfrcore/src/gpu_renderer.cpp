@@ -137,27 +137,21 @@ Method& GpuRenderer::prepare(const RenderRequest& request) {
     volumeStep_ = volumeStepOf(request, drawnVolumes_);
   }
   std::map<std::string, std::string> given = request.params;
-  // vkb's and dkb's exact tail leaves each pixel's last fragments to the hybrid tail: under another
-  // operation there is none, and their notes said "every pixel exact" over a wrong image (a bug
-  // hunt). There the bound is off by default, and refused when asked for.
   const auto& specs = method_->info().params;
-  // A k-buffer's tail, too: only hybrid reads it, and elsewhere its 20 bytes a pixel were spent on
-  // nothing (kplus-array -p tail=true under oit, the same image; a bug hunt).
-  if (operation_ != "hybrid" &&
-      std::any_of(specs.begin(), specs.end(), [](const ParamSpec& p) { return p.name == "tail"; }))
-    if (const auto it = given.find("tail"); it != given.end() && Params(specs, given, request.method).flag("tail"))
-      throw Error("--param tail=" + it->second,
-                  "only operation hybrid reads the tail (--op hybrid); this render's operation is " + operation_);
-  if (operation_ != "hybrid" &&
-      std::any_of(specs.begin(), specs.end(), [](const ParamSpec& p) { return p.name == "exact_tail"; })) {
+  // Outside hybrid nothing reads a tail, and a flag that asks for one is refused rather than taken
+  // without effect (bug hunts): a k-buffer's tail (its 20 bytes a pixel spent on nothing), vkb's
+  // and dkb's exact tail (their notes said "every pixel exact" over a wrong image; off by default
+  // there) and tail_runs, which refines the exact tail's bound.
+  if (operation_ != "hybrid") {
+    static constexpr std::pair<const char*, const char*> kHybridOnly[] = {
+        {"tail", "only operation hybrid reads the tail (--op hybrid)"},
+        {"exact_tail", "only operation hybrid composites a tail"},
+        {"tail_runs", "refines exact_tail, which only operation hybrid uses"}};
     const Params asGiven(specs, given, request.method);  // a value that is no flag is named as such first
-    if (const auto it = given.find("exact_tail"); it != given.end() && asGiven.flag("exact_tail"))
-      throw Error("--param exact_tail=" + it->second,
-                  "only operation hybrid composites a tail; this render's operation is " + operation_);
-    // tail_runs refines the exact tail's bound: asked for without one, it did nothing (a bug hunt).
-    if (const auto it = given.find("tail_runs"); it != given.end() && asGiven.flag("tail_runs"))
-      throw Error("--param tail_runs=" + it->second,
-                  "refines exact_tail, which only operation hybrid uses; this render's operation is " + operation_);
+    for (const auto& [name, reason] : kHybridOnly)
+      if (const auto it = given.find(name); it != given.end() && asGiven.flag(name))
+        throw Error("--param " + std::string(name) + "=" + it->second,
+                    std::string(reason) + "; this render's operation is " + operation_);
   }
   // Defaults of this operation (defaultValueFor: fkb's tail and the exact tail are off outside hybrid).
   for (const ParamSpec& spec : specs)
