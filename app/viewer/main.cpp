@@ -93,7 +93,9 @@ QSize parseSize(const QString& option, const QString& text) {
   return size;
 }
 
-CommandLine parseCommandLine(const QCoreApplication& app) {
+// Needs a QCoreApplication. `sessionArgs`: the --session option and its value, which
+// takeSessionOption kept from Qt.
+CommandLine parseCommandLine(const QStringList& sessionArgs) {
   QCommandLineParser parser;
   parser.setApplicationDescription(QStringLiteral("Multifragment rendering viewer"));
   parser.addHelpOption();
@@ -170,21 +172,33 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
       QStringLiteral("Section plane, as mfr render's: AXIS=VALUE (x, y, z, -x, -y, -z; keeps the side the axis points "
                      "to) or px,py,pz,nx,ny,nz, optionally :nocaps and/or :slice; 'none' removes the scene's own."),
       QStringLiteral("plane"));
+  const QCommandLineOption session(
+      QStringLiteral("session"),
+      QStringLiteral("Session file to open (the same as giving it as the scene; File > Save session writes one)."),
+      QStringLiteral("file.mfrsession"));
   const QCommandLineOption pluginSettings(QStringLiteral("plugin-settings"),
                                           QStringLiteral("Settings of a plugin, as in a session file (repeatable)."),
                                           QStringLiteral("id={json}"));
-  parser.addOptions({method,     op,      thickness, step,          field, molecule, colorBy,    colorMap,
-                     colorRange, contour, legend,    param,         view,  size,     screenshot, windowScreenshot,
-                     windowSize, clip,    section,   pluginSettings});
+  parser.addOptions({method,     op,      thickness, step,    field,         molecule, colorBy,    colorMap,
+                     colorRange, contour, legend,    param,   view,          size,     screenshot, windowScreenshot,
+                     windowSize, clip,    section,   session, pluginSettings});
   // Unknown options and missing values are command-line errors, exit 2 as every other (process()
   // exits 1 for them); process() then does only what parse() does not: -h, --help-all, --version.
-  if (!parser.parse(QCoreApplication::arguments())) fail(parser.errorText(), 2);
-  parser.process(app);
+  QStringList arguments = QCoreApplication::arguments();
+  // Before a "--", which ends the options; a --session without its value goes last of the
+  // options, so that the parser says "Missing value" instead of taking the next option as it.
+  const bool valueMissing = !sessionArgs.isEmpty() && sessionArgs.constLast() == QStringLiteral("--session");
+  qsizetype at = valueMissing ? arguments.indexOf(QStringLiteral("--")) : 1;
+  if (at < 0) at = arguments.size();
+  for (const QString& a : sessionArgs) arguments.insert(at++, a);
+  if (!parser.parse(arguments)) fail(parser.errorText(), 2);
+  parser.process(arguments);
   // An empty value is refused, as mfr refuses it: read as "not given", --screenshot '' opened the
   // interactive window and never quit.
   for (const QCommandLineOption& option :
-       {method, op, thickness, step, field, molecule, colorBy, colorMap, colorRange, contour, param, view, size,
-        screenshot, windowScreenshot, windowSize, clip, section, pluginSettings})
+       {method,           op,         thickness, step,    field,   molecule,      colorBy,
+        colorMap,         colorRange, contour,   param,   view,    size,          screenshot,
+        windowScreenshot, windowSize, clip,      section, session, pluginSettings})
     for (const QString& value : parser.values(option))
       if (value.isEmpty()) fail(QStringLiteral("--%1: an empty value").arg(option.names().constLast()), 2);
 
@@ -192,6 +206,15 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
   if (parser.positionalArguments().size() > 1)
     fail(QStringLiteral("expected one scene, got %1").arg(parser.positionalArguments().size()), 2);
   if (!parser.positionalArguments().isEmpty()) cl.scene = parser.positionalArguments().first();
+  if (parser.isSet(session)) {
+    if (parser.values(session).size() > 1)
+      fail(QStringLiteral("--session %1: more than one session is given").arg(parser.values(session).constLast()), 2);
+    if (!parser.positionalArguments().isEmpty())
+      fail(QStringLiteral("--session %1: a scene is given too (%2); give one of the two")
+               .arg(parser.value(session), cl.scene),
+           2);
+    cl.scene = cl.session = parser.value(session);
+  }
   if (cl.scene.endsWith(QStringLiteral(".mfrsession"), Qt::CaseInsensitive)) cl.session = cl.scene;
   cl.method = parser.value(method);
   cl.op = parser.value(op);
@@ -318,6 +341,31 @@ CommandLine parseCommandLine(const QCoreApplication& app) {
   return cl;
 }
 
+// QGuiApplication takes -session and --session with their value for X11 session management, so
+// `mfrview --session s.mfrsession` opened @sample without a word. mfrview's own --session (two
+// dashes) is taken out of argv before Qt sees it and handed to the parser; -session stays Qt's.
+QStringList takeSessionOption(int& argc, char** argv) {
+  QStringList taken;
+  int kept = 1;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--") == 0) {  // what follows is positional
+      while (i < argc) argv[kept++] = argv[i++];
+      break;
+    }
+    if (std::strcmp(argv[i], "--session") == 0) {
+      taken << QStringLiteral("--session");
+      if (i + 1 < argc) taken << QString::fromLocal8Bit(argv[++i]);  // else the parser's "Missing value"
+    } else if (std::strncmp(argv[i], "--session=", 10) == 0) {
+      taken << QString::fromLocal8Bit(argv[i]);
+    } else {
+      argv[kept++] = argv[i];
+    }
+  }
+  argc = kept;
+  argv[argc] = nullptr;
+  return taken;
+}
+
 // --help and --version need no display: answered by a QCoreApplication, which opens none.
 bool mentionsHelpOrVersion(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
@@ -344,13 +392,14 @@ void refuseMissingDisplay(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const QStringList sessionArgs = takeSessionOption(argc, argv);
   if (mentionsHelpOrVersion(argc, argv)) {
     QCoreApplication core(argc, argv);
     QCoreApplication::setApplicationName(QStringLiteral("mfrview"));
     QCoreApplication::setApplicationVersion(QStringLiteral(MFR_VERSION));
     // Prints the help or the version and exits; returns only where "-v" was another option's
     // value (--field -v), and the viewer starts as usual.
-    (void)parseCommandLine(core);
+    (void)parseCommandLine(sessionArgs);
   }
   refuseMissingDisplay(argc, argv);
   // Every GL context mfrview creates is 4.5 core, like mfrcore's headless one.
@@ -368,7 +417,7 @@ int main(int argc, char** argv) {
   QApplication::setApplicationName(QStringLiteral("mfrview"));
   QApplication::setOrganizationName(QStringLiteral("mfr"));
   QApplication::setApplicationVersion(QStringLiteral(MFR_VERSION));
-  const CommandLine cl = parseCommandLine(app);
+  const CommandLine cl = parseCommandLine(sessionArgs);
   const bool scripted = !cl.screenshot.isEmpty() || !cl.windowScreenshot.isEmpty();
   try {
     (void)mfr::availableHostMemory();  // a malformed MFR_MEMORY_LIMIT_MIB is refused before any work

@@ -769,6 +769,48 @@ class ViewerTest : public QObject {
     }
   }
 
+  // --session FILE opens the session as the positional FILE does: Qt's QGuiApplication took
+  // --session and its value for X11 session management, and mfrview drew @sample (exit 0; noted
+  // by a session, fixed by taking the option out of argv before Qt sees it).
+  void sessionOptionOpensTheSession() {
+    QTemporaryDir dir;
+    const QString sessionPath = dir.filePath("k.mfrsession");
+    {
+      auto w = openWindow(QStringLiteral("@csg"));
+      QVERIFY(w);
+      ViewerModel& m = w->model();
+      m.setMethod("kbuffer");
+      m.setParams({{"k", "2"}});
+      m.setCamera(navigation::orbit(m.camera(), QPointF(37, -21), QSize(400, 300)));
+      settle(m);
+      w->saveSession(sessionPath);
+    }
+    const QString positional = dir.filePath("positional.png"), option = dir.filePath("option.png"),
+                  joined = dir.filePath("joined.png"), sample = dir.filePath("sample.png");
+    QString out;
+    QCOMPARE(runProgram(MFRVIEW, {sessionPath, "--size", "64x48", "--screenshot", positional}, &out), 0);
+    QCOMPARE(runProgram(MFRVIEW, {"--session", sessionPath, "--size", "64x48", "--screenshot", option}, &out), 0);
+    QCOMPARE(runProgram(MFRVIEW, {"--size", "64x48", "--session=" + sessionPath, "--screenshot", joined}, &out), 0);
+    QCOMPARE(runProgram(MFRVIEW, {"--size", "64x48", "--screenshot", sample}, &out), 0);
+    const mfr::ImageRGBA8 expected = mfr::readPng(positional.toStdString());
+    QCOMPARE(maxChannelDifference(expected, mfr::readPng(option.toStdString())), 0);
+    QCOMPARE(maxChannelDifference(expected, mfr::readPng(joined.toStdString())), 0);
+    QVERIFY(maxChannelDifference(expected, mfr::readPng(sample.toStdString())) > 8);  // not the default scene
+    const QString png = dir.filePath("refused.png");
+    for (const auto& [args, line] : QList<std::pair<QStringList, QString>>{
+             {{"@sample", "--session", sessionPath, "--screenshot", png},
+              QStringLiteral("mfrview: --session %1: a scene is given too (@sample); give one of the two")
+                  .arg(sessionPath)},
+             {{"--session", sessionPath, "--session", sessionPath, "--screenshot", png},
+              QStringLiteral("mfrview: --session %1: more than one session is given").arg(sessionPath)},
+             {{"--session=", "--screenshot", png}, QStringLiteral("mfrview: --session: an empty value")},
+             {{"--screenshot", png, "--session"}, QStringLiteral("mfrview: Missing value after '--session'.")}}) {
+      QCOMPARE(runProgram(MFRVIEW, args, &out), 2);
+      QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(), line);
+      QVERIFY(!QFile::exists(png));
+    }
+  }
+
   // mfrview took a --clip box that holds nothing of the scene (an empty image, exit 0) and
   // dropped ':slice' on a scene without a volume, both of which mfr render refuses (a bug hunt).
   // The same line now, from both programs.
