@@ -139,8 +139,8 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   flipLabel_ = new QLabel(tr("—"));
   flipLabel_->setWordWrap(true);  // it may hold why the numbers were not computed
   flipLabel_->setObjectName(QStringLiteral("budgetFlip"));
-  rmseLabel_->setToolTip(tr("Root-mean-square RGB error against the exact image (oracle), 0 … 1"));
-  flipLabel_->setToolTip(tr("Mean (max) LDR-FLIP error against the exact image: 0 identical … 1 most different"));
+  rmseLabel_->setToolTip(qualityToolTip(rmseLabel_, QString()));
+  flipLabel_->setToolTip(qualityToolTip(flipLabel_, QString()));
   frameForm->addRow(tr("RMSE vs exact"), rmseLabel_);
   frameForm->addRow(tr("FLIP vs exact"), flipLabel_);
   kMapOverlay_ = new QCheckBox(tr("Show k(p) over the image"));
@@ -300,17 +300,26 @@ void BudgetPanel::showRobustness() {
   robustnessSlider_->setValue(static_cast<int>(std::lround((value - spec->min) / span * kRobustnessSteps)));
 }
 
+// What the number is, then why it is missing: the reason alone replaced the description, which
+// then stayed empty from the first measured frame on (a bug hunt).
+QString BudgetPanel::qualityToolTip(const QLabel* label, const QString& reason) const {
+  const QString what = label == rmseLabel_
+                           ? tr("Root-mean-square RGB error against the exact image (oracle), 0 … 1")
+                           : tr("Mean (max) LDR-FLIP error against the exact image: 0 identical … 1 most different");
+  return reason.isEmpty() ? what : what + QLatin1Char('\n') + reason;
+}
+
 void BudgetPanel::showQuality() {
   if (!ctx_.frameError().isEmpty()) {  // no frame on screen to measure
     for (QLabel* label : {rmseLabel_, flipLabel_}) {
       label->setText(tr("—"));
-      label->setToolTip(ctx_.frameError());
+      label->setToolTip(qualityToolTip(label, ctx_.frameError()));
     }
     return;
   }
   const FrameQuality q = ctx_.frameQuality();
-  rmseLabel_->setToolTip(q.error);
-  flipLabel_->setToolTip(q.error);
+  rmseLabel_->setToolTip(qualityToolTip(rmseLabel_, q.error));
+  flipLabel_->setToolTip(qualityToolTip(flipLabel_, q.error));
   if (!q.valid) {
     // Not computed for this frame: say why (the exact image may not fit in memory), not
     // "computing…" for ever.

@@ -75,6 +75,7 @@ class BudgetPanel final : public QWidget {
   void showKnob();  // what the budget drives, and whether it does yet
   void showRobustness();
   void showQuality();
+  QString qualityToolTip(const QLabel* label, const QString& reason) const;
 
   ViewerContext& ctx_;
   QComboBox* methodCombo_ = nullptr;

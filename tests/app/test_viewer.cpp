@@ -619,6 +619,10 @@ class ViewerTest : public QObject {
     auto* captured = w->findChild<QLabel*>("capturedLabel");
     auto* rmse = w->findChild<QLabel*>("budgetRmse");
     QVERIFY(slider && bar && captured && rmse);
+    // The RMSE label says what it measures, then why it has no number (the reason alone replaced
+    // the description, which then stayed empty from the first measured frame on; a bug hunt).
+    const QString rmseMeans = rmse->toolTip();
+    QVERIFY2(rmseMeans.startsWith(QStringLiteral("Root-mean-square RGB error")), qPrintable(rmseMeans));
     m.setMethod(QStringLiteral("vkb"));
     slider->setValue(16);
     settle(m);
@@ -635,11 +639,15 @@ class ViewerTest : public QObject {
     QCOMPARE(bar->value(), 0);
     QCOMPARE(captured->text(), QStringLiteral("—"));
     QCOMPARE(rmse->text(), QStringLiteral("—"));
+    QCOMPARE(rmse->toolTip(), rmseMeans + QLatin1Char('\n') + m.frameError());
     slider->setValue(16);
     QTRY_VERIFY_WITH_TIMEOUT(m.frameError().isEmpty() && bar->format().contains(QStringLiteral(" of 16 MiB (")),
                              kTimeoutMs);
     QVERIFY(captured->text() != QStringLiteral("—"));
     QVERIFY(bar->toolTip().isEmpty());
+    QTRY_VERIFY_WITH_TIMEOUT(rmse->text() != QStringLiteral("—") && rmse->text() != QStringLiteral("computing…"),
+                             kTimeoutMs);
+    QCOMPARE(rmse->toolTip(), rmseMeans);
   }
 
   void badFileKeepsScene() {
