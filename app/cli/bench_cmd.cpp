@@ -239,20 +239,9 @@ void addBench(CLI::App& app) {
       const std::vector<double>& totals = run.totals;
       const auto& perPass = run.perPass;
       const RenderOutput& last = run.last;
-      std::string label = req.method;
-      for (const auto& [k, v] : req.params) label += ":" + k + "=" + v;
-      if (req.operation != "auto") label += ":op=" + req.operation;
-      if (req.thickness > 0.0) {
-        std::ostringstream t;
-        t << req.thickness;
-        label += ":thickness=" + t.str();
-      }
-      if (req.volumeStep > 0.0) {
-        std::ostringstream t;
-        t << req.volumeStep;
-        label += ":step=" + t.str();
-      }
-      if (req.volumeShading) label += std::string(":shade=") + (*req.volumeShading ? "1" : "0");
+      // The entry as given: rebuilt from the parsed request, its parameters came out sorted by name
+      // (kplus-heap:k=8:culling=false read kplus-heap:culling=false:k=8).
+      const std::string& label = run.spec;
       nlohmann::ordered_json row;
       row["method"] = label;
       row["median_total_ms"] = median(totals);
