@@ -140,13 +140,10 @@ void addRender(CLI::App& app) {
                                     std::to_string(kMinLegendImageSize) + " pixels a side");
     }
     RenderOutput out = render(scene, camera, req);
-    // The GPU methods keep 32-bit window depths: a given near and far that cannot order what is
-    // drawn are said (the oracle casts in double precision).
-    if (req.method != "oracle" && req.method != "optimal-k")
-      if (const std::optional<std::string> note = camera.depthPrecisionNote(scene.bounds())) {
-        std::cerr << "note: view " << opt->view << ": " << *note << "\n";
-        out.stats.notes.emplace_back("depth precision", *note);
-      }
+    // The GPU methods keep 32-bit window depths: GpuRenderer notes a given near and far that cannot
+    // order what is drawn (the oracle casts in double precision).
+    for (const auto& [key, note] : out.stats.notes)
+      if (key == "depth precision") std::cerr << "note: view " << opt->view << ": " << note << "\n";
     if (!opt->dataView.empty()) {
       // n(p): the GPU's count pass for a GPU method, the oracle's lists for the CPU ones; k(p): the
       // method's own (GpuRenderer::kMap, optimal-k's allocation).

@@ -677,7 +677,11 @@ int main(int argc, char** argv) {
       };
       if (!cl.windowScreenshot.isEmpty()) requireGiven(model.params());
       try {
-        if (!cl.screenshot.isEmpty()) window.exportImage(cl.screenshot, cl.size, cl.legend, requireGiven);
+        if (!cl.screenshot.isEmpty()) {
+          // As mfr render says it: a scripted run has no Statistics dock to show the note in.
+          for (const auto& [key, note] : window.exportImage(cl.screenshot, cl.size, cl.legend, requireGiven).notes)
+            if (key == "depth precision") std::cerr << "note: " << key << ": " << note << "\n";
+        }
         if (!cl.windowScreenshot.isEmpty()) {
           // Plugins' panels update from the frame's signals; let them paint first.
           QApplication::processEvents();

@@ -641,7 +641,7 @@ MainWindow::ExportRender MainWindow::renderForExport(QSize size) {
   return render;
 }
 
-void MainWindow::exportImage(const QString& path, QSize size, bool legend, const ExportCheck& check) {
+mfr::Stats MainWindow::exportImage(const QString& path, QSize size, bool legend, const ExportCheck& check) {
   mfr::requireSomethingToDraw(model_->drawnScene());  // as mfr render refuses it, before --legend
   std::optional<ViewerModel::ColorLegend> shown;
   if (legend) {
@@ -668,6 +668,7 @@ void MainWindow::exportImage(const QString& path, QSize size, bool legend, const
   mfr::ImageRGBA8 image = std::move(render.output.image);
   if (shown) mfr::drawColorLegend(image, shown->colors, model_->scene().background, shown->ticks);
   mfr::writePng(path.toStdString(), image);
+  return std::move(render.output.stats);
 }
 
 void MainWindow::chooseFileToOpen() {
@@ -709,7 +710,7 @@ void MainWindow::chooseImageToExport() {
     // As on screen: the legend of a field colouring or of the isosurfaces, when it fits.
     const bool legend = model_->colorLegend().has_value() && size.width() >= mfr::kMinLegendImageSize &&
                         size.height() >= mfr::kMinLegendImageSize;
-    exportImage(path, size, legend);
+    (void)exportImage(path, size, legend);
     statusBar()->showMessage(tr("Wrote %1").arg(path), 5000);
   } catch (const std::exception& e) {
     showError(tr("Cannot export the image"), QString::fromUtf8(e.what()));

@@ -47,7 +47,8 @@ class MainWindow final : public QMainWindow {
   // small for one).
   // `check` (if any) sees the parameters the picture is drawn with before it is written.
   using ExportCheck = std::function<void(const std::map<std::string, std::string>& params)>;
-  void exportImage(const QString& path, QSize size, bool legend = false, const ExportCheck& check = {});
+  // Returns the render's statistics (its notes: a depth precision too coarse for given planes).
+  mfr::Stats exportImage(const QString& path, QSize size, bool legend = false, const ExportCheck& check = {});
   // The render exportImage writes: the view's method at `size`, with the plugins' parameters for
   // that size (MfrViewerPlugin::exportParams), refitted until they settle; throws mfr::Error when
   // they do not within a few renders.

@@ -283,6 +283,10 @@ Stats GpuRenderer::renderTo(GLuint target, const Camera& camera, const RenderReq
     stats.notes.emplace_back("csg buffer (bytes)", std::to_string(csgBytes));
   }
   if (!fieldColorsNote_.empty()) stats.notes.emplace_back("field colours", fieldColorsNote_);
+  // Window depths are 32-bit floats: given near and far planes that cannot order what is drawn
+  // are said, by every program that draws through here (mfrview said nothing).
+  if (const std::optional<std::string> note = camera.depthPrecisionNote(sceneBounds_))
+    stats.notes.emplace_back("depth precision", *note);
   if (operation_ == "zthickness") stats.notes.emplace_back("z-thickness", numberText(thickness_));
   if (operation_ == "volume") {
     stats.notes.emplace_back("volume step", numberText(volumeStep_));

@@ -1408,6 +1408,49 @@ class ViewerTest : public QObject {
   // A named view's own near and far planes (a cut-away view) are kept, as mfr render keeps them:
   // setCamera fitted them to the scene, so mfrview drew the whole sphere (a bug hunt). They hold
   // until the camera moves, and a session keeps them.
+  // Given planes whose 32-bit window depth cannot order what is drawn: mfr render said so, mfrview
+  // drew the misordered layers without a word (a note of an earlier session). The Statistics dock
+  // lists the note, a scripted run prints it as mfr render does; a near plane of 0.01 gets none.
+  void givenDepthRangesTooCoarseAreNoted() {
+    QTemporaryDir dir;
+    const auto scene = [&](const QString& name, const char* near) {
+      const QString path = dir.filePath(name);
+      QFile f(path);
+      if (!f.open(QIODevice::WriteOnly)) return QString();
+      f.write(QByteArray(R"({"sample": true, "objects": [], "views": [{"name": "v", "eye": [0, 0, 5], "near": )") +
+              near + R"(, "far": 6}]})");
+      return path;
+    };
+    const QString coarse = scene("coarse.mfrscene", "1e-5"), fine = scene("fine.mfrscene", "0.01");
+    QVERIFY(!coarse.isEmpty() && !fine.isEmpty());
+    const QString png = dir.filePath("n.png");
+    const QString expected = QStringLiteral("note: depth precision: near 1e-05 and far 6 resolve depths only 0.2");
+    QString out;
+    QCOMPARE(
+        runProgram(MFRVIEW, {coarse, "--view", "v", "-m", "abuffer-ll", "--size", "96x72", "--screenshot", png}, &out),
+        0);
+    QVERIFY2(out.contains(expected), qPrintable(out));
+    QCOMPARE(
+        runProgram(MFRVIEW, {fine, "--view", "v", "-m", "abuffer-ll", "--size", "96x72", "--screenshot", png}, &out),
+        0);
+    QVERIFY2(!out.contains(QStringLiteral("depth precision")), qPrintable(out));
+
+    auto w = openWindow(coarse);
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    m.setCamera(m.scene().view("v"));
+    settle(m);
+    const auto noted = [&m] {
+      for (const auto& [key, value] : m.stats().notes)
+        if (key == "depth precision") return true;
+      return false;
+    };
+    QVERIFY(noted());
+    m.setCamera(m.scene().view("fit"));  // fitted planes: no note
+    settle(m);
+    QVERIFY(!noted());
+  }
+
   void givenNearFarPlanesAreKept() {
     QTemporaryDir dir;
     const QString scene = dir.filePath(QStringLiteral("cut.mfrscene"));
