@@ -12,6 +12,7 @@
 #include <cmath>
 #include <exception>
 
+#include "header_sizing.hpp"
 #include "render_view.hpp"
 #include "viewer_model.hpp"
 
@@ -196,6 +197,7 @@ void ProbePanel::show(const ViewProbe& r) {
   }
   summary_->setText(text);
 
+  const ContentSizedSectionsHeld held(table_->horizontalHeader());  // a deep pixel has thousands of rows
   table_->setRowCount(n + 1);
   // The probe's ids are the drawn scene's: a section's volume slices come after the scene's parts.
   const auto& objects = model_.drawnScene().objects;

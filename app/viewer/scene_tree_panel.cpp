@@ -21,6 +21,7 @@
 #include <cmath>
 #include <utility>
 
+#include "header_sizing.hpp"
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/measure.hpp"
 #include "viewer_model.hpp"
@@ -322,6 +323,7 @@ void SceneTreePanel::showValues() {
   const auto& volumes = model_.scene().volumes;
   if (tree_->topLevelItemCount() != static_cast<int>(objects.size() + volumes.size())) return;
   const QSignalBlocker block(tree_);
+  const ContentSizedSectionsHeld held(tree_->header());  // every row may change (ghosting)
   for (std::size_t v = 0; v < volumes.size(); ++v) {
     QTreeWidgetItem* item = tree_->topLevelItem(static_cast<int>(objects.size() + v));
     item->setCheckState(kName, volumes[v].visible ? Qt::Checked : Qt::Unchecked);

@@ -26,6 +26,7 @@
 #include <QStatusBar>
 #include <QStandardPaths>
 #include <QSurfaceFormat>
+#include <QStyledItemDelegate>
 #include <QTableWidget>
 #include <QTemporaryDir>
 #include <QTreeWidget>
@@ -87,6 +88,18 @@ void settle(ViewerModel& model) {
 }
 
 // Largest per-channel difference of two same-size images; -1 when the sizes differ.
+// Counts the size hints an item view asks for: filling rows should ask for each a few times, not
+// once per row for every changed cell (what made thousands of rows freeze the window).
+class SizeHintCounter final : public QStyledItemDelegate {
+ public:
+  using QStyledItemDelegate::QStyledItemDelegate;
+  QSize sizeHint(const QStyleOptionViewItem& option, const QModelIndex& index) const override {
+    ++calls;
+    return QStyledItemDelegate::sizeHint(option, index);
+  }
+  mutable long long calls = 0;
+};
+
 int maxChannelDifference(const mfr::ImageRGBA8& a, const mfr::ImageRGBA8& b) {
   if (a.width != b.width || a.height != b.height) return -1;
   int diff = 0;
@@ -3923,6 +3936,48 @@ class ViewerTest : public QObject {
   // The Probe dock: Ctrl + click lists the oracle's exact fragments behind the pixel (parts in
   // depth order, shares summing to 100 %), which of them the method holds (a k-buffer's k nearest,
   // an A-buffer's all), follows the method without another click, does not orbit, and clears.
+  // Ghosting set every part's opacity in one scene edit, yet the Scene panel froze for 7 s at 1,000
+  // parts (22 s at 4,000): its columns sized to contents re-measured every row at every changed
+  // cell (a bug hunt; the Probe dock's table fills the same way). Counted by the size hints asked
+  // for, not timed: a few per row, where it was one per row per changed cell.
+  void manyRowsFillWithoutRemeasuringEachRow() {
+    constexpr int kParts = 300;
+    auto w = openWindow(QString());  // a small view and a cheap method before the deep scene
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    RenderView& view = w->view();
+    view.setFixedSize(160, 120);
+    m.setMethod("wboit");
+    w->openScene(QStringLiteral("@quads:%1").arg(kParts));
+    QTRY_VERIFY_WITH_TIMEOUT(m.hasScene() && m.framesRendered() > 0, kTimeoutMs);
+    QCOMPARE(m.renderSize(), QSize(160, 120));
+    m.setCamera(m.scene().view("front"));
+    settle(m);
+    auto* tree = w->findChild<QTreeWidget*>("sceneTree");
+    QVERIFY(tree);
+    QCOMPARE(tree->topLevelItemCount(), kParts);
+    w->findChild<QDockWidget*>("sceneDock")->raise();  // a hidden view measures nothing
+    QTRY_VERIFY_WITH_TIMEOUT(tree->isVisible(), kTimeoutMs);
+    QTest::qWait(500);
+    SizeHintCounter treeHints;  // on every column: the Opacity column has a delegate of its own
+    std::vector<QAbstractItemDelegate*> treeDelegates;
+    for (int c = 0; c < tree->columnCount(); ++c) {
+      treeDelegates.push_back(tree->itemDelegateForColumn(c));
+      tree->setItemDelegateForColumn(c, &treeHints);
+    }
+    // Ghosting: one scene edit sets every other part's opacity.
+    auto* ghost = w->findChild<QCheckBox*>("ghostOthers");
+    QVERIFY(ghost);
+    w->findChild<QDockWidget*>("plugin-ghosting")->raise();  // where the user ticks it
+    QTest::qWait(500);
+    QVERIFY(tree->isVisible());
+    ghost->setChecked(true);
+    QCOMPARE(tree->topLevelItem(kParts - 1)->data(2, Qt::EditRole).toDouble(), 0.15);  // the ghost opacity
+    QApplication::processEvents();  // the columns' one measurement, deferred
+    QVERIFY2(treeHints.calls < 20 * kParts, qPrintable(QStringLiteral("%1 size hints").arg(treeHints.calls)));
+    for (int c = 0; c < tree->columnCount(); ++c) tree->setItemDelegateForColumn(c, treeDelegates[c]);
+  }
+
   void pixelProbe() {
     auto w = openWindow();
     QVERIFY(w);
