@@ -242,15 +242,17 @@ QStringList applySession(const Session& session, ViewerModel& model) {
   for (const mfr::Object& part : model.scene().objects) partNames << QString::fromStdString(part.name);
   const std::vector<int> partOf = matchByName(objectEntries, partNames);
   QStringList unmatched;
+  std::vector<ViewerModel::ObjectState> states;
+  states.reserve(session.objects.size());
   for (std::size_t e = 0; e < session.objects.size(); ++e) {
     const Session::ObjectState& o = session.objects[e];
     if (partOf[e] < 0) {
       unmatched << QStringLiteral("'%1'").arg(o.name);
       continue;
     }
-    model.setObjectVisible(partOf[e], o.visible);
-    model.setObjectMaterial(partOf[e], o.color, o.vertexColors);
+    states.push_back({partOf[e], o.visible, o.color, o.vertexColors});
   }
+  model.setObjectStates(states);
   if (!unmatched.isEmpty())
     notes << (unmatched.size() == 1 ? QStringLiteral("the session's object %1 is no part of the scene: left out")
                                     : QStringLiteral("the session's objects %1 are no part of the scene: left out"))

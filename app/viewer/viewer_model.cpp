@@ -722,18 +722,27 @@ void ViewerModel::setMoleculeStyle(const mfr::MoleculeStyle& style) {
 
 std::vector<int> matchByName(const QStringList& entries, const QStringList& names, bool unnamedByIndex) {
   std::vector<int> match;
-  std::map<QString, int> seen;  // entries of each name so far
+  // The indices of each name, in order: a scan of every name per entry made a session of 16,000
+  // parts take 0.7 s here alone (a bug hunt).
+  std::map<QString, std::vector<int>> indicesOf;
+  for (int i = 0; i < names.size(); ++i) indicesOf[names[i]].push_back(i);
+  std::map<QString, std::size_t> seen;  // entries of each name so far
   for (const QString& entry : entries) {
-    int nth = seen[entry]++;
+    const std::size_t nth = seen[entry]++;
     int index = -1;
-    for (int i = 0; i < names.size() && index < 0 && !(unnamedByIndex && entry.isEmpty()); ++i)
-      if (names[i] == entry && nth-- == 0) index = i;
+    if (!(unnamedByIndex && entry.isEmpty()))
+      if (const auto it = indicesOf.find(entry); it != indicesOf.end() && nth < it->second.size())
+        index = it->second[nth];
     match.push_back(index);
   }
-  if (unnamedByIndex)
+  if (unnamedByIndex) {
+    std::vector<bool> taken(static_cast<std::size_t>(names.size()), false);
+    for (int index : match)
+      if (index >= 0) taken[static_cast<std::size_t>(index)] = true;
     for (int e = 0; e < entries.size(); ++e)
-      if (entries[e].isEmpty() && e < names.size() && std::find(match.begin(), match.end(), e) == match.end())
+      if (entries[e].isEmpty() && e < names.size() && !taken[static_cast<std::size_t>(e)])
         match[static_cast<std::size_t>(e)] = e;
+  }
   return match;
 }
 
@@ -1086,6 +1095,25 @@ void ViewerModel::setObjectOpacities(const QMap<int, double>& opacities) {
 double ViewerModel::loadedObjectOpacity(int index) const {
   if (index < 0 || index >= static_cast<int>(loadedMaterials_.size())) return -1.0;
   return loadedMaterials_[static_cast<std::size_t>(index)].color.a;
+}
+
+void ViewerModel::setObjectStates(const std::vector<ObjectState>& states) {
+  bool changed = false, visibility = false;
+  for (const ObjectState& state : states) {
+    if (state.index < 0 || state.index >= static_cast<int>(scene_.objects.size())) continue;
+    mfr::Object& object = scene_.objects[static_cast<std::size_t>(state.index)];
+    if (object.visible != state.visible) {
+      object.visible = state.visible;
+      visibility = changed = true;
+    }
+    if (object.material.color != state.color || object.material.vertexColors != state.vertexColors) {
+      object.material.color = state.color;
+      object.material.vertexColors = state.vertexColors;
+      changed = true;
+    }
+  }
+  if (visibility) updateSceneGeometry();
+  if (changed) sceneEdited();
 }
 
 void ViewerModel::setObjectMaterial(int index, const glm::vec4& rgba, bool vertexColors) {
