@@ -834,6 +834,11 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
           return;
         }
         pollLoadProgress();  // the loader's last report
+        if (state != load_) {  // a slot of that report cancelled the load: the model stayed busy for ever
+          --abandonedLoads_;
+          lastCancelStoppedLoader_ = false;
+          return;
+        }
         loadPoll_->stop();
         load_.reset();
         loading_ = false;

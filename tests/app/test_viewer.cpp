@@ -146,12 +146,13 @@ void writeBinaryStl(const QString& path, int triangles) {
 }
 
 // A .mfrscene of `objects` copies of one model file (and one primitive, which loads no file).
-void writeSceneFile(const QString& path, const QString& model, int objects) {
+// One object per model file (a file placed twice is read once), and a ball.
+void writeSceneFile(const QString& path, const QStringList& models) {
   QString json = QStringLiteral("{\"name\": \"%1\", \"objects\": [").arg(QFileInfo(path).baseName());
-  for (int i = 0; i < objects; ++i)
+  for (int i = 0; i < models.size(); ++i)
     json += QStringLiteral("{\"name\": \"part %1\", \"file\": \"%2\", \"transform\": {\"translate\": [0, 0, %1]}},")
                 .arg(i)
-                .arg(QFileInfo(model).fileName());
+                .arg(QFileInfo(models[i]).fileName());
   json += QStringLiteral("{\"name\": \"ball\", \"primitive\": {\"type\": \"sphere\", \"radius\": 0.5}}]}");
   QFile f(path);
   if (f.open(QIODevice::WriteOnly)) f.write(json.toUtf8());
@@ -3511,9 +3512,19 @@ class ViewerTest : public QObject {
     const QString small = dir.filePath("small.stl"), big = dir.filePath("big.stl");
     writeBinaryStl(small, 2000);
     writeBinaryStl(big, 150000);
+    // Copies, each read: a scene file reads a file it places several times once.
+    QStringList smallFiles, bigFiles;
+    for (int i = 0; i < 8; ++i) {
+      if (i < 4) {
+        smallFiles << dir.filePath(QStringLiteral("small-%1.stl").arg(i));
+        QVERIFY(QFile::copy(small, smallFiles.constLast()));
+      }
+      bigFiles << dir.filePath(QStringLiteral("big-%1.stl").arg(i));
+      QVERIFY(QFile::copy(big, bigFiles.constLast()));
+    }
     const QString smallScene = dir.filePath("small.mfrscene"), bigScene = dir.filePath("big.mfrscene");
-    writeSceneFile(smallScene, small, 4);
-    writeSceneFile(bigScene, big, 8);
+    writeSceneFile(smallScene, smallFiles);
+    writeSceneFile(bigScene, bigFiles);
 
     // mfrcore: per object, non-decreasing, from 0 to 1; false stops the loader at that report.
     ProgressRecorder all;
@@ -3596,6 +3607,24 @@ class ViewerTest : public QObject {
     QVERIFY(m.lastCancelStoppedLoader());  // LoadCancelled inside mfr::loadScene, not a dropped result
     QCOMPARE(m.scenePath(), QFileInfo(smallScene).absoluteFilePath());
     QCOMPARE(m.scene().objects.size(), std::size_t{5});
+    // A cancel at the loader's last report (a slot of loadProgressChanged(1)): the scene was set all
+    // the same and the model stayed busy for ever (found when loads got faster).
+    // A scene that loads within one poll of the loader's progress: its 1 comes with the result.
+    const QString tiny = dir.filePath("tiny.mfrscene");
+    {
+      QFile f(tiny);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(R"({"objects": [{"primitive": {"type": "sphere", "radius": 1}}]})");
+    }
+    const QMetaObject::Connection atEnd = connect(&m, &ViewerModel::loadProgressChanged, this, [&](double fraction) {
+      if (fraction == 1.0) m.cancelLoad();
+    });
+    w->openScene(tiny);
+    QTRY_VERIFY_WITH_TIMEOUT(!m.busy(), kTimeoutMs);
+    disconnect(atEnd);
+    QCOMPARE(cancelled.count(), 2);
+    QCOMPARE(loadedSpy.count(), 0);
+    QCOMPARE(m.scenePath(), QFileInfo(smallScene).absoluteFilePath());
     const quint64 frames = m.framesRendered();
     m.setCamera(navigation::orbit(m.camera(), QPointF(15, 5), m.renderSize()));
     QTRY_VERIFY_WITH_TIMEOUT(m.framesRendered() > frames, kTimeoutMs);
