@@ -30,6 +30,7 @@
 #include <exception>
 #include <map>
 #include <utility>
+#include <memory>
 #include <optional>
 #include <thread>
 
@@ -632,9 +633,10 @@ int main(int argc, char** argv) {
     // Poll until the scene is loaded, a frame is drawn (for --window-screenshot) and background
     // work (oracle image, depth-complexity histogram) is done, then take the pictures and quit.
     auto* poll = new QTimer(&app);
-    auto* clock = new QElapsedTimer;
+    // Owned by the poll's slot (raw pointers leaked both; a sanitizer run).
+    auto clock = std::make_shared<QElapsedTimer>();
     clock->start();
-    auto* settled = new QElapsedTimer;  // since everything was first drawn and idle
+    auto settled = std::make_shared<QElapsedTimer>();  // since everything was first drawn and idle
     // The poll runs on the GUI thread, which a long live frame blocks (a volume at a step of 1e-6:
     // "timed out" came after 278 s, not 120; a bug hunt). A watchdog thread keeps the promise while
     // the run waits. Each side claims the run (exchange) before it acts: a picture is written only

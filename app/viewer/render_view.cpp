@@ -89,6 +89,9 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
 }
 
 RenderView::~RenderView() {
+  // The context's aboutToBeDestroyed comes from ~QOpenGLWidget, after this destructor: its slot
+  // would call releaseGl on destroyed members (UBSan's vptr check at every close; a sanitizer run).
+  if (context()) disconnect(context(), &QOpenGLContext::aboutToBeDestroyed, this, nullptr);
   // GL objects must be deleted with their context current.
   if (renderers_[0] && context()) {
     makeCurrent();

@@ -833,7 +833,7 @@ void ViewerModel::loadSceneAsync(const QString& path, const QString& field,
           lastCancelStoppedLoader_ = loaded.stopped;
           return;
         }
-        pollLoadProgress();  // the loader's last report
+        pollLoadProgress();    // the loader's last report
         if (state != load_) {  // a slot of that report cancelled the load: the model stayed busy for ever
           --abandonedLoads_;
           lastCancelStoppedLoader_ = false;

@@ -1396,8 +1396,8 @@ TEST_F(Cli, BudgetCommandsCheckListsFilesAndBudgetsFirst) {
   const CliResult largest = runCli("evaluate @sample -s 16x12 -r 1 -m vkb,dkb --budgets 65536 --json " + json.string());
   ASSERT_EQ(largest.exitCode, 0) << largest.out;
   std::ifstream inLargest(json);
-  for (const nlohmann::json& row : nlohmann::json::parse(inLargest).at("results"))
-    EXPECT_FALSE(row.contains("error")) << row.dump();
+  const nlohmann::json largestRows = nlohmann::json::parse(inLargest);  // a temporary died before the loop
+  for (const nlohmann::json& row : largestRows.at("results")) EXPECT_FALSE(row.contains("error")) << row.dump();
 
   for (const auto& [args, message] : std::vector<std::pair<std::string, std::string>>{
            {"evaluate @sample -s 40x30 --budgets k1 -m vkb,fkb:tail=false",

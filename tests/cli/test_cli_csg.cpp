@@ -61,11 +61,13 @@ TEST_F(CliCsg, SceneFileTreeRenders) {
     const CliResult r = runCli(common + " --op csg -o " + csg.string());
     ASSERT_EQ(r.exitCode, 0) << r.out;
     ASSERT_EQ(runCli(common + " -o " + oit.string()).exitCode, 0);
-    const std::uint8_t* hole = mfr::readPng(csg).at(24, 24);
+    // The images kept: pointers into temporaries read freed pixels (a sanitizer run).
+    const mfr::ImageRGBA8 csgImage = mfr::readPng(csg), oitImage = mfr::readPng(oit);
+    const std::uint8_t* hole = csgImage.at(24, 24);
     EXPECT_EQ(int(hole[0]) + hole[1] + hole[2], 3 * 255);  // background through the bore
-    const std::uint8_t* wall = mfr::readPng(csg).at(24, 16);
+    const std::uint8_t* wall = csgImage.at(24, 16);
     EXPECT_LT(int(wall[0]) + wall[1] + wall[2], 3 * 240);  // the box's face
-    const std::uint8_t* covered = mfr::readPng(oit).at(24, 24);
+    const std::uint8_t* covered = oitImage.at(24, 24);
     EXPECT_LT(int(covered[0]) + covered[1] + covered[2], 3 * 250);  // "over": the drill's cap
   }
 }

@@ -90,8 +90,9 @@ std::string matrix(int nx, int ny, int nz, int offset = 0) {
 // A tetrahedron as VTK XML PolyData (ASCII), translated by t.
 std::string tetrahedronVtp(double t = 0.0) {
   std::string pts;
-  for (const double* p : {std::array<double, 3>{0, 0, 0}.data(), std::array<double, 3>{1, 0, 0}.data(),
-                          std::array<double, 3>{0, 1, 0}.data(), std::array<double, 3>{0, 0, 1}.data()})
+  // The arrays themselves: pointers into temporaries outlived them (a sanitizer run).
+  for (const std::array<double, 3>& p : {std::array<double, 3>{0, 0, 0}, std::array<double, 3>{1, 0, 0},
+                                         std::array<double, 3>{0, 1, 0}, std::array<double, 3>{0, 0, 1}})
     pts += std::to_string(p[0] + t) + " " + std::to_string(p[1] + t) + " " + std::to_string(p[2] + t) + " ";
   return "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
          "<PolyData><Piece NumberOfPoints=\"4\" NumberOfPolys=\"4\">\n"

@@ -326,7 +326,8 @@ class Unpacker {
     const auto n = value<std::uint64_t>();
     if (n > (bytes_.size() - at_) / sizeof(T)) fail();
     std::vector<T> values(static_cast<std::size_t>(n));
-    std::memcpy(values.data(), take(values.size() * sizeof(T)), values.size() * sizeof(T));
+    // An empty vector's data() may be null, which memcpy must not get even for 0 bytes (UBSan).
+    if (!values.empty()) std::memcpy(values.data(), take(values.size() * sizeof(T)), values.size() * sizeof(T));
     return values;
   }
   std::string text() {
