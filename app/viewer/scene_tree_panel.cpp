@@ -4,13 +4,17 @@
 #include <QColorDialog>
 #include <QComboBox>
 #include <QDoubleSpinBox>
+#include <QGuiApplication>
 #include <QGridLayout>
 #include <QHBoxLayout>
 #include <QHeaderView>
+#include <QInputDialog>
 #include <QLabel>
+#include <QLineEdit>
 #include <QMenu>
 #include <QPixmap>
 #include <QPushButton>
+#include <QRegularExpression>
 #include <QStyledItemDelegate>
 #include <QTreeWidget>
 #include <QVBoxLayout>
@@ -46,6 +50,29 @@ class OpacityDelegate : public QStyledItemDelegate {
     return box;
   }
 };
+
+// The other columns take no editor: the name cell's text editor renamed the row, not the part, and
+// a rebuild brought the name back.
+class ReadOnlyDelegate : public QStyledItemDelegate {
+ public:
+  using QStyledItemDelegate::QStyledItemDelegate;
+  QWidget* createEditor(QWidget*, const QStyleOptionViewItem&, const QModelIndex&) const override { return nullptr; }
+};
+
+// The filter's text: a name matches when it contains the text; with * (any characters) or ? (one)
+// the pattern must match the whole name, as a shell's. Case is ignored. Not Qt's fromWildcard:
+// its * stops at a '/', and assembly parts are named with paths.
+QRegularExpression filterPattern(const QString& text) {
+  const bool wildcard = text.contains(QLatin1Char('*')) || text.contains(QLatin1Char('?'));
+  QString pattern;
+  for (const QChar c : text)
+    pattern += c == QLatin1Char('*')   ? QStringLiteral(".*")
+               : c == QLatin1Char('?') ? QStringLiteral(".")
+                                       : QRegularExpression::escape(QString(c));
+  if (wildcard) pattern = QRegularExpression::anchoredPattern(pattern);
+  return QRegularExpression(pattern,
+                            QRegularExpression::CaseInsensitiveOption | QRegularExpression::DotMatchesEverythingOption);
+}
 
 QColor colourOf(const mfr::Object& o) {
   return QColor::fromRgbF(o.material.color.r, o.material.color.g, o.material.color.b);
@@ -203,6 +230,21 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   connect(rangeLow_, &QDoubleSpinBox::valueChanged, this, [this] { applyFieldColoring(false); });
   connect(rangeHigh_, &QDoubleSpinBox::valueChanged, this, [this] { applyFieldColoring(false); });
   connect(dataRange_, &QPushButton::clicked, this, [this] { applyFieldColoring(true); });
+  auto* filterRow = new QHBoxLayout;
+  filterRow->setContentsMargins(4, 4, 4, 0);
+  filter_ = new QLineEdit;
+  filter_->setObjectName(QStringLiteral("sceneFilter"));
+  filter_->setPlaceholderText(tr("Filter by name (* and ? as wildcards)"));
+  filter_->setClearButtonEnabled(true);
+  filter_->setToolTip(
+      tr("Rows whose name contains the text (case ignored); with * or ? the pattern matches the "
+         "whole name. Only the rows are hidden: the parts stay as they are drawn"));
+  filterCount_ = new QLabel;
+  filterCount_->setObjectName(QStringLiteral("sceneFilterCount"));
+  filterRow->addWidget(filter_, 1);
+  filterRow->addWidget(filterCount_);
+  layout->addLayout(filterRow);
+  connect(filter_, &QLineEdit::textChanged, this, &SceneTreePanel::applyFilter);
   tree_ = new QTreeWidget;
   tree_->setObjectName(QStringLiteral("sceneTree"));
   tree_->setColumnCount(4);
@@ -213,23 +255,53 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   tree_->header()->setSectionResizeMode(kName, QHeaderView::Stretch);
   for (int c : {kColour, kOpacity, kTriangles}) tree_->header()->setSectionResizeMode(c, QHeaderView::ResizeToContents);
   tree_->setEditTriggers(QAbstractItemView::DoubleClicked | QAbstractItemView::EditKeyPressed);
+  tree_->setSelectionMode(QAbstractItemView::ExtendedSelection);
   tree_->setItemDelegateForColumn(kOpacity, new OpacityDelegate(tree_));
+  for (int c : {kName, kColour, kTriangles}) tree_->setItemDelegateForColumn(c, new ReadOnlyDelegate(tree_));
   layout->addWidget(tree_);
   connect(tree_, &QTreeWidget::itemChanged, this, &SceneTreePanel::itemChanged);
   connect(tree_, &QTreeWidget::itemClicked, this, &SceneTreePanel::itemClicked);
-  // Right-click: back to the file's colour (a molecule's element colours) after choosing one.
+  // The selection's actions: in the context menu, with shortcuts while the tree has the focus
+  // (Space toggles, as FreeCAD's tree does). Right-click selects the row under the cursor first
+  // (Qt's views do) unless it is selected already, so the menu acts on what is selected.
+  const auto addAction = [this](const char* name, const QString& text, auto slot) {
+    auto* action = new QAction(text, this);
+    action->setObjectName(QString::fromLatin1(name));
+    action->setShortcutContext(Qt::WidgetWithChildrenShortcut);
+    connect(action, &QAction::triggered, this, slot);
+    tree_->addAction(action);
+    return action;
+  };
+  showParts_ = addAction("showPartsAction", tr("Show"), [this] { setSelectedVisible(true); });
+  hideParts_ = addAction("hidePartsAction", tr("Hide"), [this] { setSelectedVisible(false); });
+  toggleParts_ = addAction("togglePartsAction", tr("Toggle Visibility"), &SceneTreePanel::toggleSelectedVisible);
+  toggleParts_->setShortcut(QKeySequence(Qt::Key_Space));
+  showOnlyParts_ = addAction("showOnlyPartsAction", tr("Show Only These"), &SceneTreePanel::showOnlySelected);
+  showAllParts_ = addAction("showAllPartsAction", tr("Show All Parts"), [this] {
+    QMap<int, bool> visible;
+    for (int i = 0; i < static_cast<int>(model_.scene().objects.size()); ++i) visible.insert(i, true);
+    model_.setObjectVisibilities(visible);
+  });
+  fitParts_ = addAction("fitPartsAction", tr("Fit View to These"), &SceneTreePanel::fitViewToSelected);
+  colourParts_ = addAction("colourPartsAction", tr("Colour…"), &SceneTreePanel::chooseSelectedColour);
+  opacityParts_ = addAction("opacityPartsAction", tr("Opacity…"), &SceneTreePanel::chooseSelectedOpacity);
+  resetColourParts_ = addAction("resetColourAction", tr("Reset Colour to the File's"),
+                                [this] { model_.resetObjectColors(selectedParts()); });
   tree_->setContextMenuPolicy(Qt::CustomContextMenu);
   connect(tree_, &QWidget::customContextMenuRequested, this, [this](const QPoint& at) {
-    QTreeWidgetItem* item = tree_->itemAt(at);
-    if (!item || item->data(kName, Qt::UserRole).toInt() < 0) return;  // a volume row
-    const int index = item->data(kName, Qt::UserRole).toInt();
+    updateSelectionActions();
+    if (selectedParts().isEmpty()) return;  // nothing or volume rows only
     QMenu menu(this);
-    QAction* reset =
-        menu.addAction(tr("Reset Colour to the File's"), this, [this, index] { model_.resetObjectColor(index); });
-    reset->setObjectName(QStringLiteral("resetColourAction"));
-    reset->setEnabled(model_.objectColorEdited(index));
+    menu.addActions({showParts_, hideParts_, toggleParts_, showOnlyParts_, showAllParts_});
+    menu.addSeparator();
+    menu.addAction(fitParts_);
+    menu.addSeparator();
+    menu.addActions({colourParts_, opacityParts_, resetColourParts_});
     menu.exec(tree_->viewport()->mapToGlobal(at));
   });
+  connect(tree_, &QTreeWidget::itemSelectionChanged, this, &SceneTreePanel::updateSelectionActions);
+  connect(&model_, &ViewerModel::sceneChanged, this, &SceneTreePanel::updateSelectionActions);
+  updateSelectionActions();
   connect(&model_, &ViewerModel::sceneLoaded, this, &SceneTreePanel::rebuild);
   connect(&model_, &ViewerModel::sceneLoaded, this, &SceneTreePanel::showMoleculeStyle);
   // A re-read that fails or is cancelled leaves the representations drawn: the boxes show them.
@@ -385,7 +457,9 @@ void SceneTreePanel::rebuild() {
     items.push_back(item);
   }
   tree_->addTopLevelItems(items);
+  applyFilter();  // the filter typed stays for the next scene
   rebuilding_ = false;
+  updateSelectionActions();
 }
 
 void SceneTreePanel::itemChanged(QTreeWidgetItem* item, int column) {
@@ -405,10 +479,113 @@ void SceneTreePanel::itemChanged(QTreeWidgetItem* item, int column) {
 }
 
 void SceneTreePanel::itemClicked(QTreeWidgetItem* item, int column) {
-  if (column != kColour || volumeOfRow(item) >= 0) return;
+  // Not a Ctrl or Shift click, which adds to the selection.
+  if (column != kColour || volumeOfRow(item) >= 0 || QGuiApplication::keyboardModifiers() != Qt::NoModifier) return;
   const int index = item->data(kName, Qt::UserRole).toInt();
   const QColor initial = colourOf(model_.scene().objects[static_cast<std::size_t>(index)]);
   const QColor chosen = QColorDialog::getColor(initial, this, tr("Colour of %1").arg(item->text(kName)));
   if (!chosen.isValid()) return;
   model_.setObjectColor(index, chosen);
+}
+
+void SceneTreePanel::applyFilter() {
+  const QString text = filter_->text().trimmed();
+  const QRegularExpression pattern = filterPattern(text);
+  const int rows = tree_->topLevelItemCount();
+  int shown = 0;
+  {
+    const ContentSizedSectionsHeld held(tree_->header());  // rows of thousands of parts
+    for (int r = 0; r < rows; ++r) {
+      QTreeWidgetItem* item = tree_->topLevelItem(r);
+      const bool match = text.isEmpty() || pattern.match(item->text(kName)).hasMatch();
+      item->setHidden(!match);
+      shown += match ? 1 : 0;
+    }
+  }
+  filterCount_->setText(text.isEmpty() ? QString() : tr("%1 of %2").arg(shown).arg(rows));
+  filterCount_->setVisible(!text.isEmpty());
+  updateSelectionActions();
+}
+
+QList<int> SceneTreePanel::selectedParts() const {
+  QList<int> parts;
+  for (const QTreeWidgetItem* item : tree_->selectedItems())
+    // Not the rows the filter hides (Select All selects them too: "filter, select all, hide" must
+    // hide only what the filter shows).
+    if (!item->isHidden() && volumeOfRow(item) < 0) parts.push_back(item->data(kName, Qt::UserRole).toInt());
+  std::sort(parts.begin(), parts.end());
+  return parts;
+}
+
+void SceneTreePanel::updateSelectionActions() {
+  const QList<int> parts = selectedParts();
+  for (QAction* action : {showParts_, hideParts_, toggleParts_, showOnlyParts_, fitParts_, colourParts_, opacityParts_})
+    action->setEnabled(!parts.isEmpty());
+  showAllParts_->setEnabled(!model_.scene().objects.empty());
+  resetColourParts_->setEnabled(
+      std::any_of(parts.begin(), parts.end(), [this](int i) { return model_.objectColorEdited(i); }));
+}
+
+void SceneTreePanel::setSelectedVisible(bool visible) {
+  QMap<int, bool> change;
+  for (const int i : selectedParts()) change.insert(i, visible);
+  model_.setObjectVisibilities(change);
+}
+
+// As one check box for the selection: all of it shown → hidden; otherwise all of it shown.
+void SceneTreePanel::toggleSelectedVisible() {
+  const QList<int> parts = selectedParts();
+  const auto& objects = model_.scene().objects;
+  const bool allShown = std::all_of(parts.begin(), parts.end(), [&](int i) {
+    return i < static_cast<int>(objects.size()) && objects[static_cast<std::size_t>(i)].visible;
+  });
+  setSelectedVisible(!allShown);
+}
+
+void SceneTreePanel::showOnlySelected() {
+  const QList<int> parts = selectedParts();
+  if (parts.isEmpty()) return;
+  QMap<int, bool> visible;
+  for (int i = 0; i < static_cast<int>(model_.scene().objects.size()); ++i) visible.insert(i, false);
+  for (const int i : parts) visible.insert(i, true);
+  model_.setObjectVisibilities(visible);
+}
+
+QString SceneTreePanel::partsText(const QList<int>& parts) const {
+  if (parts.size() != 1) return tr("%1 parts").arg(parts.size());
+  const std::string& name = model_.scene().objects[static_cast<std::size_t>(parts.front())].name;
+  return name.empty() ? tr("object %1").arg(parts.front()) : QString::fromStdString(name);
+}
+
+void SceneTreePanel::chooseSelectedColour() {
+  const QList<int> parts = selectedParts();
+  if (parts.isEmpty()) return;
+  const QColor initial = colourOf(model_.scene().objects[static_cast<std::size_t>(parts.front())]);
+  const QColor chosen = QColorDialog::getColor(initial, this, tr("Colour of %1").arg(partsText(parts)));
+  if (chosen.isValid()) model_.setObjectColors(selectedParts(), chosen);
+}
+
+void SceneTreePanel::chooseSelectedOpacity() {
+  const QList<int> parts = selectedParts();
+  if (parts.isEmpty()) return;
+  bool ok = false;
+  const double opacity = QInputDialog::getDouble(this, tr("Opacity"),
+                                                 tr("Opacity of %1 (0 = invisible, 1 = opaque)").arg(partsText(parts)),
+                                                 model_.objectOpacity(parts.front()), 0.0, 1.0, 3, &ok);
+  if (!ok) return;
+  QMap<int, double> opacities;
+  for (const int i : selectedParts()) opacities.insert(i, opacity);
+  model_.setObjectOpacities(opacities);
+}
+
+// The view turned to nothing, only moved and zoomed so that the selected parts fill it (hidden
+// ones too: a part found by name is framed before it is shown); near and far still hold the scene.
+void SceneTreePanel::fitViewToSelected() {
+  mfr::Scene chosen;
+  for (const int i : selectedParts()) {
+    chosen.objects.push_back(model_.scene().objects[static_cast<std::size_t>(i)]);
+    chosen.objects.back().visible = true;
+  }
+  if (!chosen.bounds().valid()) return;
+  model_.setCamera(chosen.fit(model_.camera()));
 }

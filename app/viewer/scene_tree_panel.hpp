@@ -3,7 +3,9 @@
 // change) and an editable opacity, then one row per volume (name, grid size, visibility). Above
 // them, for a molecule file: its representations (spheres, ball and stick, sticks, surface); for
 // parts with data arrays: Colour by (a field, or the parts' own colours), the colour map and the
-// range mapped to its ends.
+// range mapped to its ends. A filter by name above the rows, and several rows selected edited at
+// once (context menu, Space): CAD assemblies have thousands of parts.
+#include <QList>
 #include <QWidget>
 
 #include <array>
@@ -14,7 +16,9 @@
 class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
+class QAction;
 class QLabel;
+class QLineEdit;
 class QPushButton;
 class QTreeWidget;
 class QTreeWidgetItem;
@@ -39,8 +43,34 @@ class SceneTreePanel final : public QWidget {
 
   void showMoleculeStyle();  // the model's molecule representations in the Molecule row
 
+  // The filter: rows whose name does not match are hidden (not the parts they stand for).
+  void applyFilter();
+  // The parts of the selected rows that the filter shows, in row order (volume rows left out).
+  [[nodiscard]] QList<int> selectedParts() const;
+  [[nodiscard]] QString partsText(const QList<int>& parts) const;  // a part's name, or "n parts"
+  void updateSelectionActions();
+  void setSelectedVisible(bool visible);
+  void toggleSelectedVisible();
+  void showOnlySelected();
+  void chooseSelectedColour();
+  void chooseSelectedOpacity();
+  void fitViewToSelected();
+
   ViewerModel& model_;
   QTreeWidget* tree_ = nullptr;
+  QLineEdit* filter_ = nullptr;
+  QLabel* filterCount_ = nullptr;
+  // On the selection: show, hide, toggle (Space), show only, show all, fit the view, colour,
+  // opacity, reset colour. Members, so that their shortcuts work and tests can trigger them.
+  QAction* showParts_ = nullptr;
+  QAction* hideParts_ = nullptr;
+  QAction* toggleParts_ = nullptr;
+  QAction* showOnlyParts_ = nullptr;
+  QAction* showAllParts_ = nullptr;
+  QAction* fitParts_ = nullptr;
+  QAction* colourParts_ = nullptr;
+  QAction* opacityParts_ = nullptr;
+  QAction* resetColourParts_ = nullptr;
   QWidget* moleculeRow_ = nullptr;        // shown for a molecule file
   std::array<QCheckBox*, 5> molecule_{};  // spheres, ball-and-stick, sticks, cartoon, surface
   QWidget* fieldRow_ = nullptr;           // hidden when no part has a field

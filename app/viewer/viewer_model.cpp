@@ -1039,31 +1039,57 @@ QString ViewerModel::setCsgTree(const QString& json) {
 }
 
 void ViewerModel::setObjectVisible(int index, bool visible) {
-  if (index < 0 || index >= static_cast<int>(scene_.objects.size())) return;
-  mfr::Object& object = scene_.objects[static_cast<std::size_t>(index)];
-  if (object.visible == visible) return;
-  object.visible = visible;
+  setObjectVisibilities({{index, visible}});
+}
+
+void ViewerModel::setObjectVisibilities(const QMap<int, bool>& visible) {
+  bool changed = false;
+  for (auto it = visible.begin(); it != visible.end(); ++it) {
+    if (it.key() < 0 || it.key() >= static_cast<int>(scene_.objects.size())) continue;
+    mfr::Object& object = scene_.objects[static_cast<std::size_t>(it.key())];
+    if (object.visible == it.value()) continue;
+    object.visible = it.value();
+    changed = true;
+  }
+  if (!changed) return;
   updateSceneGeometry();
   sceneEdited();
 }
 
 void ViewerModel::setObjectColor(int index, const QColor& rgb) {
-  if (index < 0 || index >= static_cast<int>(scene_.objects.size())) return;
-  mfr::Material& material = scene_.objects[static_cast<std::size_t>(index)].material;
-  glm::vec4& c = material.color;
-  c = glm::vec4(static_cast<float>(rgb.redF()), static_cast<float>(rgb.greenF()), static_cast<float>(rgb.blueF()), c.a);
-  material.vertexColors = false;
-  material.fieldColors.reset();  // a colour chosen for the part replaces its field's colours too
-  sceneEdited();
+  setObjectColors({index}, rgb);
+}
+
+void ViewerModel::setObjectColors(const QList<int>& indices, const QColor& rgb) {
+  bool changed = false;
+  for (const int index : indices) {
+    if (index < 0 || index >= static_cast<int>(scene_.objects.size())) continue;
+    mfr::Material& material = scene_.objects[static_cast<std::size_t>(index)].material;
+    glm::vec4& c = material.color;
+    c = glm::vec4(static_cast<float>(rgb.redF()), static_cast<float>(rgb.greenF()), static_cast<float>(rgb.blueF()),
+                  c.a);
+    material.vertexColors = false;
+    material.fieldColors.reset();  // a colour chosen for the part replaces its field's colours too
+    changed = true;
+  }
+  if (changed) sceneEdited();
 }
 
 void ViewerModel::resetObjectColor(int index) {
-  if (!objectColorEdited(index)) return;
-  const auto i = static_cast<std::size_t>(index);
-  mfr::Material& material = scene_.objects[i].material;
-  material.color = glm::vec4(glm::vec3(loadedMaterials_[i].color), material.color.a);
-  material.vertexColors = loadedMaterials_[i].vertexColors;
-  sceneEdited();
+  resetObjectColors({index});
+}
+
+void ViewerModel::resetObjectColors(const QList<int>& indices) {
+  bool changed = false;
+  for (const int index : indices) {
+    if (!objectColorEdited(index)) continue;
+    const auto i = static_cast<std::size_t>(index);
+    mfr::Material& material = scene_.objects[i].material;
+    material.color = glm::vec4(glm::vec3(loadedMaterials_[i].color), material.color.a);
+    material.vertexColors = loadedMaterials_[i].vertexColors;
+    changed = true;
+  }
+  if (changed) sceneEdited();
 }
 
 bool ViewerModel::objectColorEdited(int index) const {

@@ -9,6 +9,7 @@
 // compare mode. Each side has its own method, operation and parameters per method.
 #include <QColor>
 #include <QImage>
+#include <QList>
 #include <QMap>
 #include <QSize>
 #include <QString>
@@ -264,6 +265,11 @@ class ViewerModel final : public ViewerContext {
   // The colour the part had when its scene was loaded (its file's per-vertex colours, e.g. a
   // molecule's element colours, included); the opacity stays as it is.
   void resetObjectColor(int index);
+  // The same for several parts (the Scene dock's selection) in one scene edit: one edit per part
+  // makes every panel walk every part per part. Indices out of range are skipped.
+  void setObjectVisibilities(const QMap<int, bool>& visible);
+  void setObjectColors(const QList<int>& indices, const QColor& rgb);
+  void resetObjectColors(const QList<int>& indices);
   [[nodiscard]] bool objectColorEdited(int index) const;
   [[nodiscard]] double objectOpacity(int index) const override;
   void setObjectOpacity(int index, double opacity) override;

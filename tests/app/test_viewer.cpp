@@ -6,6 +6,7 @@
 #include <QComboBox>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
+#include <QInputDialog>
 #include <QJsonArray>
 #include <QLineEdit>
 #include <QLabel>
@@ -3905,6 +3906,140 @@ class ViewerTest : public QObject {
     QCOMPARE(m.scene().objects[0].material.color.a, opacity);
     settle(m);
     QCOMPARE(maxChannelDifference(before, fromQImage(w->view().grabFramebuffer())), 0);
+  }
+
+  // The Scene dock's filter and selection (a bug hunt's "no multi-select or search for thousands of
+  // parts"): the filter hides rows, not parts; the selection's actions change the selected parts that
+  // the filter shows, each action in one scene edit; names are not editable.
+  void sceneDockFiltersAndEditsTheSelection() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(160, 120);
+    w->findChild<QDockWidget*>("sceneDock")->raise();
+    auto* tree = w->findChild<QTreeWidget*>("sceneTree");
+    auto* filter = w->findChild<QLineEdit*>("sceneFilter");
+    auto* count = w->findChild<QLabel*>("sceneFilterCount");
+    QVERIFY(tree && filter && count);
+    QCOMPARE(tree->topLevelItemCount(), 6);  // outer, middle, inner shell, ring A, ring B, tangle
+    const auto shownRows = [&] {
+      QList<int> rows;
+      for (int r = 0; r < tree->topLevelItemCount(); ++r)
+        if (!tree->topLevelItem(r)->isHidden()) rows << r;
+      return rows;
+    };
+    const auto visibleParts = [&] {
+      QList<int> parts;
+      for (std::size_t i = 0; i < m.scene().objects.size(); ++i)
+        if (m.scene().objects[i].visible) parts << static_cast<int>(i);
+      return parts;
+    };
+    const auto action = [&](const char* name) {
+      auto* a = w->findChild<QAction*>(name);
+      return a;
+    };
+    // Plain text anywhere in the name, case ignored; * and ? match the whole name.
+    filter->setText("SHELL");
+    QCOMPARE(shownRows(), (QList<int>{0, 1, 2}));
+    QCOMPARE(count->text(), QStringLiteral("3 of 6"));
+    filter->setText("r*");
+    QCOMPARE(shownRows(), (QList<int>{3, 4}));
+    filter->setText("ring ?");
+    QCOMPARE(shownRows(), (QList<int>{3, 4}));
+    filter->setText("*a");
+    QCOMPARE(shownRows(), (QList<int>{3}));
+    filter->setText("ring.");  // not a regular expression
+    QCOMPARE(shownRows(), QList<int>{});
+    // Select all under a filter, hide: only the shown rows' parts, in one edit.
+    filter->setText("shell");
+    tree->selectAll();
+    QVERIFY(action("hidePartsAction")->isEnabled());
+    int edits = 0;
+    QMetaObject::Connection counting = connect(&m, &ViewerModel::sceneChanged, [&edits] { ++edits; });
+    action("hidePartsAction")->trigger();
+    QCOMPARE(edits, 1);
+    QCOMPARE(visibleParts(), (QList<int>{3, 4, 5}));
+    // Space on the tree toggles the selection as one box: all hidden → all shown.
+    w->activateWindow();
+    QVERIFY(QTest::qWaitForWindowActive(w.get()));
+    tree->setFocus();
+    QTest::keyClick(tree, Qt::Key_Space);
+    QCOMPARE(edits, 2);
+    QCOMPARE(visibleParts(), (QList<int>{0, 1, 2, 3, 4, 5}));
+    // The rows hidden by the filter keep their check boxes in step with the parts.
+    filter->clear();
+    QCOMPARE(shownRows().size(), 6);
+    QVERIFY(!count->isVisible());
+    tree->clearSelection();
+    QVERIFY(!action("hidePartsAction")->isEnabled());
+    tree->topLevelItem(3)->setSelected(true);
+    tree->topLevelItem(4)->setSelected(true);
+    action("showOnlyPartsAction")->trigger();
+    QCOMPARE(visibleParts(), (QList<int>{3, 4}));
+    QCOMPARE(tree->topLevelItem(0)->checkState(0), Qt::Unchecked);
+    QCOMPARE(tree->topLevelItem(3)->checkState(0), Qt::Checked);
+    action("showAllPartsAction")->trigger();
+    QCOMPARE(visibleParts(), (QList<int>{0, 1, 2, 3, 4, 5}));
+    QCOMPARE(edits, 4);
+    // Colour and opacity of the selection, answered in their dialogs.
+    const auto answer = [](const std::function<bool(QWidget*)>& reply) {
+      auto* timer = new QTimer;
+      QObject::connect(timer, &QTimer::timeout, [timer, reply] {
+        if (QWidget* dialog = QApplication::activeModalWidget(); dialog && reply(dialog)) timer->deleteLater();
+      });
+      timer->start(20);
+    };
+    const glm::vec4 ringB = m.scene().objects[4].material.color;
+    answer([](QWidget* dialog) {
+      auto* colours = qobject_cast<QColorDialog*>(dialog);
+      if (!colours) return false;
+      colours->setCurrentColor(QColor(255, 0, 0));
+      colours->accept();
+      return true;
+    });
+    action("colourPartsAction")->trigger();
+    QCOMPARE(edits, 5);
+    QCOMPARE(glm::vec3(m.scene().objects[3].material.color), glm::vec3(1, 0, 0));
+    QCOMPARE(glm::vec3(m.scene().objects[4].material.color), glm::vec3(1, 0, 0));
+    QCOMPARE(m.scene().objects[4].material.color.a, ringB.a);  // the opacity stays
+    QCOMPARE(glm::vec3(m.scene().objects[5].material.color), glm::vec3(0.85f, 0.45f, 0.85f));
+    QCOMPARE(tree->topLevelItem(4)->text(1), QStringLiteral("#ff0000"));
+    QVERIFY(action("resetColourAction")->isEnabled());
+    action("resetColourAction")->trigger();
+    QCOMPARE(m.scene().objects[4].material.color, ringB);
+    QVERIFY(!m.objectColorEdited(3) && !m.objectColorEdited(4));
+    QVERIFY(!action("resetColourAction")->isEnabled());
+    answer([](QWidget* dialog) {
+      auto* input = qobject_cast<QInputDialog*>(dialog);
+      if (!input) return false;
+      input->setDoubleValue(0.125);
+      input->accept();
+      return true;
+    });
+    action("opacityPartsAction")->trigger();
+    QCOMPARE(m.objectOpacity(3), 0.125);
+    QCOMPARE(m.objectOpacity(4), 0.125);
+    QCOMPARE(m.objectOpacity(5), static_cast<double>(0.4f));
+    QCOMPARE(edits, 7);
+    disconnect(counting);
+    // Fit the view to ring A: the camera looks at its box's centre from nearer than fit all, in
+    // the same direction; near and far still hold the whole scene.
+    const mfr::Camera before = m.scene().fit(m.camera());
+    m.setCamera(before);
+    tree->clearSelection();
+    tree->topLevelItem(3)->setSelected(true);
+    action("fitPartsAction")->trigger();
+    mfr::Scene ringA;
+    ringA.objects.push_back(m.scene().objects[3]);
+    const glm::dvec3 centre = ringA.bounds().center();
+    QVERIFY(glm::length(m.camera().target - centre) < 1e-9);
+    QVERIFY(glm::length(m.camera().eye - m.camera().target) < glm::length(before.eye - before.target));
+    const glm::dvec3 d0 = glm::normalize(before.eye - before.target);
+    QVERIFY(glm::length(glm::normalize(m.camera().eye - m.camera().target) - d0) < 1e-9);
+    QVERIFY(m.camera().farPlane >= glm::length(m.camera().eye - m.scene().bounds().center()));
+    // A name is not edited in place (its editor renamed the row, not the part).
+    tree->editItem(tree->topLevelItem(0), 0);
+    QVERIFY(!tree->findChild<QLineEdit*>());
   }
 
   void navigation() {
