@@ -461,8 +461,8 @@ void MainWindow::buildDocks() {
     panelsMenu_->addAction(d->toggleViewAction());
     return d;
   };
-  QDockWidget* scene =
-      dock(tr("Scene"), QStringLiteral("sceneDock"), new SceneTreePanel(*model_), Qt::LeftDockWidgetArea);
+  auto* sceneTree = new SceneTreePanel(*model_);
+  QDockWidget* scene = dock(tr("Scene"), QStringLiteral("sceneDock"), sceneTree, Qt::LeftDockWidgetArea);
   QDockWidget* clip = dock(tr("Clip"), QStringLiteral("clipDock"), new ClipPanel(*model_), Qt::LeftDockWidgetArea);
   tabifyDockWidget(scene, clip);
   scene->raise();
@@ -482,6 +482,31 @@ void MainWindow::buildDocks() {
     probe->show();
     probe->raise();
   });
+  // Which part is this: a double click on the view, or on a fragment's row in the Probe dock,
+  // selects the part's row in the Scene dock and names it in the status bar.
+  const auto pick = [this, scene, sceneTree](int part) {
+    sceneTree->selectPart(part);
+    if (part < 0) {
+      statusBar()->showMessage(tr("No part there"), 5000);
+      return;
+    }
+    scene->show();
+    scene->raise();
+    const std::string& name = model_->scene().objects[static_cast<std::size_t>(part)].name;
+    statusBar()->showMessage(tr("Part %1 of %2: %3")
+                                 .arg(part)
+                                 .arg(model_->scene().objects.size())
+                                 .arg(name.empty() ? tr("(no name)") : QString::fromStdString(name)),
+                             8000);
+  };
+  connect(view_, &RenderView::partPickRequested, this, [this, pick](QPoint point) {
+    try {
+      pick(view_->partAt(point));
+    } catch (const std::exception& e) {
+      statusBar()->showMessage(QString::fromUtf8(e.what()), 5000);
+    }
+  });
+  connect(probePanel, &ProbePanel::partChosen, this, pick);
   // The image gets most of the window; panels start narrow (users widen them as they like).
   // Deferred until the window has its size, or the layout overrides it.
   QTimer::singleShot(0, this, [this, scene, stats] {

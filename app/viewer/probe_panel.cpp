@@ -77,6 +77,10 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
   connect(clear_, &QPushButton::clicked, this, &ProbePanel::clear);
 
   connect(&view_, &RenderView::probeRequested, this, &ProbePanel::probe);
+  connect(table_, &QTableWidget::cellDoubleClicked, this, [this](int row) {
+    const QTableWidgetItem* part = table_->item(row, Part);
+    if (part && part->data(Qt::UserRole).toInt() >= 0) emit partChosen(part->data(Qt::UserRole).toInt());
+  });
   // Full frames only (navigation previews are not reported): the probe follows the view without
   // costing every drag step a ray cast.
   connect(&model_, &ViewerModel::frameRendered, this, [this] {
@@ -208,8 +212,10 @@ void ProbePanel::show(const ViewProbe& r) {
     const QColor colour = rgbOf(f.fragment.color);
     table_->setItem(i, Index, item(QString::number(i + 1), right));
     table_->setItem(i, EyeDepth, item(QString::number(f.eyeDepth, 'g', 6), right));
-    table_->setItem(i, Part,
-                    item(id < objects.size() ? QString::fromStdString(objects[id].name) : QStringLiteral("?")));
+    QTableWidgetItem* part = item(id < objects.size() ? QString::fromStdString(objects[id].name) : QStringLiteral("?"));
+    // The scene's part, for partChosen: not a volume's slice (its id lies past the scene's parts).
+    part->setData(Qt::UserRole, id < model_.scene().objects.size() ? static_cast<int>(id) : -1);
+    table_->setItem(i, Part, part);
     QTableWidgetItem* swatch = item(colour.name());
     swatch->setBackground(colour);
     swatch->setForeground(colour.lightnessF() > 0.5 ? Qt::black : Qt::white);

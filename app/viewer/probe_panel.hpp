@@ -47,6 +47,8 @@ class ProbePanel final : public QWidget {
 
  signals:
   void probed();  // the table shows a new probe (or its error)
+  // A fragment's row double-clicked: the scene part it belongs to (an index of the scene's objects).
+  void partChosen(int index);
 
  private:
   void refresh();

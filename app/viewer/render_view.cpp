@@ -742,19 +742,41 @@ mfr::RenderOutput RenderView::renderOutput(QSize size, const std::map<std::strin
 
 // ---- pixel probe ---------------------------------------------------------------------------
 
-ViewProbe RenderView::probeAt(QPoint point) {
-  if (!model_.hasScene()) throw mfr::Error("probe", "no scene loaded");
+RenderView::PanePixel RenderView::panePixelAt(QPoint point, const char* what) const {
+  if (!model_.hasScene()) throw mfr::Error(what, "no scene loaded");
   if (const QString why = model_.drawError(); !why.isEmpty()) throw mfr::Error(why.toStdString());
   const double ratio = devicePixelRatioF();
   const QPoint device(static_cast<int>(std::floor(point.x() * ratio)), static_cast<int>(std::floor(point.y() * ratio)));
+  PanePixel at;
+  at.device = device;
+  at.side = paneAt(point);
+  if (at.side < 0) throw mfr::Error(what, "the point is not on an image");
+  at.pane = paneRect(at.side);
+  at.pixel = device - at.pane.topLeft();
+  return at;
+}
+
+int RenderView::partAt(QPoint point) const {
+  const PanePixel at = panePixelAt(point, "pick");
+  const mfr::PixelProbe probe = mfr::probePixel(model_.drawnScene(), model_.camera(), at.pane.width(), at.pane.height(),
+                                                at.pixel.x(), at.pixel.y());
+  // The drawn scene's ids: a section's volume slices come after the scene's parts.
+  for (const mfr::ProbeFragment& f : probe.fragments)
+    if (f.fragment.objectId < model_.scene().objects.size() && (f.fragment.color >> 24) != 0)
+      return static_cast<int>(f.fragment.objectId);
+  return -1;
+}
+
+ViewProbe RenderView::probeAt(QPoint point) {
+  const PanePixel at = panePixelAt(point, "probe");
+  const QPoint device = at.device;
   ViewProbe result;
   result.point = point;
-  result.side = paneAt(point);
-  if (result.side < 0) throw mfr::Error("probe", "the point is not on an image");
-  const QRect pane = paneRect(result.side);
+  result.side = at.side;
+  const QRect pane = at.pane;
   result.paneSize = pane.size();
   result.method = model_.methodOf(result.side);
-  const QPoint pixel = device - pane.topLeft();
+  const QPoint pixel = at.pixel;
   result.probe =
       mfr::probePixel(model_.drawnScene(), model_.camera(), pane.width(), pane.height(), pixel.x(), pixel.y());
   const bool showsImage = model_.dataView() == DataView::Image &&
@@ -842,6 +864,13 @@ void RenderView::mouseMoveEvent(QMouseEvent* event) {
 void RenderView::mouseReleaseEvent(QMouseEvent*) {
   if (drag_ != Drag::None) endNavigation(150);
   drag_ = Drag::None;
+}
+
+// Not a press: Qt's default handler starts another orbit from it.
+void RenderView::mouseDoubleClickEvent(QMouseEvent* event) {
+  drag_ = Drag::None;
+  if (event->button() == Qt::LeftButton && event->modifiers() == Qt::NoModifier)
+    emit partPickRequested(event->position().toPoint());
 }
 
 void RenderView::wheelEvent(QWheelEvent* event) {

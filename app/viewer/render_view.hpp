@@ -117,6 +117,10 @@ class RenderView final : public QOpenGLWidget {
   // renderer of its own that shares the scene, so probing never changes what a method keeps
   // between frames). Throws mfr::Error (no scene, no GL yet, a point outside the view).
   ViewProbe probeAt(QPoint point);
+  // The part drawn nearest the eye at `point` (logical widget coordinates), as the oracle casts
+  // that one pixel: a scene object's index, or -1 where no part is drawn (the background, a
+  // volume's slice, parts of opacity 0). Throws mfr::Error as probeAt does.
+  [[nodiscard]] int partAt(QPoint point) const;
   // Marks the probed point with a small cross (nothing: no mark).
   void setProbeMark(std::optional<QPoint> point);
 
@@ -126,6 +130,8 @@ class RenderView final : public QOpenGLWidget {
   void frameReductionChanged(int reduction);
   // Ctrl + left click: the user asks what lies behind this point (logical widget coordinates).
   void probeRequested(QPoint point);
+  // Double click: the user asks which part this is (logical widget coordinates).
+  void partPickRequested(QPoint point);
 
  protected:
   void initializeGL() override;
@@ -135,9 +141,20 @@ class RenderView final : public QOpenGLWidget {
   void mousePressEvent(QMouseEvent* event) override;
   void mouseMoveEvent(QMouseEvent* event) override;
   void mouseReleaseEvent(QMouseEvent* event) override;
+  void mouseDoubleClickEvent(QMouseEvent* event) override;
   void wheelEvent(QWheelEvent* event) override;
 
  private:
+  // The image pixel under a point of the view: its pane, the pane's framebuffer rectangle, the
+  // pixel in that pane's image and in the framebuffer. Throws mfr::Error naming `what` (no scene,
+  // nothing drawable, a point off every image).
+  struct PanePixel {
+    int side = 0;
+    QRect pane;
+    QPoint pixel;
+    QPoint device;
+  };
+  [[nodiscard]] PanePixel panePixelAt(QPoint point, const char* what) const;
   // An offscreen RGBA8 colour target of one pane.
   struct PaneTarget {
     GLuint texture = 0, fbo = 0;

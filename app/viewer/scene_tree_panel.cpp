@@ -589,3 +589,14 @@ void SceneTreePanel::fitViewToSelected() {
   if (!chosen.bounds().valid()) return;
   model_.setCamera(chosen.fit(model_.camera()));
 }
+
+void SceneTreePanel::selectPart(int index) {
+  if (index < 0 || index >= static_cast<int>(model_.scene().objects.size()) || index >= tree_->topLevelItemCount()) {
+    tree_->clearSelection();
+    return;
+  }
+  QTreeWidgetItem* item = tree_->topLevelItem(index);
+  if (item->isHidden()) filter_->clear();
+  tree_->setCurrentItem(item, kName, QItemSelectionModel::ClearAndSelect | QItemSelectionModel::Rows);
+  tree_->scrollToItem(item);
+}

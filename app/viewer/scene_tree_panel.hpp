@@ -29,6 +29,9 @@ class SceneTreePanel final : public QWidget {
 
  public:
   explicit SceneTreePanel(ViewerModel& model, QWidget* parent = nullptr);
+  // Selects the part's row alone, in sight (a filter that hides it is cleared); -1 clears the
+  // selection. A part picked in the view or the Probe dock.
+  void selectPart(int index);
 
  private:
   void rebuild();

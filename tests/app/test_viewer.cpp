@@ -38,6 +38,8 @@
 #include <system_error>
 #include <cmath>
 #include <functional>
+#include <map>
+#include <set>
 #include <cstdlib>
 #include <cstring>
 #include <optional>
@@ -4040,6 +4042,86 @@ class ViewerTest : public QObject {
     // A name is not edited in place (its editor renamed the row, not the part).
     tree->editItem(tree->topLevelItem(0), 0);
     QVERIFY(!tree->findChild<QLineEdit*>());
+  }
+
+  // Which part is this: a double click on the view selects, in the Scene dock, the part the oracle
+  // finds nearest the eye at that pixel (parts of opacity 0 left out); the background clears the
+  // selection; a double click on a fragment's row of the Probe dock selects that fragment's part.
+  void pickingAPartSelectsItsRow() {
+    auto w = openWindow();
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    RenderView& view = w->view();
+    view.setFixedSize(200, 150);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(200, 150), kTimeoutMs);
+    QCOMPARE(view.devicePixelRatioF(), 1.0);  // widget points are image pixels here
+    m.setMethod("wboit");
+    m.setCamera(m.scene().view("iso"));
+    m.setObjectOpacity(0, 0.0);                         // the outer shell: drawn, of opacity 0, so not picked
+    m.setObjectVisibilities({{1, false}, {2, false}});  // the rings and the tangle show
+    settle(m);
+    auto* tree = w->findChild<QTreeWidget*>("sceneTree");
+    QVERIFY(tree);
+    const auto selectedRows = [&] {
+      QList<int> rows;
+      for (QTreeWidgetItem* item : tree->selectedItems()) rows << tree->indexOfTopLevelItem(item);
+      return rows;
+    };
+    const mfr::FragmentLists oracle = mfr::castFragments(m.scene(), m.camera(), 200, 150);
+    const auto expected = [&](QPoint p) {
+      for (const mfr::Fragment& f : oracle.pixel(p.x(), p.y()))
+        if ((f.color >> 24) != 0) return static_cast<int>(f.objectId);
+      return -1;
+    };
+    // One unambiguous pixel per part that is nearest somewhere.
+    std::map<int, QPoint> pixels;
+    for (int y = 2; y < 148; y += 3)
+      for (int x = 2; x < 198; x += 3)
+        if (!oracle.isAmbiguous(x, y) && expected(QPoint(x, y)) >= 0)
+          pixels.emplace(expected(QPoint(x, y)), QPoint(x, y));
+    QVERIFY2(pixels.size() >= 3, qPrintable(QString::number(pixels.size())));
+    QVERIFY(!pixels.contains(0));
+    tree->topLevelItem(0)->setSelected(true);
+    for (const auto& [part, pixel] : pixels) {
+      QTest::mouseDClick(&view, Qt::LeftButton, Qt::NoModifier, pixel);
+      QCOMPARE(selectedRows(), QList<int>{part});
+      QVERIFY(w->statusBar()->currentMessage().contains(QString::fromStdString(m.scene().objects[part].name)));
+    }
+    const mfr::Camera before = m.camera();
+    QTest::mouseDClick(&view, Qt::LeftButton, Qt::NoModifier, QPoint(1, 1));  // background
+    QCOMPARE(selectedRows(), QList<int>{});
+    QCOMPARE(w->statusBar()->currentMessage(), QStringLiteral("No part there"));
+    QCOMPARE(m.camera().eye, before.eye);  // a pick, not an orbit
+    // A filter that hides the picked part's row is cleared, so the row shows.
+    auto* filter = w->findChild<QLineEdit*>("sceneFilter");
+    filter->setText("no such part");
+    QTest::mouseDClick(&view, Qt::LeftButton, Qt::NoModifier, pixels.begin()->second);
+    QCOMPARE(filter->text(), QString());
+    QCOMPARE(selectedRows(), QList<int>{pixels.begin()->first});
+    // The Probe dock's rows: each selects its fragment's part.
+    auto* table = w->findChild<QTableWidget*>("probeTable");
+    QVERIFY(table);
+    QPoint deep(-1, -1);
+    for (int y = 40; y < 110; ++y)
+      for (int x = 60; x < 140; ++x)
+        if (!oracle.isAmbiguous(x, y) && (deep.x() < 0 || oracle.count(x, y) > oracle.count(deep.x(), deep.y())))
+          deep = QPoint(x, y);
+    const auto list = oracle.pixel(deep.x(), deep.y());
+    QTest::mouseClick(&view, Qt::LeftButton, Qt::ControlModifier, deep);
+    QTRY_COMPARE_WITH_TIMEOUT(table->rowCount(), static_cast<int>(list.size()) + 1, 20000);
+    std::set<int> seen;
+    for (int row = 0; row < static_cast<int>(list.size()); ++row) {
+      const int part = static_cast<int>(list[static_cast<std::size_t>(row)].objectId);
+      if (!seen.insert(part).second) continue;
+      table->scrollToItem(table->item(row, ProbePanel::Part));
+      const QPoint at = table->visualItemRect(table->item(row, ProbePanel::Part)).center();
+      // A real double click's first press: QTest's double click alone is taken as a press by the
+      // table (it opens no double click on a row not pressed before).
+      QTest::mouseClick(table->viewport(), Qt::LeftButton, Qt::NoModifier, at);
+      QTest::mouseDClick(table->viewport(), Qt::LeftButton, Qt::NoModifier, at);
+      QCOMPARE(selectedRows(), QList<int>{part});
+    }
+    QVERIFY(seen.size() >= 2);
   }
 
   void navigation() {
