@@ -499,7 +499,7 @@ void MainWindow::buildDocks() {
                                  .arg(name.empty() ? tr("(no name)") : QString::fromStdString(name)),
                              8000);
   };
-  connect(view_, &RenderView::partPickRequested, this, [this, pick](QPoint point) {
+  connect(view_, &RenderView::partPickRequested, this, [this, pick](QPointF point) {
     try {
       pick(view_->partAt(point));
     } catch (const std::exception& e) {

@@ -94,7 +94,7 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
   });
 }
 
-void ProbePanel::probe(QPoint point) {
+void ProbePanel::probe(QPointF point) {
   point_ = point;
   clear_->setEnabled(true);
   // The mark moves only here and in clear(): moving a child of the view exposes the view, which

@@ -41,9 +41,9 @@ class ProbePanel final : public QWidget {
 
   ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent = nullptr);
   // Probes `point` of the view (logical coordinates) now and after every full frame until cleared.
-  void probe(QPoint point);
+  void probe(QPointF point);
   void clear();
-  [[nodiscard]] std::optional<QPoint> point() const { return point_; }
+  [[nodiscard]] std::optional<QPointF> point() const { return point_; }
 
  signals:
   void probed();  // the table shows a new probe (or its error)
@@ -57,7 +57,7 @@ class ProbePanel final : public QWidget {
 
   ViewerModel& model_;
   RenderView& view_;
-  std::optional<QPoint> point_;
+  std::optional<QPointF> point_;
   int probedSide_ = 0;
   ImageKey probedKey_;  // the frame of probedSide_ when it was probed
   QLabel* summary_ = nullptr;

@@ -742,7 +742,7 @@ mfr::RenderOutput RenderView::renderOutput(QSize size, const std::map<std::strin
 
 // ---- pixel probe ---------------------------------------------------------------------------
 
-RenderView::PanePixel RenderView::panePixelAt(QPoint point, const char* what) const {
+RenderView::PanePixel RenderView::panePixelAt(QPointF point, const char* what) const {
   if (!model_.hasScene()) throw mfr::Error(what, "no scene loaded");
   if (const QString why = model_.drawError(); !why.isEmpty()) throw mfr::Error(why.toStdString());
   const double ratio = devicePixelRatioF();
@@ -756,7 +756,7 @@ RenderView::PanePixel RenderView::panePixelAt(QPoint point, const char* what) co
   return at;
 }
 
-int RenderView::partAt(QPoint point) const {
+int RenderView::partAt(QPointF point) const {
   const PanePixel at = panePixelAt(point, "pick");
   const mfr::PixelProbe probe = mfr::probePixel(model_.drawnScene(), model_.camera(), at.pane.width(), at.pane.height(),
                                                 at.pixel.x(), at.pixel.y());
@@ -767,7 +767,7 @@ int RenderView::partAt(QPoint point) const {
   return -1;
 }
 
-ViewProbe RenderView::probeAt(QPoint point) {
+ViewProbe RenderView::probeAt(QPointF point) {
   const PanePixel at = panePixelAt(point, "probe");
   const QPoint device = at.device;
   ViewProbe result;
@@ -824,12 +824,12 @@ ViewProbe RenderView::probeAt(QPoint point) {
   return result;
 }
 
-void RenderView::setProbeMark(std::optional<QPoint> point) {
+void RenderView::setProbeMark(std::optional<QPointF> point) {
   if (!point) {
     probeMarker_->hide();
     return;
   }
-  probeMarker_->setCentre(*point);
+  probeMarker_->setCentre(point->toPoint());
   probeMarker_->show();
   probeMarker_->raise();
 }
@@ -840,7 +840,9 @@ void RenderView::mousePressEvent(QMouseEvent* event) {
   lastMouse_ = event->position().toPoint();
   if (event->button() == Qt::LeftButton && (event->modifiers() & Qt::ControlModifier)) {
     drag_ = Drag::None;  // a probe, not the start of an orbit
-    emit probeRequested(lastMouse_);
+    // The exact position: at a fractional scale a rounded point lies in the next device pixel
+    // (scale 2: no odd row or column could be probed; a bug hunt).
+    emit probeRequested(event->position());
     return;
   }
   const bool panGesture = event->button() == Qt::MiddleButton ||
@@ -870,7 +872,7 @@ void RenderView::mouseReleaseEvent(QMouseEvent*) {
 void RenderView::mouseDoubleClickEvent(QMouseEvent* event) {
   drag_ = Drag::None;
   if (event->button() == Qt::LeftButton && event->modifiers() == Qt::NoModifier)
-    emit partPickRequested(event->position().toPoint());
+    emit partPickRequested(event->position());
 }
 
 void RenderView::wheelEvent(QWheelEvent* event) {

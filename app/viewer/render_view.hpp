@@ -39,7 +39,7 @@ class SplitHandle;
 
 // What the pixel probe found under a point of the view (RenderView::probeAt).
 struct ViewProbe {
-  QPoint point;                 // the probed point (logical widget coordinates)
+  QPointF point;                // the probed point (logical widget coordinates)
   int side = 0;                 // the pane showing it
   QSize paneSize;               // that pane's image size (device pixels)
   QString method;               // the pane's method
@@ -116,22 +116,22 @@ class RenderView final : public QOpenGLWidget {
   // lists — which of those fragments the method holds (GpuRenderer::capture of that one pixel by a
   // renderer of its own that shares the scene, so probing never changes what a method keeps
   // between frames). Throws mfr::Error (no scene, no GL yet, a point outside the view).
-  ViewProbe probeAt(QPoint point);
+  ViewProbe probeAt(QPointF point);
   // The part drawn nearest the eye at `point` (logical widget coordinates), as the oracle casts
   // that one pixel: a scene object's index, or -1 where no part is drawn (the background, a
   // volume's slice, parts of opacity 0). Throws mfr::Error as probeAt does.
-  [[nodiscard]] int partAt(QPoint point) const;
+  [[nodiscard]] int partAt(QPointF point) const;
   // Marks the probed point with a small cross (nothing: no mark).
-  void setProbeMark(std::optional<QPoint> point);
+  void setProbeMark(std::optional<QPointF> point);
 
  signals:
   void glInitialized();
   // The reduction of the frames being drawn changed (f > 1: navigation previews; 1: full frames).
   void frameReductionChanged(int reduction);
   // Ctrl + left click: the user asks what lies behind this point (logical widget coordinates).
-  void probeRequested(QPoint point);
+  void probeRequested(QPointF point);
   // Double click: the user asks which part this is (logical widget coordinates).
-  void partPickRequested(QPoint point);
+  void partPickRequested(QPointF point);
 
  protected:
   void initializeGL() override;
@@ -154,7 +154,7 @@ class RenderView final : public QOpenGLWidget {
     QPoint pixel;
     QPoint device;
   };
-  [[nodiscard]] PanePixel panePixelAt(QPoint point, const char* what) const;
+  [[nodiscard]] PanePixel panePixelAt(QPointF point, const char* what) const;
   // An offscreen RGBA8 colour target of one pane.
   struct PaneTarget {
     GLuint texture = 0, fbo = 0;
