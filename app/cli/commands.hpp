@@ -11,6 +11,7 @@
 #include <string>
 
 #include "mfr/io/load.hpp"
+#include "mfr/io_util.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "mfr/render.hpp"
 #include "mfr/scene/clip_box.hpp"
@@ -29,23 +30,7 @@ void addEvaluate(CLI::App& app);
 void addAllocations(CLI::App& app);
 void addProbe(CLI::App& app);
 
-// A file a command reads or writes, named by its option (e.g. "--json", "scene", "image A").
-struct CommandFile {
-  enum class Role {
-    kInput,           // a file read
-    kScene,           // a file read, or a built-in scene ("@sample"): no file
-    kOutput,          // written when given (empty: not given)
-    kRequiredOutput,  // written; empty is an error
-  };
-  std::string option;
-  std::string path;
-  Role role = Role::kInput;
-};
-// Before any work: each output's folder exists and its name is no folder (checkOutputPath), a
-// required output is not empty, and no output is the same file as an input or another output (a
-// relative and an absolute name, links and hard links included) — a command never writes over a
-// file named on its command line, nor one file twice. Throws mfr::Error naming the later option.
-void checkCommandFiles(const std::vector<CommandFile>& files);
+// CommandFile and checkCommandFiles: mfr/io_util.hpp (mfrview's scripted runs check theirs too).
 // The files a method's parameters name (its Text parameters: dkb's `weights`), as inputs given by
 // `option`, so that checkCommandFiles refuses an output that would write over one. An unknown
 // method adds nothing (it is refused elsewhere).

@@ -23,45 +23,6 @@
 
 namespace mfr::cli {
 
-namespace {
-
-// Whether two names are one file: the same inode where both exist (hard and symbolic links), else
-// the same absolute path with links and "." / ".." resolved as far as the path exists.
-bool sameFile(const std::string& a, const std::string& b) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(a, ec) && fs::exists(b, ec)) {
-    const bool same = fs::equivalent(a, b, ec);
-    if (!ec) return same;
-  }
-  const fs::path pa = fs::weakly_canonical(fs::absolute(a, ec), ec);
-  const fs::path pb = fs::weakly_canonical(fs::absolute(b, ec), ec);
-  return !ec && pa == pb;
-}
-
-}  // namespace
-
-void checkCommandFiles(const std::vector<CommandFile>& files) {
-  using Role = CommandFile::Role;
-  const auto output = [](const CommandFile& f) { return f.role == Role::kOutput || f.role == Role::kRequiredOutput; };
-  for (const CommandFile& f : files) {
-    if (f.role == Role::kRequiredOutput && f.path.empty()) throw Error(f.option, "empty file name");
-    if (output(f) && !f.path.empty()) checkOutputPath(f.path);
-  }
-  const auto file = [](const CommandFile& f) {
-    return !f.path.empty() && !(f.role == Role::kScene && f.path.front() == '@');  // a built-in scene
-  };
-  for (std::size_t j = 0; j < files.size(); ++j)
-    for (std::size_t i = 0; i < j; ++i) {
-      const CommandFile &a = files[i], &b = files[j];
-      if (!(output(a) || output(b)) || !file(a) || !file(b) || !sameFile(a.path, b.path)) continue;
-      throw Error(b.option + " " + b.path,
-                  "is the same file as " + a.option + " (" + a.path + ")" +
-                      (output(a) && output(b) ? ": both would be written to it"
-                                              : ": the command would write over what it reads"));
-    }
-}
-
 void addParameterFiles(std::vector<CommandFile>& files, const std::string& option, const std::string& method,
                        const std::map<std::string, std::string>& params) {
   const MethodInfo* info = findMethodInfo(method);

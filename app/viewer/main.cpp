@@ -296,16 +296,21 @@ CommandLine parseCommandLine(const QStringList& sessionArgs) {
   cl.view = parser.value(view);
   cl.screenshot = parser.value(screenshot);
   cl.windowScreenshot = parser.value(windowScreenshot);
-  // Before any work, as mfr render checks -o: a name that says another format, a missing folder.
-  for (const auto& [option, path] : {std::pair{QStringLiteral("--screenshot"), cl.screenshot},
-                                     std::pair{QStringLiteral("--window-screenshot"), cl.windowScreenshot}}) {
-    if (path.isEmpty()) continue;
-    try {
-      mfr::checkPngOutputName(option.toStdString(), path.toStdString());
-      mfr::checkOutputPath(path.toStdString());
-    } catch (const mfr::Error& e) {
-      fail(QString::fromUtf8(e.what()), 2);
-    }
+  // Before any work, as mfr render checks -o: a name that says another format, a missing folder,
+  // and an output that is the scene or session read, or the other output, by any name (a link
+  // named like a PNG wrote the picture over its session; both screenshots to one file kept the
+  // last; a bug hunt).
+  try {
+    using Role = mfr::CommandFile::Role;
+    const std::vector<mfr::CommandFile> files = {
+        {cl.session.isEmpty() ? "scene" : "session", cl.scene.toStdString(), Role::kScene},
+        {"--screenshot", cl.screenshot.toStdString(), Role::kOutput},
+        {"--window-screenshot", cl.windowScreenshot.toStdString(), Role::kOutput}};
+    for (const mfr::CommandFile& output : files)
+      if (output.role == Role::kOutput && !output.path.empty()) mfr::checkPngOutputName(output.option, output.path);
+    mfr::checkCommandFiles(files);
+  } catch (const mfr::Error& e) {
+    fail(QString::fromUtf8(e.what()), 2);
   }
   // Only --screenshot's picture uses them: with --window-screenshot alone, or in the window, they
   // were taken without a word (a bug hunt).

@@ -643,10 +643,10 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
 }
 
 Session readSessionFile(const QString& path) {
-  QFile f(path);
-  if (!f.open(QIODevice::ReadOnly)) throw mfr::Error(path.toStdString(), f.errorString().toStdString());
+  // As mfr reads files: a pipe waited for ever (the window frozen) and /dev/zero grew memory
+  // until it ran out (a bug hunt).
+  const QByteArray bytes = QByteArray::fromStdString(mfr::readFile(QFile::encodeName(path).toStdString()));
   QJsonParseError error{};
-  const QByteArray bytes = f.readAll();
   const QJsonDocument doc = QJsonDocument::fromJson(bytes, &error);
   if (error.error != QJsonParseError::NoError)
     throw mfr::Error(

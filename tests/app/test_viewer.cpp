@@ -46,6 +46,7 @@
 #include <vector>
 #include <fstream>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "camera_navigator.hpp"
@@ -834,6 +835,36 @@ class ViewerTest : public QObject {
       QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(), line);
       QVERIFY(!QFile::exists(png));
     }
+    // A screenshot is never written over the session or scene read, nor both to one file, by any
+    // name: a link named like a PNG wrote the picture over its session, exit 0 (a bug hunt), as
+    // mfr render refuses its own outputs over its inputs.
+    const QString link = dir.filePath("link.png");
+    QVERIFY(QFile::link(sessionPath, link));
+    QFile sessionFile(sessionPath);
+    QVERIFY(sessionFile.open(QIODevice::ReadOnly));
+    const QByteArray sessionBytes = sessionFile.readAll();
+    sessionFile.close();
+    const QString twice = dir.filePath("twice.png");
+    for (const auto& [args, line] : QList<std::pair<QStringList, QString>>{
+             {{sessionPath, "--size", "64x48", "--screenshot", link},
+              QStringLiteral("mfrview: --screenshot %1: is the same file as session (%2): the command would write "
+                             "over what it reads")
+                  .arg(link, sessionPath)},
+             {{"--session", link, "--size", "64x48", "--window-screenshot", sessionPath},
+              QStringLiteral("mfrview: --window-screenshot %1: is the same file as session (%2): the command would "
+                             "write over what it reads")
+                  .arg(sessionPath, link)},
+             {{"@sample", "--size", "64x48", "--screenshot", twice, "--window-screenshot", twice},
+              QStringLiteral("mfrview: --window-screenshot %1: is the same file as --screenshot (%1): both would be "
+                             "written to it")
+                  .arg(twice)}}) {
+      QCOMPARE(runProgram(MFRVIEW, args, &out), 2);
+      QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(), line);
+      QVERIFY(sessionFile.open(QIODevice::ReadOnly));
+      QCOMPARE(sessionFile.readAll(), sessionBytes);
+      sessionFile.close();
+      QVERIFY(!QFile::exists(twice));
+    }
   }
 
   // mfrview took a --clip box that holds nothing of the scene (an empty image, exit 0) and
@@ -1171,6 +1202,18 @@ class ViewerTest : public QObject {
     } catch (const mfr::Error& e) {
       QCOMPARE(QString::fromUtf8(e.what()),
                twice + QStringLiteral(": camera.near: given twice (the keys of a JSON object must differ)"));
+    }
+    // A pipe and a device are refused before any read (a FIFO froze the window, /dev/zero read
+    // until memory ran out: a bug hunt).
+    const QString fifo = dir.filePath(QStringLiteral("fifo.mfrsession"));
+    QCOMPARE(::mkfifo(QFile::encodeName(fifo).constData(), 0600), 0);
+    for (const QString& special : {fifo, QStringLiteral("/dev/zero")}) {
+      try {
+        (void)readSessionFile(special);
+        QFAIL(qPrintable(special + " was read"));
+      } catch (const mfr::Error& e) {
+        QCOMPARE(QString::fromUtf8(e.what()), special + QStringLiteral(": not a regular file (a device or pipe)"));
+      }
     }
   }
 

@@ -26,6 +26,29 @@ void writeFilesAtomically(const std::vector<std::pair<std::filesystem::path, std
 // path leaves no first file behind. Throws mfr::Error naming path.
 void checkOutputPath(const std::filesystem::path& path);
 
+// Whether two names are one file: the same inode where both exist (hard and symbolic links), else
+// the same absolute path with links and "." / ".." resolved as far as the path exists.
+bool sameFile(const std::string& a, const std::string& b);
+
+// A file a command reads or writes, named by its option (e.g. "--json", "scene", "image A").
+struct CommandFile {
+  enum class Role {
+    kInput,           // a file read
+    kScene,           // a file read, or a built-in scene ("@sample"): no file
+    kOutput,          // written when given (empty: not given)
+    kRequiredOutput,  // written; empty is an error
+  };
+  std::string option;
+  std::string path;
+  Role role = Role::kInput;
+};
+// Before any work: each output's folder exists and its name is no folder (checkOutputPath), a
+// required output is not empty, and no output is the same file as an input or another output (a
+// relative and an absolute name, links and hard links included) — a command never writes over a
+// file named on its command line, nor one file twice. Throws mfr::Error naming the later option.
+// mfr's commands and mfrview's scripted runs.
+void checkCommandFiles(const std::vector<CommandFile>& files);
+
 // While one lives, SIGINT, SIGTERM and SIGHUP are caught and remembered instead of acted on (one
 // the process ignores stays ignored); the last one alive puts the previous handlers back and
 // raises each that arrived, so the process then ends as it would have (or runs its own handler).
