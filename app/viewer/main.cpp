@@ -216,7 +216,7 @@ CommandLine parseCommandLine(const QStringList& sessionArgs) {
            2);
     cl.scene = cl.session = parser.value(session);
   }
-  if (cl.scene.endsWith(QStringLiteral(".mfrsession"), Qt::CaseInsensitive)) cl.session = cl.scene;
+  if (MainWindow::isSessionFile(cl.scene)) cl.session = cl.scene;  // by its name or its "format"
   cl.method = parser.value(method);
   cl.op = parser.value(op);
   if (parser.isSet(thickness)) {

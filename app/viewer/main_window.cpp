@@ -11,6 +11,8 @@
 #include <QFileInfo>
 #include <QHeaderView>
 #include <QInputDialog>
+#include <QJsonDocument>
+#include <QJsonObject>
 #include <QJsonValue>
 #include <QLabel>
 #include <QMenuBar>
@@ -34,6 +36,7 @@
 #include <cmath>
 #include <iostream>
 #include <exception>
+#include <filesystem>
 
 #include "camera_navigator.hpp"
 #include "clip_panel.hpp"
@@ -578,7 +581,8 @@ void MainWindow::rebuildRecentFiles() {
 }
 
 void MainWindow::addRecentFile(const QString& path) {
-  if (path.isEmpty()) return;
+  // A scripted run (--screenshot) filled the user's Open Recent with its files (a bug hunt).
+  if (path.isEmpty() || !options_.restoreSettings) return;
   QSettings settings;
   QStringList recent = settings.value(QStringLiteral("recentFiles")).toStringList();
   recent.removeAll(path);
@@ -591,10 +595,29 @@ void MainWindow::addRecentFile(const QString& path) {
 // ---- files -------------------------------------------------------------------------------
 
 void MainWindow::open(const QString& path) {
-  if (path.endsWith(kSessionSuffix, Qt::CaseInsensitive))
+  if (isSessionFile(path))
     openSession(path);
   else
     openScene(path);
+}
+
+// A session by its name, or by what it says it is ("format": "mfrview-session"): one opened with
+// --session under another name went to Open Recent, which read it as a scene file (a bug hunt).
+// Only a small regular file that starts as a JSON object is read to tell.
+bool MainWindow::isSessionFile(const QString& path) {
+  if (path.endsWith(kSessionSuffix, Qt::CaseInsensitive)) return true;
+  std::error_code ec;
+  const std::filesystem::path file(QFile::encodeName(path).toStdString());
+  if (!std::filesystem::is_regular_file(file, ec) ||
+      std::filesystem::file_size(file, ec) > (std::uintmax_t{16} << 20) || ec)
+    return false;
+  QFile f(path);
+  if (!f.open(QIODevice::ReadOnly)) return false;
+  const QByteArray bytes = f.readAll();
+  if (!bytes.trimmed().startsWith('{')) return false;
+  const QJsonDocument doc = QJsonDocument::fromJson(bytes);
+  return doc.isObject() &&
+         doc.object().value(QStringLiteral("format")) == QJsonValue(QStringLiteral("mfrview-session"));
 }
 
 void MainWindow::openScene(const QString& path, const QString& field,

@@ -33,7 +33,8 @@ class MainWindow final : public QMainWindow {
   ~MainWindow() override;
 
   // Starts loading a model, .mfrscene, built-in (@sample) or .mfrsession file.
-  void open(const QString& path);
+  void open(const QString& path);  // a session (isSessionFile) or a scene
+  [[nodiscard]] static bool isSessionFile(const QString& path);
   // `field`: the array or grid of a volume file (mfr::LoadOptions::field); empty: its default.
   // `molecule`: a molecule file's representations (mfr::LoadOptions::molecule); none: spheres.
   void openScene(const QString& path, const QString& field = {},

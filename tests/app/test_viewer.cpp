@@ -820,6 +820,26 @@ class ViewerTest : public QObject {
     QCOMPARE(runProgram(MFRVIEW, {"--size", "64x48", "--screenshot", sample}, &out), 0);
     const mfr::ImageRGBA8 expected = mfr::readPng(positional.toStdString());
     QCOMPARE(maxChannelDifference(expected, mfr::readPng(option.toStdString())), 0);
+    // A session under another name is one by what it says ("format"), wherever it is opened from:
+    // Open Recent read such a file as a scene (a bug hunt). A scripted run, with a settings folder
+    // of its own here, leaves the user's settings (Open Recent) as they were (it added its files).
+    const QString renamed = dir.filePath("k.json"), renamedPng = dir.filePath("renamed.png");
+    QVERIFY(QFile::copy(sessionPath, renamed));
+    QVERIFY(MainWindow::isSessionFile(renamed) && MainWindow::isSessionFile(sessionPath));
+    QVERIFY(!MainWindow::isSessionFile(QStringLiteral("@csg")) && !MainWindow::isSessionFile(dir.path()));
+    const QString config = dir.filePath("config");
+    const QByteArray userConfig = qgetenv("XDG_CONFIG_HOME");
+    qputenv("XDG_CONFIG_HOME", QFile::encodeName(config));
+    const int renamedExit = runProgram(MFRVIEW, {renamed, "--size", "64x48", "--screenshot", renamedPng}, &out);
+    qputenv("XDG_CONFIG_HOME", userConfig);
+    QCOMPARE(renamedExit, 0);
+    QCOMPARE(maxChannelDifference(expected, mfr::readPng(renamedPng.toStdString())), 0);
+    QDirIterator written(config, QDir::Files, QDirIterator::Subdirectories);
+    while (written.hasNext()) {
+      QFile settings(written.next());
+      QVERIFY(settings.open(QIODevice::ReadOnly));
+      QVERIFY2(!settings.readAll().contains("recentFiles"), qPrintable(settings.fileName()));
+    }
     QCOMPARE(maxChannelDifference(expected, mfr::readPng(joined.toStdString())), 0);
     QVERIFY(maxChannelDifference(expected, mfr::readPng(sample.toStdString())) > 8);  // not the default scene
     const QString png = dir.filePath("refused.png");
