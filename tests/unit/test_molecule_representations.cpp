@@ -434,6 +434,26 @@ TEST_F(MoleculeStyles, AModelFilePlacedSeveralTimesSharesItsMeshes) {
     EXPECT_EQ(a.name.substr(0, 2), "a/");
     EXPECT_EQ(b.name.substr(0, 2), "b/");
   }
+  // Links to one file from two folders are two models: each is read through its own name and folder,
+  // where its side files lie (an OBJ's mtllib; the second link took the first one's colours: a
+  // review). Two names of one folder's file still share.
+  namespace fs = std::filesystem;
+  fs::create_directories(dir() / "real");
+  fs::create_directories(dir() / "red");
+  fs::create_directories(dir() / "blue");
+  write("real/model.obj", "mtllib model.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl paint\nf 1 2 3\n");
+  write("red/model.mtl", "newmtl paint\nKd 1 0 0\n");
+  write("blue/model.mtl", "newmtl paint\nKd 0 0 1\n");
+  fs::create_symlink(dir() / "real/model.obj", dir() / "red/model.obj");
+  fs::create_symlink(dir() / "real/model.obj", dir() / "blue/model.obj");
+  const Scene linked = loadScene(write("linked.mfrscene", R"({"objects": [
+      {"name": "r", "file": "red/model.obj"}, {"name": "b", "file": "blue/model.obj"},
+      {"name": "b2", "file": "blue/../blue/model.obj"}]})"));
+  ASSERT_EQ(linked.objects.size(), 3u);
+  EXPECT_EQ(glm::vec3(linked.objects[0].material.color), glm::vec3(1, 0, 0));
+  EXPECT_EQ(glm::vec3(linked.objects[1].material.color), glm::vec3(0, 0, 1));
+  EXPECT_EQ(glm::vec3(linked.objects[2].material.color), glm::vec3(0, 0, 1));
+  EXPECT_EQ(linked.objects[1].mesh.get(), linked.objects[2].mesh.get());
 }
 
 TEST_F(MoleculeStyles, OnlyForMoleculeFiles) {

@@ -747,10 +747,15 @@ Scene parseSceneFile(const std::string& text, const std::filesystem::path& baseD
             r.fail(where + ".molecule", "only a molecule file (.pdb .ent .cif .mmcif) has representations");
         }
         options.notes = &scene.notes;
+        // The file by its folder, links resolved, and its name as given: a link is read through
+        // its own name and folder (an OBJ's mtllib, a glTF's buffers lie beside the link, not its
+        // target: two links to one OBJ beside two .mtl files took the first one's colours; a review).
         std::error_code canonicalError;
-        const std::filesystem::path canonical = std::filesystem::weakly_canonical(file, canonicalError);
-        const std::pair<std::string, std::string> modelKey{canonicalError ? file.string() : canonical.string(),
-                                                           o.contains("molecule") ? o["molecule"].dump() : ""};
+        const std::filesystem::path folder = std::filesystem::weakly_canonical(
+            file.has_parent_path() ? file.parent_path() : std::filesystem::path("."), canonicalError);
+        const std::pair<std::string, std::string> modelKey{
+            canonicalError ? file.string() : (folder / file.filename()).string(),
+            o.contains("molecule") ? o["molecule"].dump() : ""};
         std::vector<Object> parts;
         try {
           if (const auto read = modelsRead.find(modelKey); read != modelsRead.end())
