@@ -91,7 +91,6 @@ void settle(ViewerModel& model) {
   }
 }
 
-// Largest per-channel difference of two same-size images; -1 when the sizes differ.
 // Counts the size hints an item view asks for: filling rows should ask for each a few times, not
 // once per row for every changed cell (what made thousands of rows freeze the window).
 class SizeHintCounter final : public QStyledItemDelegate {
@@ -104,6 +103,7 @@ class SizeHintCounter final : public QStyledItemDelegate {
   mutable long long calls = 0;
 };
 
+// Largest per-channel difference of two same-size images; -1 when the sizes differ.
 int maxChannelDifference(const mfr::ImageRGBA8& a, const mfr::ImageRGBA8& b) {
   if (a.width != b.width || a.height != b.height) return -1;
   int diff = 0;
@@ -1520,9 +1520,6 @@ class ViewerTest : public QObject {
              qPrintable(out));
   }
 
-  // A named view's own near and far planes (a cut-away view) are kept, as mfr render keeps them:
-  // setCamera fitted them to the scene, so mfrview drew the whole sphere (a bug hunt). They hold
-  // until the camera moves, and a session keeps them.
   // Given planes whose 32-bit window depth cannot order what is drawn: mfr render said so, mfrview
   // drew the misordered layers without a word (a note of an earlier session). The Statistics dock
   // lists the note, a scripted run prints it as mfr render does; a near plane of 0.01 gets none.
@@ -1566,6 +1563,9 @@ class ViewerTest : public QObject {
     QVERIFY(!noted());
   }
 
+  // A named view's own near and far planes (a cut-away view) are kept, as mfr render keeps them:
+  // setCamera fitted them to the scene, so mfrview drew the whole sphere (a bug hunt). They hold
+  // until the camera moves, and a session keeps them.
   void givenNearFarPlanesAreKept() {
     QTemporaryDir dir;
     const QString scene = dir.filePath(QStringLiteral("cut.mfrscene"));
@@ -4291,9 +4291,6 @@ class ViewerTest : public QObject {
     }
   }
 
-  // The Probe dock: Ctrl + click lists the oracle's exact fragments behind the pixel (parts in
-  // depth order, shares summing to 100 %), which of them the method holds (a k-buffer's k nearest,
-  // an A-buffer's all), follows the method without another click, does not orbit, and clears.
   // Ghosting set every part's opacity in one scene edit, yet the Scene panel froze for 7 s at 1,000
   // parts (22 s at 4,000): its columns sized to contents re-measured every row at every changed
   // cell (a bug hunt; the Probe dock's table fills the same way). Counted by the size hints asked
@@ -4333,9 +4330,19 @@ class ViewerTest : public QObject {
     QCOMPARE(tree->topLevelItem(kParts - 1)->data(2, Qt::EditRole).toDouble(), 0.15);  // the ghost opacity
     QApplication::processEvents();  // the columns' one measurement, deferred
     QVERIFY2(treeHints.calls < 20 * kParts, qPrintable(QStringLiteral("%1 size hints").arg(treeHints.calls)));
+    // Edits that change no row measure nothing again (each measured every column again: a slider
+    // dragged over a section plane or a ghost opacity re-measured the tree at every step; a review).
+    treeHints.calls = 0;
+    const glm::vec4 colour = m.scene().objects[0].material.color;
+    for (int i = 0; i < 5; ++i) m.setObjectColor(0, QColor::fromRgbF(colour.r, colour.g, colour.b));  // no new value
+    QApplication::processEvents();
+    QVERIFY2(treeHints.calls < kParts, qPrintable(QStringLiteral("%1 size hints").arg(treeHints.calls)));
     for (int c = 0; c < tree->columnCount(); ++c) tree->setItemDelegateForColumn(c, treeDelegates[c]);
   }
 
+  // The Probe dock: Ctrl + click lists the oracle's exact fragments behind the pixel (parts in
+  // depth order, shares summing to 100 %), which of them the method holds (a k-buffer's k nearest,
+  // an A-buffer's all), follows the method without another click, does not orbit, and clears.
   void pixelProbe() {
     auto w = openWindow();
     QVERIFY(w);
