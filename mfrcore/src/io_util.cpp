@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cerrno>
@@ -106,6 +107,14 @@ void checkFolderTakesFiles(const std::filesystem::path& dir, const std::filesyst
 
 }  // namespace
 
+namespace {
+// The longest file name the folder takes, in bytes (NAME_MAX, 255 on Linux's file systems).
+std::size_t nameMax(const std::filesystem::path& dir) {
+  const long most = ::pathconf(dir.c_str(), _PC_NAME_MAX);
+  return most > 0 ? static_cast<std::size_t>(most) : 255;
+}
+}  // namespace
+
 void checkOutputPath(const std::filesystem::path& given) {
   if (given.empty()) throw Error("output", "empty file name");
   std::error_code ec;
@@ -117,6 +126,11 @@ void checkOutputPath(const std::filesystem::path& given) {
   const std::filesystem::path path = outputTarget(given);
   const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   if (!std::filesystem::is_directory(dir, ec)) throw Error(given.string(), "folder does not exist");
+  // Refused here, before the work, not by the write after it.
+  const std::size_t nameBytes = path.filename().native().size();
+  if (const std::size_t most = nameMax(dir); nameBytes > most)
+    throw Error(given.string(), "file name too long (" + std::to_string(nameBytes) + " bytes; the folder takes " +
+                                    std::to_string(most) + " at most)");
   checkFolderTakesFiles(dir, given);
 }
 
@@ -176,9 +190,15 @@ struct Temporary {
 Temporary writeTemporary(const std::filesystem::path& given, std::string_view bytes) {
   checkOutputPath(given);
   Temporary t{given, outputTarget(given), {}};  // a link's file, not the link
-  // Temporary beside the target (same file system), renamed over it only when complete.
-  t.tmp = t.target;
-  t.tmp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(std::random_device{}() & 0xFFFFFF);
+  // Temporary beside the target (same file system), renamed over it only when complete. Its name
+  // is the target's, shortened so that the suffix fits the folder's longest name: a name of 234 to
+  // 255 bytes, valid, was refused as "File name too long" after the render (a bug hunt).
+  const std::string suffix =
+      ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(std::random_device{}() & 0xFFFFFF);
+  std::string name = t.target.filename().native();
+  const std::filesystem::path dir = t.target.has_parent_path() ? t.target.parent_path() : std::filesystem::path(".");
+  name.resize(std::min(name.size(), nameMax(dir) > suffix.size() ? nameMax(dir) - suffix.size() : 0));
+  t.tmp = t.target.parent_path() / (name + suffix);
   std::ofstream out(t.tmp, std::ios::binary | std::ios::trunc);
   if (!out) throw Error(given.string(), std::string("cannot write (") + std::strerror(errno) + ")");
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
