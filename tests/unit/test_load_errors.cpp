@@ -592,6 +592,24 @@ TEST_F(LoadModel, ObjMissingMaterialsAreNoted) {
   mfr::loadModel(write("plain.obj", geometry + "f 1 2 3\n"), options);
   mfr::loadModel(write("named.obj", geometry + "usemtl Default\nf 1 2 3\n"), options);  // no library named
   EXPECT_TRUE(notes.empty()) << notes.front();
+
+  // A library named with spaces, as Blender writes "my model.mtl": the rest of the line when the
+  // words name no files (two libraries 'my' and 'model.mtl' were not found: a bug hunt); words
+  // that do name files are several libraries, as the format says.
+  write("my model.mtl", "newmtl red\nKd 0 1 0\n");
+  const auto spaced =
+      mfr::loadModel(write("my model.obj", "mtllib my model.mtl \r\n" + geometry + "usemtl red\nf 1 2 3\n"), options);
+  ASSERT_EQ(spaced.size(), 1u);
+  EXPECT_EQ(spaced[0].material.color, glm::vec4(0, 1, 0, 1));
+  EXPECT_TRUE(notes.empty()) << notes.front();
+  write("blue.mtl", "newmtl blue\nKd 0 0 1\n");
+  const auto two = mfr::loadModel(
+      write("two.obj", "mtllib some.mtl blue.mtl\n" + geometry + "usemtl red\nf 1 2 3\nusemtl blue\nf 3 2 1\n"),
+      options);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[0].material.color, glm::vec4(1, 0, 0, 1));
+  EXPECT_EQ(two[1].material.color, glm::vec4(0, 0, 1, 1));
+  EXPECT_TRUE(notes.empty()) << notes.front();
 }
 
 // Material values taken other than as written, and lines and points (no surface), are notes: they

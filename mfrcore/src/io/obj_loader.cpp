@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <fstream>
 #include <map>
+#include <system_error>
 #include <unordered_map>
 #include <utility>
 
@@ -209,16 +210,30 @@ std::vector<ObjPart> parseObj(std::string_view bytes, const fs::path& directory,
       current = it->second;
     } else if (w[0] == "mtllib") {
       libraryNamed = libraryNamed || w.size() > 1;
-      for (std::size_t k = 1; k < w.size(); ++k) {
+      // Several libraries by the format, one name per word; but Blender writes the name of
+      // "my model.mtl" as it is, spaces included: the rest of the line, when it names a file and
+      // the words do not (a bug hunt: two libraries 'my' and 'model.mtl' not found).
+      std::vector<std::string> libraries;
+      for (std::size_t k = 1; k < w.size(); ++k) libraries.emplace_back(w[k]);
+      if (libraries.size() > 1) {
+        std::string whole(line.substr(static_cast<std::size_t>(w[1].data() - line.data())));
+        while (!whole.empty() && std::isspace(static_cast<unsigned char>(whole.back()))) whole.pop_back();
+        std::error_code ec;
+        const bool wordsExist = std::all_of(libraries.begin(), libraries.end(), [&](const std::string& l) {
+          return std::filesystem::is_regular_file(directory / l, ec);
+        });
+        if (!wordsExist && std::filesystem::is_regular_file(directory / whole, ec)) libraries = {whole};
+      }
+      for (const std::string& library : libraries) {
         std::string why;
         std::vector<std::string> taken;
-        for (auto& [key, c] : readMaterials(directory / std::string(w[k]), why, taken)) materials.emplace(key, c);
+        for (auto& [key, c] : readMaterials(directory / library, why, taken)) materials.emplace(key, c);
         libraryUnread = libraryUnread || !why.empty();
         if (!why.empty() && notes != nullptr)
-          notes->push_back(name + ": material library '" + std::string(w[k]) + "' " + why +
+          notes->push_back(name + ": material library '" + library + "' " + why +
                            " (its materials get the default colour)");
         if (notes != nullptr)
-          for (const std::string& t : taken) notes->push_back(name + ": " + std::string(w[k]) + ": " + t);
+          for (const std::string& t : taken) notes->push_back(name + ": " + library + ": " + t);
       }
     }
     // vt, vp, g, o, s and the free-form statements carry nothing we draw; l and p are counted.
