@@ -740,6 +740,19 @@ TEST_F(LoadModel, GzippedPlyAndStl) {
   EXPECT_EQ(mfr::loadModel(writeGz("cube.obj.gz", kCubeObj))[0].mesh->triangleCount(), 12u);
   EXPECT_EQ(mfr::loadModel(writeGz("three.stl.gz", binaryStl(3, 3)))[0].mesh->triangleCount(), 3u);
   expectLoadError(writeGz("truncated.stl.gz", binaryStl(10, 3)), "truncated binary STL");
+  // A gzipped STL goes through a temporary file: a TMPDIR that cannot take one is named (it read
+  // "filesystem error: temp_directory_path: No such file or directory"; a bug hunt).
+  const char* given = std::getenv("TMPDIR");
+  const std::string before = given != nullptr ? given : "";
+  const std::string missing = (dir() / "no such folder").string();
+  ::setenv("TMPDIR", missing.c_str(), 1);
+  expectLoadError(dir() / "four.stl.gz", "cannot create a temporary file for the decompressed data in TMPDIR " +
+                                             missing + " (No such file or directory)");
+  if (given != nullptr)
+    ::setenv("TMPDIR", before.c_str(), 1);
+  else
+    ::unsetenv("TMPDIR");
+  EXPECT_EQ(triangles(mfr::loadModel(dir() / "four.stl.gz")), 4u);
 }
 
 TEST_F(LoadModel, OffWithPolygonsCommentsAndColors) {

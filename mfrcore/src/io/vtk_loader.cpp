@@ -142,9 +142,20 @@ namespace {
 class TempFile {
  public:
   TempFile(const std::string& contents, const std::string& suffix, const std::string& name) {
-    std::string pattern = (fs::temp_directory_path() / ("mfr-load-XXXXXX" + suffix)).string();
+    // The reason names the folder (TMPDIR's): a missing or read-only TMPDIR read as
+    // "filesystem error: temp_directory_path: No such file or directory", or gave no reason (a bug hunt).
+    std::error_code ec;
+    const fs::path folder = fs::temp_directory_path(ec);
+    const char* tmpdir = std::getenv("TMPDIR");
+    const std::string where = tmpdir != nullptr ? "TMPDIR " + std::string(tmpdir) : "the temporary folder";
+    if (ec)
+      throw Error(name,
+                  "cannot create a temporary file for the decompressed data in " + where + " (" + ec.message() + ")");
+    std::string pattern = (folder / ("mfr-load-XXXXXX" + suffix)).string();
     const int fd = ::mkstemps(pattern.data(), static_cast<int>(suffix.size()));
-    if (fd < 0) throw Error(name, "cannot create a temporary file for the decompressed data");
+    if (fd < 0)
+      throw Error(name, "cannot create a temporary file for the decompressed data in " + where + " (" +
+                            std::strerror(errno) + ")");
     path_ = pattern;
     std::size_t written = 0;
     while (written < contents.size()) {
@@ -156,7 +167,7 @@ class TempFile {
     if (written != contents.size()) {
       std::error_code ec;
       fs::remove(path_, ec);
-      throw Error(name, "cannot write the decompressed data to a temporary file");
+      throw Error(name, "cannot write the decompressed data to a temporary file in " + where);
     }
   }
   ~TempFile() {
