@@ -850,7 +850,12 @@ class ViewerTest : public QObject {
              {{"--session", sessionPath, "--session", sessionPath, "--screenshot", png},
               QStringLiteral("mfrview: --session %1: more than one session is given").arg(sessionPath)},
              {{"--session=", "--screenshot", png}, QStringLiteral("mfrview: --session: an empty value")},
-             {{"--screenshot", png, "--session"}, QStringLiteral("mfrview: Missing value after '--session'.")}}) {
+             {{"--screenshot", png, "--session"}, QStringLiteral("mfrview: Missing value after '--session'.")},
+             // One dash is Qt's option (an X11 session id): it opened @sample, exit 0 (a review).
+             {{"-session", sessionPath, "--screenshot", png},
+              QStringLiteral("mfrview: -session %1: one dash is Qt's X11 session-management option (an id); open a "
+                             "session file with --session %1")
+                  .arg(sessionPath)}}) {
       QCOMPARE(runProgram(MFRVIEW, args, &out), 2);
       QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(), line);
       QVERIFY(!QFile::exists(png));
