@@ -405,9 +405,22 @@ void refuseMissingDisplay(int argc, char** argv) {
        1);
 }
 
+// Qt reads arguments as UTF-8 and turns other bytes into U+FFFD: a Latin-1 name (caf\xE9.obj) was
+// "no such file", and as a screenshot's name wrote another file, exit 0 (a bug hunt). Refused:
+// mfr takes such names as they are.
+void refuseArgumentsQtCannotRead(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (QString::fromLocal8Bit(argv[i]).toLocal8Bit() != QByteArray(argv[i]))
+      fail(QStringLiteral("argument '%1' is not valid UTF-8: mfrview reads names as UTF-8 (rename the file, or use "
+                          "mfr, which takes any name)")
+               .arg(QString::fromLocal8Bit(argv[i])),
+           2);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  refuseArgumentsQtCannotRead(argc, argv);
   const QStringList sessionArgs = takeSessionOption(argc, argv);
   if (mentionsHelpOrVersion(argc, argv)) {
     QCoreApplication core(argc, argv);

@@ -758,6 +758,22 @@ class ViewerTest : public QObject {
   void emptyAndRepeatedOptionsAreRefused() {
     QTemporaryDir dir;
     const QString png = dir.filePath(QStringLiteral("empty.png"));
+    // A name that is not UTF-8 (Latin-1 "caf\xE9.png"): Qt read it as "caf\uFFFD.png" and wrote
+    // the screenshot there, exit 0 (a bug hunt). Passed as bytes through the shell.
+    {
+      QProcess p;
+      p.setProcessChannelMode(QProcess::MergedChannels);
+      p.setWorkingDirectory(dir.path());
+      p.start(QStringLiteral("sh"),
+              {QStringLiteral("-c"), QStringLiteral("exec \"$0\" @sample --screenshot \"$(printf 'caf\\351.png')\""),
+               QStringLiteral(MFRVIEW)});
+      QVERIFY(p.waitForFinished(kTimeoutMs));
+      QCOMPARE(p.exitCode(), 2);
+      QCOMPARE(QString::fromUtf8(p.readAll()).trimmed().split(QLatin1Char('\n')).constLast(),
+               QStringLiteral("mfrview: argument 'caf\uFFFD.png' is not valid UTF-8: mfrview reads names as UTF-8 "
+                              "(rename the file, or use mfr, which takes any name)"));
+      QCOMPARE(QDir(dir.path()).entryList(QDir::Files), QStringList{});
+    }
     for (const QString& option :
          {QStringLiteral("--screenshot"), QStringLiteral("--window-screenshot"), QStringLiteral("-m"),
           QStringLiteral("--op"), QStringLiteral("--view"), QStringLiteral("--color-by"), QStringLiteral("--size")}) {
