@@ -91,6 +91,7 @@ void addBench(CLI::App& app) {
     const auto [w, h] = parseSize("--size", opt->size);
     std::vector<RenderRequest> requests;
     const std::vector<std::string> specs = splitList(opt->methods, "--methods");
+    refuseRepeats(specs, "--methods");  // one configuration timed twice, in two rows of one label (a review)
     for (const std::string& spec : specs) {
       requests.push_back(parseMethodSpec(spec, w, h));
       // The oracle's refusal comes from the registry; optimal-k, a CPU method too, would be refused

@@ -541,6 +541,10 @@ TEST_F(Cli, GpuAndOracleImagesAgree) {
 // depend on the frame order (round-robin by default, --sequential on request), the exact method
 // below the approximate one against the oracle, and a bad method refused before any JSON exists.
 TEST_F(Cli, BenchRowsAndOrders) {
+  // An entry given twice would be timed twice, in two rows of one label (a review).
+  const CliResult twice = runCli("bench @sample -m kbuffer:k=4,kbuffer:k=4 --size 64x48");
+  EXPECT_EQ(twice.exitCode, 1);
+  EXPECT_NE(twice.out.find("--methods: 'kbuffer:k=4' is given twice"), std::string::npos) << twice.out;
   // A row is labelled by its entry as given (the parameters came out sorted by name: a bug hunt).
   const std::string methods = " -m abuffer-ll,kplus-array:spin_limit=512:k=2 -r 2 --size 64x48 --view iso";
   std::map<std::string, nlohmann::json> runs;
