@@ -8,6 +8,7 @@
 #include <QLabel>
 #include <QListWidget>
 #include <QPushButton>
+#include <QSet>
 #include <QSignalBlocker>
 #include <QSlider>
 #include <QVBoxLayout>
@@ -357,9 +358,12 @@ void GhostingPanel::loadSettings(const QJsonObject& settings) {
                         .arg(ghostOpacity(), 0, 'f', 2));
     saved_.clear();
     const QStringList labels = settingNames();
+    // Sets, not lists: a session ghosting n parts looked each up in a list of n (quadratic; a hunt).
+    const QSet<QString> focusSet(focus.begin(), focus.end());
+    const QSet<QString> labelSet(labels.begin(), labels.end());
     for (int id = 0; id < parts_->count(); ++id) {
       QListWidgetItem* item = parts_->item(id);
-      item->setCheckState(focus.contains(labels[id]) ? Qt::Checked : Qt::Unchecked);
+      item->setCheckState(focusSet.contains(labels[id]) ? Qt::Checked : Qt::Unchecked);
       // The opacities the session's ghosted parts had before (the session's objects hold the ghosted ones).
       if (ghosted.contains(labels[id])) {
         const QJsonValue before = ghosted.value(labels[id]);
@@ -374,11 +378,11 @@ void GhostingPanel::loadSettings(const QJsonObject& settings) {
     // A focus part the scene lacks was dropped without a word (the rest was ghosted around nothing).
     QStringList missing, unknown;
     for (const QString& name : focus)
-      if (!labels.contains(name)) missing << QStringLiteral("'%1'").arg(name);
+      if (!labelSet.contains(name)) missing << QStringLiteral("'%1'").arg(name);
     if (!missing.isEmpty())
       context_.note(tr("ghosting: no part %1 in this scene to focus on").arg(missing.join(QStringLiteral(", "))));
     for (auto it = ghosted.begin(); it != ghosted.end(); ++it)
-      if (!labels.contains(it.key())) unknown << QStringLiteral("'%1'").arg(it.key());
+      if (!labelSet.contains(it.key())) unknown << QStringLiteral("'%1'").arg(it.key());
     if (!unknown.isEmpty())
       context_.note(
           tr("ghosting: ghosted: no part %1 in this scene (left out)").arg(unknown.join(QStringLiteral(", "))));
