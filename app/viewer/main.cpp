@@ -365,12 +365,12 @@ QStringList takeSessionOption(int& argc, char** argv) {
       if (i + 1 < argc) taken << QString::fromLocal8Bit(argv[++i]);  // else the parser's "Missing value"
     } else if (std::strncmp(argv[i], "--session=", 10) == 0) {
       taken << QString::fromLocal8Bit(argv[i]);
-    } else if (std::error_code ec; std::strcmp(argv[i], "-session") == 0 && i + 1 < argc &&
-                                   std::filesystem::is_regular_file(argv[i + 1], ec)) {
-      // Qt's session manager gives an id, never a file: a file is the user's --session with one
-      // dash, which opened @sample, exit 0 (a review).
-      fail(QStringLiteral("-session %1: one dash is Qt's X11 session-management option (an id); open a session "
-                          "file with --session %1")
+    } else if (std::strcmp(argv[i], "-session") == 0 && i + 1 < argc && std::getenv("SESSION_MANAGER") == nullptr) {
+      // Only a session manager (SESSION_MANAGER set) restores a window with Qt's -session id;
+      // without one it is the user's --session with one dash, which opened @sample, exit 0 (a
+      // review; a misspelt file too).
+      fail(QStringLiteral("-session %1: one dash is Qt's X11 session-management option (an id), and no session "
+                          "manager runs; open a session file with --session %1")
                .arg(QString::fromLocal8Bit(argv[i + 1])),
            2);
     } else {

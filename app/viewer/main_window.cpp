@@ -488,6 +488,8 @@ void MainWindow::buildDocks() {
   // Which part is this: a double click on the view, or on a fragment's row in the Probe dock,
   // selects the part's row in the Scene dock and names it in the status bar.
   const auto pick = [this, scene, sceneTree](int part) {
+    // A Probe row of parts since changed (isosurfaces removed) may name none.
+    if (part >= static_cast<int>(model_->scene().objects.size())) part = -1;
     sceneTree->selectPart(part);
     if (part < 0) {
       statusBar()->showMessage(tr("No part there"), 5000);

@@ -87,6 +87,12 @@ ProbePanel::ProbePanel(ViewerModel& model, RenderView& view, QWidget* parent)
     if (point_) QTimer::singleShot(0, this, &ProbePanel::refreshIfChanged);
   });
   connect(&model_, &ViewerModel::sceneLoaded, this, &ProbePanel::clear);
+  // Parts added or removed (isosurfaces): the rows' part indices may name other parts until the
+  // next frame probes again, so they choose none meanwhile (a review).
+  connect(&model_, &ViewerModel::partsChanged, this, [this] {
+    for (int row = 0; row < table_->rowCount(); ++row)
+      if (QTableWidgetItem* part = table_->item(row, Part)) part->setData(Qt::UserRole, -1);
+  });
   // A frame that cannot be drawn (every part hidden) reports no frame: the probe says why instead
   // of listing the fragments of what was drawn before (a bug hunt).
   connect(&model_, &ViewerModel::renderErrorChanged, this, [this] {

@@ -2,6 +2,7 @@
 
 #include <QLoggingCategory>
 #include <QMouseEvent>
+#include <QWindow>
 #include <QOpenGLContext>
 #include <QTimer>
 #include <QWheelEvent>
@@ -15,6 +16,7 @@
 #include "mfr/error.hpp"
 #include "mfr/gl/context.hpp"
 #include "mfr/reference/metrics.hpp"
+#include "mfr/scene/csg.hpp"
 #include "view_overlays.hpp"
 
 namespace {
@@ -760,10 +762,24 @@ int RenderView::partAt(QPointF point) const {
   const PanePixel at = panePixelAt(point, "pick");
   const mfr::PixelProbe probe = mfr::probePixel(model_.drawnScene(), model_.camera(), at.pane.width(), at.pane.height(),
                                                 at.pixel.x(), at.pixel.y());
-  // The drawn scene's ids: a section's volume slices come after the scene's parts.
+  // The drawn scene's ids: a section's volume slices come after the scene's parts, and a slice
+  // in front hides what lies behind it (the part behind was picked: a review).
+  const auto part = [&](const mfr::Fragment& f) {
+    return f.objectId < model_.scene().objects.size() ? static_cast<int>(f.objectId) : -1;
+  };
+  // With the operation csg the pixel shows the surface the classification keeps, not the nearest
+  // fragment (a ball cut away, or a drill's hole, was picked where the block or nothing shows).
+  const mfr::Scene& drawn = model_.drawnScene();
+  if (model_.effectiveOperationOf(at.side) == QLatin1String("csg") && !drawn.csg.empty()) {
+    std::vector<mfr::Fragment> sorted;
+    sorted.reserve(probe.fragments.size());
+    for (const mfr::ProbeFragment& f : probe.fragments) sorted.push_back(f.fragment);
+    const std::optional<std::size_t> visible =
+        mfr::csgVisibleFragment(drawn.csg, sorted, mfr::csgMirroredPrimitives(drawn));
+    return visible ? part(sorted[*visible]) : -1;
+  }
   for (const mfr::ProbeFragment& f : probe.fragments)
-    if (f.fragment.objectId < model_.scene().objects.size() && (f.fragment.color >> 24) != 0)
-      return static_cast<int>(f.fragment.objectId);
+    if ((f.fragment.color >> 24) != 0) return part(f.fragment);
   return -1;
 }
 
@@ -840,9 +856,7 @@ void RenderView::mousePressEvent(QMouseEvent* event) {
   lastMouse_ = event->position().toPoint();
   if (event->button() == Qt::LeftButton && (event->modifiers() & Qt::ControlModifier)) {
     drag_ = Drag::None;  // a probe, not the start of an orbit
-    // The exact position: at a fractional scale a rounded point lies in the next device pixel
-    // (scale 2: no odd row or column could be probed; a bug hunt).
-    emit probeRequested(event->position());
+    emit probeRequested(exactPosition(*event));
     return;
   }
   const bool panGesture = event->button() == Qt::MiddleButton ||
@@ -868,11 +882,49 @@ void RenderView::mouseReleaseEvent(QMouseEvent*) {
   drag_ = Drag::None;
 }
 
-// Not a press: Qt's default handler starts another orbit from it.
+// A plain left double click picks; any other is the press it is (a second pan, zoom or probe
+// started quickly after the first was swallowed: a review).
 void RenderView::mouseDoubleClickEvent(QMouseEvent* event) {
-  drag_ = Drag::None;
-  if (event->button() == Qt::LeftButton && event->modifiers() == Qt::NoModifier)
-    emit partPickRequested(event->position());
+  if (event->button() != Qt::LeftButton || event->modifiers() != Qt::NoModifier) {
+    mousePressEvent(event);
+    return;
+  }
+  drag_ = Drag::None;  // not the start of an orbit
+  emit partPickRequested(exactPosition(*event));
+}
+
+// The point under the cursor, with its fraction of a logical pixel: at a fractional scale a
+// rounded point lies in the next device pixel (scale 2: no odd row or column could be probed or
+// picked; a bug hunt). QApplication rounds the positions of the event a widget gets (a review);
+// the top-level window's own event, seen by eventFilter, keeps the fraction.
+QPointF RenderView::exactPosition(const QMouseEvent& event) const {
+  if (windowPress_.type != event.type() || windowPress_.timestamp != event.timestamp()) return event.position();
+  const QPointF local = windowPress_.position - mapTo(window(), QPointF(0, 0));
+  // The same press (within the rounding), or another's.
+  return std::abs(local.x() - event.position().x()) <= 0.5 && std::abs(local.y() - event.position().y()) <= 0.5
+             ? local
+             : event.position();
+}
+
+void RenderView::showEvent(QShowEvent* event) {
+  QOpenGLWidget::showEvent(event);
+  QWindow* top = window()->windowHandle();
+  if (top == watchedWindow_ || top == nullptr) return;
+  if (watchedWindow_) watchedWindow_->removeEventFilter(this);
+  watchedWindow_ = top;
+  top->installEventFilter(this);
+  connect(top, &QObject::destroyed, this, [this, top] {
+    if (watchedWindow_ == top) watchedWindow_ = nullptr;
+  });
+}
+
+bool RenderView::eventFilter(QObject* watched, QEvent* event) {
+  if (watched == watchedWindow_ &&
+      (event->type() == QEvent::MouseButtonPress || event->type() == QEvent::MouseButtonDblClick)) {
+    const auto* press = static_cast<const QMouseEvent*>(event);
+    windowPress_ = {event->type(), press->timestamp(), press->position()};
+  }
+  return QOpenGLWidget::eventFilter(watched, event);
 }
 
 void RenderView::wheelEvent(QWheelEvent* event) {

@@ -15,6 +15,7 @@
 #include <epoxy/gl.h>
 
 #include <QColor>
+#include <QEvent>
 #include <QLabel>
 #include <QOpenGLWidget>
 #include <QPoint>
@@ -33,6 +34,7 @@
 
 class MapLegend;
 class QTimer;
+class QWindow;
 class PaneCaption;
 class ProbeMarker;
 class SplitHandle;
@@ -142,6 +144,8 @@ class RenderView final : public QOpenGLWidget {
   void mouseMoveEvent(QMouseEvent* event) override;
   void mouseReleaseEvent(QMouseEvent* event) override;
   void mouseDoubleClickEvent(QMouseEvent* event) override;
+  void showEvent(QShowEvent* event) override;
+  bool eventFilter(QObject* watched, QEvent* event) override;
   void wheelEvent(QWheelEvent* event) override;
 
  private:
@@ -155,6 +159,7 @@ class RenderView final : public QOpenGLWidget {
     QPoint device;
   };
   [[nodiscard]] PanePixel panePixelAt(QPointF point, const char* what) const;
+  [[nodiscard]] QPointF exactPosition(const QMouseEvent& event) const;
   // An offscreen RGBA8 colour target of one pane.
   struct PaneTarget {
     GLuint texture = 0, fbo = 0;
@@ -228,6 +233,15 @@ class RenderView final : public QOpenGLWidget {
   } depthCache_;
   QString glInfo_;
   QPoint lastMouse_;
+  // The last press as the top-level window received it, with its fraction of a logical pixel:
+  // QApplication rounds a widget's mouse positions, local and global, to whole logical pixels,
+  // so at a fractional scale the widget's own event lies in the next device pixel (exactPosition).
+  struct WindowPress {
+    QEvent::Type type = QEvent::None;
+    quint64 timestamp = 0;
+    QPointF position;  // in the top-level widget's coordinates
+  } windowPress_;
+  QWindow* watchedWindow_ = nullptr;
   enum class Drag { None, Orbit, Pan } drag_ = Drag::None;
   bool fastNavigation_ = true;
   bool liveFrames_ = true;

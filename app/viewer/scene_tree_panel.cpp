@@ -291,8 +291,8 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   tree_->setContextMenuPolicy(Qt::CustomContextMenu);
   connect(tree_, &QWidget::customContextMenuRequested, this, [this](const QPoint& at) {
     updateSelectionActions();
-    if (selectedParts().isEmpty()) return;  // nothing or volume rows only
-    QMenu menu(this);
+    if (model_.scene().objects.empty()) return;
+    QMenu menu(this);  // also on empty space or a volume row: Show All Parts needs no selection
     menu.addActions({showParts_, hideParts_, toggleParts_, showOnlyParts_, showAllParts_});
     menu.addSeparator();
     menu.addAction(fitParts_);

@@ -60,6 +60,7 @@
 #include "mfr/image.hpp"
 #include "mfr/io/load.hpp"
 #include "mfr/methods/registry.hpp"
+#include "mfr/reference/composite.hpp"
 #include "mfr/reference/metrics.hpp"
 #include "mfr/reference/oracle.hpp"
 #include "mfr/render.hpp"
@@ -859,6 +860,7 @@ class ViewerTest : public QObject {
     QCOMPARE(maxChannelDifference(expected, mfr::readPng(joined.toStdString())), 0);
     QVERIFY(maxChannelDifference(expected, mfr::readPng(sample.toStdString())) > 8);  // not the default scene
     const QString png = dir.filePath("refused.png");
+    qunsetenv("SESSION_MANAGER");  // -session is refused where no session manager runs
     for (const auto& [args, line] : QList<std::pair<QStringList, QString>>{
              {{"@sample", "--session", sessionPath, "--screenshot", png},
               QStringLiteral("mfrview: --session %1: a scene is given too (@sample); give one of the two")
@@ -869,9 +871,13 @@ class ViewerTest : public QObject {
              {{"--screenshot", png, "--session"}, QStringLiteral("mfrview: Missing value after '--session'.")},
              // One dash is Qt's option (an X11 session id): it opened @sample, exit 0 (a review).
              {{"-session", sessionPath, "--screenshot", png},
-              QStringLiteral("mfrview: -session %1: one dash is Qt's X11 session-management option (an id); open a "
-                             "session file with --session %1")
-                  .arg(sessionPath)}}) {
+              QStringLiteral("mfrview: -session %1: one dash is Qt's X11 session-management option (an id), and no "
+                             "session manager runs; open a session file with --session %1")
+                  .arg(sessionPath)},
+             {{"-session", "typo.mfrsession", "--screenshot", png},
+              QStringLiteral(
+                  "mfrview: -session typo.mfrsession: one dash is Qt's X11 session-management option (an "
+                  "id), and no session manager runs; open a session file with --session typo.mfrsession")}}) {
       QCOMPARE(runProgram(MFRVIEW, args, &out), 2);
       QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(), line);
       QVERIFY(!QFile::exists(png));
@@ -4171,11 +4177,9 @@ class ViewerTest : public QObject {
       QCOMPARE(selectedRows(), QList<int>{part});
       QVERIFY(w->statusBar()->currentMessage().contains(QString::fromStdString(m.scene().objects[part].name)));
     }
-    const mfr::Camera before = m.camera();
     QTest::mouseDClick(&view, Qt::LeftButton, Qt::NoModifier, QPoint(1, 1));  // background
     QCOMPARE(selectedRows(), QList<int>{});
     QCOMPARE(w->statusBar()->currentMessage(), QStringLiteral("No part there"));
-    QCOMPARE(m.camera().eye, before.eye);  // a pick, not an orbit
     // A filter that hides the picked part's row is cleared, so the row shows.
     auto* filter = w->findChild<QLineEdit*>("sceneFilter");
     filter->setText("no such part");
@@ -4193,14 +4197,16 @@ class ViewerTest : public QObject {
     const auto list = oracle.pixel(deep.x(), deep.y());
     // A point within the pixel but nearer its right and bottom edges probes that pixel (the rounded
     // point probed the next one: at scale 2 no odd row or column could be probed; a bug hunt).
-    // Pressed as Qt gives a click at a fractional scale: a position between integers.
+    // Pressed as the window system gives a click at a fractional scale: a position between integers
+    // to the top-level window, which QApplication rounds for the widget (a review).
     const auto ctrlPress = [&](QPointF at) {
-      QMouseEvent press(QEvent::MouseButtonPress, at, view.mapToGlobal(at), Qt::LeftButton, Qt::LeftButton,
+      const QPointF inWindow = at + view.mapTo(w.get(), QPointF(0, 0));
+      QMouseEvent press(QEvent::MouseButtonPress, inWindow, view.mapToGlobal(at), Qt::LeftButton, Qt::LeftButton,
                         Qt::ControlModifier);
-      QCoreApplication::sendEvent(&view, &press);
-      QMouseEvent release(QEvent::MouseButtonRelease, at, view.mapToGlobal(at), Qt::LeftButton, Qt::NoButton,
+      QCoreApplication::sendEvent(w->windowHandle(), &press);
+      QMouseEvent release(QEvent::MouseButtonRelease, inWindow, view.mapToGlobal(at), Qt::LeftButton, Qt::NoButton,
                           Qt::ControlModifier);
-      QCoreApplication::sendEvent(&view, &release);
+      QCoreApplication::sendEvent(w->windowHandle(), &release);
     };
     ctrlPress(QPointF(deep) + QPointF(0.75, 0.75));
     QTRY_COMPARE_WITH_TIMEOUT(table->rowCount(), static_cast<int>(list.size()) + 1, 20000);
@@ -4220,6 +4226,76 @@ class ViewerTest : public QObject {
       QCOMPARE(selectedRows(), QList<int>{part});
     }
     QVERIFY(seen.size() >= 2);
+  }
+
+  // The pick follows what is drawn, not the nearest fragment: with the operation csg the surface
+  // the classification keeps (a cut-away ball, or a drill's hole showing the background, was
+  // picked; a review), checked against the oracle's CSG image (its pixel is a fragment of the part
+  // picked, and the background where nothing is picked); an opaque volume slice in front hides the
+  // part behind it (that part was picked).
+  void pickingFollowsWhatIsDrawn() {
+    auto w = openWindow(QStringLiteral("@csg"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    RenderView& view = w->view();
+    view.setFixedSize(160, 120);
+    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(160, 120), kTimeoutMs);
+    m.setMethod("abuffer-sbuffer");
+    m.setOperation(QStringLiteral("csg"));
+    m.setCamera(m.scene().view("front"));
+    settle(m);
+    const mfr::FragmentLists lists = mfr::castFragments(m.drawnScene(), m.camera(), 160, 120);
+    const mfr::ImageRGBA8 csg = mfr::compositeCsg(lists, m.drawnScene());
+    const glm::vec3 bg = m.scene().background;
+    const auto rgbAt = [&](int x, int y) {
+      const std::size_t i = (static_cast<std::size_t>(y) * 160 + x) * 4;
+      return glm::ivec3(csg.pixels[i], csg.pixels[i + 1], csg.pixels[i + 2]);
+    };
+    const glm::ivec3 background(glm::round(bg * 255.0f));
+    int checked = 0, notNearest = 0, holes = 0;
+    for (int y = 4; y < 120; y += 7)
+      for (int x = 4; x < 160; x += 7) {
+        if (lists.isAmbiguous(x, y) || lists.count(x, y) == 0) continue;
+        const int part = view.partAt(QPointF(x + 0.5, y + 0.5));
+        const glm::ivec3 shown = rgbAt(x, y);
+        if (part < 0) {
+          QCOMPARE(shown, background);
+          ++holes;
+        } else {
+          bool found = false;  // the image's colour is a fragment of the part picked
+          for (const mfr::Fragment& f : lists.pixel(x, y))
+            found = found || (static_cast<int>(f.objectId) == part &&
+                              glm::ivec3(f.color & 0xFF, (f.color >> 8) & 0xFF, (f.color >> 16) & 0xFF) == shown);
+          QVERIFY2(found, qPrintable(QStringLiteral("pixel %1,%2: part %3").arg(x).arg(y).arg(part)));
+        }
+        notNearest += part != static_cast<int>(lists.pixel(x, y).front().objectId) ? 1 : 0;
+        ++checked;
+      }
+    QVERIFY2(checked > 100 && notNearest > 5 && holes > 0,
+             qPrintable(QStringLiteral("%1 %2 %3").arg(checked).arg(notNearest).arg(holes)));
+    // A volume's opaque slice in front of a part: nothing is picked there.
+    w->openScene(QStringLiteral("@volume"));
+    QTRY_VERIFY_WITH_TIMEOUT(m.hasScene() && m.scene().name == "volume" && !m.busy(), kTimeoutMs);
+    m.setMethod("abuffer-sbuffer");
+    m.setOperation(QStringLiteral("auto"));
+    m.setCamera(m.scene().view("front"));
+    m.setSection(mfr::parseSectionPlane("-z=0.9:slice", "test"));
+    settle(m);
+    const std::size_t parts = m.scene().objects.size();
+    const mfr::FragmentLists sliced = mfr::castFragments(m.drawnScene(), m.camera(), 160, 120);
+    int slices = 0;
+    for (int y = 4; y < 120; y += 5)
+      for (int x = 4; x < 160; x += 5) {
+        const auto list = sliced.pixel(x, y);
+        if (sliced.isAmbiguous(x, y) || list.size() < 2 || list.front().objectId < parts) continue;
+        const bool partBehind = std::any_of(list.begin(), list.end(), [&](const mfr::Fragment& f) {
+          return f.objectId < parts && (f.color >> 24) != 0;
+        });
+        if (!partBehind) continue;
+        QCOMPARE(view.partAt(QPointF(x + 0.5, y + 0.5)), -1);
+        ++slices;
+      }
+    QVERIFY2(slices > 0, "no pixel with a slice in front of a part");
   }
 
   void navigation() {

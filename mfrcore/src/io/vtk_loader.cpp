@@ -144,10 +144,16 @@ class TempFile {
   TempFile(const std::string& contents, const std::string& suffix, const std::string& name) {
     // The reason names the folder (TMPDIR's): a missing or read-only TMPDIR read as
     // "filesystem error: temp_directory_path: No such file or directory", or gave no reason (a bug hunt).
+    // libstdc++ takes the first of TMPDIR, TMP, TEMP and TEMPDIR that is set (a review).
     std::error_code ec;
     const fs::path folder = fs::temp_directory_path(ec);
-    const char* tmpdir = std::getenv("TMPDIR");
-    const std::string where = tmpdir != nullptr ? "TMPDIR " + std::string(tmpdir) : "the temporary folder";
+    std::string variable;
+    for (const char* v : {"TMPDIR", "TMP", "TEMP", "TEMPDIR"})
+      if (const char* value = std::getenv(v); value != nullptr && variable.empty())
+        variable = std::string(v) + " " + value;
+    const std::string where = !ec                ? folder.string() + (variable.empty() ? "" : " (" + variable + ")")
+                              : variable.empty() ? std::string("the temporary folder")
+                                                 : variable;
     if (ec)
       throw Error(name,
                   "cannot create a temporary file for the decompressed data in " + where + " (" + ec.message() + ")");
@@ -165,7 +171,6 @@ class TempFile {
     }
     ::close(fd);
     if (written != contents.size()) {
-      std::error_code ec;
       fs::remove(path_, ec);
       throw Error(name, "cannot write the decompressed data to a temporary file in " + where);
     }
