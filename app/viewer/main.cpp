@@ -37,6 +37,7 @@
 #include <thread>
 
 #include "main_window.hpp"
+#include "session.hpp"
 #include "mfr/error.hpp"
 #include "mfr/json_text.hpp"
 #include "mfr/host_memory.hpp"
@@ -304,10 +305,19 @@ CommandLine parseCommandLine(const QStringList& sessionArgs) {
   // last; a bug hunt).
   try {
     using Role = mfr::CommandFile::Role;
-    const std::vector<mfr::CommandFile> files = {
+    std::vector<mfr::CommandFile> files = {
         {cl.session.isEmpty() ? "scene" : "session", cl.scene.toStdString(), Role::kScene},
         {"--screenshot", cl.screenshot.toStdString(), Role::kOutput},
         {"--window-screenshot", cl.windowScreenshot.toStdString(), Role::kOutput}};
+    // The scene a session names is read too (a link named like a PNG to it was written over; a
+    // review). A session that cannot be read is refused later, with its own reason.
+    if (!cl.session.isEmpty() && (!cl.screenshot.isEmpty() || !cl.windowScreenshot.isEmpty())) {
+      try {
+        files.insert(files.begin() + 1,
+                     {"the session's scene", readSessionFile(cl.session).scenePath.toStdString(), Role::kScene});
+      } catch (const mfr::Error&) {
+      }
+    }
     for (const mfr::CommandFile& output : files)
       if (output.role == Role::kOutput && !output.path.empty()) mfr::checkPngOutputName(output.option, output.path);
     mfr::checkCommandFiles(files);

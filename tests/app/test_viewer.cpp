@@ -912,6 +912,28 @@ class ViewerTest : public QObject {
       sessionFile.close();
       QVERIFY(!QFile::exists(twice));
     }
+    // Nor over the scene file a session names (a review).
+    const QString model = dir.filePath("model.stl"), modelSession = dir.filePath("model.mfrsession");
+    const QByteArray stl =
+        "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+        "endloop\nendfacet\nendsolid t\n";
+    QFile modelFile(model);
+    QVERIFY(modelFile.open(QIODevice::WriteOnly) && modelFile.write(stl) == stl.size());
+    modelFile.close();
+    QFile modelSessionFile(modelSession);
+    QVERIFY(modelSessionFile.open(QIODevice::WriteOnly));
+    modelSessionFile.write(QByteArray(sessionBytes).replace("\"@csg\"", "\"model.stl\""));
+    modelSessionFile.close();
+    QCOMPARE(readSessionFile(modelSession).scenePath, model);
+    const QString modelLink = dir.filePath("model-link.png");
+    QVERIFY(QFile::link(model, modelLink));
+    QCOMPARE(runProgram(MFRVIEW, {modelSession, "--size", "64x48", "--screenshot", modelLink}, &out), 2);
+    QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(),
+             QStringLiteral("mfrview: --screenshot %1: is the same file as the session's scene (%2): the command "
+                            "would write over what it reads")
+                 .arg(modelLink, model));
+    QVERIFY(modelFile.open(QIODevice::ReadOnly));
+    QCOMPARE(modelFile.readAll(), stl);
   }
 
   // mfrview took a --clip box that holds nothing of the scene (an empty image, exit 0) and
