@@ -104,6 +104,17 @@ class SizeHintCounter final : public QStyledItemDelegate {
   mutable long long calls = 0;
 };
 
+// The pixel of `area` with the longest list whose order is defined (no edge, no depth tie), or
+// (-1, -1) when there is none.
+QPoint deepestPixel(const mfr::FragmentLists& lists, const QRect& area) {
+  QPoint deep(-1, -1);
+  for (int y = area.top(); y <= area.bottom(); ++y)
+    for (int x = area.left(); x <= area.right(); ++x)
+      if (!lists.isAmbiguous(x, y) && (deep.x() < 0 || lists.count(x, y) > lists.count(deep.x(), deep.y())))
+        deep = QPoint(x, y);
+  return deep;
+}
+
 // Largest per-channel difference of two same-size images; -1 when the sizes differ.
 int maxChannelDifference(const mfr::ImageRGBA8& a, const mfr::ImageRGBA8& b) {
   if (a.width != b.width || a.height != b.height) return -1;
@@ -403,6 +414,18 @@ class ViewerTest : public QObject {
     again->view().setFixedSize(size);
     again->openSession(path);
     return again;
+  }
+
+  // A window on `scene` whose view is `size` device pixels, a point of the widget one pixel of the
+  // image (null when no such window could be made).
+  std::unique_ptr<MainWindow> openFixedView(QSize size, const QString& scene = QStringLiteral("@sample")) {
+    auto w = openWindow(scene);
+    if (!w) return w;
+    w->view().setFixedSize(size);
+    if (!QTest::qWaitFor([&] { return w->model().renderSize() == size; }, kTimeoutMs) ||
+        w->view().devicePixelRatioF() != 1.0)
+      return nullptr;
+    return w;
   }
 
   std::unique_ptr<MainWindow> openWindow(const QString& scene = QStringLiteral("@sample")) {
@@ -4160,13 +4183,10 @@ class ViewerTest : public QObject {
   // finds nearest the eye at that pixel (parts of opacity 0 left out); the background clears the
   // selection; a double click on a fragment's row of the Probe dock selects that fragment's part.
   void pickingAPartSelectsItsRow() {
-    auto w = openWindow();
+    auto w = openFixedView(QSize(200, 150));  // widget points are image pixels
     QVERIFY(w);
     ViewerModel& m = w->model();
     RenderView& view = w->view();
-    view.setFixedSize(200, 150);
-    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(200, 150), kTimeoutMs);
-    QCOMPARE(view.devicePixelRatioF(), 1.0);  // widget points are image pixels here
     m.setMethod("wboit");
     m.setCamera(m.scene().view("iso"));
     m.setObjectOpacity(0, 0.0);                         // the outer shell: drawn, of opacity 0, so not picked
@@ -4211,11 +4231,8 @@ class ViewerTest : public QObject {
     // The Probe dock's rows: each selects its fragment's part.
     auto* table = w->findChild<QTableWidget*>("probeTable");
     QVERIFY(table);
-    QPoint deep(-1, -1);
-    for (int y = 40; y < 110; ++y)
-      for (int x = 60; x < 140; ++x)
-        if (!oracle.isAmbiguous(x, y) && (deep.x() < 0 || oracle.count(x, y) > oracle.count(deep.x(), deep.y())))
-          deep = QPoint(x, y);
+    const QPoint deep = deepestPixel(oracle, QRect(60, 40, 80, 70));
+    QVERIFY(deep.x() >= 0);
     const auto list = oracle.pixel(deep.x(), deep.y());
     // A point within the pixel but nearer its right and bottom edges probes that pixel (the rounded
     // point probed the next one: at scale 2 no odd row or column could be probed; a bug hunt).
@@ -4256,12 +4273,10 @@ class ViewerTest : public QObject {
   // picked, and the background where nothing is picked); an opaque volume slice in front hides the
   // part behind it (that part was picked).
   void pickingFollowsWhatIsDrawn() {
-    auto w = openWindow(QStringLiteral("@csg"));
+    auto w = openFixedView(QSize(160, 120), QStringLiteral("@csg"));
     QVERIFY(w);
     ViewerModel& m = w->model();
     RenderView& view = w->view();
-    view.setFixedSize(160, 120);
-    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(160, 120), kTimeoutMs);
     m.setMethod("abuffer-sbuffer");
     m.setOperation(QStringLiteral("csg"));
     m.setCamera(m.scene().view("front"));
@@ -4463,24 +4478,16 @@ class ViewerTest : public QObject {
   // depth order, shares summing to 100 %), which of them the method holds (a k-buffer's k nearest,
   // an A-buffer's all), follows the method without another click, does not orbit, and clears.
   void pixelProbe() {
-    auto w = openWindow();
+    auto w = openFixedView(QSize(200, 150));  // widget points are image pixels
     QVERIFY(w);
     ViewerModel& m = w->model();
     RenderView& view = w->view();
-    view.setFixedSize(200, 150);
-    QTRY_COMPARE_WITH_TIMEOUT(m.renderSize(), QSize(200, 150), kTimeoutMs);
-    QCOMPARE(view.devicePixelRatioF(), 1.0);  // widget points are image pixels here
     m.setMethod("kplus-array");
     m.setParams({{"k", "2"}});
     m.setCamera(m.scene().view("iso"));
     settle(m);
     const mfr::FragmentLists oracle = mfr::castFragments(m.scene(), m.camera(), 200, 150);
-    // The deepest unambiguous pixel near the middle.
-    QPoint pixel(-1, -1);
-    for (int y = 50; y < 100; ++y)
-      for (int x = 70; x < 130; ++x)
-        if (!oracle.isAmbiguous(x, y) && (pixel.x() < 0 || oracle.count(x, y) > oracle.count(pixel.x(), pixel.y())))
-          pixel = QPoint(x, y);
+    const QPoint pixel = deepestPixel(oracle, QRect(70, 50, 60, 50));  // near the middle
     QVERIFY(pixel.x() >= 0);
     const auto list = oracle.pixel(pixel.x(), pixel.y());
     const int n = static_cast<int>(list.size());
