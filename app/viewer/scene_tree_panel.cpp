@@ -16,6 +16,7 @@
 #include <QPushButton>
 #include <QRegularExpression>
 #include <QStyledItemDelegate>
+#include <QTimer>
 #include <QTreeWidget>
 #include <QVBoxLayout>
 
@@ -175,7 +176,7 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
         showMoleculeStyle();  // one at least
         return;
       }
-      model_.setMoleculeStyle(style);
+      if (!model_.setMoleculeStyle(style)) showMoleculeStyle();  // refused while another file is read
     });
   }
   molecule_[0]->setToolTip(tr("Van der Waals spheres (space-filling, CPK)"));
@@ -439,6 +440,7 @@ void SceneTreePanel::showValues() {
 }
 
 void SceneTreePanel::rebuild() {
+  ++rowsBuilt_;
   rebuilding_ = true;
   colorBy_->clear();  // another scene: its own fields
   showFieldColoring();
@@ -505,9 +507,16 @@ void SceneTreePanel::itemClicked(QTreeWidgetItem* item, int column) {
   if (column != kColour || volumeOfRow(item) >= 0 || QGuiApplication::keyboardModifiers() != Qt::NoModifier) return;
   const int index = item->data(kName, Qt::UserRole).toInt();
   const QColor initial = colourOf(model_.scene().objects[static_cast<std::size_t>(index)]);
-  const QColor chosen = QColorDialog::getColor(initial, this, tr("Colour of %1").arg(item->text(kName)));
-  if (!chosen.isValid()) return;
-  model_.setObjectColor(index, chosen);
+  const QString title = tr("Colour of %1").arg(item->text(kName));
+  // After the click's own handling: the dialog's event loop may see a load end and the rows
+  // rebuilt, which inside the click left the tree drawing the old scene's rows (a bug hunt).
+  QTimer::singleShot(0, this, [this, index, initial, title] {
+    const quint64 rows = rowsBuilt_;
+    const QColor chosen = QColorDialog::getColor(initial, this, title);
+    // Another scene, or other parts, meanwhile: the index names another part (it recoloured the
+    // new scene's part of that index).
+    if (chosen.isValid() && rows == rowsBuilt_) model_.setObjectColor(index, chosen);
+  });
 }
 
 void SceneTreePanel::applyFilter() {
@@ -583,20 +592,22 @@ void SceneTreePanel::chooseSelectedColour() {
   const QList<int> parts = selectedParts();
   if (parts.isEmpty()) return;
   const QColor initial = colourOf(model_.scene().objects[static_cast<std::size_t>(parts.front())]);
+  const quint64 rows = rowsBuilt_;
   const QColor chosen = QColorDialog::getColor(initial, this, tr("Colour of %1").arg(partsText(parts)));
-  if (chosen.isValid()) model_.setObjectColors(selectedParts(), chosen);
+  if (chosen.isValid() && rows == rowsBuilt_) model_.setObjectColors(parts, chosen);
 }
 
 void SceneTreePanel::chooseSelectedOpacity() {
   const QList<int> parts = selectedParts();
   if (parts.isEmpty()) return;
   bool ok = false;
+  const quint64 rows = rowsBuilt_;
   const double opacity = QInputDialog::getDouble(this, tr("Opacity"),
                                                  tr("Opacity of %1 (0 = invisible, 1 = opaque)").arg(partsText(parts)),
                                                  model_.objectOpacity(parts.front()), 0.0, 1.0, 3, &ok);
-  if (!ok) return;
+  if (!ok || rows != rowsBuilt_) return;  // another scene meanwhile
   QMap<int, double> opacities;
-  for (const int i : selectedParts()) opacities.insert(i, opacity);
+  for (const int i : parts) opacities.insert(i, opacity);
   model_.setObjectOpacities(opacities);
 }
 

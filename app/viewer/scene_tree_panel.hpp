@@ -84,4 +84,5 @@ class SceneTreePanel final : public QWidget {
   QPushButton* dataRange_ = nullptr;
   QLabel* fieldNote_ = nullptr;
   bool rebuilding_ = false;
+  quint64 rowsBuilt_ = 0;  // rebuilds so far: a dialog open across one edits no part
 };

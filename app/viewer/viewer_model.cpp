@@ -711,13 +711,18 @@ void ViewerModel::setDataView(DataView view, bool overImage) {
 
 // ---- scene -------------------------------------------------------------------------------
 
-void ViewerModel::setMoleculeStyle(const mfr::MoleculeStyle& style) {
-  if (!moleculeStyle_ || !style.any()) return;
+bool ViewerModel::setMoleculeStyle(const mfr::MoleculeStyle& style) {
+  if (!moleculeStyle_ || !style.any()) return false;
+  // Not while another file or session is read: this re-read superseded it, so the file asked for
+  // never came and a session waiting for it was applied to this scene (a bug hunt). A re-read of
+  // these representations in flight is superseded, so that quick clicks add up.
+  if (loading_ && !requestedMoleculeStyle_) return false;
   // Compared with what was asked last: a change undone before its read ends is a read of its own.
-  if (style == requestedMoleculeStyle_.value_or(*moleculeStyle_)) return;
+  if (style == requestedMoleculeStyle_.value_or(*moleculeStyle_)) return true;
   loadSceneAsync(scenePath_, {}, style);
   keepView_ = true;
   requestedMoleculeStyle_ = style;
+  return true;
 }
 
 std::vector<int> matchByName(const QStringList& entries, const QStringList& names, bool unnamedByIndex) {

@@ -234,7 +234,8 @@ class ViewerModel final : public ViewerContext {
   // the file in the background with `style`, keeping the camera (sceneLoaded follows; colours and
   // opacities chosen for parts start again from the file's).
   [[nodiscard]] std::optional<mfr::MoleculeStyle> moleculeStyle() const { return moleculeStyle_; }
-  void setMoleculeStyle(const mfr::MoleculeStyle& style);
+  // False, changing nothing, while another file or session is read (or for no molecule).
+  bool setMoleculeStyle(const mfr::MoleculeStyle& style);
   void cancelLoad();
   [[nodiscard]] bool isLoading() const { return loading_; }
   [[nodiscard]] double loadProgress() const { return loadProgress_; }  // of the current or last load

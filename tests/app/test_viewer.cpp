@@ -6,6 +6,7 @@
 #include <QComboBox>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
+#include <QHeaderView>
 #include <QInputDialog>
 #include <QJsonArray>
 #include <QLineEdit>
@@ -4333,6 +4334,51 @@ class ViewerTest : public QObject {
         ++slices;
       }
     QVERIFY2(slices > 0, "no pixel with a slice in front of a part");
+  }
+
+  // Edits made while another scene loads do not land on the wrong scene (a bug hunt): a Molecule
+  // box clicked while a file was read re-read the molecule instead, so the file never came (and a
+  // session waiting for it was applied to the molecule); a part's colour dialog open across a load
+  // recoloured the new scene's part of that index, and the tree kept the old scene's rows.
+  void editsDuringALoadDoNotLandOnTheNextScene() {
+    auto w = openWindow(QStringLiteral("/usr/share/pymol/data/demo/pept.pdb"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    w->view().setFixedSize(160, 120);
+    w->findChild<QDockWidget*>("sceneDock")->raise();
+    auto* sticks = w->findChild<QCheckBox*>("moleculeSticks");
+    QVERIFY(sticks && sticks->isVisible() && !sticks->isChecked());
+    w->openScene(QStringLiteral("@sample"));
+    QVERIFY(m.isLoading());
+    sticks->click();  // refused: the box shows the molecule's representations again
+    QVERIFY(!sticks->isChecked());
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.scene().name == "sample", kTimeoutMs);
+    settle(m);
+    // A colour dialog open while another scene loads: the choice is dropped, the rows are the new scene's.
+    auto* tree = w->findChild<QTreeWidget*>("sceneTree");
+    const mfr::Scene csgScene = mfr::makeCsgSampleScene();
+    bool loaded = false;
+    auto* timer = new QTimer(w.get());
+    connect(timer, &QTimer::timeout, [&, timer] {
+      auto* dialog = qobject_cast<QColorDialog*>(QApplication::activeModalWidget());
+      if (!dialog) return;
+      timer->stop();
+      w->openScene(QStringLiteral("@csg"));
+      loaded = QTest::qWaitFor([&] { return !m.isLoading() && m.scene().name == "csg"; }, kTimeoutMs);
+      dialog->setCurrentColor(QColor(255, 0, 255));
+      dialog->accept();
+    });
+    timer->start(20);
+    const QRect cell = tree->visualItemRect(tree->topLevelItem(1));
+    QTest::mouseClick(tree->viewport(), Qt::LeftButton, Qt::NoModifier,
+                      QPoint(tree->header()->sectionViewportPosition(1) + 8, cell.center().y()));
+    QTRY_VERIFY_WITH_TIMEOUT(loaded && !QApplication::activeModalWidget(), kTimeoutMs);
+    QApplication::processEvents();
+    QCOMPARE(m.scene().objects[1].material.color, csgScene.objects[1].material.color);
+    QCOMPARE(tree->topLevelItemCount(), static_cast<int>(csgScene.objects.size()));
+    for (int i = 0; i < tree->topLevelItemCount(); ++i)
+      QCOMPARE(tree->topLevelItem(i)->text(0),
+               QString::fromStdString(csgScene.objects[static_cast<std::size_t>(i)].name));
   }
 
   void navigation() {
