@@ -931,6 +931,9 @@ void ViewerModel::setScene(mfr::Scene scene, const QString& path, const std::fun
   hasScene_ = true;
   ++sceneRevision_;
   ++sceneSerial_;
+  // A CPU method's last picture is of the old scene: shown "until the new one is ready", the view
+  // drew the previous file for seconds under the new one's name (a bug hunt). Nothing until then.
+  cpuLast_.clear();
   updateSceneGeometry(false);  // the camera is the new scene's fit view, below
   updateDrawnScene();
   // The z-thickness is a length in the old scene's units: the new one starts at its own default.

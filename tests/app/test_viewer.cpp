@@ -4379,6 +4379,20 @@ class ViewerTest : public QObject {
     for (int i = 0; i < tree->topLevelItemCount(); ++i)
       QCOMPARE(tree->topLevelItem(i)->text(0),
                QString::fromStdString(csgScene.objects[static_cast<std::size_t>(i)].name));
+    // A CPU method's picture of the old scene is not shown under the new one while the new one is
+    // computed (the view drew the previous file for seconds; a bug hunt).
+    m.setMethod(QStringLiteral("oracle"));
+    settle(m);
+    QVERIFY(m.lastCpuImage(ViewerModel::paneSlot(0)) != nullptr);
+    bool stale = true;
+    const QMetaObject::Connection checking = connect(&m, &ViewerModel::sceneLoaded, [&] {
+      const CpuImage* last = m.lastCpuImage(ViewerModel::paneSlot(0));
+      stale = last != nullptr && last->key.scene != m.sceneRevision();
+    });
+    w->openScene(QStringLiteral("@sample"));
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.scene().name == "sample", kTimeoutMs);
+    disconnect(checking);
+    QVERIFY(!stale);
   }
 
   void navigation() {
