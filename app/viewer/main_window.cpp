@@ -605,9 +605,18 @@ void MainWindow::open(const QString& path) {
 
 // A session by its name, or by what it says it is ("format": "mfrview-session"): one opened with
 // --session under another name went to Open Recent, which read it as a scene file (a bug hunt).
-// Only a small regular file that starts as a JSON object is read to tell.
+// Only a small regular file whose name says no scene, model or volume format (a glTF is JSON too,
+// and was parsed twice), and that starts as a JSON object, is read to tell.
 bool MainWindow::isSessionFile(const QString& path) {
   if (path.endsWith(kSessionSuffix, Qt::CaseInsensitive)) return true;
+  std::vector<std::string> formats = mfr::supportedModelExtensions();
+  const std::vector<std::string> volumes = mfr::supportedVolumeExtensions();
+  formats.insert(formats.end(), volumes.begin(), volumes.end());
+  formats.emplace_back(".mfrscene");
+  if (std::any_of(formats.begin(), formats.end(), [&](const std::string& ext) {
+        return path.endsWith(QString::fromStdString(ext), Qt::CaseInsensitive);
+      }))
+    return false;
   std::error_code ec;
   const std::filesystem::path file(QFile::encodeName(path).toStdString());
   if (!std::filesystem::is_regular_file(file, ec) ||
