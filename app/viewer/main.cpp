@@ -12,6 +12,7 @@
 #include <QCoreApplication>
 #include <QCommandLineParser>
 #include <QElapsedTimer>
+#include <QFileInfo>
 #include <QImage>
 #include <QJsonDocument>
 #include <QJsonObject>
@@ -25,6 +26,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -359,6 +361,16 @@ CommandLine parseCommandLine(const QStringList& sessionArgs) {
   return cl;
 }
 
+// What a session manager hands back to Qt's -session when it restores a window: an XSMP client
+// id (letters and digits) and Qt's key after '_'. A name with a dot or a slash, or of a file that
+// exists, is the user's session file; and with no session manager running nothing hands one back.
+bool isSessionManagerId(const char* value) {
+  if (std::getenv("SESSION_MANAGER") == nullptr || *value == '\0') return false;
+  for (const char* c = value; *c; ++c)
+    if (!std::isalnum(static_cast<unsigned char>(*c)) && *c != '_') return false;
+  return !QFileInfo::exists(QString::fromLocal8Bit(value));
+}
+
 // QGuiApplication takes -session and --session with their value for X11 session management, so
 // `mfrview --session s.mfrsession` opened @sample without a word. mfrview's own --session (two
 // dashes) is taken out of argv before Qt sees it and handed to the parser; -session stays Qt's.
@@ -375,13 +387,14 @@ QStringList takeSessionOption(int& argc, char** argv) {
       if (i + 1 < argc) taken << QString::fromLocal8Bit(argv[++i]);  // else the parser's "Missing value"
     } else if (std::strncmp(argv[i], "--session=", 10) == 0) {
       taken << QString::fromLocal8Bit(argv[i]);
-    } else if (std::strcmp(argv[i], "-session") == 0 && i + 1 < argc && std::getenv("SESSION_MANAGER") == nullptr) {
-      // Only a session manager (SESSION_MANAGER set) restores a window with Qt's -session id;
-      // without one it is the user's --session with one dash, which opened @sample, exit 0 (a
-      // review; a misspelt file too).
-      fail(QStringLiteral("-session %1: one dash is Qt's X11 session-management option (an id), and no session "
-                          "manager runs; open a session file with --session %1")
-               .arg(QString::fromLocal8Bit(argv[i + 1])),
+    } else if (std::strcmp(argv[i], "-session") == 0 && i + 1 < argc && !isSessionManagerId(argv[i + 1])) {
+      // The user's --session with one dash: Qt took it and @sample opened, exit 0 (a review; a
+      // misspelt file too, and on every desktop, where a session manager runs).
+      fail(QStringLiteral("-session %1: one dash is Qt's X11 session-management option (an id%2); open a session "
+                          "file with --session %1")
+               .arg(QString::fromLocal8Bit(argv[i + 1]), std::getenv("SESSION_MANAGER") == nullptr
+                                                             ? QStringLiteral(", and no session manager runs")
+                                                             : QString()),
            2);
     } else {
       argv[kept++] = argv[i];

@@ -609,14 +609,9 @@ void MainWindow::open(const QString& path) {
 // and was parsed twice), and that starts as a JSON object, is read to tell.
 bool MainWindow::isSessionFile(const QString& path) {
   if (path.endsWith(kSessionSuffix, Qt::CaseInsensitive)) return true;
-  std::vector<std::string> formats = mfr::supportedModelExtensions();
-  const std::vector<std::string> volumes = mfr::supportedVolumeExtensions();
-  formats.insert(formats.end(), volumes.begin(), volumes.end());
-  formats.emplace_back(".mfrscene");
-  if (std::any_of(formats.begin(), formats.end(), [&](const std::string& ext) {
-        return path.endsWith(QString::fromStdString(ext), Qt::CaseInsensitive);
-      }))
-    return false;
+  // By its content whatever its name (a session saved as s.gltf opened as a model, and went to
+  // Open Recent as one), cheaply: a file is parsed only if it starts as JSON and names the format
+  // (a glTF is JSON too, and was parsed once to tell and again to load).
   std::error_code ec;
   const std::filesystem::path file(QFile::encodeName(path).toStdString());
   if (!std::filesystem::is_regular_file(file, ec) ||
@@ -624,8 +619,9 @@ bool MainWindow::isSessionFile(const QString& path) {
     return false;
   QFile f(path);
   if (!f.open(QIODevice::ReadOnly)) return false;
+  if (!f.peek(256).trimmed().startsWith('{')) return false;
   const QByteArray bytes = f.readAll();
-  if (!bytes.trimmed().startsWith('{')) return false;
+  if (!bytes.contains("\"mfrview-session\"")) return false;
   const QJsonDocument doc = QJsonDocument::fromJson(bytes);
   return doc.isObject() &&
          doc.object().value(QStringLiteral("format")) == QJsonValue(QStringLiteral("mfrview-session"));

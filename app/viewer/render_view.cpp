@@ -4,6 +4,7 @@
 #include <QMouseEvent>
 #include <QWindow>
 #include <QOpenGLContext>
+#include <QScopedValueRollback>
 #include <QTimer>
 #include <QWheelEvent>
 
@@ -37,22 +38,28 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
   setFocusPolicy(Qt::StrongFocus);
   setMinimumSize(160, 120);
   // Any change that alters the image schedules one repaint (Qt merges repeated requests).
-  const auto repaint = [this] { update(); };
-  connect(&model_, &ViewerModel::sceneChanged, this, repaint);
-  connect(&model_, &ViewerModel::viewChanged, this, repaint);
-  connect(&model_, &ViewerModel::sideChanged, this, repaint);
-  connect(&model_, &ViewerModel::compareChanged, this, repaint);
-  connect(&model_, &ViewerModel::dataViewChanged, this, repaint);
-  connect(&model_, &ViewerModel::cpuImageReady, this, repaint);
+  const auto repaint = [this](const char* reason) { return [this, reason] { requestFrame(reason); }; };
+  connect(&model_, &ViewerModel::sceneChanged, this, repaint("scene"));
+  connect(&model_, &ViewerModel::viewChanged, this, repaint("view"));
+  connect(&model_, &ViewerModel::sideChanged, this, repaint("side"));
+  connect(&model_, &ViewerModel::compareChanged, this, repaint("compare"));
+  connect(&model_, &ViewerModel::dataViewChanged, this, repaint("data view"));
+  // Only a pane of a CPU method draws CPU images: the reference of the metrics comes for every
+  // frame while they are wanted (the budget panel's quality), and a GPU frame drawn again for it
+  // changed nothing and cost as much as the view change.
+  connect(&model_, &ViewerModel::cpuImageReady, this, [this] {
+    for (int side = 0; side < model_.paneCount(); ++side)
+      if (model_.isCpuMethod(model_.methodOf(side))) return requestFrame("cpu image");
+  });
   // A requested frame quality needs the frame on the CPU: draw it once more and read it back
   // (the widget's framebuffer is not kept between paints).
-  connect(&model_, &ViewerModel::frameImageWanted, this, repaint);
+  connect(&model_, &ViewerModel::frameImageWanted, this, repaint("frame image wanted"));
   // Counted on the GPU between frames (queued: the request may come from inside a paint's report).
   connect(&model_, &ViewerModel::depthComplexityWanted, this, &RenderView::reportDepthComplexity, Qt::QueuedConnection);
   connect(&model_, &ViewerModel::metricsReady, this, [this] {
     // Heat maps are drawn into the image; the captions are widgets.
     if (model_.compareEnabled() && model_.compareDisplay() != CompareDisplay::Images)
-      update();
+      requestFrame("metrics");
     else
       updateOverlays();
   });
@@ -69,7 +76,7 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
   settle_->setSingleShot(true);
   connect(settle_, &QTimer::timeout, this, [this] {
     navigating_ = false;
-    if (lastReduction_ > 1) update();  // the full frame of where the motion stopped
+    if (lastReduction_ > 1) requestFrame("navigation settled");  // the full frame of where the motion stopped
   });
 
   errorNote_ = new QLabel(this);
@@ -146,8 +153,15 @@ void RenderView::initializeGL() {
 }
 
 void RenderView::resizeGL(int, int) {
+  // QOpenGLWidget paints right after this: the new size's viewChanged needs no second frame.
+  const QScopedValueRollback inFrame(sizingFrame_, true);
   model_.setRenderSize(pixelSize());
 }
+
+// QWidget repaints a widget that gains or loses focus, for a focus frame; the view draws none,
+// and clicking into it from a dock cost a full frame.
+void RenderView::focusInEvent(QFocusEvent*) {}
+void RenderView::focusOutEvent(QFocusEvent*) {}
 
 void RenderView::resizeEvent(QResizeEvent* event) {
   QOpenGLWidget::resizeEvent(event);
@@ -195,14 +209,24 @@ void RenderView::clearToBackground() {
 // what a slow interaction or a scripted run spends its time on.
 Q_LOGGING_CATEGORY(lcViewFrames, "mfr.view.frames", QtWarningMsg)
 
-void RenderView::setLiveFrames(bool on) {
-  if (on == liveFrames_) return;
-  liveFrames_ = on;
+void RenderView::requestFrame(const char* reason) {
+  if (sizingFrame_) return;
+  if (const QString r = QLatin1String(reason); !frameReasons_.contains(r)) frameReasons_.append(r);
   update();
 }
 
+void RenderView::setLiveFrames(bool on) {
+  if (on == liveFrames_) return;
+  liveFrames_ = on;
+  requestFrame("live frames");
+}
+
 void RenderView::paintGL() {
-  model_.setRenderSize(pixelSize());
+  const QStringList reasons = std::exchange(frameReasons_, {});
+  {
+    const QScopedValueRollback inFrame(sizingFrame_, true);  // this frame draws the new size
+    model_.setRenderSize(pixelSize());
+  }
   if (!liveFrames_) {
     clearToBackground();
     maps_ = {};
@@ -231,7 +255,8 @@ void RenderView::paintGL() {
         this, [this, reduction] { emit frameReductionChanged(reduction); }, Qt::QueuedConnection);
   }
   glBindFramebuffer(GL_FRAMEBUFFER, defaultFramebufferObject());
-  qCDebug(lcViewFrames, "frame %dx%d, 1/%d", pixelSize().width(), pixelSize().height(), reduction);
+  qCDebug(lcViewFrames, "frame %dx%d, 1/%d (%s)", pixelSize().width(), pixelSize().height(), reduction,
+          qUtf8Printable(reasons.isEmpty() ? QStringLiteral("window system") : reasons.join(", ")));
   errors.removeDuplicates();
   reports_->error = errors.join(QStringLiteral("; "));
   reports_->reportError = renderers_[0] != nullptr;
@@ -456,9 +481,14 @@ QRectF RenderView::logicalRect(const QRect& device) const {
   return {device.x() / ratio, device.y() / ratio, device.width() / ratio, device.height() / ratio};
 }
 
+QPoint RenderView::devicePixel(QPointF point, double ratio) {
+  constexpr double kRoundingSlack = 1e-6;  // of a device pixel: far above the error, far below a real offset
+  return {static_cast<int>(std::floor(point.x() * ratio + kRoundingSlack)),
+          static_cast<int>(std::floor(point.y() * ratio + kRoundingSlack))};
+}
+
 int RenderView::paneAt(QPointF point) const {
-  const double ratio = devicePixelRatioF();
-  const QPoint device(static_cast<int>(std::floor(point.x() * ratio)), static_cast<int>(std::floor(point.y() * ratio)));
+  const QPoint device = devicePixel(point, devicePixelRatioF());
   int found = -1;
   for (int side = 0; side < model_.paneCount(); ++side)
     if (paneVisibleRect(side).contains(device)) found = side;
@@ -507,7 +537,7 @@ void RenderView::blitPane(int side, const PaneTarget& target) {
 
 void RenderView::setFastNavigation(bool on) {
   fastNavigation_ = on;
-  if (!on && lastReduction_ > 1) update();
+  if (!on && lastReduction_ > 1) requestFrame("fast navigation");
 }
 
 int RenderView::navigationReduction() const {
@@ -747,8 +777,7 @@ mfr::RenderOutput RenderView::renderOutput(QSize size, const std::map<std::strin
 RenderView::PanePixel RenderView::panePixelAt(QPointF point, const char* what) const {
   if (!model_.hasScene()) throw mfr::Error(what, "no scene loaded");
   if (const QString why = model_.drawError(); !why.isEmpty()) throw mfr::Error(why.toStdString());
-  const double ratio = devicePixelRatioF();
-  const QPoint device(static_cast<int>(std::floor(point.x() * ratio)), static_cast<int>(std::floor(point.y() * ratio)));
+  const QPoint device = devicePixel(point, devicePixelRatioF());
   PanePixel at;
   at.device = device;
   at.side = paneAt(point);

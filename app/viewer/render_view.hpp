@@ -106,6 +106,11 @@ class RenderView final : public QOpenGLWidget {
   [[nodiscard]] QRect paneVisibleRect(int side) const;
   // The side whose visible image holds `point` (logical widget coordinates), or -1 off every image.
   [[nodiscard]] int paneAt(QPointF point) const;
+  // The device pixel under a logical point at this device-pixel ratio. A point the window system
+  // gave in device pixels comes back as x / ratio less the view's offset, a hair below the
+  // whole number it stands for (38.666…67 × 1.5 = 57.99999999999994): a plain floor lost one
+  // column in three at 1.5 (a review).
+  [[nodiscard]] static QPoint devicePixel(QPointF point, double ratio);
   // A framebuffer rectangle (device pixels) in logical widget coordinates.
   [[nodiscard]] QRectF logicalRect(const QRect& device) const;
   // The pane under `point` (logical widget coordinates), in logical coordinates: what the mouse
@@ -140,6 +145,8 @@ class RenderView final : public QOpenGLWidget {
   void resizeGL(int width, int height) override;
   void paintGL() override;
   void resizeEvent(QResizeEvent* event) override;
+  void focusInEvent(QFocusEvent* event) override;
+  void focusOutEvent(QFocusEvent* event) override;
   void mousePressEvent(QMouseEvent* event) override;
   void mouseMoveEvent(QMouseEvent* event) override;
   void mouseReleaseEvent(QMouseEvent* event) override;
@@ -149,6 +156,8 @@ class RenderView final : public QOpenGLWidget {
   void wheelEvent(QWheelEvent* event) override;
 
  private:
+  // update() with why, for the mfr.view.frames log.
+  void requestFrame(const char* reason);
   // The image pixel under a point of the view: its pane, the pane's framebuffer rectangle, the
   // pixel in that pane's image and in the framebuffer. Throws mfr::Error naming `what` (no scene,
   // nothing drawable, a point off every image).
@@ -245,6 +254,8 @@ class RenderView final : public QOpenGLWidget {
   enum class Drag { None, Orbit, Pan } drag_ = Drag::None;
   bool fastNavigation_ = true;
   bool liveFrames_ = true;
+  bool sizingFrame_ = false;  // the size changes inside a frame that draws it (requestFrame: none)
+  QStringList frameReasons_;  // why the next frame is drawn (mfr.view.frames); none: the window system
   bool navigating_ = false;
   QTimer* settle_ = nullptr;  // ends navigation a moment after the last drag or wheel step
   int lastReduction_ = 1;

@@ -509,9 +509,10 @@ void SceneTreePanel::itemClicked(QTreeWidgetItem* item, int column) {
   const QColor initial = colourOf(model_.scene().objects[static_cast<std::size_t>(index)]);
   const QString title = tr("Colour of %1").arg(item->text(kName));
   // After the click's own handling: the dialog's event loop may see a load end and the rows
-  // rebuilt, which inside the click left the tree drawing the old scene's rows (a bug hunt).
-  QTimer::singleShot(0, this, [this, index, initial, title] {
-    const quint64 rows = rowsBuilt_;
+  // rebuilt, which inside the click left the tree drawing the old scene's rows (a bug hunt). The
+  // rows the click was on are those of now: a load's end already queued rebuilds them first.
+  QTimer::singleShot(0, this, [this, index, initial, title, rows = rowsBuilt_] {
+    if (rows != rowsBuilt_) return;
     const QColor chosen = QColorDialog::getColor(initial, this, title);
     // Another scene, or other parts, meanwhile: the index names another part (it recoloured the
     // new scene's part of that index).

@@ -26,6 +26,13 @@ StatsPanel::StatsPanel(ViewerModel& model, QWidget* parent) : QWidget(parent), m
   tree_->setAlternatingRowColors(true);
   layout->addWidget(tree_);
   connect(&model_, &ViewerModel::frameRendered, this, &StatsPanel::showStats);
+  // A CPU method's first frame of a new scene takes seconds: the previous scene's numbers stood
+  // under the new scene's name until then (a bug hunt). A GPU frame follows at once.
+  connect(&model_, &ViewerModel::sceneLoaded, this, [this] {
+    if (!model_.isCpuMethod(model_.method())) return;
+    tree_->clear();
+    new QTreeWidgetItem(tree_, {tr("Frame"), tr("being computed for this scene")});
+  });
   // No numbers of the last frame drawn under a frame that cannot be drawn.
   connect(&model_, &ViewerContext::frameErrorChanged, this, [this] {
     const QString error = model_.frameError();

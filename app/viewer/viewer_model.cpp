@@ -3,6 +3,7 @@
 #include <QRegularExpression>
 
 #include <QFutureWatcher>
+#include <QMetaMethod>
 #include <QTimer>
 #include <QtConcurrent/QtConcurrentRun>
 
@@ -1407,7 +1408,10 @@ bool ViewerModel::wantsFrameImage(int side) const {
   if (frame && frame->first == frameKey(side)) return false;
   // Once frame qualities are asked for, every main frame is kept (a read-back is cheap; drawing
   // the frame again when the request comes is not).
-  return metricsWanted(side) || (side == 0 && keepFrameImages_);
+  // Whoever listens for the frame quality (the budget panel) will ask for it after this frame:
+  // read it back now, or the view draws it again to read it (a slow method's whole cost).
+  static const QMetaMethod qualitySignal = QMetaMethod::fromSignal(&ViewerContext::frameQualityReady);
+  return metricsWanted(side) || (side == 0 && (keepFrameImages_ || isSignalConnected(qualitySignal)));
 }
 
 void ViewerModel::reportFrameImage(int side, const ImageKey& key, mfr::ImageRGBA8 image) {

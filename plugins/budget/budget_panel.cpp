@@ -129,6 +129,9 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   exactLabel_->setToolTip(
       tr("The least budget at which this frame's image is exact (vkb, dkb: a one-fragment "
          "tail, and a final run of one colour, are exact: Σ max(1, n − m) slots suffice)"));
+  // Each frame's numbers wrap rather than widen the dock: a wider dock narrows the view, and the
+  // view draws its frame again at the new size (a slow method's whole cost, for a longer number).
+  for (QLabel* l : {memoryLabel_, capturedLabel_, kLabel_, exactLabel_}) l->setWordWrap(true);
   frameForm->addRow(tr("Memory"), memoryBar_);
   frameForm->addRow(tr("Holding data"), memoryLabel_);
   frameForm->addRow(tr("Captured"), capturedLabel_);
@@ -137,6 +140,7 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   rmseLabel_ = new QLabel(tr("—"));
   rmseLabel_->setObjectName(QStringLiteral("budgetRmse"));
   flipLabel_ = new QLabel(tr("—"));
+  rmseLabel_->setWordWrap(true);
   flipLabel_->setWordWrap(true);  // it may hold why the numbers were not computed
   flipLabel_->setObjectName(QStringLiteral("budgetFlip"));
   rmseLabel_->setToolTip(qualityToolTip(rmseLabel_, QString()));

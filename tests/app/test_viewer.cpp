@@ -867,6 +867,18 @@ class ViewerTest : public QObject {
     const QString renamed = dir.filePath("k.json"), renamedPng = dir.filePath("renamed.png");
     QVERIFY(QFile::copy(sessionPath, renamed));
     QVERIFY(MainWindow::isSessionFile(renamed) && MainWindow::isSessionFile(sessionPath));
+    // Whatever the name says (a review: named like a model, it was read as one), and a model that
+    // is JSON too is not one.
+    const QString likeAModel = dir.filePath("k.gltf");
+    QVERIFY(QFile::copy(sessionPath, likeAModel));
+    QVERIFY(MainWindow::isSessionFile(likeAModel));
+    const QString gltf = dir.filePath("empty.gltf");
+    {
+      QFile f(gltf);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(R"({"asset": {"version": "2.0"}, "extras": {"format": "mfrview-scene"}})");
+    }
+    QVERIFY(!MainWindow::isSessionFile(gltf));
     QVERIFY(!MainWindow::isSessionFile(QStringLiteral("@csg")) && !MainWindow::isSessionFile(dir.path()));
     const QString config = dir.filePath("config");
     const QByteArray userConfig = qgetenv("XDG_CONFIG_HOME");
@@ -884,7 +896,16 @@ class ViewerTest : public QObject {
     QCOMPARE(maxChannelDifference(expected, mfr::readPng(joined.toStdString())), 0);
     QVERIFY(maxChannelDifference(expected, mfr::readPng(sample.toStdString())) > 8);  // not the default scene
     const QString png = dir.filePath("refused.png");
-    qunsetenv("SESSION_MANAGER");  // -session is refused where no session manager runs
+    // -session is refused on a desktop, where a session manager runs (it was refused only where
+    // none ran, a review): a file's name is no session manager's id.
+    const QByteArray userSessionManager = qgetenv("SESSION_MANAGER");
+    const auto restoreSessionManager = qScopeGuard([&] {
+      if (userSessionManager.isNull())
+        qunsetenv("SESSION_MANAGER");
+      else
+        qputenv("SESSION_MANAGER", userSessionManager);
+    });
+    qputenv("SESSION_MANAGER", "local/mfr-test:@/tmp/.ICE-unix/1,unix/mfr-test:/tmp/.ICE-unix/1");
     for (const auto& [args, line] : QList<std::pair<QStringList, QString>>{
              {{"@sample", "--session", sessionPath, "--screenshot", png},
               QStringLiteral("mfrview: --session %1: a scene is given too (@sample); give one of the two")
@@ -895,17 +916,32 @@ class ViewerTest : public QObject {
              {{"--screenshot", png, "--session"}, QStringLiteral("mfrview: Missing value after '--session'.")},
              // One dash is Qt's option (an X11 session id): it opened @sample, exit 0 (a review).
              {{"-session", sessionPath, "--screenshot", png},
-              QStringLiteral("mfrview: -session %1: one dash is Qt's X11 session-management option (an id), and no "
-                             "session manager runs; open a session file with --session %1")
+              QStringLiteral("mfrview: -session %1: one dash is Qt's X11 session-management option (an id); open a "
+                             "session file with --session %1")
                   .arg(sessionPath)},
              {{"-session", "typo.mfrsession", "--screenshot", png},
-              QStringLiteral(
-                  "mfrview: -session typo.mfrsession: one dash is Qt's X11 session-management option (an "
-                  "id), and no session manager runs; open a session file with --session typo.mfrsession")}}) {
+              QStringLiteral("mfrview: -session typo.mfrsession: one dash is Qt's X11 session-management option (an "
+                             "id); open a session file with --session typo.mfrsession")}}) {
       QCOMPARE(runProgram(MFRVIEW, args, &out), 2);
       QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(), line);
       QVERIFY(!QFile::exists(png));
     }
+    // A file named like an id (no dot, no slash) is still the user's file; with no session manager
+    // nothing hands Qt an id at all.
+    QVERIFY(QFile::copy(sessionPath, dir.filePath("plain")));
+    const QString cwd = QDir::currentPath();
+    QDir::setCurrent(dir.path());
+    const auto back = qScopeGuard([&] { QDir::setCurrent(cwd); });
+    QCOMPARE(runProgram(MFRVIEW, {"-session", "plain", "--screenshot", png}, &out), 2);
+    QVERIFY2(out.contains("mfrview: -session plain: one dash is Qt's"), qPrintable(out));
+    qunsetenv("SESSION_MANAGER");
+    QCOMPARE(runProgram(MFRVIEW, {"-session", "10d4f54d2f000162937474200000016010007_1", "--screenshot", png}, &out),
+             2);
+    QCOMPARE(out.trimmed().split(QLatin1Char('\n')).constLast(),
+             QStringLiteral("mfrview: -session 10d4f54d2f000162937474200000016010007_1: one dash is Qt's X11 "
+                            "session-management option (an id, and no session manager runs); open a session file "
+                            "with --session 10d4f54d2f000162937474200000016010007_1"));
+    QVERIFY(!QFile::exists(png));
     // A screenshot is never written over the session or scene read, nor both to one file, by any
     // name: a link named like a PNG wrote the picture over its session, exit 0 (a bug hunt), as
     // mfr render refuses its own outputs over its inputs.
@@ -3861,6 +3897,74 @@ class ViewerTest : public QObject {
     QVERIFY(!robustness->isVisible());
   }
 
+  // The pixel probed or picked is the device pixel clicked at any scale: the window system's
+  // device position comes as x / ratio in the window, less the view's offset; a plain floor of
+  // that times the ratio lost one column in three at 1.5 (a review: device x 700 probed 57, not 58).
+  void devicePixelsAtFractionalScales() {
+    for (const double ratio : {1.0, 1.25, 1.5, 1.75, 2.0, 2.5, 3.0})
+      for (const int offset : {0, 4, 12, 428, 1000}) {  // logical, whole device pixels at each ratio
+        const double deviceOffset = offset * ratio;
+        if (deviceOffset != std::floor(deviceOffset)) continue;
+        for (int x = static_cast<int>(deviceOffset); x < 4000; ++x) {
+          const double local = x / ratio - offset;  // as QHighDpi and mapTo give it
+          const QPoint at = RenderView::devicePixel(QPointF(local, (x + 0.5) / ratio), ratio);
+          if (at.x() != x - static_cast<int>(deviceOffset) || at.y() != x)
+            QFAIL(qPrintable(QStringLiteral("ratio %1, offset %2: device x %3 gave column %4, row %5")
+                                 .arg(ratio)
+                                 .arg(offset)
+                                 .arg(x)
+                                 .arg(at.x())
+                                 .arg(at.y())));
+        }
+      }
+  }
+
+  // Each change draws one frame, with every plugin loaded (GPU frames are drawn on the GUI thread:
+  // each extra one froze the window for a slow method's whole time). Three causes, from a bug
+  // hunt: the budget panel's first quality request drew the frame again to read it back; the
+  // exact image behind the quality, when it came, drew the GPU frame again; and the budget
+  // panel's longer numbers after a frame widened its dock, narrowing the view, which drew again.
+  // Giving the view the keyboard focus drew one more.
+  void eachChangeDrawsOneFrame() {
+    auto w = std::make_unique<MainWindow>(MainWindow::Options{.restoreSettings = false, .loadPlugins = true});
+    w->resize(1100, 700);
+    w->show();
+    QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+    ViewerModel& m = w->model();
+    QVERIFY(w->findChild<QDockWidget*>("plugin-budget"));
+    w->findChild<QDockWidget*>("plugin-budget")->raise();
+    QList<QSize> sizes;  // of every frame the view reported
+    connect(&m, &ViewerContext::frameRendered, this, [&] { sizes << m.renderSize(); });
+    w->openScene(QStringLiteral("@sample"));
+    QTRY_VERIFY_WITH_TIMEOUT(m.hasScene() && m.framesRendered() > 0, kTimeoutMs);
+    QTRY_VERIFY_WITH_TIMEOUT(m.frameQuality().valid, kTimeoutMs);  // the budget panel asked for it
+    settle(m);
+    QVERIFY(!sizes.isEmpty());
+    QCOMPARE(sizes.count(sizes.first()), sizes.size());  // the panels' numbers moved no dock
+    QCOMPARE(sizes.size(), 1);
+
+    const quint64 before = m.framesRendered();
+    m.setCamera(navigation::orbit(m.camera(), QPointF(25, -10), m.renderSize()));
+    QTRY_VERIFY_WITH_TIMEOUT(m.framesRendered() > before && m.frameQuality().valid, kTimeoutMs);
+    settle(m);
+    QCOMPARE(m.framesRendered() - before, quint64{1});
+
+    // The keyboard focus moving into the view and out again draws nothing.
+    auto* filter = w->findChild<QLineEdit*>("sceneFilter");
+    QVERIFY(filter);
+    w->activateWindow();
+    QVERIFY(QTest::qWaitForWindowActive(w.get()));
+    filter->setFocus();
+    QTRY_VERIFY(filter->hasFocus());
+    const quint64 focused = m.framesRendered();
+    w->view().setFocus();
+    QTRY_VERIFY(w->view().hasFocus());
+    filter->setFocus();
+    QTRY_VERIFY(filter->hasFocus());
+    settle(m);
+    QCOMPARE(m.framesRendered(), focused);
+  }
+
   // Fast navigation: while the camera is dragged, a slow method is drawn at a fraction of the
   // size (its budget scaled with the pixels, nothing reported); when the drag ends the full frame
   // of the new camera follows and is reported. Off, every frame is full.
@@ -4379,20 +4483,47 @@ class ViewerTest : public QObject {
     for (int i = 0; i < tree->topLevelItemCount(); ++i)
       QCOMPARE(tree->topLevelItem(i)->text(0),
                QString::fromStdString(csgScene.objects[static_cast<std::size_t>(i)].name));
+    // Nor does a click whose rows are rebuilt before its dialog opens (a load's end already
+    // queued behind the click: the dialog offered the old part, and the choice recoloured the new
+    // scene's part of that index; a review).
+    bool opened = false;
+    auto* watch = new QTimer(w.get());
+    connect(watch, &QTimer::timeout, [&] {
+      if (auto* dialog = qobject_cast<QColorDialog*>(QApplication::activeModalWidget())) {
+        opened = true;
+        dialog->reject();
+      }
+    });
+    watch->start(20);
+    const QRect row = tree->visualItemRect(tree->topLevelItem(1));
+    QTest::mouseClick(tree->viewport(), Qt::LeftButton, Qt::NoModifier,
+                      QPoint(tree->header()->sectionViewportPosition(1) + 8, row.center().y()));
+    m.setScene(mfr::makeSampleScene(), QStringLiteral("@sample"));
+    QTest::qWait(300);
+    watch->stop();
+    QVERIFY(!opened);
+    QCOMPARE(tree->topLevelItemCount(), static_cast<int>(mfr::makeSampleScene().objects.size()));
     // A CPU method's picture of the old scene is not shown under the new one while the new one is
     // computed (the view drew the previous file for seconds; a bug hunt).
     m.setMethod(QStringLiteral("oracle"));
     settle(m);
     QVERIFY(m.lastCpuImage(ViewerModel::paneSlot(0)) != nullptr);
     bool stale = true;
+    QString statistics;  // nor its numbers (they stood until the new frame)
+    auto* statsTree = w->findChild<QTreeWidget*>("statsTree");
+    QVERIFY(statsTree && statsTree->topLevelItemCount() > 1);
     const QMetaObject::Connection checking = connect(&m, &ViewerModel::sceneLoaded, [&] {
       const CpuImage* last = m.lastCpuImage(ViewerModel::paneSlot(0));
       stale = last != nullptr && last->key.scene != m.sceneRevision();
+      statistics.clear();
+      for (int i = 0; i < statsTree->topLevelItemCount(); ++i)
+        statistics += statsTree->topLevelItem(i)->text(0) + ": " + statsTree->topLevelItem(i)->text(1) + "; ";
     });
     w->openScene(QStringLiteral("@sample"));
     QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.scene().name == "sample", kTimeoutMs);
     disconnect(checking);
     QVERIFY(!stale);
+    QCOMPARE(statistics, QStringLiteral("Frame: being computed for this scene; "));
   }
 
   void navigation() {
