@@ -278,8 +278,18 @@ TEST_F(LoadModel, NanCoordinates) {
                         "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\nvertex 0 1 0\n"
                         "endloop\nendfacet\nendsolid x\n"),
                   "non-finite coordinate");
-  // CGAL's OFF scanner does not parse "nan" at all.
-  expectLoadError(write("nan.off", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n"), "malformed or truncated OFF");
+  // CGAL's OFF scanner does not parse "nan" at all; in a coloured file it then read past the end
+  // of that line's numbers and crashed (fuzzing).
+  expectLoadError(write("nan.off", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n"),
+                  "nan.off: OFF line 4: 'nan' is not a finite number");
+  for (const char* bad : {"inf", "nan", "abc", "1e400", "-"})
+    for (const char* keyword : {"COFF", "CNOFF", "STCOFF"}) {
+      const bool normals = std::string(keyword) == "CNOFF", texture = std::string(keyword) == "STCOFF";
+      const std::string tail = std::string(normals ? " 0 0 1" : "") + " 1 0 0 1" + (texture ? " 0 0" : "");
+      std::string file = std::string(keyword) + "\n3 1 0\n";
+      file += std::string(bad) + " 0 0" + tail + "\n1 0 0" + tail + "\n0 1 0" + tail + "\n3 0 1 2\n";
+      expectLoadError(write("bad.off", file), "bad.off: OFF line 3: '" + std::string(bad) + "' is not a finite number");
+    }
   expectLoadError(write("malformed.obj", "v 0 0 0\nv 1x 0 0\nv 0 1 0\nf 1 2 3\n"), "line 2: malformed number '1x'");
 }
 
@@ -440,6 +450,14 @@ TEST_F(LoadModel, GarbageVtp) {
       "</Piece></PolyData>\n</VTKFile>\n";
   EXPECT_EQ(mfr::loadModel(write("whole.vtp", whole)).at(0).mesh->triangleCount(), 1u);
   expectLoadError(write("cut.vtp", whole.substr(0, whole.size() * 3 / 4)), "truncated: a VTK XML file ends with");
+  // Component counts VTK allocates before it reads a value (fuzzing: 2^32 − 1 spun for minutes in
+  // vtkXMLReader::CreateArray, 2^31 − 1 took 12 GB, −1 came out as "vector::_M_default_append").
+  for (const char* count : {"4294967295", "-1", "0", "3x"}) {
+    std::string bad = whole;
+    bad.replace(bad.find("NumberOfComponents=\"3\""), 22, std::string("NumberOfComponents=\"") + count + "\"");
+    expectLoadError(write("components.vtp", bad), std::string("an unnamed DataArray's NumberOfComponents=\"") + count +
+                                                      "\" is not a count in [1, 4096]");
+  }
 }
 
 TEST_F(LoadModel, GarbageLegacyVtk) {
@@ -451,6 +469,9 @@ TEST_F(LoadModel, GarbageLegacyVtk) {
       write("early.vtk",
             "# vtk DataFile Version 3.0\nshort\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0\n1 0 0\n1 1"),
       "unexpected end of data");
+  // A last line without its newline: the reason was libstdc++'s "basic_string_view::substr: __pos
+  // (which is 32) > __size (which is 31)" (fuzzing).
+  expectLoadError(write("cut.vtk", "# vtk DataFile Version 3.0\ncube"), "unexpected end of file");
   // A mangled keyword line made vtkPolyDataReader read from a closed stream and crash.
   expectLoadError(write("mangled.vtk",
                         "# vtk DataFile Version 3.0\nq\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n0 0 0E1 0 0\n1 1 1\n"
@@ -615,7 +636,7 @@ TEST_F(LoadModel, ObjMissingMaterialsAreNoted) {
 // Material values taken other than as written, and lines and points (no surface), are notes: they
 // were clamped, replaced or dropped without a word (a bug hunt).
 TEST_F(LoadModel, ObjValuesTakenOtherwiseAreNoted) {
-  write("odd.mtl", "newmtl a\nKd nan 0 0\nd 7\nnewmtl b\nKd 0.5 2 0\n");
+  write("odd.mtl", "newmtl a\nKd nan 0 0\nd 7\nnewmtl b\nKd 0.5 2 0\nKd abc 0 0\nKd xyz 0.2 0.3 0.4\n");
   mfr::LoadOptions options;
   std::vector<std::string> notes;
   options.notes = &notes;
@@ -626,15 +647,19 @@ TEST_F(LoadModel, ObjValuesTakenOtherwiseAreNoted) {
   ASSERT_EQ(parts.size(), 2u);
   EXPECT_EQ(parts[0].material.color, glm::vec4(0.8f, 0.8f, 0.8f, 1.0f));  // Kd nan ignored, d 7 clamped
   EXPECT_EQ(parts[1].material.color, glm::vec4(0.5f, 1.0f, 0.0f, 1.0f));
-  ASSERT_EQ(notes.size(), 4u);
+  ASSERT_EQ(notes.size(), 6u);
   EXPECT_NE(notes[0].find("odd.obj: odd.mtl: material 'a': 'Kd nan 0 0': not a number (ignored)"), std::string::npos)
       << notes[0];
   EXPECT_NE(notes[1].find("material 'a': 'd 7': outside 0 … 1 (clamped)"), std::string::npos) << notes[1];
   EXPECT_NE(notes[2].find("material 'b': 'Kd 0.5 2 0': outside 0 … 1 (clamped)"), std::string::npos) << notes[2];
-  EXPECT_NE(notes[3].find("odd.obj: 3 line or point elements (l, p, or faces of fewer than 3 corners) are not a "
+  // Dropped without a word where `Kd nan` was noted (fuzzing); another colour space likewise.
+  EXPECT_NE(notes[3].find("material 'b': 'Kd abc 0 0': not a number (ignored)"), std::string::npos) << notes[3];
+  EXPECT_NE(notes[4].find("material 'b': 'Kd xyz 0.2 0.3 0.4': not an RGB colour (ignored)"), std::string::npos)
+      << notes[4];
+  EXPECT_NE(notes[5].find("odd.obj: 3 line or point elements (l, p, or faces of fewer than 3 corners) are not a "
                           "surface: left out"),
             std::string::npos)
-      << notes[3];
+      << notes[5];
 }
 
 // A file whose first triangle is wound against the other eleven: the part keeps the winding most
@@ -682,6 +707,21 @@ TEST_F(LoadModel, AsciiPlyWithColors) {
   // grey of a part without colours, which tinted them (pure red drew 204; a bug hunt).
   EXPECT_EQ(objects[0].material.color, glm::vec4(1.0f, 1.0f, 1.0f, mfr::Material{}.color.a));
   EXPECT_TRUE(objects[0].material.vertexColors);
+  // A uchar is a whole number in [0, 255]: "nan" drew NaN shading, 300 and -1 were clamped without
+  // a word (fuzzing); a float colour that is not finite is refused too.
+  for (const char* bad : {"nan", "300", "-1", "1.5"}) {
+    std::string wrong = ply;
+    wrong.replace(wrong.find("2 0 0 0 255"), 11, std::string("2 0 0 0 ") + bad);
+    expectLoadError(write("bad.ply", wrong),
+                    "'" + std::string(bad) +
+                        "' is not a whole number in [0, 255] (its property's type) in PLY element "
+                        "'vertex' 1");
+  }
+  std::string floats = ply;
+  for (const char* channel : {"red", "green", "blue", "alpha"})
+    floats.replace(floats.find(std::string("uchar ") + channel), 5, "float");
+  floats.replace(floats.find("2 0 0 0 255"), 11, "2 0 0 0 nan");
+  expectLoadError(write("nan.ply", floats), "non-finite colour 'green' in PLY element 'vertex' 1");
 }
 
 // The same for the other formats with per-vertex colours; an OBJ material's Kd still tints them.

@@ -854,6 +854,23 @@ TEST_F(VolumeLoading, BadLegacyMetaImageAndNrrd) {
                                            "<DataArray type=\"Float32\" Name=\"f\" NumberOfComponents=\"2147483647\" "
                                            "format=\"ascii\">1 2 3</DataArray>")),
                     "DataArray 'f' NumberOfComponents=\"2147483647\" is not a count in [1, 4096]");
+  // An appended array's offset that is no place in the file: −1 read garbage (values of 1e36) and
+  // "nan" the first array, exit 0 (fuzzing).
+  const auto appended = [](const std::string& offset) {
+    std::string data(4, '\0');
+    data[0] = 32;  // the block's byte count (UInt32 header), then 8 floats of 0
+    data += std::string(32, '\0');
+    return "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\" "
+           "header_type=\"UInt32\">\n<ImageData WholeExtent=\"0 1 0 1 0 1\" Origin=\"0 0 0\" Spacing=\"1 1 1\">\n"
+           "<Piece Extent=\"0 1 0 1 0 1\"><PointData Scalars=\"f\">\n<DataArray type=\"Float32\" Name=\"f\" "
+           "format=\"appended\" offset=\"" +
+           offset + "\"/>\n</PointData></Piece></ImageData>\n<AppendedData encoding=\"raw\">_" + data +
+           "</AppendedData></VTKFile>\n";
+  };
+  EXPECT_EQ(mfr::loadVolume(write("appended.vti", appended("0"))).grid->values.size(), 8u);
+  for (const char* offset : {"-1", "nan", "99999"})
+    expectVolumeError(write("offset.vti", appended(offset)),
+                      std::string("DataArray 'f' offset=\"") + offset + "\" is not a place in the file's");
 
   const std::string mhd =
       "ObjectType = Image\nNDims = 3\nDimSize = 4 3 2\nElementType = MET_FLOAT\n"

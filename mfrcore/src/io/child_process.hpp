@@ -9,6 +9,7 @@
 
 #include "mfr/io/load.hpp"
 #include "mfr/scene/scene.hpp"
+#include "mfr/scene/volume.hpp"
 
 namespace mfr::io {
 
@@ -29,7 +30,7 @@ int importSeconds(const std::string& name);
 // host_memory.hpp) and a time limit (importSeconds) counted from the child's last progress report,
 // and returns the bytes it returned. `work` gets a LoadProgress whose reports reach `progress`
 // here; cancelling `progress` kills the child and throws LoadCancelled. An mfr::Error that `work`
-// throws is thrown here with its message; a crash, the time limit, the memory limit or a child
+// throws is thrown here with its message (a FieldNotFound as one); a crash, the time limit, the memory limit or a child
 // that ends without a result is an mfr::Error(name, "cannot read <format>: <library> …").
 // std::nullopt when no child could be made (the caller then does the work itself, unguarded).
 std::optional<std::string> runInChild(const std::string& name, const ChildLibrary& library,
@@ -42,5 +43,8 @@ std::optional<std::string> runInChild(const std::string& name, const ChildLibrar
 // are appended to `notes` when it is not null.
 std::string packObjects(const std::vector<Object>& objects, const std::vector<std::string>& notes = {});
 std::vector<Object> unpackObjects(const std::string& bytes, std::vector<std::string>* notes = nullptr);
+// A volume and a loader's notes likewise: every member of Volume.
+std::string packVolume(const Volume& volume, const std::vector<std::string>& notes = {});
+Volume unpackVolume(const std::string& bytes, std::vector<std::string>* notes = nullptr);
 
 }  // namespace mfr::io

@@ -1,11 +1,15 @@
 #include "file_checks.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 #include <fstream>
 #include <iterator>
 #include <string_view>
+#include <system_error>
+#include <tuple>
 #include <unistd.h>
 
 #include "mfr/error.hpp"
@@ -101,6 +105,83 @@ void checkVtkXmlFileEnd(const std::filesystem::path& path, const std::string* co
   if (last == std::string::npos || last + 1 < kEnd.size() ||
       tail.compare(last + 1 - kEnd.size(), kEnd.size(), kEnd) != 0)
     throw Error(name, "truncated: a VTK XML file ends with </VTKFile>, and this one does not");
+}
+
+std::vector<std::string> vtkXmlTags(const std::filesystem::path& path, const std::string* contents) {
+  std::vector<std::string> tags;
+  std::string tag;
+  bool inTag = false, appended = false;
+  const auto take = [&](const char* bytes, std::size_t count) {
+    for (std::size_t i = 0; i < count && !appended; ++i) {
+      const char c = bytes[i];
+      if (!inTag) {
+        inTag = c == '<';
+      } else if (c != '>') {
+        if (tag.size() < (1u << 16)) tag += c;
+      } else {
+        appended = tag.rfind("AppendedData", 0) == 0;
+        if (!appended) tags.push_back(std::move(tag));
+        tag.clear();
+        inTag = false;
+      }
+    }
+  };
+  if (contents != nullptr) {
+    take(contents->data(), contents->size());
+    return tags;
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::string chunk(1 << 16, '\0');
+  while (!appended && in) {
+    in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    take(chunk.data(), static_cast<std::size_t>(in.gcount()));
+  }
+  return tags;
+}
+
+std::string vtkXmlAttribute(std::string_view tag, std::string_view key) {
+  for (std::size_t at = tag.find(key); at != std::string_view::npos; at = tag.find(key, at + 1)) {
+    const bool word = at > 0 && std::isspace(static_cast<unsigned char>(tag[at - 1]));
+    std::size_t i = at + key.size();
+    while (i < tag.size() && std::isspace(static_cast<unsigned char>(tag[i]))) ++i;
+    if (!word || i >= tag.size() || tag[i] != '=') continue;
+    ++i;
+    while (i < tag.size() && std::isspace(static_cast<unsigned char>(tag[i]))) ++i;
+    if (i >= tag.size() || (tag[i] != '"' && tag[i] != '\'')) continue;
+    const std::size_t end = tag.find(tag[i], i + 1);
+    if (end == std::string_view::npos) return {};
+    return std::string(tag.substr(i + 1, end - i - 1));
+  }
+  return {};
+}
+
+void checkVtkXmlDataArray(std::string_view tag, long long maxComponents, long long maxTuples, std::uintmax_t fileBytes,
+                          const std::string& name) {
+  const auto whole = [](const std::string& text, long long& value) {
+    if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) return false;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+    return ec == std::errc() && end == text.data() + text.size();
+  };
+  const auto array = [&] {
+    const std::string named = vtkXmlAttribute(tag, "Name");
+    return named.empty() ? std::string("an unnamed DataArray's ") : "DataArray '" + named + "' ";
+  };
+  for (const auto& [key, least, most] :
+       {std::tuple<const char*, long long, long long>{"NumberOfComponents", 1, maxComponents},
+        std::tuple<const char*, long long, long long>{"NumberOfTuples", 0, maxTuples}}) {
+    const std::string text = vtkXmlAttribute(tag, key);
+    if (text.empty()) continue;
+    long long count = 0;
+    if (!whole(text, count) || count < least || count > most)
+      throw Error(name, array() + key + "=\"" + text.substr(0, 24) + "\" is not a count in [" + std::to_string(least) +
+                            ", " + std::to_string(most) + "]");
+  }
+  if (vtkXmlAttribute(tag, "format") != "appended") return;
+  const std::string text = vtkXmlAttribute(tag, "offset");
+  long long offset = 0;
+  if (!whole(text, offset) || static_cast<std::uintmax_t>(offset) >= fileBytes)
+    throw Error(name, array() + "offset=\"" + text.substr(0, 24) + "\" is not a place in the file's " +
+                          std::to_string(fileBytes) + " bytes");
 }
 
 std::string oneLine(std::string s) {

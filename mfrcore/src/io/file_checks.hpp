@@ -2,11 +2,13 @@
 // Checks shared by the model and volume loaders: a file is looked at before any library reads it,
 // so that missing, unreadable, empty or special files get one line naming them, never a hang.
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <new>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "mfr/error.hpp"
 #include "mfr/io/load.hpp"
@@ -30,6 +32,20 @@ FileEnds fileEnds(const std::filesystem::path& path, const std::string* contents
 // garbage with exit 0 (a bug hunt). Reads the end of `contents` when given, else of the file at
 // path. Throws mfr::Error(name, "truncated: …").
 void checkVtkXmlFileEnd(const std::filesystem::path& path, const std::string* contents, const std::string& name);
+
+// The tags of a VTK XML file (the text between < and >, each cut at 64 KiB) before its
+// <AppendedData: what its elements declare, read in one pass without keeping the data between
+// them. From `contents` when given, else from the file at path.
+std::vector<std::string> vtkXmlTags(const std::filesystem::path& path, const std::string* contents);
+// The value of attribute `key` of a tag (quoted with " or '), empty when it has none.
+std::string vtkXmlAttribute(std::string_view tag, std::string_view key);
+// What a DataArray declares that VTK's XML readers allocate or seek to before they read a value:
+// NumberOfComponents in [1, maxComponents] (2^32 − 1 spun in vtkXMLReader::CreateArray, 2^31 − 1
+// took 12 GB: fuzzing), NumberOfTuples in [0, maxTuples], an appended array's offset a whole
+// number below the file's size (−1 read garbage, "nan" the first array, exit 0: fuzzing). Throws
+// mfr::Error(name, "DataArray 'NAME' …").
+void checkVtkXmlDataArray(std::string_view tag, long long maxComponents, long long maxTuples, std::uintmax_t fileBytes,
+                          const std::string& name);
 
 // A library's (possibly multi-line) message as one line: newlines and tabs become spaces, runs of
 // spaces collapse, trailing spaces go.

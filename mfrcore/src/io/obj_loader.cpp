@@ -101,6 +101,12 @@ std::map<std::string, glm::vec4> readMaterials(const fs::path& file, std::string
       if (check(v, 1)) c.a = static_cast<float>(std::clamp(v[0], 0.0, 1.0));
     } else if (w[0] == "Tr" && w.size() >= 2 && parseDouble(w.back(), v[0])) {
       if (check(v, 1)) c.a = static_cast<float>(1.0 - std::clamp(v[0], 0.0, 1.0));
+    } else if (w[0] == "Kd" || w[0] == "d" || w[0] == "Tr") {
+      // `Kd abc` was dropped without a word where `Kd nan` was noted (fuzzing); `Kd spectral
+      // file.rfl` and `Kd xyz x y z` are MTL too, and not read.
+      const bool otherSpace = w[0] == "Kd" && w.size() >= 2 && (w[1] == "spectral" || w[1] == "xyz");
+      taken.push_back("material '" + current + "': '" + line.substr(0, 64) + "'" +
+                      (otherSpace ? ": not an RGB colour (ignored)" : ": not a number (ignored)"));
     }
   }
   return out;

@@ -90,6 +90,37 @@ void checkAsciiFaceSizes(std::string_view bytes, std::size_t pos, std::uint64_t 
   }
 }
 
+// Every number after the counts, whatever the layout: CGAL's scanner of a coloured file (COFF,
+// CNOFF, STCOFF) read a vertex line whose coordinate did not parse ("inf", "nan", "abc", "1e400")
+// and then indexed that line's colour past its end — a crash (found by fuzzing); a plain OFF
+// file's came out as "malformed".
+void checkAsciiNumbers(std::string_view bytes, std::size_t pos, const std::string& name) {
+  std::size_t line = 1 + static_cast<std::size_t>(std::count(bytes.begin(), bytes.begin() + pos, '\n'));
+  while (pos < bytes.size()) {
+    const char c = bytes[pos];
+    if (c == '\n') {
+      ++line;
+      ++pos;
+    } else if (c == '#') {
+      pos = bytes.find('\n', pos);
+      if (pos == std::string_view::npos) break;
+    } else if (c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v') {
+      ++pos;
+    } else {
+      const std::size_t end = std::min(bytes.find_first_of(" \t\r\n\f\v#", pos), bytes.size());
+      std::string_view token = bytes.substr(pos, end - pos);
+      const std::string_view spelled = token;
+      if (token.size() > 1 && token.front() == '+') token.remove_prefix(1);
+      double value = 0.0;
+      const auto [at, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+      if (ec != std::errc() || at != token.data() + token.size() || !std::isfinite(value))
+        throw Error(name, "OFF line " + std::to_string(line) + ": '" + std::string(spelled.substr(0, 40)) +
+                              "' is not a finite number");
+      pos = end;
+    }
+  }
+}
+
 // A face's corner indices. CGAL sizes each face from the count it reads, before it reads the
 // indices. A binary file's counts are not checked above (its records' length depends on the
 // header's flags): a 60-byte file whose face declared 2³¹ − 1 corners took 16 GB and 70 s before
@@ -151,7 +182,10 @@ std::size_t checkHeader(std::string_view bytes, const std::string& name, std::ui
   }
   vertices = counts[0];
   faces = counts[1];
-  if (!binary) checkAsciiFaceSizes(bytes, pos, vertices, faces, name);
+  if (!binary) {
+    checkAsciiFaceSizes(bytes, pos, vertices, faces, name);
+    checkAsciiNumbers(bytes, pos, name);
+  }
   if (vertices > 0xffffffffull || faces > 0xffffffffull ||
       vertices * vertexBytes + faces * faceBytes > bytes.size() - (binary ? pos : 0))
     throw Error(name, "OFF header declares " + std::to_string(vertices) + " vertices and " + std::to_string(faces) +

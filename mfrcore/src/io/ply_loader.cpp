@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstring>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "mfr/error.hpp"
@@ -63,6 +64,26 @@ double colorScale(Type t) {
   }
 }
 
+// The values an integer type holds, for ASCII data (binary data holds nothing else).
+std::optional<std::pair<double, double>> integerRange(Type t) {
+  switch (t) {
+    case Type::Int8:
+      return std::pair{-128.0, 127.0};
+    case Type::UInt8:
+      return std::pair{0.0, 255.0};
+    case Type::Int16:
+      return std::pair{-32768.0, 32767.0};
+    case Type::UInt16:
+      return std::pair{0.0, 65535.0};
+    case Type::Int32:
+      return std::pair{-2147483648.0, 2147483647.0};
+    case Type::UInt32:
+      return std::pair{0.0, 4294967295.0};
+    default:
+      return std::nullopt;
+  }
+}
+
 struct Property {
   std::string name;
   bool list = false;
@@ -101,7 +122,7 @@ class Reader {
   }
   [[nodiscard]] std::size_t remaining() const { return data_.size() - pos_; }
 
-  double read(Type t) { return encoding_ == Encoding::Ascii ? readAscii() : readBinary(t); }
+  double read(Type t) { return encoding_ == Encoding::Ascii ? readAscii(t) : readBinary(t); }
 
   [[noreturn]] void fail(const std::string& what) const {
     throw Error(name_,
@@ -109,7 +130,9 @@ class Reader {
   }
 
  private:
-  double readAscii() {
+  // A value of an integer type is a whole number in its range: "nan", 300 or −1 for a uchar colour
+  // came out as NaN shading or a silent clamp (fuzzing).
+  double readAscii(Type t) {
     while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_]))) ++pos_;
     if (pos_ == data_.size()) fail("unexpected end of data (truncated file?)");
     std::size_t end = pos_;
@@ -119,10 +142,12 @@ class Reader {
     if (*first == '+') ++first;  // from_chars rejects an explicit plus sign
     double value = 0.0;
     const auto [ptr, ec] = std::from_chars(first, last, value);
-    if (ec != std::errc() || ptr != last) {
-      const std::string token(data_.substr(pos_, std::min<std::size_t>(end - pos_, 32)));
-      fail("bad number '" + token + "'");
-    }
+    const std::string token(data_.substr(pos_, std::min<std::size_t>(end - pos_, 32)));
+    if (ec != std::errc() || ptr != last) fail("bad number '" + token + "'");
+    if (const auto range = integerRange(t);
+        range && !(value >= range->first && value <= range->second && value == std::floor(value)))
+      fail("'" + token + "' is not a whole number in [" + std::to_string(static_cast<long long>(range->first)) + ", " +
+           std::to_string(static_cast<long long>(range->second)) + "] (its property's type)");
     pos_ = end;
     return value;
   }
@@ -391,6 +416,8 @@ PolygonSoup parsePly(std::string_view bytes, const std::string& name) {
         if (hasColors) {
           const auto channel = [&](int index) {
             const auto i = static_cast<std::size_t>(index);
+            // std::clamp passes NaN through: NaN shading, exit 0 (fuzzing).
+            if (!std::isfinite(values[i])) reader.fail("non-finite colour '" + e.properties[i].name + "'");
             return static_cast<float>(std::clamp(values[i] * colorScale(e.properties[i].type), 0.0, 1.0));
           };
           soup.colors.emplace_back(channel(cr), channel(cg), channel(cb), ca >= 0 ? channel(ca) : 1.0f);

@@ -759,45 +759,10 @@ SampleArray sampleArray(vtkImageData* image, const std::string& name, const std:
 // data, and left unread. (name, whether it is cell data); FieldData's are refused, as VTK cannot
 // be told to skip them. The ImageData's Origin, Spacing and Direction must be finite numbers.
 std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, const std::string& name) {
-  // The tags (the text between < and >) before <AppendedData, read in one pass: the samples
-  // between them are skipped, not kept.
-  std::vector<std::string> tags;
-  {
-    std::ifstream in(path, std::ios::binary);
-    std::string chunk(1 << 16, '\0'), tag;
-    bool inTag = false, appended = false;
-    while (!appended && in) {
-      in.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
-      for (std::size_t i = 0; i < static_cast<std::size_t>(in.gcount()) && !appended; ++i) {
-        const char c = chunk[i];
-        if (!inTag) {
-          inTag = c == '<';
-        } else if (c != '>') {
-          if (tag.size() < (1u << 16)) tag += c;
-        } else {
-          appended = tag.rfind("AppendedData", 0) == 0;
-          if (!appended) tags.push_back(std::move(tag));
-          tag.clear();
-          inTag = false;
-        }
-      }
-    }
-  }
-  const auto attribute = [](std::string_view tag, std::string_view key) -> std::string {
-    for (std::size_t at = tag.find(key); at != std::string_view::npos; at = tag.find(key, at + 1)) {
-      const bool word = at > 0 && std::isspace(static_cast<unsigned char>(tag[at - 1]));
-      std::size_t i = at + key.size();
-      while (i < tag.size() && std::isspace(static_cast<unsigned char>(tag[i]))) ++i;
-      if (!word || i >= tag.size() || tag[i] != '=') continue;
-      ++i;
-      while (i < tag.size() && std::isspace(static_cast<unsigned char>(tag[i]))) ++i;
-      if (i >= tag.size() || (tag[i] != '"' && tag[i] != '\'')) continue;
-      const std::size_t end = tag.find(tag[i], i + 1);
-      if (end == std::string_view::npos) return {};
-      return std::string(tag.substr(i + 1, end - i - 1));
-    }
-    return {};
-  };
+  const std::vector<std::string> tags = vtkXmlTags(path, nullptr);
+  const auto attribute = vtkXmlAttribute;
+  std::error_code sizeError;
+  const std::uintmax_t fileBytes = fs::file_size(path, sizeError);
   std::vector<std::pair<std::string, bool>> found;
   enum class Section { kNone, kPoints, kCells, kField } section = Section::kNone;
   // Extents as 6 whole numbers (x0 x1 y0 y1 z0 z1), when they are.
@@ -844,22 +809,11 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
     if (is("CellData")) section = Section::kCells;
     if (is("FieldData")) section = Section::kField;
     if (is("/PointData") || is("/CellData") || is("/FieldData")) section = Section::kNone;
-    if (is("DataArray")) {
-      // VTK allocates what these declare before it reads a value (2^31 components: 12 GB, then
-      // killed; found by fuzzing).
-      for (const auto& [key, most] :
-           {std::pair<const char*, long long>{"NumberOfComponents", kMaxComponents},
-            std::pair<const char*, long long>{"NumberOfTuples", static_cast<long long>(VolumeGrid::kMaxPoints)}}) {
-        const std::string text = attribute(tag, key);
-        if (text.empty()) continue;
-        char* end = nullptr;
-        errno = 0;
-        const long long count = std::strtoll(text.c_str(), &end, 10);
-        if (errno != 0 || *end != '\0' || count < (std::string_view(key) == "NumberOfTuples" ? 0 : 1) || count > most)
-          throw Error(name, "DataArray '" + attribute(tag, "Name") + "' " + key + "=\"" + text.substr(0, 24) +
-                                "\" is not a count in [1, " + std::to_string(most) + "]");
-      }
-    }
+    // VTK allocates what these declare before it reads a value (2^31 components: 12 GB, then
+    // killed; found by fuzzing).
+    if (is("DataArray"))
+      checkVtkXmlDataArray(tag, kMaxComponents, static_cast<long long>(VolumeGrid::kMaxPoints),
+                           sizeError ? ~std::uintmax_t{0} : fileBytes, name);
     if (!is("DataArray") || attribute(tag, "type") != "String") continue;
     if (section == Section::kField)
       throw Error(name, "field data array '" + attribute(tag, "Name") + "' holds text, which VTK's reader cannot skip");

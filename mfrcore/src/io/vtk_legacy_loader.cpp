@@ -64,7 +64,7 @@ class Parser {
     std::size_t end = s_.find('\n', pos_);
     if (end == std::string_view::npos) end = s_.size();
     std::string_view l = s_.substr(pos_, end - pos_);
-    pos_ = end + 1;
+    pos_ = std::min(end + 1, s_.size());  // a last line without '\n' ends at the end (token() read past it: fuzzing)
     if (!l.empty() && l.back() == '\r') l.remove_suffix(1);
     return l;
   }
@@ -421,6 +421,7 @@ PolygonSoup parseLegacyVtk(std::string_view bytes, const std::string& name) {
   if (p.line().rfind("# vtk DataFile", 0) != 0) p.fail("not a legacy VTK file (no '# vtk DataFile' header)");
   p.line();  // title
   std::string_view format = p.token();
+  if (format.empty()) p.fail("unexpected end of file after the title (truncated?)");
   bool binary = false;
   if (format == "BINARY")
     binary = true;

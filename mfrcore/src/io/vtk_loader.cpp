@@ -584,6 +584,15 @@ Mesh readWithVtk(VtkFormat format, const fs::path& path, const std::string* cont
     }
     case VtkFormat::Vtp: {
       checkVtkXmlFileEnd(path, contents, name);
+      {
+        // What VTK allocates or seeks to before it reads a value, checked first (fuzzing: 2^32 − 1
+        // components spun for minutes, 2^31 − 1 took 12 GB). A part's points and indices are 32-bit.
+        constexpr long long kMaxComponents = 4096, kMaxTuples = 0xffffffffLL;
+        const std::uintmax_t bytes = contents != nullptr ? contents->size() : fs::file_size(path);
+        for (const std::string& tag : vtkXmlTags(path, contents))
+          if (tag.starts_with("DataArray") && (tag.size() == 9 || std::isspace(static_cast<unsigned char>(tag[9]))))
+            checkVtkXmlDataArray(tag, kMaxComponents, kMaxTuples, bytes, name);
+      }
       vtkNew<vtkXMLPolyDataReader> reader;
       if (contents != nullptr) {
         reader->ReadFromInputStringOn();
