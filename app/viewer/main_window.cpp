@@ -29,6 +29,7 @@
 #include <QStatusBar>
 #include <QTableWidget>
 #include <QTimer>
+#include <QUndoStack>
 #include <QToolBar>
 #include <QVBoxLayout>
 
@@ -466,6 +467,17 @@ void MainWindow::buildDocks() {
   };
   auto* sceneTree = new SceneTreePanel(*model_);
   QDockWidget* scene = dock(tr("Scene"), QStringLiteral("sceneDock"), sceneTree, Qt::LeftDockWidgetArea);
+  // Edit: the Scene dock's edits of parts, undone and redone (a text field with the focus keeps
+  // its own Ctrl+Z).
+  auto* edit = new QMenu(tr("&Edit"), this);
+  menuBar()->insertMenu(viewMenu_->menuAction(), edit);
+  QAction* undo = sceneTree->undoStack()->createUndoAction(edit);
+  undo->setObjectName(QStringLiteral("undoAction"));
+  undo->setShortcut(QKeySequence::Undo);
+  QAction* redo = sceneTree->undoStack()->createRedoAction(edit);
+  redo->setObjectName(QStringLiteral("redoAction"));
+  redo->setShortcut(QKeySequence::Redo);
+  edit->addActions({undo, redo});
   QDockWidget* clip = dock(tr("Clip"), QStringLiteral("clipDock"), new ClipPanel(*model_), Qt::LeftDockWidgetArea);
   tabifyDockWidget(scene, clip);
   scene->raise();

@@ -18,6 +18,7 @@
 #include <QStyledItemDelegate>
 #include <QTimer>
 #include <QTreeWidget>
+#include <QUndoStack>
 #include <QVBoxLayout>
 
 #include <QSignalBlocker>
@@ -31,6 +32,24 @@
 #include "mfr/scene/color_map.hpp"
 #include "mfr/scene/measure.hpp"
 #include "viewer_model.hpp"
+
+namespace {
+
+// One step of the Scene dock's history: the looks of the parts an action changed, before and after.
+class PartsEdit final : public QUndoCommand {
+ public:
+  PartsEdit(ViewerModel& model, const QString& text, std::vector<ViewerModel::PartLook> before,
+            std::vector<ViewerModel::PartLook> after)
+      : QUndoCommand(text), model_(model), before_(std::move(before)), after_(std::move(after)) {}
+  void undo() override { model_.setPartLooks(before_); }
+  void redo() override { model_.setPartLooks(after_); }  // on push: the edit was made, nothing changes
+
+ private:
+  ViewerModel& model_;
+  std::vector<ViewerModel::PartLook> before_, after_;
+};
+
+}  // namespace
 
 namespace {
 
@@ -261,6 +280,8 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   tree_->setItemDelegateForColumn(kOpacity, new OpacityDelegate(tree_));
   for (int c : {kName, kColour, kTriangles}) tree_->setItemDelegateForColumn(c, new ReadOnlyDelegate(tree_));
   layout->addWidget(tree_);
+  undo_ = new QUndoStack(this);
+  undo_->setUndoLimit(50);  // a step of 16,000 parts holds each one's material twice
   connect(tree_, &QTreeWidget::itemChanged, this, &SceneTreePanel::itemChanged);
   connect(tree_, &QTreeWidget::itemClicked, this, &SceneTreePanel::itemClicked);
   // The selection's actions: in the context menu, with shortcuts while the tree has the focus
@@ -280,15 +301,21 @@ SceneTreePanel::SceneTreePanel(ViewerModel& model, QWidget* parent) : QWidget(pa
   toggleParts_->setShortcut(QKeySequence(Qt::Key_Space));
   showOnlyParts_ = addAction("showOnlyPartsAction", tr("Show Only These"), &SceneTreePanel::showOnlySelected);
   showAllParts_ = addAction("showAllPartsAction", tr("Show All Parts"), [this] {
-    QMap<int, bool> visible;
-    for (int i = 0; i < static_cast<int>(model_.scene().objects.size()); ++i) visible.insert(i, true);
-    model_.setObjectVisibilities(visible);
+    const QList<int> parts = allParts();
+    recordEdit(tr("Show All Parts"), parts, [&] {
+      QMap<int, bool> visible;
+      for (const int i : parts) visible.insert(i, true);
+      model_.setObjectVisibilities(visible);
+    });
   });
   fitParts_ = addAction("fitPartsAction", tr("Fit View to These"), &SceneTreePanel::fitViewToSelected);
   colourParts_ = addAction("colourPartsAction", tr("Colour…"), &SceneTreePanel::chooseSelectedColour);
   opacityParts_ = addAction("opacityPartsAction", tr("Opacity…"), &SceneTreePanel::chooseSelectedOpacity);
-  resetColourParts_ = addAction("resetColourAction", tr("Reset Colour to the File's"),
-                                [this] { model_.resetObjectColors(selectedParts()); });
+  resetColourParts_ = addAction("resetColourAction", tr("Reset Colour to the File's"), [this] {
+    const QList<int> parts = selectedParts();
+    if (parts.isEmpty()) return;
+    recordEdit(tr("Reset Colour of %1").arg(partsText(parts)), parts, [&] { model_.resetObjectColors(parts); });
+  });
   tree_->setContextMenuPolicy(Qt::CustomContextMenu);
   connect(tree_, &QWidget::customContextMenuRequested, this, [this](const QPoint& at) {
     updateSelectionActions();
@@ -388,6 +415,7 @@ void SceneTreePanel::applyFieldColoring(bool dataRange) {
   std::optional<glm::dvec2> range;
   if (!dataRange && !field.isEmpty()) range = glm::dvec2(rangeLow_->value(), rangeHigh_->value());
   model_.setFieldColoring(field, colorMap_->currentText(), range);
+  undo_->clear();       // the steps' materials name the colouring before
   showFieldColoring();  // the range picked, or the refusal
 }
 
@@ -441,6 +469,7 @@ void SceneTreePanel::showValues() {
 
 void SceneTreePanel::rebuild() {
   ++rowsBuilt_;
+  undo_->clear();  // the steps name parts by index
   rebuilding_ = true;
   colorBy_->clear();  // another scene: its own fields
   showFieldColoring();
@@ -494,10 +523,12 @@ void SceneTreePanel::itemChanged(QTreeWidgetItem* item, int column) {
   }
   const int index = item->data(kName, Qt::UserRole).toInt();
   if (column == kName) {
-    model_.setObjectVisible(index, item->checkState(kName) == Qt::Checked);
+    const bool visible = item->checkState(kName) == Qt::Checked;
+    recordEdit((visible ? tr("Show %1") : tr("Hide %1")).arg(partsText({index})), {index},
+               [&] { model_.setObjectVisible(index, visible); });
   } else if (column == kOpacity) {
     const double opacity = std::clamp(item->data(kOpacity, Qt::EditRole).toDouble(), 0.0, 1.0);
-    model_.setObjectOpacity(index, opacity);
+    recordEdit(tr("Opacity of %1").arg(partsText({index})), {index}, [&] { model_.setObjectOpacity(index, opacity); });
     showValues();  // the clamped value, also when it was the part's opacity already (no sceneChanged)
   }
 }
@@ -516,7 +547,8 @@ void SceneTreePanel::itemClicked(QTreeWidgetItem* item, int column) {
     const QColor chosen = QColorDialog::getColor(initial, this, title);
     // Another scene, or other parts, meanwhile: the index names another part (it recoloured the
     // new scene's part of that index).
-    if (chosen.isValid() && rows == rowsBuilt_) model_.setObjectColor(index, chosen);
+    if (chosen.isValid() && rows == rowsBuilt_)
+      recordEdit(tr("Colour of %1").arg(partsText({index})), {index}, [&] { model_.setObjectColor(index, chosen); });
   });
 }
 
@@ -559,9 +591,13 @@ void SceneTreePanel::updateSelectionActions() {
 }
 
 void SceneTreePanel::setSelectedVisible(bool visible) {
-  QMap<int, bool> change;
-  for (const int i : selectedParts()) change.insert(i, visible);
-  model_.setObjectVisibilities(change);
+  const QList<int> parts = selectedParts();
+  if (parts.isEmpty()) return;
+  recordEdit((visible ? tr("Show %1") : tr("Hide %1")).arg(partsText(parts)), parts, [&] {
+    QMap<int, bool> change;
+    for (const int i : parts) change.insert(i, visible);
+    model_.setObjectVisibilities(change);
+  });
 }
 
 // As one check box for the selection: all of it shown → hidden; otherwise all of it shown.
@@ -577,10 +613,27 @@ void SceneTreePanel::toggleSelectedVisible() {
 void SceneTreePanel::showOnlySelected() {
   const QList<int> parts = selectedParts();
   if (parts.isEmpty()) return;
-  QMap<int, bool> visible;
-  for (int i = 0; i < static_cast<int>(model_.scene().objects.size()); ++i) visible.insert(i, false);
-  for (const int i : parts) visible.insert(i, true);
-  model_.setObjectVisibilities(visible);
+  const QList<int> all = allParts();
+  recordEdit(tr("Show Only %1").arg(partsText(parts)), all, [&] {
+    QMap<int, bool> visible;
+    for (const int i : all) visible.insert(i, false);
+    for (const int i : parts) visible.insert(i, true);
+    model_.setObjectVisibilities(visible);
+  });
+}
+
+QList<int> SceneTreePanel::allParts() const {
+  QList<int> parts;
+  parts.reserve(static_cast<qsizetype>(model_.scene().objects.size()));
+  for (int i = 0; i < static_cast<int>(model_.scene().objects.size()); ++i) parts.push_back(i);
+  return parts;
+}
+
+void SceneTreePanel::recordEdit(const QString& text, const QList<int>& parts, const std::function<void()>& edit) {
+  std::vector<ViewerModel::PartLook> before = model_.partLooks(parts);
+  edit();
+  std::vector<ViewerModel::PartLook> after = model_.partLooks(parts);
+  if (before != after) undo_->push(new PartsEdit(model_, text, std::move(before), std::move(after)));
 }
 
 QString SceneTreePanel::partsText(const QList<int>& parts) const {
@@ -595,7 +648,8 @@ void SceneTreePanel::chooseSelectedColour() {
   const QColor initial = colourOf(model_.scene().objects[static_cast<std::size_t>(parts.front())]);
   const quint64 rows = rowsBuilt_;
   const QColor chosen = QColorDialog::getColor(initial, this, tr("Colour of %1").arg(partsText(parts)));
-  if (chosen.isValid() && rows == rowsBuilt_) model_.setObjectColors(parts, chosen);
+  if (chosen.isValid() && rows == rowsBuilt_)
+    recordEdit(tr("Colour of %1").arg(partsText(parts)), parts, [&] { model_.setObjectColors(parts, chosen); });
 }
 
 void SceneTreePanel::chooseSelectedOpacity() {
@@ -607,9 +661,11 @@ void SceneTreePanel::chooseSelectedOpacity() {
                                                  tr("Opacity of %1 (0 = invisible, 1 = opaque)").arg(partsText(parts)),
                                                  model_.objectOpacity(parts.front()), 0.0, 1.0, 3, &ok);
   if (!ok || rows != rowsBuilt_) return;  // another scene meanwhile
-  QMap<int, double> opacities;
-  for (const int i : parts) opacities.insert(i, opacity);
-  model_.setObjectOpacities(opacities);
+  recordEdit(tr("Opacity of %1").arg(partsText(parts)), parts, [&] {
+    QMap<int, double> opacities;
+    for (const int i : parts) opacities.insert(i, opacity);
+    model_.setObjectOpacities(opacities);
+  });
 }
 
 // The view turned to nothing, only moved and zoomed so that the selected parts fill it (hidden

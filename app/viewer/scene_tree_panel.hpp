@@ -10,6 +10,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 
 #include "mfr/scene/volume.hpp"
 
@@ -22,6 +23,7 @@ class QLineEdit;
 class QPushButton;
 class QTreeWidget;
 class QTreeWidgetItem;
+class QUndoStack;
 class ViewerModel;
 
 class SceneTreePanel final : public QWidget {
@@ -32,8 +34,16 @@ class SceneTreePanel final : public QWidget {
   // Selects the part's row alone, in sight (a filter that hides it is cleared); -1 clears the
   // selection. A part picked in the view or the Probe dock.
   void selectPart(int index);
+  // The edits of parts made in this dock (visibility, colour, opacity; one step per action), for
+  // Edit ▸ Undo and Redo. A new scene, parts added or removed, or another colouring by a field
+  // clears it (its steps name parts by index, and colours of the field before).
+  [[nodiscard]] QUndoStack* undoStack() const { return undo_; }
 
  private:
+  // Runs `edit` of `parts` and records it as one undoable step named `text`: the parts' looks
+  // before and after (nothing when it changed nothing).
+  void recordEdit(const QString& text, const QList<int>& parts, const std::function<void()>& edit);
+  [[nodiscard]] QList<int> allParts() const;
   void rebuild();
   void showValues();
   // A volume's row: its name (with the field read, for a file with several) and its grid size.
@@ -85,4 +95,5 @@ class SceneTreePanel final : public QWidget {
   QLabel* fieldNote_ = nullptr;
   bool rebuilding_ = false;
   quint64 rowsBuilt_ = 0;  // rebuilds so far: a dialog open across one edits no part
+  QUndoStack* undo_ = nullptr;
 };

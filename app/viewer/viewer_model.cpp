@@ -1156,6 +1156,32 @@ void ViewerModel::setObjectStates(const std::vector<ObjectState>& states) {
   if (changed) sceneEdited();
 }
 
+std::vector<ViewerModel::PartLook> ViewerModel::partLooks(const QList<int>& indices) const {
+  std::vector<PartLook> looks;
+  looks.reserve(static_cast<std::size_t>(indices.size()));
+  for (const int index : indices) {
+    if (index < 0 || index >= static_cast<int>(scene_.objects.size())) continue;
+    const mfr::Object& object = scene_.objects[static_cast<std::size_t>(index)];
+    looks.push_back({index, object.visible, object.material});
+  }
+  return looks;
+}
+
+void ViewerModel::setPartLooks(const std::vector<PartLook>& looks) {
+  bool changed = false, visibility = false;
+  for (const PartLook& look : looks) {
+    if (look.index < 0 || look.index >= static_cast<int>(scene_.objects.size())) continue;
+    mfr::Object& object = scene_.objects[static_cast<std::size_t>(look.index)];
+    if (PartLook{look.index, object.visible, object.material} == look) continue;
+    visibility = visibility || object.visible != look.visible;
+    object.visible = look.visible;
+    object.material = look.material;
+    changed = true;
+  }
+  if (visibility) updateSceneGeometry();
+  if (changed) sceneEdited();
+}
+
 void ViewerModel::setObjectMaterial(int index, const glm::vec4& rgba, bool vertexColors) {
   if (index < 0 || index >= static_cast<int>(scene_.objects.size())) return;
   mfr::Material& material = scene_.objects[static_cast<std::size_t>(index)].material;

@@ -286,6 +286,20 @@ class ViewerModel final : public ViewerContext {
     bool vertexColors = true;
   };
   void setObjectStates(const std::vector<ObjectState>& states);
+  // Visibility and the whole material (colour, opacity, vertex and field colours) of parts: what
+  // the Scene dock's Undo puts back. setPartLooks makes one scene edit, of the parts that differ
+  // (none: no edit); indices out of range are skipped.
+  struct PartLook {
+    int index = -1;
+    bool visible = true;
+    mfr::Material material;
+    bool operator==(const PartLook& other) const {
+      return index == other.index && visible == other.visible && material.color == other.material.color &&
+             material.vertexColors == other.material.vertexColors && material.fieldColors == other.material.fieldColors;
+    }
+  };
+  [[nodiscard]] std::vector<PartLook> partLooks(const QList<int>& indices) const;
+  void setPartLooks(const std::vector<PartLook>& looks);
 
   // Surfaces coloured by a field (ParaView's "Color by"; mfr::colorObjectsByField on the meshes as
   // loaded): every part whose mesh has the field, one colour map, one range. The fields the parts

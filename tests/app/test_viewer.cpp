@@ -4198,7 +4198,10 @@ class ViewerTest : public QObject {
     QVERIFY(action("hidePartsAction")->isEnabled());
     int edits = 0;
     QMetaObject::Connection counting = connect(&m, &ViewerModel::sceneChanged, [&edits] { ++edits; });
+    const QList<int> all{0, 1, 2, 3, 4, 5};
+    std::vector<std::vector<ViewerModel::PartLook>> looks{m.partLooks(all)};  // after each edit, for Undo
     action("hidePartsAction")->trigger();
+    looks.push_back(m.partLooks(all));
     QCOMPARE(edits, 1);
     QCOMPARE(visibleParts(), (QList<int>{3, 4, 5}));
     // Space on the tree toggles the selection as one box: all hidden → all shown.
@@ -4207,6 +4210,7 @@ class ViewerTest : public QObject {
     tree->setFocus();
     QTest::keyClick(tree, Qt::Key_Space);
     QCOMPARE(edits, 2);
+    looks.push_back(m.partLooks(all));
     QCOMPARE(visibleParts(), (QList<int>{0, 1, 2, 3, 4, 5}));
     // The rows hidden by the filter keep their check boxes in step with the parts.
     filter->clear();
@@ -4217,10 +4221,12 @@ class ViewerTest : public QObject {
     tree->topLevelItem(3)->setSelected(true);
     tree->topLevelItem(4)->setSelected(true);
     action("showOnlyPartsAction")->trigger();
+    looks.push_back(m.partLooks(all));
     QCOMPARE(visibleParts(), (QList<int>{3, 4}));
     QCOMPARE(tree->topLevelItem(0)->checkState(0), Qt::Unchecked);
     QCOMPARE(tree->topLevelItem(3)->checkState(0), Qt::Checked);
     action("showAllPartsAction")->trigger();
+    looks.push_back(m.partLooks(all));
     QCOMPARE(visibleParts(), (QList<int>{0, 1, 2, 3, 4, 5}));
     QCOMPARE(edits, 4);
     // Colour and opacity of the selection, answered in their dialogs.
@@ -4241,6 +4247,7 @@ class ViewerTest : public QObject {
     });
     action("colourPartsAction")->trigger();
     QCOMPARE(edits, 5);
+    looks.push_back(m.partLooks(all));
     QCOMPARE(glm::vec3(m.scene().objects[3].material.color), glm::vec3(1, 0, 0));
     QCOMPARE(glm::vec3(m.scene().objects[4].material.color), glm::vec3(1, 0, 0));
     QCOMPARE(m.scene().objects[4].material.color.a, ringB.a);  // the opacity stays
@@ -4248,6 +4255,7 @@ class ViewerTest : public QObject {
     QCOMPARE(tree->topLevelItem(4)->text(1), QStringLiteral("#ff0000"));
     QVERIFY(action("resetColourAction")->isEnabled());
     action("resetColourAction")->trigger();
+    looks.push_back(m.partLooks(all));
     QCOMPARE(m.scene().objects[4].material.color, ringB);
     QVERIFY(!m.objectColorEdited(3) && !m.objectColorEdited(4));
     QVERIFY(!action("resetColourAction")->isEnabled());
@@ -4263,6 +4271,38 @@ class ViewerTest : public QObject {
     QCOMPARE(m.objectOpacity(4), 0.125);
     QCOMPARE(m.objectOpacity(5), static_cast<double>(0.4f));
     QCOMPARE(edits, 7);
+    looks.push_back(m.partLooks(all));
+    disconnect(counting);
+    // Edit ▸ Undo takes the seven steps back one at a time, each in one scene edit, to the parts as
+    // loaded (colours with their vertex colours, opacities, visibility); Redo takes them forward.
+    auto* undo = action("undoAction");
+    auto* redo = action("redoAction");
+    QVERIFY(undo && redo);
+    QCOMPARE(undo->text(), QStringLiteral("Undo Opacity of 2 parts"));
+    edits = 0;
+    counting = connect(&m, &ViewerModel::sceneChanged, [&edits] { ++edits; });
+    for (std::size_t step = looks.size() - 1; step > 0; --step) {
+      QVERIFY(undo->isEnabled());
+      undo->trigger();
+      QVERIFY2(m.partLooks(all) == looks[step - 1], qPrintable(QString::number(step)));
+    }
+    QVERIFY(!undo->isEnabled());
+    QCOMPARE(edits, 7);
+    QCOMPARE(redo->text(), QStringLiteral("Redo Hide 3 parts"));
+    for (std::size_t step = 1; step < looks.size(); ++step) {
+      redo->trigger();
+      QVERIFY2(m.partLooks(all) == looks[step], qPrintable(QString::number(step)));
+    }
+    QVERIFY(!redo->isEnabled());
+    // Ctrl+Z from the view; a new edit drops what could be redone.
+    w->view().setFocus();
+    QTest::keyClick(&w->view(), Qt::Key_Z, Qt::ControlModifier);
+    QVERIFY(m.partLooks(all) == looks[looks.size() - 2]);
+    tree->clearSelection();
+    tree->topLevelItem(5)->setCheckState(0, Qt::Unchecked);
+    QVERIFY(!m.scene().objects[5].visible);
+    QVERIFY(!redo->isEnabled());
+    QCOMPARE(undo->text(), QStringLiteral("Undo Hide tangle"));
     disconnect(counting);
     // Fit the view to ring A: the camera looks at its box's centre from nearer than fit all, in
     // the same direction; near and far still hold the whole scene.
@@ -4282,6 +4322,11 @@ class ViewerTest : public QObject {
     // A name is not edited in place (its editor renamed the row, not the part).
     tree->editItem(tree->topLevelItem(0), 0);
     QVERIFY(!tree->findChild<QLineEdit*>());
+    // Another scene's parts are other parts: the history goes with the old ones.
+    QVERIFY(undo->isEnabled());
+    w->openScene(QStringLiteral("@csg"));
+    QTRY_VERIFY_WITH_TIMEOUT(!m.isLoading() && m.scene().name == "csg", kTimeoutMs);
+    QVERIFY(!undo->isEnabled() && !redo->isEnabled());
   }
 
   // Which part is this: a double click on the view selects, in the Scene dock, the part the oracle
