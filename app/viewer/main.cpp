@@ -362,12 +362,13 @@ CommandLine parseCommandLine(const QStringList& sessionArgs) {
 }
 
 // What a session manager hands back to Qt's -session when it restores a window: an XSMP client
-// id (letters and digits) and Qt's key after '_'. A name with a dot or a slash, or of a file that
-// exists, is the user's session file; and with no session manager running nothing hands one back.
+// id (libSM's: hex digits, or "2" and a UUID with its hyphens) and Qt's key after '_'. A name with
+// a dot or a slash, or of a file that exists, is the user's session file; and with no session
+// manager running nothing hands one back.
 bool isSessionManagerId(const char* value) {
   if (std::getenv("SESSION_MANAGER") == nullptr || *value == '\0') return false;
   for (const char* c = value; *c; ++c)
-    if (!std::isalnum(static_cast<unsigned char>(*c)) && *c != '_') return false;
+    if (!std::isalnum(static_cast<unsigned char>(*c)) && *c != '_' && *c != '-') return false;
   return !QFileInfo::exists(QString::fromLocal8Bit(value));
 }
 

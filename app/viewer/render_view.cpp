@@ -36,6 +36,11 @@ mfr::ImageRGBA8 colourise(const RenderView::DataMap& map, const mfr::ImageRGBA8*
 
 RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(parent), model_(model) {
   setFocusPolicy(Qt::StrongFocus);
+  // The framebuffer keeps the last frame between paints: Qt repaints the view under its captions,
+  // legends and notes whenever one of them changes (each a full frame of a slow method, three
+  // times per compare-mode view change: a review), and such a paint, asked for by nothing that
+  // changes the picture, shows the frame there is (paintGL).
+  setUpdateBehavior(QOpenGLWidget::PartialUpdate);
   setMinimumSize(160, 120);
   // Any change that alters the image schedules one repaint (Qt merges repeated requests).
   const auto repaint = [this](const char* reason) { return [this, reason] { requestFrame(reason); }; };
@@ -44,12 +49,12 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
   connect(&model_, &ViewerModel::sideChanged, this, repaint("side"));
   connect(&model_, &ViewerModel::compareChanged, this, repaint("compare"));
   connect(&model_, &ViewerModel::dataViewChanged, this, repaint("data view"));
-  // Only a pane of a CPU method draws CPU images: the reference of the metrics comes for every
-  // frame while they are wanted (the budget panel's quality), and a GPU frame drawn again for it
-  // changed nothing and cost as much as the view change.
-  connect(&model_, &ViewerModel::cpuImageReady, this, [this] {
+  // Only a pane of a CPU method draws CPU images, and only its own: the reference of the metrics
+  // comes for every frame while they are wanted (the budget panel's quality, compare mode), and a
+  // frame drawn again for it changed nothing and cost as much as the view change.
+  connect(&model_, &ViewerModel::cpuImageReady, this, [this](const ImageKey& key) {
     for (int side = 0; side < model_.paneCount(); ++side)
-      if (model_.isCpuMethod(model_.methodOf(side))) return requestFrame("cpu image");
+      if (model_.isCpuMethod(model_.methodOf(side)) && model_.frameKey(side) == key) return requestFrame("cpu image");
   });
   // A requested frame quality needs the frame on the CPU: draw it once more and read it back
   // (the widget's framebuffer is not kept between paints).
@@ -129,6 +134,7 @@ QSize RenderView::pixelSize() const {
 }
 
 void RenderView::initializeGL() {
+  framed_ = false;  // a new context (a dock floated): its framebuffer holds nothing yet
   const QSurfaceFormat f = context()->format();
   glInfo_ =
       QStringLiteral("OpenGL %1.%2 %3")
@@ -153,6 +159,7 @@ void RenderView::initializeGL() {
 }
 
 void RenderView::resizeGL(int, int) {
+  framed_ = false;  // a new framebuffer, empty
   // QOpenGLWidget paints right after this: the new size's viewChanged needs no second frame.
   const QScopedValueRollback inFrame(sizingFrame_, true);
   model_.setRenderSize(pixelSize());
@@ -211,6 +218,7 @@ Q_LOGGING_CATEGORY(lcViewFrames, "mfr.view.frames", QtWarningMsg)
 
 void RenderView::requestFrame(const char* reason) {
   if (sizingFrame_) return;
+  framed_ = false;
   if (const QString r = QLatin1String(reason); !frameReasons_.contains(r)) frameReasons_.append(r);
   update();
 }
@@ -222,6 +230,13 @@ void RenderView::setLiveFrames(bool on) {
 }
 
 void RenderView::paintGL() {
+  if (framed_) {
+    // Nothing asked for this frame: Qt repaints the widgets over the view. The framebuffer holds
+    // the last frame, which still shows what there is.
+    qCDebug(lcViewFrames, "no frame: nothing changed (the window system repainted; the last frame stands)");
+    return;
+  }
+  framed_ = true;  // until requestFrame or a resize
   const QStringList reasons = std::exchange(frameReasons_, {});
   {
     const QScopedValueRollback inFrame(sizingFrame_, true);  // this frame draws the new size

@@ -254,6 +254,7 @@ class RenderView final : public QOpenGLWidget {
   enum class Drag { None, Orbit, Pan } drag_ = Drag::None;
   bool fastNavigation_ = true;
   bool liveFrames_ = true;
+  bool framed_ = false;       // the framebuffer holds the frame of the current state (paintGL)
   bool sizingFrame_ = false;  // the size changes inside a frame that draws it (requestFrame: none)
   QStringList frameReasons_;  // why the next frame is drawn (mfr.view.frames); none: the window system
   bool navigating_ = false;

@@ -1322,14 +1322,14 @@ QString ViewerModel::renderErrorShown() const {
 }
 
 ImageKey ViewerModel::imageKey(const mfr::RenderRequest& request) const {
-  std::string text = request.method + ";" + request.operation;
-  for (const auto& [name, value] : request.params) text += ";" + name + "=" + value;
-  if (request.operation == "zthickness")
-    text += ";thickness=" + QString::number(request.thickness, 'g', 17).toStdString();
-  // The step matters to images of the operation volume, "auto" included where it resolves to it.
+  // The operation as it resolves: an oracle pane's "auto" is its reference's "oit", and was computed
+  // twice under two keys (a review).
   const mfr::MethodInfo* info = request.method == "oracle" ? nullptr : mfr::findMethodInfo(request.method);
-  if (mfr::effectiveOperation(request.operation, info, scene_.hasVisibleVolume()) == "volume")
-    text += ";step=" + QString::number(request.volumeStep, 'g', 17).toStdString();
+  const std::string operation = mfr::effectiveOperation(request.operation, info, scene_.hasVisibleVolume());
+  std::string text = request.method + ";" + operation;
+  for (const auto& [name, value] : request.params) text += ";" + name + "=" + value;
+  if (operation == "zthickness") text += ";thickness=" + QString::number(request.thickness, 'g', 17).toStdString();
+  if (operation == "volume") text += ";step=" + QString::number(request.volumeStep, 'g', 17).toStdString();
   return {sceneRevision_, viewRevision_, QSize(request.width, request.height), text};
 }
 
@@ -1410,7 +1410,7 @@ void ViewerModel::startCpuJob() {
         cpuRunning_ = false;
         cpuCache_.push_front(result);
         while (cpuCache_.size() > kCpuCacheSize) cpuCache_.pop_back();
-        emit cpuImageReady();
+        emit cpuImageReady(result->key);
         updateMetrics();
         startCpuJob();
       });

@@ -398,10 +398,10 @@ class ViewerModel final : public ViewerContext {
   void sceneLoaded();  // followed by sceneChanged
   void loadFailed(const QString& path, const QString& message);
   void loadCancelled();
-  void sideChanged(int side);     // method, operation or parameters of a side
-  void compareChanged();          // enabled, layout, split or display
-  void secondaryFrameRendered();  // statsOf(1) describes the new frame
-  void cpuImageReady();
+  void sideChanged(int side);               // method, operation or parameters of a side
+  void compareChanged();                    // enabled, layout, split or display
+  void secondaryFrameRendered();            // statsOf(1) describes the new frame
+  void cpuImageReady(const ImageKey& key);  // the image of that key is in the cache
   void metricsReady(int side);
   void frameImageWanted();       // a frame quality was requested: the view reads back what it shows
   void depthComplexityWanted();  // requestDepthComplexity: the view counts n(p) on the GPU

@@ -199,7 +199,8 @@ std::uint32_t GpuRenderer::resolveCount() const {
 
 FrameContext GpuRenderer::frameContext(const Camera& camera, int width, int height, gl::PassTimer& timer) const {
   const double aspect = static_cast<double>(width) / height;
-  gl::FrameUniforms frame = scene_->relativeFrame(camera.projectionMatrix(aspect) * camera.viewMatrix(), clipBox_);
+  gl::FrameUniforms frame =
+      gl::GpuScene::relativeFrame(camera.projectionMatrix(aspect) * camera.viewMatrix(), clipBox_, camera.eye);
   frame.viewDir = glm::vec3(camera.forward());
   frame.payload = operation_ == "csg" ? MFR_PAYLOAD_OBJECT : MFR_PAYLOAD_COLOR;
   return FrameContext{*scene_,

@@ -5,9 +5,11 @@
 #include <QDoubleSpinBox>
 #include <QFormLayout>
 #include <QGroupBox>
+#include <QHideEvent>
 #include <QLabel>
 #include <QLocale>
 #include <QProgressBar>
+#include <QShowEvent>
 #include <QSignalBlocker>
 #include <QSlider>
 #include <QSpinBox>
@@ -181,7 +183,6 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
   connect(qualityTimer_, &QTimer::timeout, this, [this] {
     if (isVisible()) ctx_.requestFrameQuality();  // hidden panels cost nothing
   });
-  connect(&ctx_, &ViewerContext::frameQualityReady, this, &BudgetPanel::showQuality);
 
   connect(robustnessSlider_, &QSlider::valueChanged, this, [this](int v) {
     const double span = robustness_->maximum() - robustness_->minimum();
@@ -200,6 +201,19 @@ BudgetPanel::BudgetPanel(ViewerContext& context, QWidget* parent) : QWidget(pare
     kMapOverlay_->setChecked(ctx_.dataView() == DataView::Capacity && ctx_.dataViewOverImage());
   });
   methodChanged();
+}
+
+void BudgetPanel::showEvent(QShowEvent* event) {
+  QWidget::showEvent(event);
+  if (!qualityListened_)
+    qualityListened_ = connect(&ctx_, &ViewerContext::frameQualityReady, this, &BudgetPanel::showQuality);
+  qualityTimer_->start();  // the quality of the frame shown now
+}
+
+void BudgetPanel::hideEvent(QHideEvent* event) {
+  QWidget::hideEvent(event);
+  disconnect(qualityListened_);
+  qualityListened_ = {};
 }
 
 int BudgetPanel::budgetMiB() const {

@@ -51,6 +51,12 @@ class BudgetPanel final : public QWidget {
                                                                 const std::map<std::string, std::string>* tried,
                                                                 const mfr::Stats* measured) const;
 
+ protected:
+  // The frame's quality is listened for only while the panel shows: the viewer reads each frame
+  // back while anyone listens (ViewerModel::wantsFrameImage), a GPU stall a hidden panel need not cost.
+  void showEvent(QShowEvent* event) override;
+  void hideEvent(QHideEvent* event) override;
+
  private:
   enum class Knob { None, Budget, Pool, Slots };
   struct Driver {
@@ -96,6 +102,7 @@ class BudgetPanel final : public QWidget {
   QLabel* rmseLabel_ = nullptr;
   QLabel* flipLabel_ = nullptr;
   QTimer* qualityTimer_ = nullptr;
+  QMetaObject::Connection qualityListened_;
   QCheckBox* kMapOverlay_ = nullptr;
 
   bool driving_ = false;  // the slider has been used: the budget owns the method's parameter

@@ -934,6 +934,12 @@ class ViewerTest : public QObject {
     const auto back = qScopeGuard([&] { QDir::setCurrent(cwd); });
     QCOMPARE(runProgram(MFRVIEW, {"-session", "plain", "--screenshot", png}, &out), 2);
     QVERIFY2(out.contains("mfrview: -session plain: one dash is Qt's"), qPrintable(out));
+    // A session manager's own id goes to Qt: libSM's are "2" and a UUID (hyphens), Qt adds its key
+    // (they were refused, so no desktop could restore the window; a review).
+    const QString smId = QStringLiteral("23d0f1f03-288f-4d21-a140-1edd450bdbc2_1733598000_123456");
+    QCOMPARE(runProgram(MFRVIEW, {"-session", smId, "--size", "64x48", "--screenshot", png}, &out), 0);
+    QVERIFY2(!out.contains("one dash"), qPrintable(out));
+    QVERIFY(QFile::remove(png));
     qunsetenv("SESSION_MANAGER");
     QCOMPARE(runProgram(MFRVIEW, {"-session", "10d4f54d2f000162937474200000016010007_1", "--screenshot", png}, &out),
              2);
@@ -3948,6 +3954,22 @@ class ViewerTest : public QObject {
     QTRY_VERIFY_WITH_TIMEOUT(m.framesRendered() > before && m.frameQuality().valid, kTimeoutMs);
     settle(m);
     QCOMPARE(m.framesRendered() - before, quint64{1});
+    // Side by side with the oracle: two frames, the change's (pane A reported) and the one when the
+    // oracle's image comes (both panes reported). The reference of the metrics is that same image
+    // (an oracle pane's "auto" was keyed apart from its reference's "oit" and computed twice), its
+    // arrival redrew the view again, and so did each caption's update underneath: 8 reports (a
+    // review).
+    m.setMethodOf(1, QStringLiteral("oracle"));
+    m.setCompareEnabled(true);
+    QTRY_VERIFY_WITH_TIMEOUT(m.metricsCurrent(0) && m.metricsCurrent(1), kTimeoutMs);
+    settle(m);
+    const quint64 compared = m.framesRendered();
+    m.setCamera(navigation::orbit(m.camera(), QPointF(-20, 5), m.renderSize()));
+    QTRY_VERIFY_WITH_TIMEOUT(m.metricsCurrent(0) && m.metricsCurrent(1), kTimeoutMs);
+    settle(m);
+    QCOMPARE(m.framesRendered() - compared, quint64{3});
+    m.setCompareEnabled(false);
+    settle(m);
 
     // The keyboard focus moving into the view and out again draws nothing.
     auto* filter = w->findChild<QLineEdit*>("sceneFilter");

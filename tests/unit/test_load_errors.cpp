@@ -290,6 +290,18 @@ TEST_F(LoadModel, NanCoordinates) {
       file += std::string(bad) + " 0 0" + tail + "\n1 0 0" + tail + "\n0 1 0" + tail + "\n3 0 1 2\n";
       expectLoadError(write("bad.off", file), "bad.off: OFF line 3: '" + std::string(bad) + "' is not a finite number");
     }
+  // What follows the last face is left alone ("END", a DOS end-of-file byte, NULs), and a number
+  // too small for a double is 0, as CGAL reads them (a review: these were refused).
+  for (const std::string& tail : {std::string("END\n"), std::string("\x1a"), std::string(4, '\0')})
+    EXPECT_EQ(mfr::loadModel(write("tail.off",
+                                   "COFF\n3 1 0\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n0 1 1e-400 1 0 0 1\n"
+                                   "3 0 1 2\n" +
+                                       tail))
+                  .at(0)
+                  .mesh->triangleCount(),
+              1u);
+  expectLoadError(write("nul.off", std::string("OFF\n3 1 0\n0 0 0\n1 0 \0\n0 1 0\n3 0 1 2\n", 36)),
+                  "nul.off: OFF line 4: '?' is not a finite number");
   expectLoadError(write("malformed.obj", "v 0 0 0\nv 1x 0 0\nv 0 1 0\nf 1 2 3\n"), "line 2: malformed number '1x'");
 }
 
@@ -458,6 +470,15 @@ TEST_F(LoadModel, GarbageVtp) {
     expectLoadError(write("components.vtp", bad), std::string("an unnamed DataArray's NumberOfComponents=\"") + count +
                                                       "\" is not a count in [1, 4096]");
   }
+  // As VTK reads them: spaces and "3.0" are 3; a commented-out DataArray declares nothing (a review).
+  for (const char* count : {" 3", "3.0", "3 "}) {
+    std::string spelled = whole;
+    spelled.replace(spelled.find("NumberOfComponents=\"3\""), 22, std::string("NumberOfComponents=\"") + count + "\"");
+    EXPECT_EQ(mfr::loadModel(write("spelled.vtp", spelled)).at(0).mesh->triangleCount(), 1u) << count;
+  }
+  std::string commented = whole;
+  commented.insert(commented.find("<PolyData>"), "<!-- <DataArray NumberOfComponents=\"0\"> -->");
+  EXPECT_EQ(mfr::loadModel(write("commented.vtp", commented)).at(0).mesh->triangleCount(), 1u);
 }
 
 TEST_F(LoadModel, GarbageLegacyVtk) {
@@ -636,16 +657,18 @@ TEST_F(LoadModel, ObjMissingMaterialsAreNoted) {
 // Material values taken other than as written, and lines and points (no surface), are notes: they
 // were clamped, replaced or dropped without a word (a bug hunt).
 TEST_F(LoadModel, ObjValuesTakenOtherwiseAreNoted) {
-  write("odd.mtl", "newmtl a\nKd nan 0 0\nd 7\nnewmtl b\nKd 0.5 2 0\nKd abc 0 0\nKd xyz 0.2 0.3 0.4\n");
+  write("odd.mtl",
+        "newmtl a\nKd nan 0 0\nd 7\nnewmtl b\nKd 0.5 2 0\nKd abc 0 0\nKd xyz 0.2 0.3 0.4\nnewmtl grey\nKd 0.25\n");
   mfr::LoadOptions options;
   std::vector<std::string> notes;
   options.notes = &notes;
   const auto parts = mfr::loadModel(write("odd.obj",
                                           "mtllib odd.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n"
-                                          "l 1 2\np 1\nf 1 2\nusemtl b\nf 1 3 2\n"),
+                                          "l 1 2\np 1\nf 1 2\nusemtl b\nf 1 3 2\nusemtl grey\nf 2 1 3\n"),
                                     options);
-  ASSERT_EQ(parts.size(), 2u);
-  EXPECT_EQ(parts[0].material.color, glm::vec4(0.8f, 0.8f, 0.8f, 1.0f));  // Kd nan ignored, d 7 clamped
+  ASSERT_EQ(parts.size(), 3u);
+  EXPECT_EQ(parts[2].material.color, glm::vec4(0.25f, 0.25f, 0.25f, 1.0f));  // `Kd r` is grey, no note
+  EXPECT_EQ(parts[0].material.color, glm::vec4(0.8f, 0.8f, 0.8f, 1.0f));     // Kd nan ignored, d 7 clamped
   EXPECT_EQ(parts[1].material.color, glm::vec4(0.5f, 1.0f, 0.0f, 1.0f));
   ASSERT_EQ(notes.size(), 6u);
   EXPECT_NE(notes[0].find("odd.obj: odd.mtl: material 'a': 'Kd nan 0 0': not a number (ignored)"), std::string::npos)
@@ -717,6 +740,12 @@ TEST_F(LoadModel, AsciiPlyWithColors) {
                         "' is not a whole number in [0, 255] (its property's type) in PLY element "
                         "'vertex' 1");
   }
+  // Data the loader keeps as read is not checked so: a uint flags of -1 loads.
+  std::string flagged = ply;
+  flagged.replace(flagged.find("property uchar alpha\n"), 21, "property uchar alpha\nproperty uint flags\n");
+  for (const char* line : {"0 255 0 0 255\n", "0 0 255 0 255\n", "0 0 0 255 255\n", "0 255 255 255 51\n"})
+    flagged.replace(flagged.find(line), std::strlen(line), std::string(line, std::strlen(line) - 1) + " -1\n");
+  EXPECT_EQ(mfr::loadModel(write("flags.ply", flagged)).at(0).mesh->triangleCount(), 2u);
   std::string floats = ply;
   for (const char* channel : {"red", "green", "blue", "alpha"})
     floats.replace(floats.find(std::string("uchar ") + channel), 5, "float");

@@ -42,8 +42,6 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
   if (previous)
     for (const std::shared_ptr<const GpuMesh>& g : previous->meshes_) before.emplace(g->source.get(), g);
   std::map<const Mesh*, std::size_t> uploaded;
-  origin_ = scene.bounds().center();
-  if (!(std::isfinite(origin_.x) && std::isfinite(origin_.y) && std::isfinite(origin_.z))) origin_ = glm::dvec3(0.0);
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
     if (!o.visible || !o.mesh || o.mesh->triangleCount() == 0) continue;
@@ -84,11 +82,10 @@ GpuScene::GpuScene(const Scene& scene, const GpuScene* previous,
       }
       bytes_ += meshes_.back()->bytes;
     }
-    // Mesh centre → world → relative to origin_, composed in double: what the GPU computes in
-    // float stays near zero.
+    // Mesh centre → world, composed in double; draw() makes it relative to the eye.
     const glm::dvec3 centre = meshes_[it->second]->centre;
     const glm::dmat4 toMesh = glm::translate(glm::dmat4(1.0), centre);
-    const glm::mat4 model(glm::translate(glm::dmat4(1.0), -origin_) * o.transform * toMesh);
+    const glm::dmat4 model = o.transform * toMesh;
     // A field colouring needs the field's values on the mesh (colorByField puts them there).
     const std::optional<FieldColors>& field = o.material.fieldColors;
     const bool mapped = field && o.mesh->scalars.size() == o.mesh->positions.size();
@@ -130,13 +127,15 @@ std::shared_ptr<Texture> GpuScene::fieldGrid(const VolumeGrid* grid) const {
   return nullptr;
 }
 
-FrameUniforms GpuScene::relativeFrame(const glm::dmat4& viewProj, const std::optional<Bounds>& clipBox) const {
+FrameUniforms GpuScene::relativeFrame(const glm::dmat4& viewProj, const std::optional<Bounds>& clipBox,
+                                      const glm::dvec3& eye) {
   FrameUniforms frame;
-  frame.viewProj = glm::mat4(viewProj * glm::translate(glm::dmat4(1.0), origin_));
+  frame.origin = std::isfinite(eye.x) && std::isfinite(eye.y) && std::isfinite(eye.z) ? eye : glm::dvec3(0.0);
+  frame.viewProj = glm::mat4(viewProj * glm::translate(glm::dmat4(1.0), frame.origin));
   if (clipBox) {
     frame.clip = true;
-    frame.clipMin = glm::vec3(clipBox->min - origin_);
-    frame.clipMax = glm::vec3(clipBox->max - origin_);
+    frame.clipMin = glm::vec3(clipBox->min - frame.origin);
+    frame.clipMax = glm::vec3(clipBox->max - frame.origin);
   }
   return frame;
 }
@@ -158,7 +157,9 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
   }
   for (const DrawItem& item : items_) {
     const GpuMesh& m = *meshes_[item.mesh];
-    program.set("uModel", item.model);
+    glm::dmat4 model = item.model;  // world → relative to the eye: a translation, in double
+    model[3] -= glm::dvec4(frame.origin, 0.0);
+    program.set("uModel", glm::mat4(model));
     program.set("uNormalMatrix", item.normalMatrix);
     program.set("uColor", item.color);
     program.set("uVertexColors", item.vertexColors ? 1 : 0);

@@ -341,7 +341,7 @@ class Unpacker {
     return {take(static_cast<std::size_t>(n)), static_cast<std::size_t>(n)};
   }
   [[nodiscard]] bool done() const { return at_ == bytes_.size(); }
-  [[noreturn]] static void fail() { throw std::logic_error("unpack: bytes its packer did not write"); }
+  [[noreturn]] static void fail() { throw std::logic_error("unpackObjects: bytes packObjects did not write"); }
 
  private:
   const char* take(std::size_t n) {
@@ -451,75 +451,6 @@ std::vector<Object> unpackObjects(const std::string& bytes, std::vector<std::str
   if (!in.done()) Unpacker::fail();
   if (notes != nullptr) notes->insert(notes->end(), read.begin(), read.end());
   return objects;
-}
-
-std::string packVolume(const Volume& volume, const std::vector<std::string>& notes) {
-  Packer out;
-  out.text(volume.name);
-  out.value(volume.grid != nullptr);
-  if (volume.grid) {
-    out.value(volume.grid->dims);
-    out.array(volume.grid->values);
-  }
-  out.value(volume.origin);
-  out.value(volume.spacing);
-  out.value(volume.transform);
-  out.value(static_cast<std::uint64_t>(volume.transfer.points.size()));
-  for (const TransferPoint& p : volume.transfer.points) {
-    out.value(p.value);
-    out.value(p.color);
-  }
-  out.value(volume.transfer.unitDistance);
-  out.value(volume.visible);
-  out.value(volume.shading);
-  out.text(volume.field);
-  out.value(static_cast<std::uint64_t>(volume.fields.size()));
-  for (const std::string& field : volume.fields) out.text(field);
-  out.text(volume.file.string());
-  out.value(volume.sceneTransform);
-  out.value(static_cast<std::uint64_t>(notes.size()));
-  for (const std::string& note : notes) out.text(note);
-  return std::move(out.bytes);
-}
-
-Volume unpackVolume(const std::string& bytes, std::vector<std::string>* notes) {
-  Unpacker in(bytes);
-  Volume volume;
-  volume.name = in.text();
-  if (in.value<bool>()) {
-    auto grid = std::make_shared<VolumeGrid>();
-    grid->dims = in.value<glm::ivec3>();
-    grid->values = in.array<float>();
-    volume.grid = std::move(grid);
-  }
-  volume.origin = in.value<glm::dvec3>();
-  volume.spacing = in.value<glm::dvec3>();
-  volume.transform = in.value<glm::dmat4>();
-  const auto points = in.value<std::uint64_t>();
-  if (points > bytes.size()) Unpacker::fail();
-  for (std::uint64_t i = 0; i < points; ++i) {
-    TransferPoint p;
-    p.value = in.value<double>();
-    p.color = in.value<glm::vec4>();
-    volume.transfer.points.push_back(p);
-  }
-  volume.transfer.unitDistance = in.value<double>();
-  volume.visible = in.value<bool>();
-  volume.shading = in.value<bool>();
-  volume.field = in.text();
-  const auto fields = in.value<std::uint64_t>();
-  if (fields > bytes.size()) Unpacker::fail();
-  for (std::uint64_t i = 0; i < fields; ++i) volume.fields.push_back(in.text());
-  volume.file = in.text();
-  volume.sceneTransform = in.value<glm::dmat4>();
-  const auto count = in.value<std::uint64_t>();
-  if (count > bytes.size()) Unpacker::fail();
-  for (std::uint64_t i = 0; i < count; ++i) {
-    std::string note = in.text();
-    if (notes) notes->push_back(std::move(note));
-  }
-  if (!in.done()) Unpacker::fail();
-  return volume;
 }
 
 }  // namespace mfr::io

@@ -9,7 +9,6 @@
 
 #include "mfr/io/load.hpp"
 #include "mfr/scene/scene.hpp"
-#include "mfr/scene/volume.hpp"
 
 namespace mfr::io {
 
@@ -43,8 +42,5 @@ std::optional<std::string> runInChild(const std::string& name, const ChildLibrar
 // are appended to `notes` when it is not null.
 std::string packObjects(const std::vector<Object>& objects, const std::vector<std::string>& notes = {});
 std::vector<Object> unpackObjects(const std::string& bytes, std::vector<std::string>* notes = nullptr);
-// A volume and a loader's notes likewise: every member of Volume.
-std::string packVolume(const Volume& volume, const std::vector<std::string>& notes = {});
-Volume unpackVolume(const std::string& bytes, std::vector<std::string>* notes = nullptr);
 
 }  // namespace mfr::io

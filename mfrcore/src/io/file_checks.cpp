@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cerrno>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -111,13 +112,28 @@ std::vector<std::string> vtkXmlTags(const std::filesystem::path& path, const std
   std::vector<std::string> tags;
   std::string tag;
   bool inTag = false, appended = false;
+  // Comments and CDATA sections are no tags: a DataArray commented out declares nothing (a review).
+  std::string_view closing;  // "-->" or "]]>" while inside one; the last bytes seen
+  std::string recent;
   const auto take = [&](const char* bytes, std::size_t count) {
     for (std::size_t i = 0; i < count && !appended; ++i) {
       const char c = bytes[i];
+      if (!closing.empty()) {
+        recent.push_back(c);
+        if (recent.size() > 3) recent.erase(0, recent.size() - 3);
+        if (recent == closing) closing = {};
+        continue;
+      }
       if (!inTag) {
         inTag = c == '<';
       } else if (c != '>') {
         if (tag.size() < (1u << 16)) tag += c;
+        if (tag == "!--" || tag == "![CDATA[") {
+          closing = tag == "!--" ? std::string_view("-->") : std::string_view("]]>");
+          recent.clear();
+          tag.clear();
+          inTag = false;
+        }
       } else {
         appended = tag.rfind("AppendedData", 0) == 0;
         if (!appended) tags.push_back(std::move(tag));
@@ -157,10 +173,17 @@ std::string vtkXmlAttribute(std::string_view tag, std::string_view key) {
 
 void checkVtkXmlDataArray(std::string_view tag, long long maxComponents, long long maxTuples, std::uintmax_t fileBytes,
                           const std::string& name) {
+  // A whole number as VTK reads one (surrounding spaces, "3.0"); a sign, a fraction or garbage is not.
   const auto whole = [](const std::string& text, long long& value) {
-    if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) return false;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    return ec == std::errc() && end == text.data() + text.size();
+    const std::size_t first = text.find_first_not_of(" \t\r\n"), last = text.find_last_not_of(" \t\r\n");
+    if (first == std::string::npos || text[first] == '-' || text[first] == '+') return false;
+    double number = 0.0;
+    const auto [end, ec] = std::from_chars(text.data() + first, text.data() + last + 1, number);
+    if (ec != std::errc() || end != text.data() + last + 1 || !(number >= 0.0 && number <= 9.0e18) ||
+        number != std::floor(number))
+      return false;
+    value = static_cast<long long>(number);
+    return true;
   };
   const auto array = [&] {
     const std::string named = vtkXmlAttribute(tag, "Name");

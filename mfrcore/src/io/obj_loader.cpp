@@ -94,8 +94,11 @@ std::map<std::string, glm::vec4> readMaterials(const fs::path& file, std::string
                         (finite ? ": outside 0 … 1 (clamped)" : ": not a number (ignored)"));
       return finite;
     };
-    if (w[0] == "Kd" && w.size() >= 4 && parseDouble(w[1], v[0]) && parseDouble(w[2], v[1]) &&
-        parseDouble(w[3], v[2])) {
+    // `Kd r` is MTL's grey: g and b equal to r (a review: it was noted as "not a number").
+    const bool grey = w[0] == "Kd" && w.size() == 2 && parseDouble(w[1], v[0]);
+    if (grey) v[1] = v[2] = v[0];
+    if (w[0] == "Kd" &&
+        (grey || (w.size() >= 4 && parseDouble(w[1], v[0]) && parseDouble(w[2], v[1]) && parseDouble(w[3], v[2])))) {
       if (check(v, 3)) c = glm::vec4(glm::clamp(glm::vec3(v[0], v[1], v[2]), 0.0f, 1.0f), c.a);
     } else if (w[0] == "d" && w.size() >= 2 && parseDouble(w.back(), v[0])) {
       if (check(v, 1)) c.a = static_cast<float>(std::clamp(v[0], 0.0, 1.0));

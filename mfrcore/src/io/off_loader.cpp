@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <iterator>
 #include <optional>
 #include <sstream>
@@ -90,15 +91,22 @@ void checkAsciiFaceSizes(std::string_view bytes, std::size_t pos, std::uint64_t 
   }
 }
 
-// Every number after the counts, whatever the layout: CGAL's scanner of a coloured file (COFF,
-// CNOFF, STCOFF) read a vertex line whose coordinate did not parse ("inf", "nan", "abc", "1e400")
-// and then indexed that line's colour past its end — a crash (found by fuzzing); a plain OFF
-// file's came out as "malformed".
-void checkAsciiNumbers(std::string_view bytes, std::size_t pos, const std::string& name) {
+// Every number of the vertex and face records after the counts: CGAL's scanner of a coloured file
+// (COFF, CNOFF, STCOFF) read a vertex line whose coordinate did not parse ("inf", "nan", "abc",
+// "1e400") and then indexed that line's colour past its end — a crash (found by fuzzing); a plain
+// OFF file's came out as "malformed". Records are lines, as checkAsciiFaceSizes reads them; what
+// follows the last one (an "END" line, a DOS end-of-file byte) is left alone, as CGAL leaves it.
+// A number too small for a double is 0, as CGAL reads it.
+void checkAsciiNumbers(std::string_view bytes, std::size_t pos, std::uint64_t records, const std::string& name) {
   std::size_t line = 1 + static_cast<std::size_t>(std::count(bytes.begin(), bytes.begin() + pos, '\n'));
+  pos = bytes.find('\n', pos);  // the rest of the counts' line
+  if (pos == std::string_view::npos) return;
+  bool tokens = false;  // on the current line
   while (pos < bytes.size()) {
     const char c = bytes[pos];
     if (c == '\n') {
+      if (tokens && --records == 0) return;
+      tokens = false;
       ++line;
       ++pos;
     } else if (c == '#') {
@@ -112,11 +120,20 @@ void checkAsciiNumbers(std::string_view bytes, std::size_t pos, const std::strin
       const std::string_view spelled = token;
       if (token.size() > 1 && token.front() == '+') token.remove_prefix(1);
       double value = 0.0;
-      const auto [at, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
-      if (ec != std::errc() || at != token.data() + token.size() || !std::isfinite(value))
-        throw Error(name, "OFF line " + std::to_string(line) + ": '" + std::string(spelled.substr(0, 40)) +
-                              "' is not a finite number");
+      auto [at, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+      if (ec == std::errc::result_out_of_range && at == token.data() + token.size()) {
+        const std::string spelledOut(token);  // underflow is 0 (strtod says which); overflow is not a number
+        value = std::strtod(spelledOut.c_str(), nullptr);
+        ec = std::isinf(value) ? ec : std::errc();
+      }
+      if (ec != std::errc() || at != token.data() + token.size() || !std::isfinite(value)) {
+        std::string shown(spelled.substr(0, 40));
+        for (char& ch : shown)
+          if (static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f) ch = '?';  // a NUL cut the message short
+        throw Error(name, "OFF line " + std::to_string(line) + ": '" + shown + "' is not a finite number");
+      }
       pos = end;
+      tokens = true;
     }
   }
 }
@@ -184,7 +201,7 @@ std::size_t checkHeader(std::string_view bytes, const std::string& name, std::ui
   faces = counts[1];
   if (!binary) {
     checkAsciiFaceSizes(bytes, pos, vertices, faces, name);
-    checkAsciiNumbers(bytes, pos, name);
+    if (vertices + faces > 0) checkAsciiNumbers(bytes, pos, vertices + faces, name);
   }
   if (vertices > 0xffffffffull || faces > 0xffffffffull ||
       vertices * vertexBytes + faces * faceBytes > bytes.size() - (binary ? pos : 0))

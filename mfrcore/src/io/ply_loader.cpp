@@ -122,7 +122,8 @@ class Reader {
   }
   [[nodiscard]] std::size_t remaining() const { return data_.size() - pos_; }
 
-  double read(Type t) { return encoding_ == Encoding::Ascii ? readAscii(t) : readBinary(t); }
+  // `whole`: an ASCII value must be a whole number in the type's range (colours: scaled by it).
+  double read(Type t, bool whole = false) { return encoding_ == Encoding::Ascii ? readAscii(t, whole) : readBinary(t); }
 
   [[noreturn]] void fail(const std::string& what) const {
     throw Error(name_,
@@ -130,9 +131,10 @@ class Reader {
   }
 
  private:
-  // A value of an integer type is a whole number in its range: "nan", 300 or −1 for a uchar colour
-  // came out as NaN shading or a silent clamp (fuzzing).
-  double readAscii(Type t) {
+  // A colour of an integer type is a whole number in its range: "nan", 300 or −1 for a uchar colour
+  // came out as NaN shading or a silent clamp (fuzzing). Other properties are data the loader
+  // keeps as read (a `uint flags` of −1 refused the file; a review).
+  double readAscii(Type t, bool whole) {
     while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_]))) ++pos_;
     if (pos_ == data_.size()) fail("unexpected end of data (truncated file?)");
     std::size_t end = pos_;
@@ -144,7 +146,7 @@ class Reader {
     const auto [ptr, ec] = std::from_chars(first, last, value);
     const std::string token(data_.substr(pos_, std::min<std::size_t>(end - pos_, 32)));
     if (ec != std::errc() || ptr != last) fail("bad number '" + token + "'");
-    if (const auto range = integerRange(t);
+    if (const auto range = whole ? integerRange(t) : std::nullopt;
         range && !(value >= range->first && value <= range->second && value == std::floor(value)))
       fail("'" + token + "' is not a whole number in [" + std::to_string(static_cast<long long>(range->first)) + ", " +
            std::to_string(static_cast<long long>(range->second)) + "] (its property's type)");
@@ -385,7 +387,9 @@ PolygonSoup parsePly(std::string_view bytes, const std::string& name) {
       for (std::size_t pi = 0; pi < e.properties.size(); ++pi) {
         const Property& p = e.properties[pi];
         if (!p.list) {
-          values[pi] = reader.read(p.type);
+          const auto index = static_cast<int>(pi);
+          values[pi] =
+              reader.read(p.type, isVertex && hasColors && (index == cr || index == cg || index == cb || index == ca));
           continue;
         }
         const double countValue = reader.read(p.countType);

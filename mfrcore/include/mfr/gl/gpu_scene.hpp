@@ -20,7 +20,9 @@
 namespace mfr::gl {
 
 struct FrameUniforms {
-  // Relative to GpuScene::origin(), as are clipMin/clipMax: made by GpuScene::relativeFrame.
+  // The world point the GPU's coordinates are relative to: the eye. viewProj and clipMin/clipMax
+  // are relative to it (GpuScene::relativeFrame), and so is each part's model matrix (draw()).
+  glm::dvec3 origin{0.0};
   glm::mat4 viewProj{1.0f};
   glm::vec3 viewDir{0.0f, 0.0f, -1.0f};  // headlight direction (camera forward), world space
   int payload = 0;  // what capture passes store in a fragment's colour word: MFR_PAYLOAD_* (bindings.h)
@@ -49,13 +51,14 @@ class GpuScene {
   // The texture (R32F) of a volume grid that colours a surface here (mfr::VolumeFieldSampler), else
   // null: the renderer's volume operation uses it rather than upload the grid twice.
   [[nodiscard]] std::shared_ptr<Texture> fieldGrid(const VolumeGrid* grid) const;
-  // The world point the GPU's coordinates are relative to (the scene's centre): draw() takes a
-  // FrameUniforms whose viewProj and clip box are relative to it (relativeFrame). Positions far
-  // from the world's origin (survey coordinates, 1e6 and beyond) lost their float precision in the
-  // view transform: a unit cube at 1e7 was RMSE 0.16 from the oracle (a bug hunt).
-  [[nodiscard]] const glm::dvec3& origin() const { return origin_; }
-  // `viewProj` (world → clip, double) and the scene's clip box as draw() needs them.
-  [[nodiscard]] FrameUniforms relativeFrame(const glm::dmat4& viewProj, const std::optional<Bounds>& clipBox) const;
+  // `viewProj` (world → clip, double) and the scene's clip box as draw() needs them: relative to
+  // `eye`, in float. Positions far from the world's origin (survey coordinates, 1e6 and beyond)
+  // lost their float precision in the view transform: a unit cube at 1e7 was RMSE 0.16 from the
+  // oracle (a bug hunt); relative to the scene's centre, a part 1e-4 in size 40 units from it, or
+  // beside the eye of a scene reaching 1e6 away, was drawn jagged and mis-sorted (hunt 31). What
+  // the GPU computes in float is then small wherever the eye looks.
+  [[nodiscard]] static FrameUniforms relativeFrame(const glm::dmat4& viewProj, const std::optional<Bounds>& clipBox,
+                                                   const glm::dvec3& eye);
 
  private:
   struct GpuMesh {
@@ -69,7 +72,7 @@ class GpuScene {
   };
   struct DrawItem {
     std::size_t mesh;
-    glm::mat4 model;
+    glm::dmat4 model;  // mesh (relative to its centre) → world, in double: draw() makes it relative to the eye
     glm::mat3 normalMatrix;
     glm::vec4 color;
     bool vertexColors;
@@ -89,7 +92,6 @@ class GpuScene {
   std::vector<DrawItem> items_;
   Texture colorMaps_;  // every colour map's table (common/color_map.glsl), bound while drawing
   std::size_t triangles_ = 0;
-  glm::dvec3 origin_{0.0};
   std::size_t bytes_ = 0;
   std::size_t uploaded_ = 0;
 };
