@@ -297,63 +297,6 @@ std::optional<std::string> runInChild(const std::string& name, const ChildLibrar
 
 namespace {
 
-class Packer {
- public:
-  template <typename T>
-  void value(const T& v) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
-  }
-  template <typename T>
-  void array(const std::vector<T>& values) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    value(static_cast<std::uint64_t>(values.size()));
-    bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-  }
-  void text(const std::string& s) {
-    value(static_cast<std::uint64_t>(s.size()));
-    bytes += s;
-  }
-  std::string bytes;
-};
-
-class Unpacker {
- public:
-  explicit Unpacker(const std::string& bytes) : bytes_(bytes) {}
-  template <typename T>
-  T value() {
-    T v{};
-    std::memcpy(&v, take(sizeof v), sizeof v);
-    return v;
-  }
-  template <typename T>
-  std::vector<T> array() {
-    const auto n = value<std::uint64_t>();
-    if (n > (bytes_.size() - at_) / sizeof(T)) fail();
-    std::vector<T> values(static_cast<std::size_t>(n));
-    // An empty vector's data() may be null, which memcpy must not get even for 0 bytes (UBSan).
-    if (!values.empty()) std::memcpy(values.data(), take(values.size() * sizeof(T)), values.size() * sizeof(T));
-    return values;
-  }
-  std::string text() {
-    const auto n = value<std::uint64_t>();
-    if (n > bytes_.size() - at_) fail();
-    return {take(static_cast<std::size_t>(n)), static_cast<std::size_t>(n)};
-  }
-  [[nodiscard]] bool done() const { return at_ == bytes_.size(); }
-  [[noreturn]] static void fail() { throw std::logic_error("unpackObjects: bytes packObjects did not write"); }
-
- private:
-  const char* take(std::size_t n) {
-    if (n > bytes_.size() - at_) fail();
-    const char* p = bytes_.data() + at_;
-    at_ += n;
-    return p;
-  }
-  const std::string& bytes_;
-  std::size_t at_ = 0;
-};
-
 constexpr std::uint64_t kNoMesh = ~std::uint64_t{0};
 
 }  // namespace

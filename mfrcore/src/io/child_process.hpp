@@ -2,9 +2,14 @@
 // Loaders whose library can crash, hang or allocate without end on a damaged file (assimp, Open
 // CASCADE) run it in a child process (private to mfrcore/io): a crash, a hang or a runaway is then
 // one error naming the file, and the process that asked (mfr, or mfrview loading a scene) lives on.
+#include <cstdint>
+#include <cstring>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
+#include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "mfr/io/load.hpp"
@@ -35,6 +40,68 @@ int importSeconds(const std::string& name);
 std::optional<std::string> runInChild(const std::string& name, const ChildLibrary& library,
                                       const LoadProgress& progress,
                                       const std::function<std::string(const LoadProgress&)>& work);
+
+// A child's result as bytes, written in the child and read back here (a process of the same
+// build): plain values, arrays of them and texts, each length-prefixed. Unpacker throws
+// std::logic_error for bytes a Packer did not write.
+class Packer {
+ public:
+  template <typename T>
+  void value(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  template <typename T>
+  void array(const std::vector<T>& values) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    value(static_cast<std::uint64_t>(values.size()));
+    bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+  }
+  void text(const std::string& s) {
+    value(static_cast<std::uint64_t>(s.size()));
+    bytes += s;
+  }
+  std::string bytes;
+};
+
+class Unpacker {
+ public:
+  explicit Unpacker(const std::string& bytes) : bytes_(bytes) {}
+  template <typename T>
+  T value() {
+    T v{};
+    std::memcpy(&v, take(sizeof v), sizeof v);
+    return v;
+  }
+  template <typename T>
+  std::vector<T> array() {
+    const auto n = value<std::uint64_t>();
+    if (n > (bytes_.size() - at_) / sizeof(T)) fail();
+    std::vector<T> values(static_cast<std::size_t>(n));
+    // An empty vector's data() may be null, which memcpy must not get even for 0 bytes (UBSan).
+    if (!values.empty()) std::memcpy(values.data(), take(values.size() * sizeof(T)), values.size() * sizeof(T));
+    return values;
+  }
+  std::string text() {
+    const auto n = value<std::uint64_t>();
+    if (n > bytes_.size() - at_) fail();
+    return {take(static_cast<std::size_t>(n)), static_cast<std::size_t>(n)};
+  }
+  // What follows what was read (bytes a Packer appended as they are).
+  [[nodiscard]] std::string_view rest() const { return std::string_view(bytes_).substr(at_); }
+  [[nodiscard]] bool done() const { return at_ == bytes_.size(); }
+  [[noreturn]] static void fail() { throw std::logic_error("unpack: bytes a Packer did not write"); }
+
+ private:
+  const char* take(std::size_t n) {
+    if (n > bytes_.size() - at_) fail();
+    const char* p = bytes_.data() + at_;
+    at_ += n;
+    return p;
+  }
+  const std::string& bytes_;
+  std::size_t at_ = 0;
+};
 
 // Objects and a loader's notes as bytes and back, to pass a loader's result out of its child:
 // names, meshes (shared meshes stay shared), fields, transforms, materials, visibility. Only for

@@ -279,42 +279,27 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
     const ChosenGrid read = readChosenGrid(path, name, field, child, notes != nullptr ? &childNotes : nullptr);
     std::ostringstream grid(std::ios::binary);
     openvdb::io::Stream(grid).write(openvdb::GridCPtrVec{read.grid});
-    // The label, the readable grids, the notes (each a length and its bytes), then the grid.
-    std::string out;
-    const auto text = [&out](const std::string& t) {
-      const std::uint64_t size = t.size();
-      out.append(reinterpret_cast<const char*>(&size), sizeof size);
-      out += t;
-    };
-    text(read.label);
-    text(std::to_string(read.readable.size()));
-    for (const std::string& r : read.readable) text(r);
-    text(std::to_string(childNotes.size()));
-    for (const std::string& n : childNotes) text(n);
-    out += std::move(grid).str();
-    return out;
+    // The label, the readable grids, the notes, then the grid.
+    Packer out;
+    out.text(read.label);
+    out.value(static_cast<std::uint64_t>(read.readable.size()));
+    for (const std::string& r : read.readable) out.text(r);
+    out.value(static_cast<std::uint64_t>(childNotes.size()));
+    for (const std::string& n : childNotes) out.text(n);
+    out.bytes += std::move(grid).str();
+    return std::move(out.bytes);
   });
   if (!bytes) return denseVolume(readChosenGrid(path, name, field, progress, notes), path, name, progress);
-  std::size_t at = 0;
-  const auto text = [&]() {
-    std::uint64_t size = 0;
-    if (bytes->size() - at < sizeof size) throw std::logic_error("readOpenVdb: bytes its child did not write");
-    std::memcpy(&size, bytes->data() + at, sizeof size);
-    at += sizeof size;
-    if (bytes->size() - at < size) throw std::logic_error("readOpenVdb: bytes its child did not write");
-    std::string t = bytes->substr(at, static_cast<std::size_t>(size));
-    at += static_cast<std::size_t>(size);
-    return t;
-  };
+  Unpacker in(*bytes);
   ChosenGrid read;
-  read.label = text();
-  for (std::size_t n = std::stoul(text()); n > 0; --n) read.readable.push_back(text());
-  for (std::size_t n = std::stoul(text()); n > 0; --n) {
-    std::string note = text();
+  read.label = in.text();
+  for (auto n = in.value<std::uint64_t>(); n > 0; --n) read.readable.push_back(in.text());
+  for (auto n = in.value<std::uint64_t>(); n > 0; --n) {
+    std::string note = in.text();
     if (notes != nullptr) notes->push_back(std::move(note));
   }
   ensureOpenVdb();
-  std::istringstream grid(bytes->substr(at), std::ios::binary);
+  std::istringstream grid(std::string(in.rest()), std::ios::binary);
   const openvdb::GridPtrVecPtr grids = openvdb::io::Stream(grid, false).getGrids();
   if (!grids || grids->size() != 1) throw std::logic_error("readOpenVdb: no grid from its child");
   read.grid = grids->front();
