@@ -155,6 +155,12 @@ std::vector<std::string> vtkXmlTags(const std::filesystem::path& path, const std
   return tags;
 }
 
+bool isVtkXmlElement(std::string_view tag, std::string_view element) {
+  return tag.substr(0, element.size()) == element &&
+         (tag.size() == element.size() || std::isspace(static_cast<unsigned char>(tag[element.size()])) ||
+          tag[element.size()] == '/');
+}
+
 std::string vtkXmlAttribute(std::string_view tag, std::string_view key) {
   for (std::size_t at = tag.find(key); at != std::string_view::npos; at = tag.find(key, at + 1)) {
     const bool word = at > 0 && std::isspace(static_cast<unsigned char>(tag[at - 1]));

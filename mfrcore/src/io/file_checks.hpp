@@ -37,6 +37,8 @@ void checkVtkXmlFileEnd(const std::filesystem::path& path, const std::string* co
 // <AppendedData: what its elements declare, read in one pass without keeping the data between
 // them. From `contents` when given, else from the file at path.
 std::vector<std::string> vtkXmlTags(const std::filesystem::path& path, const std::string* contents);
+// Whether a tag (vtkXmlTags) opens or closes element `element`: its name, then the end, a space or '/'.
+bool isVtkXmlElement(std::string_view tag, std::string_view element);
 // The value of attribute `key` of a tag (quoted with " or '), empty when it has none.
 std::string vtkXmlAttribute(std::string_view tag, std::string_view key);
 // What a DataArray declares that VTK's XML readers allocate or seek to before they read a value:

@@ -760,7 +760,6 @@ SampleArray sampleArray(vtkImageData* image, const std::string& name, const std:
 // be told to skip them. The ImageData's Origin, Spacing and Direction must be finite numbers.
 std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, const std::string& name) {
   const std::vector<std::string> tags = vtkXmlTags(path, nullptr);
-  const auto attribute = vtkXmlAttribute;
   std::error_code sizeError;
   const std::uintmax_t fileBytes = fs::file_size(path, sizeError);
   std::vector<std::pair<std::string, bool>> found;
@@ -778,15 +777,11 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
   std::vector<Extent> pieces;
   for (const std::string& tagText : tags) {
     const std::string_view tag(tagText);
-    const auto is = [&](std::string_view element) {
-      return tag.substr(0, element.size()) == element &&
-             (tag.size() == element.size() || std::isspace(static_cast<unsigned char>(tag[element.size()])) ||
-              tag[element.size()] == '/');
-    };
+    const auto is = [&](std::string_view element) { return isVtkXmlElement(tag, element); };
     if (is("ImageData"))
       for (const char* key : {"Origin", "Spacing", "Direction"}) {
         // VTK reads a value it cannot parse (nan, 1e309) as its default and says nothing.
-        const std::string text = attribute(tag, key);
+        const std::string text = vtkXmlAttribute(tag, key);
         if (text.empty()) continue;
         std::istringstream numbers(text);
         std::string number;
@@ -802,9 +797,9 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
           throw Error(name, std::string("ImageData ") + key + " '" + text.substr(0, 64) + "' has " +
                                 std::to_string(count) + " numbers");
       }
-    if (is("ImageData")) whole = extentOf(attribute(tag, "WholeExtent"));
+    if (is("ImageData")) whole = extentOf(vtkXmlAttribute(tag, "WholeExtent"));
     if (is("Piece"))
-      if (const std::optional<Extent> e = extentOf(attribute(tag, "Extent"))) pieces.push_back(*e);
+      if (const std::optional<Extent> e = extentOf(vtkXmlAttribute(tag, "Extent"))) pieces.push_back(*e);
     if (is("PointData")) section = Section::kPoints;
     if (is("CellData")) section = Section::kCells;
     if (is("FieldData")) section = Section::kField;
@@ -814,10 +809,11 @@ std::vector<std::pair<std::string, bool>> xmlStringArrays(const fs::path& path, 
     if (is("DataArray"))
       checkVtkXmlDataArray(tag, kMaxComponents, static_cast<long long>(VolumeGrid::kMaxPoints),
                            sizeError ? ~std::uintmax_t{0} : fileBytes, name);
-    if (!is("DataArray") || attribute(tag, "type") != "String") continue;
+    if (!is("DataArray") || vtkXmlAttribute(tag, "type") != "String") continue;
     if (section == Section::kField)
-      throw Error(name, "field data array '" + attribute(tag, "Name") + "' holds text, which VTK's reader cannot skip");
-    if (section != Section::kNone) found.emplace_back(attribute(tag, "Name"), section == Section::kCells);
+      throw Error(name,
+                  "field data array '" + vtkXmlAttribute(tag, "Name") + "' holds text, which VTK's reader cannot skip");
+    if (section != Section::kNone) found.emplace_back(vtkXmlAttribute(tag, "Name"), section == Section::kCells);
   }
   // Pieces that leave points of the WholeExtent out: VTK reads them into a grid of the whole
   // extent and leaves the rest as it was allocated (two reads of one file drew different images; a

@@ -590,8 +590,7 @@ Mesh readWithVtk(VtkFormat format, const fs::path& path, const std::string* cont
         constexpr long long kMaxComponents = 4096, kMaxTuples = 0xffffffffLL;
         const std::uintmax_t bytes = contents != nullptr ? contents->size() : fs::file_size(path);
         for (const std::string& tag : vtkXmlTags(path, contents))
-          if (tag.starts_with("DataArray") && (tag.size() == 9 || std::isspace(static_cast<unsigned char>(tag[9]))))
-            checkVtkXmlDataArray(tag, kMaxComponents, kMaxTuples, bytes, name);
+          if (isVtkXmlElement(tag, "DataArray")) checkVtkXmlDataArray(tag, kMaxComponents, kMaxTuples, bytes, name);
       }
       vtkNew<vtkXMLPolyDataReader> reader;
       if (contents != nullptr) {
