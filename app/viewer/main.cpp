@@ -469,6 +469,8 @@ int main(int argc, char** argv) {
   std::setlocale(LC_NUMERIC, "C");
   QApplication::setApplicationName(QStringLiteral("mfrview"));
   QApplication::setOrganizationName(QStringLiteral("mfr"));
+  // Ties the window to the installed desktop entry (its icon and name on Wayland's task bars).
+  QGuiApplication::setDesktopFileName(QStringLiteral("mfrview"));
   QApplication::setApplicationVersion(QStringLiteral(MFR_VERSION));
   const CommandLine cl = parseCommandLine(sessionArgs);
   const bool scripted = !cl.screenshot.isEmpty() || !cl.windowScreenshot.isEmpty();

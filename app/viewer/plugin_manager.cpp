@@ -64,7 +64,7 @@ QStringList PluginManager::searchPaths() {
   for (const QString& p : env.split(QLatin1Char(':'), Qt::SkipEmptyParts)) paths << QDir(p).absolutePath();
   const QDir exe(QCoreApplication::applicationDirPath());
   paths << exe.absoluteFilePath(QStringLiteral("plugins"))
-        << exe.absoluteFilePath(QStringLiteral("../lib/mfrview/plugins"));
+        << QDir::cleanPath(exe.absoluteFilePath(QStringLiteral(MFRVIEW_PLUGINS_FROM_BINDIR)));
   paths.removeDuplicates();
   return paths;
 }

@@ -1,7 +1,8 @@
 #pragma once
 // Finds and loads mfrview plugins: every shared library in $MFR_PLUGIN_PATH (colon-separated
-// folders, searched first) and in `plugins` beside the executable (also ../lib/mfrview/plugins
-// for an installed layout). Failures are kept with their reason for Help → Plugins.
+// folders, searched first), in `plugins` beside the executable (the build tree), and in the
+// installed layout's folder (../lib/mfrview/plugins from bin/: cmake/MfrInstall.cmake). Failures are kept with their
+// reason for Help → Plugins.
 #include <QString>
 #include <QStringList>
 
