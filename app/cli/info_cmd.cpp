@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <optional>
 #include <sstream>
@@ -23,6 +25,24 @@
 namespace mfr::cli {
 
 namespace {
+
+// Bounds with the digits their size needs: six significant digits beyond those the coordinates
+// spend on their distance from the origin, so a unit part at 1e7 reads [9999999.5 …] – [10000000.5 …]
+// (printed as 1e+07 – 1e+07 before: hunt 31), while an ordinary scene reads as before.
+std::string boundsText(const Bounds& b) {
+  const glm::dvec3 size = b.max - b.min;
+  const double extent = std::max({size.x, size.y, size.z});
+  const double far = std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z), std::abs(b.max.x),
+                               std::abs(b.max.y), std::abs(b.max.z)});
+  int digits = 6;
+  if (extent > 0.0 && far > extent && std::isfinite(far / extent))
+    digits = std::min(17, 6 + static_cast<int>(std::ceil(std::log10(far / extent))));
+  std::ostringstream out;
+  out.precision(digits);
+  out << "[" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – [" << b.max.x << ", " << b.max.y << ", "
+      << b.max.z << "]";
+  return out.str();
+}
 
 // Every method render() accepts, where it runs, what it is and its parameters (name, type,
 // default, range or choices): what -m and -p take.
@@ -257,8 +277,7 @@ void addInfo(CLI::App& app) {
     std::cout << "scene      " << scene.name << "\nparts      " << scene.objects.size()
               << (hidden > 0 ? " (" + std::to_string(hidden) + " hidden)" : std::string()) << "\ntriangles  "
               << scene.triangleCount() << (hidden > 0 || section.removed > 0 ? " (of the visible parts)" : "")
-              << "\nbounds     [" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – [" << b.max.x << ", "
-              << b.max.y << ", " << b.max.z << "]\nviews     ";
+              << "\nbounds     " << boundsText(b) << "\nviews     ";
     for (const std::string& v : scene.viewNames()) std::cout << " " << v;
     std::cout << "\n";
     if (!bondsError.empty()) std::cout << "molecule   atoms and bonds not counted: " << bondsError << "\n";

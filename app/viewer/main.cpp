@@ -366,7 +366,10 @@ CommandLine parseCommandLine(const QStringList& sessionArgs) {
 // a dot or a slash, or of a file that exists, is the user's session file; and with no session
 // manager running nothing hands one back.
 bool isSessionManagerId(const char* value) {
-  if (std::getenv("SESSION_MANAGER") == nullptr || *value == '\0') return false;
+  // libSM's ids are "1" and 35 hex digits, or "2" and a UUID; Qt appends "_" and its key. A word
+  // the user meant as a file ("-session work", none of that name) was taken as an id (review 27).
+  if (std::getenv("SESSION_MANAGER") == nullptr || (*value != '1' && *value != '2') || std::strlen(value) < 20)
+    return false;
   for (const char* c = value; *c; ++c)
     if (!std::isalnum(static_cast<unsigned char>(*c)) && *c != '_' && *c != '-') return false;
   return !QFileInfo::exists(QString::fromLocal8Bit(value));

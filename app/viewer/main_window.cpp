@@ -34,6 +34,7 @@
 #include <QVBoxLayout>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <iostream>
 #include <exception>
@@ -631,7 +632,11 @@ bool MainWindow::isSessionFile(const QString& path) {
     return false;
   QFile f(path);
   if (!f.open(QIODevice::ReadOnly)) return false;
-  if (!f.peek(256).trimmed().startsWith('{')) return false;
+  // The first character that is not white space (a session indented by 256 spaces was missed: review 27).
+  char c = ' ';
+  while (f.getChar(&c) && std::isspace(static_cast<unsigned char>(c))) {
+  }
+  if (c != '{' || !f.seek(0)) return false;
   const QByteArray bytes = f.readAll();
   if (!bytes.contains("\"mfrview-session\"")) return false;
   const QJsonDocument doc = QJsonDocument::fromJson(bytes);

@@ -166,7 +166,7 @@ void MethodPanel::showThickness() {
   thickness_->setSpecialValueText(tr("default (%1)").arg(fallback, 0, 'g', 4));
   thickness_->setSingleStep(std::max(1.0e-6, fallback / 10.0));
   thickness_->setValue(model_.zThickness());
-  topLayout_->setRowVisible(thickness_, model_.operationOf(side_) == QLatin1String("zthickness"));
+  topLayout_->setRowVisible(thickness_, model_.effectiveOperationOf(side_) == QLatin1String("zthickness"));
 }
 
 QString MethodPanel::objectName(const QString& base) const {
@@ -180,7 +180,9 @@ void MethodPanel::syncMethodCombo() {
   // What "auto" runs now (a scene with a visible volume: "volume" for the methods with sorted lists).
   operationCombo_->setItemText(
       0, tr("auto — the method's own (now: %1)").arg(model_.resolvedOperation(side_, QStringLiteral("auto"))));
-  if (thickness_) topLayout_->setRowVisible(thickness_, model_.operationOf(side_) == QLatin1String("zthickness"));
+  // As the renderer resolves "auto" (kbuffer-zmerge's own is zthickness: its thickness row was hidden; review 28).
+  if (thickness_)
+    topLayout_->setRowVisible(thickness_, model_.effectiveOperationOf(side_) == QLatin1String("zthickness"));
   if (stepRow_) topLayout_->setRowVisible(stepRow_, model_.effectiveOperationOf(side_) == QLatin1String("volume"));
 }
 

@@ -41,6 +41,13 @@ RenderView::RenderView(ViewerModel& model, QWidget* parent) : QOpenGLWidget(pare
   // times per compare-mode view change: a review), and such a paint, asked for by nothing that
   // changes the picture, shows the frame there is (paintGL).
   setUpdateBehavior(QOpenGLWidget::PartialUpdate);
+  // A framebuffer made anew holds nothing. Qt makes one when the size changes (resizeGL follows)
+  // and when the window moves to a screen of another pixel ratio, where it calls no resizeGL: the
+  // next paint found its frame "drawn" and left the view empty (review 28).
+  connect(this, &QOpenGLWidget::resized, this, [this] {
+    framed_ = false;
+    update();
+  });
   setMinimumSize(160, 120);
   // Any change that alters the image schedules one repaint (Qt merges repeated requests).
   const auto repaint = [this](const char* reason) { return [this, reason] { requestFrame(reason); }; };

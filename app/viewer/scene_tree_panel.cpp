@@ -36,15 +36,39 @@
 namespace {
 
 // One step of the Scene dock's history: the looks of the parts an action changed, before and after.
+// Undo and redo put back only what the step changed — visibility, the colour (with the file's
+// vertex colours and a field colouring) and the opacity, each on its own — over the parts as they
+// are now: edits made since by others (the ghosting panel's opacities) stay. Putting back whole
+// looks undid those too, and undoing a colour reset the opacity (review 28).
 class PartsEdit final : public QUndoCommand {
  public:
   PartsEdit(ViewerModel& model, const QString& text, std::vector<ViewerModel::PartLook> before,
             std::vector<ViewerModel::PartLook> after)
       : QUndoCommand(text), model_(model), before_(std::move(before)), after_(std::move(after)) {}
-  void undo() override { model_.setPartLooks(before_); }
-  void redo() override { model_.setPartLooks(after_); }  // on push: the edit was made, nothing changes
+  void undo() override { apply(after_, before_); }
+  void redo() override { apply(before_, after_); }  // on push: the edit was made, nothing changes
 
  private:
+  void apply(const std::vector<ViewerModel::PartLook>& from, const std::vector<ViewerModel::PartLook>& to) {
+    QList<int> parts;
+    for (const ViewerModel::PartLook& look : to) parts.push_back(look.index);
+    std::vector<ViewerModel::PartLook> now = model_.partLooks(parts);
+    if (now.size() != to.size()) return;  // parts gone: a new scene clears the history first
+    for (std::size_t i = 0; i < to.size(); ++i) {
+      mfr::Material& material = now[i].material;
+      const mfr::Material &a = from[i].material, &b = to[i].material;
+      if (from[i].visible != to[i].visible) now[i].visible = to[i].visible;
+      if (glm::vec3(a.color) != glm::vec3(b.color) || a.vertexColors != b.vertexColors ||
+          a.fieldColors != b.fieldColors) {
+        material.color = glm::vec4(glm::vec3(b.color), material.color.a);
+        material.vertexColors = b.vertexColors;
+        material.fieldColors = b.fieldColors;
+      }
+      if (a.color.a != b.color.a) material.color.a = b.color.a;
+    }
+    model_.setPartLooks(now);
+  }
+
   ViewerModel& model_;
   std::vector<ViewerModel::PartLook> before_, after_;
 };

@@ -195,8 +195,9 @@ void ViewerModel::setZThickness(double thickness) {
   if (!std::isfinite(thickness) || thickness < 0.0 || thickness == thickness_) return;
   thickness_ = thickness;
   emit zThicknessChanged(thickness_);
+  // As the renderer resolves it: "auto" is zthickness for kbuffer-zmerge (review 28).
   for (int side = 0; side < kSides; ++side)
-    if (operationOf(side) == QLatin1String("zthickness")) emit sideChanged(side);
+    if (effectiveOperationOf(side) == QLatin1String("zthickness")) emit sideChanged(side);
 }
 
 double ViewerModel::zThicknessDefault() const {

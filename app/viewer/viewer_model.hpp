@@ -293,10 +293,7 @@ class ViewerModel final : public ViewerContext {
     int index = -1;
     bool visible = true;
     mfr::Material material;
-    bool operator==(const PartLook& other) const {
-      return index == other.index && visible == other.visible && material.color == other.material.color &&
-             material.vertexColors == other.material.vertexColors && material.fieldColors == other.material.fieldColors;
-    }
+    bool operator==(const PartLook&) const = default;
   };
   [[nodiscard]] std::vector<PartLook> partLooks(const QList<int>& indices) const;
   void setPartLooks(const std::vector<PartLook>& looks);

@@ -872,6 +872,14 @@ class ViewerTest : public QObject {
     const QString likeAModel = dir.filePath("k.gltf");
     QVERIFY(QFile::copy(sessionPath, likeAModel));
     QVERIFY(MainWindow::isSessionFile(likeAModel));
+    // However much white space comes first (the first 256 bytes were looked at: review 27).
+    const QString indented = dir.filePath("indented.json");
+    {
+      QFile from(sessionPath), to(indented);
+      QVERIFY(from.open(QIODevice::ReadOnly) && to.open(QIODevice::WriteOnly));
+      to.write(QByteArray(300, ' ') + "\n\t" + from.readAll());
+    }
+    QVERIFY(MainWindow::isSessionFile(indented));
     const QString gltf = dir.filePath("empty.gltf");
     {
       QFile f(gltf);
@@ -934,6 +942,9 @@ class ViewerTest : public QObject {
     const auto back = qScopeGuard([&] { QDir::setCurrent(cwd); });
     QCOMPARE(runProgram(MFRVIEW, {"-session", "plain", "--screenshot", png}, &out), 2);
     QVERIFY2(out.contains("mfrview: -session plain: one dash is Qt's"), qPrintable(out));
+    // A word that names no file and is no session manager's id is a mistyped --session too (review 27).
+    QCOMPARE(runProgram(MFRVIEW, {"-session", "work", "--screenshot", png}, &out), 2);
+    QVERIFY2(out.contains("mfrview: -session work: one dash is Qt's"), qPrintable(out));
     // A session manager's own id goes to Qt: libSM's are "2" and a UUID (hyphens), Qt adds its key
     // (they were refused, so no desktop could restore the window; a review).
     const QString smId = QStringLiteral("23d0f1f03-288f-4d21-a140-1edd450bdbc2_1733598000_123456");
@@ -2327,6 +2338,23 @@ class ViewerTest : public QObject {
       if (supported) QCOMPARE(QString::fromStdString(m.stats().operation), QStringLiteral("zthickness"));
     }
     QVERIFY(m.supportsOperation(QStringLiteral("oracle"), QStringLiteral("zthickness")));
+    // kbuffer-zmerge's own operation is zthickness: on "auto" the method panel shows the Thickness
+    // row (it showed it only for an operation set to "zthickness"; review 28), and another
+    // thickness draws the view again.
+    auto* thicknessBox = w->findChild<QDoubleSpinBox*>(QStringLiteral("zThickness"));
+    QVERIFY(thicknessBox);
+    m.setMethod(QStringLiteral("oracle"));
+    m.setOperationOf(0, QStringLiteral("auto"));
+    m.setOperationOf(1, QStringLiteral("oit"));  // the hidden side B's zthickness would draw the view too
+    settle(m);
+    QVERIFY(!thicknessBox->isVisibleTo(thicknessBox->window()));
+    m.setMethod(QStringLiteral("kbuffer-zmerge"));
+    settle(m);
+    QCOMPARE(m.effectiveOperationOf(0), QStringLiteral("zthickness"));
+    QVERIFY(thicknessBox->isVisibleTo(thicknessBox->window()));
+    const quint64 drawn = m.framesRendered();
+    m.setZThickness(0.11);
+    QTRY_VERIFY_WITH_TIMEOUT(m.framesRendered() > drawn, kTimeoutMs);
   }
 
   // The Ghosting plugin on @intersect: the blend switch (picking an A-buffer for a method without
@@ -3985,6 +4013,13 @@ class ViewerTest : public QObject {
     QTRY_VERIFY(filter->hasFocus());
     settle(m);
     QCOMPARE(m.framesRendered(), focused);
+    // A repaint that nothing asked for draws nothing; a framebuffer made anew (Qt makes one when
+    // the window moves to a screen of another pixel ratio, calling no resizeGL) is drawn again.
+    w->view().update();
+    settle(m);
+    QCOMPARE(m.framesRendered(), focused);
+    emit w->view().resized();
+    QTRY_COMPARE_WITH_TIMEOUT(m.framesRendered(), focused + 1, kTimeoutMs);
   }
 
   // Fast navigation: while the camera is dragged, a slow method is drawn at a fraction of the
@@ -4325,6 +4360,16 @@ class ViewerTest : public QObject {
     QVERIFY(!m.scene().objects[5].visible);
     QVERIFY(!redo->isEnabled());
     QCOMPARE(undo->text(), QStringLiteral("Undo Hide tangle"));
+    // A step puts back only what it changed: an opacity set since by others (the ghosting panel
+    // sets opacities through ViewerContext, not as steps) stays when the hide is undone and redone
+    // (review 28: the whole look came back, opacity and all).
+    m.setObjectOpacity(5, 0.3);
+    undo->trigger();
+    QVERIFY(m.scene().objects[5].visible);
+    QCOMPARE(m.scene().objects[5].material.color.a, 0.3f);
+    redo->trigger();
+    QVERIFY(!m.scene().objects[5].visible);
+    QCOMPARE(m.scene().objects[5].material.color.a, 0.3f);
     disconnect(counting);
     // Fit the view to ring A: the camera looks at its box's centre from nearer than fit all, in
     // the same direction; near and far still hold the whole scene.

@@ -822,6 +822,23 @@ TEST_F(Cli, InfoReportsTrianglesAndHistogram) {
   EXPECT_NE(r.out.find("n=7: 1024 pixels"), std::string::npos) << r.out;  // every pixel has 7 layers
 }
 
+// The bounds are printed with the digits their size needs: a unit box 1e7 from the origin read
+// [1e+07, …] – [1e+07, …], its min equal to its max (hunt 31); an ordinary scene reads as before.
+TEST_F(Cli, InfoPrintsBoundsWithTheDigitsTheyNeed) {
+  const fs::path far = write("far.mfrscene", R"({"objects": [{"primitive": {"type": "box"},
+      "transform": {"translate": [10000000, -20000000, 0.25]}}]})");
+  CliResult r = runCli("info " + far.string() + " --size 16x16");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("bounds     [9999999.5, -20000000.5, -0.25] – [10000000.5, -19999999.5, 0.75]"),
+            std::string::npos)
+      << r.out;
+  const fs::path near = write("near.mfrscene", R"({"objects": [{"primitive": {"type": "box"},
+      "transform": {"translate": [0.125, 3, 0.25]}}]})");
+  r = runCli("info " + near.string() + " --size 16x16");
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("bounds     [-0.375, 2.5, -0.25] – [0.625, 3.5, 0.75]"), std::string::npos) << r.out;
+}
+
 // `info --methods`: every method -m takes, where it runs and its parameters, as text and JSON
 // (--json wrote nothing without a scene; the text was bare names).
 TEST_F(Cli, InfoListsMethodsWithTheirParameters) {

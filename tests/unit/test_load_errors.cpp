@@ -464,14 +464,15 @@ TEST_F(LoadModel, GarbageVtp) {
   expectLoadError(write("cut.vtp", whole.substr(0, whole.size() * 3 / 4)), "truncated: a VTK XML file ends with");
   // Component counts VTK allocates before it reads a value (fuzzing: 2^32 − 1 spun for minutes in
   // vtkXMLReader::CreateArray, 2^31 − 1 took 12 GB, −1 came out as "vector::_M_default_append").
-  for (const char* count : {"4294967295", "-1", "0", "3x"}) {
+  for (const char* count : {"4294967295", "-1", "0", "3x", "3.5", "1e3", "+-3", "99999999999999999999"}) {
     std::string bad = whole;
     bad.replace(bad.find("NumberOfComponents=\"3\""), 22, std::string("NumberOfComponents=\"") + count + "\"");
     expectLoadError(write("components.vtp", bad), std::string("an unnamed DataArray's NumberOfComponents=\"") + count +
                                                       "\" is not a count in [1, 4096]");
   }
-  // As VTK reads them: spaces and "3.0" are 3; a commented-out DataArray declares nothing (a review).
-  for (const char* count : {" 3", "3.0", "3 "}) {
+  // As VTK reads them: spaces, "+3" and "3.0" are 3 (review 28: "+3" was refused); a
+  // commented-out DataArray declares nothing (a review).
+  for (const char* count : {" 3", "3.0", "3 ", "+3", "3."}) {
     std::string spelled = whole;
     spelled.replace(spelled.find("NumberOfComponents=\"3\""), 22, std::string("NumberOfComponents=\"") + count + "\"");
     EXPECT_EQ(mfr::loadModel(write("spelled.vtp", spelled)).at(0).mesh->triangleCount(), 1u) << count;

@@ -128,9 +128,10 @@ std::shared_ptr<Texture> GpuScene::fieldGrid(const VolumeGrid* grid) const {
 }
 
 FrameUniforms GpuScene::relativeFrame(const glm::dmat4& viewProj, const std::optional<Bounds>& clipBox,
-                                      const glm::dvec3& eye) {
+                                      const glm::dvec3& origin) {
   FrameUniforms frame;
-  frame.origin = std::isfinite(eye.x) && std::isfinite(eye.y) && std::isfinite(eye.z) ? eye : glm::dvec3(0.0);
+  frame.origin =
+      std::isfinite(origin.x) && std::isfinite(origin.y) && std::isfinite(origin.z) ? origin : glm::dvec3(0.0);
   frame.viewProj = glm::mat4(viewProj * glm::translate(glm::dmat4(1.0), frame.origin));
   if (clipBox) {
     frame.clip = true;
@@ -157,7 +158,7 @@ void GpuScene::draw(const Program& program, const FrameUniforms& frame) const {
   }
   for (const DrawItem& item : items_) {
     const GpuMesh& m = *meshes_[item.mesh];
-    glm::dmat4 model = item.model;  // world → relative to the eye: a translation, in double
+    glm::dmat4 model = item.model;  // world → relative to frame.origin: a translation, in double
     model[3] -= glm::dvec4(frame.origin, 0.0);
     program.set("uModel", glm::mat4(model));
     program.set("uNormalMatrix", item.normalMatrix);

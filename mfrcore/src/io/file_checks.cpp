@@ -179,17 +179,20 @@ std::string vtkXmlAttribute(std::string_view tag, std::string_view key) {
 
 void checkVtkXmlDataArray(std::string_view tag, long long maxComponents, long long maxTuples, std::uintmax_t fileBytes,
                           const std::string& name) {
-  // A whole number as VTK reads one (surrounding spaces, "3.0"); a sign, a fraction or garbage is not.
+  // A whole number as VTK reads one (istream >>: surrounding spaces, a '+', "3.0"). A '-', a
+  // fraction, an exponent or other garbage after the digits is refused, though VTK would read the
+  // digits before it ("3.5" and "3x" as 3, "1e3" as 1): such a file is damaged (review 28).
   const auto whole = [](const std::string& text, long long& value) {
-    const std::size_t first = text.find_first_not_of(" \t\r\n"), last = text.find_last_not_of(" \t\r\n");
-    if (first == std::string::npos || text[first] == '-' || text[first] == '+') return false;
-    double number = 0.0;
-    const auto [end, ec] = std::from_chars(text.data() + first, text.data() + last + 1, number);
-    if (ec != std::errc() || end != text.data() + last + 1 || !(number >= 0.0 && number <= 9.0e18) ||
-        number != std::floor(number))
-      return false;
-    value = static_cast<long long>(number);
-    return true;
+    std::size_t first = text.find_first_not_of(" \t\r\n");
+    const std::size_t last = text.find_last_not_of(" \t\r\n");
+    if (first == std::string::npos) return false;
+    if (text[first] == '+') ++first;
+    const char* const end = text.data() + last + 1;
+    const auto [digitsEnd, ec] = std::from_chars(text.data() + first, end, value);
+    if (ec != std::errc() || text[first] == '-' || text[first] == '+') return false;
+    if (digitsEnd == end) return true;
+    // "3.0", "3.": a point and zeros only.
+    return *digitsEnd == '.' && std::all_of(digitsEnd + 1, end, [](char c) { return c == '0'; });
   };
   const auto array = [&] {
     const std::string named = vtkXmlAttribute(tag, "Name");

@@ -13,6 +13,8 @@
 #include <optional>
 #include <sstream>
 #include <stdexcept>
+#include <streambuf>
+#include <string_view>
 
 #include <log4cplus/appender.h>
 #include <log4cplus/logger.h>
@@ -27,7 +29,33 @@
 #include "volume_loader.hpp"
 
 namespace mfr::io {
+
 namespace {
+
+// An input stream's buffer over bytes held elsewhere: the child's grid is read where it lies (a
+// std::istringstream of it copied the sparse grid, twice its size at the peak: review 28).
+class SpanBuffer final : public std::streambuf {
+ public:
+  explicit SpanBuffer(std::string_view bytes) {
+    // The get area is only read: std::streambuf's pointers are not const.
+    char* const begin = const_cast<char*>(bytes.data());
+    setg(begin, begin, begin + bytes.size());
+  }
+
+ protected:
+  pos_type seekoff(off_type offset, std::ios_base::seekdir from, std::ios_base::openmode which) override {
+    if ((which & std::ios_base::in) == 0) return pos_type(off_type(-1));
+    const off_type size = egptr() - eback();
+    const off_type base = from == std::ios_base::beg ? 0 : from == std::ios_base::cur ? gptr() - eback() : size;
+    const off_type to = base + offset;
+    if (to < 0 || to > size) return pos_type(off_type(-1));
+    setg(eback(), eback() + to, egptr());
+    return pos_type(to);
+  }
+  pos_type seekpos(pos_type position, std::ios_base::openmode which) override {
+    return seekoff(off_type(position), std::ios_base::beg, which);
+  }
+};
 
 namespace fs = std::filesystem;
 
@@ -299,7 +327,8 @@ Volume readOpenVdb(const fs::path& path, const std::string& name, const std::str
     if (notes != nullptr) notes->push_back(std::move(note));
   }
   ensureOpenVdb();
-  std::istringstream grid(std::string(in.rest()), std::ios::binary);
+  SpanBuffer buffer(in.rest());
+  std::istream grid(&buffer);
   const openvdb::GridPtrVecPtr grids = openvdb::io::Stream(grid, false).getGrids();
   if (!grids || grids->size() != 1) throw std::logic_error("readOpenVdb: no grid from its child");
   read.grid = grids->front();

@@ -20,7 +20,8 @@
 namespace mfr::gl {
 
 struct FrameUniforms {
-  // The world point the GPU's coordinates are relative to: the eye. viewProj and clipMin/clipMax
+  // The world point the GPU's coordinates are relative to: a point of the view axis where what is
+  // seen is drawn finest (GpuRenderer's floatOrigin). viewProj and clipMin/clipMax
   // are relative to it (GpuScene::relativeFrame), and so is each part's model matrix (draw()).
   glm::dvec3 origin{0.0};
   glm::mat4 viewProj{1.0f};
@@ -52,13 +53,14 @@ class GpuScene {
   // null: the renderer's volume operation uses it rather than upload the grid twice.
   [[nodiscard]] std::shared_ptr<Texture> fieldGrid(const VolumeGrid* grid) const;
   // `viewProj` (world → clip, double) and the scene's clip box as draw() needs them: relative to
-  // `eye`, in float. Positions far from the world's origin (survey coordinates, 1e6 and beyond)
+  // `origin`, in float. Positions far from the world's origin (survey coordinates, 1e6 and beyond)
   // lost their float precision in the view transform: a unit cube at 1e7 was RMSE 0.16 from the
   // oracle (a bug hunt); relative to the scene's centre, a part 1e-4 in size 40 units from it, or
-  // beside the eye of a scene reaching 1e6 away, was drawn jagged and mis-sorted (hunt 31). What
-  // the GPU computes in float is then small wherever the eye looks.
+  // beside the eye of a scene reaching 1e6 away, was drawn jagged and mis-sorted (hunt 31). The
+  // renderer takes the origin on the view axis where what is seen is drawn finest
+  // (GpuRenderer's floatOrigin), so what the GPU computes in float is small where it matters.
   [[nodiscard]] static FrameUniforms relativeFrame(const glm::dmat4& viewProj, const std::optional<Bounds>& clipBox,
-                                                   const glm::dvec3& eye);
+                                                   const glm::dvec3& origin);
 
  private:
   struct GpuMesh {

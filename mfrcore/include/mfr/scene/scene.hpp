@@ -35,6 +35,7 @@ struct Material {
   // Set: the colour map of the mesh's scalars replaces `color`'s RGB and the vertex colours;
   // `color.a` stays the opacity.
   std::optional<FieldColors> fieldColors;
+  bool operator==(const Material&) const = default;
 };
 
 struct Object {
