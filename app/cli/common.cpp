@@ -425,6 +425,10 @@ std::optional<ContourLegend> ContourOptions::apply(Scene& scene, double sceneOpa
   request.opacity = static_cast<float>(opacity >= 0.0 ? opacity : sceneOpacity >= 0.0 ? sceneOpacity : 0.5);
   addContours(scene, request, what);
   Volume& volume = scene.volumes[request.volume];
+  // Kept hidden, it is not drawn: a --keep-volume that changes nothing is refused (hunt 32).
+  if (keepVolume && !volume.visible)
+    throw Error("--keep-volume", "scene '" + scene.name + "' hides volume '" + volume.name +
+                                     "' (\"visible\": false): there is nothing to keep drawing");
   if (!keepVolume) volume.visible = false;
   const glm::dvec2 range = contourColorRange(request.values, glm::dvec2(volume.grid->range()));
   return ContourLegend{{volume.name, "cool-warm", range}, request.values};

@@ -183,7 +183,10 @@ Session captureSession(const ViewerModel& model) {
   s.clip = model.clipBox();
   s.hasSection = true;
   s.section = model.section();
-  s.hasColorBy = true;
+  // One colouring is saved, for every part that has its field: the Colour by chosen. Colourings as
+  // the scene file gave them, which may differ per part, are left to it (hunt 32: the first part's
+  // colouring came back on every part).
+  s.hasColorBy = !model.fieldColoringsAsLoaded();
   s.colorBy = model.fieldColoring();
   for (std::size_t i = 0; i < model.scene().volumes.size(); ++i) {
     const mfr::Volume& v = model.scene().volumes[i];
@@ -426,10 +429,13 @@ QJsonObject sessionToJson(const Session& s) {
                                   {"caps", s.section->caps},
                                   {"slice", s.section->slice}})
                             : QJsonValue(QJsonValue::Null)},
-      {"color_by", s.colorBy ? QJsonValue(QJsonObject{{"field", QString::fromStdString(s.colorBy->field)},
-                                                      {"map", QString::fromStdString(s.colorBy->map)},
-                                                      {"range", QJsonArray{s.colorBy->range.x, s.colorBy->range.y}}})
-                             : QJsonValue(QJsonValue::Null)}};
+  };
+  if (s.hasColorBy)
+    json.insert("color_by", s.colorBy
+                                ? QJsonValue(QJsonObject{{"field", QString::fromStdString(s.colorBy->field)},
+                                                         {"map", QString::fromStdString(s.colorBy->map)},
+                                                         {"range", QJsonArray{s.colorBy->range.x, s.colorBy->range.y}}})
+                                : QJsonValue(QJsonValue::Null));
   if (s.molecule) json.insert("molecule", QString::fromStdString(s.molecule->text()));
   return json;
 }

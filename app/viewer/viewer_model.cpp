@@ -461,6 +461,12 @@ QString ViewerModel::setIsosurfacesAt(int index, const std::vector<double>& valu
     } catch (const std::exception& e) {
       return QString::fromUtf8(e.what());
     }
+    // Nor one the scene file made ("contours"): two coincident parts of one name (hunt 32).
+    for (const mfr::Object& part : scratch.objects)
+      for (std::size_t i = 0; i < loadedPartCount_ && i < scene_.objects.size(); ++i)
+        if (scene_.objects[i].name == part.name)
+          return tr("scene '%1' has isosurface '%2' already")
+              .arg(QString::fromStdString(scene_.name), QString::fromStdString(part.name));
     next.parts = std::move(scratch.objects);
   }
   set = std::move(next);
@@ -491,6 +497,17 @@ void ViewerModel::spliceIsosurfaces() {
   std::map<std::string, Edited> edited;
   for (std::size_t i = base; i < scene_.objects.size() && i < loadedMaterials_.size(); ++i)
     edited[scene_.objects[i].name] = {loadedMaterials_[i], scene_.objects[i].material, scene_.objects[i].visible};
+  // A colouring by a field the user chose (Colour by: every part that has the field) covers the new
+  // parts too, as mfr render --color-by does: the colouring of a part that differs from the one it
+  // was loaded or made with. A scene file's colourings of its own parts stay theirs, and the new
+  // parts are coloured by value, as mfr render --contour does (hunt 32: the first part's colouring
+  // was laid on every part, another map on the second bearing and on the isosurfaces).
+  std::optional<mfr::FieldColors> chosen;
+  for (std::size_t i = 0; i < scene_.objects.size() && i < loadedMaterials_.size(); ++i)
+    if (scene_.objects[i].material.fieldColors != loadedMaterials_[i].fieldColors) {
+      chosen = scene_.objects[i].material.fieldColors;  // none: the user took the colouring off
+      break;
+    }
   scene_.objects.resize(base);
   loadedMaterials_.resize(base);
   loadedMeshes_.resize(base);
@@ -510,12 +527,16 @@ void ViewerModel::spliceIsosurfaces() {
   }
   updateSceneGeometry();
   emit partsChanged();
-  // A colouring by a field covers the new parts too.
-  std::optional<mfr::FieldColors> shown;
-  for (std::size_t i = 0; i < base && !shown; ++i) shown = scene_.objects[i].material.fieldColors;
-  if (!shown ||
-      !setFieldColoring(QString::fromStdString(shown->field), QString::fromStdString(shown->map), shown->range))
+  if (!chosen ||
+      !setFieldColoring(QString::fromStdString(chosen->field), QString::fromStdString(chosen->map), chosen->range))
     sceneEdited();
+}
+
+bool ViewerModel::fieldColoringsAsLoaded() const {
+  if (loadedMaterials_.size() != scene_.objects.size()) return false;
+  for (std::size_t i = 0; i < scene_.objects.size(); ++i)
+    if (scene_.objects[i].material.fieldColors != loadedMaterials_[i].fieldColors) return false;
+  return true;
 }
 
 void ViewerModel::setVolumeVisible(bool visible) {

@@ -304,6 +304,9 @@ class ViewerModel final : public ViewerContext {
   // range over the parts that have it.
   [[nodiscard]] QStringList surfaceFields() const;
   [[nodiscard]] std::optional<mfr::FieldColors> fieldColoring() const;
+  // Every part is coloured by a field as it was loaded or made (a scene file's own colourings, which
+  // may differ per part; none): a session need not say, and the scene file brings them back.
+  [[nodiscard]] bool fieldColoringsAsLoaded() const;
   // What the colour legend shows (the view's corner, Export Image): the field colouring's map; else
   // the current volume's isosurfaces' — cool-warm over contourColorRange, ticked at their values, as
   // mfr render --contour … --legend draws it; else nothing.

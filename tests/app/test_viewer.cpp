@@ -5296,6 +5296,49 @@ class ViewerTest : public QObject {
     for (int id = 0; id < parts->count(); ++id) QCOMPARE(parts->item(id)->checkState(), Qt::Unchecked);
   }
 
+  // A scene file's own colourings by a field, another map per part, stay theirs when isosurfaces
+  // are added (the first part's was laid on every part and on the isosurfaces) and when a session
+  // is saved and reopened (the first part's came back on every part): the pixels of mfr render
+  // (hunt 32).
+  void sceneFileColouringsStayTheirs() {
+    QTemporaryDir dir;
+    QVERIFY(writeTwoArrayVti(
+        dir.filePath("v.vti"), "a", [](int i, int j, int k) { return i + j + k; }, "b",
+        [](int i, int, int) { return i; }));
+    const QString scene = dir.filePath("s.mfrscene");
+    {
+      QFile f(scene);
+      QVERIFY(f.open(QIODevice::WriteOnly));
+      f.write(R"({"objects": [
+        {"name": "p", "primitive": {"type": "sphere", "radius": 0.25}, "transform": {"translate": [0.3, 0.55, 0.55]},
+         "color_by": {"field": "@v", "map": "viridis", "range": [0, 33]}, "opacity": 0.6},
+        {"name": "q", "primitive": {"type": "sphere", "radius": 0.25}, "transform": {"translate": [0.8, 0.55, 0.55]},
+         "color_by": {"field": "@v", "map": "magma", "range": [0, 33]}, "opacity": 0.6}],
+       "volumes": [{"name": "v", "file": "v.vti", "visible": false}]})");
+    }
+    const QStringList common{"--size", "96x72", "--view", "iso", "-m", "abuffer-ll"};
+    const QString cli = dir.filePath("cli.png"), viewer = dir.filePath("viewer.png"), plain = dir.filePath("plain.png");
+    QString out;
+    QCOMPARE(runProgram(MFR_CLI, QStringList{"render", scene, "--contour", "16.5", "-o", cli} + common, &out), 0);
+    QCOMPARE(runProgram(MFRVIEW, QStringList{scene, "--contour", "16.5", "--screenshot", viewer} + common, &out), 0);
+    QCOMPARE(maxChannelDifference(mfr::readPng(cli.toStdString()), mfr::readPng(viewer.toStdString())), 0);
+    QCOMPARE(runProgram(MFR_CLI, QStringList{"render", scene, "-o", plain} + common, &out), 0);
+    const mfr::ImageRGBA8 expected = mfr::readPng(plain.toStdString());
+    QVERIFY(maxChannelDifference(expected, mfr::readPng(cli.toStdString())) > 20);  // the isosurface shows
+    auto w = openWindow(scene);
+    QVERIFY(w);
+    const QSize size(96, 72);
+    QVERIFY(showAbufferIso(*w, size));
+    QCOMPARE(maxChannelDifference(expected, w->view().renderImage(size)), 0);
+    auto again = reopenedSession(*w, dir.filePath("s.mfrsession"), size);
+    QVERIFY(again);
+    ViewerModel& a = again->model();
+    QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.scene().objects.size() == 2, kTimeoutMs);
+    settle(a);
+    QCOMPARE(maxChannelDifference(expected, again->view().renderImage(size)), 0);
+    QVERIFY(a.scene().objects[1].material.fieldColors && a.scene().objects[1].material.fieldColors->map == "magma");
+  }
+
   void isosurfaces() {
     // The Volume panel's Isosurfaces: parts "field = V" in the scene tree, the volume hidden, the
     // pixels of mfr render --contour; refusals leave the scene as it was; sessions keep them.

@@ -923,6 +923,28 @@ TEST_F(Cli, InfoMeasuresEachPartsSurface) {
   EXPECT_NE(measured.out.find("area 0: no surface (every triangle is degenerate)"), std::string::npos) << measured.out;
 }
 
+// A sphere cut through a ring of its vertices (sectionMesh cuts 10⁻⁶ of its size further in) is
+// closed by its cap, whichever side is kept, and holds half the sphere's volume: welding at 10⁻⁶
+// alone also merged the slivers beside the ring, and it read "not closed (24 boundary edges)"
+// (hunt 32).
+TEST_F(Cli, InfoMeasuresASphereCutThroughARingOfItsVertices) {
+  const fs::path scene = write("ball.mfrscene", R"({"objects": [{"primitive": {"type": "sphere", "radius": 1}}]})");
+  const fs::path json = dir() / "ball.json";
+  ASSERT_EQ(runCli("info " + scene.string() + " --no-histogram --json " + json.string()).exitCode, 0);
+  const double whole = nlohmann::json::parse(mfr::readFile(json))["part_list"][0]["volume"].get<double>();
+  EXPECT_NEAR(whole, 4.0 / 3.0 * 3.14159265358979, 0.05);  // a tessellated unit sphere
+  for (const char* section : {"x=0", "-x=0", "z=0", "-z=0", "y=0"}) {
+    SCOPED_TRACE(section);
+    const CliResult r =
+        runCli("info " + scene.string() + " --no-histogram --section=" + section + " --json " + json.string());
+    ASSERT_EQ(r.exitCode, 0) << r.out;
+    const nlohmann::json part = nlohmann::json::parse(mfr::readFile(json))["part_list"][0];
+    EXPECT_EQ(part["section"], "capped");
+    ASSERT_TRUE(part["volume"].is_number()) << r.out;
+    EXPECT_NEAR(part["volume"].get<double>(), whole / 2.0, 1e-3 * whole) << r.out;
+  }
+}
+
 // With a section (--section, or the scene file's own) parts are measured as cut: a capped solid is
 // closed, with the volume kept and the cap's area as its cross-section; a part on the cut-away side
 // is removed, with nothing to measure.
@@ -1322,7 +1344,10 @@ TEST_F(Cli, VariableKBuffersUnderOitKeepNoExactTail) {
     ASSERT_EQ(runCli(common + " -p budget_mib=" + std::to_string(mib + 0.01) + " --stats " + json).exitCode, 0);
     const nlohmann::json atExact = nlohmann::json::parse(mfr::readFile(json));
     EXPECT_EQ(atExact["fragments_stored"], atExact["fragments_generated"]) << atExact.dump();
-    EXPECT_LT(mfr::rmse(mfr::readPng(png), mfr::readPng(exact)), 1e-6);
+    // Every fragment held, as abuffer-ll holds them: at most a triangle edge's pixel, where one
+    // surface is rasterised twice and the copies tie, may sum them in another order (1/255 at one
+    // pixel: RMSE 2.7e-5; the bug was 40/255).
+    EXPECT_LT(mfr::rmse(mfr::readPng(png), mfr::readPng(exact)), 1e-4);
     for (const std::string value : {"true", "1", "on"}) {  // every spelling Params reads as true
       const CliResult asked = runCli(common + " -p exact_tail=" + value);
       EXPECT_EQ(asked.exitCode, 1) << asked.out;

@@ -197,6 +197,27 @@ TEST_F(CliContour, BadInputIsOneLine) {
   expectCleanFailure("render @volume --contour-opacity 0.5", "--contour-opacity: needs --contour");
   expectCleanFailure("render @volume --keep-volume", "--keep-volume: needs --contour");
   expectCleanFailure("render @volume --contour 0.5 --contour-opacity 2", "--contour-opacity");
+  // A value the scene file's "contours" has already (two coincident parts of one name), and
+  // --keep-volume where the scene file hides the volume (it was taken and changed nothing): hunt 32.
+  writeTwoVolumeScene(dir());
+  {
+    std::ofstream scene(dir() / "own.mfrscene");
+    scene << R"({"name": "own", "volumes": [{"file": "ramp.vtk", "name": "a", "contours": [1.5, 2.5]}]})";
+    std::ofstream hidden(dir() / "hidden.mfrscene");
+    hidden << R"({"name": "hidden", "objects": [{"primitive": {"type": "box"}, "transform": {"translate": [5, 0, 0]}}],
+                 "volumes": [{"file": "ramp.vtk", "name": "a", "visible": false}]})";
+  }
+  expectCleanFailure("render " + (dir() / "own.mfrscene").string() + " --contour 2.5",
+                     "--contour 2.5: scene 'own' has isosurface 'a = 2.5' already");
+  const CliResult other = runCli("info " + (dir() / "own.mfrscene").string() + " --contour 2 --no-histogram");
+  EXPECT_EQ(other.exitCode, 0) << other.out;
+  EXPECT_NE(other.out.find("parts      3"), std::string::npos) << other.out;
+  expectCleanFailure("render " + (dir() / "hidden.mfrscene").string() + " --contour 2 --keep-volume",
+                     "--keep-volume: scene 'hidden' hides volume 'a' (\"visible\": false): there is nothing to keep "
+                     "drawing");
+  const CliResult plain = runCli("render " + (dir() / "hidden.mfrscene").string() + " --contour 2 -s 16x16 -o " +
+                                 (dir() / "plain.png").string());
+  EXPECT_EQ(plain.exitCode, 0) << plain.out;
 }
 
 }  // namespace

@@ -162,6 +162,12 @@ std::vector<std::size_t> addContours(Scene& scene, const ContourRequest& request
                               ? shortNumberText(request.values[i]) + " is given twice"
                               : "values " + numberText(request.values[j]) + " and " + numberText(request.values[i]) +
                                     " are one isosurface to 6 digits: give values that differ there");
+  // Nor may a value repeat an isosurface the scene has (a scene file's "contours"): two parts of one
+  // name, coincident (hunt 32).
+  for (const double value : request.values)
+    for (const Object& o : scene.objects)
+      if (o.name == contourPartName(volume.name, value))
+        throw Error(what, "scene '" + scene.name + "' has isosurface '" + o.name + "' already");
   const glm::vec2 colourRange(contourColorRange(request.values, glm::dvec2(range)));
   // Every surface is made before the scene is touched, so that a failure leaves it as it was.
   std::vector<Object> parts;
