@@ -184,6 +184,13 @@ void addInfo(CLI::App& app) {
     j["parts"] = scene.objects.size();
     j["triangles"] = scene.triangleCount();
     j["bounds"] = {{"min", {b.min.x, b.min.y, b.min.z}}, {"max", {b.max.x, b.max.y, b.max.z}}};
+    // A scene file's clip box: the histogram counts what it keeps, the measures are of whole parts;
+    // said, as the section is (it was not: hunt 32).
+    j["clip"] =
+        scene.clipBox
+            ? nlohmann::ordered_json{{"min", {scene.clipBox->min.x, scene.clipBox->min.y, scene.clipBox->min.z}},
+                                     {"max", {scene.clipBox->max.x, scene.clipBox->max.y, scene.clipBox->max.z}}}
+            : nlohmann::ordered_json(nullptr);
     j["views"] = scene.viewNames();
     // A molecule: its atoms and bonds as drawn (the first model, the first alternative locations).
     // A file whose bonds cannot be found (atoms packed denser than any molecule) still loads as
@@ -277,7 +284,12 @@ void addInfo(CLI::App& app) {
     std::cout << "scene      " << scene.name << "\nparts      " << scene.objects.size()
               << (hidden > 0 ? " (" + std::to_string(hidden) + " hidden)" : std::string()) << "\ntriangles  "
               << scene.triangleCount() << (hidden > 0 || section.removed > 0 ? " (of the visible parts)" : "")
-              << "\nbounds     " << boundsText(b) << "\nviews     ";
+              << "\nbounds     " << boundsText(b)
+              << (scene.clipBox
+                      ? "\nclip       " + boundsText(*scene.clipBox) +
+                            " (the scene file's: the histogram counts what it keeps; parts are measured whole)"
+                      : std::string())
+              << "\nviews     ";
     for (const std::string& v : scene.viewNames()) std::cout << " " << v;
     std::cout << "\n";
     if (!bondsError.empty()) std::cout << "molecule   atoms and bonds not counted: " << bondsError << "\n";

@@ -923,6 +923,28 @@ TEST_F(Cli, InfoMeasuresEachPartsSurface) {
   EXPECT_NE(measured.out.find("area 0: no surface (every triangle is degenerate)"), std::string::npos) << measured.out;
 }
 
+// A scene file's clip box is said, with what it does to the report (nothing said it: hunt 32), in
+// the text and in the JSON (null without one).
+TEST_F(Cli, InfoSaysTheScenesClipBox) {
+  const fs::path clipped = write("clipped.mfrscene", R"({"objects": [{"primitive": {"type": "sphere", "radius": 1}}],
+      "clip": {"min": [-2, -2, -2], "max": [0.5, 2, 2]}})");
+  const fs::path json = dir() / "clip.json";
+  CliResult r = runCli("info " + clipped.string() + " -s 16x16 --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("\nclip       [-2, -2, -2] – [0.5, 2, 2] (the scene file's: the histogram counts what it "
+                       "keeps; parts are measured whole)\n"),
+            std::string::npos)
+      << r.out;
+  nlohmann::json j = nlohmann::json::parse(mfr::readFile(json));
+  EXPECT_EQ(j["clip"]["max"][0], 0.5);
+  const fs::path whole = write("whole.mfrscene", R"({"objects": [{"primitive": {"type": "sphere", "radius": 1}}]})");
+  r = runCli("info " + whole.string() + " -s 16x16 --json " + json.string());
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_EQ(r.out.find("clip "), std::string::npos) << r.out;
+  j = nlohmann::json::parse(mfr::readFile(json));
+  EXPECT_TRUE(j["clip"].is_null());
+}
+
 // A sphere cut through a ring of its vertices (sectionMesh cuts 10⁻⁶ of its size further in) is
 // closed by its cap, whichever side is kept, and holds half the sphere's volume: welding at 10⁻⁶
 // alone also merged the slivers beside the ring, and it read "not closed (24 boundary edges)"
