@@ -130,6 +130,24 @@ void addRender(CLI::App& app) {
           legend = ContourLegend{*o.material.fieldColors, {}};
           break;
         }
+      // One bar keys one colouring: parts coloured otherwise (a scene file's per-part color_by)
+      // are said, not passed over (hunt 32).
+      if (legend) {
+        std::vector<std::string> others;
+        for (const Object& o : scene.objects)
+          if (o.material.fieldColors && *o.material.fieldColors != legend->colors) {
+            const FieldColors& c = *o.material.fieldColors;
+            const std::string text = "'" + o.name + "' (" + c.field + ", " + c.map + ")";
+            if (std::find(others.begin(), others.end(), text) == others.end()) others.push_back(text);
+          }
+        if (!others.empty()) {
+          std::string list;
+          for (std::size_t i = 0; i < others.size() && i < 3; ++i) list += (i > 0 ? ", " : "") + others[i];
+          if (others.size() > 3) list += ", … (" + std::to_string(others.size()) + " parts)";
+          std::cerr << "note: --legend: the bar keys " << legend->colors.field << " (" << legend->colors.map
+                    << "); also coloured otherwise: " << list << "\n";
+        }
+      }
       if (!legend) legend = contourLegend;
       if (!legend)
         throw Error("--legend",

@@ -184,6 +184,31 @@ TEST_F(CliContour, LegendShowsTheIsosurfacesMapInTheCorner) {
   expectCleanFailure("render @volume --legend", "and there is no --contour");
 }
 
+// One bar keys one colouring: parts a scene file colours by another map are said in a note (the
+// bar showed the first part's map without a word: hunt 32).
+TEST_F(CliContour, LegendNotesPartsColouredOtherwise) {
+  writeTwoVolumeScene(dir());
+  const auto scene = [&](const std::string& name, const std::string& secondMap) {
+    std::ofstream out(dir() / name);
+    out << R"({"objects": [
+      {"name": "p", "primitive": {"type": "box"}, "color_by": {"field": "@a", "map": "viridis", "range": [0, 4]}},
+      {"name": "q", "primitive": {"type": "box"}, "transform": {"translate": [0, 0, 0.5]},
+       "color_by": {"field": "@a", "map": ")" +
+               secondMap + R"(", "range": [0, 4]}}],
+      "volumes": [{"file": "ramp.vtk", "name": "a", "visible": false}]})";
+    return (dir() / name).string();
+  };
+  const std::string png = (dir() / "l.png").string();
+  CliResult r = runCli("render " + scene("two.mfrscene", "magma") + " --legend -s 120x96 -o " + png);
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_NE(r.out.find("note: --legend: the bar keys @a (viridis); also coloured otherwise: 'q' (@a, magma)\n"),
+            std::string::npos)
+      << r.out;
+  r = runCli("render " + scene("one.mfrscene", "viridis") + " --legend -s 120x96 -o " + png);
+  ASSERT_EQ(r.exitCode, 0) << r.out;
+  EXPECT_EQ(r.out.find("note:"), std::string::npos) << r.out;
+}
+
 TEST_F(CliContour, BadInputIsOneLine) {
   expectCleanFailure("render @volume --contour abc", "--contour abc: 'abc' is not a number");
   expectCleanFailure("render @volume --contour 0.3,", "--contour 0.3,");
