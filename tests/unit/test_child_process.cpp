@@ -83,6 +83,18 @@ TEST(ChildProcess, ErrorsAndCrashesAreOneLine) {
             "in.fmt: cannot read fmt: the library crashed (Segmentation fault; corrupt or truncated file?)");
   EXPECT_EQ(errorOf([](const LoadProgress&) -> std::string { std::abort(); }),
             "in.fmt: cannot read fmt: the library crashed (Aborted; corrupt or truncated file?)");
+  // Killed from outside (the out-of-memory killer's SIGKILL) or stopped: not blamed on the file.
+  EXPECT_EQ(errorOf([](const LoadProgress&) -> std::string {
+              std::raise(SIGKILL);
+              return "";
+            }),
+            "in.fmt: cannot read fmt: the process reading it with the library was stopped from outside (Killed: by "
+            "the system when memory ran out, or by another program)");
+  EXPECT_EQ(errorOf([](const LoadProgress&) -> std::string {
+              std::raise(SIGTERM);
+              return "";
+            }),
+            "in.fmt: cannot read fmt: the process reading it with the library was stopped from outside (Terminated)");
   EXPECT_EQ(errorOf([](const LoadProgress&) -> std::string { _exit(3); }),
             "in.fmt: cannot read fmt: the library ended without a result (corrupt or truncated file?)");
 }

@@ -285,6 +285,15 @@ std::optional<std::string> runInChild(const std::string& name, const ChildLibrar
   if (finalTag == 'E') throw Error(finalBytes);
   if (finalTag == 'F') throw FieldNotFound(finalBytes);
   if (finalTag == 'R') return finalBytes;
+  // Killed or stopped from outside (the kernel's out-of-memory killer sends SIGKILL) is no fault of
+  // the file, and was blamed on it ("crashed (Killed; corrupt or truncated file?)").
+  if (finalTag == '\0' && WIFSIGNALED(status) &&
+      (WTERMSIG(status) == SIGKILL || WTERMSIG(status) == SIGTERM || WTERMSIG(status) == SIGINT ||
+       WTERMSIG(status) == SIGHUP))
+    throw Error(
+        name, "cannot read " + format + ": the process reading it with " + library.library +
+                  " was stopped from outside (" + std::string(strsignal(WTERMSIG(status))) +
+                  (WTERMSIG(status) == SIGKILL ? ": by the system when memory ran out, or by another program)" : ")"));
   if (finalTag == '\0' && WIFSIGNALED(status))
     throw Error(name, "cannot read " + format + ": " + library.library + " crashed (" +
                           std::string(strsignal(WTERMSIG(status))) + "; corrupt or truncated file?)");
