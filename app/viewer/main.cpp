@@ -419,14 +419,17 @@ bool mentionsHelpOrVersion(int argc, char** argv) {
 
 // Qt's xcb platform aborts with a paragraph (and exit 134) when there is no X server to connect
 // to; the usual case, no display at all, is said in one line instead.
-void refuseMissingDisplay(int argc, char** argv) {
+bool displayMissing(int argc, char** argv) {
   const QByteArray platform = qgetenv("QT_QPA_PLATFORM");
   for (int i = 1; i < argc; ++i)  // the user chose one (Qt takes -platform and --platform): Qt checks it
-    if (std::strcmp(argv[i], "-platform") == 0 || std::strcmp(argv[i], "--platform") == 0) return;
-  if (!platform.isEmpty() && !platform.startsWith("xcb")) return;
-  if (!qEnvironmentVariableIsEmpty("DISPLAY") ||
-      (platform.isEmpty() && !qEnvironmentVariableIsEmpty("WAYLAND_DISPLAY")))
-    return;
+    if (std::strcmp(argv[i], "-platform") == 0 || std::strcmp(argv[i], "--platform") == 0) return false;
+  if (!platform.isEmpty() && !platform.startsWith("xcb")) return false;
+  return qEnvironmentVariableIsEmpty("DISPLAY") &&
+         (!platform.isEmpty() || qEnvironmentVariableIsEmpty("WAYLAND_DISPLAY"));
+}
+
+void refuseMissingDisplay(int argc, char** argv) {
+  if (!displayMissing(argc, argv)) return;
   fail(QStringLiteral("no display: DISPLAY is not set (mfrview needs X11 or Wayland with OpenGL, or xvfb-run; "
                       "mfr render needs none)"),
        1);
@@ -449,12 +452,13 @@ void refuseArgumentsQtCannotRead(int argc, char** argv) {
 int main(int argc, char** argv) {
   refuseArgumentsQtCannotRead(argc, argv);
   const QStringList sessionArgs = takeSessionOption(argc, argv);
-  if (mentionsHelpOrVersion(argc, argv)) {
+  if (mentionsHelpOrVersion(argc, argv) || displayMissing(argc, argv)) {
     QCoreApplication core(argc, argv);
     QCoreApplication::setApplicationName(QStringLiteral("mfrview"));
     QCoreApplication::setApplicationVersion(QStringLiteral(MFR_VERSION));
     // Prints the help or the version and exits; returns only where "-v" was another option's
-    // value (--field -v), and the viewer starts as usual.
+    // value (--field -v), and the viewer starts as usual. Without a display, a command line it
+    // cannot read is refused first, exit 2, as with one (mfrview --bogus said "no display").
     (void)parseCommandLine(sessionArgs);
   }
   refuseMissingDisplay(argc, argv);

@@ -2060,6 +2060,12 @@ class ViewerTest : public QObject {
     const QStringList lines = out.split(QLatin1Char('\n'), Qt::SkipEmptyParts);
     QVERIFY2(lines.size() == 1 && lines[0].startsWith(QStringLiteral("mfrview: no display: DISPLAY is not set")),
              qPrintable(out));
+    // A command line mfrview cannot read is said as such, exit 2, display or not (it said "no
+    // display").
+    QCOMPARE(run({QStringLiteral("--bogus")}, &out), 2);
+    QVERIFY2(out.startsWith(QStringLiteral("mfrview: Unknown option 'bogus'")), qPrintable(out));
+    QCOMPARE(run({QStringLiteral("--size"), QStringLiteral("10x")}, &out), 2);
+    QVERIFY2(!out.contains(QStringLiteral("no display")), qPrintable(out));
   }
 
   // Under a comma-decimal locale (de_DE), QApplication's setlocale made mfrcore's std::stod read
