@@ -28,7 +28,8 @@ namespace {
 
 // Bounds with the digits their size needs: six significant digits beyond those the coordinates
 // spend on their distance from the origin, so a unit part at 1e7 reads [9999999.5 …] – [10000000.5 …]
-// (printed as 1e+07 – 1e+07 before: hunt 31), while an ordinary scene reads as before.
+// (printed as 1e+07 – 1e+07 before: hunt 31), while an ordinary scene reads as before. At most
+// 15, the digits a double holds for sure: more printed a float's noise (0.49999999999950001).
 std::string boundsText(const Bounds& b) {
   const glm::dvec3 size = b.max - b.min;
   const double extent = std::max({size.x, size.y, size.z});
@@ -36,7 +37,7 @@ std::string boundsText(const Bounds& b) {
                                std::abs(b.max.y), std::abs(b.max.z)});
   int digits = 6;
   if (extent > 0.0 && far > extent && std::isfinite(far / extent))
-    digits = std::min(17, 6 + static_cast<int>(std::ceil(std::log10(far / extent))));
+    digits = std::min(15, 6 + static_cast<int>(std::ceil(std::log10(far / extent))));
   std::ostringstream out;
   out.precision(digits);
   out << "[" << b.min.x << ", " << b.min.y << ", " << b.min.z << "] – [" << b.max.x << ", " << b.max.y << ", "

@@ -1,7 +1,8 @@
 #pragma once
 // The mfrview plugin interface: what a plugin sees of the viewer (ViewerContext) and what it
-// provides (MfrViewerPlugin). Plugins are Qt plugins loaded with QPluginLoader from the folder
-// `plugins` beside the executable, or from the folders in $MFR_PLUGIN_PATH (colon-separated).
+// provides (MfrViewerPlugin). Plugins are Qt plugins loaded with QPluginLoader from the folders in
+// $MFR_PLUGIN_PATH (colon-separated), the folder `plugins` beside the executable, and an installed
+// tree's ../lib/mfrview/plugins (PluginManager::searchPaths).
 //
 // ViewerContext is abstract and its virtual functions are the whole API, so a plugin needs only
 // mfrcore's headers, not its library; its signals' meta-object comes from the executable, which

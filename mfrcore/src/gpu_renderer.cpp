@@ -206,10 +206,13 @@ namespace {
 // depths [z0, z1] where the scene lies (within near … far). A pixel spans a length proportional
 // to z in a perspective view, so the worst of |z − d| / z is least at the harmonic mean
 // 2·z0·z1 / (z0 + z1) — the eye itself when something lies at it, the scene's depth in a narrow
-// view from far away; in an orthographic view a pixel spans the same length at every depth, and
-// the midpoint is best. Relative to the eye in every view (hunt 31), an orthographic view from
-// 3.7e4 away, 0.05 high, or a perspective one 8e-5° wide, drew 0.01 spheres jagged and mis-sorted
-// (review 28): the viewer zooms an orthographic view by its height, leaving the eye far back.
+// view from far away. In an orthographic view a pixel spans the same length at every depth, so no
+// depth is finer than another: the target's, where the user looks (the viewer zooms towards the
+// cursor by moving it there), within [z0, z1] (review 29: the middle of a 100-unit hull's depths
+// drew a 1e-4 assembly just in front of the eye, inside the hull, 28-62 pixels off the oracle). Relative to the eye in
+// every view (hunt 31), an orthographic view from 3.7e4 away, 0.05 high, or a perspective one 8e-5° wide, drew 0.01
+// spheres jagged and mis-sorted (review 28): the viewer zooms an orthographic view by its height, leaving the eye far
+// back.
 glm::dvec3 floatOrigin(const Camera& camera, const Bounds& scene) {
   const glm::dvec3 forward = camera.forward();
   if (!scene.valid()) return camera.eye;
@@ -224,9 +227,10 @@ glm::dvec3 floatOrigin(const Camera& camera, const Bounds& scene) {
   z0 = std::max(z0, camera.nearPlane);
   z1 = std::min(z1, camera.farPlane);
   if (!(z0 <= z1) || !std::isfinite(z0) || !std::isfinite(z1)) return camera.eye;
-  const double depth = camera.projection == Projection::Orthographic ? 0.5 * (z0 + z1)
-                       : z0 <= 0.0                                   ? 0.0
-                                                                     : 2.0 * z0 * z1 / (z0 + z1);
+  const double depth = camera.projection == Projection::Orthographic
+                           ? std::clamp(glm::dot(camera.target - camera.eye, forward), z0, z1)
+                       : z0 <= 0.0 ? 0.0
+                                   : 2.0 * z0 * z1 / (z0 + z1);
   return camera.eye + forward * depth;
 }
 

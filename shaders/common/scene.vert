@@ -18,7 +18,7 @@ uniform vec2 uColorMapRange;  // common/color_map.glsl: the field's values at th
 // samples it per fragment at vFieldGrid; affine, so interpolating it is exact).
 uniform mat4 uFieldToGrid;
 // Scene::clipBox: distances to its six faces, positive inside. uModel, uViewProj and the box are
-// relative to the eye (gl::FrameUniforms::origin), so that far scenes and small parts keep float precision. GL clips with them
+// relative to a point of the view axis (gl::FrameUniforms::origin), so that far scenes and small parts keep float precision. GL clips with them
 // only while GpuScene::draw enables GL_CLIP_DISTANCE0…5 (a scene with a clip box).
 uniform vec3 uClipMin;
 uniform vec3 uClipMax;

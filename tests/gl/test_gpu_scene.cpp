@@ -140,6 +140,20 @@ TEST(GpuSceneUpload, ASmallPartSeenUpCloseFarFromTheScenesCentreKeepsItsDetail) 
     const ImageRGBA8 gpu = render(scene, camera, request(method, 160, 120)).image;
     EXPECT_LE(pixelsDifferingBy(gpu, exact, 8), std::size_t{160 * 120 / 500});  // measured: 2 (old: 796 to 814)
   }
+  // Orthographic from inside the hull, the far plane at its far side: a pixel is as long at every
+  // depth, and the float origin is the target's depth, where the user looks, not the middle of
+  // the hull's (review 29: the middle drew up to 56 pixels off).
+  camera.projection = Projection::Orthographic;
+  camera.eye = glm::dvec3(40.0, 0.0, 0.001);
+  camera.orthoHeight = 3e-4;
+  camera.nearPlane = 5e-4;
+  camera.farPlane = 100.0;
+  const ImageRGBA8 exactOrtho = render(scene, camera, request("oracle", 160, 120)).image;
+  for (const char* method : {"abuffer-ll", "peel-f2b", "kbuffer"}) {
+    SCOPED_TRACE(std::string("orthographic, ") + method);
+    const ImageRGBA8 gpu = render(scene, camera, request(method, 160, 120)).image;
+    EXPECT_LE(pixelsDifferingBy(gpu, exactOrtho, 8), std::size_t{160 * 120 / 500});
+  }
 }
 
 // Seen from far away through an orthographic view a few hundredths high (the viewer zooms an

@@ -12,6 +12,12 @@ version=$3
 fail() { echo "install.debianPackage: $*" >&2; exit 1; }
 unset MFR_PLUGIN_PATH MFR_SHADER_DIR
 rm -rf "$scratch" && mkdir -p "$scratch"
+# cmake --install and cpack rewrite the build's install_manifest.txt, the list of what the user
+# installed (docs/install.md): it is put back as it was (the two tests hold one ctest lock).
+manifest=$build/install_manifest.txt
+if [ -e "$manifest" ]; then cp -p "$manifest" "$scratch/manifest.saved"; fi
+restore() { if [ -e "$scratch/manifest.saved" ]; then cp -p "$scratch/manifest.saved" "$manifest"; else rm -f "$manifest"; fi; }
+trap restore EXIT
 cpack --config "$build/CPackConfig.cmake" -B "$scratch" >"$scratch/cpack.log" 2>&1 || fail "cpack failed: $(tail -2 "$scratch/cpack.log")"
 deb=$(ls "$scratch"/mfr_*.deb)
 [ "$(basename "$deb")" = "mfr_${version}_$(dpkg --print-architecture).deb" ] || fail "unexpected package name $(basename "$deb")"
@@ -30,7 +36,7 @@ while read -r dep; do
 done < <(tr ',' '\n' <<<"$depends" | sed 's/^ *//')
 # Only what belongs in a package: programs, plugins, desktop data and docs under /usr.
 files=$(dpkg-deb -c "$deb" | awk '$1 !~ /^d/ {print $6}')
-bad=$(grep -vE '^\./usr/(bin|lib/mfrview/plugins|share/(applications|icons/hicolor|mime/packages|doc/mfr))/' || true)
+bad=$(grep -vE '^\./usr/(bin|lib/mfrview/plugins|share/(applications|icons/hicolor|mime/packages|doc/mfr))/' <<<"$files" || true)
 [ -z "$bad" ] || fail "the package holds files outside its folders: $(head -3 <<<"$bad")"
 for p in budget csg ghosting hybridvolume; do
   grep -qx "\./usr/lib/mfrview/plugins/mfrview_$p.so" <<<"$files" || fail "the package lacks the $p plugin"
@@ -42,4 +48,6 @@ cd "$scratch"
 root/usr/bin/mfr render @sample --size 96x72 -o packaged.png >/dev/null || fail "the packaged mfr failed to render @sample"
 "$build/app/mfr" render @sample --size 96x72 -o built.png >/dev/null || fail "the build's mfr failed to render @sample"
 cmp -s packaged.png built.png || fail "the packaged mfr's @sample differs from the build's"
-echo "install.debianPackage: $(basename "$deb"), $(stat -c %s "$deb") bytes; Depends: $depends"
+size=$(stat -c %s "$deb")
+cd / && find "$scratch" -mindepth 1 -maxdepth 1 ! -name manifest.saved -exec rm -rf {} +  # passed: the scratch tree goes
+echo "install.debianPackage: $(basename "$deb"), $size bytes; Depends: $depends"

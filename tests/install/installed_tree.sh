@@ -11,6 +11,12 @@ scratch=$2
 fail() { echo "install.installedTreeRuns: $*" >&2; exit 1; }
 unset MFR_PLUGIN_PATH MFR_SHADER_DIR
 rm -rf "$scratch" && mkdir -p "$scratch"
+# cmake --install and cpack rewrite the build's install_manifest.txt, the list of what the user
+# installed (docs/install.md): it is put back as it was (the two tests hold one ctest lock).
+manifest=$build/install_manifest.txt
+if [ -e "$manifest" ]; then cp -p "$manifest" "$scratch/manifest.saved"; fi
+restore() { if [ -e "$scratch/manifest.saved" ]; then cp -p "$scratch/manifest.saved" "$manifest"; else rm -f "$manifest"; fi; }
+trap restore EXIT
 cmake --install "$build" --prefix "$scratch/usr" --strip >"$scratch/install.log" || fail "cmake --install failed"
 
 plugins="mfrview_budget.so mfrview_csg.so mfrview_ghosting.so mfrview_hybridvolume.so"
@@ -32,6 +38,29 @@ out=$(update-mime-database -V "$scratch/mime" 2>&1) || fail "update-mime-databas
 for g in 'application/x-mfrscene:\*\.mfrscene' 'application/x-mfrview-session:\*\.mfrsession' 'model/step:\*\.step'; do
   grep -q "$g" "$scratch/mime/globs2" || fail "the MIME database lacks $g"
 done
+# Files are told by their names and first bytes as a file manager tells them (GIO over this
+# database alone): a PDB file that starts with any record, beside Palm's and AportisDoc's *.pdb
+# (review 29: MODEL and HETATM files were AportisDoc), a gzipped one, STEP, PLY, legacy VTK, NRRD;
+# and a text that merely starts with "ply" is no PLY file.
+mkdir -p "$scratch/files" "$scratch/nohome"
+cd "$scratch/files"
+printf 'MODEL        1\nATOM      1  N   ALA A   1      11.104   6.134  -6.504  1.00  0.00           N\n' >model.pdb
+printf 'HETATM    1  C1  LIG A   1       0.000   0.000   0.000  1.00  0.00           C\n' >ligand.pdb
+printf 'HEADER    PLANT PROTEIN                           01-JAN-00   1ABC\n' >header.pdb
+printf 'x\n' | gzip >packed.pdb.gz
+printf 'ISO-10303-21;\nHEADER;\n' >part.stp
+printf 'ply\nformat ascii 1.0\n' >mesh.ply
+printf '# vtk DataFile Version 3.0\nv\nASCII\n' >volume.vtk
+printf 'NRRD0004\n' >volume.nrrd
+printf 'ply for the record\n' >note
+for pair in model.pdb=chemical/x-pdb ligand.pdb=chemical/x-pdb header.pdb=chemical/x-pdb packed.pdb.gz=chemical/x-pdb \
+  part.stp=model/step mesh.ply=model/x-ply volume.vtk=application/x-vtk volume.nrrd=application/x-nrrd note=text/plain; do
+  file=${pair%%=*}
+  type=$(XDG_DATA_DIRS="$scratch" XDG_DATA_HOME="$scratch/nohome" gio info -a standard::content-type "$file" |
+    sed -n 's/^ *standard::content-type: //p')
+  [ "$type" = "${pair#*=}" ] || fail "GIO takes $file for '$type', not ${pair#*=}"
+done
+cd "$scratch"
 # Every type the desktop entry opens is one the database knows (the system's or ours).
 types=$(sed -n 's/^MimeType=//p' "$scratch/usr/share/applications/mfrview.desktop" | tr ';' ' ')
 for t in $types; do
@@ -56,4 +85,5 @@ if "$bin/mfrview" @sample --window-size 480x360 --screenshot none.png --plugin-s
   fail "mfrview found a ghosting plugin with its installed plugin folder removed"
 fi
 grep -q "no plugin of that id is loaded" none.err || fail "mfrview without plugins: $(tail -1 none.err)"
+cd / && find "$scratch" -mindepth 1 -maxdepth 1 ! -name manifest.saved -exec rm -rf {} +  # passed: the scratch tree goes
 echo "install.installedTreeRuns: the installed tree renders @sample as the build does and loads its 4 plugins after a move"
