@@ -582,14 +582,22 @@ FragmentLists castFragments(const Scene& scene, const Camera& camera, int width,
       options.threads > 0 ? static_cast<unsigned>(options.threads) : std::thread::hardware_concurrency();
   threadCount = std::max(threadCount, 1u);
 
-  // The ray through window point (wx, wy): origin on the near plane, dir to the far plane.
+  // The ray through window point (wx, wy): origin on the near plane, dir to the far plane — or,
+  // where the far plane lies beyond double's reach of the near one (near 0.01, far 1e30: its
+  // point's w is (f + n) − (f − n) = 0, and the ray was infinite, hitting nothing: a blank
+  // reference, review 29), to the mid-depth point of the same line.
   const auto windowRay = [&](double wx, double wy, glm::dvec3& origin, glm::dvec3& dir) {
     const double ndcX = 2.0 * wx / width - 1.0;
     const double ndcY = 2.0 * wy / height - 1.0;
     const glm::dvec4 n4 = invViewProj * glm::dvec4(ndcX, ndcY, -1.0, 1.0);
-    const glm::dvec4 f4 = invViewProj * glm::dvec4(ndcX, ndcY, 1.0, 1.0);
     origin = glm::dvec3(n4) / n4.w;
-    dir = glm::dvec3(f4) / f4.w - origin;
+    const glm::dvec4 f4 = invViewProj * glm::dvec4(ndcX, ndcY, 1.0, 1.0);
+    glm::dvec3 end = glm::dvec3(f4) / f4.w;
+    if (!std::isfinite(end.x) || !std::isfinite(end.y) || !std::isfinite(end.z)) {
+      const glm::dvec4 m4 = invViewProj * glm::dvec4(ndcX, ndcY, 0.0, 1.0);
+      end = glm::dvec3(m4) / m4.w;
+    }
+    dir = end - origin;
   };
   // How far the rays as cast stray from their pixel centres, in window pixels: the largest distance
   // of a ray's projected ends from its centre, over the region. A point of the segment projects
