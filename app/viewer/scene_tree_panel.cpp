@@ -438,8 +438,19 @@ void SceneTreePanel::applyFieldColoring(bool dataRange) {
   const QString field = colorBy_->currentData().toString();
   std::optional<glm::dvec2> range;
   if (!dataRange && !field.isEmpty()) range = glm::dvec2(rangeLow_->value(), rangeHigh_->value());
-  model_.setFieldColoring(field, colorMap_->currentText(), range);
-  undo_->clear();       // the steps' materials name the colouring before
+  // The colouring shown asked for again (Data Range over the data's range, the same field picked
+  // again) changes nothing: laid on anew, it took back colours chosen for parts, and the history
+  // with them (hunt 33).
+  const std::optional<mfr::FieldColors> shown = model_.fieldColoring();
+  if (shown && !field.isEmpty() && shown->field == field.toStdString() &&
+      shown->map == colorMap_->currentText().toStdString() &&
+      shown->range == (range ? *range : model_.fieldDataRange(field)) && !model_.fieldColoringsAsLoaded()) {
+    showFieldColoring();
+    return;
+  }
+  // A refusal changes nothing either: the history stays.
+  if (model_.setFieldColoring(field, colorMap_->currentText(), range))
+    undo_->clear();     // the steps' materials name the colouring before
   showFieldColoring();  // the range picked, or the refusal
 }
 

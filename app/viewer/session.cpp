@@ -196,7 +196,8 @@ Session captureSession(const ViewerModel& model) {
   }
   s.params = model.allParams();
   for (const mfr::Object& o : model.scene().objects) {
-    s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color, o.material.vertexColors});
+    s.objects.push_back({QString::fromStdString(o.name), o.visible, o.material.color, o.material.vertexColors,
+                         s.hasColorBy ? std::optional<bool>(o.material.fieldColors.has_value()) : std::nullopt});
   }
   s.compare.enabled = model.compareEnabled();
   s.compare.layout = model.compareLayout();
@@ -279,6 +280,15 @@ QStringList applySession(const Session& session, ViewerModel& model) {
     notes << QStringLiteral("color_by %1: %2 (not applied)")
                  .arg(session.colorBy ? QString::fromStdString(session.colorBy->field) : QString(),
                       model.fieldColoringError());
+  // Parts the session's colouring does not cover: a colour chosen for them over it.
+  if (session.hasColorBy && session.colorBy) {
+    QList<int> plain;
+    for (std::size_t e = 0; e < session.objects.size(); ++e)
+      if (session.objects[e].fieldColored == false && partOf[e] >= 0) plain << partOf[e];
+    std::vector<ViewerModel::PartLook> looks = model.partLooks(plain);
+    for (ViewerModel::PartLook& look : looks) look.material.fieldColors.reset();
+    model.setPartLooks(looks);
+  }
   for (std::size_t i = 0; i < session.volumes.size(); ++i)
     if (const int index = volumeOf[i]; index >= 0) {
       const Session::VolumeState& v = session.volumes[i];
@@ -399,12 +409,15 @@ QJsonObject sessionToJson(const Session& s) {
     volumes.append(volume);
   }
   QJsonArray objects;
-  for (const Session::ObjectState& o : s.objects)
-    objects.append(QJsonObject{{"name", o.name},
-                               {"visible", o.visible},
-                               {"color", QJsonArray{o.color.r, o.color.g, o.color.b}},
-                               {"opacity", o.color.a},
-                               {"vertex_colors", o.vertexColors}});
+  for (const Session::ObjectState& o : s.objects) {
+    QJsonObject object{{"name", o.name},
+                       {"visible", o.visible},
+                       {"color", QJsonArray{o.color.r, o.color.g, o.color.b}},
+                       {"opacity", o.color.a},
+                       {"vertex_colors", o.vertexColors}};
+    if (o.fieldColored) object.insert("field_colored", *o.fieldColored);
+    objects.append(object);
+  }
   QJsonObject json{
       {"format", "mfrview-session"},
       {"version", 1},
@@ -634,8 +647,10 @@ Session sessionFromJson(const QJsonObject& json, const QString& file) {
     for (int k = 0; k < 3; ++k) rgba[k] = r.unit(c[k], at + QStringLiteral(".color[%1]").arg(k));
     rgba.a = o.contains("opacity") ? r.unit(o.value("opacity"), at + QStringLiteral(".opacity")) : 1.0;
     // vertex_colors: absent in sessions written before it existed, when colours always multiplied.
-    s.objects.push_back({r.string(o, "name", at), r.boolean(o, "visible", at, true), glm::vec4(rgba),
-                         r.boolean(o, "vertex_colors", at, true)});
+    s.objects.push_back(
+        {r.string(o, "name", at), r.boolean(o, "visible", at, true), glm::vec4(rgba),
+         r.boolean(o, "vertex_colors", at, true),
+         o.contains("field_colored") ? std::optional<bool>(r.boolean(o, "field_colored", at, true)) : std::nullopt});
   }
   if (json.contains("plugins") && !json.value("plugins").isObject())
     r.fail(QStringLiteral("plugins"), QStringLiteral("expected an object of plugin id: settings"));

@@ -22,6 +22,9 @@ struct Session {
     bool visible = true;
     glm::vec4 color{1.0f};     // RGB + opacity, the material's floats exactly
     bool vertexColors = true;  // Material::vertexColors: false once a colour was chosen for the part
+    // Whether the session's "color_by" colours this part ("field_colored", written with it): a
+    // colour chosen for one part over a colouring by a field came back field-coloured (hunt 33).
+    std::optional<bool> fieldColored;
   };
   QString scenePath;
   // A molecule file's representations ("molecule": "surface,sticks"; absent: the default spheres).

@@ -514,22 +514,25 @@ void ViewerModel::spliceIsosurfaces() {
   for (const IsosurfaceSet& set : isosurfaces_)
     for (const mfr::Object& part : set.parts) scene_.objects.push_back(part);
   mfr::addVolumeFields(scene_);  // the other volumes' "@NAME" fields on the new parts
+  QList<int> toColour;           // the new parts, and those made again that were coloured by a field
   for (std::size_t i = base; i < scene_.objects.size(); ++i) {
     mfr::Object& part = scene_.objects[i];
     loadedMaterials_.push_back(part.material);
     loadedMeshes_.push_back(part.mesh);
     const auto it = edited.find(part.name);
+    bool colour = true;
     if (it != edited.end() && it->second.made.color == part.material.color) {
       part.material = it->second.now;
-      part.material.fieldColors.reset();  // a colouring by a field is laid on again below
+      colour = part.material.fieldColors.has_value();  // not over a colour of its own
+      part.material.fieldColors.reset();               // laid on again below
       part.visible = it->second.visible;
     }
+    if (colour) toColour << static_cast<int>(i);
   }
   updateSceneGeometry();
   emit partsChanged();
-  if (!chosen ||
-      !setFieldColoring(QString::fromStdString(chosen->field), QString::fromStdString(chosen->map), chosen->range))
-    sceneEdited();
+  // Only those: laid on every part, the colouring took back colours chosen for the others (hunt 33).
+  if (!chosen || !colorPartsByField(*chosen, toColour)) sceneEdited();
 }
 
 bool ViewerModel::fieldColoringsAsLoaded() const {
@@ -1111,7 +1114,15 @@ void ViewerModel::resetObjectColor(int index) {
 }
 
 void ViewerModel::resetObjectColors(const QList<int>& indices) {
+  // Under a colouring by a field the parts had before a colour was chosen for them — the one chosen
+  // in the Scene dock, else their own as loaded — that colouring comes back too: it stayed off, the
+  // part in its file's plain colour beside the field-coloured others (hunt 33).
+  std::optional<mfr::FieldColors> chosen;  // a colouring laid on in the Scene dock: not as loaded
+  for (std::size_t i = 0; i < scene_.objects.size() && i < loadedMaterials_.size() && !chosen; ++i)
+    if (scene_.objects[i].material.fieldColors != loadedMaterials_[i].fieldColors)
+      chosen = scene_.objects[i].material.fieldColors;
   bool changed = false;
+  QList<int> recolour;
   for (const int index : indices) {
     if (!objectColorEdited(index)) continue;
     const auto i = static_cast<std::size_t>(index);
@@ -1119,7 +1130,13 @@ void ViewerModel::resetObjectColors(const QList<int>& indices) {
     material.color = glm::vec4(glm::vec3(loadedMaterials_[i].color), material.color.a);
     material.vertexColors = loadedMaterials_[i].vertexColors;
     changed = true;
+    if (material.fieldColors) continue;
+    if (chosen)
+      recolour << index;
+    else if (loadedMaterials_[i].fieldColors)
+      (void)colorPartsByField(*loadedMaterials_[i].fieldColors, {index});
   }
+  if (!recolour.isEmpty() && colorPartsByField(*chosen, recolour)) return;
   if (changed) sceneEdited();
 }
 
@@ -1277,6 +1294,35 @@ bool ViewerModel::setFieldColoring(const QString& field, const QString& map, con
   for (std::size_t i = 0; i < parts.size(); ++i) {
     scene_.objects[i].mesh = parts[i].mesh;
     scene_.objects[i].material.fieldColors = parts[i].material.fieldColors;
+  }
+  sceneEdited();
+  return true;
+}
+
+bool ViewerModel::colorPartsByField(const mfr::FieldColors& colors, const QList<int>& parts) {
+  if (loadedMeshes_.size() != scene_.objects.size()) return false;
+  std::vector<mfr::Object> chosen;
+  std::vector<std::size_t> indices;
+  for (const int index : parts) {
+    if (index < 0 || index >= static_cast<int>(scene_.objects.size())) continue;
+    const auto i = static_cast<std::size_t>(index);
+    if (!loadedMeshes_[i]) continue;
+    chosen.push_back(scene_.objects[i]);
+    chosen.back().mesh = loadedMeshes_[i];
+    chosen.back().material.fieldColors.reset();
+    indices.push_back(i);
+  }
+  if (chosen.empty()) return false;
+  std::vector<mfr::Object*> pointers;
+  for (mfr::Object& o : chosen) pointers.push_back(&o);
+  try {
+    mfr::colorObjectsByField(pointers, colors.field, colors.map, colors.range, scene_.name);
+  } catch (const std::exception&) {
+    return false;  // none of them has the field
+  }
+  for (std::size_t k = 0; k < chosen.size(); ++k) {
+    scene_.objects[indices[k]].mesh = chosen[k].mesh;
+    scene_.objects[indices[k]].material.fieldColors = chosen[k].material.fieldColors;
   }
   sceneEdited();
   return true;

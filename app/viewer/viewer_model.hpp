@@ -316,6 +316,9 @@ class ViewerModel final : public ViewerContext {
   };
   [[nodiscard]] std::optional<ColorLegend> colorLegend() const;
   [[nodiscard]] glm::dvec2 fieldDataRange(const QString& field) const;
+  // Colours only `parts` (those whose mesh has the field) by `colors`, leaving every other part as
+  // it is; false, and nothing changed, when none has it. One scene edit.
+  bool colorPartsByField(const mfr::FieldColors& colors, const QList<int>& parts);
   // An empty field: every part back to its own colour. No range: the field's data range. Returns
   // false, leaving the scene as it was, when refused (fieldColoringError() says why).
   bool setFieldColoring(const QString& field, const QString& map = QStringLiteral("cool-warm"),

@@ -1374,9 +1374,9 @@ class ViewerTest : public QObject {
     QCOMPARE(parts[5].name, std::string("tangle"));
     QCOMPARE(parts[1].name, std::string("middle shell"));
     Session session = captureSession(m);
-    session.objects = {{"tangle", false, glm::vec4(1, 0, 0, 0.5f), false},
-                       {"nosuch", false, glm::vec4(0, 1, 0, 1), false},
-                       {"middle shell", true, glm::vec4(0, 0, 1, 0.25f), false}};
+    session.objects = {{"tangle", false, glm::vec4(1, 0, 0, 0.5f), false, std::nullopt},
+                       {"nosuch", false, glm::vec4(0, 1, 0, 1), false, std::nullopt},
+                       {"middle shell", true, glm::vec4(0, 0, 1, 0.25f), false, std::nullopt}};
     const QStringList notes = applySession(session, m);
     QVERIFY(!parts[5].visible);
     QCOMPARE(parts[5].material.color, glm::vec4(1, 0, 0, 0.5f));
@@ -5343,6 +5343,67 @@ class ViewerTest : public QObject {
     settle(a);
     QCOMPARE(maxChannelDifference(expected, again->view().renderImage(size)), 0);
     QVERIFY(a.scene().objects[1].material.fieldColors && a.scene().objects[1].material.fieldColors->map == "magma");
+  }
+
+  // A colour chosen for one part over a colouring by a field stays through what else recolours by
+  // that field — the Data Range button on the range there is, isosurfaces added, a session saved
+  // and reopened — and Reset Colour brings the field's colours back (hunt 33: each of the first
+  // three laid the colouring on every part again, the chosen colour lost, and Reset left the part
+  // in its file's plain colour).
+  void chosenColoursOverAFieldColouring() {
+    QTemporaryDir dir;
+    auto w = openWindow(QStringLiteral("@volume"));
+    QVERIFY(w);
+    ViewerModel& m = w->model();
+    const QSize size(96, 72);
+    QVERIFY(showAbufferIso(*w, size));
+    int sphere = -1;
+    for (std::size_t i = 0; i < m.scene().objects.size(); ++i)
+      if (m.scene().objects[i].name == "sphere") sphere = static_cast<int>(i);
+    QVERIFY(sphere >= 0);
+    const auto part = [&](int i) -> const mfr::Object& { return m.scene().objects[static_cast<std::size_t>(i)]; };
+    auto* colorBy = w->findChild<QComboBox*>("colorByField");
+    auto* map = w->findChild<QComboBox*>("colorByMap");
+    auto* dataRange = w->findChild<QPushButton*>("colorRangeReset");
+    QVERIFY(colorBy && map && dataRange);
+    const int at = colorBy->findData(QStringLiteral("@field"));
+    QVERIFY(at > 0);
+    colorBy->setCurrentIndex(at);
+    emit colorBy->activated(at);  // as a user's choice
+    settle(m);
+    QVERIFY(part(sphere).material.fieldColors && part(sphere).material.fieldColors->field == "@field");
+    const mfr::FieldColors colouring = *part(sphere).material.fieldColors;
+    m.setObjectColor(sphere, QColor(255, 0, 0));
+    QVERIFY(!part(sphere).material.fieldColors);
+    const glm::vec4 red = part(sphere).material.color;
+    // Data Range over the range there is: nothing changes.
+    QTest::mouseClick(dataRange, Qt::LeftButton);
+    settle(m);
+    QVERIFY(!part(sphere).material.fieldColors);
+    QCOMPARE(part(sphere).material.color, red);
+    // Isosurfaces added: the new part takes the colouring, the sphere keeps its colour.
+    const std::size_t before = m.scene().objects.size();
+    QCOMPARE(m.setIsosurfaces({0.3}, 0.5), QString());
+    settle(m);
+    QCOMPARE(m.scene().objects.size(), before + 1);
+    QVERIFY(!part(sphere).material.fieldColors);
+    QCOMPARE(part(sphere).material.color, red);
+    QVERIFY(m.scene().objects.back().material.fieldColors == colouring);
+    const mfr::ImageRGBA8 frame = w->view().renderImage(size);
+    // A session brings the same back.
+    auto again = reopenedSession(*w, dir.filePath("chosen.mfrsession"), size);
+    QVERIFY(again);
+    ViewerModel& a = again->model();
+    QTRY_VERIFY_WITH_TIMEOUT(a.hasScene() && a.scene().objects.size() == before + 1, kTimeoutMs);
+    settle(a);
+    QVERIFY(!a.scene().objects[static_cast<std::size_t>(sphere)].material.fieldColors);
+    QVERIFY(a.scene().objects.back().material.fieldColors == colouring);
+    QCOMPARE(maxChannelDifference(frame, again->view().renderImage(size)), 0);
+    again.reset();
+    // Reset Colour to the File's: the field's colours again.
+    m.resetObjectColors({sphere});
+    settle(m);
+    QVERIFY(part(sphere).material.fieldColors == colouring);
   }
 
   void isosurfaces() {
