@@ -1314,6 +1314,7 @@ bool ViewerModel::colorPartsByField(const mfr::FieldColors& colors, const QList<
   }
   if (chosen.empty()) return false;
   std::vector<mfr::Object*> pointers;
+  pointers.reserve(chosen.size());
   for (mfr::Object& o : chosen) pointers.push_back(&o);
   try {
     mfr::colorObjectsByField(pointers, colors.field, colors.map, colors.range, scene_.name);
