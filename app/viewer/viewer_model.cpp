@@ -1122,7 +1122,7 @@ void ViewerModel::resetObjectColors(const QList<int>& indices) {
     if (scene_.objects[i].material.fieldColors != loadedMaterials_[i].fieldColors)
       chosen = scene_.objects[i].material.fieldColors;
   bool changed = false;
-  QList<int> recolour;
+  std::vector<std::pair<mfr::FieldColors, QList<int>>> recolour;  // by colouring: one edit each
   for (const int index : indices) {
     if (!objectColorEdited(index)) continue;
     const auto i = static_cast<std::size_t>(index);
@@ -1130,14 +1130,18 @@ void ViewerModel::resetObjectColors(const QList<int>& indices) {
     material.color = glm::vec4(glm::vec3(loadedMaterials_[i].color), material.color.a);
     material.vertexColors = loadedMaterials_[i].vertexColors;
     changed = true;
-    if (material.fieldColors) continue;
-    if (chosen)
-      recolour << index;
-    else if (loadedMaterials_[i].fieldColors)
-      (void)colorPartsByField(*loadedMaterials_[i].fieldColors, {index});
+    const std::optional<mfr::FieldColors>& colouring = chosen ? chosen : loadedMaterials_[i].fieldColors;
+    if (material.fieldColors || !colouring) continue;
+    const auto group =
+        std::find_if(recolour.begin(), recolour.end(), [&](const auto& g) { return g.first == *colouring; });
+    if (group == recolour.end())
+      recolour.push_back({*colouring, {index}});
+    else
+      group->second << index;
   }
-  if (!recolour.isEmpty() && colorPartsByField(*chosen, recolour)) return;
-  if (changed) sceneEdited();
+  bool edited = false;  // colorPartsByField's own scene edit
+  for (const auto& [colouring, parts] : recolour) edited = colorPartsByField(colouring, parts) || edited;
+  if (changed && !edited) sceneEdited();
 }
 
 bool ViewerModel::objectColorEdited(int index) const {

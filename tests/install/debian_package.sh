@@ -9,15 +9,9 @@ set -euo pipefail
 build=$1
 scratch=$2
 version=$3
-fail() { echo "install.debianPackage: $*" >&2; exit 1; }
-unset MFR_PLUGIN_PATH MFR_SHADER_DIR
-rm -rf "$scratch" && mkdir -p "$scratch"
-# cmake --install and cpack rewrite the build's install_manifest.txt, the list of what the user
-# installed (docs/install.md): it is put back as it was (the two tests hold one ctest lock).
-manifest=$build/install_manifest.txt
-if [ -e "$manifest" ]; then cp -p "$manifest" "$scratch/manifest.saved"; fi
-restore() { if [ -e "$scratch/manifest.saved" ]; then cp -p "$scratch/manifest.saved" "$manifest"; else rm -f "$manifest"; fi; }
-trap restore EXIT
+test=install.debianPackage
+# shellcheck source=scratch.sh
+source "$(dirname "${BASH_SOURCE[0]}")/scratch.sh"
 cpack --config "$build/CPackConfig.cmake" -B "$scratch" >"$scratch/cpack.log" 2>&1 || fail "cpack failed: $(tail -2 "$scratch/cpack.log")"
 deb=$(ls "$scratch"/mfr_*.deb)
 [ "$(basename "$deb")" = "mfr_${version}_$(dpkg --print-architecture).deb" ] || fail "unexpected package name $(basename "$deb")"
@@ -49,5 +43,5 @@ root/usr/bin/mfr render @sample --size 96x72 -o packaged.png >/dev/null || fail 
 "$build/app/mfr" render @sample --size 96x72 -o built.png >/dev/null || fail "the build's mfr failed to render @sample"
 cmp -s packaged.png built.png || fail "the packaged mfr's @sample differs from the build's"
 size=$(stat -c %s "$deb")
-cd / && find "$scratch" -mindepth 1 -maxdepth 1 ! -name manifest.saved -exec rm -rf {} +  # passed: the scratch tree goes
+clean_scratch  # passed
 echo "install.debianPackage: $(basename "$deb"), $size bytes; Depends: $depends"

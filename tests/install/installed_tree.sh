@@ -8,15 +8,9 @@
 set -euo pipefail
 build=$1
 scratch=$2
-fail() { echo "install.installedTreeRuns: $*" >&2; exit 1; }
-unset MFR_PLUGIN_PATH MFR_SHADER_DIR
-rm -rf "$scratch" && mkdir -p "$scratch"
-# cmake --install and cpack rewrite the build's install_manifest.txt, the list of what the user
-# installed (docs/install.md): it is put back as it was (the two tests hold one ctest lock).
-manifest=$build/install_manifest.txt
-if [ -e "$manifest" ]; then cp -p "$manifest" "$scratch/manifest.saved"; fi
-restore() { if [ -e "$scratch/manifest.saved" ]; then cp -p "$scratch/manifest.saved" "$manifest"; else rm -f "$manifest"; fi; }
-trap restore EXIT
+test=install.installedTreeRuns
+# shellcheck source=scratch.sh
+source "$(dirname "${BASH_SOURCE[0]}")/scratch.sh"
 cmake --install "$build" --prefix "$scratch/usr" --strip >"$scratch/install.log" || fail "cmake --install failed"
 
 plugins="mfrview_budget.so mfrview_csg.so mfrview_ghosting.so mfrview_hybridvolume.so"
@@ -85,5 +79,5 @@ if "$bin/mfrview" @sample --window-size 480x360 --screenshot none.png --plugin-s
   fail "mfrview found a ghosting plugin with its installed plugin folder removed"
 fi
 grep -q "no plugin of that id is loaded" none.err || fail "mfrview without plugins: $(tail -1 none.err)"
-cd / && find "$scratch" -mindepth 1 -maxdepth 1 ! -name manifest.saved -exec rm -rf {} +  # passed: the scratch tree goes
+clean_scratch  # passed
 echo "install.installedTreeRuns: the installed tree renders @sample as the build does and loads its 4 plugins after a move"
