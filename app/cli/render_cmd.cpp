@@ -116,6 +116,16 @@ void addRender(CLI::App& app) {
     if (const auto unused = unusedMethodParam(req)) throw Error("--" + unused->name, unused->reason);
     opt->contours.requireKeptVolumeDrawn(req, scene);
     if (opt->blend && opt->dataView.empty()) throw Error("--blend", "needs --data-view");
+    // A data view alone draws n(p) or k(p), not the image: a setting only the image uses was taken
+    // and did nothing (hunt 32). With --blend the image is drawn under the map, and they count.
+    if (!opt->dataView.empty() && !opt->blend)
+      for (const auto& [given, option] :
+           {std::pair{!opt->colorBy.field.empty(), "--color-by"}, std::pair{stepOption->count() > 0, "--step"},
+            std::pair{opt->shade, "--shade"}, std::pair{thicknessGiven->count() > 0, "--thickness"}})
+        if (given)
+          throw Error(option, std::string("--data-view ") + opt->dataView + " draws " +
+                                  (opt->dataView == "capacity" ? "k(p)" : "n(p)") +
+                                  ", not the image: it uses nothing of this (add --blend to draw the image under it)");
     if (opt->dataView == "capacity" && opt->method == "oracle")
       throw Error("--data-view capacity", "the oracle keeps every fragment: it has no k(p) (use a method that does)");
     // --legend: the field colouring's map, else the isosurfaces' (ticked at their values).

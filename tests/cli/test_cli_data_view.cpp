@@ -125,13 +125,29 @@ TEST_F(CliDataView, MethodsWithoutACapacityAndBadOptionsAreRefused) {
            {"-m oracle --data-view capacity", "--data-view capacity: the oracle keeps every fragment"},
            {"-m abuffer-ll --blend", "--blend: needs --data-view"},
            {"-m abuffer-ll --data-view colour", "--data-view"},
-           {"-m abuffer-ll --data-view depth-complexity --legend", "--legend: the image 32x32 is too small"}}) {
+           {"-m abuffer-ll --data-view depth-complexity --legend", "--legend: the image 32x32 is too small"},
+           // Settings only the image uses, given to a map drawn instead of it: taken and unused (hunt 32).
+           {"-m abuffer-ll --data-view depth-complexity --op zthickness --thickness 0.1",
+            "mfr: --thickness: --data-view depth-complexity draws n(p), not the image: it uses nothing of this (add "
+            "--blend to draw the image under it)\n"}}) {
     SCOPED_TRACE(args);
     const CliResult r = runCli(common + args + " -o " + png.string());
     EXPECT_NE(r.exitCode, 0) << r.out;
     EXPECT_NE(r.out.find(mention), std::string::npos) << r.out;
     EXPECT_FALSE(fs::exists(png));
   }
+  const CliResult coloured = runCli(
+      "render @volume -s 32x32 -m kplus-sbuffer -p k=4 --data-view capacity --color-by @field -o " + png.string());
+  EXPECT_EQ(coloured.exitCode, 1) << coloured.out;
+  EXPECT_NE(coloured.out.find("mfr: --color-by: --data-view capacity draws k(p), not the image"), std::string::npos)
+      << coloured.out;
+  EXPECT_FALSE(fs::exists(png));
+  // With --blend the image is drawn under the map: they count.
+  EXPECT_EQ(
+      runCli("render @volume -s 32x32 -m kplus-sbuffer -p k=4 --data-view capacity --blend --color-by @field -o " +
+             png.string())
+          .exitCode,
+      0);
 }
 
 }  // namespace
