@@ -502,12 +502,7 @@ void ViewerModel::spliceIsosurfaces() {
   // was loaded or made with. A scene file's colourings of its own parts stay theirs, and the new
   // parts are coloured by value, as mfr render --contour does (hunt 32: the first part's colouring
   // was laid on every part, another map on the second bearing and on the isosurfaces).
-  std::optional<mfr::FieldColors> chosen;
-  for (std::size_t i = 0; i < scene_.objects.size() && i < loadedMaterials_.size(); ++i)
-    if (scene_.objects[i].material.fieldColors != loadedMaterials_[i].fieldColors) {
-      chosen = scene_.objects[i].material.fieldColors;  // none: the user took the colouring off
-      break;
-    }
+  const std::optional<mfr::FieldColors> chosen = chosenFieldColoring();
   scene_.objects.resize(base);
   loadedMaterials_.resize(base);
   loadedMeshes_.resize(base);
@@ -533,6 +528,13 @@ void ViewerModel::spliceIsosurfaces() {
   emit partsChanged();
   // Only those: laid on every part, the colouring took back colours chosen for the others (hunt 33).
   if (!chosen || !colorPartsByField(*chosen, toColour)) sceneEdited();
+}
+
+std::optional<mfr::FieldColors> ViewerModel::chosenFieldColoring() const {
+  for (std::size_t i = 0; i < scene_.objects.size() && i < loadedMaterials_.size(); ++i)
+    if (const auto& now = scene_.objects[i].material.fieldColors; now && now != loadedMaterials_[i].fieldColors)
+      return now;
+  return std::nullopt;  // none laid on: as loaded, or the colouring taken off
 }
 
 bool ViewerModel::fieldColoringsAsLoaded() const {
@@ -1117,10 +1119,7 @@ void ViewerModel::resetObjectColors(const QList<int>& indices) {
   // Under a colouring by a field the parts had before a colour was chosen for them — the one chosen
   // in the Scene dock, else their own as loaded — that colouring comes back too: it stayed off, the
   // part in its file's plain colour beside the field-coloured others (hunt 33).
-  std::optional<mfr::FieldColors> chosen;  // a colouring laid on in the Scene dock: not as loaded
-  for (std::size_t i = 0; i < scene_.objects.size() && i < loadedMaterials_.size() && !chosen; ++i)
-    if (scene_.objects[i].material.fieldColors != loadedMaterials_[i].fieldColors)
-      chosen = scene_.objects[i].material.fieldColors;
+  const std::optional<mfr::FieldColors> chosen = chosenFieldColoring();
   bool changed = false;
   std::vector<std::pair<mfr::FieldColors, QList<int>>> recolour;  // by colouring: one edit each
   for (const int index : indices) {

@@ -307,6 +307,9 @@ class ViewerModel final : public ViewerContext {
   // Every part is coloured by a field as it was loaded or made (a scene file's own colourings, which
   // may differ per part; none): a session need not say, and the scene file brings them back.
   [[nodiscard]] bool fieldColoringsAsLoaded() const;
+  // The colouring by a field laid on in the Scene dock: that of a part coloured otherwise than as
+  // loaded (a part given a colour of its own has none, and is passed over); none if there is none.
+  [[nodiscard]] std::optional<mfr::FieldColors> chosenFieldColoring() const;
   // What the colour legend shows (the view's corner, Export Image): the field colouring's map; else
   // the current volume's isosurfaces' — cool-warm over contourColorRange, ticked at their values, as
   // mfr render --contour … --legend draws it; else nothing.
